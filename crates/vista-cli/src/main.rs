@@ -1,0 +1,239 @@
+//! `vista`: thin command-line glue over vista's libraries.
+//! Exit codes: 0 success, 1 failed check (or run failure), 2 bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use vista_golden::{BlessOptions, CheckOptions, GoldenError, Store};
+use vista_gpu::Context;
+use vista_image::metrics;
+
+mod bench;
+
+#[derive(Parser)]
+#[command(name = "vista", version, about = "Headless GPU compute validation for procedural WGSL kernels")]
+struct Cli {
+    /// Adapter: cpu (lavapipe, default) or gpu (hardware). Same as VISTA_ADAPTER.
+    #[arg(long, global = true)]
+    adapter: Option<String>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List kernels with their parameters (ranges, defaults) and presets.
+    List,
+    /// Render one kernel to a PNG (display values) or EXR (raw/linear values).
+    Render {
+        kernel: String,
+        #[arg(long)]
+        preset: Option<String>,
+        /// Parameter override NAME=VALUE (repeatable; vectors comma-separated).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        #[arg(long, default_value = "256x256")]
+        size: String,
+        #[arg(short, long)]
+        out: PathBuf,
+    },
+    /// Compare two images (PNG or EXR): PSNR, SSIM, max-abs, bad pixels, NaN/Inf.
+    Compare {
+        a: PathBuf,
+        b: PathBuf,
+        #[arg(long)]
+        json: bool,
+        /// PSNR peak = max of A (for HDR/EXR data) instead of 1.
+        #[arg(long)]
+        hdr: bool,
+    },
+    /// Render golden cases and compare them with their goldens.
+    Check {
+        #[arg(long = "case", value_name = "GLOB")]
+        case: Option<String>,
+    },
+    /// Re-render cases and write their goldens (refused under CI=true without --force).
+    Bless {
+        #[arg(long = "case", value_name = "GLOB")]
+        case: Option<String>,
+        #[arg(long)]
+        force: bool,
+        /// Delete golden images that no case refers to.
+        #[arg(long)]
+        prune: bool,
+    },
+    /// Median kernel throughput after a warm-up (excludes device creation and compilation).
+    Bench {
+        kernel: String,
+        #[arg(long)]
+        preset: Option<String>,
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        #[arg(long, default_value = "1024x1024")]
+        size: String,
+        #[arg(long, default_value_t = 7)]
+        runs: u32,
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if let Some(a) = &cli.adapter {
+        // SAFETY: single-threaded at this point; read once by Context::shared.
+        unsafe { std::env::set_var("VISTA_ADAPTER", a) };
+    }
+    match run(cli.command) {
+        Ok(code) => ExitCode::from(code as u8),
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}
+
+/// Splits `NAME=VALUE` pairs.
+pub fn parse_sets(sets: &[String]) -> Result<Vec<(String, String)>, GoldenError> {
+    sets.iter()
+        .map(|s| {
+            s.split_once('=')
+                .map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))
+                .ok_or_else(|| GoldenError::BadInput(format!("--set '{s}' is not NAME=VALUE")))
+        })
+        .collect()
+}
+
+fn bad(e: impl std::fmt::Display) -> GoldenError {
+    GoldenError::BadInput(e.to_string())
+}
+
+fn run(cmd: Command) -> Result<i32, GoldenError> {
+    match cmd {
+        Command::List => {
+            list();
+            Ok(0)
+        }
+        Command::Render { kernel, preset, set, size, out } => {
+            let k = vista_kernels::find(&kernel).map_err(bad)?;
+            let p = k.resolve(preset.as_deref(), &parse_sets(&set)?).map_err(bad)?;
+            let (w, h) = vista_kernels::parse_size(&size).map_err(bad)?;
+            check_output_path(&out)?;
+            vista_golden::check_request(k, &p, w, h)?;
+            let ctx = Context::shared()?;
+            let r = vista_golden::render(ctx, k, &p, w, h)?;
+            let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+            vista_image::save(&out, if is_exr { &r.raw } else { &r.display })?;
+            eprintln!(
+                "rendered {kernel} {w}x{h} on {} in {:.1} ms -> {}",
+                ctx.adapter_description(),
+                r.stats.gpu_wall.as_secs_f64() * 1e3,
+                out.display()
+            );
+            if let Some((x, y)) = r.raw.first_nonfinite() {
+                eprintln!("error: output has {} NaN/Inf pixels, first at ({x}, {y})", r.raw.nonfinite_count());
+                return Ok(1);
+            }
+            Ok(0)
+        }
+        Command::Compare { a, b, json, hdr } => {
+            let ia = vista_image::load(&a)?;
+            let ib = vista_image::load(&b)?;
+            let m = if hdr { metrics::compare_hdr(&ia, &ib)? } else { metrics::compare(&ia, &ib)? };
+            if json {
+                let v = serde_json::json!({
+                    "psnr": if m.psnr.is_finite() { serde_json::json!(m.psnr) } else { serde_json::json!("inf") },
+                    "ssim": m.ssim, "max_abs": m.max_abs, "bad_pixels": m.bad_pixels, "nan": m.nan, "mse": m.mse,
+                });
+                println!("{v}");
+            } else {
+                println!("PSNR       {}", metrics::format_psnr(m.psnr));
+                println!("SSIM       {:.6}", m.ssim);
+                println!("max abs    {:.6e}", m.max_abs);
+                println!("bad pixels {} (> 1/255)", m.bad_pixels);
+                println!("NaN/Inf    {}", m.nan);
+            }
+            Ok(0)
+        }
+        Command::Check { case } => check(case.as_deref()),
+        Command::Bless { case, force, prune } => {
+            let store = Store::open_default();
+            let ctx = Context::shared()?;
+            let summary = vista_golden::bless(ctx, &store, &BlessOptions { glob: case, force, prune })?;
+            println!("{:<40} {:<10} {}", "case", "status", "PSNR new vs old");
+            for r in &summary.rows {
+                println!("{:<40} {:<10} {}", r.id, r.status, r.psnr_vs_previous);
+            }
+            for o in &summary.orphans {
+                println!("{} golden with no case: {}", if summary.pruned { "deleted" } else { "orphaned" }, o.display());
+            }
+            println!("blessed {} cases on {}", summary.rows.len(), ctx.adapter_description());
+            Ok(0)
+        }
+        Command::Bench { kernel, preset, set, size, runs, json } => bench::bench(&kernel, preset.as_deref(), &set, &size, runs, json),
+    }
+}
+
+/// Refuses an output path whose directory does not exist or is not writable,
+/// before any GPU work.
+fn check_output_path(out: &Path) -> Result<(), GoldenError> {
+    let ext_ok = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png") || e.eq_ignore_ascii_case("exr"));
+    if !ext_ok {
+        return Err(bad(format!("output {} must end in .png or .exr", out.display())));
+    }
+    let dir = match out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return Err(bad(format!("output directory {} does not exist", dir.display())));
+    }
+    let probe = dir.join(format!(".vista-write-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| bad(format!("output directory {} is not writable: {e}", dir.display())))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
+
+fn check(glob: Option<&str>) -> Result<i32, GoldenError> {
+    let store = Store::open_default();
+    let cases = store.load_cases()?;
+    let picked = vista_golden::select(&cases, glob)?;
+    let manifest = store.manifest()?;
+    let ctx = Context::shared()?;
+    let opts = CheckOptions { report_dir: vista_golden::default_report_dir(), twice: false };
+    let mut outcomes = Vec::new();
+    for case in picked {
+        let o = vista_golden::check_case(ctx, &store, &manifest, case, &opts);
+        let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
+        println!("{:<6} {:<40} PSNR {:<12} {:>8.1} ms", if o.passed() { "ok" } else { "FAIL" }, o.id, psnr, o.gpu_ms);
+        if !o.passed() {
+            print!("{}", o.explain(&opts.report_dir));
+        }
+        outcomes.push(o);
+    }
+    let index = vista_golden::write_report(&opts.report_dir, &ctx.adapter_description(), &outcomes)?;
+    let failed = outcomes.iter().filter(|o| !o.passed()).count();
+    println!("{} passed, {} failed", outcomes.len() - failed, failed);
+    println!("report: {}", index.display());
+    Ok(if failed == 0 { 0 } else { 1 })
+}
+
+fn list() {
+    for k in vista_kernels::registry() {
+        println!("{} — {}", k.name(), k.summary());
+        println!("  params:");
+        for p in k.params() {
+            println!("    {:<22} default {:<14} {:<40} {}", p.name, p.default, p.kind.range_text(), p.doc);
+        }
+        println!("  presets:");
+        for p in k.presets() {
+            let set = p.set.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
+            println!("    {:<22} {}{}", p.name, p.doc, if set.is_empty() { String::new() } else { format!("  [{set}]") });
+        }
+        println!();
+    }
+}

@@ -1,0 +1,131 @@
+//! `vista bless`: re-render cases and write their goldens and manifest.
+//!
+//! Everything selected is rendered first; nothing is written unless every
+//! render succeeded and is finite. Each golden and the manifest are then
+//! written atomically, one case at a time, so an interrupted bless leaves
+//! every golden either old or new, never truncated.
+
+use std::path::PathBuf;
+
+use vista_gpu::Context;
+use vista_image::metrics;
+
+use crate::render::{Rendered, quantize16, render};
+use crate::store::{ManifestEntry, Store, params_hash};
+use crate::{GoldenError, now_utc, select};
+
+#[derive(Debug, Clone, Default)]
+pub struct BlessOptions {
+    /// Glob over case ids; all cases when `None`.
+    pub glob: Option<String>,
+    /// Bless even when `CI=true`.
+    pub force: bool,
+    /// Delete golden PNGs that no case refers to (otherwise only listed).
+    pub prune: bool,
+}
+
+/// One blessed case, for the summary table.
+#[derive(Debug, Clone)]
+pub struct BlessRow {
+    pub id: String,
+    /// "new", "changed" or "unchanged".
+    pub status: &'static str,
+    /// PSNR of the new golden against the old one.
+    pub psnr_vs_previous: String,
+    pub path: PathBuf,
+}
+
+/// Result of a bless: the rows, and orphaned goldens (deleted if pruned).
+#[derive(Debug, Clone, Default)]
+pub struct BlessSummary {
+    pub rows: Vec<BlessRow>,
+    pub orphans: Vec<PathBuf>,
+    pub pruned: bool,
+}
+
+fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| v.eq_ignore_ascii_case("true") || v == "1")
+}
+
+/// Test hook: abort the process after this many golden writes (fault injection).
+fn fault_after() -> Option<usize> {
+    std::env::var("VISTA_FAULT_ABORT_AFTER_WRITES").ok().and_then(|s| s.parse().ok())
+}
+
+pub fn bless(ctx: &Context, store: &Store, opts: &BlessOptions) -> Result<BlessSummary, GoldenError> {
+    if in_ci() && !opts.force {
+        return Err(GoldenError::Refused(
+            "CI=true: refusing to bless goldens in CI (a failing golden must be reviewed, not overwritten); \
+             bless locally, or pass --force"
+                .into(),
+        ));
+    }
+    let cases = store.load_cases()?;
+    let picked = select(&cases, opts.glob.as_deref())?;
+    let mut manifest = store.manifest()?;
+    let adapter = ctx.adapter_description();
+
+    let mut rendered: Vec<(&crate::Case, Rendered)> = Vec::new();
+    for case in &picked {
+        let r = render(ctx, case.kernel, &case.params, case.width, case.height)?;
+        if let Some((x, y)) = r.raw.first_nonfinite() {
+            return Err(GoldenError::BadInput(format!(
+                "case {}: output has {} NaN/Inf pixels (first at ({x}, {y})); refusing to bless it",
+                case.id,
+                r.raw.nonfinite_count()
+            )));
+        }
+        rendered.push((case, r));
+    }
+
+    let mut rows = Vec::new();
+    for (written, (case, r)) in rendered.into_iter().enumerate() {
+        let path = store.golden_path(case);
+        let new = quantize16(&r.display);
+        let (status, psnr) = match vista_image::read_png16(&path) {
+            Ok(old) if (old.width, old.height) == (new.width, new.height) => {
+                let p = metrics::psnr(&old, &new);
+                (if p.is_infinite() { "unchanged" } else { "changed" }, metrics::format_psnr(p))
+            }
+            Ok(_) => ("changed", "size changed".to_string()),
+            Err(_) if path.exists() => ("changed", "old golden unreadable".to_string()),
+            Err(_) => ("new", "new".to_string()),
+        };
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent)
+                .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+        }
+        vista_image::write_png16(&path, &new)?;
+        if fault_after() == Some(written + 1) {
+            eprintln!("VISTA_FAULT_ABORT_AFTER_WRITES: aborting after {} golden writes", written + 1);
+            std::process::abort();
+        }
+        manifest.case.insert(
+            case.id.clone(),
+            ManifestEntry {
+                kernel: case.kernel.name().to_string(),
+                size: format!("{}x{}", case.width, case.height),
+                params_hash: params_hash(case),
+                shader_hash: ctx.shaders().source_hash(case.kernel.shader())?,
+                adapter: adapter.clone(),
+                date: now_utc(),
+                raw_hash: r.raw.content_hash(),
+                psnr_vs_previous: psnr.clone(),
+                psnr_vs_cpu: None,
+            },
+        );
+        store.write_manifest(&manifest)?;
+        rows.push(BlessRow { id: case.id.clone(), status, psnr_vs_previous: psnr, path });
+    }
+
+    let orphans = store.orphans(&cases);
+    if opts.prune {
+        for o in &orphans {
+            std::fs::remove_file(o).map_err(|e| GoldenError::Io { path: o.display().to_string(), message: e.to_string() })?;
+        }
+        let live: std::collections::HashSet<&str> = cases.iter().map(|c| c.id.as_str()).collect();
+        manifest.case.retain(|id, _| live.contains(id.as_str()));
+        store.write_manifest(&manifest)?;
+    }
+    Ok(BlessSummary { rows, orphans, pruned: opts.prune })
+}

@@ -1,0 +1,165 @@
+//! `golden/cases.toml`: the list of golden cases, one `[[case]]` table each.
+//!
+//! ```toml
+//! [[case]]
+//! id = "fbm-perlin-default"      # unique; becomes the test name
+//! kernel = "fbm"
+//! preset = "default"             # optional
+//! set = { octaves = 4 }          # optional overrides (numbers, strings or vectors)
+//! size = "256x256"               # optional, default 256x256
+//! psnr_same_driver = 60.0        # optional thresholds (dB)
+//! psnr_other_driver = 35.0
+//! min_ssim = 0.99                # optional
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::Deserialize;
+use vista_kernels::ParamSet;
+
+use crate::GoldenError;
+
+pub const DEFAULT_SIZE: (u32, u32) = (256, 256);
+pub const DEFAULT_PSNR_SAME_DRIVER: f64 = 60.0;
+pub const DEFAULT_PSNR_OTHER_DRIVER: f64 = 35.0;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CaseFile {
+    #[serde(default)]
+    case: Vec<RawCase>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCase {
+    id: String,
+    kernel: String,
+    preset: Option<String>,
+    #[serde(default)]
+    set: BTreeMap<String, toml::Value>,
+    size: Option<String>,
+    psnr_same_driver: Option<f64>,
+    psnr_other_driver: Option<f64>,
+    min_ssim: Option<f64>,
+    #[serde(default)]
+    doc: String,
+}
+
+/// One validated golden case.
+#[derive(Debug, Clone)]
+pub struct Case {
+    pub id: String,
+    pub kernel: &'static dyn vista_kernels::Kernel,
+    pub preset: Option<String>,
+    pub overrides: Vec<(String, String)>,
+    pub params: ParamSet,
+    pub width: u32,
+    pub height: u32,
+    pub psnr_same_driver: f64,
+    pub psnr_other_driver: f64,
+    pub min_ssim: Option<f64>,
+    pub doc: String,
+}
+
+/// Text form of a TOML value as `--set` would take it.
+fn value_text(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Array(items) => items.iter().map(value_text).collect::<Vec<_>>().join(","),
+        other => other.to_string(),
+    }
+}
+
+impl Case {
+    /// Golden PNG path relative to the golden dir: `<kernel>/<id>.png`.
+    pub fn golden_rel_path(&self) -> String {
+        format!("{}/{}.png", self.kernel.name(), self.id)
+    }
+
+    /// The `vista bless` command that (re)writes this case's golden.
+    pub fn bless_command(&self) -> String {
+        format!("cargo run --release -p vista-cli -- bless --case '{}'", self.id)
+    }
+}
+
+/// Parses and validates a case file. Errors name the file, the line (for
+/// TOML syntax) or the case id and the bad value.
+pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
+    let file: CaseFile = toml::from_str(text).map_err(|e| GoldenError::Cases {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let mut seen = std::collections::HashSet::new();
+    let mut out = Vec::new();
+    for raw in file.case {
+        let bad = |message: String| GoldenError::Cases {
+            path: path.display().to_string(),
+            message: format!("case '{}': {message}", raw.id),
+        };
+        if raw.id.is_empty() || !raw.id.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+            return Err(bad("id must be non-empty and use only letters, digits, '-' and '_'".into()));
+        }
+        if !seen.insert(raw.id.clone()) {
+            return Err(bad("duplicate id".into()));
+        }
+        let kernel = vista_kernels::find(&raw.kernel).map_err(|e| bad(e.to_string()))?;
+        let overrides: Vec<(String, String)> = raw.set.iter().map(|(k, v)| (k.clone(), value_text(v))).collect();
+        let params = kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?;
+        let (width, height) = match &raw.size {
+            Some(s) => vista_kernels::parse_size(s).map_err(|e| bad(e.to_string()))?,
+            None => DEFAULT_SIZE,
+        };
+        let psnr_same_driver = raw.psnr_same_driver.unwrap_or(DEFAULT_PSNR_SAME_DRIVER);
+        let psnr_other_driver = raw.psnr_other_driver.unwrap_or(DEFAULT_PSNR_OTHER_DRIVER);
+        for (name, v) in [("psnr_same_driver", psnr_same_driver), ("psnr_other_driver", psnr_other_driver)] {
+            if !(0.0..=200.0).contains(&v) {
+                return Err(bad(format!("{name}={v} is out of range; allowed: [0, 200] dB")));
+            }
+        }
+        if let Some(s) = raw.min_ssim {
+            if !(-1.0..=1.0).contains(&s) {
+                return Err(bad(format!("min_ssim={s} is out of range; allowed: [-1, 1]")));
+            }
+        }
+        out.push(Case {
+            id: raw.id,
+            kernel,
+            preset: raw.preset,
+            overrides,
+            params,
+            width,
+            height,
+            psnr_same_driver,
+            psnr_other_driver,
+            min_ssim: raw.min_ssim,
+            doc: raw.doc,
+        });
+    }
+    Ok(out)
+}
+
+pub fn load_cases(path: &Path) -> Result<Vec<Case>, GoldenError> {
+    let text = std::fs::read_to_string(path).map_err(|e| GoldenError::Cases {
+        path: path.display().to_string(),
+        message: format!("cannot read: {e}"),
+    })?;
+    parse_cases(path, &text)
+}
+
+/// Cases whose id matches the glob (all when `None`).
+pub fn select<'a>(cases: &'a [Case], glob: Option<&str>) -> Result<Vec<&'a Case>, GoldenError> {
+    let Some(pattern) = glob else { return Ok(cases.iter().collect()) };
+    let matcher = globset::Glob::new(pattern)
+        .map_err(|e| GoldenError::BadInput(format!("--case '{pattern}' is not a valid glob: {e}")))?
+        .compile_matcher();
+    let picked: Vec<&Case> = cases.iter().filter(|c| matcher.is_match(&c.id)).collect();
+    if picked.is_empty() {
+        return Err(GoldenError::BadInput(format!(
+            "--case '{pattern}' matches no case; valid ids: {}",
+            cases.iter().map(|c| c.id.as_str()).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    Ok(picked)
+}

@@ -1,0 +1,248 @@
+//! Render one case and judge it against its golden.
+
+use std::path::PathBuf;
+
+use vista_gpu::Context;
+use vista_image::Image;
+use vista_image::metrics::{self, Metrics};
+
+use crate::render::{quantize16, render};
+use crate::store::{Manifest, Store, params_hash};
+use crate::{Case, GoldenError};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    Pass,
+    /// Rendered, but a metric or invariant is outside its threshold.
+    Fail,
+    /// No golden on disk: never created silently.
+    Missing,
+    /// Could not render or read (bad params, GPU error, corrupt golden).
+    Error,
+}
+
+/// Images written for the report (paths relative to the report dir).
+#[derive(Debug, Clone, Default)]
+pub struct ReportFiles {
+    pub expected: Option<String>,
+    pub actual: Option<String>,
+    pub diff: Option<String>,
+}
+
+/// What happened to one case. `#[must_use]`: callers decide pass/fail.
+#[must_use]
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub id: String,
+    pub kernel: String,
+    pub verdict: Verdict,
+    pub metrics: Option<Metrics>,
+    /// The PSNR threshold that applied, and whether the adapter matched the
+    /// manifest's (60 dB same driver, 35 dB other driver by default).
+    pub psnr_threshold: f64,
+    pub same_driver: bool,
+    pub min_ssim: Option<f64>,
+    /// One line per problem or note (shader changed since bless, ...).
+    pub problems: Vec<String>,
+    pub notes: Vec<String>,
+    pub files: ReportFiles,
+    pub gpu_ms: f64,
+    pub bless_command: String,
+}
+
+impl Outcome {
+    pub fn passed(&self) -> bool {
+        self.verdict == Verdict::Pass
+    }
+
+    /// Multi-line explanation for test output and `vista check`.
+    pub fn explain(&self, report_dir: &std::path::Path) -> String {
+        let mut s = format!("case {} ({}): {:?}\n", self.id, self.kernel, self.verdict);
+        if let Some(m) = &self.metrics {
+            s += &format!(
+                "  PSNR {} (threshold >= {:.1} dB, {} driver), SSIM {:.5}{}, max-abs {:.3e}, bad pixels {}, NaN/Inf {}\n",
+                metrics::format_psnr(m.psnr),
+                self.psnr_threshold,
+                if self.same_driver { "same" } else { "other" },
+                m.ssim,
+                self.min_ssim.map(|t| format!(" (threshold >= {t})")).unwrap_or_default(),
+                m.max_abs,
+                m.bad_pixels,
+                m.nan
+            );
+        }
+        for p in &self.problems {
+            s += &format!("  FAIL: {p}\n");
+        }
+        for n in &self.notes {
+            s += &format!("  note: {n}\n");
+        }
+        for (what, f) in [("expected", &self.files.expected), ("actual", &self.files.actual), ("diff", &self.files.diff)] {
+            if let Some(f) = f {
+                s += &format!("  {what}: {}\n", report_dir.join(f).display());
+            }
+        }
+        if !self.passed() {
+            s += &format!("  report: {}\n", report_dir.join("index.html").display());
+            s += &format!("  if this change is intended, bless it: {}\n", self.bless_command);
+        }
+        s
+    }
+}
+
+/// Options for checking.
+#[derive(Debug, Clone)]
+pub struct CheckOptions {
+    /// Where expected/actual/diff images go (`target/vista-report`).
+    pub report_dir: PathBuf,
+    /// Render twice in this process and require bit-identical output.
+    pub twice: bool,
+}
+
+/// Renders `case`, compares it with its golden and manifest entry, writes
+/// report images, and returns the outcome (errors become `Verdict::Error`).
+pub fn check_case(ctx: &Context, store: &Store, manifest: &Manifest, case: &Case, opts: &CheckOptions) -> Outcome {
+    let mut out = Outcome {
+        id: case.id.clone(),
+        kernel: case.kernel.name().to_string(),
+        verdict: Verdict::Pass,
+        metrics: None,
+        psnr_threshold: case.psnr_same_driver,
+        same_driver: true,
+        min_ssim: case.min_ssim,
+        problems: Vec::new(),
+        notes: Vec::new(),
+        files: ReportFiles::default(),
+        gpu_ms: 0.0,
+        bless_command: case.bless_command(),
+    };
+    if let Err(e) = judge(ctx, store, manifest, case, opts, &mut out) {
+        out.verdict = Verdict::Error;
+        out.problems.push(e.to_string());
+    } else if out.verdict == Verdict::Pass && !out.problems.is_empty() {
+        out.verdict = Verdict::Fail;
+    }
+    out
+}
+
+fn judge(
+    ctx: &Context,
+    store: &Store,
+    manifest: &Manifest,
+    case: &Case,
+    opts: &CheckOptions,
+    out: &mut Outcome,
+) -> Result<(), GoldenError> {
+    let r = render(ctx, case.kernel, &case.params, case.width, case.height)?;
+    out.gpu_ms = r.stats.gpu_wall.as_secs_f64() * 1e3;
+    let case_dir = opts.report_dir.join(&case.id);
+    let write = |name: &str, img: &Image| -> Result<String, GoldenError> {
+        std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
+            path: case_dir.display().to_string(),
+            message: format!("cannot create report dir: {e}"),
+        })?;
+        vista_image::write_png16(&case_dir.join(name), img)?;
+        Ok(format!("{}/{name}", case.id))
+    };
+    let actual = quantize16(&r.display);
+    out.files.actual = Some(write("actual.png", &actual)?);
+
+    // Invariants that need no golden: finite, within the documented range.
+    if let Some((x, y)) = r.raw.first_nonfinite() {
+        out.problems.push(format!(
+            "{} pixels contain NaN/Inf; first at ({x}, {y}) = {:?}",
+            r.raw.nonfinite_count(),
+            r.raw.get(x, y)
+        ));
+    }
+    let (lo, hi) = case.kernel.output_bounds(&case.params);
+    if let Some((x, y, v)) = first_out_of_bounds(&r.raw, lo, hi) {
+        out.problems.push(format!("raw output {v} at ({x}, {y}) is outside the kernel's range [{lo}, {hi}]"));
+    }
+    if opts.twice {
+        let again = render(ctx, case.kernel, &case.params, case.width, case.height)?;
+        if !again.raw.bit_identical(&r.raw) {
+            out.problems.push("two renders in one process are not bit-identical (non-deterministic kernel)".into());
+        }
+    }
+
+    let entry = manifest.case.get(&case.id);
+    let adapter = ctx.adapter_description();
+    let shader_hash = ctx.shaders().source_hash(case.kernel.shader())?;
+    match entry {
+        Some(e) => {
+            out.same_driver = e.adapter == adapter;
+            if !out.same_driver {
+                out.psnr_threshold = case.psnr_other_driver;
+                out.notes.push(format!("golden blessed on '{}', running on '{adapter}'", e.adapter));
+            }
+            if e.shader_hash != shader_hash {
+                out.notes.push(format!(
+                    "shader changed since the last bless (manifest {}, now {shader_hash})",
+                    e.shader_hash
+                ));
+            }
+            if e.params_hash != params_hash(case) {
+                out.notes.push("case parameters changed since the last bless".into());
+            } else if out.same_driver && e.shader_hash == shader_hash && e.raw_hash != r.raw.content_hash() {
+                out.problems.push(format!(
+                    "not bit-identical with the bless-time render on the same adapter, shader and params \
+                     (raw hash {} vs manifest {})",
+                    r.raw.content_hash(),
+                    e.raw_hash
+                ));
+            }
+        }
+        None => out.notes.push("no manifest entry for this case".into()),
+    }
+
+    let golden_path = store.golden_path(case);
+    if !golden_path.exists() {
+        out.verdict = Verdict::Missing;
+        out.problems.push(format!(
+            "golden {} does not exist; render and review it, then create it with: {}",
+            golden_path.display(),
+            case.bless_command()
+        ));
+        return Ok(());
+    }
+    let expected = vista_image::read_png16(&golden_path)?;
+    out.files.expected = Some(write("expected.png", &expected)?);
+    if (expected.width, expected.height) != (actual.width, actual.height) {
+        out.problems.push(format!(
+            "golden {} is {}x{} but the case renders {}x{}; re-bless if the size change is intended",
+            golden_path.display(),
+            expected.width,
+            expected.height,
+            actual.width,
+            actual.height
+        ));
+        return Ok(());
+    }
+    let mut m = metrics::compare(&expected, &actual)?;
+    m.nan = r.raw.nonfinite_count();
+    out.files.diff = Some(write("diff.png", &vista_image::diff_heatmap(&expected, &actual, None))?);
+    if m.psnr < out.psnr_threshold {
+        out.problems.push(format!(
+            "PSNR {} is below the threshold {:.1} dB",
+            metrics::format_psnr(m.psnr),
+            out.psnr_threshold
+        ));
+    }
+    if let Some(t) = case.min_ssim {
+        if m.ssim < t {
+            out.problems.push(format!("SSIM {:.5} is below the threshold {t}", m.ssim));
+        }
+    }
+    out.metrics = Some(m);
+    Ok(())
+}
+
+fn first_out_of_bounds(img: &Image, lo: f32, hi: f32) -> Option<(u32, u32, f32)> {
+    img.data.iter().enumerate().find_map(|(i, p)| {
+        p[..3]
+            .iter()
+            .find(|v| v.is_finite() && (**v < lo || **v > hi))
+            .map(|v| (i as u32 % img.width, i as u32 / img.width, *v))
+    })
+}

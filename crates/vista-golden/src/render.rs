@@ -1,0 +1,61 @@
+//! case -> kernel -> GPU run -> image: the one path every render takes.
+
+use vista_gpu::{Context, Dispatch, RunStats};
+use vista_image::Image;
+use vista_kernels::{Kernel, ParamSet};
+
+use crate::GoldenError;
+
+/// Default cap on `work_per_pixel * pixels`. Lavapipe on 2 cores evaluates
+/// roughly 1e8-1e9 noise samples per second, so this keeps any accepted
+/// dispatch under about a minute there instead of stalling the device.
+pub const DEFAULT_MAX_WORK: f64 = 4.0e10;
+
+fn max_work() -> f64 {
+    std::env::var("VISTA_MAX_WORK").ok().and_then(|s| s.parse().ok()).unwrap_or(DEFAULT_MAX_WORK)
+}
+
+/// A rendered kernel: raw output (what the shader wrote) and display values.
+#[derive(Debug, Clone)]
+pub struct Rendered {
+    pub raw: Image,
+    pub display: Image,
+    pub stats: RunStats,
+}
+
+/// Checks size and work bounds before any GPU work.
+pub fn check_request(kernel: &dyn Kernel, p: &ParamSet, width: u32, height: u32) -> Result<(), GoldenError> {
+    vista_kernels::check_size(width, height).map_err(|e| GoldenError::BadInput(e.to_string()))?;
+    let work = kernel.work_per_pixel(p) * width as f64 * height as f64;
+    let cap = max_work();
+    if work > cap {
+        return Err(GoldenError::BadInput(format!(
+            "{}: this request needs about {work:.2e} inner-loop evaluations ({}x{} pixels x {:.0} per pixel), \
+             above the cap of {cap:.2e}; lower the size or the step/octave counts (or raise VISTA_MAX_WORK)",
+            kernel.name(),
+            width,
+            height,
+            kernel.work_per_pixel(p)
+        )));
+    }
+    Ok(())
+}
+
+/// Renders `kernel` with `p` at `width` x `height` on the GPU.
+pub fn render(ctx: &Context, kernel: &dyn Kernel, p: &ParamSet, width: u32, height: u32) -> Result<Rendered, GoldenError> {
+    check_request(kernel, p, width, height)?;
+    let uniforms = kernel.uniforms(p, width, height).to_bytes();
+    let table = kernel.table(p);
+    let (raw, stats) = ctx.run(&Dispatch { shader: kernel.shader(), uniforms: &uniforms, table: &table, width, height })?;
+    let display = kernel.display(&raw, p);
+    Ok(Rendered { raw, display, stats })
+}
+
+/// Display values as a 16-bit PNG stores them, so a fresh render compares
+/// with a golden exactly as it would after being blessed.
+pub fn quantize16(img: &Image) -> Image {
+    let q = |v: f32| {
+        if v.is_nan() { 0.0 } else { (v.clamp(0.0, 1.0) * 65535.0).round() / 65535.0 }
+    };
+    Image::from_raw(img.width, img.height, img.data.iter().map(|p| p.map(q)).collect()).expect("same size")
+}

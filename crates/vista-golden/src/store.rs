@@ -1,0 +1,119 @@
+//! The golden store: `golden/<kernel>/<case>.png` plus `golden/manifest.toml`
+//! recording, per case, how and where each golden was made.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Case, GoldenError};
+
+/// Provenance of one golden at bless time.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct ManifestEntry {
+    pub kernel: String,
+    pub size: String,
+    /// Hash of the case's canonical resolved parameters.
+    pub params_hash: String,
+    /// Hash of the kernel's WGSL and every `shaders/lib` file.
+    pub shader_hash: String,
+    /// Adapter name | driver | backend | device type.
+    pub adapter: String,
+    pub date: String,
+    /// Hash of the raw f32 output bits: a later render on the same adapter
+    /// and shader must reproduce it exactly (determinism across processes).
+    pub raw_hash: String,
+    /// PSNR of this golden against the one it replaced ("new" if none).
+    pub psnr_vs_previous: String,
+    /// PSNR / max-abs of the GPU raw output against the f64 CPU reference,
+    /// where the kernel's reference was run at bless time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub psnr_vs_cpu: Option<String>,
+}
+
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct Manifest {
+    #[serde(default)]
+    pub case: BTreeMap<String, ManifestEntry>,
+}
+
+/// A golden directory.
+#[derive(Debug, Clone)]
+pub struct Store {
+    pub dir: PathBuf,
+}
+
+impl Store {
+    /// `$VISTA_GOLDEN_DIR`, else the repository's `golden/`.
+    pub fn default_dir() -> PathBuf {
+        match std::env::var_os("VISTA_GOLDEN_DIR") {
+            Some(d) => PathBuf::from(d),
+            None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../golden"),
+        }
+    }
+
+    pub fn open_default() -> Store {
+        Store { dir: Self::default_dir() }
+    }
+
+    pub fn cases_path(&self) -> PathBuf {
+        self.dir.join("cases.toml")
+    }
+
+    pub fn manifest_path(&self) -> PathBuf {
+        self.dir.join("manifest.toml")
+    }
+
+    pub fn golden_path(&self, case: &Case) -> PathBuf {
+        self.dir.join(case.golden_rel_path())
+    }
+
+    pub fn load_cases(&self) -> Result<Vec<Case>, GoldenError> {
+        crate::load_cases(&self.cases_path())
+    }
+
+    /// The manifest; empty if the file does not exist yet.
+    pub fn manifest(&self) -> Result<Manifest, GoldenError> {
+        let path = self.manifest_path();
+        match std::fs::read_to_string(&path) {
+            Ok(text) => toml::from_str(&text).map_err(|e| GoldenError::Cases {
+                path: path.display().to_string(),
+                message: format!("malformed manifest: {e}"),
+            }),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Manifest::default()),
+            Err(e) => Err(GoldenError::Io { path: path.display().to_string(), message: e.to_string() }),
+        }
+    }
+
+    pub fn write_manifest(&self, m: &Manifest) -> Result<(), GoldenError> {
+        let text = format!(
+            "# Written by `vista bless`: provenance of every golden. Do not edit by hand.\n\n{}",
+            toml::to_string_pretty(m).map_err(|e| GoldenError::BadInput(format!("manifest encode: {e}")))?
+        );
+        vista_image::atomic_write(&self.manifest_path(), text.as_bytes())?;
+        Ok(())
+    }
+
+    /// Golden PNGs on disk that no case refers to.
+    pub fn orphans(&self, cases: &[Case]) -> Vec<PathBuf> {
+        let known: std::collections::HashSet<PathBuf> = cases.iter().map(|c| self.golden_path(c)).collect();
+        let mut out = Vec::new();
+        let Ok(kernels) = std::fs::read_dir(&self.dir) else { return out };
+        for k in kernels.flatten().filter(|e| e.path().is_dir()) {
+            let Ok(files) = std::fs::read_dir(k.path()) else { continue };
+            for f in files.flatten() {
+                let p = f.path();
+                if p.extension().is_some_and(|e| e == "png") && !known.contains(&p) {
+                    out.push(p);
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+}
+
+/// Params hash as recorded in the manifest.
+pub fn params_hash(case: &Case) -> String {
+    crate::short_hash(&format!("{}|{}x{}|{}", case.kernel.name(), case.width, case.height, case.params.canonical()))
+}

@@ -1,0 +1,402 @@
+//! The shared headless context and the dispatch/readback path.
+
+use std::collections::HashMap;
+use std::sync::mpsc;
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::{Duration, Instant};
+
+use vista_image::Image;
+use wgpu::util::DeviceExt;
+
+use crate::shaders::{ShaderSet, default_shader_dir};
+use crate::{GpuError, INSTALL_HINT};
+
+/// Which adapter to ask for.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum AdapterChoice {
+    /// A CPU (software) adapter: lavapipe. Reproducible; the default.
+    Software,
+    /// A hardware adapter (discrete preferred, then integrated, then virtual).
+    Hardware,
+    /// The first adapter whose name contains this text (case-insensitive).
+    Named(String),
+}
+
+impl AdapterChoice {
+    /// `WGPU_ADAPTER_NAME` wins, then `VISTA_ADAPTER=gpu|cpu`, else software.
+    pub fn from_env() -> Result<AdapterChoice, GpuError> {
+        if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME") {
+            if !name.is_empty() {
+                return Ok(AdapterChoice::Named(name));
+            }
+        }
+        match std::env::var("VISTA_ADAPTER").as_deref() {
+            Err(_) | Ok("") | Ok("cpu") | Ok("software") | Ok("lavapipe") => Ok(AdapterChoice::Software),
+            Ok("gpu") | Ok("hardware") => Ok(AdapterChoice::Hardware),
+            Ok(other) => Err(GpuError::Request(format!(
+                "VISTA_ADAPTER={other} is not valid; expected one of cpu|gpu"
+            ))),
+        }
+    }
+
+    fn describe(&self) -> String {
+        match self {
+            AdapterChoice::Software => "software (CPU, lavapipe)".into(),
+            AdapterChoice::Hardware => "hardware GPU".into(),
+            AdapterChoice::Named(n) => format!("adapter named like '{n}'"),
+        }
+    }
+}
+
+/// One compute job over a W x H image.
+#[derive(Debug, Clone)]
+pub struct Dispatch<'a> {
+    /// Kernel WGSL file relative to the shader dir; entry point `main`.
+    pub shader: &'a str,
+    /// Uniform block for binding 0 (padded to 16 bytes by the caller).
+    pub uniforms: &'a [u8],
+    /// Read-only u32 table for binding 2.
+    pub table: &'a [u32],
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Timing of one run, excluding device creation and shader compilation.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunStats {
+    /// Submit to completion of the compute pass and readback copy.
+    pub gpu_wall: Duration,
+    /// Whole call: upload, dispatch, wait, map and unpack.
+    pub total: Duration,
+}
+
+const WORKGROUP: u32 = 8;
+
+/// Headless wgpu state shared by everything in one process.
+pub struct Context {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    shaders: ShaderSet,
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
+    timeout: Duration,
+    /// Serialises submissions so a timeout is attributed to the right job.
+    submit_lock: Mutex<()>,
+    pub creation_time: Duration,
+}
+
+static SHARED: OnceLock<Result<Context, GpuError>> = OnceLock::new();
+
+impl Context {
+    /// The process-wide context, created on first use from the environment.
+    pub fn shared() -> Result<&'static Context, GpuError> {
+        SHARED
+            .get_or_init(|| Context::new(AdapterChoice::from_env()?))
+            .as_ref()
+            .map_err(Clone::clone)
+    }
+
+    pub fn new(choice: AdapterChoice) -> Result<Context, GpuError> {
+        let start = Instant::now();
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
+        let backends = desc.backends;
+        let instance = wgpu::Instance::new(desc);
+        let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+        let seen = adapters
+            .iter()
+            .map(|a| {
+                let i = a.get_info();
+                format!("{} [{:?}, {:?}]", i.name, i.device_type, i.backend)
+            })
+            .collect::<Vec<_>>();
+        let adapter = pick(adapters, &choice).ok_or_else(|| GpuError::NoAdapter {
+            wanted: choice.describe(),
+            seen: if seen.is_empty() { "none".into() } else { seen.join("; ") },
+            hint: INSTALL_HINT,
+        })?;
+        let info = adapter.get_info();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("vista"),
+            required_features: wgpu::Features::empty(),
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::Device { adapter: info.name.clone(), message: e.to_string() })?;
+        let shaders = ShaderSet::load(&default_shader_dir())?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("vista kernel io"),
+            entries: &[
+                entry(0, wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                }),
+                entry(1, wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: wgpu::TextureFormat::Rgba32Float,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                }),
+                entry(2, wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                }),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("vista kernel"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let timeout = std::env::var("VISTA_GPU_TIMEOUT_S")
+            .ok()
+            .and_then(|s| s.parse::<u64>().ok())
+            .unwrap_or(120);
+        Ok(Context {
+            device,
+            queue,
+            info,
+            shaders,
+            layout,
+            pipeline_layout,
+            pipelines: Mutex::new(HashMap::new()),
+            timeout: Duration::from_secs(timeout),
+            submit_lock: Mutex::new(()),
+            creation_time: start.elapsed(),
+        })
+    }
+
+    pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
+        &self.info
+    }
+
+    /// "name | driver driver_info | backend | device type": recorded in every
+    /// report and golden manifest.
+    pub fn adapter_description(&self) -> String {
+        let i = &self.info;
+        format!("{} | {} {} | {:?} | {:?}", i.name, i.driver, i.driver_info, i.backend, i.device_type)
+    }
+
+    /// True for CPU (software) adapters such as lavapipe.
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    pub fn shaders(&self) -> &ShaderSet {
+        &self.shaders
+    }
+
+    /// Largest width/height a storage texture may have on this device.
+    pub fn max_dimension(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
+    }
+
+    /// Compiles (once) the pipeline of a kernel file.
+    pub fn pipeline(&self, shader: &str) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+        if let Some(p) = self.pipelines.lock().expect("pipeline cache").get(shader) {
+            return Ok(p.clone());
+        }
+        let module = self.shaders.compose(shader)?;
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let sm = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(shader),
+            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module)),
+        });
+        let pipeline = self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(shader),
+            layout: Some(&self.pipeline_layout),
+            module: &sm,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Validation { what: shader.to_string(), message: e.to_string() });
+        }
+        let pipeline = Arc::new(pipeline);
+        self.pipelines.lock().expect("pipeline cache").insert(shader.to_string(), pipeline.clone());
+        Ok(pipeline)
+    }
+
+    /// Runs one dispatch and reads the output texture back.
+    pub fn run(&self, job: &Dispatch<'_>) -> Result<(Image, RunStats), GpuError> {
+        let max = self.max_dimension();
+        if job.width == 0 || job.height == 0 || job.width > max || job.height > max {
+            return Err(GpuError::Request(format!(
+                "size {}x{} is outside this device's range: each side in [1, {max}]",
+                job.width, job.height
+            )));
+        }
+        let pipeline = self.pipeline(job.shader)?;
+        let start = Instant::now();
+        let d = &self.device;
+        let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+        let uniforms = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: job.uniforms,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let table_words: Vec<u32> = if job.table.is_empty() { vec![0; 4] } else { job.table.to_vec() };
+        let table = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("table"),
+            contents: &words_to_bytes(&table_words),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let extent = wgpu::Extent3d { width: job.width, height: job.height, depth_or_array_layers: 1 };
+        let texture = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("output"),
+            size: extent,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        // Buffer rows must be 256-byte aligned; unpadded again after mapping.
+        let row_bytes = job.width * 16;
+        let padded_row = row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let readback = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: padded_row as u64 * job.height as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let view = texture.create_view(&Default::default());
+        let bind_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("io"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
+                wgpu::BindGroupEntry { binding: 2, resource: table.as_entire_binding() },
+            ],
+        });
+        let mut encoder = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups(job.width.div_ceil(WORKGROUP), job.height.div_ceil(WORKGROUP), 1);
+        }
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(job.height),
+                },
+            },
+            extent,
+        );
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Validation { what: job.shader.to_string(), message: e.to_string() });
+        }
+        let _serial = self.submit_lock.lock().expect("submit lock");
+        let gpu_start = Instant::now();
+        let index = self.queue.submit([encoder.finish()]);
+        let (tx, rx) = mpsc::channel();
+        readback.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait(index, job.shader)?;
+        let gpu_wall = gpu_start.elapsed();
+        match rx.recv_timeout(self.timeout) {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return Err(GpuError::Validation { what: "readback map".into(), message: e.to_string() }),
+            Err(_) => return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs() }),
+        }
+        let image = {
+            let mapped = readback
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Validation { what: "readback map".into(), message: e.to_string() })?;
+            unpad_rows(&mapped, job.width, job.height, padded_row)
+        };
+        readback.unmap();
+        Ok((image, RunStats { gpu_wall, total: start.elapsed() }))
+    }
+
+    /// Blocks until `index` completes, or fails after the watchdog timeout.
+    fn wait(&self, index: wgpu::SubmissionIndex, what: &str) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::Wait { submission_index: Some(index), timeout: Some(self.timeout) })
+            .map(|_| ())
+            .map_err(|e| match e {
+                wgpu::PollError::Timeout => {
+                    GpuError::Timeout { what: what.to_string(), seconds: self.timeout.as_secs() }
+                }
+                other => GpuError::Validation { what: what.to_string(), message: other.to_string() },
+            })
+    }
+}
+
+fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+}
+
+fn words_to_bytes(words: &[u32]) -> Vec<u8> {
+    words.iter().flat_map(|w| w.to_le_bytes()).collect()
+}
+
+/// Copies `height` rows of `width` RGBA f32 texels out of a buffer whose rows
+/// are `padded_row` bytes apart.
+pub(crate) fn unpad_rows(bytes: &[u8], width: u32, height: u32, padded_row: u32) -> Image {
+    let mut data = Vec::with_capacity((width * height) as usize);
+    for y in 0..height as usize {
+        let row = &bytes[y * padded_row as usize..][..width as usize * 16];
+        for px in row.chunks_exact(16) {
+            let c = |i: usize| f32::from_le_bytes(px[i * 4..i * 4 + 4].try_into().expect("4 bytes"));
+            data.push([c(0), c(1), c(2), c(3)]);
+        }
+    }
+    Image::from_raw(width, height, data).expect("unpadded rows fill the image")
+}
+
+/// Picks the adapter matching `choice` from those enumerated.
+fn pick(adapters: Vec<wgpu::Adapter>, choice: &AdapterChoice) -> Option<wgpu::Adapter> {
+    use wgpu::DeviceType as T;
+    let rank = |a: &wgpu::Adapter| -> Option<u8> {
+        let i = a.get_info();
+        match choice {
+            AdapterChoice::Software => (i.device_type == T::Cpu).then_some(0),
+            AdapterChoice::Hardware => match i.device_type {
+                T::DiscreteGpu => Some(0),
+                T::IntegratedGpu => Some(1),
+                T::VirtualGpu => Some(2),
+                _ => None,
+            },
+            AdapterChoice::Named(n) => i.name.to_lowercase().contains(&n.to_lowercase()).then_some(0),
+        }
+    };
+    adapters.into_iter().filter_map(|a| rank(&a).map(|r| (r, a))).min_by_key(|(r, _)| *r).map(|(_, a)| a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unpad_rows_skips_row_padding() {
+        // 3 x 2 image, rows padded to 256 bytes: padding bytes are garbage.
+        let (w, h, padded) = (3u32, 2u32, 256u32);
+        let mut bytes = vec![0xAB_u8; (padded * h) as usize];
+        for y in 0..h {
+            for x in 0..w {
+                for c in 0..4 {
+                    let v = (y * 100 + x * 10 + c) as f32;
+                    let at = (y * padded + x * 16 + c * 4) as usize;
+                    bytes[at..at + 4].copy_from_slice(&v.to_le_bytes());
+                }
+            }
+        }
+        let img = unpad_rows(&bytes, w, h, padded);
+        assert_eq!(img.get(2, 1), [120.0, 121.0, 122.0, 123.0]);
+        assert_eq!(img.get(0, 0), [0.0, 1.0, 2.0, 3.0]);
+    }
+}

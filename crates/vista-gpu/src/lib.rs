@@ -1,0 +1,33 @@
+//! Headless wgpu compute for vista: one shared context per process (instance,
+//! adapter choice, device, queue), WGSL composition from `shaders/`, dispatch
+//! of a compute entry point over a W x H image, and readback into an f32 RGBA
+//! [`Image`](vista_image::Image).
+//!
+//! Not for: knowing about specific kernels. A dispatch is a shader file name,
+//! a uniform block, a u32 table and a size; meaning lives in `vista-kernels`.
+
+mod context;
+mod shaders;
+
+pub use context::{AdapterChoice, Context, Dispatch, RunStats};
+pub use shaders::{ShaderSet, binding_struct_layout, default_shader_dir, validate};
+
+/// Hint printed whenever no usable Vulkan adapter is found.
+pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \
+(or `sudo apt-get install mesa-vulkan-drivers libvulkan1`); set VISTA_ALLOW_NO_GPU=1 to skip GPU tests loudly";
+
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum GpuError {
+    #[error("no {wanted} Vulkan adapter found (adapters seen: {seen}); {hint}")]
+    NoAdapter { wanted: String, seen: String, hint: &'static str },
+    #[error("device request failed on {adapter}: {message}")]
+    Device { adapter: String, message: String },
+    #[error("{0}")]
+    Shader(String),
+    #[error("GPU validation error in {what}: {message}")]
+    Validation { what: String, message: String },
+    #[error("GPU wait exceeded {seconds} s ({what}); the dispatch is too heavy for this device or the driver hung; lower the size or step counts, or raise VISTA_GPU_TIMEOUT_S")]
+    Timeout { what: String, seconds: u64 },
+    #[error("{0}")]
+    Request(String),
+}

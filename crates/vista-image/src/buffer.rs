@@ -1,0 +1,162 @@
+//! The in-memory image type.
+
+use crate::ImageError;
+
+/// A linear f32 RGBA image, row-major with `y = 0` at the top.
+///
+/// Values are stored exactly as produced (no clamping, NaN/Inf allowed), so
+/// the type can hold both LDR output and raw HDR kernel results.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    /// `width * height` pixels; pixel `(x, y)` is at `y * width + x`.
+    pub data: Vec<[f32; 4]>,
+}
+
+impl Image {
+    /// An all-zero (transparent black) image.
+    pub fn new(width: u32, height: u32) -> Image {
+        Image {
+            width,
+            height,
+            data: vec![[0.0; 4]; pixel_count(width, height)],
+        }
+    }
+
+    /// Builds an image by evaluating `f(x, y)` for every pixel in row-major order.
+    pub fn from_fn(width: u32, height: u32, mut f: impl FnMut(u32, u32) -> [f32; 4]) -> Image {
+        let mut data = Vec::with_capacity(pixel_count(width, height));
+        for y in 0..height {
+            for x in 0..width {
+                data.push(f(x, y));
+            }
+        }
+        Image {
+            width,
+            height,
+            data,
+        }
+    }
+
+    /// Wraps an existing pixel buffer, checking that its length is `width * height`.
+    pub fn from_raw(width: u32, height: u32, data: Vec<[f32; 4]>) -> Result<Image, ImageError> {
+        let expected = u64::from(width) * u64::from(height);
+        if data.len() as u64 != expected {
+            return Err(ImageError::BadDimensions {
+                width,
+                height,
+                expected,
+                len: data.len(),
+            });
+        }
+        Ok(Image {
+            width,
+            height,
+            data,
+        })
+    }
+
+    /// `(width, height)`.
+    pub fn dimensions(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The pixel at `(x, y)`.
+    ///
+    /// # Panics
+    /// If `(x, y)` is outside the image.
+    pub fn get(&self, x: u32, y: u32) -> [f32; 4] {
+        self.data[self.index(x, y)]
+    }
+
+    /// Overwrites the pixel at `(x, y)`.
+    ///
+    /// # Panics
+    /// If `(x, y)` is outside the image.
+    pub fn set(&mut self, x: u32, y: u32, v: [f32; 4]) {
+        let i = self.index(x, y);
+        self.data[i] = v;
+    }
+
+    /// The first pixel in row-major order with a NaN or ±Inf in any channel
+    /// (alpha included).
+    pub fn first_nonfinite(&self) -> Option<(u32, u32)> {
+        let i = self.data.iter().position(|p| !is_finite_pixel(p))?;
+        // `i < width * height`, so both coordinates fit in u32.
+        let w = self.width as usize;
+        Some(((i % w) as u32, (i / w) as u32))
+    }
+
+    /// Number of pixels with a NaN or ±Inf in any channel (alpha included).
+    pub fn nonfinite_count(&self) -> u64 {
+        self.data.iter().filter(|p| !is_finite_pixel(p)).count() as u64
+    }
+
+    /// A 16-hex-digit FNV-1a 64 hash of the width, height and the exact f32
+    /// bit patterns (all little-endian), so it is stable across runs and
+    /// platforms and distinguishes `0.0` from `-0.0` and NaN payloads.
+    pub fn content_hash(&self) -> String {
+        let mut h = Fnv1a64::new();
+        h.write(&self.width.to_le_bytes());
+        h.write(&self.height.to_le_bytes());
+        for p in &self.data {
+            for c in p {
+                h.write(&c.to_bits().to_le_bytes());
+            }
+        }
+        format!("{:016x}", h.finish())
+    }
+
+    /// True if both images have the same size and every channel has the same
+    /// f32 bit pattern. Unlike `==`, this treats identical NaNs as equal and
+    /// `0.0` / `-0.0` as different.
+    pub fn bit_identical(&self, other: &Image) -> bool {
+        self.dimensions() == other.dimensions()
+            && self
+                .data
+                .iter()
+                .zip(&other.data)
+                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
+    }
+
+    fn index(&self, x: u32, y: u32) -> usize {
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) is outside the {}x{} image",
+            self.width,
+            self.height
+        );
+        y as usize * self.width as usize + x as usize
+    }
+}
+
+fn pixel_count(width: u32, height: u32) -> usize {
+    width as usize * height as usize
+}
+
+fn is_finite_pixel(p: &[f32; 4]) -> bool {
+    p.iter().all(|c| c.is_finite())
+}
+
+/// Minimal FNV-1a 64; hand-rolled so the hash never changes with a dependency.
+struct Fnv1a64(u64);
+
+impl Fnv1a64 {
+    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+
+    fn new() -> Self {
+        Fnv1a64(Self::OFFSET)
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(Self::PRIME);
+        }
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}

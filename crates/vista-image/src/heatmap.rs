@@ -1,0 +1,121 @@
+//! Diff heat maps for reports.
+
+use crate::Image;
+
+/// Colour for pixels whose difference is NaN/Inf or that `actual` lacks; the
+/// colormap never produces pure green, so these stand out.
+const INVALID: [f32; 4] = [0.0, 1.0, 0.0, 1.0];
+
+/// Smallest default scale, so differences of one 8-bit step or less are
+/// still visible instead of being stretched from noise.
+const MIN_SCALE: f32 = 1.0 / 255.0;
+
+/// Colormap stops: black → blue → magenta → yellow → white (monotonic in
+/// brightness, readable without a legend).
+const STOPS: [[f32; 3]; 5] = [
+    [0.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [1.0, 0.0, 1.0],
+    [1.0, 1.0, 0.0],
+    [1.0, 1.0, 1.0],
+];
+
+/// Visualises where and how much `actual` differs from `reference`.
+///
+/// Each pixel's error is the max absolute RGB difference; it is divided by
+/// `scale` (the difference that maps to white), clamped to `[0, 1]` and
+/// mapped through the colormap above. The default scale (also used when
+/// `scale` is not a positive finite number) is the largest finite difference
+/// in the image, but at least 1/255. Pixels with a non-finite difference are
+/// pure green. The output has the reference's size; if `actual` is smaller,
+/// the pixels it lacks are green too. Alpha is always 1.
+pub fn diff_heatmap(reference: &Image, actual: &Image, scale: Option<f32>) -> Image {
+    let diffs = pixel_diffs(reference, actual);
+    let scale = match scale {
+        Some(s) if s.is_finite() && s > 0.0 => s,
+        _ => default_scale(&diffs),
+    };
+    let data = diffs
+        .iter()
+        .map(|d| match d {
+            Some(d) => colormap(d / scale),
+            None => INVALID,
+        })
+        .collect();
+    Image {
+        width: reference.width,
+        height: reference.height,
+        data,
+    }
+}
+
+/// Per reference pixel: `Some(max RGB |diff|)`, or `None` when non-finite or
+/// outside `actual`.
+fn pixel_diffs(reference: &Image, actual: &Image) -> Vec<Option<f32>> {
+    let mut out = Vec::with_capacity(reference.data.len());
+    for y in 0..reference.height {
+        for x in 0..reference.width {
+            let inside = x < actual.width && y < actual.height;
+            out.push(
+                inside
+                    .then(|| max_rgb_diff(reference.get(x, y), actual.get(x, y)))
+                    .flatten(),
+            );
+        }
+    }
+    out
+}
+
+fn max_rgb_diff(a: [f32; 4], b: [f32; 4]) -> Option<f32> {
+    let mut m = 0.0f32;
+    for c in 0..3 {
+        if a[c].to_bits() == b[c].to_bits() {
+            continue;
+        }
+        let d = (a[c] - b[c]).abs();
+        if !d.is_finite() {
+            return None;
+        }
+        m = m.max(d);
+    }
+    Some(m)
+}
+
+fn default_scale(diffs: &[Option<f32>]) -> f32 {
+    diffs.iter().flatten().fold(MIN_SCALE, |m, &d| m.max(d))
+}
+
+/// Piecewise-linear interpolation between [`STOPS`] for `t` in `[0, 1]`.
+fn colormap(t: f32) -> [f32; 4] {
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let segments = (STOPS.len() - 1) as f32;
+    let pos = t * segments;
+    let i = (pos.floor() as usize).min(STOPS.len() - 2);
+    let f = pos - i as f32;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    let lerp = |c: usize| a[c] + (b[c] - a[c]) * f;
+    [lerp(0), lerp(1), lerp(2), 1.0]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colormap_endpoints_and_stops() {
+        assert_eq!(colormap(0.0), [0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(colormap(0.25), [0.0, 0.0, 1.0, 1.0]);
+        assert_eq!(colormap(0.5), [1.0, 0.0, 1.0, 1.0]);
+        assert_eq!(colormap(0.75), [1.0, 1.0, 0.0, 1.0]);
+        assert_eq!(colormap(1.0), [1.0, 1.0, 1.0, 1.0]);
+        assert_eq!(colormap(7.0), [1.0, 1.0, 1.0, 1.0]);
+    }
+
+    #[test]
+    fn colormap_never_pure_green() {
+        for i in 0..=1000 {
+            let c = colormap(i as f32 / 1000.0);
+            assert!(!(c[0] == 0.0 && c[1] > 0.0 && c[2] == 0.0), "{c:?}");
+        }
+    }
+}

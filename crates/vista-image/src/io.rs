@@ -1,0 +1,223 @@
+//! PNG16 / EXR reading and writing. Every write encodes to memory first and
+//! then goes through [`atomic_write`], so a crash never leaves a truncated file.
+
+use std::io::{Cursor, Write};
+use std::path::{Path, PathBuf};
+
+use image::{DynamicImage, ImageBuffer, ImageFormat, Rgba};
+
+use crate::{Image, ImageError};
+
+/// Writes `img` as a 16-bit RGBA PNG.
+///
+/// Each channel is clamped to `[0, 1]` and quantised as `round(v * 65535)`;
+/// NaN is written as 0. Use [`write_exr`] to keep values unchanged.
+pub fn write_png16(path: &Path, img: &Image) -> Result<(), ImageError> {
+    let samples: Vec<u16> = img.data.iter().flatten().map(|&v| quantize16(v)).collect();
+    let buf = ImageBuffer::<Rgba<u16>, Vec<u16>>::from_raw(img.width, img.height, samples)
+        .ok_or_else(|| encode_error(path, "PNG", "pixel buffer does not match image size"))?;
+    let mut bytes = Cursor::new(Vec::new());
+    DynamicImage::ImageRgba16(buf)
+        .write_to(&mut bytes, ImageFormat::Png)
+        .map_err(|e| encode_error(path, "PNG", e))?;
+    atomic_write(path, bytes.get_ref())
+}
+
+/// Reads any PNG (1-16 bit, grey/grey+alpha/RGB/RGBA/palette) as f32 RGBA in
+/// `[0, 1]`; missing alpha becomes 1 and grey is replicated to RGB.
+pub fn read_png16(path: &Path) -> Result<Image, ImageError> {
+    let bytes = read_file(path)?;
+    let decoded = image::load_from_memory_with_format(&bytes, ImageFormat::Png)
+        .map_err(|e| decode_error(path, "PNG", e))?;
+    Ok(normalize_png(decoded))
+}
+
+/// Writes `img` as a ZIP-compressed f32 RGBA OpenEXR file; values (including
+/// NaN, Inf and negatives) are stored bit-exactly.
+pub fn write_exr(path: &Path, img: &Image) -> Result<(), ImageError> {
+    use exr::prelude::{Encoding, SpecificChannels, WritableImage};
+
+    // The exr crate panics (instead of erroring) on an empty image.
+    if img.width == 0 || img.height == 0 {
+        let msg = format!("cannot store an empty {}x{} image", img.width, img.height);
+        return Err(encode_error(path, "EXR", msg));
+    }
+    let (w, h) = (img.width as usize, img.height as usize);
+    let channels = SpecificChannels::rgba(|pos: exr::math::Vec2<usize>| {
+        let [r, g, b, a] = img.data[pos.y() * w + pos.x()];
+        (r, g, b, a)
+    });
+    let exr_image =
+        exr::image::Image::from_encoded_channels((w, h), Encoding::SMALL_LOSSLESS, channels);
+    let mut bytes = Cursor::new(Vec::new());
+    exr_image
+        .write()
+        .non_parallel()
+        .to_buffered(&mut bytes)
+        .map_err(|e| encode_error(path, "EXR", e))?;
+    atomic_write(path, bytes.get_ref())
+}
+
+/// Reads an OpenEXR file with R, G, B (and optionally A) channels as f32
+/// RGBA; missing alpha becomes 1, half-float channels are widened exactly.
+pub fn read_exr(path: &Path) -> Result<Image, ImageError> {
+    let bytes = read_file(path)?;
+    let decoded = image::load_from_memory_with_format(&bytes, ImageFormat::OpenExr)
+        .map_err(|e| decode_error(path, "EXR", e))?;
+    Ok(from_rgba32f(decoded.into_rgba32f()))
+}
+
+/// Writes `img` as PNG16 or EXR depending on the (case-insensitive) extension.
+pub fn save(path: &Path, img: &Image) -> Result<(), ImageError> {
+    match kind_of(path)? {
+        Kind::Png => write_png16(path, img),
+        Kind::Exr => write_exr(path, img),
+    }
+}
+
+/// Reads a PNG or EXR depending on the (case-insensitive) extension.
+pub fn load(path: &Path) -> Result<Image, ImageError> {
+    match kind_of(path)? {
+        Kind::Png => read_png16(path),
+        Kind::Exr => read_exr(path),
+    }
+}
+
+/// Replaces `path` with `bytes` atomically: writes a temporary file in the
+/// same directory, fsyncs it and renames it over `path`. On failure the
+/// temporary file is removed and any existing `path` is left untouched.
+pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
+    let io_err = |source| ImageError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = parent_dir(path);
+    let mut tmp = create_temp(&dir, path).map_err(io_err)?;
+    tmp.write_all(bytes).map_err(io_err)?;
+    tmp.as_file().sync_all().map_err(io_err)?;
+    tmp.persist(path).map_err(|e| io_err(e.error))?;
+    sync_dir(&dir);
+    Ok(())
+}
+
+enum Kind {
+    Png,
+    Exr,
+}
+
+fn kind_of(path: &Path) -> Result<Kind, ImageError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => Ok(Kind::Png),
+        Some("exr") => Ok(Kind::Exr),
+        _ => Err(ImageError::UnsupportedExtension {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+/// `round(clamp(v) * 65535)` computed in f64 so every u16 level round-trips.
+fn quantize16(v: f32) -> u16 {
+    if v.is_nan() {
+        return 0;
+    }
+    (f64::from(v.clamp(0.0, 1.0)) * 65535.0).round() as u16
+}
+
+/// Converts integer samples to `v / max` with one correctly rounded f32
+/// division (image's own u8 -> f32 path is off by an ulp for some values).
+fn normalize_png(decoded: DynamicImage) -> Image {
+    let ct = decoded.color();
+    let (width, height) = (decoded.width(), decoded.height());
+    let data = if ct.bytes_per_pixel() > ct.channel_count() {
+        let buf = decoded.into_rgba16();
+        buf.pixels()
+            .map(|p| p.0.map(|v| f32::from(v) / 65535.0))
+            .collect()
+    } else {
+        let buf = decoded.into_rgba8();
+        buf.pixels()
+            .map(|p| p.0.map(|v| f32::from(v) / 255.0))
+            .collect()
+    };
+    Image {
+        width,
+        height,
+        data,
+    }
+}
+
+fn from_rgba32f(buf: image::Rgba32FImage) -> Image {
+    let (width, height) = buf.dimensions();
+    let data = buf.pixels().map(|p| p.0).collect();
+    Image {
+        width,
+        height,
+        data,
+    }
+}
+
+fn read_file(path: &Path) -> Result<Vec<u8>, ImageError> {
+    std::fs::read(path).map_err(|source| ImageError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn decode_error(path: &Path, format: &'static str, e: impl ToString) -> ImageError {
+    ImageError::Decode {
+        path: path.to_path_buf(),
+        format,
+        msg: e.to_string(),
+    }
+}
+
+fn encode_error(path: &Path, format: &'static str, e: impl ToString) -> ImageError {
+    ImageError::Encode {
+        path: path.to_path_buf(),
+        format,
+        msg: e.to_string(),
+    }
+}
+
+/// The directory the temp file must live in so the final rename stays on one
+/// filesystem; a bare file name means the current directory.
+fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Creates the temp file as `.<target>.XXXXXX.tmp` so a stray one (after a
+/// hard kill) is recognisable and hidden.
+fn create_temp(dir: &Path, path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let prefix = format!(".{name}.");
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(".tmp");
+    // tempfile defaults to 0600; ask for 0666 so the umask decides, like File::create.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    b.tempfile_in(dir)
+}
+
+/// Best effort: make the rename itself durable. Not all platforms or
+/// filesystems allow syncing a directory, and the data is already safe.
+fn sync_dir(dir: &Path) {
+    #[cfg(unix)]
+    if let Ok(d) = std::fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    #[cfg(not(unix))]
+    let _ = dir;
+}

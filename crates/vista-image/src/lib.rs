@@ -1,0 +1,37 @@
+//! Image handling for vista.
+//!
+//! This crate owns the [`Image`] type (row-major f32 RGBA, `y = 0` is the top
+//! row), lossless-enough file I/O (16-bit PNG and f32 OpenEXR, always written
+//! atomically via [`atomic_write`]), comparison [`metrics`] (MSE, PSNR, SSIM,
+//! max abs error, bad-pixel and NaN counts), diff heat maps
+//! ([`diff_heatmap`]) and display tone mapping ([`tonemap`]).
+//!
+//! Not for: GPU work, kernels or golden-image bookkeeping; those live in the
+//! other vista crates and call into this one.
+//!
+//! ```
+//! use vista_image::{Image, metrics};
+//!
+//! let reference = Image::from_fn(16, 16, |x, y| [x as f32 / 16.0, y as f32 / 16.0, 0.5, 1.0]);
+//! let mut actual = reference.clone();
+//! actual.set(3, 4, [1.0, 0.0, 0.0, 1.0]);
+//! let m = metrics::compare(&reference, &actual)?;
+//! assert_eq!(m.bad_pixels, 1);
+//! assert!(m.psnr > 20.0 && m.ssim < 1.0);
+//! println!("PSNR {}", metrics::format_psnr(m.psnr));
+//! # Ok::<(), vista_image::ImageError>(())
+//! ```
+
+mod buffer;
+mod error;
+mod heatmap;
+mod io;
+pub mod metrics;
+mod ssim;
+mod tonemap;
+
+pub use buffer::Image;
+pub use error::ImageError;
+pub use heatmap::diff_heatmap;
+pub use io::{atomic_write, load, read_exr, read_png16, save, write_exr, write_png16};
+pub use tonemap::{srgb_encode, tonemap};

@@ -1,0 +1,266 @@
+//! Image comparison metrics.
+//!
+//! All metrics look at R, G and B only (alpha is excluded) and use the values
+//! as stored, accumulated in f64. They agree with scikit-image to well below
+//! 1e-3 (see `tests/skimage_agreement.rs`).
+//!
+//! # Non-finite values
+//! A channel pair whose f32 bit patterns are identical (including identical
+//! NaNs) counts as no difference, so bit-identical images always give
+//! `mse == 0` and `psnr == inf`. Any other pair whose difference is NaN or
+//! ±Inf counts as
+//! * an error of `+inf` for [`max_abs`] (the pixel is also a bad pixel), and
+//! * a squared error of `1.0` (a full-scale LDR error) for [`mse`]/[`psnr`],
+//!   so PSNR stays finite and meaningful instead of collapsing to NaN/-inf;
+//! * for [`ssim`], non-finite channels are replaced by 0 before the luma is
+//!   computed, so a few bad pixels lower SSIM locally instead of poisoning it.
+//!
+//! [`Metrics::nan`] reports how many pixels of the actual image are
+//! non-finite, so these substitutions never hide a problem.
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Image, ImageError, ssim as ssim_impl};
+
+/// A pixel is "bad" when any RGB channel differs by more than one 8-bit step.
+pub const BAD_PIXEL_THRESHOLD: f64 = 1.0 / 255.0;
+
+/// Every metric for one reference/actual pair.
+///
+/// Serialises non-finite floats (`psnr` of identical images is `+inf`) as the
+/// strings `"inf"`, `"-inf"` and `"nan"`, because JSON has no such numbers
+/// and serde_json would otherwise write `null` and fail to read it back.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq)]
+pub struct Metrics {
+    /// dB; `+inf` when the images are identical.
+    #[serde(with = "float_repr")]
+    pub psnr: f64,
+    #[serde(with = "float_repr")]
+    pub ssim: f64,
+    #[serde(with = "float_repr")]
+    pub max_abs: f64,
+    /// Pixels where any RGB channel differs by more than 1/255.
+    pub bad_pixels: u64,
+    /// Pixels of the actual image with a NaN/Inf in any channel (RGBA).
+    pub nan: u64,
+    #[serde(with = "float_repr")]
+    pub mse: f64,
+}
+
+/// All metrics with a PSNR peak of 1 (LDR data in `[0, 1]`).
+pub fn compare(reference: &Image, actual: &Image) -> Result<Metrics, ImageError> {
+    check_same_size(reference, actual)?;
+    Ok(all_metrics(reference, actual, 1.0))
+}
+
+/// All metrics for HDR data: PSNR uses peak = [`hdr_peak`] of the reference.
+/// SSIM is still computed on the raw values with dynamic range 1.
+pub fn compare_hdr(reference: &Image, actual: &Image) -> Result<Metrics, ImageError> {
+    check_same_size(reference, actual)?;
+    Ok(all_metrics(reference, actual, hdr_peak(reference)))
+}
+
+/// The largest finite RGB value of `reference`, or 1 when there is no
+/// positive finite value (an all-black reference would otherwise give peak 0).
+pub fn hdr_peak(reference: &Image) -> f64 {
+    let peak = rgb_values(reference)
+        .filter(|v| v.is_finite())
+        .fold(f64::NEG_INFINITY, f64::max);
+    if peak > 0.0 { peak } else { 1.0 }
+}
+
+/// Mean squared error over all pixels and the three RGB channels (0 for an
+/// empty image).
+///
+/// # Panics
+/// If the images differ in size; [`compare`] returns an error instead.
+pub fn mse(a: &Image, b: &Image) -> f64 {
+    assert_same_size(a, b);
+    let n = a.data.len() * 3;
+    if n == 0 {
+        return 0.0;
+    }
+    let sum: f64 = channel_pairs(a, b).map(|(x, y)| squared_error(x, y)).sum();
+    sum / n as f64
+}
+
+/// PSNR in dB with peak 1; `+inf` when the images are identical.
+///
+/// # Panics
+/// If the images differ in size.
+pub fn psnr(a: &Image, b: &Image) -> f64 {
+    psnr_with_peak(a, b, 1.0)
+}
+
+/// `10 log10(peak² / MSE)`; `+inf` when MSE is 0.
+///
+/// # Panics
+/// If the images differ in size.
+pub fn psnr_with_peak(a: &Image, b: &Image, peak: f64) -> f64 {
+    psnr_from_mse(mse(a, b), peak)
+}
+
+/// Mean SSIM of the Rec. 709 luma (`0.2126 R + 0.7152 G + 0.0722 B`) of both
+/// images: 11x11 Gaussian window (sigma 1.5), population statistics,
+/// dynamic range 1, averaged over pixels whose whole window is inside the
+/// image (a 5-pixel border is cropped), like scikit-image's
+/// `structural_similarity(gaussian_weights=True, sigma=1.5,
+/// use_sample_covariance=False, data_range=1.0)`.
+///
+/// Images smaller than 11 pixels in either direction (where scikit-image
+/// raises an error) use one global window with uniform weights instead; an
+/// empty image scores 1.
+///
+/// # Panics
+/// If the images differ in size.
+pub fn ssim(a: &Image, b: &Image) -> f64 {
+    assert_same_size(a, b);
+    let (w, h) = (a.width as usize, a.height as usize);
+    ssim_impl::ssim(&luma(a), &luma(b), w, h)
+}
+
+/// Largest absolute RGB difference; `+inf` if any differing pair is non-finite.
+///
+/// # Panics
+/// If the images differ in size.
+pub fn max_abs(a: &Image, b: &Image) -> f64 {
+    assert_same_size(a, b);
+    channel_pairs(a, b)
+        .map(|(x, y)| abs_diff(x, y))
+        .fold(0.0, f64::max)
+}
+
+/// Number of pixels where any RGB channel differs by more than 1/255
+/// (non-finite differences count as bad).
+///
+/// # Panics
+/// If the images differ in size.
+pub fn bad_pixels(a: &Image, b: &Image) -> u64 {
+    assert_same_size(a, b);
+    a.data
+        .iter()
+        .zip(&b.data)
+        .filter(|(p, q)| (0..3).any(|c| abs_diff(p[c], q[c]) > BAD_PIXEL_THRESHOLD))
+        .count() as u64
+}
+
+/// `"identical"` for `+inf`, otherwise e.g. `"42.13 dB"`.
+pub fn format_psnr(psnr: f64) -> String {
+    if psnr == f64::INFINITY {
+        "identical".to_string()
+    } else {
+        format!("{psnr:.2} dB")
+    }
+}
+
+fn all_metrics(reference: &Image, actual: &Image, peak: f64) -> Metrics {
+    let mse = mse(reference, actual);
+    Metrics {
+        psnr: psnr_from_mse(mse, peak),
+        ssim: ssim(reference, actual),
+        max_abs: max_abs(reference, actual),
+        bad_pixels: bad_pixels(reference, actual),
+        nan: actual.nonfinite_count(),
+        mse,
+    }
+}
+
+fn psnr_from_mse(mse: f64, peak: f64) -> f64 {
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (peak * peak / mse).log10()
+    }
+}
+
+/// `|a - b|` in f64; 0 for identical bit patterns, `+inf` when non-finite.
+fn abs_diff(a: f32, b: f32) -> f64 {
+    if a.to_bits() == b.to_bits() {
+        return 0.0;
+    }
+    let d = (f64::from(a) - f64::from(b)).abs();
+    if d.is_finite() { d } else { f64::INFINITY }
+}
+
+/// Squared error with a non-finite difference counted as a full-scale error.
+fn squared_error(a: f32, b: f32) -> f64 {
+    let d = abs_diff(a, b);
+    if d.is_finite() { d * d } else { 1.0 }
+}
+
+fn channel_pairs<'a>(a: &'a Image, b: &'a Image) -> impl Iterator<Item = (f32, f32)> + 'a {
+    a.data
+        .iter()
+        .zip(&b.data)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c], q[c])))
+}
+
+fn rgb_values(img: &Image) -> impl Iterator<Item = f64> + '_ {
+    img.data
+        .iter()
+        .flat_map(|p| p[..3].iter().map(|&v| f64::from(v)))
+}
+
+/// Rec. 709 luma with non-finite channels replaced by 0 (see module docs).
+fn luma(img: &Image) -> Vec<f64> {
+    let finite = |v: f32| if v.is_finite() { f64::from(v) } else { 0.0 };
+    img.data
+        .iter()
+        .map(|p| 0.2126 * finite(p[0]) + 0.7152 * finite(p[1]) + 0.0722 * finite(p[2]))
+        .collect()
+}
+
+fn check_same_size(reference: &Image, actual: &Image) -> Result<(), ImageError> {
+    if reference.dimensions() == actual.dimensions() {
+        Ok(())
+    } else {
+        Err(ImageError::SizeMismatch {
+            expected: reference.dimensions(),
+            actual: actual.dimensions(),
+        })
+    }
+}
+
+fn assert_same_size(a: &Image, b: &Image) {
+    if let Err(e) = check_same_size(a, b) {
+        panic!("{e}");
+    }
+}
+
+/// Serde adapter writing non-finite f64 as `"inf"` / `"-inf"` / `"nan"` and
+/// reading numbers, those strings, or `null` (as NaN).
+mod float_repr {
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_finite() {
+            s.serialize_f64(*v)
+        } else if v.is_nan() {
+            s.serialize_str("nan")
+        } else if *v > 0.0 {
+            s.serialize_str("inf")
+        } else {
+            s.serialize_str("-inf")
+        }
+    }
+
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Repr {
+        Num(f64),
+        Text(String),
+        Null(()),
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        match Repr::deserialize(d)? {
+            Repr::Num(v) => Ok(v),
+            Repr::Text(t) => t.parse::<f64>().map_err(|_| {
+                D::Error::custom(format!(
+                    "expected a number, \"inf\", \"-inf\" or \"nan\", got {t:?}"
+                ))
+            }),
+            Repr::Null(()) => Ok(f64::NAN),
+        }
+    }
+}

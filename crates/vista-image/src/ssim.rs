@@ -1,0 +1,146 @@
+//! SSIM on single-channel f64 images, matching scikit-image's
+//! `structural_similarity(gaussian_weights=True, sigma=1.5,
+//! use_sample_covariance=False, data_range=1.0)`.
+
+/// Gaussian sigma and the radius scipy derives from it (`int(3.5 * 1.5 + 0.5)`).
+const SIGMA: f64 = 1.5;
+const RADIUS: usize = 5;
+const WIN: usize = 2 * RADIUS + 1;
+/// Stabilisers for dynamic range L = 1: (0.01 L)^2 and (0.03 L)^2.
+const C1: f64 = 0.01 * 0.01;
+const C2: f64 = 0.03 * 0.03;
+
+/// Local moments under the window: E[x], E[y], E[x²], E[y²], E[xy].
+type Moments = [f64; 5];
+
+/// Mean SSIM of two `w x h` single-channel images.
+///
+/// The map is averaged over pixels whose whole 11x11 window lies inside the
+/// image (a 5-pixel border is cropped, exactly like scikit-image), so the
+/// border mode of the filter never matters. Images narrower or shorter than
+/// 11 pixels have no such pixel; they fall back to one global window with
+/// uniform weights over the whole image. An empty image scores 1.
+pub(crate) fn ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
+    debug_assert_eq!(x.len(), w * h);
+    debug_assert_eq!(y.len(), w * h);
+    if w >= WIN && h >= WIN {
+        windowed_ssim(x, y, w, h)
+    } else {
+        global_ssim(x, y)
+    }
+}
+
+/// Normalised 11-tap Gaussian, as `scipy.ndimage.gaussian_filter` builds it.
+fn gaussian_kernel() -> [f64; WIN] {
+    let mut k = [0.0; WIN];
+    for (i, v) in k.iter_mut().enumerate() {
+        let d = i as f64 - RADIUS as f64;
+        *v = (-0.5 * d * d / (SIGMA * SIGMA)).exp();
+    }
+    let sum: f64 = k.iter().sum();
+    k.map(|v| v / sum)
+}
+
+fn windowed_ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
+    let k = gaussian_kernel();
+    let filter = |plane: &[f64]| filter_valid(plane, w, h, &k);
+    let product =
+        |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(p, q)| p * q).collect() };
+    let mx = filter(x);
+    let my = filter(y);
+    let mxx = filter(&product(x, x));
+    let myy = filter(&product(y, y));
+    let mxy = filter(&product(x, y));
+    let total: f64 = (0..mx.len())
+        .map(|i| ssim_from_moments(&[mx[i], my[i], mxx[i], myy[i], mxy[i]]))
+        .sum();
+    total / mx.len() as f64
+}
+
+/// Separable Gaussian filter of a `w x h` plane, evaluated only where the
+/// whole window fits: returns `(w - 10) x (h - 10)` values. Both passes run
+/// over contiguous row slices so the inner loops stay simple and fast.
+fn filter_valid(src: &[f64], w: usize, h: usize, k: &[f64; WIN]) -> Vec<f64> {
+    let ow = w - 2 * RADIUS;
+    let oh = h - 2 * RADIUS;
+    let mut rows = vec![0.0; h * ow];
+    for (row, out) in src.chunks_exact(w).zip(rows.chunks_exact_mut(ow)) {
+        for (t, &kt) in k.iter().enumerate() {
+            for (o, &v) in out.iter_mut().zip(&row[t..t + ow]) {
+                *o += kt * v;
+            }
+        }
+    }
+    let mut out = vec![0.0; oh * ow];
+    for (r, dst) in out.chunks_exact_mut(ow).enumerate() {
+        for (t, &kt) in k.iter().enumerate() {
+            let src_row = &rows[(r + t) * ow..(r + t + 1) * ow];
+            for (o, &v) in dst.iter_mut().zip(src_row) {
+                *o += kt * v;
+            }
+        }
+    }
+    out
+}
+
+/// One window over the whole image with uniform weights.
+fn global_ssim(x: &[f64], y: &[f64]) -> f64 {
+    if x.is_empty() {
+        return 1.0;
+    }
+    let n = x.len() as f64;
+    let mut m = [0.0; 5];
+    for (&a, &b) in x.iter().zip(y) {
+        m[0] += a;
+        m[1] += b;
+        m[2] += a * a;
+        m[3] += b * b;
+        m[4] += a * b;
+    }
+    ssim_from_moments(&m.map(|v| v / n))
+}
+
+/// Wang et al. 2004 with population (biased) variances and covariance.
+fn ssim_from_moments(m: &Moments) -> f64 {
+    let [mx, my, mxx, myy, mxy] = *m;
+    let vx = mxx - mx * mx;
+    let vy = myy - my * my;
+    let vxy = mxy - mx * my;
+    let num = (2.0 * mx * my + C1) * (2.0 * vxy + C2);
+    let den = (mx * mx + my * my + C1) * (vx + vy + C2);
+    num / den
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kernel_is_normalised_and_symmetric() {
+        let k = gaussian_kernel();
+        assert!((k.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        for i in 0..RADIUS {
+            assert_eq!(k[i], k[WIN - 1 - i]);
+        }
+        // Centre tap of a sigma-1.5 Gaussian truncated at radius 5.
+        assert!((k[RADIUS] - 0.266_011_724).abs() < 1e-8, "{}", k[RADIUS]);
+    }
+
+    #[test]
+    fn identical_inputs_score_one() {
+        let x: Vec<f64> = (0..20 * 13)
+            .map(|i| (i as f64 * 0.37).sin() * 0.5 + 0.5)
+            .collect();
+        assert!((ssim(&x, &x, 20, 13) - 1.0).abs() < 1e-12);
+        assert!((ssim(&x[..50], &x[..50], 10, 5) - 1.0).abs() < 1e-12);
+        assert_eq!(ssim(&[], &[], 0, 0), 1.0);
+    }
+
+    #[test]
+    fn global_fallback_matches_formula() {
+        // x = [0, 1], y = [0, 0]: mx = 0.5, my = 0, vx = 0.25, vy = 0, vxy = 0.
+        let s = ssim(&[0.0, 1.0], &[0.0, 0.0], 2, 1);
+        let expected = (C1 * C2) / ((0.25 + C1) * (0.25 + C2));
+        assert!((s - expected).abs() < 1e-15, "{s} vs {expected}");
+    }
+}

@@ -1,0 +1,278 @@
+//! PNG16 / EXR round trips, error reporting and atomic writes.
+
+use std::path::Path;
+
+use vista_image::{
+    Image, ImageError, atomic_write, load, read_exr, read_png16, save, write_exr, write_png16,
+};
+
+fn tempdir() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn dir_entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+fn gradient(w: u32, h: u32) -> Image {
+    Image::from_fn(w, h, |x, y| {
+        let u = x as f32 / (w - 1) as f32;
+        let v = y as f32 / (h - 1) as f32;
+        [u, v, (u * 7.3 + v * 2.1).fract(), 1.0 - 0.5 * u]
+    })
+}
+
+#[test]
+fn png16_round_trip_within_half_a_step() {
+    let dir = tempdir();
+    let path = dir.path().join("g.png");
+    let img = gradient(37, 21);
+    write_png16(&path, &img).unwrap();
+    let back = read_png16(&path).unwrap();
+    assert_eq!(back.dimensions(), (37, 21));
+    for (p, q) in img.data.iter().zip(&back.data) {
+        for c in 0..4 {
+            let err = (p[c] - q[c]).abs();
+            assert!(
+                err <= 0.5 / 65535.0 + 1e-7,
+                "{} vs {} (err {err})",
+                p[c],
+                q[c]
+            );
+            // Read values sit exactly on the 16-bit grid.
+            let level = q[c] * 65535.0;
+            assert!((level - level.round()).abs() < 1e-3);
+        }
+    }
+    // Writing what was read reproduces the file byte for byte.
+    let again = dir.path().join("again.png");
+    write_png16(&again, &back).unwrap();
+    assert_eq!(
+        std::fs::read(&path).unwrap(),
+        std::fs::read(&again).unwrap()
+    );
+}
+
+#[test]
+fn png16_levels_are_exact_and_out_of_range_is_clamped() {
+    let dir = tempdir();
+    let path = dir.path().join("levels.png");
+    let levels = [0u16, 1, 2, 255, 256, 32767, 32768, 65534, 65535];
+    let mut img = Image::from_fn(levels.len() as u32, 2, |x, _| {
+        let v = f32::from(levels[x as usize]) / 65535.0;
+        [v, v, v, v]
+    });
+    img.set(0, 1, [-0.5, 2.0, f32::NAN, f32::INFINITY]);
+    img.set(1, 1, [f32::NEG_INFINITY, 1.0 + 1e-6, -0.0, 0.5]);
+    write_png16(&path, &img).unwrap();
+    let back = read_png16(&path).unwrap();
+    for (x, &l) in levels.iter().enumerate() {
+        let q = back.get(x as u32, 0).map(|v| (v * 65535.0).round() as u16);
+        assert_eq!(q, [l; 4]);
+    }
+    assert_eq!(back.get(0, 1), [0.0, 1.0, 0.0, 1.0]);
+    assert_eq!(back.get(1, 1)[..3], [0.0, 1.0, 0.0]);
+    assert_eq!((back.get(1, 1)[3] * 65535.0).round(), 32768.0); // round(0.5 * 65535)
+}
+
+#[test]
+fn reads_8_bit_rgb_and_grey_png() {
+    let dir = tempdir();
+    let rgb_path = dir.path().join("rgb8.png");
+    let rgb = image::RgbImage::from_fn(3, 2, |x, y| image::Rgb([x as u8 * 100, y as u8 * 255, 17]));
+    rgb.save(&rgb_path).unwrap();
+    let img = read_png16(&rgb_path).unwrap();
+    assert_eq!(img.dimensions(), (3, 2));
+    assert_eq!(img.get(2, 1), [200.0 / 255.0, 1.0, 17.0 / 255.0, 1.0]);
+    assert_eq!(img.get(0, 0), [0.0, 0.0, 17.0 / 255.0, 1.0]);
+
+    let grey_path = dir.path().join("grey8.png");
+    image::GrayImage::from_fn(2, 2, |x, _| image::Luma([x as u8 * 51]))
+        .save(&grey_path)
+        .unwrap();
+    let img = read_png16(&grey_path).unwrap();
+    assert_eq!(img.get(1, 0), [0.2, 0.2, 0.2, 1.0]);
+}
+
+#[test]
+fn exr_round_trip_is_bit_exact() {
+    let dir = tempdir();
+    let path = dir.path().join("hdr.exr");
+    let specials = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        -0.0,
+        -3.5,
+        1e30,
+        1e-40,                       // subnormal
+        f32::from_bits(0x7fc0_1234), // NaN with payload
+    ];
+    let img = Image::from_fn(19, 7, |x, y| {
+        let i = (x + 19 * y) as usize;
+        [
+            specials[i % specials.len()],
+            x as f32 * 0.1 - 0.7,
+            (y as f32).exp(),
+            1.0 / (1.0 + i as f32),
+        ]
+    });
+    write_exr(&path, &img).unwrap();
+    let back = read_exr(&path).unwrap();
+    assert!(back.bit_identical(&img));
+    assert_eq!(back.content_hash(), img.content_hash());
+}
+
+#[test]
+fn exr_without_alpha_reads_alpha_one() {
+    let dir = tempdir();
+    let path = dir.path().join("rgb.exr");
+    exr::prelude::write_rgb_file(&path, 4, 3, |x, y| (x as f32, y as f32, -1.0f32)).unwrap();
+    let img = read_exr(&path).unwrap();
+    assert_eq!(img.dimensions(), (4, 3));
+    assert_eq!(img.get(3, 2), [3.0, 2.0, -1.0, 1.0]);
+}
+
+#[test]
+fn corrupt_files_give_decode_errors_naming_the_path() {
+    let dir = tempdir();
+    let png = dir.path().join("corrupt.png");
+    std::fs::write(&png, b"definitely not a png").unwrap();
+    let err = read_png16(&png).unwrap_err();
+    assert!(
+        matches!(err, ImageError::Decode { format: "PNG", .. }),
+        "{err:?}"
+    );
+    let msg = err.to_string();
+    assert!(msg.contains(&png.display().to_string()), "{msg}");
+    assert!(msg.contains("is not a valid PNG"), "{msg}");
+
+    // A truncated but otherwise genuine PNG.
+    let good = dir.path().join("good.png");
+    write_png16(&good, &gradient(32, 32)).unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    let truncated = dir.path().join("truncated.png");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    assert!(matches!(
+        read_png16(&truncated),
+        Err(ImageError::Decode { .. })
+    ));
+
+    let exr = dir.path().join("corrupt.exr");
+    std::fs::write(&exr, b"\x76\x2f\x31\x01garbage").unwrap();
+    let err = read_exr(&exr).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains(&exr.display().to_string()) && msg.contains("is not a valid EXR"),
+        "{msg}"
+    );
+
+    // A PNG is not an EXR.
+    assert!(matches!(
+        read_exr(&good),
+        Err(ImageError::Decode { format: "EXR", .. })
+    ));
+}
+
+#[test]
+fn missing_file_is_an_io_error_naming_the_path() {
+    let dir = tempdir();
+    let path = dir.path().join("missing.png");
+    let err = read_png16(&path).unwrap_err();
+    match &err {
+        ImageError::Io { path: p, source } => {
+            assert_eq!(p, &path);
+            assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
+        }
+        other => panic!("expected Io, got {other:?}"),
+    }
+    assert!(err.to_string().contains("missing.png"));
+}
+
+#[test]
+fn save_and_load_dispatch_on_extension() {
+    let dir = tempdir();
+    let img = gradient(9, 5);
+    for name in ["a.png", "b.PNG", "c.exr", "d.Exr"] {
+        let path = dir.path().join(name);
+        save(&path, &img).unwrap();
+        let back = load(&path).unwrap();
+        assert_eq!(back.dimensions(), (9, 5));
+        if name.to_lowercase().ends_with(".exr") {
+            assert!(back.bit_identical(&img), "{name}");
+        }
+    }
+    // The PNG really is a PNG and the EXR an EXR.
+    assert!(read_png16(&dir.path().join("b.PNG")).is_ok());
+    assert!(read_exr(&dir.path().join("d.Exr")).is_ok());
+
+    for name in ["e.jpg", "noext"] {
+        let path = dir.path().join(name);
+        let err = save(&path, &img).unwrap_err();
+        assert!(matches!(err, ImageError::UnsupportedExtension { .. }));
+        let msg = err.to_string();
+        assert!(
+            msg.contains(name) && msg.contains(".png") && msg.contains(".exr"),
+            "{msg}"
+        );
+        assert!(matches!(
+            load(&path),
+            Err(ImageError::UnsupportedExtension { .. })
+        ));
+    }
+    assert!(!dir.path().join("e.jpg").exists());
+}
+
+#[test]
+fn atomic_write_replaces_content_and_leaves_no_temp_files() {
+    let dir = tempdir();
+    let path = dir.path().join("out.bin");
+    atomic_write(&path, b"first version, rather long").unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), b"first version, rather long");
+    atomic_write(&path, b"second").unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), b"second");
+    write_png16(&dir.path().join("img.png"), &gradient(4, 4)).unwrap();
+    write_exr(&dir.path().join("img.exr"), &gradient(4, 4)).unwrap();
+    assert_eq!(dir_entries(dir.path()), ["img.exr", "img.png", "out.bin"]);
+}
+
+#[test]
+fn atomic_write_failure_keeps_old_file_and_cleans_up() {
+    let dir = tempdir();
+    // Target is a non-empty directory: the final rename must fail.
+    let target = dir.path().join("occupied");
+    std::fs::create_dir(&target).unwrap();
+    std::fs::write(target.join("keep"), b"x").unwrap();
+    let err = atomic_write(&target, b"data").unwrap_err();
+    assert!(matches!(err, ImageError::Io { .. }), "{err:?}");
+    assert!(err.to_string().contains("occupied"));
+    assert_eq!(dir_entries(dir.path()), ["occupied"]);
+    assert_eq!(dir_entries(&target), ["keep"]);
+
+    // Missing parent directory.
+    let nowhere = dir.path().join("no/such/dir/x.png");
+    let err = write_png16(&nowhere, &gradient(2, 2)).unwrap_err();
+    assert!(matches!(err, ImageError::Io { .. }));
+    assert!(err.to_string().contains("x.png"));
+}
+
+#[test]
+fn encoding_an_empty_image_is_an_error_not_a_panic() {
+    let dir = tempdir();
+    let path = dir.path().join("empty.png");
+    let err = write_png16(&path, &Image::new(0, 0)).unwrap_err();
+    assert!(matches!(err, ImageError::Encode { .. }), "{err:?}");
+    assert!(!path.exists());
+    let exr = dir.path().join("empty.exr");
+    let err = write_exr(&exr, &Image::new(0, 3)).unwrap_err();
+    assert!(
+        matches!(err, ImageError::Encode { format: "EXR", .. }),
+        "{err:?}"
+    );
+    assert!(dir_entries(dir.path()).is_empty());
+}

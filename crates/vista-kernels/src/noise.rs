@@ -1,0 +1,325 @@
+//! f64 CPU reference of the noise bases (SPEC 3.1) and the fBm / ridged sums
+//! built on them (SPEC 3.2, 3.3). Written from the published algorithms, not
+//! from the WGSL: the GPU side is checked against these.
+
+use rand::seq::SliceRandom;
+
+/// Ken Perlin's reference permutation (Improved Noise, 2002).
+pub const PERLIN_PERMUTATION: [u8; 256] = [
+    151, 160, 137, 91, 90, 15, 131, 13, 201, 95, 96, 53, 194, 233, 7, 225, 140, 36, 103, 30, 69, 142, 8, 99, 37,
+    240, 21, 10, 23, 190, 6, 148, 247, 120, 234, 75, 0, 26, 197, 62, 94, 252, 219, 203, 117, 35, 11, 32, 57, 177,
+    33, 88, 237, 149, 56, 87, 174, 20, 125, 136, 171, 168, 68, 175, 74, 165, 71, 134, 139, 48, 27, 166, 77, 146,
+    158, 231, 83, 111, 229, 122, 60, 211, 133, 230, 220, 105, 92, 41, 55, 46, 245, 40, 244, 102, 143, 54, 65, 25,
+    63, 161, 1, 216, 80, 73, 209, 76, 132, 187, 208, 89, 18, 169, 200, 196, 135, 130, 116, 188, 159, 86, 164, 100,
+    109, 198, 173, 186, 3, 64, 52, 217, 226, 250, 124, 123, 5, 202, 38, 147, 118, 126, 255, 82, 85, 212, 207, 206,
+    59, 227, 47, 16, 58, 17, 182, 189, 28, 42, 223, 183, 170, 213, 119, 248, 152, 2, 44, 154, 163, 70, 221, 153,
+    101, 155, 167, 43, 172, 9, 129, 22, 39, 253, 19, 98, 108, 110, 79, 113, 224, 232, 178, 185, 112, 104, 218,
+    246, 97, 228, 251, 34, 242, 193, 238, 210, 144, 12, 191, 179, 162, 241, 81, 51, 145, 235, 249, 14, 239, 107,
+    49, 192, 214, 31, 181, 199, 106, 157, 184, 84, 204, 176, 115, 121, 50, 45, 127, 4, 150, 254, 138, 236, 205,
+    93, 222, 114, 67, 29, 24, 72, 243, 141, 128, 195, 78, 66, 215, 61, 156, 180,
+];
+
+/// PCG32 stream selector used for seeded permutations (pcg_basic's default).
+const PCG_STREAM: u64 = 0xda3e_39cb_94b9_5bdb;
+
+/// The 512-entry permutation table for `seed`: Perlin's own for seed 0,
+/// otherwise a Fisher-Yates shuffle of 0..255 driven by PCG32(seed),
+/// duplicated so `p[i + 1]` never needs a wrap.
+pub fn permutation(seed: u32) -> Vec<u32> {
+    let mut base: Vec<u32> = if seed == 0 {
+        PERLIN_PERMUTATION.iter().map(|&v| v as u32).collect()
+    } else {
+        let mut rng = rand_pcg::Pcg32::new(seed as u64, PCG_STREAM);
+        let mut p: Vec<u32> = (0..256).collect();
+        p.shuffle(&mut rng);
+        p
+    };
+    base.extend_from_within(..);
+    base
+}
+
+fn fade(t: f64) -> f64 {
+    t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
+}
+
+fn lerp(t: f64, a: f64, b: f64) -> f64 {
+    a + t * (b - a)
+}
+
+/// Dot product with one of the 12 cube-edge gradients chosen by `hash & 15`.
+fn grad(hash: u32, x: f64, y: f64, z: f64) -> f64 {
+    let h = hash & 15;
+    let u = if h < 8 { x } else { y };
+    let v = if h < 4 {
+        y
+    } else if h == 12 || h == 14 {
+        x
+    } else {
+        z
+    };
+    (if h & 1 == 0 { u } else { -u }) + (if h & 2 == 0 { v } else { -v })
+}
+
+/// Improved Perlin noise at (x, y, z) with permutation table `p` (512 entries).
+pub fn perlin(p: &[u32], x: f64, y: f64, z: f64) -> f64 {
+    let (fx, fy, fz) = (x.floor(), y.floor(), z.floor());
+    let xi = (fx as i64 & 255) as usize;
+    let yi = (fy as i64 & 255) as usize;
+    let zi = (fz as i64 & 255) as usize;
+    let (x, y, z) = (x - fx, y - fy, z - fz);
+    let (u, v, w) = (fade(x), fade(y), fade(z));
+    let a = p[xi] as usize + yi;
+    let aa = p[a] as usize + zi;
+    let ab = p[a + 1] as usize + zi;
+    let b = p[xi + 1] as usize + yi;
+    let ba = p[b] as usize + zi;
+    let bb = p[b + 1] as usize + zi;
+    lerp(
+        w,
+        lerp(
+            v,
+            lerp(u, grad(p[aa], x, y, z), grad(p[ba], x - 1.0, y, z)),
+            lerp(u, grad(p[ab], x, y - 1.0, z), grad(p[bb], x - 1.0, y - 1.0, z)),
+        ),
+        lerp(
+            v,
+            lerp(u, grad(p[aa + 1], x, y, z - 1.0), grad(p[ba + 1], x - 1.0, y, z - 1.0)),
+            lerp(u, grad(p[ab + 1], x, y - 1.0, z - 1.0), grad(p[bb + 1], x - 1.0, y - 1.0, z - 1.0)),
+        ),
+    )
+}
+
+/// pcg3d (Jarzynski & Olano 2020): a 3D -> 3D integer hash, wrapping u32 math.
+pub fn pcg3d(v: [u32; 3]) -> [u32; 3] {
+    let mut v = v.map(|c| c.wrapping_mul(1_664_525).wrapping_add(1_013_904_223));
+    v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[2]));
+    v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
+    v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
+    v = v.map(|c| c ^ (c >> 16));
+    v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[2]));
+    v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
+    v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
+    v
+}
+
+/// Seed mixing for value noise: the seed is folded into z by a Weyl step so
+/// that seeds give unrelated lattices while seed 0 is the plain hash.
+pub fn value_seed_offset(seed: u32) -> u32 {
+    seed.wrapping_mul(0x9E37_79B9)
+}
+
+/// Hash of one lattice point, as u32 (component x of pcg3d).
+pub fn lattice_hash(seed: u32, i: i32, j: i32, k: i32) -> u32 {
+    pcg3d([i as u32, j as u32, (k as u32).wrapping_add(value_seed_offset(seed))])[0]
+}
+
+/// Lattice value in [-1, 1): (h >> 8) * 2^-24 mapped from [0, 1).
+pub fn lattice_value(seed: u32, i: i32, j: i32, k: i32) -> f64 {
+    let unit = (lattice_hash(seed, i, j, k) >> 8) as f64 * (1.0 / 16_777_216.0);
+    2.0 * unit - 1.0
+}
+
+/// Value noise: quintic-faded trilinear interpolation of lattice values.
+pub fn value(seed: u32, x: f64, y: f64, z: f64) -> f64 {
+    let (fx, fy, fz) = (x.floor(), y.floor(), z.floor());
+    let (i, j, k) = (fx as i32, fy as i32, fz as i32);
+    let (u, v, w) = (fade(x - fx), fade(y - fy), fade(z - fz));
+    let c = |di: i32, dj: i32, dk: i32| lattice_value(seed, i.wrapping_add(di), j.wrapping_add(dj), k.wrapping_add(dk));
+    lerp(
+        w,
+        lerp(v, lerp(u, c(0, 0, 0), c(1, 0, 0)), lerp(u, c(0, 1, 0), c(1, 1, 0))),
+        lerp(v, lerp(u, c(0, 0, 1), c(1, 0, 1)), lerp(u, c(0, 1, 1), c(1, 1, 1))),
+    )
+}
+
+/// The noise basis N of SPEC 3.1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Basis {
+    Perlin,
+    Value,
+}
+
+pub const BASIS_NAMES: &[&str] = &["perlin", "value"];
+
+impl Basis {
+    pub fn from_name(name: &str) -> Basis {
+        match name {
+            "value" => Basis::Value,
+            _ => Basis::Perlin,
+        }
+    }
+}
+
+/// A seeded basis ready to evaluate: owns its permutation table.
+#[derive(Debug, Clone)]
+pub struct Noise {
+    pub basis: Basis,
+    pub seed: u32,
+    perm: Vec<u32>,
+}
+
+impl Noise {
+    pub fn new(basis: Basis, seed: u32) -> Noise {
+        Noise { basis, seed, perm: permutation(seed) }
+    }
+
+    pub fn eval(&self, x: f64, y: f64, z: f64) -> f64 {
+        match self.basis {
+            Basis::Perlin => perlin(&self.perm, x, y, z),
+            Basis::Value => value(self.seed, x, y, z),
+        }
+    }
+
+    /// Upper bound of |N| used for amplitude invariants and normalisation.
+    /// Improved Perlin noise never exceeds 1 in magnitude for these gradients
+    /// (its true bound is about 0.97); value noise interpolates values in [-1, 1).
+    pub fn max_abs(&self) -> f64 {
+        1.0
+    }
+}
+
+/// fBm octave parameters (SPEC 3.2).
+#[derive(Debug, Clone, Copy)]
+pub struct Fbm {
+    pub octaves: u32,
+    pub lacunarity: f64,
+    pub gain: f64,
+    /// Octave rotation angle in radians.
+    pub theta: f64,
+}
+
+impl Fbm {
+    /// A = sum_{i < octaves} gain^i.
+    pub fn amplitude_sum(&self) -> f64 {
+        (0..self.octaves).map(|i| self.gain.powi(i as i32)).sum()
+    }
+
+    /// f(p) = sum gain^i N(p_i), p_{i+1} = lacunarity R(theta) p_i, at height z.
+    pub fn eval(&self, n: &Noise, p: [f64; 2], z: f64) -> f64 {
+        let (s, c) = self.theta.sin_cos();
+        let (mut x, mut y) = (p[0], p[1]);
+        let mut amp = 1.0;
+        let mut sum = 0.0;
+        for _ in 0..self.octaves {
+            sum += amp * n.eval(x, y, z);
+            amp *= self.gain;
+            (x, y) = (self.lacunarity * (c * x - s * y), self.lacunarity * (s * x + c * y));
+        }
+        sum
+    }
+
+    /// Three-dimensional fBm (clouds): p_{i+1} = lacunarity * p_i.
+    pub fn eval3(&self, n: &Noise, p: [f64; 3]) -> f64 {
+        let mut q = p;
+        let mut amp = 1.0;
+        let mut sum = 0.0;
+        for _ in 0..self.octaves {
+            sum += amp * n.eval(q[0], q[1], q[2]);
+            amp *= self.gain;
+            q = q.map(|c| c * self.lacunarity);
+        }
+        sum
+    }
+}
+
+/// Musgrave's ridged multifractal parameters (SPEC 3.3).
+#[derive(Debug, Clone, Copy)]
+pub struct Ridged {
+    pub octaves: u32,
+    pub lacunarity: f64,
+    pub h: f64,
+    pub offset: f64,
+    pub gain: f64,
+}
+
+impl Ridged {
+    /// w_i = lacunarity^(-i H).
+    pub fn weight(&self, i: u32) -> f64 {
+        self.lacunarity.powf(-(i as f64) * self.h)
+    }
+
+    /// Analytic maximum offset^2 * sum w_i: each term's signal is at most
+    /// offset^2 (N = 0) and its weight at most 1.
+    pub fn max_value(&self) -> f64 {
+        self.offset * self.offset * (0..self.octaves).map(|i| self.weight(i)).sum::<f64>()
+    }
+
+    /// Raw ridged value (not normalised).
+    pub fn eval(&self, n: &Noise, p: [f64; 2], z: f64) -> f64 {
+        let (mut x, mut y) = (p[0], p[1]);
+        let mut signal = self.offset - n.eval(x, y, z).abs();
+        signal *= signal;
+        let mut result = signal;
+        for i in 1..self.octaves {
+            x *= self.lacunarity;
+            y *= self.lacunarity;
+            let weight = (signal * self.gain).clamp(0.0, 1.0);
+            let s = self.offset - n.eval(x, y, z).abs();
+            signal = s * s * weight;
+            result += signal * self.weight(i);
+        }
+        result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn perlin_reference_value() {
+        // SPEC 3.1: the value printed by Perlin's Java reference implementation.
+        let p = permutation(0);
+        let v = perlin(&p, 3.14, 42.0, 7.0);
+        assert!((v - 0.136_919_958_784_000_12).abs() < 1e-15, "perlin(3.14, 42, 7) = {v}");
+    }
+
+    #[test]
+    fn perlin_is_zero_on_the_lattice() {
+        for seed in [0, 1, 99] {
+            let n = Noise::new(Basis::Perlin, seed);
+            for (x, y, z) in [(0, 0, 0), (3, -7, 11), (255, 256, -1000)] {
+                assert_eq!(n.eval(x as f64, y as f64, z as f64), 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn seeded_permutation_is_a_permutation_and_differs() {
+        for seed in [1, 2, 12345] {
+            let p = permutation(seed);
+            let mut sorted = p[..256].to_vec();
+            sorted.sort();
+            assert_eq!(sorted, (0..256).collect::<Vec<_>>());
+            assert_eq!(p[..256], p[256..]);
+            assert_ne!(p, permutation(0));
+        }
+        assert_ne!(permutation(1), permutation(2));
+    }
+
+    #[test]
+    fn value_noise_equals_remapped_hash_on_lattice() {
+        for (i, j, k) in [(0, 0, 0), (5, -3, 2), (-100, 77, 9)] {
+            let want = ((lattice_hash(7, i, j, k) >> 8) as f64) / 16_777_216.0 * 2.0 - 1.0;
+            assert_eq!(value(7, i as f64, j as f64, k as f64), want);
+        }
+    }
+
+    #[test]
+    fn pcg3d_known_vector() {
+        // pcg3d(0,0,0): every lane starts at 1013904223; computed by hand-run
+        // of the published recurrence in wrapping u32 arithmetic.
+        let v = pcg3d([0, 0, 0]);
+        let mut w = [1_013_904_223u32; 3];
+        w[0] = w[0].wrapping_add(w[1].wrapping_mul(w[2]));
+        w[1] = w[1].wrapping_add(w[2].wrapping_mul(w[0]));
+        w[2] = w[2].wrapping_add(w[0].wrapping_mul(w[1]));
+        let w = w.map(|c| c ^ (c >> 16));
+        let mut x = w;
+        x[0] = x[0].wrapping_add(x[1].wrapping_mul(x[2]));
+        x[1] = x[1].wrapping_add(x[2].wrapping_mul(x[0]));
+        x[2] = x[2].wrapping_add(x[0].wrapping_mul(x[1]));
+        assert_eq!(v, x);
+        assert_ne!(v, [0, 0, 0]);
+    }
+}

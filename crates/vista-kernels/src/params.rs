@@ -1,0 +1,256 @@
+//! Named, typed, range-checked kernel parameters.
+//!
+//! Every kernel declares its parameters as data (`ParamSpec`): name, kind with
+//! its allowed range, default and a one-line doc. `vista list`, `--set`,
+//! presets, golden cases and the manifest's params hash all go through this
+//! one table, so a value is validated the same way wherever it comes from.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use crate::ParamError;
+
+/// The kind of a parameter and its allowed range (inclusive unless noted).
+#[derive(Debug, Clone, Copy)]
+pub enum Kind {
+    /// A real number in `[min, max]`, or `(min, max]` when `open_min`.
+    Float { min: f64, max: f64, open_min: bool },
+    /// An integer in `[min, max]`.
+    Int { min: i64, max: i64 },
+    /// `n` comma-separated reals, each in `[min, max]`.
+    Vector { n: usize, min: f64, max: f64 },
+    /// One name out of a fixed list.
+    Enum(&'static [&'static str]),
+}
+
+impl Kind {
+    pub const fn float(min: f64, max: f64) -> Kind {
+        Kind::Float { min, max, open_min: false }
+    }
+    pub const fn float_open(min: f64, max: f64) -> Kind {
+        Kind::Float { min, max, open_min: true }
+    }
+    pub const fn int(min: i64, max: i64) -> Kind {
+        Kind::Int { min, max }
+    }
+
+    /// The allowed range as users read it in errors and in `vista list`.
+    pub fn range_text(&self) -> String {
+        match *self {
+            Kind::Float { min, max, open_min } => {
+                format!("{}{min}, {max}]", if open_min { "(" } else { "[" })
+            }
+            Kind::Int { min, max } => format!("integer in [{min}, {max}]"),
+            Kind::Vector { n, min, max } => format!("{n} comma-separated numbers each in [{min}, {max}]"),
+            Kind::Enum(names) => format!("one of {}", names.join("|")),
+        }
+    }
+}
+
+/// One declared parameter.
+#[derive(Debug, Clone, Copy)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub kind: Kind,
+    pub default: &'static str,
+    pub doc: &'static str,
+}
+
+impl ParamSpec {
+    pub const fn new(name: &'static str, kind: Kind, default: &'static str, doc: &'static str) -> Self {
+        ParamSpec { name, kind, default, doc }
+    }
+}
+
+/// A named set of overrides on top of the defaults.
+#[derive(Debug, Clone, Copy)]
+pub struct Preset {
+    pub name: &'static str,
+    pub doc: &'static str,
+    pub set: &'static [(&'static str, &'static str)],
+}
+
+/// A parsed, validated parameter value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    Float(f64),
+    Int(i64),
+    Vector(Vec<f64>),
+    Enum(&'static str),
+}
+
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Value::Float(v) => write!(f, "{v}"),
+            Value::Int(v) => write!(f, "{v}"),
+            Value::Vector(v) => {
+                f.write_str(&v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","))
+            }
+            Value::Enum(s) => f.write_str(s),
+        }
+    }
+}
+
+/// Parses `text` as a value of `spec`, checking its range.
+pub fn parse_value(spec: &ParamSpec, text: &str) -> Result<Value, ParamError> {
+    let t = text.trim();
+    let bad = |expected: String| ParamError::BadValue {
+        param: spec.name.to_string(),
+        value: text.to_string(),
+        expected,
+    };
+    let out_of_range = || ParamError::OutOfRange {
+        param: spec.name.to_string(),
+        value: text.to_string(),
+        range: spec.kind.range_text(),
+    };
+    let real = |s: &str| -> Result<f64, ParamError> {
+        let v: f64 = s.trim().parse().map_err(|_| bad(format!("a number, {}", spec.kind.range_text())))?;
+        if v.is_finite() { Ok(v) } else { Err(bad(format!("a finite number, {}", spec.kind.range_text()))) }
+    };
+    match spec.kind {
+        Kind::Float { min, max, open_min } => {
+            let v = real(t)?;
+            let low_ok = if open_min { v > min } else { v >= min };
+            if low_ok && v <= max { Ok(Value::Float(v)) } else { Err(out_of_range()) }
+        }
+        Kind::Int { min, max } => {
+            let v: i64 = t.parse().map_err(|_| bad(spec.kind.range_text()))?;
+            if (min..=max).contains(&v) { Ok(Value::Int(v)) } else { Err(out_of_range()) }
+        }
+        Kind::Vector { n, min, max } => {
+            let parts: Vec<&str> = t.split(',').collect();
+            if parts.len() != n {
+                return Err(bad(spec.kind.range_text()));
+            }
+            let v = parts.into_iter().map(real).collect::<Result<Vec<f64>, _>>()?;
+            if v.iter().all(|c| (min..=max).contains(c)) { Ok(Value::Vector(v)) } else { Err(out_of_range()) }
+        }
+        Kind::Enum(names) => names
+            .iter()
+            .find(|n| n.eq_ignore_ascii_case(t))
+            .map(|n| Value::Enum(n))
+            .ok_or_else(|| bad(spec.kind.range_text())),
+    }
+}
+
+/// A complete, validated assignment of every parameter of one kernel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamSet {
+    kernel: &'static str,
+    values: BTreeMap<&'static str, Value>,
+}
+
+impl ParamSet {
+    /// Defaults, then the preset's overrides, then `overrides` (later wins).
+    pub fn resolve(
+        kernel: &'static str,
+        specs: &'static [ParamSpec],
+        presets: &'static [Preset],
+        preset: Option<&str>,
+        overrides: &[(String, String)],
+    ) -> Result<ParamSet, ParamError> {
+        let mut set = ParamSet { kernel, values: BTreeMap::new() };
+        for spec in specs {
+            let v = parse_value(spec, spec.default)
+                .unwrap_or_else(|e| panic!("kernel {kernel}: default of {} is invalid: {e}", spec.name));
+            set.values.insert(spec.name, v);
+        }
+        if let Some(name) = preset {
+            let p = presets.iter().find(|p| p.name == name).ok_or_else(|| ParamError::UnknownPreset {
+                kernel: kernel.to_string(),
+                name: name.to_string(),
+                valid: presets.iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
+            })?;
+            for (k, v) in p.set {
+                set.apply(specs, k, v)?;
+            }
+        }
+        for (k, v) in overrides {
+            set.apply(specs, k, v)?;
+        }
+        Ok(set)
+    }
+
+    fn apply(&mut self, specs: &'static [ParamSpec], name: &str, text: &str) -> Result<(), ParamError> {
+        let spec = specs.iter().find(|s| s.name == name).ok_or_else(|| ParamError::UnknownParam {
+            kernel: self.kernel.to_string(),
+            name: name.to_string(),
+            valid: specs.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
+        })?;
+        self.values.insert(spec.name, parse_value(spec, text)?);
+        Ok(())
+    }
+
+    pub fn kernel(&self) -> &'static str {
+        self.kernel
+    }
+
+    fn get(&self, name: &str) -> &Value {
+        self.values
+            .get(name)
+            .unwrap_or_else(|| panic!("kernel {} has no parameter {name}", self.kernel))
+    }
+
+    pub fn f64(&self, name: &str) -> f64 {
+        match self.get(name) {
+            Value::Float(v) => *v,
+            Value::Int(v) => *v as f64,
+            v => panic!("{}.{name} is {v:?}, not a number", self.kernel),
+        }
+    }
+    pub fn f32(&self, name: &str) -> f32 {
+        self.f64(name) as f32
+    }
+    pub fn int(&self, name: &str) -> i64 {
+        match self.get(name) {
+            Value::Int(v) => *v,
+            v => panic!("{}.{name} is {v:?}, not an integer", self.kernel),
+        }
+    }
+    pub fn u32(&self, name: &str) -> u32 {
+        self.int(name) as u32
+    }
+    pub fn vector(&self, name: &str) -> &[f64] {
+        match self.get(name) {
+            Value::Vector(v) => v,
+            v => panic!("{}.{name} is {v:?}, not a vector", self.kernel),
+        }
+    }
+    pub fn vec3(&self, name: &str) -> [f64; 3] {
+        let v = self.vector(name);
+        [v[0], v[1], v[2]]
+    }
+    pub fn vec2(&self, name: &str) -> [f64; 2] {
+        let v = self.vector(name);
+        [v[0], v[1]]
+    }
+    pub fn choice(&self, name: &str) -> &'static str {
+        match self.get(name) {
+            Value::Enum(s) => s,
+            v => panic!("{}.{name} is {v:?}, not an enum", self.kernel),
+        }
+    }
+    /// Index of an enum value in its declared list (what the WGSL side sees).
+    pub fn choice_index(&self, name: &str, names: &[&str]) -> u32 {
+        let c = self.choice(name);
+        names.iter().position(|n| *n == c).expect("validated enum value") as u32
+    }
+
+    /// Sets one value by text (validated), for sweeps and tests.
+    pub fn with(mut self, specs: &'static [ParamSpec], name: &str, text: &str) -> Result<ParamSet, ParamError> {
+        self.apply(specs, name, text)?;
+        Ok(self)
+    }
+
+    /// `name=value` pairs sorted by name: the canonical text that is hashed
+    /// into the golden manifest.
+    pub fn canonical(&self) -> String {
+        self.values.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";")
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = (&'static str, &Value)> {
+        self.values.iter().map(|(k, v)| (*k, v))
+    }
+}

@@ -1,0 +1,36 @@
+// fbm kernel (SPEC 3.2): R = G = B = 0.5 + 0.5 f / A, alpha = 1.
+#import vista::fractal::{FbmSettings, fbm2}
+
+struct Params {
+    width: u32,
+    height: u32,
+    basis: u32,
+    octaves: u32,
+    seed: u32,
+    lacunarity: f32,
+    gain: f32,
+    frequency: f32,
+    offset_x: f32,
+    offset_y: f32,
+    rot_cos: f32,
+    rot_sin: f32,
+    z_slice: f32,
+    inv_amplitude: f32,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(f32(params.width), f32(params.height));
+    let settings = FbmSettings(params.basis, params.seed, params.octaves, params.lacunarity,
+                               params.gain, params.rot_cos, params.rot_sin);
+    let p0 = params.frequency * uv + vec2(params.offset_x, params.offset_y);
+    let f = fbm2(settings, p0, params.z_slice);
+    let value = 0.5 + 0.5 * f * params.inv_amplitude;
+    textureStore(output, id.xy, vec4(value, value, value, 1.0));
+}

@@ -1,0 +1,68 @@
+// Fractal sums over a basis: fBm (SPEC 3.2), ridged multifractal (SPEC 3.3), 3D fBm (clouds).
+#define_import_path vista::fractal
+
+#import vista::noise::basis_noise
+
+struct FbmSettings {
+    basis: u32,
+    seed: u32,
+    octaves: u32,
+    lacunarity: f32,
+    gain: f32,
+    rot_cos: f32,
+    rot_sin: f32,
+}
+
+// f(p) = sum_i gain^i N(p_i, z), p_{i+1} = lacunarity * R(theta) * p_i.
+fn fbm2(s: FbmSettings, p0: vec2<f32>, z: f32) -> f32 {
+    let rot = mat2x2<f32>(s.rot_cos, s.rot_sin, -s.rot_sin, s.rot_cos);
+    var p = p0;
+    var amplitude = 1.0;
+    var sum = 0.0;
+    for (var i = 0u; i < s.octaves; i++) {
+        sum += amplitude * basis_noise(s.basis, s.seed, vec3(p, z));
+        amplitude *= s.gain;
+        p = s.lacunarity * (rot * p);
+    }
+    return sum;
+}
+
+struct RidgedSettings {
+    basis: u32,
+    seed: u32,
+    octaves: u32,
+    lacunarity: f32,
+    h: f32,
+    offset: f32,
+    gain: f32,
+}
+
+// Musgrave: each octave's squared ridge signal is weighted by the previous
+// signal (clamped feedback) and by lacunarity^(-i H).
+fn ridged2(s: RidgedSettings, p0: vec2<f32>, z: f32) -> f32 {
+    var p = p0;
+    var signal = s.offset - abs(basis_noise(s.basis, s.seed, vec3(p, z)));
+    signal *= signal;
+    var result = signal;
+    for (var i = 1u; i < s.octaves; i++) {
+        p *= s.lacunarity;
+        let weight = clamp(signal * s.gain, 0.0, 1.0);
+        let ridge = s.offset - abs(basis_noise(s.basis, s.seed, vec3(p, z)));
+        signal = ridge * ridge * weight;
+        result += signal * pow(s.lacunarity, -f32(i) * s.h);
+    }
+    return result;
+}
+
+// 3D fBm without rotation: sum_i gain^i N(lacunarity^i p).
+fn fbm3(s: FbmSettings, p0: vec3<f32>) -> f32 {
+    var p = p0;
+    var amplitude = 1.0;
+    var sum = 0.0;
+    for (var i = 0u; i < s.octaves; i++) {
+        sum += amplitude * basis_noise(s.basis, s.seed, p);
+        amplitude *= s.gain;
+        p *= s.lacunarity;
+    }
+    return sum;
+}

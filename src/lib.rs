@@ -1,0 +1,9 @@
+//! vista: headless GPU compute validation for procedural WGSL kernels.
+//!
+//! This root package re-exports the workspace crates; its `tests/` hold the
+//! golden harness and the kernel test suites, `benches/` the benchmarks.
+
+pub use vista_golden as golden;
+pub use vista_gpu as gpu;
+pub use vista_image as image;
+pub use vista_kernels as kernels;

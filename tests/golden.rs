@@ -1,0 +1,58 @@
+//! Golden harness: every case in `golden/cases.toml` is its own named test
+//! (libtest-mimic), so `cargo test fbm` and nextest filter and shard them.
+//! After the run it writes `target/vista-report/index.html`.
+
+use std::sync::{Arc, Mutex};
+
+use libtest_mimic::{Arguments, Failed, Trial};
+use vista_golden::{CheckOptions, Store, allow_no_gpu, default_report_dir};
+use vista_gpu::Context;
+
+fn main() {
+    let args = Arguments::from_args();
+    let store = Store::open_default();
+    let cases = store.load_cases().unwrap_or_else(|e| panic!("cannot load golden cases: {e}"));
+    let manifest = Arc::new(store.manifest().unwrap_or_else(|e| panic!("cannot load manifest: {e}")));
+    let report_dir = default_report_dir();
+    let outcomes = Arc::new(Mutex::new(Vec::new()));
+
+    // Listing must work without a device (nextest lists before it runs).
+    let gpu = if args.list { None } else { Some(Context::shared()) };
+    let no_gpu = matches!(&gpu, Some(Err(_)));
+    if no_gpu {
+        let e = gpu.as_ref().and_then(|g| g.as_ref().err()).expect("error");
+        if allow_no_gpu() {
+            eprintln!("\n!!! VISTA_ALLOW_NO_GPU=1 and no adapter: {e}");
+            eprintln!("!!! SKIPPING all {} golden cases: {}\n", cases.len(), cases.iter().map(|c| c.id.as_str()).collect::<Vec<_>>().join(", "));
+        }
+    }
+
+    let trials: Vec<Trial> = cases
+        .iter()
+        .map(|case| {
+            let (case, store, manifest, outcomes, report_dir) =
+                (case.clone(), store.clone(), manifest.clone(), outcomes.clone(), report_dir.clone());
+            let name = format!("golden::{}::{}", case.kernel.name(), case.id);
+            Trial::test(name, move || {
+                let ctx = Context::shared().map_err(|e| Failed::from(format!("no GPU adapter: {e}")))?;
+                let opts = CheckOptions { report_dir: report_dir.clone(), twice: true };
+                let o = vista_golden::check_case(ctx, &store, &manifest, &case, &opts);
+                let result = if o.passed() { Ok(()) } else { Err(Failed::from(o.explain(&report_dir))) };
+                outcomes.lock().expect("outcomes").push(o);
+                result
+            })
+            .with_ignored_flag(no_gpu && allow_no_gpu())
+        })
+        .collect();
+
+    let conclusion = libtest_mimic::run(&args, trials);
+    let outcomes = outcomes.lock().expect("outcomes");
+    if !outcomes.is_empty() {
+        let adapter = Context::shared().map(|c| c.adapter_description()).unwrap_or_default();
+        match vista_golden::write_report(&report_dir, &adapter, &outcomes) {
+            Ok(index) => eprintln!("vista report: {}", index.display()),
+            Err(e) => eprintln!("could not write the vista report: {e}"),
+        }
+    }
+    conclusion.exit();
+}
