@@ -24,7 +24,11 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// List kernels with their parameters (ranges, defaults) and presets.
-    List,
+    List {
+        /// Print only `KERNEL PRESET` lines (for scripts).
+        #[arg(long)]
+        names: bool,
+    },
     /// Render one kernel to a PNG (display values) or EXR (raw/linear values).
     Render {
         kernel: String,
@@ -111,8 +115,16 @@ fn bad(e: impl std::fmt::Display) -> GoldenError {
 
 fn run(cmd: Command) -> Result<i32, GoldenError> {
     match cmd {
-        Command::List => {
-            list();
+        Command::List { names } => {
+            if names {
+                for k in vista_kernels::registry() {
+                    for p in k.presets() {
+                        println!("{} {}", k.name(), p.name);
+                    }
+                }
+            } else {
+                list();
+            }
             Ok(0)
         }
         Command::Render { kernel, preset, set, size, out } => {

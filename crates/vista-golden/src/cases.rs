@@ -80,7 +80,7 @@ impl Case {
 
     /// The `vista bless` command that (re)writes this case's golden.
     pub fn bless_command(&self) -> String {
-        format!("cargo run --release -p vista-cli -- bless --case '{}'", self.id)
+        format!("make golden CASE='{}'  (or: cargo run -p vista-cli -- bless --case '{}')", self.id, self.id)
     }
 }
 

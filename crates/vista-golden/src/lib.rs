@@ -80,3 +80,10 @@ pub fn gpu_for_test(test: &str) -> Option<&'static vista_gpu::Context> {
         Err(e) => panic!("GPU test '{test}' cannot run: {e}"),
     }
 }
+
+/// The repository root (two levels above this crate), where `golden/`,
+/// `shaders/` and `target/` live.
+pub fn repo_root() -> std::path::PathBuf {
+    let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    here.ancestors().nth(2).unwrap_or(here).to_path_buf()
+}

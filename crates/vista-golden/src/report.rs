@@ -15,7 +15,7 @@ pub fn default_report_dir() -> PathBuf {
         None => {
             let target = std::env::var_os("CARGO_TARGET_DIR")
                 .map(PathBuf::from)
-                .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target"));
+                .unwrap_or_else(|| crate::repo_root().join("target"));
             target.join("vista-report")
         }
     }

@@ -2,7 +2,7 @@
 //! recording, per case, how and where each golden was made.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
@@ -48,7 +48,7 @@ impl Store {
     pub fn default_dir() -> PathBuf {
         match std::env::var_os("VISTA_GOLDEN_DIR") {
             Some(d) => PathBuf::from(d),
-            None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../golden"),
+            None => crate::repo_root().join("golden"),
         }
     }
 

@@ -17,7 +17,7 @@ use crate::GpuError;
 pub fn default_shader_dir() -> PathBuf {
     match std::env::var_os("VISTA_SHADERS") {
         Some(dir) => PathBuf::from(dir),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shaders"),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).unwrap_or(Path::new(".")).join("shaders"),
     }
 }
 

@@ -8,6 +8,7 @@
 pub mod fbm;
 pub mod noise;
 pub mod params;
+pub mod phase;
 pub mod ridged;
 mod uniforms;
 

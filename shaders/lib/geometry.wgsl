@@ -1,0 +1,27 @@
+// Ray geometry shared by the sky and cloud kernels.
+#define_import_path vista::geometry
+
+// Distances (t0, t1), t0 <= t1, where the ray o + t d (d unit) meets the
+// sphere of radius r centred at the origin; (-1, -1) when it misses.
+fn ray_sphere(o: vec3<f32>, d: vec3<f32>, r: f32) -> vec2<f32> {
+    let b = dot(o, d);
+    let c = dot(o, o) - r * r;
+    let disc = b * b - c;
+    if disc < 0.0 {
+        return vec2(-1.0, -1.0);
+    }
+    let s = sqrt(disc);
+    // Stable form: avoids cancellation for the near root when |b| >> s.
+    let sb = select(-1.0, 1.0, b >= 0.0);
+    let q = -b - sb * s;
+    let tb = select(c / q, 0.0, q == 0.0);
+    return vec2(min(q, tb), max(q, tb));
+}
+
+// Direction on the upper hemisphere for the latlong projection:
+// azimuth phi = 2 pi u, elevation e = (pi / 2)(1 - v).
+fn latlong_direction(u: f32, v: f32) -> vec3<f32> {
+    let phi = 2.0 * 3.141592653589793 * u;
+    let e = 0.5 * 3.141592653589793 * (1.0 - v);
+    return vec3(cos(e) * sin(phi), sin(e), cos(e) * cos(phi));
+}

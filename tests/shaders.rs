@@ -1,0 +1,55 @@
+//! Every WGSL file composes and validates with naga alone (no device), and
+//! every kernel's uniform block matches the `Params` struct naga reflects.
+
+use vista_gpu::{ShaderSet, binding_struct_layout, default_shader_dir};
+
+#[test]
+fn every_kernel_shader_composes_and_validates_without_a_device() {
+    let set = ShaderSet::load(&default_shader_dir()).unwrap();
+    let files = set.kernel_files().unwrap();
+    assert!(files.len() >= 2, "expected kernel shaders, found {files:?}");
+    for f in &files {
+        set.compose(f).unwrap_or_else(|e| panic!("{f}: {e}"));
+    }
+}
+
+#[test]
+fn every_registered_kernel_has_a_shader_file() {
+    let set = ShaderSet::load(&default_shader_dir()).unwrap();
+    let files = set.kernel_files().unwrap();
+    for k in vista_kernels::registry() {
+        assert!(files.iter().any(|f| f == k.shader()), "{}: shader {} missing", k.name(), k.shader());
+    }
+}
+
+#[test]
+fn uniform_layouts_match_the_wgsl_params_struct() {
+    let set = ShaderSet::load(&default_shader_dir()).unwrap();
+    for k in vista_kernels::registry() {
+        let p = k.resolve(None, &[]).unwrap();
+        let u = k.uniforms(&p, 64, 32);
+        let module = set.compose(k.shader()).unwrap();
+        let (size, members) = binding_struct_layout(&module, 0)
+            .unwrap_or_else(|| panic!("{}: no struct at @group(0) @binding(0)", k.name()));
+        let ours: Vec<(String, u32)> = u.fields().iter().map(|f| (f.name.to_string(), f.offset)).collect();
+        assert_eq!(ours, members, "{}: uniform fields differ from the WGSL Params struct", k.name());
+        assert_eq!(u.len() as u32, size, "{}: uniform size differs from the WGSL struct", k.name());
+    }
+}
+
+#[test]
+fn a_broken_shader_reports_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let lib = dir.path().join("lib");
+    std::fs::create_dir_all(&lib).unwrap();
+    std::fs::write(lib.join("x.wgsl"), "#define_import_path vista::x\nfn one() -> f32 { return 1.0; }\n").unwrap();
+    std::fs::write(
+        dir.path().join("bad.wgsl"),
+        "#import vista::x::one\n\n@compute @workgroup_size(1)\nfn main() {\n    let a: f32 = one() + undefined_name;\n}\n",
+    )
+    .unwrap();
+    let set = ShaderSet::load(dir.path()).unwrap();
+    let err = set.compose("bad.wgsl").unwrap_err().to_string();
+    assert!(err.contains("bad.wgsl"), "error does not name the file: {err}");
+    assert!(err.contains(":5:") || err.contains("5 │") || err.contains("5 |"), "error does not name line 5: {err}");
+}
