@@ -89,7 +89,7 @@ impl Case {
 pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
     let file: CaseFile = toml::from_str(text).map_err(|e| GoldenError::Cases {
         path: path.display().to_string(),
-        message: e.to_string(),
+        message: one_line_toml_error(text, &e),
     })?;
     let mut seen = std::collections::HashSet::new();
     let mut out = Vec::new();
@@ -138,6 +138,21 @@ pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
         });
     }
     Ok(out)
+}
+
+/// toml's errors span several lines (with a source excerpt); users get one:
+/// "line L, column C: message".
+pub fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().trim().replace('\n', " ");
+    match e.span() {
+        Some(span) => {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.len() - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
+            format!("line {line}, column {column}: {msg}")
+        }
+        None => msg,
+    }
 }
 
 pub fn load_cases(path: &Path) -> Result<Vec<Case>, GoldenError> {

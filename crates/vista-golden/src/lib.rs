@@ -45,7 +45,8 @@ impl GoldenError {
         match self {
             GoldenError::Cases { .. } | GoldenError::BadInput(_) | GoldenError::Refused(_) => 2,
             GoldenError::Gpu(GpuError::Request(_)) => 2,
-            GoldenError::Image(ImageError::UnsupportedExtension { .. }) => 2,
+            // Unreadable, corrupt or unwritable image paths are the user's to fix.
+            GoldenError::Image(_) => 2,
             GoldenError::Io { .. } => 2,
             _ => 1,
         }

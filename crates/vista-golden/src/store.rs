@@ -78,7 +78,7 @@ impl Store {
         match std::fs::read_to_string(&path) {
             Ok(text) => toml::from_str(&text).map_err(|e| GoldenError::Cases {
                 path: path.display().to_string(),
-                message: format!("malformed manifest: {e}"),
+                message: format!("malformed manifest: {}", crate::cases::one_line_toml_error(&text, &e)),
             }),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Manifest::default()),
             Err(e) => Err(GoldenError::Io { path: path.display().to_string(), message: e.to_string() }),

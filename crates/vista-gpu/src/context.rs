@@ -153,8 +153,9 @@ impl Context {
         });
         let timeout = std::env::var("VISTA_GPU_TIMEOUT_S")
             .ok()
-            .and_then(|s| s.parse::<u64>().ok())
-            .unwrap_or(120);
+            .and_then(|s| s.parse::<f64>().ok())
+            .filter(|s| s.is_finite() && *s >= 0.0)
+            .unwrap_or(120.0);
         Ok(Context {
             device,
             queue,
@@ -163,7 +164,7 @@ impl Context {
             layout,
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
-            timeout: Duration::from_secs(timeout),
+            timeout: Duration::from_secs_f64(timeout),
             submit_lock: Mutex::new(()),
             creation_time: start.elapsed(),
         })
@@ -309,7 +310,7 @@ impl Context {
         match rx.recv_timeout(self.timeout) {
             Ok(Ok(())) => {}
             Ok(Err(e)) => return Err(GpuError::Validation { what: "readback map".into(), message: e.to_string() }),
-            Err(_) => return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs() }),
+            Err(_) => return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs_f64() }),
         }
         let image = {
             let mapped = readback
@@ -329,7 +330,7 @@ impl Context {
             .map(|_| ())
             .map_err(|e| match e {
                 wgpu::PollError::Timeout => {
-                    GpuError::Timeout { what: what.to_string(), seconds: self.timeout.as_secs() }
+                    GpuError::Timeout { what: what.to_string(), seconds: self.timeout.as_secs_f64() }
                 }
                 other => GpuError::Validation { what: what.to_string(), message: other.to_string() },
             })

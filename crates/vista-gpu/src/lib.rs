@@ -27,7 +27,7 @@ pub enum GpuError {
     #[error("GPU validation error in {what}: {message}")]
     Validation { what: String, message: String },
     #[error("GPU wait exceeded {seconds} s ({what}); the dispatch is too heavy for this device or the driver hung; lower the size or step counts, or raise VISTA_GPU_TIMEOUT_S")]
-    Timeout { what: String, seconds: u64 },
+    Timeout { what: String, seconds: f64 },
     #[error("{0}")]
     Request(String),
 }

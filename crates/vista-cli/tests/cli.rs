@@ -1,0 +1,334 @@
+//! The `vista` binary end to end: the README's bad-input table (every row),
+//! exit codes, bless safety (CI refusal, atomic writes under fault
+//! injection, no deletion without --prune), and the compare/render paths.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+struct Run {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+fn vista_in(golden: Option<&Path>, env: &[(&str, &str)], args: &[&str]) -> Run {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_vista"));
+    cmd.args(args).env("XDG_RUNTIME_DIR", "/tmp").env_remove("CI");
+    if let Some(g) = golden {
+        cmd.env("VISTA_GOLDEN_DIR", g).env("VISTA_REPORT_DIR", g.join("report"));
+    }
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let Output { status, stdout, stderr } = cmd.output().expect("run vista");
+    Run {
+        code: status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&stderr).into_owned(),
+    }
+}
+
+fn vista(args: &[&str]) -> Run {
+    vista_in(None, &[], args)
+}
+
+/// A bad input: exit `code`, one `error:` line containing every `needle`, no panic.
+fn assert_rejected(r: &Run, code: i32, needles: &[&str]) {
+    assert_eq!(r.code, code, "exit code; stderr: {}", r.stderr);
+    assert!(!r.stderr.contains("panicked") && !r.stderr.contains("RUST_BACKTRACE"), "panic: {}", r.stderr);
+    let errors: Vec<&str> = r.stderr.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(errors.len(), 1, "want exactly one error line, got: {}", r.stderr);
+    for n in needles {
+        assert!(errors[0].contains(n), "error line lacks '{n}': {}", errors[0]);
+    }
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().expect("tempdir")
+}
+
+fn out_png(dir: &Path) -> String {
+    dir.join("x.png").to_string_lossy().into_owned()
+}
+
+#[test]
+fn unknown_kernel_lists_valid_kernels() {
+    let d = tmp();
+    assert_rejected(&vista(&["render", "nope", "-o", &out_png(d.path())]), 2, &["unknown kernel 'nope'", "fbm", "ridged"]);
+}
+
+#[test]
+fn unknown_preset_lists_valid_presets() {
+    let d = tmp();
+    assert_rejected(&vista(&["render", "fbm", "--preset", "zzz", "-o", &out_png(d.path())]), 2, &["'zzz'", "default", "value"]);
+}
+
+#[test]
+fn unknown_param_lists_valid_params() {
+    let d = tmp();
+    assert_rejected(&vista(&["render", "fbm", "--set", "octavez=3", "-o", &out_png(d.path())]), 2, &["'octavez'", "octaves", "lacunarity"]);
+}
+
+#[test]
+fn out_of_range_value_names_value_and_range() {
+    let d = tmp();
+    assert_rejected(&vista(&["render", "fbm", "--set", "octaves=17", "-o", &out_png(d.path())]), 2, &["octaves=17", "[1, 16]"]);
+    assert_rejected(&vista(&["render", "fbm", "--set", "gain=1.5", "-o", &out_png(d.path())]), 2, &["gain=1.5", "[0, 1]"]);
+}
+
+#[test]
+fn wrong_type_names_value_and_expected_kind() {
+    let d = tmp();
+    assert_rejected(&vista(&["render", "fbm", "--set", "octaves=many", "-o", &out_png(d.path())]), 2, &["octaves=many", "integer"]);
+    assert_rejected(&vista(&["render", "fbm", "--set", "basis=simplex", "-o", &out_png(d.path())]), 2, &["basis=simplex", "perlin|value"]);
+    assert_rejected(&vista(&["render", "fbm", "--set", "offset=1", "-o", &out_png(d.path())]), 2, &["offset=1", "2 comma-separated"]);
+    assert_rejected(&vista(&["render", "fbm", "--set", "gain=nan", "-o", &out_png(d.path())]), 2, &["gain=nan"]);
+    assert_rejected(&vista(&["render", "fbm", "--set", "gain", "-o", &out_png(d.path())]), 2, &["NAME=VALUE"]);
+}
+
+#[test]
+fn bad_sizes_are_rejected_before_gpu_work() {
+    let d = tmp();
+    // VISTA_ADAPTER=nonsense would fail at device creation: these never get there.
+    let env = [("VISTA_ADAPTER", "nonsense")];
+    for (size, needle) in [("0x16", "width=0"), ("16x0", "height=0"), ("axb", "WIDTHxHEIGHT"), ("9000x16", "[1, 8192]"), ("64", "WIDTHxHEIGHT")] {
+        let r = vista_in(None, &env, &["render", "fbm", "--size", size, "-o", &out_png(d.path())]);
+        assert_rejected(&r, 2, &[needle]);
+    }
+}
+
+#[test]
+fn absurd_work_is_refused_with_the_cap() {
+    let d = tmp();
+    let r = vista_in(None, &[("VISTA_MAX_WORK", "1000")], &["render", "fbm", "-o", &out_png(d.path())]);
+    assert_rejected(&r, 2, &["above the cap", "VISTA_MAX_WORK"]);
+}
+
+#[test]
+fn unwritable_output_directory_is_refused() {
+    let d = tmp();
+    let missing = d.path().join("no/such/dir/x.png");
+    assert_rejected(&vista(&["render", "fbm", "-o", missing.to_str().unwrap()]), 2, &["does not exist"]);
+    assert_rejected(&vista(&["render", "fbm", "-o", d.path().join("x.jpg").to_str().unwrap()]), 2, &[".png or .exr"]);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let ro = d.path().join("ro");
+        std::fs::create_dir(&ro).unwrap();
+        std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).unwrap();
+        // root ignores directory permissions; only assert where they bite.
+        if std::fs::write(ro.join("probe"), b"").is_err() {
+            assert_rejected(&vista(&["render", "fbm", "-o", ro.join("x.png").to_str().unwrap()]), 2, &["not writable"]);
+        }
+    }
+}
+
+#[test]
+fn compare_reports_json_fields_and_rejects_bad_files() {
+    let d = tmp();
+    let a = d.path().join("a.png");
+    let b = d.path().join("b.png");
+    assert_eq!(vista(&["render", "fbm", "--size", "32x32", "-o", a.to_str().unwrap()]).code, 0);
+    assert_eq!(vista(&["render", "fbm", "--size", "32x32", "--set", "seed=4", "-o", b.to_str().unwrap()]).code, 0);
+    let same = vista(&["compare", a.to_str().unwrap(), a.to_str().unwrap(), "--json"]);
+    assert_eq!(same.code, 0, "{}", same.stderr);
+    assert!(same.stdout.contains("\"psnr\":\"inf\""), "{}", same.stdout);
+    let diff = vista(&["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--json"]);
+    for field in ["\"psnr\":", "\"ssim\":", "\"max_abs\":", "\"bad_pixels\":", "\"nan\":"] {
+        assert!(diff.stdout.contains(field), "missing {field}: {}", diff.stdout);
+    }
+    let corrupt = d.path().join("corrupt.png");
+    std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnot really").unwrap();
+    assert_rejected(&vista(&["compare", a.to_str().unwrap(), corrupt.to_str().unwrap()]), 2, &["corrupt.png"]);
+    let small = d.path().join("small.png");
+    assert_eq!(vista(&["render", "fbm", "--size", "16x16", "-o", small.to_str().unwrap()]).code, 0);
+    assert_rejected(&vista(&["compare", a.to_str().unwrap(), small.to_str().unwrap()]), 2, &["32", "16"]);
+}
+
+#[test]
+fn render_exr_holds_the_raw_fbm_field() {
+    let d = tmp();
+    let exr = d.path().join("f.exr");
+    let r = vista(&["render", "fbm", "--size", "24x16", "--set", "octaves=3", "-o", exr.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let img = vista_image::read_exr(&exr).unwrap();
+    let k = vista_kernels::find("fbm").unwrap();
+    let p = k.resolve(None, &[("octaves".into(), "3".into())]).unwrap();
+    let cpu = k.reference(&p, 24, 16);
+    let err = img.data.iter().zip(&cpu.data).map(|(a, b)| (a[0] - b[0]).abs()).fold(0.0f32, f32::max);
+    assert!(err < 1e-5, "EXR R channel differs from 0.5 + 0.5 f / A by {err}");
+}
+
+// ---- golden store: a private golden dir per test --------------------------
+
+const CASES: &str = r#"
+[[case]]
+id = "a"
+kernel = "fbm"
+size = "32x32"
+
+[[case]]
+id = "b"
+kernel = "fbm"
+size = "32x32"
+set = { basis = "value" }
+
+[[case]]
+id = "c"
+kernel = "ridged"
+size = "32x32"
+"#;
+
+fn golden_dir(cases: &str) -> tempfile::TempDir {
+    let d = tmp();
+    std::fs::write(d.path().join("cases.toml"), cases).unwrap();
+    d
+}
+
+fn golden(d: &Path, kernel: &str, id: &str) -> PathBuf {
+    d.join(kernel).join(format!("{id}.png"))
+}
+
+#[test]
+fn missing_golden_fails_with_the_bless_command_and_is_not_created() {
+    let d = golden_dir(CASES);
+    let r = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("does not exist") && r.stdout.contains("bless --case 'a'"), "{}", r.stdout);
+    assert!(r.stdout.contains("actual: ") && r.stdout.contains("index.html"), "{}", r.stdout);
+    assert!(!golden(d.path(), "fbm", "a").exists(), "check must never create a golden");
+}
+
+#[test]
+fn bless_then_check_passes_and_bless_is_refused_in_ci() {
+    let d = golden_dir(CASES);
+    let refused = vista_in(Some(d.path()), &[("CI", "true")], &["bless"]);
+    assert_rejected(&refused, 2, &["CI=true", "--force"]);
+    assert!(!golden(d.path(), "fbm", "a").exists());
+    let b = vista_in(Some(d.path()), &[], &["bless"]);
+    assert_eq!(b.code, 0, "{}", b.stderr);
+    assert!(b.stdout.contains("new"), "{}", b.stdout);
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 0, "{}{}", c.stdout, c.stderr);
+    assert!(c.stdout.contains("3 passed, 0 failed"), "{}", c.stdout);
+    assert!(d.path().join("report/index.html").exists());
+    let forced = vista_in(Some(d.path()), &[("CI", "true")], &["bless", "--force", "--case", "a"]);
+    assert_eq!(forced.code, 0, "{}", forced.stderr);
+    assert!(forced.stdout.contains("unchanged"), "{}", forced.stdout);
+}
+
+#[test]
+fn a_changed_render_fails_check_with_metrics_and_images() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    std::fs::write(d.path().join("cases.toml"), CASES.replace("set = { basis = \"value\" }", "set = { basis = \"value\", seed = 9 }")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    for needle in ["PSNR", "below the threshold 60.0 dB", "expected: ", "actual: ", "diff: ", "parameters changed since the last bless"] {
+        assert!(r.stdout.contains(needle), "missing '{needle}' in: {}", r.stdout);
+    }
+    assert!(d.path().join("report/b/diff.png").exists());
+}
+
+#[test]
+fn corrupt_and_wrong_size_goldens_fail_clearly() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    std::fs::write(golden(d.path(), "fbm", "a"), b"\x89PNG\r\n\x1a\ngarbage").unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "a"]);
+    assert_eq!(r.code, 1);
+    assert!(r.stdout.contains("a.png") && r.stdout.contains("not a valid PNG"), "{}", r.stdout);
+    std::fs::write(d.path().join("cases.toml"), CASES.replace("id = \"b\"\nkernel = \"fbm\"\nsize = \"32x32\"", "id = \"b\"\nkernel = \"fbm\"\nsize = \"48x32\"")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert_eq!(r.code, 1);
+    assert!(r.stdout.contains("is 32x32 but the case renders 48x32"), "{}", r.stdout);
+}
+
+#[test]
+fn malformed_cases_toml_names_the_line() {
+    let d = golden_dir("[[case]]\nid = \"a\"\nkernel = \"fbm\"\nsize = 32x32\n");
+    let r = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("cases.toml") && r.stderr.contains("line 4"), "{}", r.stderr);
+    let d = golden_dir("[[case]]\nid = \"a\"\nkernel = \"fbm\"\nset = { octaves = 99 }\n");
+    assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["case 'a'", "octaves=99", "[1, 16]"]);
+    let d = golden_dir("[[case]]\nid = \"a\"\nkernel = \"fbm\"\ncolour = 1\n");
+    assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["colour"]);
+    let d = golden_dir(CASES);
+    assert_rejected(&vista_in(Some(d.path()), &[], &["check", "--case", "zz*"]), 2, &["matches no case", "a, b, c"]);
+}
+
+#[test]
+fn interrupted_bless_leaves_every_golden_old_or_new() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let ids = [("fbm", "a"), ("fbm", "b"), ("ridged", "c")];
+    let old: Vec<Vec<u8>> = ids.iter().map(|(k, i)| std::fs::read(golden(d.path(), k, i)).unwrap()).collect();
+    // Change every case, then kill bless after its first golden write.
+    std::fs::write(d.path().join("cases.toml"), CASES.replace("size = \"32x32\"", "size = \"32x32\"\nset = { seed = 5 }").replace("set = { seed = 5 }\nset = { basis = \"value\" }", "set = { basis = \"value\", seed = 5 }")).unwrap();
+    let r = vista_in(Some(d.path()), &[("VISTA_FAULT_ABORT_AFTER_WRITES", "1")], &["bless"]);
+    assert_ne!(r.code, 0, "the fault hook must abort the bless");
+    assert!(r.stderr.contains("aborting after 1 golden writes"), "{}", r.stderr);
+    let mut changed = 0;
+    for ((k, i), before) in ids.iter().zip(&old) {
+        let now = std::fs::read(golden(d.path(), k, i)).unwrap();
+        vista_image::read_png16(&golden(d.path(), k, i)).expect("golden must stay a valid PNG");
+        if &now != before {
+            changed += 1;
+        }
+    }
+    assert_eq!(changed, 1, "exactly the first golden is new, the rest old");
+    let leftovers: Vec<_> = walk(d.path()).into_iter().filter(|p| p.to_string_lossy().ends_with(".tmp")).collect();
+    assert!(leftovers.is_empty(), "temp files left behind: {leftovers:?}");
+    // A complete bless afterwards converges, and check passes.
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0);
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() { out.extend(walk(&p)) } else { out.push(p) }
+    }
+    out
+}
+
+#[test]
+fn bless_keeps_orphans_unless_pruned() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let orphan = golden(d.path(), "fbm", "old-case");
+    std::fs::copy(golden(d.path(), "fbm", "a"), &orphan).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["bless", "--case", "a"]);
+    assert!(r.stdout.contains("orphaned golden with no case") && orphan.exists(), "{}", r.stdout);
+    let r = vista_in(Some(d.path()), &[], &["bless", "--case", "a", "--prune"]);
+    assert!(r.stdout.contains("deleted golden with no case") && !orphan.exists(), "{}", r.stdout);
+    assert!(golden(d.path(), "fbm", "b").exists(), "prune must keep live goldens");
+}
+
+#[test]
+fn gpu_watchdog_turns_a_long_wait_into_a_clear_error() {
+    let d = tmp();
+    let r = vista_in(None, &[("VISTA_GPU_TIMEOUT_S", "0.001")], &["render", "fbm", "--set", "octaves=16", "--size", "4096x4096", "-o", &out_png(d.path())]);
+    assert_rejected(&r, 1, &["GPU wait exceeded", "VISTA_GPU_TIMEOUT_S"]);
+}
+
+#[test]
+fn list_shows_params_ranges_and_presets() {
+    let r = vista(&["list"]);
+    assert_eq!(r.code, 0);
+    for needle in ["fbm", "ridged", "octaves", "[1, 16]", "presets:", "rotated"] {
+        assert!(r.stdout.contains(needle), "list lacks {needle}");
+    }
+    let names = vista(&["list", "--names"]);
+    assert!(names.stdout.lines().any(|l| l == "fbm default"), "{}", names.stdout);
+}
+
+#[test]
+fn bench_json_reports_throughput() {
+    let r = vista(&["bench", "fbm", "--size", "64x64", "--runs", "3", "--json"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(r.stdout.contains("\"mpix_per_s\":"), "{}", r.stdout);
+    assert_rejected(&vista(&["bench", "fbm", "--runs", "0"]), 2, &["--runs 0", "[1, 1000]"]);
+}
