@@ -1,0 +1,177 @@
+//! Reliability: non-finite output fails a case naming the count and first
+//! pixel; NaN renders are never blessed; random in-range parameters for every
+//! kernel (proptest) give finite output inside each kernel's documented range.
+
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
+use vista_golden::{Case, CheckOptions, Store};
+use vista_image::Image;
+use vista_kernels::{Kernel, Kind, ParamSet, ParamSpec, Preset, Uniforms};
+
+/// Test-only kernel backed by `shaders/test/nan.wgsl`.
+struct NanKernel;
+
+impl Kernel for NanKernel {
+    fn name(&self) -> &'static str {
+        "test-nan"
+    }
+    fn summary(&self) -> &'static str {
+        "writes NaN at (5, 3) and +Inf at (7, 3)"
+    }
+    fn params(&self) -> &'static [ParamSpec] {
+        &[]
+    }
+    fn presets(&self) -> &'static [Preset] {
+        &[]
+    }
+    fn shader(&self) -> &'static str {
+        "test/nan.wgsl"
+    }
+    fn uniforms(&self, _p: &ParamSet, width: u32, height: u32) -> Uniforms {
+        Uniforms::new(width, height)
+    }
+    fn work_per_pixel(&self, _p: &ParamSet) -> f64 {
+        1.0
+    }
+    fn reference(&self, _p: &ParamSet, width: u32, height: u32) -> Image {
+        Image::from_fn(width, height, |_, _| [0.5, 0.5, 0.5, 1.0])
+    }
+}
+
+static NAN: NanKernel = NanKernel;
+
+fn nan_case() -> Case {
+    Case {
+        id: "nan-injected".into(),
+        kernel: &NAN,
+        preset: None,
+        overrides: vec![],
+        params: ParamSet::resolve("test-nan", &[], &[], None, &[]).unwrap(),
+        width: 16,
+        height: 8,
+        psnr_same_driver: 60.0,
+        psnr_other_driver: 35.0,
+        min_ssim: None,
+        doc: String::new(),
+    }
+}
+
+#[test]
+fn injected_nan_fails_the_case_naming_count_and_first_pixel() {
+    let Some(ctx) = vista_golden::gpu_for_test("NaN injection") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let store = Store { dir: dir.path().to_path_buf() };
+    // A golden that would otherwise match: NaN must fail on its own.
+    let golden = store.golden_path(&nan_case());
+    std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
+    vista_image::write_png16(&golden, &Image::from_fn(16, 8, |_, _| [0.5, 0.5, 0.5, 1.0])).unwrap();
+    let opts = CheckOptions { report_dir: dir.path().join("report"), twice: false };
+    let o = vista_golden::check_case(ctx, &store, &Default::default(), &nan_case(), &opts);
+    assert!(!o.passed(), "a NaN render passed: {o:?}");
+    let text = o.explain(&opts.report_dir);
+    assert!(text.contains("2 pixels contain NaN/Inf; first at (5, 3)"), "{text}");
+    assert_eq!(o.metrics.map(|m| m.nan), Some(2), "{text}");
+}
+
+#[test]
+fn render_path_reports_nan_from_the_gpu_bit_exactly() {
+    let Some(ctx) = vista_golden::gpu_for_test("NaN readback") else { return };
+    let r = vista_golden::render(ctx, &NAN, &nan_case().params, 16, 8).unwrap();
+    assert!(r.raw.get(5, 3)[0].is_nan());
+    assert_eq!(r.raw.get(7, 3)[0], f32::INFINITY);
+    assert_eq!(r.raw.first_nonfinite(), Some((5, 3)));
+    assert_eq!(r.raw.nonfinite_count(), 2);
+}
+
+// ---- parameter fuzzing -----------------------------------------------------
+
+/// A strategy producing text for one parameter, anywhere in its range.
+fn value_strategy(spec: &ParamSpec) -> BoxedStrategy<String> {
+    match spec.kind {
+        Kind::Float { min, max, open_min } => {
+            let lo = if open_min { min + (max - min) * 1e-6 } else { min };
+            prop_oneof![
+                1 => Just(lo),
+                1 => Just(max),
+                6 => lo..=max,
+            ]
+            .prop_map(|v| v.to_string())
+            .boxed()
+        }
+        Kind::Int { min, max } => prop_oneof![
+            1 => Just(min),
+            1 => Just(max),
+            6 => min..=max,
+        ]
+        .prop_map(|v| v.to_string())
+        .boxed(),
+        Kind::Vector { n, min, max } => proptest::collection::vec(min..=max, n)
+            .prop_map(|v| v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","))
+            .boxed(),
+        Kind::Enum(names) => proptest::sample::select(names.to_vec()).prop_map(str::to_string).boxed(),
+    }
+}
+
+fn fuzz_cases() -> u32 {
+    std::env::var("VISTA_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(16)
+}
+
+/// Size small enough that even maximal step counts stay quick on lavapipe.
+const FUZZ_SIZE: (u32, u32) = (8, 8);
+
+#[test]
+fn random_in_range_params_give_finite_output_within_documented_bounds() {
+    let Some(ctx) = vista_golden::gpu_for_test("parameter fuzzing") else { return };
+    let mut total = 0;
+    for kernel in vista_kernels::registry() {
+        let specs = kernel.params();
+        let strategy: Vec<BoxedStrategy<String>> = specs.iter().map(value_strategy).collect();
+        let config = Config {
+            cases: fuzz_cases(),
+            rng_seed: RngSeed::Fixed(0x5eed_0000 + kernel.name().len() as u64),
+            failure_persistence: None,
+            ..Config::default()
+        };
+        let mut runner = TestRunner::new(config);
+        let tried = std::cell::Cell::new(0u32);
+        let result = runner.run(&strategy, |values| {
+            let overrides: Vec<(String, String)> =
+                specs.iter().zip(&values).map(|(s, v)| (s.name.to_string(), v.clone())).collect();
+            // Cross-parameter rules (e.g. a camera looking straight up) may reject a draw.
+            let Ok(p) = kernel.resolve(None, &overrides) else { return Ok(()) };
+            let (w, h) = FUZZ_SIZE;
+            if vista_golden::check_request(*kernel, &p, w, h).is_err() {
+                return Ok(());
+            }
+            tried.set(tried.get() + 1);
+            let r = vista_golden::render(ctx, *kernel, &p, w, h)
+                .map_err(|e| TestCaseError::fail(format!("{}: {e}", kernel.name())))?;
+            if let Some((x, y)) = r.raw.first_nonfinite() {
+                return Err(TestCaseError::fail(format!(
+                    "{}: NaN/Inf at ({x}, {y}) with {}",
+                    kernel.name(),
+                    p.canonical()
+                )));
+            }
+            let (lo, hi) = kernel.output_bounds(&p);
+            for (i, px) in r.raw.data.iter().enumerate() {
+                if px[..3].iter().any(|v| *v < lo || *v > hi) {
+                    return Err(TestCaseError::fail(format!(
+                        "{}: pixel {i} = {px:?} outside [{lo}, {hi}] with {}",
+                        kernel.name(),
+                        p.canonical()
+                    )));
+                }
+            }
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("{}: {e}", kernel.name());
+        }
+        let tried = tried.get();
+        eprintln!("fuzz {}: {tried} renders of random in-range params, all finite and in range", kernel.name());
+        assert!(tried > 0, "{}: every random draw was rejected; the fuzzer tested nothing", kernel.name());
+        total += tried;
+    }
+    eprintln!("fuzz: {total} renders in total");
+}
