@@ -113,6 +113,11 @@ impl Kernel for FbmKernel {
     fn work_per_pixel(&self, p: &ParamSet) -> f64 {
         p.f64("octaves")
     }
+    /// |f| <= A * max|N|, and 3D perlin (non-integer z_slice) exceeds 1 slightly.
+    fn output_bounds(&self, p: &ParamSet) -> (f32, f32) {
+        let m = noise_of(p).max_abs();
+        ((0.5 - 0.5 * m) as f32, (0.5 + 0.5 * m) as f32)
+    }
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
         let (n, f) = (noise_of(p), fbm_of(p));
         let (freq, [ox, oy], z) = (p.f64("frequency"), p.vec2("offset"), p.f64("z_slice"));

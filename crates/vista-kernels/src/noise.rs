@@ -89,6 +89,13 @@ pub fn perlin(p: &[u32], x: f64, y: f64, z: f64) -> f64 {
     )
 }
 
+/// Upper bound of |perlin| in 3D: the maximum over the unit cell of
+/// sum_c W_c * max_g (g . d_c) (each corner's best edge gradient, W_c >= 0),
+/// found numerically as 1.036354 near (0.645, 0.519, 0.5). It is reached:
+/// Perlin's own table gives 1.03615 at (223.35, 61.525, 233.5), so 1 is not a
+/// bound off integer z. On an integer-z slice the same maximum is exactly 1.
+pub const PERLIN_MAX_ABS: f64 = 1.0364;
+
 /// pcg3d (Jarzynski & Olano 2020): a 3D -> 3D integer hash, wrapping u32 math.
 pub fn pcg3d(v: [u32; 3]) -> [u32; 3] {
     let mut v = v.map(|c| c.wrapping_mul(1_664_525).wrapping_add(1_013_904_223));
@@ -170,11 +177,13 @@ impl Noise {
         }
     }
 
-    /// Upper bound of |N| used for amplitude invariants and normalisation.
-    /// Improved Perlin noise never exceeds 1 in magnitude for these gradients
-    /// (its true bound is about 0.97); value noise interpolates values in [-1, 1).
+    /// Upper bound of |N| used for amplitude invariants and normalisation:
+    /// `PERLIN_MAX_ABS` for perlin; value noise interpolates values in [-1, 1).
     pub fn max_abs(&self) -> f64 {
-        1.0
+        match self.basis {
+            Basis::Perlin => PERLIN_MAX_ABS,
+            Basis::Value => 1.0,
+        }
     }
 }
 

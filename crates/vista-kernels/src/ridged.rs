@@ -1,7 +1,7 @@
 //! `ridged`: Musgrave's ridged multifractal (SPEC 3.3), normalised to [0, 1].
 
 use crate::fbm::{BASIS, LACUNARITY, OCTAVES, SEED, noise_of, noise_table};
-use crate::noise::{BASIS_NAMES, Ridged};
+use crate::noise::{BASIS_NAMES, PERLIN_MAX_ABS, Ridged};
 use crate::{Kernel, Kind, ParamSet, ParamSpec, Preset, Uniforms, render_cpu};
 use vista_image::Image;
 
@@ -34,11 +34,12 @@ pub fn ridged_of(p: &ParamSet) -> Ridged {
     }
 }
 
-/// Normaliser: the largest raw value possible. With |N| <= 1 each signal is
-/// at most max(offset, 1 - offset)^2 (offset^2 when offset >= 1, SPEC 3.3)
-/// and each weight at most 1.
+/// Normaliser: the largest raw value possible. With |N| <= M (M =
+/// PERLIN_MAX_ABS bounds both bases) each signal is at most
+/// max(offset, M - offset)^2 (offset^2 when offset >= 1, SPEC 3.3) and each
+/// weight at most 1.
 pub fn ridged_max(r: &Ridged) -> f64 {
-    let peak = r.offset.max(1.0 - r.offset);
+    let peak = r.offset.max(PERLIN_MAX_ABS - r.offset);
     peak * peak * (0..r.octaves).map(|i| r.weight(i)).sum::<f64>()
 }
 
