@@ -53,3 +53,32 @@ fn a_broken_shader_reports_file_and_line() {
     assert!(err.contains("bad.wgsl"), "error does not name the file: {err}");
     assert!(err.contains(":5:") || err.contains("5 │") || err.contains("5 |"), "error does not name line 5: {err}");
 }
+
+/// The provenance hash follows imports: editing a module fbm reaches only
+/// through fractal -> noise -> hash changes fbm's hash; editing a module it
+/// never imports (geometry) does not.
+#[test]
+fn shader_hash_covers_transitive_imports_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let src = default_shader_dir();
+    for sub in ["", "lib"] {
+        std::fs::create_dir_all(tmp.path().join(sub)).unwrap();
+        for e in std::fs::read_dir(src.join(sub)).unwrap().flatten() {
+            if e.path().extension().is_some_and(|x| x == "wgsl") {
+                std::fs::copy(e.path(), tmp.path().join(sub).join(e.file_name())).unwrap();
+            }
+        }
+    }
+    let hash = |name: &str| ShaderSet::load(tmp.path()).unwrap().source_hash(name).unwrap();
+    let (fbm0, atmo0) = (hash("fbm.wgsl"), hash("atmosphere.wgsl"));
+    let append = |file: &str| {
+        let p = tmp.path().join(file);
+        let s = std::fs::read_to_string(&p).unwrap();
+        std::fs::write(&p, s + "\n// edited\n").unwrap();
+    };
+    append("lib/geometry.wgsl");
+    assert_eq!(hash("fbm.wgsl"), fbm0, "fbm does not import geometry");
+    assert_ne!(hash("atmosphere.wgsl"), atmo0, "atmosphere imports geometry");
+    append("lib/hash.wgsl");
+    assert_ne!(hash("fbm.wgsl"), fbm0, "fbm reaches hash through fractal and noise");
+}

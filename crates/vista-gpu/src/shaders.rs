@@ -122,18 +122,58 @@ impl ShaderSet {
         Ok(module)
     }
 
-    /// Hash of the kernel file and every library file: any WGSL edit that can
-    /// change a kernel's output changes this.
+    /// Hash of the kernel file and of the library modules it imports,
+    /// directly or through other modules: any WGSL edit that can change this
+    /// kernel's output changes it, and edits to unrelated modules do not
+    /// (so they do not mark every golden's provenance stale).
     pub fn source_hash(&self, name: &str) -> Result<String, GpuError> {
+        let source = read(&self.dir.join(name))?;
         let mut h = blake3::Hasher::new();
         h.update(name.as_bytes());
-        h.update(read(&self.dir.join(name))?.as_bytes());
-        for (path, source) in &self.lib {
+        h.update(source.as_bytes());
+        for (path, source) in self.imported_lib(&source) {
             h.update(path.as_bytes());
             h.update(source.as_bytes());
         }
         Ok(h.finalize().to_hex()[..16].to_string())
     }
+
+    /// Library files reachable from `source` through `#import`, in `lib` order.
+    fn imported_lib(&self, source: &str) -> Vec<&(String, String)> {
+        let path_of = |src: &str| {
+            src.lines().find_map(|l| l.trim().strip_prefix("#define_import_path").map(|p| p.trim().to_string()))
+        };
+        let mut wanted: Vec<String> = imports(source);
+        let mut used = vec![false; self.lib.len()];
+        while let Some(module) = wanted.pop() {
+            for (k, entry) in self.lib.iter().enumerate() {
+                if !used[k] && path_of(&entry.1).as_deref() == Some(module.as_str()) {
+                    used[k] = true;
+                    wanted.extend(imports(&entry.1));
+                }
+            }
+        }
+        self.lib.iter().zip(used).filter(|(_, u)| *u).map(|(e, _)| e).collect()
+    }
+}
+
+/// Module paths named by `#import` lines (`#import vista::noise::{a, b}` and
+/// `#import vista::noise` both name `vista::noise`; only `vista::X` paths are ours).
+fn imports(source: &str) -> Vec<String> {
+    source
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("#import"))
+        .filter_map(|rest| {
+            let path: Vec<&str> = rest.trim().split("::").take(2).collect();
+            match path.as_slice() {
+                ["vista", m] => {
+                    let m: String = m.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                    Some(format!("vista::{m}"))
+                }
+                _ => None,
+            }
+        })
+        .collect()
 }
 
 fn describe(composer: &Composer, dir: &Path, e: &ComposerError) -> String {
