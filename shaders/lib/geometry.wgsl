@@ -4,8 +4,14 @@
 // Distances (t0, t1), t0 <= t1, where the ray o + t d (d unit) meets the
 // sphere of radius r centred at the origin; (-1, -1) when it misses.
 fn ray_sphere(o: vec3<f32>, d: vec3<f32>, r: f32) -> vec2<f32> {
-    let b = dot(o, d);
-    let c = dot(o, o) - r * r;
+    return ray_sphere_bc(dot(o, d), dot(o, o) - r * r);
+}
+
+// ray_sphere from b = dot(o, d) and c = |o|^2 - r^2 given by the caller.
+// At planetary radii dot(o, o) - r * r cancels catastrophically in f32 (an
+// ulp of 6.4e6^2 is 4e6 m^2); callers that know c exactly (from an altitude
+// h: c = h (2 r + h)) pass it here instead.
+fn ray_sphere_bc(b: f32, c: f32) -> vec2<f32> {
     let disc = b * b - c;
     if disc < 0.0 {
         return vec2(-1.0, -1.0);

@@ -159,6 +159,26 @@ fn render_exr_holds_the_raw_fbm_field() {
     assert!(err < 1e-5, "EXR R channel differs from 0.5 + 0.5 f / A by {err}");
 }
 
+#[test]
+fn render_exr_holds_heightfield_depth_over_t_max() {
+    let d = tmp();
+    let exr = d.path().join("d.exr");
+    let args = ["render", "heightfield", "--preset", "valley", "--set", "view=depth", "--size", "32x20"];
+    let r = vista(&[&args[..], &["-o", exr.to_str().unwrap()]].concat());
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let img = vista_image::read_exr(&exr).unwrap();
+    let r_of = |x: u32, y: u32| img.get(x, y)[0];
+    assert!(img.data.iter().all(|p| (0.0..=1.0).contains(&p[0])), "depth outside [0, 1]");
+    // The valley camera sees sky in the top row and terrain in the bottom row.
+    assert!((0..32).all(|x| r_of(x, 0) == 1.0), "top row should be sky (depth exactly 1)");
+    assert!((0..32).all(|x| r_of(x, 19) < 1.0), "bottom row should hit the terrain (depth < 1)");
+    let k = vista_kernels::find("heightfield").unwrap();
+    let p = k.resolve(Some("valley"), &[("view".into(), "depth".into())]).unwrap();
+    let cpu = k.reference(&p, 32, 20);
+    let agree = img.data.iter().zip(&cpu.data).filter(|(a, b)| (a[0] - b[0]).abs() <= 0.02 * b[0].max(1e-3)).count();
+    assert!(agree * 100 >= 97 * img.data.len(), "EXR depth agrees with the CPU march at {agree}/640 pixels");
+}
+
 // ---- golden store: a private golden dir per test --------------------------
 
 const CASES: &str = r#"

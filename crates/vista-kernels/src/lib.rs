@@ -6,6 +6,9 @@
 //! Kernels never touch the file system.
 
 pub mod fbm;
+pub mod heightfield;
+pub mod clouds;
+pub mod atmosphere;
 pub mod noise;
 pub mod params;
 pub mod phase;
@@ -104,7 +107,7 @@ impl std::fmt::Debug for dyn Kernel {
 
 /// All kernels, in the order `vista list` shows them.
 pub fn registry() -> &'static [&'static dyn Kernel] {
-    &[&fbm::FbmKernel, &ridged::RidgedKernel]
+    &[&fbm::FbmKernel, &ridged::RidgedKernel, &atmosphere::AtmosphereKernel, &clouds::CloudsKernel, &heightfield::HeightfieldKernel]
 }
 
 /// Looks a kernel up by name.

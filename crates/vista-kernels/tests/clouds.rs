@@ -1,0 +1,328 @@
+//! clouds (SPEC 3.6): CPU-only invariants of the f64 reference march.
+
+use vista_kernels::clouds::{
+    Clouds, CloudsKernel, Profile, T_CUTOFF, analytic_weight, height_profile, ign, remap, white,
+};
+use vista_kernels::{Kernel, ParamError, ParamSet};
+
+fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
+    let set: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    CloudsKernel.resolve(Some(preset), &set).expect("valid test params")
+}
+
+const GENERA: &[&str] = &[
+    "cumulus",
+    "cumulonimbus",
+    "nimbostratus",
+    "stratocumulus",
+    "stratus",
+    "altocumulus",
+    "altostratus",
+    "cirrus",
+    "cirrocumulus",
+    "cirrostratus",
+];
+
+/// Every n-th pixel ray of a 64 x 64 view.
+fn rays(c: &Clouds, every: u32) -> impl Iterator<Item = (u32, u32, [f64; 3], [f64; 3])> + '_ {
+    (0..64).step_by(every as usize).flat_map(move |y| {
+        (0..64).step_by(every as usize).map(move |x| {
+            let (o, d) = c.ray(x, y, 64, 64);
+            (x, y, o, d)
+        })
+    })
+}
+
+#[test]
+fn transmittance_is_in_unit_interval_and_never_increases_along_a_ray() {
+    let mut rays_checked = 0;
+    let mut cloudy = 0;
+    for preset in GENERA {
+        for (integrator, jitter) in [("riemann", "none"), ("analytic", "ign"), ("analytic", "white")] {
+            let c = Clouds::from_params(&params(preset, &[("integrator", integrator), ("jitter", jitter)]));
+            for (x, y, o, d) in rays(&c, 7) {
+                let r = c.march(o, d, c.jitter_offset(x, y), true);
+                let mut prev = 1.0;
+                for (k, &t) in r.trace.iter().enumerate() {
+                    assert!((0.0..=1.0).contains(&t), "{preset} ({x},{y}) step {k}: T = {t}");
+                    assert!(t <= prev, "{preset} ({x},{y}) step {k}: T rose from {prev} to {t}");
+                    prev = t;
+                }
+                assert_eq!(r.transmittance, prev);
+                rays_checked += 1;
+                cloudy += (prev < 0.9) as u32;
+            }
+        }
+    }
+    // The check must have seen real cloud, not only empty rays.
+    assert!(cloudy * 4 > rays_checked, "only {cloudy} of {rays_checked} rays met cloud");
+}
+
+#[test]
+fn doubling_density_never_raises_transmittance_cpu() {
+    for preset in GENERA {
+        let d = params(preset, &[]).f64("density_scale");
+        let mut lower = 0;
+        // The preset's density and an eighth of it (dense presets are opaque
+        // on every ray at full density, where T = 0 both times).
+        for d1 in [d, d / 8.0] {
+            let c1 = Clouds::from_params(&params(preset, &[("density_scale", &d1.to_string())]));
+            let c2 = Clouds::from_params(&params(preset, &[("density_scale", &(2.0 * d1).to_string())]));
+            for (x, y, o, dir) in rays(&c1, 5) {
+                let xi = c1.jitter_offset(x, y);
+                let (t1, t2) = (c1.march(o, dir, xi, false).transmittance, c2.march(o, dir, xi, false).transmittance);
+                assert!(t2 <= t1, "{preset} ({x},{y}): T {t1} at density {d1}, {t2} at {}", 2.0 * d1);
+                lower += (t2 < t1) as u32;
+            }
+        }
+        assert!(lower > 0, "{preset}: doubling the density changed no ray");
+    }
+}
+
+#[test]
+fn zero_coverage_gives_exactly_the_background() {
+    for preset in GENERA {
+        let c = Clouds::from_params(&params(preset, &[("coverage", "0")]));
+        for (x, y, _, d) in rays(&c, 3) {
+            let px = c.pixel(x, y, 64, 64);
+            let bg = c.background(d);
+            assert_eq!(px, [bg[0], bg[1], bg[2], 0.0], "{preset} ({x},{y})");
+        }
+    }
+}
+
+/// Analytic integration is energy-conserving: with a constant in-scattered
+/// radiance (ambient only, no height falloff, no absorption) each step adds
+/// Lin (T_k - T_k+1), so L = Lin (1 - T) exactly for any density field.
+/// Riemann sums T_k x_k >= T_k (1 - exp(-x_k)) and overshoots.
+#[test]
+fn analytic_integrator_conserves_energy_and_riemann_overshoots() {
+    let flat = [("sun_intensity", "0"), ("ambient", "1,1,1"), ("ambient_bottom", "1"), ("steps", "16")];
+    let ca = Clouds::from_params(&params("cumulus", &[&flat[..], &[("integrator", "analytic")]].concat()));
+    let cr = Clouds::from_params(&params("cumulus", &[&flat[..], &[("integrator", "riemann")]].concat()));
+    let mut worst_riemann: f64 = 0.0;
+    for (x, y, o, d) in rays(&ca, 3) {
+        let a = ca.march(o, d, 0.5, false);
+        // The T cutoff drops at most T_CUTOFF of the remaining light.
+        let err = (a.radiance[0] - (1.0 - a.transmittance)).abs();
+        assert!(err <= T_CUTOFF + 1e-12, "({x},{y}): L = {} but 1 - T = {}", a.radiance[0], 1.0 - a.transmittance);
+        let r = cr.march(o, d, 0.5, false);
+        assert!(r.radiance[0] >= a.radiance[0] - 1e-12, "({x},{y}): riemann below analytic");
+        worst_riemann = worst_riemann.max(r.radiance[0] - (1.0 - r.transmittance));
+    }
+    assert!(worst_riemann > 0.01, "riemann at 16 steps should overshoot L = 1 - T, max excess {worst_riemann}");
+}
+
+#[test]
+fn analytic_weight_has_the_right_limit() {
+    assert_eq!(analytic_weight(0.0), 1.0);
+    assert!((analytic_weight(1e-12) - 1.0).abs() < 1e-12);
+    assert!((analytic_weight(1e-4) - (1.0 - 0.5e-4 + 1e-8 / 6.0)).abs() < 1e-13);
+    assert!((analytic_weight(2.0) - (1.0 - (-2.0f64).exp()) / 2.0).abs() < 1e-15);
+    assert!(analytic_weight(1e6).is_finite() && analytic_weight(1e6) > 0.0);
+}
+
+#[test]
+fn remap_and_height_profile() {
+    assert_eq!(remap(0.75, 0.5, 1.0, 0.0, 1.0), 0.5);
+    assert_eq!(remap(0.2, 0.4, 0.4, 0.0, 1.0), 0.0, "empty interval: step, no division by zero");
+    assert_eq!(remap(0.6, 0.4, 0.4, 0.0, 1.0), 1.0);
+    for profile in [Profile::Stratiform, Profile::Cumuliform, Profile::Anvil] {
+        assert_eq!(height_profile(profile, 0.1, 0.4, 0.0), 0.0);
+        assert_eq!(height_profile(profile, 0.1, 0.4, 1.0), 0.0);
+        for i in 0..=100 {
+            let v = height_profile(profile, 0.1, 0.4, i as f64 / 100.0);
+            assert!((0.0..=1.0).contains(&v), "{profile:?} at {i}%: {v}");
+        }
+    }
+    // Anvil: denser near the top than in the middle of the tower.
+    assert!(height_profile(Profile::Anvil, 0.03, 0.12, 0.8) > height_profile(Profile::Anvil, 0.03, 0.12, 0.4));
+}
+
+#[test]
+fn jitter_hashes() {
+    // IGN (Jimenez 2014) by its formula.
+    assert_eq!(ign(0, 0, 0), 0.0);
+    let want = (52.9829189 * (0.06711056f64 * 3.0 + 0.00583715 * 5.0).fract()).fract();
+    assert_eq!(ign(3, 5, 0), want);
+    assert_ne!(ign(3, 5, 1), ign(3, 5, 0));
+    assert_eq!(ign(3, 5, 64), ign(3, 5, 0), "the seed shift has period 64");
+    let mut sum = 0.0;
+    for y in 0..64 {
+        for x in 0..64 {
+            for v in [ign(x, y, 7), white(x, y, 7)] {
+                assert!((0.0..1.0).contains(&v));
+            }
+            sum += white(x, y, 7);
+        }
+    }
+    let mean = sum / 4096.0;
+    assert!((mean - 0.5).abs() < 0.02, "white jitter mean {mean}");
+    assert_ne!(white(3, 5, 1), white(3, 5, 2));
+}
+
+#[test]
+fn bad_parameters_are_rejected_with_the_value_and_range() {
+    let err = CloudsKernel.resolve(Some("cumulus"), &[("cloud_top_km".into(), "0.5".into())]).unwrap_err();
+    assert!(matches!(&err, ParamError::Invalid(m) if m.contains("cloud_top_km=0.5") && m.contains("cloud_base_km=1")));
+    let err = CloudsKernel.resolve(None, &[("steps".into(), "0".into())]).unwrap_err();
+    assert!(matches!(&err, ParamError::OutOfRange { param, .. } if param == "steps"), "{err}");
+    let err = CloudsKernel.resolve(None, &[("jitter".into(), "blue".into())]).unwrap_err();
+    assert!(err.to_string().contains("none|white|ign"), "{err}");
+    let err = CloudsKernel.resolve(Some("cumulonimbus"), &[("sun_elevation_deg".into(), "-5".into())]).unwrap_err();
+    assert!(err.to_string().contains("sun_elevation_deg"), "{err}");
+}
+
+#[test]
+fn presets_are_valid_and_state_their_altitudes() {
+    let names: Vec<&str> = CloudsKernel.presets().iter().map(|p| p.name).collect();
+    for g in GENERA.iter().chain(&["clear"]) {
+        assert!(names.contains(g), "missing preset {g}");
+    }
+    for preset in CloudsKernel.presets() {
+        let p = params(preset.name, &[]);
+        if preset.name != "clear" {
+            let (base, top) = (p.f64("cloud_base_km"), p.f64("cloud_top_km"));
+            assert!(
+                preset.doc.contains(&format!("base {base:.1} km")) && preset.doc.contains(&format!("top {top:.1} km")),
+                "{}: doc '{}' must state base {base:.1} km and top {top:.1} km",
+                preset.name,
+                preset.doc
+            );
+        }
+        let (lo, hi) = CloudsKernel.output_bounds(&p);
+        assert!(lo == 0.0 && hi.is_finite() && hi > 0.0);
+    }
+    // Temperate-latitude levels: high 5-13 km, middle 2-7 km, low below 2 km.
+    let level = |name: &str| {
+        let p = params(name, &[]);
+        (p.f64("cloud_base_km"), p.f64("cloud_top_km"))
+    };
+    for high in ["cirrus", "cirrocumulus", "cirrostratus"] {
+        let (b, t) = level(high);
+        assert!(b >= 5.0 && t <= 13.0, "{high}: {b}-{t} km");
+    }
+    for middle in ["altocumulus", "altostratus"] {
+        let (b, _) = level(middle);
+        assert!((2.0..7.0).contains(&b), "{middle}: base {b} km");
+    }
+    for low in ["stratocumulus", "stratus", "cumulus", "nimbostratus", "cumulonimbus"] {
+        let (b, _) = level(low);
+        assert!(b < 2.0, "{low}: base {b} km");
+    }
+    let (_, cb_top) = level("cumulonimbus");
+    assert!((9.0..=12.0).contains(&cb_top), "cumulonimbus top {cb_top} km");
+}
+
+#[test]
+fn work_estimate_and_high_quality() {
+    let p = params("cumulus", &[]);
+    let wpp = CloudsKernel.work_per_pixel(&p);
+    assert_eq!(wpp, 64.0 * 13.0 * p.f64("octaves"));
+    let hq = CloudsKernel.high_quality();
+    assert!(hq.contains(&("steps", "512")) && hq.contains(&("light_steps", "32")), "{hq:?}");
+}
+
+#[test]
+fn output_stays_within_the_declared_bounds() {
+    // Dense, thick, few steps: the case where riemann overshoots most.
+    for integrator in ["riemann", "analytic"] {
+        let p = params("cumulonimbus", &[("density_scale", "200"), ("steps", "4"), ("integrator", integrator)]);
+        let (lo, hi) = CloudsKernel.output_bounds(&p);
+        let img = CloudsKernel.reference(&p, 24, 24);
+        for px in &img.data {
+            for &v in &px[..3] {
+                assert!(v.is_finite() && v >= lo && v <= hi, "{integrator}: {v} outside [{lo}, {hi}]");
+            }
+        }
+    }
+}
+
+fn hq(preset: &str, set: &[(&str, &str)]) -> ParamSet {
+    let mut all: Vec<(&str, &str)> = CloudsKernel.high_quality().to_vec();
+    all.extend_from_slice(set);
+    params(preset, &all)
+}
+
+/// SPEC 7/8 seed experiment on `cumulus`: against the 512 x 32 reference,
+/// analytic integration + IGN jitter at 32 x 6 steps must be at least as
+/// close (PSNR, peak = reference max) as riemann without jitter at 64 x 12.
+#[test]
+fn seed_experiment_analytic_ign_at_half_the_steps_beats_riemann_64x12() {
+    let (w, h) = (96, 96);
+    let reference = CloudsKernel.reference(&hq("cumulus", &[]), w, h);
+    let peak = vista_image::metrics::hdr_peak(&reference);
+    let psnr = |set: &[(&str, &str)]| {
+        let img = CloudsKernel.reference(&params("cumulus", set), w, h);
+        vista_image::metrics::psnr_with_peak(&reference, &img, peak)
+    };
+    let base = psnr(&[("integrator", "riemann"), ("jitter", "none"), ("steps", "64"), ("light_steps", "12")]);
+    let fast = psnr(&[("integrator", "analytic"), ("jitter", "ign"), ("steps", "32"), ("light_steps", "6")]);
+    // The same two with uniform light steps (light_spread = 1).
+    let base_u = psnr(&[("steps", "64"), ("light_steps", "12"), ("light_spread", "1")]);
+    let fast_u = psnr(&[
+        ("integrator", "analytic"),
+        ("jitter", "ign"),
+        ("steps", "32"),
+        ("light_steps", "6"),
+        ("light_spread", "1"),
+    ]);
+    eprintln!(
+        "clouds seed experiment (cumulus {w}x{h}, reference 512x32 analytic): riemann/none 64x12 {base:.2} dB, \
+         analytic/ign 32x6 {fast:.2} dB; with uniform light steps: {base_u:.2} dB vs {fast_u:.2} dB"
+    );
+    assert!(fast >= base, "analytic/ign 32x6 ({fast:.2} dB) is less close than riemann/none 64x12 ({base:.2} dB)");
+    // Why light_spread defaults to 8: six uniform light steps cost ~5 dB.
+    assert!(fast > fast_u + 2.0, "geometric light steps: {fast:.2} dB vs uniform {fast_u:.2} dB");
+}
+
+/// Geometric and uniform light steps converge to the same radiance.
+#[test]
+fn light_step_spacings_converge_to_the_same_image() {
+    let a = CloudsKernel.reference(&hq("cumulus", &[("light_steps", "128"), ("light_spread", "1")]), 24, 24);
+    let b = CloudsKernel.reference(&hq("cumulus", &[("light_steps", "128"), ("light_spread", "8")]), 24, 24);
+    let p = vista_image::metrics::psnr_with_peak(&a, &b, vista_image::metrics::hdr_peak(&a));
+    assert!(p > 55.0, "uniform vs geometric light steps at 128 steps: {p:.1} dB");
+    for (n, spread) in [(1, 8.0), (6, 8.0), (12, 1.0), (32, 8.0), (256, 1.0001)] {
+        let (first, growth) = vista_kernels::clouds::light_step_layout(n, spread);
+        let total: f64 = (0..n).map(|i| first * growth.powi(i as i32)).sum();
+        let last = first * growth.powi(n as i32 - 1);
+        assert!((total - 1.0).abs() < 1e-12, "n {n} spread {spread}: steps sum to {total}");
+        if n > 1 {
+            assert!((last / first - spread).abs() < 1e-9 * spread, "n {n}: last/first = {}", last / first);
+        }
+    }
+}
+
+/// SPEC 9: cost grows about as steps * (1 + light_steps). Every ray spends
+/// at most that many density evaluations (work_per_pixel / octaves), and a
+/// thin overcast layer, where no cutoff fires, spends exactly that.
+#[test]
+fn density_evaluations_follow_steps_times_one_plus_light_steps() {
+    for (steps, light) in [(16u32, 4u32), (32, 8), (64, 12)] {
+        let (s, l) = (steps.to_string(), light.to_string());
+        let p = params(
+            "altostratus",
+            &[
+                ("steps", &s),
+                ("light_steps", &l),
+                ("coverage", "1"),
+                ("density_scale", "0.5"),
+                ("profile_bottom", "0.01"),
+                ("profile_top", "0.01"),
+            ],
+        );
+        let c = Clouds::from_params(&p);
+        let bound = steps * (1 + light);
+        assert_eq!(CloudsKernel.work_per_pixel(&p), bound as f64 * p.f64("octaves"));
+        let mut full = 0;
+        let mut n = 0;
+        for (x, y, o, d) in rays(&c, 8) {
+            let r = c.march(o, d, 0.5, false);
+            assert!(r.density_evals <= bound, "{steps}x{light} ({x},{y}): {} evaluations > {bound}", r.density_evals);
+            full += (r.density_evals == bound) as u32;
+            n += 1;
+        }
+        assert!(full * 10 >= n * 9, "{steps}x{light}: only {full} of {n} rays spent steps * (1 + light_steps)");
+    }
+}

@@ -1,0 +1,229 @@
+// clouds kernel (SPEC 3.6): a cloud slab between cloud_base and cloud_top
+// (km, y up), ray marched with a light march toward the sun at each sample.
+// rgb = L_cloud + T * background (linear radiance), alpha = 1 - T.
+// The f64 reference with the same formulas is crates/vista-kernels/src/clouds.rs.
+#import vista::fractal::{FbmSettings, fbm3}
+#import vista::hash::{pcg3d, unit_from_hash}
+#import vista::phase::dual_hg_phase
+
+struct Params {
+    width: u32,
+    height: u32,
+    steps: u32,
+    light_steps: u32,
+    integrator: u32,
+    jitter: u32,
+    jitter_seed: u32,
+    profile: u32,
+    octaves: u32,
+    seed: u32,
+    lacunarity: f32,
+    gain: f32,
+    inv_amplitude: f32,
+    cloud_base: f32,
+    cloud_top: f32,
+    coverage: f32,
+    density_scale: f32,
+    absorption: f32,
+    profile_bottom: f32,
+    profile_top: f32,
+    freq_x: f32,
+    freq_y: f32,
+    freq_z: f32,
+    wind_x: f32,
+    wind_y: f32,
+    wind_z: f32,
+    cam_x: f32,
+    cam_y: f32,
+    cam_z: f32,
+    fwd_x: f32,
+    fwd_y: f32,
+    fwd_z: f32,
+    right_x: f32,
+    right_y: f32,
+    right_z: f32,
+    up_x: f32,
+    up_y: f32,
+    up_z: f32,
+    tan_half_fov: f32,
+    max_distance: f32,
+    light_first: f32,
+    light_growth: f32,
+    sun_dir_x: f32,
+    sun_dir_y: f32,
+    sun_dir_z: f32,
+    sun_r: f32,
+    sun_g: f32,
+    sun_b: f32,
+    g1: f32,
+    g2: f32,
+    phase_blend: f32,
+    powder: f32,
+    ambient_r: f32,
+    ambient_g: f32,
+    ambient_b: f32,
+    ambient_bottom: f32,
+    zenith_r: f32,
+    zenith_g: f32,
+    zenith_b: f32,
+    horizon_r: f32,
+    horizon_g: f32,
+    horizon_b: f32,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
+
+const INTEGRATOR_ANALYTIC: u32 = 1u;
+const JITTER_WHITE: u32 = 1u;
+const JITTER_IGN: u32 = 2u;
+const PROFILE_CUMULIFORM: u32 = 1u;
+const PROFILE_ANVIL: u32 = 2u;
+// Same cutoffs as the reference (T_CUTOFF, TAU_SUN_CUTOFF).
+const T_CUTOFF: f32 = 1e-4;
+const TAU_SUN_CUTOFF: f32 = 16.0;
+
+fn height01(y: f32) -> f32 {
+    return (y - params.cloud_base) / (params.cloud_top - params.cloud_base);
+}
+
+// Plateau smoothstep(0, bottom, h) * smoothstep(0, top, 1 - h) times the genus shape.
+fn height_profile(h: f32) -> f32 {
+    let plateau = smoothstep(0.0, params.profile_bottom, h) * smoothstep(0.0, params.profile_top, 1.0 - h);
+    if params.profile == PROFILE_CUMULIFORM {
+        return plateau * (1.0 - 0.5 * h);
+    }
+    if params.profile == PROFILE_ANVIL {
+        return plateau * (0.45 + 0.55 * smoothstep(0.5, 0.7, h));
+    }
+    return plateau;
+}
+
+// d(p) = density_scale * profile(h) * max(0, remap(G, 1 - coverage, 1, 0, 1)),
+// G = 0.5 + 0.5 fbm3 / A (fBm normalised to [0, 1] like the fbm kernel).
+fn density(p: vec3<f32>) -> f32 {
+    let h = height01(p.y);
+    if h < 0.0 || h > 1.0 || params.coverage <= 0.0 {
+        return 0.0;
+    }
+    let profile = height_profile(h);
+    if profile <= 0.0 {
+        return 0.0;
+    }
+    let q = p * vec3(params.freq_x, params.freq_y, params.freq_z) + vec3(params.wind_x, params.wind_y, params.wind_z);
+    let settings = FbmSettings(0u, params.seed, params.octaves, params.lacunarity, params.gain, 1.0, 0.0);
+    let g = 0.5 + 0.5 * fbm3(settings, q) * params.inv_amplitude;
+    // remap(g, 1 - c, 1, 0, 1); coverage > 0 here, so the interval is never empty.
+    let shape = max(0.0, (g - (1.0 - params.coverage)) / params.coverage);
+    return params.density_scale * profile * shape;
+}
+
+// Optical depth toward the sun up to the slab top: midpoint rule on steps
+// growing geometrically (first = light_first of the path, ratio light_growth).
+fn sun_optical_depth(p: vec3<f32>, s: vec3<f32>) -> f32 {
+    let len = clamp((params.cloud_top - p.y) / s.y, 0.0, params.max_distance);
+    let ext = 1.0 + params.absorption;
+    var dt = len * params.light_first;
+    var t = 0.0;
+    var tau = 0.0;
+    for (var j = 0u; j < params.light_steps; j++) {
+        tau += density(p + s * (t + 0.5 * dt)) * ext * dt;
+        if tau > TAU_SUN_CUTOFF {
+            break;
+        }
+        t += dt;
+        dt *= params.light_growth;
+    }
+    return tau;
+}
+
+// (1 - exp(-x)) / x; a series near 0 where the quotient loses all precision in f32.
+fn analytic_weight(x: f32) -> f32 {
+    if x < 1e-3 {
+        return 1.0 - x * (0.5 - x / 6.0);
+    }
+    return (1.0 - exp(-x)) / x;
+}
+
+// Offset xi of the first sample, in steps: 0.5 (midpoint), white (pcg3d) or IGN.
+fn jitter_offset(pixel: vec2<u32>) -> f32 {
+    if params.jitter == JITTER_WHITE {
+        return unit_from_hash(pcg3d(vec3(pixel, params.jitter_seed)).x);
+    }
+    if params.jitter == JITTER_IGN {
+        // Jimenez 2014; the seed shifts the pattern by 5.588238 px (period 64).
+        let shift = 5.588238 * f32(params.jitter_seed % 64u);
+        let px = f32(pixel.x) + shift;
+        let py = f32(pixel.y) + shift;
+        return fract(52.9829189 * fract(0.06711056 * px + 0.00583715 * py));
+    }
+    return 0.5;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    let size = vec2<f32>(f32(params.width), f32(params.height));
+    let uv = (vec2<f32>(id.xy) + 0.5) / size;
+    let sx = (2.0 * uv.x - 1.0) * params.tan_half_fov * (size.x / size.y);
+    let sy = (1.0 - 2.0 * uv.y) * params.tan_half_fov;
+    let fwd = vec3(params.fwd_x, params.fwd_y, params.fwd_z);
+    let right = vec3(params.right_x, params.right_y, params.right_z);
+    let up = vec3(params.up_x, params.up_y, params.up_z);
+    let d = normalize(fwd + sx * right + sy * up);
+    let o = vec3(params.cam_x, params.cam_y, params.cam_z);
+
+    let zenith = vec3(params.zenith_r, params.zenith_g, params.zenith_b);
+    let horizon = vec3(params.horizon_r, params.horizon_g, params.horizon_b);
+    let background = horizon + (zenith - horizon) * clamp(d.y, 0.0, 1.0);
+
+    // Segment of the ray inside the slab and within max_distance.
+    var t0 = 0.0;
+    var t1 = 0.0;
+    if abs(d.y) < 1e-6 {
+        if o.y >= params.cloud_base && o.y <= params.cloud_top {
+            t1 = params.max_distance;
+        }
+    } else {
+        let ta = (params.cloud_base - o.y) / d.y;
+        let tb = (params.cloud_top - o.y) / d.y;
+        t0 = max(min(ta, tb), 0.0);
+        t1 = min(max(ta, tb), params.max_distance);
+    }
+
+    var radiance = vec3(0.0);
+    var transmittance = 1.0;
+    if t1 > t0 {
+        let s = vec3(params.sun_dir_x, params.sun_dir_y, params.sun_dir_z);
+        let sun = vec3(params.sun_r, params.sun_g, params.sun_b);
+        let ambient = vec3(params.ambient_r, params.ambient_g, params.ambient_b);
+        let phase = dual_hg_phase(dot(d, s), params.g1, params.g2, params.phase_blend);
+        let ext = 1.0 + params.absorption;
+        let dt = (t1 - t0) / f32(params.steps);
+        let xi = jitter_offset(id.xy);
+        for (var k = 0u; k < params.steps; k++) {
+            let p = o + d * (t0 + (f32(k) + xi) * dt);
+            let sigma_s = density(p);
+            if sigma_s > 0.0 {
+                let tau_sun = sun_optical_depth(p, s);
+                let sun_vis = exp(-tau_sun) * (1.0 - params.powder * exp(-2.0 * tau_sun));
+                let amb = params.ambient_bottom + (1.0 - params.ambient_bottom) * clamp(height01(p.y), 0.0, 1.0);
+                let l_in = sun * (phase * sun_vis) + ambient * amb;
+                let x = sigma_s * ext * dt;
+                var w = dt;
+                if params.integrator == INTEGRATOR_ANALYTIC {
+                    w = dt * analytic_weight(x);
+                }
+                radiance += transmittance * sigma_s * l_in * w;
+                transmittance *= exp(-x);
+                if transmittance < T_CUTOFF {
+                    transmittance = 0.0;
+                    break;
+                }
+            }
+        }
+    }
+    textureStore(output, id.xy, vec4(radiance + transmittance * background, 1.0 - transmittance));
+}

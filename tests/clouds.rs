@@ -1,0 +1,181 @@
+//! clouds (SPEC 3.6) on the GPU: against the f64 CPU reference, the
+//! invariants that need a render, and the seed experiment of SPEC 7/8.
+
+use std::time::Instant;
+
+use vista_golden::render;
+use vista_image::Image;
+use vista_image::metrics::{compare_hdr, hdr_peak, psnr_with_peak};
+use vista_kernels::clouds::CloudsKernel;
+use vista_kernels::{Kernel, ParamSet};
+
+fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
+    let set: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    CloudsKernel.resolve(Some(preset), &set).expect("valid test params")
+}
+
+fn gpu(ctx: &vista_gpu::Context, p: &ParamSet, w: u32, h: u32) -> Image {
+    render(ctx, &CloudsKernel, p, w, h).expect("render").raw
+}
+
+/// PSNR on the raw linear radiance with peak = the reference's max RGB
+/// (vista_image::metrics::compare_hdr).
+#[test]
+fn gpu_matches_f64_reference() {
+    let Some(ctx) = vista_golden::gpu_for_test("clouds gpu vs cpu") else {
+        return;
+    };
+    let (w, h) = (48, 48);
+    for preset in ["cumulus", "cirrus", "cumulonimbus"] {
+        for (integrator, jitter) in [("riemann", "none"), ("analytic", "ign"), ("analytic", "white")] {
+            let p = params(preset, &[("integrator", integrator), ("jitter", jitter), ("jitter_seed", "5")]);
+            let t = Instant::now();
+            let g = gpu(ctx, &p, w, h);
+            let gpu_s = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let c = CloudsKernel.reference(&p, w, h);
+            let cpu_s = t.elapsed().as_secs_f64();
+            let m = compare_hdr(&c, &g).unwrap();
+            eprintln!(
+                "clouds {preset} {integrator}/{jitter}: PSNR {:.1} dB (peak {:.3}), max abs {:.2e}, \
+                 gpu {gpu_s:.2} s, cpu {cpu_s:.2} s",
+                m.psnr,
+                hdr_peak(&c),
+                m.max_abs
+            );
+            assert!(m.psnr >= 50.0, "clouds {preset} {integrator}/{jitter}: GPU vs CPU PSNR {} < 50 dB", m.psnr);
+            // Alpha = 1 - T: same march, so it matches too.
+            let alpha_err = g.data.iter().zip(&c.data).map(|(a, b)| (a[3] - b[3]).abs()).fold(0.0f32, f32::max);
+            assert!(alpha_err < 2e-3, "clouds {preset} {integrator}/{jitter}: max alpha error {alpha_err}");
+        }
+    }
+}
+
+/// Coverage 0: exactly the background (bit for bit) and alpha exactly 0.
+#[test]
+fn zero_coverage_is_exactly_the_background() {
+    let Some(ctx) = vista_golden::gpu_for_test("clouds zero coverage") else {
+        return;
+    };
+    let sky = [0.3f32, 0.5, 0.9];
+    for preset in ["clear", "cumulus", "cumulonimbus"] {
+        let p = params(preset, &[("coverage", "0"), ("sky_zenith", "0.3,0.5,0.9"), ("sky_horizon", "0.3,0.5,0.9")]);
+        let img = gpu(ctx, &p, 32, 32);
+        for (i, px) in img.data.iter().enumerate() {
+            assert!(
+                px[..3] == sky[..] && px[3] == 0.0,
+                "clouds {preset} coverage 0: pixel {i} = {px:?}, want {sky:?} with alpha 0"
+            );
+        }
+    }
+    // With the sky gradient: equal to the CPU background to f32 rounding.
+    let p = params("cumulus", &[("coverage", "0")]);
+    let img = gpu(ctx, &p, 32, 32);
+    let c = vista_kernels::clouds::Clouds::from_params(&p);
+    for y in 0..32 {
+        for x in 0..32 {
+            let bg = c.background(c.ray(x, y, 32, 32).1);
+            let g = img.get(x, y);
+            for ch in 0..3 {
+                assert!((g[ch] as f64 - bg[ch]).abs() < 1e-6, "({x}, {y}) ch {ch}: {} vs {}", g[ch], bg[ch]);
+            }
+            assert_eq!(g[3], 0.0);
+        }
+    }
+}
+
+/// Doubling density_scale never raises T: alpha = 1 - T never falls.
+#[test]
+fn doubling_density_never_raises_transmittance() {
+    let Some(ctx) = vista_golden::gpu_for_test("clouds density monotone") else {
+        return;
+    };
+    for (preset, d) in [("cumulus", "40"), ("cirrostratus", "0.25"), ("stratocumulus", "4")] {
+        let d2 = (d.parse::<f64>().unwrap() * 2.0).to_string();
+        let a = gpu(ctx, &params(preset, &[("density_scale", d)]), 40, 40);
+        let b = gpu(ctx, &params(preset, &[("density_scale", &d2)]), 40, 40);
+        let mut raised = 0;
+        for (pa, pb) in a.data.iter().zip(&b.data) {
+            // 1e-6: slack for a non-monotone f32 exp in the driver.
+            if pb[3] < pa[3] - 1e-6 {
+                raised += 1;
+            }
+        }
+        let mean = |img: &Image| img.data.iter().map(|p| p[3] as f64).sum::<f64>() / img.data.len() as f64;
+        eprintln!("clouds {preset}: mean alpha {:.4} at density {d}, {:.4} at {d2}", mean(&a), mean(&b));
+        assert_eq!(raised, 0, "clouds {preset}: {raised} pixels gained transmittance when density doubled");
+        assert!(mean(&b) > mean(&a) + 0.01, "clouds {preset}: doubling density barely changed alpha");
+    }
+}
+
+/// With the sun behind the camera the backward lobe keeps clouds lit.
+#[test]
+fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind() {
+    let Some(ctx) = vista_golden::gpu_for_test("clouds dual lobe") else {
+        return;
+    };
+    let sun_behind = [("sun_azimuth_deg", "180"), ("sun_elevation_deg", "30"), ("yaw_deg", "0")];
+    let dual = gpu(ctx, &params("cumulus", &[&sun_behind[..], &[("phase_blend", "0.5")]].concat()), 40, 40);
+    let single = gpu(ctx, &params("cumulus", &[&sun_behind[..], &[("phase_blend", "0")]].concat()), 40, 40);
+    let (mut sum_dual, mut sum_single, mut n) = (0.0, 0.0, 0);
+    for (d, s) in dual.data.iter().zip(&single.data) {
+        if d[3] > 0.5 {
+            let lum = |p: &[f32; 4]| (p[0] + p[1] + p[2]) as f64;
+            sum_dual += lum(d);
+            sum_single += lum(s);
+            n += 1;
+            assert!(lum(d) >= lum(s) - 1e-5, "a cloudy pixel got darker with the backward lobe: {d:?} vs {s:?}");
+        }
+    }
+    assert!(n > 100, "too few cloudy pixels ({n}) for the comparison");
+    let ratio = sum_dual / sum_single;
+    eprintln!("clouds dual/single-lobe brightness over {n} cloudy pixels: {ratio:.3}");
+    assert!(ratio > 1.1, "dual-lobe HG only {ratio:.3}x as bright as single-lobe with the sun behind");
+}
+
+#[test]
+fn renders_are_deterministic_and_jitter_follows_its_seed() {
+    let Some(ctx) = vista_golden::gpu_for_test("clouds determinism") else {
+        return;
+    };
+    let (w, h) = (32, 32);
+    let none = params("cumulus", &[]);
+    assert!(gpu(ctx, &none, w, h).bit_identical(&gpu(ctx, &none, w, h)), "jitter none: renders differ");
+    let ign = params("cumulus", &[("jitter", "ign"), ("jitter_seed", "3")]);
+    assert!(gpu(ctx, &ign, w, h).bit_identical(&gpu(ctx, &ign, w, h)), "ign seed 3: renders differ");
+    let white = |seed: &str| gpu(ctx, &params("cumulus", &[("jitter", "white"), ("jitter_seed", seed)]), w, h);
+    let (a, b) = (white("1"), white("2"));
+    let differ = a.data.iter().zip(&b.data).filter(|(p, q)| p != q).count();
+    assert!(differ > (w * h / 4) as usize, "white jitter seed 1 vs 2: only {differ} pixels differ");
+    let ign2 = params("cumulus", &[("jitter", "ign"), ("jitter_seed", "4")]);
+    assert!(!gpu(ctx, &ign2, w, h).bit_identical(&gpu(ctx, &ign, w, h)), "ign seed 3 vs 4: identical");
+}
+
+/// The seed experiment (SPEC 7/8) with the candidates rendered on the GPU;
+/// the 512 x 32 reference comes from the f64 CPU march (the same march,
+/// 10x faster than lavapipe here). The full-size version is the CPU test
+/// `seed_experiment_analytic_ign_at_half_the_steps_beats_riemann_64x12`.
+#[test]
+fn seed_experiment_on_the_gpu() {
+    let Some(ctx) = vista_golden::gpu_for_test("clouds seed experiment") else {
+        return;
+    };
+    let (w, h) = (48, 48);
+    let mut hq: Vec<(&str, &str)> = CloudsKernel.high_quality().to_vec();
+    hq.push(("jitter", "none"));
+    let reference = CloudsKernel.reference(&params("cumulus", &hq), w, h);
+    let peak = hdr_peak(&reference);
+    let base = gpu(ctx, &params("cumulus", &[("steps", "64"), ("light_steps", "12")]), w, h);
+    let fast_p =
+        params("cumulus", &[("integrator", "analytic"), ("jitter", "ign"), ("steps", "32"), ("light_steps", "6")]);
+    let fast = gpu(ctx, &fast_p, w, h);
+    let (pb, pf) = (psnr_with_peak(&reference, &base, peak), psnr_with_peak(&reference, &fast, peak));
+    eprintln!(
+        "clouds seed experiment on the GPU ({w}x{h}): riemann/none 64x12 {pb:.2} dB, analytic/ign 32x6 {pf:.2} dB"
+    );
+    assert!(pf >= pb, "GPU analytic/ign 32x6 ({pf:.2} dB) less close than riemann/none 64x12 ({pb:.2} dB)");
+    // The GPU candidate is the CPU candidate up to f32 rounding.
+    let cpu_fast = CloudsKernel.reference(&fast_p, w, h);
+    let agree = compare_hdr(&cpu_fast, &fast).unwrap().psnr;
+    assert!(agree >= 50.0, "GPU vs CPU analytic/ign 32x6: {agree:.1} dB");
+}

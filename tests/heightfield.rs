@@ -1,0 +1,258 @@
+//! GPU checks of the heightfield kernel (SPEC 3.4, SPEC 9) against its f64
+//! CPU reference: depth agreement with the brute-force march, the eps rule at
+//! every refined hit, max_steps monotonicity, overstepping at relax = 1, and
+//! the analytic terrains. World unit: 1 km. Images are small (64 x 40) so
+//! every test stays within a few seconds on lavapipe.
+
+use vista_image::Image;
+use vista_kernels::heightfield::{Camera, HeightfieldKernel, Terrain, brute_force_hit, camera_of};
+use vista_kernels::{Kernel, ParamSet, pixel_uv};
+
+const W: u32 = 64;
+const H: u32 = 40;
+
+fn params(preset: &str, sets: &[(&str, &str)]) -> ParamSet {
+    let o: Vec<(String, String)> = sets.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    HeightfieldKernel.resolve(Some(preset), &o).unwrap_or_else(|e| panic!("{preset} {sets:?}: {e}"))
+}
+
+fn gpu(ctx: &vista_gpu::Context, p: &ParamSet) -> Image {
+    vista_golden::render(ctx, &HeightfieldKernel, p, W, H).expect("render").raw
+}
+
+/// Hit distance of a depth pixel (None for sky, depth 1).
+fn hit_t(depth: f32, t_max: f64) -> Option<f64> {
+    (depth < 1.0).then_some(depth as f64 * t_max)
+}
+
+/// Pixels where GPU and reference agree: both miss, or both hit with depths
+/// within 2% (relative to the reference).
+fn agreement(gpu: &Image, reference: &Image) -> (usize, usize) {
+    let ok = gpu
+        .data
+        .iter()
+        .zip(&reference.data)
+        .filter(|(g, r)| match (g[0] < 1.0, r[0] < 1.0) {
+            (false, false) => true,
+            (true, true) => (g[0] - r[0]).abs() <= 0.02 * r[0],
+            _ => false,
+        })
+        .count();
+    (ok, gpu.data.len())
+}
+
+#[test]
+fn depth_agrees_with_brute_force_reference() {
+    let Some(ctx) = vista_golden::gpu_for_test("heightfield depth_agrees_with_brute_force_reference") else { return };
+    for preset in ["valley", "ridges", "grazing"] {
+        let p = params(preset, &[("view", "depth")]);
+        let g = gpu(ctx, &p);
+        let r = HeightfieldKernel.reference(&p, W, H);
+        let (ok, n) = agreement(&g, &r);
+        let hits = r.data.iter().filter(|c| c[0] < 1.0).count();
+        let pct = 100.0 * ok as f64 / n as f64;
+        // SPEC 3.4: no hit behind the reference's (which never passes the
+        // first point under the terrain). relax = 0.5 is not below
+        // 1/sqrt(1 + L^2) for these noise terrains, so allow 0.5%.
+        let behind = oversteps(&g, &r);
+        eprintln!(
+            "heightfield {preset}: depth agrees at {ok}/{n} pixels ({pct:.2}%), {hits} reference hits, {behind} behind"
+        );
+        assert!(hits > n / 4, "{preset}: only {hits} terrain pixels");
+        assert!(pct >= 97.0, "{preset}: depth agrees with the brute-force reference at only {pct:.2}% of pixels");
+        assert!(behind * 200 <= n, "{preset}: {behind} hits lie behind the reference's");
+    }
+}
+
+#[test]
+fn refined_hits_satisfy_eps_rule() {
+    let Some(ctx) = vista_golden::gpu_for_test("heightfield refined_hits_satisfy_eps_rule") else { return };
+    for preset in ["valley", "ridges", "grazing"] {
+        let p = params(preset, &[("view", "depth")]);
+        let g = gpu(ctx, &p);
+        let cam: Camera = camera_of(&p, W, H).unwrap();
+        let terrain = Terrain::from_params(&p);
+        let (t_max, eps) = (p.f64("t_max"), p.f64("eps"));
+        let (mut hits, mut worst) = (0, 0.0_f64);
+        for (i, px) in g.data.iter().enumerate() {
+            let Some(t) = hit_t(px[0], t_max) else { continue };
+            let (u, v) = pixel_uv(i as u32 % W, i as u32 / W, W, H);
+            let d = cam.ray(u, v);
+            let above = terrain.above(cam.pos, d, t);
+            // f32 slack: the stored depth (ulp 6e-8 relative) times |dD/dt|
+            // <= 1 + L, the f32 ray and the f32 height (about 1e-6 km each):
+            // 2e-5 km (2 cm) plus 1e-5 t covers all of them with margin.
+            let slack = 2e-5 + 1e-5 * t;
+            worst = worst.max(above.abs() / (eps * t));
+            assert!(
+                above.abs() <= eps * t + slack,
+                "{preset}: pixel {i}: |p.y - h| = {above:e} > eps t = {:e} at t = {t}",
+                eps * t
+            );
+            hits += 1;
+        }
+        eprintln!("heightfield {preset}: {hits} GPU hits, max |p.y - h| / (eps t) = {worst:.3}");
+        assert!(hits > 300, "{preset}: only {hits} hits");
+    }
+}
+
+#[test]
+fn raising_max_steps_never_removes_hits() {
+    let Some(ctx) = vista_golden::gpu_for_test("heightfield raising_max_steps_never_removes_hits") else { return };
+    for preset in ["valley", "grazing"] {
+        let renders: Vec<Image> = ["64", "128", "256"]
+            .iter()
+            .map(|s| gpu(ctx, &params(preset, &[("view", "depth"), ("max_steps", s)])))
+            .collect();
+        let hits: Vec<usize> = renders.iter().map(|r| r.data.iter().filter(|c| c[0] < 1.0).count()).collect();
+        for k in 1..renders.len() {
+            for (i, (lo, hi)) in renders[k - 1].data.iter().zip(&renders[k].data).enumerate() {
+                // Same march prefix: a hit keeps its exact distance.
+                assert!(lo[0] == 1.0 || lo[0] == hi[0], "{preset}: pixel {i}: depth {} became {}", lo[0], hi[0]);
+            }
+        }
+        eprintln!("heightfield {preset}: hits at 64/128/256 steps: {hits:?}");
+        assert!(hits[0] < hits[2], "{preset}: 64 steps already found every hit ({hits:?}); the test would be idle");
+    }
+}
+
+/// Pixels where the march went past the reference's hit: a miss where the
+/// reference hits, or a hit more than 2% behind it (overstepping).
+fn oversteps(gpu: &Image, reference: &Image) -> usize {
+    gpu.data.iter().zip(&reference.data).filter(|(g, r)| r[0] < 1.0 && g[0] > r[0] * 1.02).count()
+}
+
+/// Why relax defaults to 0.5: relax = 1 steps by the full height above the
+/// terrain, which is only safe for slopes L = 0 (the safe factor is
+/// 1/sqrt(1 + L^2)). On the grazing preset the rays run nearly parallel to
+/// sharp ridged crests far steeper than that, and relax = 1 steps over them
+/// (hits land behind the true one or the ray escapes), while 0.5 keeps the
+/// steps short enough to stop in front of nearly every crest at roughly
+/// twice the cost in steps.
+#[test]
+fn relax_one_oversteps_on_grazing_where_half_does_not() {
+    let Some(ctx) = vista_golden::gpu_for_test("heightfield relax_one_oversteps_on_grazing_where_half_does_not") else {
+        return;
+    };
+    let p = params("grazing", &[("view", "depth")]);
+    let reference = HeightfieldKernel.reference(&p, W, H);
+    let count = |relax: &str| {
+        let g = gpu(ctx, &params("grazing", &[("view", "depth"), ("relax", relax)]));
+        (oversteps(&g, &reference), agreement(&g, &reference).0)
+    };
+    let (half, half_ok) = count("0.5");
+    let (one, one_ok) = count("1.0");
+    let n = (W * H) as usize;
+    eprintln!(
+        "heightfield grazing: overstepped pixels relax 1.0: {one}, relax 0.5: {half} (of {n}); depth agreement {:.2}% vs {:.2}%",
+        100.0 * one_ok as f64 / n as f64,
+        100.0 * half_ok as f64 / n as f64
+    );
+    assert!(half * 200 <= n, "relax 0.5 overstepped at {half} pixels (> 0.5%)");
+    assert!(one >= 4 * half + 20, "relax 1.0 overstepped at only {one} pixels vs {half} at 0.5");
+}
+
+#[test]
+fn analytic_plane_depth_and_ramp_normals() {
+    let Some(ctx) = vista_golden::gpu_for_test("heightfield analytic_plane_depth_and_ramp_normals") else { return };
+    // Flat plane h0 = 0.2: t* = (o.y - h0) / (-d.y) within eps t. Near the
+    // horizon D shrinks by (1 - relax |d.y|) per step, so those rays need
+    // more than the default 256 steps.
+    let flat = [("terrain", "plane"), ("amplitude", "0.2"), ("camera_pos", "0.3,1.4,-1"), ("camera_target", "1,0.2,6")];
+    let p = params("valley", &[&flat[..], &[("view", "depth"), ("t_max", "80"), ("max_steps", "4096")]].concat());
+    let g = gpu(ctx, &p);
+    let cam = camera_of(&p, W, H).unwrap();
+    let (mut hits, mut worst) = (0, 0.0_f64);
+    for (i, px) in g.data.iter().enumerate() {
+        let (u, v) = pixel_uv(i as u32 % W, i as u32 / W, W, H);
+        let d = cam.ray(u, v);
+        let t_star = (cam.pos[1] - 0.2) / -d[1];
+        if d[1] >= 0.0 || t_star > 80.0 {
+            assert_eq!(px[0], 1.0, "pixel {i}: the plane is out of reach but depth is {}", px[0]);
+            continue;
+        }
+        let t = hit_t(px[0], 80.0).unwrap_or_else(|| panic!("pixel {i} missed the plane (t* = {t_star})"));
+        // Slack for the f32 march: 1e-5 relative (depth storage, f32 ray).
+        assert!((t - t_star).abs() <= 1e-3 * t_star + 1e-5 * t_star, "pixel {i}: t {t} vs t* {t_star}");
+        worst = worst.max((t - t_star).abs() / t_star);
+        hits += 1;
+    }
+    eprintln!("heightfield plane: {hits} hits, worst |t - t*| / t* = {worst:.2e}");
+    assert!(hits > 1000);
+
+    // Ramp h = 0.1 + s x + r z: every normal is normalize(-s, 1, -r).
+    let (s, r) = (0.3_f64, -0.45_f64);
+    let ramp = [("terrain", "plane"), ("amplitude", "0.1"), ("plane_slope", "0.3,-0.45"), ("view", "normal")];
+    let g =
+        gpu(ctx, &params("valley", &[&ramp[..], &[("camera_pos", "0,3,-2"), ("camera_target", "0.5,0,3")]].concat()));
+    let l = (s * s + 1.0 + r * r).sqrt();
+    let want = [-s / l, 1.0 / l, -r / l];
+    let mut n = 0;
+    for px in g.data.iter().filter(|px| px[..3] != [0.0, 0.0, 0.0]) {
+        for c in 0..3 {
+            let got = 2.0 * px[c] as f64 - 1.0;
+            assert!((got - want[c]).abs() < 2e-3, "ramp normal {:?} vs {want:?}", &px[..3]);
+        }
+        n += 1;
+    }
+    assert!(n > 1000, "only {n} ramp pixels");
+}
+
+#[test]
+fn sine_terrain_matches_bisection_and_normals_face_up() {
+    let Some(ctx) = vista_golden::gpu_for_test("heightfield sine_terrain_matches_bisection_and_normals_face_up") else {
+        return;
+    };
+    let sets = [("terrain", "sine"), ("amplitude", "0.4"), ("scale", "1.3"), ("camera_pos", "0.2,1.6,0.1")];
+    let p = params("valley", &[&sets[..], &[("camera_target", "3,0,6"), ("view", "depth")]].concat());
+    let g = gpu(ctx, &p);
+    let cam = camera_of(&p, W, H).unwrap();
+    let terrain = Terrain::from_params(&p);
+    let (t_max, eps) = (p.f64("t_max"), p.f64("eps"));
+    let (mut ok, mut hits) = (0, 0);
+    for (i, px) in g.data.iter().enumerate() {
+        let (u, v) = pixel_uv(i as u32 % W, i as u32 / W, W, H);
+        let d = cam.ray(u, v);
+        let b = brute_force_hit(&terrain, cam.pos, d, t_max, eps, 8192);
+        hits += b.is_some() as usize;
+        ok += match (hit_t(px[0], t_max), b) {
+            (None, None) => 1,
+            (Some(t), Some(tb)) => ((t - tb).abs() <= 2.0 * eps * tb + 1e-4) as usize,
+            _ => 0,
+        };
+    }
+    let n = g.data.len();
+    eprintln!("heightfield sine: {ok}/{n} pixels match f64 bisection within 2 eps t, {hits} hits");
+    assert!(hits > n / 2 && ok * 100 >= n * 99, "sine: {ok}/{n} match");
+
+    // Normal view of the fbm valley: every hit normal has y > 0.
+    let g = gpu(ctx, &params("valley", &[("view", "normal")]));
+    let hits: Vec<_> = g.data.iter().filter(|px| px[..3] != [0.0, 0.0, 0.0]).collect();
+    assert!(hits.len() > 1000);
+    assert!(hits.iter().all(|px| px[1] > 0.5), "a normal points down");
+}
+
+#[test]
+fn color_and_steps_match_reference() {
+    let Some(ctx) = vista_golden::gpu_for_test("heightfield color_and_steps_match_reference") else { return };
+    // Smaller than the other tests: the f64 reference shades every hit
+    // (normal, shadow march) on top of the brute-force search.
+    let (w, h) = (48, 30);
+    for preset in ["valley", "ridges", "fog"] {
+        let p = params(preset, &[]);
+        let g = vista_golden::render(ctx, &HeightfieldKernel, &p, w, h).expect("render").raw;
+        let r = HeightfieldKernel.reference(&p, w, h);
+        let psnr = vista_image::metrics::psnr(&r, &g);
+        eprintln!("heightfield {preset}: color PSNR GPU vs CPU {psnr:.1} dB");
+        assert!(psnr >= 30.0, "{preset}: color PSNR {psnr:.1} dB");
+    }
+    // Steps: the reference counts the f64 relax march; f32 may differ by a
+    // step or two at a few pixels.
+    let p = params("valley", &[("view", "steps")]);
+    let (g, r) = (gpu(ctx, &p), HeightfieldKernel.reference(&p, W, H));
+    let max_steps = p.f64("max_steps");
+    let diffs: Vec<f64> = g.data.iter().zip(&r.data).map(|(a, b)| ((a[0] - b[0]) as f64 * max_steps).abs()).collect();
+    let close = diffs.iter().filter(|d| **d <= 2.0).count();
+    eprintln!("heightfield valley steps: {close}/{} within 2 steps of the f64 march", diffs.len());
+    assert!(close * 100 >= diffs.len() * 97);
+}
