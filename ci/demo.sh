@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Renders every preset of every kernel into OUT (PNG display + EXR raw),
+# Renders every preset of every kernel into OUT (PNG display values),
 # then runs `vista check` over all golden cases and prints the report path.
 set -euo pipefail
 vista=${1:-target/debug/vista}

@@ -10,6 +10,7 @@ use vista_gpu::Context;
 use vista_image::metrics;
 
 mod bench;
+mod sweep;
 
 #[derive(Parser)]
 #[command(name = "vista", version, about = "Headless GPU compute validation for procedural WGSL kernels")]
@@ -66,6 +67,40 @@ enum Command {
         /// Delete golden images that no case refers to.
         #[arg(long)]
         prune: bool,
+    },
+    /// Sweep a parameter (or a grid of two) against a high-quality reference:
+    /// curve.csv, curve.svg, curve.png and a table naming the cheapest setting
+    /// reaching --target-psnr.
+    Sweep {
+        kernel: String,
+        #[arg(long)]
+        preset: Option<String>,
+        /// Fixed override NAME=VALUE for every point and the reference (repeatable).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        /// Numeric parameter to sweep.
+        #[arg(long)]
+        param: String,
+        /// Comma-separated values of --param, e.g. 8,16,32,64.
+        #[arg(long)]
+        values: String,
+        /// Second parameter for a 2-D grid (heat map).
+        #[arg(long, requires = "values2")]
+        param2: Option<String>,
+        #[arg(long, requires = "param2")]
+        values2: Option<String>,
+        /// Reference override NAME=VALUE (repeatable); default: the kernel's high-quality settings.
+        #[arg(long = "reference-set", value_name = "NAME=VALUE")]
+        reference_set: Vec<String>,
+        #[arg(long, default_value_t = vista_sweep::DEFAULT_TARGET_PSNR, allow_negative_numbers = true)]
+        target_psnr: f64,
+        #[arg(long, default_value = "128x128")]
+        size: String,
+        /// Timed renders per point (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        runs: u32,
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Median kernel throughput after a warm-up (excludes device creation and compilation).
     Bench {
@@ -183,6 +218,22 @@ fn run(cmd: Command) -> Result<i32, GoldenError> {
             println!("blessed {} cases on {}", summary.rows.len(), ctx.adapter_description());
             Ok(0)
         }
+        Command::Sweep { kernel, preset, set, param, values, param2, values2, reference_set, target_psnr, size, runs, out } => {
+            sweep::sweep(sweep::Args {
+                kernel,
+                preset,
+                set,
+                param,
+                values,
+                param2,
+                values2,
+                reference_set,
+                target_psnr,
+                size,
+                runs,
+                out,
+            })
+        }
         Command::Bench { kernel, preset, set, size, runs, json } => bench::bench(&kernel, preset.as_deref(), &set, &size, runs, json),
     }
 }
@@ -204,6 +255,19 @@ fn check_output_path(out: &Path) -> Result<(), GoldenError> {
     if !dir.is_dir() {
         return Err(bad(format!("output directory {} does not exist", dir.display())));
     }
+    probe_writable(&dir)
+}
+
+/// Creates the output directory of a sweep if needed and checks it is writable.
+pub fn check_output_dir(dir: &Path) -> Result<(), GoldenError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(bad(format!("--out {} exists and is not a directory", dir.display())));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| bad(format!("cannot create output directory {}: {e}", dir.display())))?;
+    probe_writable(dir)
+}
+
+fn probe_writable(dir: &Path) -> Result<(), GoldenError> {
     let probe = dir.join(format!(".vista-write-probe-{}", std::process::id()));
     std::fs::write(&probe, b"").map_err(|e| bad(format!("output directory {} is not writable: {e}", dir.display())))?;
     let _ = std::fs::remove_file(probe);

@@ -179,6 +179,71 @@ fn render_exr_holds_heightfield_depth_over_t_max() {
     assert!(agree * 100 >= 97 * img.data.len(), "EXR depth agrees with the CPU march at {agree}/640 pixels");
 }
 
+// ---- sweep ------------------------------------------------------------------
+
+/// A sweep's bad input fails before any render and writes nothing.
+#[test]
+fn sweep_rejects_bad_input_before_rendering() {
+    let d = tmp();
+    let out = d.path().join("sw");
+    let o = out.to_str().unwrap();
+    let cases: &[(&[&str], &[&str])] = &[
+        (&["sweep", "fbm", "--param", "octavez", "--values", "1,2", "--out", o], &["'octavez'", "octaves"]),
+        (&["sweep", "fbm", "--param", "basis", "--values", "perlin,value", "--out", o], &["basis", "numeric"]),
+        (&["sweep", "fbm", "--param", "octaves", "--values", "1,99", "--out", o], &["octaves=99", "[1, 16]"]),
+        (&["sweep", "fbm", "--param", "octaves", "--values", "1,,2", "--out", o], &["empty value"]),
+        (&["sweep", "fbm", "--param", "octaves", "--values", "1,2", "--target-psnr", "-3", "--out", o], &["-3", "[0, 200]"]),
+        (&["sweep", "fbm", "--param", "octaves", "--values", "2", "--param2", "octaves", "--values2", "3", "--out", o], &["both 'octaves'"]),
+        (&["sweep", "clouds", "--param", "steps", "--values", "8", "--reference-set", "light_steps=0", "--out", o], &["light_steps=0"]),
+    ];
+    for (args, needles) in cases {
+        assert_rejected(&vista(args), 2, needles);
+    }
+    assert!(!out.exists(), "a rejected sweep must not create its output directory");
+}
+
+#[test]
+fn sweep_writes_csv_plots_and_names_the_cheapest_setting() {
+    let d = tmp();
+    let out = d.path().join("sw");
+    let r = vista(&[
+        "sweep", "fbm", "--param", "octaves", "--values", "1,2,4,8,16", "--size", "48x48", "--runs", "1", "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let csv = std::fs::read_to_string(out.join("curve.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows[0], ["octaves", "psnr", "ssim", "max_abs", "bad_pixels", "gpu_ms", "work_per_pixel"]);
+    assert_eq!(rows.len(), 6, "{csv}");
+    // The reference is octaves=16, so that point is bit-identical to it.
+    assert_eq!(rows[5][1], "inf", "{csv}");
+    let psnr: Vec<f64> = rows[1..5].iter().map(|r| r[1].parse().unwrap()).collect();
+    assert!(psnr.windows(2).all(|w| w[1] > w[0]), "PSNR must grow with octaves: {psnr:?}");
+    let expected = rows[1..].iter().find(|r| r[1] == "inf" || r[1].parse::<f64>().unwrap() >= 40.0).unwrap()[0];
+    assert!(r.stdout.contains(&format!("cheapest reaching 40.0 dB: octaves={expected} ")), "{}", r.stdout);
+    if vista_sweep::find_font().is_some() {
+        let png = vista_image::load(&out.join("curve.png")).unwrap();
+        assert_eq!((png.width, png.height), (900, 560));
+        assert!(std::fs::read_to_string(out.join("curve.svg")).unwrap().contains("<svg"));
+    } else {
+        assert!(r.stderr.contains("NOT written"), "a missing font must be reported: {}", r.stderr);
+    }
+}
+
+#[test]
+fn sweep_grid_has_one_row_per_point() {
+    let d = tmp();
+    let out = d.path().join("grid");
+    let r = vista(&[
+        "sweep", "atmosphere", "--param", "view_samples", "--values", "4,16", "--param2", "light_samples", "--values2",
+        "2,8,32", "--size", "32x16", "--runs", "1", "--out", out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let csv = std::fs::read_to_string(out.join("curve.csv")).unwrap();
+    assert!(csv.starts_with("view_samples,light_samples,psnr,"), "{csv}");
+    assert_eq!(csv.lines().count(), 1 + 6, "{csv}");
+}
+
 // ---- golden store: a private golden dir per test --------------------------
 
 const CASES: &str = r#"

@@ -118,6 +118,10 @@ impl Kernel for FbmKernel {
         let m = noise_of(p).max_abs();
         ((0.5 - 0.5 * m) as f32, (0.5 + 0.5 * m) as f32)
     }
+    /// Sweeps compare octave counts against the most octaves allowed.
+    fn high_quality(&self) -> &'static [(&'static str, &'static str)] {
+        &[("octaves", "16")]
+    }
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
         let (n, f) = (noise_of(p), fbm_of(p));
         let (freq, [ox, oy], z) = (p.f64("frequency"), p.vec2("offset"), p.f64("z_slice"));

@@ -81,6 +81,10 @@ impl Kernel for RidgedKernel {
     fn work_per_pixel(&self, p: &ParamSet) -> f64 {
         p.f64("octaves")
     }
+    /// Sweeps compare octave counts against the most octaves allowed.
+    fn high_quality(&self) -> &'static [(&'static str, &'static str)] {
+        &[("octaves", "16")]
+    }
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
         let (n, r) = (noise_of(p), ridged_of(p));
         let (freq, z, inv) = (p.f64("frequency"), p.f64("z_slice"), 1.0 / ridged_max(&r));

@@ -1,0 +1,78 @@
+//! `vista sweep`: argument checking, a progress bar, and the printed table
+//! around `vista_sweep`.
+
+use std::path::PathBuf;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use vista_golden::GoldenError;
+use vista_gpu::Context;
+use vista_sweep::{Axis, SweepSpec};
+
+use crate::{bad, parse_sets};
+
+pub struct Args {
+    pub kernel: String,
+    pub preset: Option<String>,
+    pub set: Vec<String>,
+    pub param: String,
+    pub values: String,
+    pub param2: Option<String>,
+    pub values2: Option<String>,
+    pub reference_set: Vec<String>,
+    pub target_psnr: f64,
+    pub size: String,
+    pub runs: u32,
+    pub out: PathBuf,
+}
+
+pub fn sweep(a: Args) -> Result<i32, GoldenError> {
+    let kernel = vista_kernels::find(&a.kernel).map_err(bad)?;
+    let (width, height) = vista_kernels::parse_size(&a.size).map_err(bad)?;
+    let y = match (a.param2, a.values2) {
+        (Some(name), Some(v)) => Some(Axis { name, values: vista_sweep::parse_values("--values2", &v)? }),
+        _ => None,
+    };
+    let reference = if a.reference_set.is_empty() {
+        kernel.high_quality().iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    } else {
+        parse_sets(&a.reference_set)?
+    };
+    let spec = SweepSpec {
+        kernel,
+        preset: a.preset,
+        base: parse_sets(&a.set)?,
+        x: Axis { name: a.param, values: vista_sweep::parse_values("--values", &a.values)? },
+        y,
+        reference,
+        width,
+        height,
+        target_psnr: a.target_psnr,
+        runs: a.runs,
+    };
+    // Every value is checked before the device is touched.
+    spec.resolve()?;
+    crate::check_output_dir(&a.out)?;
+    let ctx = Context::shared()?;
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{bar:30}] {pos}/{len} {msg} ({elapsed})")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    let result = vista_sweep::run(ctx, &spec, |done, total, label| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        bar.set_message(label.to_string());
+    });
+    bar.finish_and_clear();
+    let sweep = result?;
+    print!("{}", sweep.table());
+    let (written, plot_problem) = sweep.write(&a.out)?;
+    for p in &written {
+        println!("wrote {}", p.display());
+    }
+    if let Some(why) = plot_problem {
+        eprintln!("warning: curve.svg and curve.png NOT written: {why}");
+    }
+    Ok(0)
+}

@@ -1,0 +1,302 @@
+//! Quality-versus-cost sweeps: render a kernel at every value of one
+//! parameter (or every point of a two-parameter grid), compare each render
+//! with a high-quality reference render, and record PSNR, SSIM, max-abs and
+//! GPU time, so users can pick the cheapest settings that still look right.
+//!
+//! Metrics are taken on display values (what a viewer sees, and what golden
+//! checks compare), PSNR peak 1. The cost of a point is the kernel's own work
+//! estimate (`Kernel::work_per_pixel`: octaves, steps x light steps, ...);
+//! measured GPU time breaks ties (e.g. `relax`, which changes no count).
+//!
+//! Not for: drawing progress bars (the caller gets a callback) or golden
+//! checks (`vista-golden`).
+
+mod plot;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use vista_golden::GoldenError;
+use vista_gpu::Context;
+use vista_image::metrics::{self, Metrics};
+use vista_kernels::{Kernel, Kind, ParamSet};
+
+pub use plot::{PlotError, find_font, write_plots};
+
+/// Default `--target-psnr` (dB).
+pub const DEFAULT_TARGET_PSNR: f64 = 40.0;
+
+/// One swept parameter and its values, as typed by the user.
+#[derive(Debug, Clone)]
+pub struct Axis {
+    pub name: String,
+    pub values: Vec<String>,
+}
+
+/// What to sweep.
+#[derive(Debug, Clone)]
+pub struct SweepSpec {
+    pub kernel: &'static dyn Kernel,
+    pub preset: Option<String>,
+    /// Fixed overrides applied to every point and to the reference.
+    pub base: Vec<(String, String)>,
+    pub x: Axis,
+    pub y: Option<Axis>,
+    /// Overrides of the reference render (default: the kernel's high-quality settings).
+    pub reference: Vec<(String, String)>,
+    pub width: u32,
+    pub height: u32,
+    pub target_psnr: f64,
+    /// Timed renders per point (median reported).
+    pub runs: u32,
+}
+
+/// One measured point.
+#[derive(Debug, Clone)]
+pub struct Point {
+    pub x: String,
+    pub y: Option<String>,
+    pub metrics: Metrics,
+    pub gpu_ms: f64,
+    /// `work_per_pixel` of the point's settings.
+    pub work: f64,
+}
+
+/// A finished sweep.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    pub spec: SweepSpec,
+    pub adapter: String,
+    pub reference_ms: f64,
+    pub reference_params: String,
+    pub points: Vec<Point>,
+}
+
+fn bad(e: impl std::fmt::Display) -> GoldenError {
+    GoldenError::BadInput(e.to_string())
+}
+
+/// Splits `a,b,c` into values; `a:b` style ranges are not accepted so a CSV
+/// row always shows exactly what was typed.
+pub fn parse_values(flag: &str, text: &str) -> Result<Vec<String>, GoldenError> {
+    let values: Vec<String> = text.split(',').map(|v| v.trim().to_string()).collect();
+    if values.iter().any(String::is_empty) {
+        return Err(bad(format!("{flag} '{text}' has an empty value; give a comma-separated list like 8,16,32")));
+    }
+    if values.len() > 64 {
+        return Err(bad(format!("{flag} has {} values; allowed: 1 to 64", values.len())));
+    }
+    Ok(values)
+}
+
+impl SweepSpec {
+    /// Every point's parameter set and the reference's, validated before
+    /// any GPU work: unknown names and out-of-range values fail here, and so
+    /// does a sweep whose total work is past the per-dispatch cap.
+    pub fn resolve(&self) -> Result<(ParamSet, Vec<(String, Option<String>, ParamSet)>), GoldenError> {
+        let k = self.kernel;
+        for axis in std::iter::once(&self.x).chain(&self.y) {
+            let spec = k.params().iter().find(|s| s.name == axis.name).ok_or_else(|| {
+                bad(format!(
+                    "{} has no parameter '{}'; valid: {}",
+                    k.name(),
+                    axis.name,
+                    k.params().iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+                ))
+            })?;
+            if !matches!(spec.kind, Kind::Float { .. } | Kind::Int { .. }) {
+                return Err(bad(format!(
+                    "{}: cannot sweep '{}' ({}); sweeps need a numeric parameter (use --set for choices)",
+                    k.name(),
+                    axis.name,
+                    spec.kind.range_text()
+                )));
+            }
+        }
+        if self.y.as_ref().is_some_and(|y| y.name == self.x.name) {
+            return Err(bad(format!("--param and --param2 are both '{}'", self.x.name)));
+        }
+        if !(1..=100).contains(&self.runs) {
+            return Err(bad(format!("--runs {} is out of range; allowed: [1, 100]", self.runs)));
+        }
+        if !self.target_psnr.is_finite() || !(0.0..=200.0).contains(&self.target_psnr) {
+            return Err(bad(format!("--target-psnr {} is out of range; allowed: [0, 200] dB", self.target_psnr)));
+        }
+        let preset = self.preset.as_deref();
+        let reference = k.resolve(preset, &[self.base.clone(), self.reference.clone()].concat()).map_err(bad)?;
+        vista_golden::check_request(k, &reference, self.width, self.height)?;
+        let ys: Vec<Option<&String>> = match &self.y {
+            Some(y) => y.values.iter().map(Some).collect(),
+            None => vec![None],
+        };
+        let mut points = Vec::new();
+        for yv in ys {
+            for xv in &self.x.values {
+                let mut set = self.base.clone();
+                set.push((self.x.name.clone(), xv.clone()));
+                if let (Some(axis), Some(v)) = (&self.y, yv) {
+                    set.push((axis.name.clone(), v.clone()));
+                }
+                let p = k.resolve(preset, &set).map_err(bad)?;
+                vista_golden::check_request(k, &p, self.width, self.height)?;
+                points.push((xv.clone(), yv.cloned(), p));
+            }
+        }
+        Ok((reference, points))
+    }
+}
+
+fn median_ms(ctx: &Context, k: &dyn Kernel, p: &ParamSet, w: u32, h: u32, runs: u32) -> Result<(f64, vista_golden::Rendered), GoldenError> {
+    let first = vista_golden::render(ctx, k, p, w, h)?;
+    let mut times = vec![first.stats.gpu_wall.as_secs_f64() * 1e3];
+    for _ in 1..runs {
+        times.push(vista_golden::render(ctx, k, p, w, h)?.stats.gpu_wall.as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    Ok((times[times.len() / 2], first))
+}
+
+/// Runs the sweep. `progress(done, total, label)` is called before each render group.
+pub fn run(ctx: &Context, spec: &SweepSpec, mut progress: impl FnMut(usize, usize, &str)) -> Result<Sweep, GoldenError> {
+    let (reference_params, points) = spec.resolve()?;
+    let (k, w, h) = (spec.kernel, spec.width, spec.height);
+    let total = points.len() + 1;
+    progress(0, total, "reference");
+    // Warm-up: pipeline compilation is not part of any timing.
+    vista_golden::render(ctx, k, &points[0].2, 8, 8)?;
+    let (reference_ms, reference) = median_ms(ctx, k, &reference_params, w, h, spec.runs)?;
+    if let Some((x, y)) = reference.raw.first_nonfinite() {
+        return Err(GoldenError::BadInput(format!("the reference render has NaN/Inf, first at ({x}, {y})")));
+    }
+    let mut out = Vec::with_capacity(points.len());
+    for (i, (xv, yv, p)) in points.iter().enumerate() {
+        let label = match yv {
+            Some(y) => format!("{}={xv} {}={y}", spec.x.name, spec.y.as_ref().map(|a| a.name.as_str()).unwrap_or("")),
+            None => format!("{}={xv}", spec.x.name),
+        };
+        progress(i + 1, total, &label);
+        let (gpu_ms, r) = median_ms(ctx, k, p, w, h, spec.runs)?;
+        let m = metrics::compare(&reference.display, &r.display)?;
+        out.push(Point { x: xv.clone(), y: yv.clone(), metrics: m, gpu_ms, work: k.work_per_pixel(p) });
+    }
+    progress(total, total, "done");
+    Ok(Sweep {
+        spec: spec.clone(),
+        adapter: ctx.adapter_description(),
+        reference_ms,
+        reference_params: reference_params.canonical(),
+        points: out,
+    })
+}
+
+fn fmt_psnr(p: f64) -> String {
+    if p.is_infinite() { "inf".into() } else { format!("{p:.2}") }
+}
+
+impl Sweep {
+    /// The cheapest point reaching the target PSNR: least work, then least time.
+    pub fn cheapest(&self) -> Option<&Point> {
+        self.points
+            .iter()
+            .filter(|p| p.metrics.psnr >= self.spec.target_psnr)
+            .min_by(|a, b| a.work.total_cmp(&b.work).then(a.gpu_ms.total_cmp(&b.gpu_ms)))
+    }
+
+    fn setting(&self, p: &Point) -> String {
+        match (&self.spec.y, &p.y) {
+            (Some(axis), Some(y)) => format!("{}={} {}={y}", self.spec.x.name, p.x, axis.name),
+            _ => format!("{}={}", self.spec.x.name, p.x),
+        }
+    }
+
+    /// `value[,value2],psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel`.
+    pub fn csv(&self) -> String {
+        let mut s = String::new();
+        let y_col = self.spec.y.as_ref().map(|a| format!(",{}", a.name)).unwrap_or_default();
+        let _ = writeln!(s, "{}{y_col},psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel", self.spec.x.name);
+        for p in &self.points {
+            let y = p.y.as_ref().map(|v| format!(",{v}")).unwrap_or_default();
+            let _ = writeln!(
+                s,
+                "{}{y},{},{:.6},{:.6e},{},{:.3},{}",
+                p.x,
+                fmt_psnr(p.metrics.psnr),
+                p.metrics.ssim,
+                p.metrics.max_abs,
+                p.metrics.bad_pixels,
+                p.gpu_ms,
+                p.work
+            );
+        }
+        s
+    }
+
+    /// The table printed to the terminal, ending with the cheapest setting.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        let sp = &self.spec;
+        let pairs = |v: &[(String, String)]| v.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
+        let _ = writeln!(
+            s,
+            "{} {}x{} on {}\nsweep: preset {}{}\nreference: {} ({:.1} ms)",
+            sp.kernel.name(),
+            sp.width,
+            sp.height,
+            self.adapter,
+            sp.preset.as_deref().unwrap_or("(defaults)"),
+            if sp.base.is_empty() { String::new() } else { format!(" + {}", pairs(&sp.base)) },
+            if sp.reference.is_empty() { "same settings".to_string() } else { pairs(&sp.reference) },
+            self.reference_ms
+        );
+        let _ = writeln!(s, "{:<32} {:>9} {:>8} {:>11} {:>10}", "setting", "PSNR dB", "SSIM", "max abs", "gpu ms");
+        for p in &self.points {
+            let mark = if p.metrics.psnr >= self.spec.target_psnr { "" } else { "  (below target)" };
+            let _ = writeln!(
+                s,
+                "{:<32} {:>9} {:>8.4} {:>11.3e} {:>10.2}{mark}",
+                self.setting(p),
+                fmt_psnr(p.metrics.psnr),
+                p.metrics.ssim,
+                p.metrics.max_abs,
+                p.gpu_ms
+            );
+        }
+        match self.cheapest() {
+            Some(p) => {
+                let _ = writeln!(
+                    s,
+                    "cheapest reaching {:.1} dB: {} ({} dB, {:.2} ms)",
+                    self.spec.target_psnr,
+                    self.setting(p),
+                    fmt_psnr(p.metrics.psnr),
+                    p.gpu_ms
+                );
+            }
+            None => {
+                let _ = writeln!(s, "no swept setting reaches {:.1} dB", self.spec.target_psnr);
+            }
+        }
+        s
+    }
+
+    /// Writes `curve.csv`, `summary.txt`, and (when a font is found)
+    /// `curve.svg` and `curve.png` into `dir`, atomically each. Returns the
+    /// written paths and, when the plots could not be drawn, why.
+    pub fn write(&self, dir: &Path) -> Result<(Vec<PathBuf>, Option<String>), GoldenError> {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| GoldenError::Io { path: dir.display().to_string(), message: format!("cannot create: {e}") })?;
+        let mut written = Vec::new();
+        for (name, text) in [("curve.csv", self.csv()), ("summary.txt", self.table())] {
+            let path = dir.join(name);
+            vista_image::atomic_write(&path, text.as_bytes())?;
+            written.push(path);
+        }
+        match write_plots(self, dir) {
+            Ok(paths) => {
+                written.extend(paths);
+                Ok((written, None))
+            }
+            Err(e) => Ok((written, Some(e.to_string()))),
+        }
+    }
+}
