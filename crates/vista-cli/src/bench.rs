@@ -17,7 +17,8 @@ pub fn bench(kernel: &str, preset: Option<&str>, set: &[String], size: &str, run
     vista_golden::check_request(k, &p, w, h)?;
     let ctx = Context::shared()?;
     // Warm-up: compiles the pipeline and touches every allocation path once.
-    vista_golden::render(ctx, k, &p, w, h)?;
+    // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
+    let first = vista_golden::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
     let mut times: Vec<Duration> = Vec::new();
     for _ in 0..runs {
         times.push(vista_golden::render(ctx, k, &p, w, h)?.stats.gpu_wall);
@@ -31,11 +32,18 @@ pub fn bench(kernel: &str, preset: Option<&str>, set: &[String], size: &str, run
             serde_json::json!({
                 "kernel": kernel, "width": w, "height": h, "runs": runs,
                 "median_ms": median * 1e3, "mpix_per_s": mpix,
+                "device_creation_ms": ctx.creation_time.as_secs_f64() * 1e3,
+                "first_dispatch_ms": first * 1e3,
                 "adapter": ctx.adapter_description(), "params": p.canonical(),
             })
         );
     } else {
         println!("{kernel} {w}x{h}: median {:.2} ms over {runs} runs, {mpix:.2} Mpix/s on {}", median * 1e3, ctx.adapter_description());
+        println!(
+            "device creation {:.1} ms, first call (compose + pipeline compile + dispatch + readback) {:.1} ms",
+            ctx.creation_time.as_secs_f64() * 1e3,
+            first * 1e3
+        );
     }
     Ok(0)
 }

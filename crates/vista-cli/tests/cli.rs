@@ -414,6 +414,8 @@ fn list_shows_params_ranges_and_presets() {
 fn bench_json_reports_throughput() {
     let r = vista(&["bench", "fbm", "--size", "64x64", "--runs", "3", "--json"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
-    assert!(r.stdout.contains("\"mpix_per_s\":"), "{}", r.stdout);
+    for field in ["\"mpix_per_s\":", "\"device_creation_ms\":", "\"first_dispatch_ms\":"] {
+        assert!(r.stdout.contains(field), "{field} missing: {}", r.stdout);
+    }
     assert_rejected(&vista(&["bench", "fbm", "--runs", "0"]), 2, &["--runs 0", "[1, 1000]"]);
 }
