@@ -99,6 +99,9 @@ enum Command {
         /// Timed renders per point (the median is reported).
         #[arg(long, default_value_t = 3)]
         runs: u32,
+        /// Compare display values (PSNR peak 1) or linear raw output (PSNR peak = reference max).
+        #[arg(long, default_value = "display", value_name = "display|linear")]
+        metric: String,
         #[arg(long)]
         out: PathBuf,
     },
@@ -218,7 +221,7 @@ fn run(cmd: Command) -> Result<i32, GoldenError> {
             println!("blessed {} cases on {}", summary.rows.len(), ctx.adapter_description());
             Ok(0)
         }
-        Command::Sweep { kernel, preset, set, param, values, param2, values2, reference_set, target_psnr, size, runs, out } => {
+        Command::Sweep { kernel, preset, set, param, values, param2, values2, reference_set, target_psnr, size, runs, metric, out } => {
             sweep::sweep(sweep::Args {
                 kernel,
                 preset,
@@ -231,6 +234,7 @@ fn run(cmd: Command) -> Result<i32, GoldenError> {
                 target_psnr,
                 size,
                 runs,
+                metric,
                 out,
             })
         }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use indicatif::{ProgressBar, ProgressStyle};
 use vista_golden::GoldenError;
 use vista_gpu::Context;
-use vista_sweep::{Axis, SweepSpec};
+use vista_sweep::{Axis, Metric, SweepSpec};
 
 use crate::{bad, parse_sets};
 
@@ -22,6 +22,7 @@ pub struct Args {
     pub target_psnr: f64,
     pub size: String,
     pub runs: u32,
+    pub metric: String,
     pub out: PathBuf,
 }
 
@@ -48,6 +49,7 @@ pub fn sweep(a: Args) -> Result<i32, GoldenError> {
         height,
         target_psnr: a.target_psnr,
         runs: a.runs,
+        metric: Metric::parse(&a.metric)?,
     };
     // Every value is checked before the device is touched.
     spec.resolve()?;

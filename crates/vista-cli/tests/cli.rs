@@ -195,6 +195,7 @@ fn sweep_rejects_bad_input_before_rendering() {
         (&["sweep", "fbm", "--param", "octaves", "--values", "1,2", "--target-psnr", "-3", "--out", o], &["-3", "[0, 200]"]),
         (&["sweep", "fbm", "--param", "octaves", "--values", "2", "--param2", "octaves", "--values2", "3", "--out", o], &["both 'octaves'"]),
         (&["sweep", "clouds", "--param", "steps", "--values", "8", "--reference-set", "light_steps=0", "--out", o], &["light_steps=0"]),
+        (&["sweep", "fbm", "--param", "octaves", "--values", "2", "--metric", "log", "--out", o], &["--metric=log", "display|linear"]),
     ];
     for (args, needles) in cases {
         assert_rejected(&vista(args), 2, needles);

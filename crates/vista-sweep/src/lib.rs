@@ -3,8 +3,10 @@
 //! with a high-quality reference render, and record PSNR, SSIM, max-abs and
 //! GPU time, so users can pick the cheapest settings that still look right.
 //!
-//! Metrics are taken on display values (what a viewer sees, and what golden
-//! checks compare), PSNR peak 1. The cost of a point is the kernel's own work
+//! Metrics are taken on display values by default (what a viewer sees, and
+//! what golden checks compare), PSNR peak 1; `Metric::Linear` compares the
+//! raw output instead, PSNR peak = max of the reference (SPEC 5's rule for
+//! HDR data). The cost of a point is the kernel's own work
 //! estimate (`Kernel::work_per_pixel`: octaves, steps x light steps, ...);
 //! measured GPU time breaks ties (e.g. `relax`, which changes no count).
 //!
@@ -25,6 +27,31 @@ pub use plot::{PlotError, find_font, write_plots};
 
 /// Default `--target-psnr` (dB).
 pub const DEFAULT_TARGET_PSNR: f64 = 40.0;
+
+/// What the images are compared on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Metric {
+    /// Display values (tone-mapped for HDR kernels), PSNR peak 1.
+    Display,
+    /// Raw output (linear radiance for HDR kernels), PSNR peak = reference max.
+    Linear,
+}
+
+impl Metric {
+    pub fn parse(text: &str) -> Result<Metric, GoldenError> {
+        match text {
+            "display" => Ok(Metric::Display),
+            "linear" => Ok(Metric::Linear),
+            _ => Err(bad(format!("--metric={text} is not valid; expected one of display|linear"))),
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Display => "display",
+            Metric::Linear => "linear",
+        }
+    }
+}
 
 /// One swept parameter and its values, as typed by the user.
 #[derive(Debug, Clone)]
@@ -49,6 +76,7 @@ pub struct SweepSpec {
     pub target_psnr: f64,
     /// Timed renders per point (median reported).
     pub runs: u32,
+    pub metric: Metric,
 }
 
 /// One measured point.
@@ -176,7 +204,10 @@ pub fn run(ctx: &Context, spec: &SweepSpec, mut progress: impl FnMut(usize, usiz
         };
         progress(i + 1, total, &label);
         let (gpu_ms, r) = median_ms(ctx, k, p, w, h, spec.runs)?;
-        let m = metrics::compare(&reference.display, &r.display)?;
+        let m = match spec.metric {
+            Metric::Display => metrics::compare(&reference.display, &r.display)?,
+            Metric::Linear => metrics::compare_hdr(&reference.raw, &r.raw)?,
+        };
         out.push(Point { x: xv.clone(), y: yv.clone(), metrics: m, gpu_ms, work: k.work_per_pixel(p) });
     }
     progress(total, total, "done");
@@ -238,13 +269,14 @@ impl Sweep {
         let pairs = |v: &[(String, String)]| v.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
         let _ = writeln!(
             s,
-            "{} {}x{} on {}\nsweep: preset {}{}\nreference: {} ({:.1} ms)",
+            "{} {}x{} on {}\nsweep: preset {}{}, metrics on {} values\nreference: {} ({:.1} ms)",
             sp.kernel.name(),
             sp.width,
             sp.height,
             self.adapter,
             sp.preset.as_deref().unwrap_or("(defaults)"),
             if sp.base.is_empty() { String::new() } else { format!(" + {}", pairs(&sp.base)) },
+            sp.metric.name(),
             if sp.reference.is_empty() { "same settings".to_string() } else { pairs(&sp.reference) },
             self.reference_ms
         );

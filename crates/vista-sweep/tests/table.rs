@@ -1,7 +1,7 @@
 //! CSV, table and cheapest-point logic on hand-made sweeps (no device).
 
 use vista_image::metrics::Metrics;
-use vista_sweep::{Axis, Point, Sweep, SweepSpec};
+use vista_sweep::{Axis, Metric, Point, Sweep, SweepSpec};
 
 fn point(x: &str, y: Option<&str>, psnr: f64, gpu_ms: f64, work: f64) -> Point {
     let metrics = Metrics { psnr, ssim: 0.99, max_abs: 0.01, bad_pixels: 3, nan: 0, mse: 1e-4 };
@@ -20,6 +20,7 @@ fn sweep(y: Option<Axis>, points: Vec<Point>) -> Sweep {
         height: 8,
         target_psnr: 40.0,
         runs: 1,
+        metric: Metric::Display,
     };
     Sweep { spec, adapter: "test".into(), reference_ms: 1.0, reference_params: String::new(), points }
 }
@@ -62,4 +63,12 @@ fn values_lists_are_checked() {
     assert!(vista_sweep::parse_values("--values", "8,,16").unwrap_err().to_string().contains("empty value"));
     let many = (0..65).map(|i| i.to_string()).collect::<Vec<_>>().join(",");
     assert!(vista_sweep::parse_values("--values", &many).unwrap_err().to_string().contains("65 values"));
+}
+
+#[test]
+fn metric_names_parse_and_bad_ones_are_named() {
+    assert_eq!(Metric::parse("linear").unwrap(), Metric::Linear);
+    assert_eq!(Metric::parse("display").unwrap(), Metric::Display);
+    let e = Metric::parse("log").unwrap_err().to_string();
+    assert!(e.contains("log") && e.contains("display|linear"), "{e}");
 }
