@@ -211,7 +211,7 @@ fn run(cmd: Command) -> Result<i32, GoldenError> {
             let store = Store::open_default();
             let ctx = Context::shared()?;
             let summary = vista_golden::bless(ctx, &store, &BlessOptions { glob: case, force, prune })?;
-            println!("{:<40} {:<10} {}", "case", "status", "PSNR new vs old");
+            println!("{:<40} {:<10} PSNR new vs old", "case", "status");
             for r in &summary.rows {
                 println!("{:<40} {:<10} {}", r.id, r.status, r.psnr_vs_previous);
             }

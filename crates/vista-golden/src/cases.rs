@@ -118,11 +118,10 @@ pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
                 return Err(bad(format!("{name}={v} is out of range; allowed: [0, 200] dB")));
             }
         }
-        if let Some(s) = raw.min_ssim {
-            if !(-1.0..=1.0).contains(&s) {
+        if let Some(s) = raw.min_ssim
+            && !(-1.0..=1.0).contains(&s) {
                 return Err(bad(format!("min_ssim={s} is out of range; allowed: [-1, 1]")));
             }
-        }
         out.push(Case {
             id: raw.id,
             kernel,

@@ -229,11 +229,10 @@ fn judge(
             out.psnr_threshold
         ));
     }
-    if let Some(t) = case.min_ssim {
-        if m.ssim < t {
+    if let Some(t) = case.min_ssim
+        && m.ssim < t {
             out.problems.push(format!("SSIM {:.5} is below the threshold {t}", m.ssim));
         }
-    }
     out.metrics = Some(m);
     Ok(())
 }

@@ -25,11 +25,10 @@ pub enum AdapterChoice {
 impl AdapterChoice {
     /// `WGPU_ADAPTER_NAME` wins, then `VISTA_ADAPTER=gpu|cpu`, else software.
     pub fn from_env() -> Result<AdapterChoice, GpuError> {
-        if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME") {
-            if !name.is_empty() {
+        if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME")
+            && !name.is_empty() {
                 return Ok(AdapterChoice::Named(name));
             }
-        }
         match std::env::var("VISTA_ADAPTER").as_deref() {
             Err(_) | Ok("") | Ok("cpu") | Ok("software") | Ok("lavapipe") => Ok(AdapterChoice::Software),
             Ok("gpu") | Ok("hardware") => Ok(AdapterChoice::Hardware),

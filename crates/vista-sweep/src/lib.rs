@@ -60,6 +60,9 @@ pub struct Axis {
     pub values: Vec<String>,
 }
 
+/// A point to render: x value, y value (2-D sweeps), resolved parameters.
+pub type SweepPoint = (String, Option<String>, ParamSet);
+
 /// What to sweep.
 #[derive(Debug, Clone)]
 pub struct SweepSpec {
@@ -121,7 +124,7 @@ impl SweepSpec {
     /// Every point's parameter set and the reference's, validated before
     /// any GPU work: unknown names and out-of-range values fail here, and so
     /// does a sweep whose total work is past the per-dispatch cap.
-    pub fn resolve(&self) -> Result<(ParamSet, Vec<(String, Option<String>, ParamSet)>), GoldenError> {
+    pub fn resolve(&self) -> Result<(ParamSet, Vec<SweepPoint>), GoldenError> {
         let k = self.kernel;
         for axis in std::iter::once(&self.x).chain(&self.y) {
             let spec = k.params().iter().find(|s| s.name == axis.name).ok_or_else(|| {
