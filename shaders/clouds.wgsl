@@ -5,6 +5,7 @@
 #import vista::fractal::{FbmSettings, fbm3}
 #import vista::hash::{pcg3d, unit_from_hash}
 #import vista::phase::dual_hg_phase
+#import vista::geometry::pinhole_ray
 
 struct Params {
     width: u32,
@@ -167,12 +168,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let size = vec2<f32>(f32(params.width), f32(params.height));
     let uv = (vec2<f32>(id.xy) + 0.5) / size;
-    let sx = (2.0 * uv.x - 1.0) * params.tan_half_fov * (size.x / size.y);
-    let sy = (1.0 - 2.0 * uv.y) * params.tan_half_fov;
-    let fwd = vec3(params.fwd_x, params.fwd_y, params.fwd_z);
-    let right = vec3(params.right_x, params.right_y, params.right_z);
-    let up = vec3(params.up_x, params.up_y, params.up_z);
-    let d = normalize(fwd + sx * right + sy * up);
+    let d = pinhole_ray(uv, params.tan_half_fov, size.x / size.y, vec3(params.fwd_x, params.fwd_y, params.fwd_z),
+                        vec3(params.right_x, params.right_y, params.right_z), vec3(params.up_x, params.up_y, params.up_z));
     let o = vec3(params.cam_x, params.cam_y, params.cam_z);
 
     let zenith = vec3(params.zenith_r, params.zenith_g, params.zenith_b);

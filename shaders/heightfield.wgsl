@@ -3,6 +3,7 @@
 // hit at p.y - h < eps * t, refined by interpolation; Lambert sun, soft
 // shadow, sky ambient, fog with extinction sigma = 3.912 / visibility.
 #import vista::fractal::{FbmSettings, RidgedSettings, fbm2, ridged2}
+#import vista::geometry::pinhole_ray
 
 struct Params {
     width: u32,
@@ -226,11 +227,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(f32(params.width), f32(params.height));
     let o = vec3(params.cam_x, params.cam_y, params.cam_z);
-    let fwd = vec3(params.fwd_x, params.fwd_y, params.fwd_z);
-    let right = vec3(params.right_x, params.right_y, params.right_z);
-    let up = vec3(params.up_x, params.up_y, params.up_z);
-    let d = normalize(fwd + (2.0 * uv.x - 1.0) * params.tan_half_fov * params.aspect * right
-                      + (1.0 - 2.0 * uv.y) * params.tan_half_fov * up);
+    let d = pinhole_ray(uv, params.tan_half_fov, params.aspect, vec3(params.fwd_x, params.fwd_y, params.fwd_z),
+                        vec3(params.right_x, params.right_y, params.right_z), vec3(params.up_x, params.up_y, params.up_z));
     let m = march(o, d);
     var rgb: vec3<f32>;
     if params.view == VIEW_STEPS {

@@ -1,5 +1,14 @@
-// Ray geometry shared by the sky and cloud kernels.
+// Ray geometry shared by the sky, cloud and heightfield kernels.
 #define_import_path vista::geometry
+
+// SPEC 3.4 pinhole camera: the unit ray through the pixel-centre coordinates
+// uv (v down) for the basis fwd/right/up, tan(fov / 2) and aspect W / H.
+// Twin of `Camera::ray` in crates/vista-kernels/src/geometry.rs.
+fn pinhole_ray(uv: vec2<f32>, tan_half_fov: f32, aspect: f32, fwd: vec3<f32>, right: vec3<f32>, up: vec3<f32>) -> vec3<f32> {
+    let sx = (2.0 * uv.x - 1.0) * tan_half_fov * aspect;
+    let sy = (1.0 - 2.0 * uv.y) * tan_half_fov;
+    return normalize(fwd + sx * right + sy * up);
+}
 
 // Distances (t0, t1), t0 <= t1, where the ray o + t d (d unit) meets the
 // sphere of radius r centred at the origin; (-1, -1) when it misses.

@@ -1,7 +1,5 @@
 //! `vista bench`: median kernel throughput after a warm-up run.
 
-use std::time::Duration;
-
 use vista_golden::GoldenError;
 use vista_gpu::Context;
 
@@ -19,12 +17,7 @@ pub fn bench(kernel: &str, preset: Option<&str>, set: &[String], size: &str, run
     // Warm-up: compiles the pipeline and touches every allocation path once.
     // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
     let first = vista_golden::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
-    let mut times: Vec<Duration> = Vec::new();
-    for _ in 0..runs {
-        times.push(vista_golden::render(ctx, k, &p, w, h)?.stats.gpu_wall);
-    }
-    times.sort();
-    let median = times[times.len() / 2].as_secs_f64();
+    let median = vista_golden::render_median(ctx, k, &p, w, h, runs)?.1.as_secs_f64();
     let mpix = (w as f64 * h as f64) / 1e6 / median;
     if json {
         println!(

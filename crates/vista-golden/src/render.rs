@@ -51,6 +51,25 @@ pub fn render(ctx: &Context, kernel: &dyn Kernel, p: &ParamSet, width: u32, heig
     Ok(Rendered { raw, display, stats })
 }
 
+/// Renders `runs` (at least 1) times; returns the first render and the
+/// median GPU wall time, for benchmarks and sweeps.
+pub fn render_median(
+    ctx: &Context,
+    kernel: &dyn Kernel,
+    p: &ParamSet,
+    width: u32,
+    height: u32,
+    runs: u32,
+) -> Result<(Rendered, std::time::Duration), GoldenError> {
+    let first = render(ctx, kernel, p, width, height)?;
+    let mut times = vec![first.stats.gpu_wall];
+    for _ in 1..runs {
+        times.push(render(ctx, kernel, p, width, height)?.stats.gpu_wall);
+    }
+    times.sort();
+    Ok((first, times[times.len() / 2]))
+}
+
 /// Display values as a 16-bit PNG stores them, so a fresh render compares
 /// with a golden exactly as it would after being blessed.
 pub fn quantize16(img: &Image) -> Image {

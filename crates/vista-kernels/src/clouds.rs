@@ -35,6 +35,8 @@
 //! WGSL in `shaders/clouds.wgsl` does the same in f32.
 
 use crate::fbm::{LACUNARITY, SEED};
+pub use crate::geometry::direction;
+use crate::geometry::{Camera, V3, add, dot, scale, smoothstep};
 use crate::noise::{Basis, Fbm, Noise, pcg3d};
 use crate::phase::dual_hg;
 use crate::{Kernel, Kind, Output, ParamError, ParamSet, ParamSpec, Preset, Uniforms, render_cpu};
@@ -370,29 +372,6 @@ pub enum Profile {
     Anvil,
 }
 
-type V3 = [f64; 3];
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn scale(a: V3, s: f64) -> V3 {
-    a.map(|c| c * s)
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn normalize(a: V3) -> V3 {
-    scale(a, 1.0 / dot(a, a).sqrt())
-}
-
-/// Unit vector at azimuth `az` (from +z toward +x) and elevation `el`, radians.
-pub fn direction(az: f64, el: f64) -> V3 {
-    [el.cos() * az.sin(), el.sin(), el.cos() * az.cos()]
-}
-
 /// remap(x, a, b, c, d) = c + (x - a)(d - c)/(b - a); with b == a (no
 /// interval) it is the step c below and d above a. Clouds only use it with
 /// a = 1 - coverage, b = 1, so coverage 0 gives c = 0 for every G <= 1.
@@ -401,11 +380,6 @@ pub fn remap(x: f64, a: f64, b: f64, c: f64, d: f64) -> f64 {
         return if x > a { d } else { c };
     }
     c + (x - a) * (d - c) / (b - a)
-}
-
-fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
 }
 
 /// Height profile in [0, 1] of the normalised height h in the slab:
@@ -484,11 +458,8 @@ pub struct Clouds {
     pub fbm: Fbm,
     pub noise: Noise,
     pub inv_amplitude: f64,
-    pub camera: V3,
-    pub forward: V3,
-    pub right: V3,
-    pub up: V3,
-    pub tan_half_fov: f64,
+    /// Position and basis; the aspect is set per image in [`Clouds::ray`].
+    pub view: Camera,
     pub max_distance: f64,
     pub sun_dir: V3,
     /// sun_color * sun_intensity.
@@ -515,9 +486,8 @@ impl Clouds {
         let fbm = Fbm { octaves: p.u32("octaves"), lacunarity: p.f64("lacunarity"), gain: p.f64("gain"), theta: 0.0 };
         let stretch = p.vec3("noise_stretch");
         let ns = p.f64("noise_scale");
+        // pitch is within +-89 deg, so forward is never vertical.
         let forward = direction(p.f64("yaw_deg").to_radians(), p.f64("pitch_deg").to_radians());
-        let right = normalize(cross(forward, [0.0, 1.0, 0.0]));
-        let up = cross(right, forward);
         let sun_color = p.vec3("sun_color");
         Clouds {
             base: p.f64("cloud_base_km"),
@@ -537,11 +507,7 @@ impl Clouds {
             fbm,
             noise: Noise::new(Basis::Perlin, p.u32("seed")),
             inv_amplitude: 1.0 / fbm.amplitude_sum(),
-            camera: p.vec3("camera_pos"),
-            forward,
-            right,
-            up,
-            tan_half_fov: (p.f64("fov_deg").to_radians() * 0.5).tan(),
+            view: Camera::looking(p.vec3("camera_pos"), forward, p.f64("fov_deg"), 1.0),
             max_distance: p.f64("max_distance_km"),
             sun_dir: direction(p.f64("sun_azimuth_deg").to_radians(), p.f64("sun_elevation_deg").to_radians()),
             sun: sun_color.map(|c| c * p.f64("sun_intensity")),
@@ -590,11 +556,8 @@ impl Clouds {
     /// The camera ray through the centre of pixel (x, y).
     pub fn ray(&self, x: u32, y: u32, width: u32, height: u32) -> (V3, V3) {
         let (u, v) = crate::pixel_uv(x, y, width, height);
-        let aspect = width as f64 / height as f64;
-        let sx = (2.0 * u - 1.0) * self.tan_half_fov * aspect;
-        let sy = (1.0 - 2.0 * v) * self.tan_half_fov;
-        let d = normalize(add(add(self.forward, scale(self.right, sx)), scale(self.up, sy)));
-        (self.camera, d)
+        let camera = Camera { aspect: width as f64 / height as f64, ..self.view };
+        (camera.pos, camera.ray(u, v))
     }
 
     /// Background sky: horizon + (zenith - horizon) * clamp(d.y, 0, 1).
@@ -799,11 +762,11 @@ impl Kernel for CloudsKernel {
             .f32("profile_top", c.profile_top as f32)
             .vec3(["freq_x", "freq_y", "freq_z"], c.frequency)
             .vec3(["wind_x", "wind_y", "wind_z"], c.wind)
-            .vec3(["cam_x", "cam_y", "cam_z"], c.camera)
-            .vec3(["fwd_x", "fwd_y", "fwd_z"], c.forward)
-            .vec3(["right_x", "right_y", "right_z"], c.right)
-            .vec3(["up_x", "up_y", "up_z"], c.up)
-            .f32("tan_half_fov", c.tan_half_fov as f32)
+            .vec3(["cam_x", "cam_y", "cam_z"], c.view.pos)
+            .vec3(["fwd_x", "fwd_y", "fwd_z"], c.view.forward)
+            .vec3(["right_x", "right_y", "right_z"], c.view.right)
+            .vec3(["up_x", "up_y", "up_z"], c.view.up)
+            .f32("tan_half_fov", c.view.tan_half as f32)
             .f32("max_distance", c.max_distance as f32)
             .f32("light_first", c.light_step_layout().0 as f32)
             .f32("light_growth", c.light_step_layout().1 as f32)

@@ -48,6 +48,8 @@
 use crate::fbm::{BASIS, LACUNARITY, OCTAVES, SEED};
 use crate::noise::{BASIS_NAMES, Basis, Fbm, Noise, Ridged};
 use crate::ridged::ridged_max;
+pub use crate::geometry::{Camera, V3};
+use crate::geometry::{add, direction, dot, mix3, normalize, scale, smoothstep};
 use crate::{Kernel, Kind, ParamError, ParamSet, ParamSpec, Preset, Uniforms, render_cpu};
 use vista_image::Image;
 
@@ -217,95 +219,6 @@ const PRESETS: &[Preset] = &[
     },
 ];
 
-// ---------------------------------------------------------------- vectors
-
-type V3 = [f64; 3];
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn mul(a: V3, s: f64) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn length(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn normalize(a: V3) -> V3 {
-    mul(a, 1.0 / length(a))
-}
-fn mix3(a: V3, b: V3, t: f64) -> V3 {
-    add(mul(a, 1.0 - t), mul(b, t))
-}
-fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
-
-// ---------------------------------------------------------------- camera
-
-/// The pinhole camera of SPEC 3.4.
-#[derive(Debug, Clone, Copy)]
-pub struct Camera {
-    pub pos: V3,
-    pub forward: V3,
-    pub right: V3,
-    pub up: V3,
-    /// tan(fov / 2), fov vertical.
-    pub tan_half: f64,
-    /// W / H.
-    pub aspect: f64,
-}
-
-impl Camera {
-    /// f = normalize(target - pos), r = normalize(cross(f, (0,1,0))), up = cross(r, f).
-    /// Errors when target == pos or the view is vertical (r undefined).
-    pub fn new(pos: V3, target: V3, fov_deg: f64, aspect: f64) -> Result<Camera, ParamError> {
-        let delta = sub(target, pos);
-        let dist = length(delta);
-        if dist < 1e-9 {
-            return Err(ParamError::Invalid(format!(
-                "heightfield: camera_target ({}) equals camera_pos ({}); the view direction is undefined",
-                fmt3(target),
-                fmt3(pos)
-            )));
-        }
-        let forward = mul(delta, 1.0 / dist);
-        let side = cross(forward, [0.0, 1.0, 0.0]);
-        // |cross(f, y)| = sin of the angle to the vertical; 1e-6 rad is still
-        // well conditioned in f32 once normalised here in f64.
-        if length(side) < 1e-6 {
-            return Err(ParamError::Invalid(format!(
-                "heightfield: the view direction camera_target - camera_pos = ({}) is vertical, so \
-                 right = cross(f, (0,1,0)) is zero; move camera_target off the vertical through camera_pos",
-                fmt3(delta)
-            )));
-        }
-        let right = normalize(side);
-        let up = cross(right, forward);
-        Ok(Camera { pos, forward, right, up, tan_half: (fov_deg.to_radians() * 0.5).tan(), aspect })
-    }
-
-    /// Unit ray direction through the pixel-centre coordinates (u, v).
-    pub fn ray(&self, u: f64, v: f64) -> V3 {
-        let a = (2.0 * u - 1.0) * self.tan_half * self.aspect;
-        let b = (1.0 - 2.0 * v) * self.tan_half;
-        normalize(add(self.forward, add(mul(self.right, a), mul(self.up, b))))
-    }
-}
-
-fn fmt3(v: V3) -> String {
-    format!("{},{},{}", v[0], v[1], v[2])
-}
-
 // ---------------------------------------------------------------- terrain
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -412,7 +325,7 @@ impl Terrain {
 
     /// Height of the ray point o + t d above the terrain, D(t) = p.y - h(p.xz).
     pub fn above(&self, o: V3, d: V3, t: f64) -> f64 {
-        let p = add(o, mul(d, t));
+        let p = add(o, scale(d, t));
         p[1] - self.height(p[0], p[2])
     }
 
@@ -593,8 +506,7 @@ pub fn brute_force_hit(terrain: &Terrain, o: V3, d: V3, t_max: f64, eps: f64, st
 
 /// Unit direction toward the sun (azimuth 0 = +z, 90 = +x).
 pub fn sun_direction(azimuth_deg: f64, elevation_deg: f64) -> V3 {
-    let (a, e) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
-    [e.cos() * a.sin(), e.sin(), e.cos() * a.cos()]
+    direction(azimuth_deg.to_radians(), elevation_deg.to_radians())
 }
 
 /// Fog extinction (1/km) for a meteorological visibility V (km): 3.912 / V.
@@ -607,7 +519,7 @@ pub fn fog_extinction(visibility_km: f64) -> f64 {
 /// (c - horizon) therefore falls as T: to 2% at t = V.
 pub fn apply_fog(c: V3, t: f64, sigma: f64) -> V3 {
     let tr = (-sigma * t).exp();
-    add(mul(c, tr), mul(SKY_HORIZON, 1.0 - tr))
+    add(scale(c, tr), scale(SKY_HORIZON, 1.0 - tr))
 }
 
 /// The fixed sky gradient: horizon colour at and below the horizon, zenith
@@ -670,13 +582,13 @@ impl Scene {
 
     /// Surface normal at the hit at distance t along d.
     pub fn normal_at(&self, d: V3, t: f64) -> V3 {
-        let p = add(self.camera.pos, mul(d, t));
+        let p = add(self.camera.pos, scale(d, t));
         self.terrain.normal(p[0], p[2], Terrain::normal_step(p[0], p[2], self.march.eps, t))
     }
 
     /// Linear colour of a terrain hit at distance t along d.
     pub fn shade(&self, d: V3, t: f64) -> V3 {
-        let hit = add(self.camera.pos, mul(d, t));
+        let hit = add(self.camera.pos, scale(d, t));
         let (x, z) = (hit[0], hit[2]);
         let h = self.terrain.height(x, z);
         let n = self.normal_at(d, t);

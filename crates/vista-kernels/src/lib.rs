@@ -6,6 +6,7 @@
 //! Kernels never touch the file system.
 
 pub mod fbm;
+pub mod geometry;
 pub mod heightfield;
 pub mod clouds;
 pub mod atmosphere;

@@ -177,16 +177,6 @@ impl SweepSpec {
     }
 }
 
-fn median_ms(ctx: &Context, k: &dyn Kernel, p: &ParamSet, w: u32, h: u32, runs: u32) -> Result<(f64, vista_golden::Rendered), GoldenError> {
-    let first = vista_golden::render(ctx, k, p, w, h)?;
-    let mut times = vec![first.stats.gpu_wall.as_secs_f64() * 1e3];
-    for _ in 1..runs {
-        times.push(vista_golden::render(ctx, k, p, w, h)?.stats.gpu_wall.as_secs_f64() * 1e3);
-    }
-    times.sort_by(f64::total_cmp);
-    Ok((times[times.len() / 2], first))
-}
-
 /// Runs the sweep. `progress(done, total, label)` is called before each render group.
 pub fn run(ctx: &Context, spec: &SweepSpec, mut progress: impl FnMut(usize, usize, &str)) -> Result<Sweep, GoldenError> {
     let (reference_params, points) = spec.resolve()?;
@@ -195,7 +185,8 @@ pub fn run(ctx: &Context, spec: &SweepSpec, mut progress: impl FnMut(usize, usiz
     progress(0, total, "reference");
     // Warm-up: pipeline compilation is not part of any timing.
     vista_golden::render(ctx, k, &points[0].2, 8, 8)?;
-    let (reference_ms, reference) = median_ms(ctx, k, &reference_params, w, h, spec.runs)?;
+    let (reference, reference_time) = vista_golden::render_median(ctx, k, &reference_params, w, h, spec.runs)?;
+    let reference_ms = reference_time.as_secs_f64() * 1e3;
     if let Some((x, y)) = reference.raw.first_nonfinite() {
         return Err(GoldenError::BadInput(format!("the reference render has NaN/Inf, first at ({x}, {y})")));
     }
@@ -206,7 +197,8 @@ pub fn run(ctx: &Context, spec: &SweepSpec, mut progress: impl FnMut(usize, usiz
             None => format!("{}={xv}", spec.x.name),
         };
         progress(i + 1, total, &label);
-        let (gpu_ms, r) = median_ms(ctx, k, p, w, h, spec.runs)?;
+        let (r, time) = vista_golden::render_median(ctx, k, p, w, h, spec.runs)?;
+        let gpu_ms = time.as_secs_f64() * 1e3;
         let m = match spec.metric {
             Metric::Display => metrics::compare(&reference.display, &r.display)?,
             Metric::Linear => metrics::compare_hdr(&reference.raw, &r.raw)?,
