@@ -13,6 +13,8 @@ fn max_field_error(gpu: &Image, cpu: &Image) -> (f32, (u32, u32)) {
     let mut worst = (0.0f32, (0, 0));
     for (i, (g, c)) in gpu.data.iter().zip(&cpu.data).enumerate() {
         let e = (g[0] - c[0]).abs();
+        // Negated so that a NaN error becomes the worst.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(e <= worst.0) {
             worst = (e, (i as u32 % gpu.width, i as u32 / gpu.width));
         }
@@ -20,7 +22,10 @@ fn max_field_error(gpu: &Image, cpu: &Image) -> (f32, (u32, u32)) {
     worst
 }
 
-fn gpu_vs_cpu(kernel_name: &str, cases: &[(Option<&str>, &[(&str, &str)])]) {
+/// (preset, overrides) of one comparison.
+type Setting<'a> = (Option<&'a str>, &'a [(&'a str, &'a str)]);
+
+fn gpu_vs_cpu(kernel_name: &str, cases: &[Setting]) {
     let Some(ctx) = vista_golden::gpu_for_test(kernel_name) else { return };
     let k = vista_kernels::find(kernel_name).unwrap();
     for (preset, set) in cases {

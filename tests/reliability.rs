@@ -36,6 +36,9 @@ impl Kernel for NanKernel {
     fn reference(&self, _p: &ParamSet, width: u32, height: u32) -> Image {
         Image::from_fn(width, height, |_, _| [0.5, 0.5, 0.5, 1.0])
     }
+    fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image {
+        self.reference(p, width, height)
+    }
 }
 
 static NAN: NanKernel = NanKernel;

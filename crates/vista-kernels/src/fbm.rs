@@ -1,7 +1,8 @@
 //! `fbm`: 2D fractional Brownian motion over a noise basis (SPEC 3.2).
 
-use crate::noise::{BASIS_NAMES, Basis, Fbm, Noise};
-use crate::{Kernel, Kind, ParamError, ParamSet, ParamSpec, Preset, Uniforms, render_cpu};
+pub use crate::cpu64::fbm::{fbm_of, noise_of};
+use crate::noise::BASIS_NAMES;
+use crate::{Kernel, Kind, ParamError, ParamSet, ParamSpec, Preset, Uniforms};
 use vista_image::Image;
 
 /// The noise parameters shared by `fbm`, `ridged` and the kernels built on them.
@@ -44,21 +45,6 @@ const PRESETS: &[Preset] = &[
         set: &[("octaves", "12"), ("gain", "0.65"), ("lacunarity", "2.1")],
     },
 ];
-
-/// Builds the seeded noise basis named by `basis` / `seed`.
-pub fn noise_of(p: &ParamSet) -> Noise {
-    Noise::new(Basis::from_name(p.choice("basis")), p.u32("seed"))
-}
-
-/// The fBm octave settings of a parameter set.
-pub fn fbm_of(p: &ParamSet) -> Fbm {
-    Fbm {
-        octaves: p.u32("octaves"),
-        lacunarity: p.f64("lacunarity"),
-        gain: p.f64("gain"),
-        theta: p.f64("octave_rotation_deg").to_radians(),
-    }
-}
 
 /// Table binding for noise kernels: the 512-entry permutation.
 pub fn noise_table(p: &ParamSet) -> Vec<u32> {
@@ -123,12 +109,9 @@ impl Kernel for FbmKernel {
         &[("octaves", "16")]
     }
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
-        let (n, f) = (noise_of(p), fbm_of(p));
-        let (freq, [ox, oy], z) = (p.f64("frequency"), p.vec2("offset"), p.f64("z_slice"));
-        let inv_a = 1.0 / f.amplitude_sum();
-        render_cpu(width, height, |u, v, _, _| {
-            let value = 0.5 + 0.5 * f.eval(&n, [freq * u + ox, freq * v + oy], z) * inv_a;
-            [value, value, value, 1.0]
-        })
+        crate::cpu64::fbm::render(p, width, height)
+    }
+    fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image {
+        crate::cpu32::fbm::render(p, width, height)
     }
 }

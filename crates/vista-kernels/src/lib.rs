@@ -1,22 +1,69 @@
 //! vista's kernels: one module per kernel with its typed parameters, presets,
-//! range validation, uniform layout for its WGSL entry point, and an f64 CPU
-//! reference written from the math in SPEC.
+//! range validation and uniform layout for its WGSL entry point; and the CPU
+//! references written from the math in SPEC (`src/cpu/`), built twice: in
+//! f64 as the oracles ([`cpu64`], re-exported by each kernel module) and in
+//! f32 as the throughput baseline ([`cpu32`]).
 //!
 //! Not for: GPU work (see `vista-gpu`), files or goldens (see `vista-golden`).
 //! Kernels never touch the file system.
 
-pub mod fbm;
-pub mod geometry;
-pub mod heightfield;
-pub mod clouds;
+/// Declares the CPU reference modules of `src/cpu/` for one float type: the
+/// same source compiled once per precision, so the f32 baseline cannot drift
+/// from the f64 oracle. Literals take the type from context; code names the
+/// float type `Real` and glam's 3-vector `Vec3`.
+macro_rules! cpu_references {
+    ($real:ident, $vec3:ty) => {
+        /// The float type this build computes in.
+        pub type Real = $real;
+        /// glam's 3-vector of [`Real`].
+        pub type Vec3 = $vec3;
+        pub use std::$real::consts;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/common.rs"]
+        mod common;
+        pub use common::*;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/geometry.rs"]
+        pub mod geometry;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/phase.rs"]
+        pub mod phase;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/noise.rs"]
+        pub mod noise;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/fbm.rs"]
+        pub mod fbm;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/ridged.rs"]
+        pub mod ridged;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/atmosphere.rs"]
+        pub mod atmosphere;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/clouds.rs"]
+        pub mod clouds;
+        #[allow(clippy::duplicate_mod)]
+        #[path = "cpu/heightfield.rs"]
+        pub mod heightfield;
+    };
+}
+
+pub mod cpu32;
+pub mod cpu64;
+
 pub mod atmosphere;
+pub mod clouds;
+pub mod fbm;
+pub mod heightfield;
 pub mod noise;
 pub mod params;
 pub mod phase;
 pub mod ridged;
 mod uniforms;
 
-use rayon::prelude::*;
+pub use cpu64::geometry;
+pub use cpu64::{pixel_uv, render_cpu};
 pub use params::{Kind, ParamSet, ParamSpec, Preset, Value};
 pub use uniforms::{Field, Uniforms};
 use vista_image::Image;
@@ -75,6 +122,9 @@ pub trait Kernel: Send + Sync {
     fn work_per_pixel(&self, p: &ParamSet) -> f64;
     /// The f64 CPU reference of the raw output (what the GPU writes).
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image;
+    /// The same reference computed in f32 ([`cpu32`]): a throughput
+    /// baseline for benches, not an oracle.
+    fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image;
     /// Inclusive bounds every RGB value of the raw output must respect.
     fn output_bounds(&self, _p: &ParamSet) -> (f32, f32) {
         (0.0, 1.0)
@@ -149,22 +199,4 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), ParamError> {
     let h: u32 = h.trim().parse().map_err(|_| bad())?;
     check_size(w, h)?;
     Ok((w, h))
-}
-
-/// Pixel-centre coordinates (SPEC 3): u = (x + 0.5) / W, v = (y + 0.5) / H.
-pub fn pixel_uv(x: u32, y: u32, width: u32, height: u32) -> (f64, f64) {
-    ((x as f64 + 0.5) / width as f64, (y as f64 + 0.5) / height as f64)
-}
-
-/// Evaluates `f(u, v, x, y)` at every pixel on all cores, storing f32.
-pub fn render_cpu(width: u32, height: u32, f: impl Fn(f64, f64, u32, u32) -> [f64; 4] + Sync) -> Image {
-    let data: Vec<[f32; 4]> = (0..width * height)
-        .into_par_iter()
-        .map(|i| {
-            let (x, y) = (i % width, i / width);
-            let (u, v) = pixel_uv(x, y, width, height);
-            f(u, v, x, y).map(|c| c as f32)
-        })
-        .collect();
-    Image::from_raw(width, height, data).expect("render_cpu fills every pixel")
 }

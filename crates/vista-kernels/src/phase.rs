@@ -1,26 +1,11 @@
-//! Phase functions in f64 (SPEC 3.5, 3.6). `mu` is the cosine between the
-//! direction toward the light and the view ray's direction.
+//! Phase functions: the f64 build of `src/cpu/phase.rs`, and their tests.
 
-use std::f64::consts::PI;
-
-/// Rayleigh: 3 / (16 pi) (1 + mu^2).
-pub fn rayleigh(mu: f64) -> f64 {
-    3.0 / (16.0 * PI) * (1.0 + mu * mu)
-}
-
-/// Henyey-Greenstein: (1 - g^2) / (4 pi (1 + g^2 - 2 g mu)^1.5).
-pub fn hg(mu: f64, g: f64) -> f64 {
-    (1.0 - g * g) / (4.0 * PI * (1.0 + g * g - 2.0 * g * mu).powf(1.5))
-}
-
-/// (1 - blend) HG(g1) + blend HG(g2).
-pub fn dual_hg(mu: f64, g1: f64, g2: f64, blend: f64) -> f64 {
-    (1.0 - blend) * hg(mu, g1) + blend * hg(mu, g2)
-}
+pub use crate::cpu64::phase::*;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     /// Integral over the sphere of f(mu): 2 pi * int_{-1}^{1} f(mu) dmu (Simpson).
     fn sphere_integral(f: impl Fn(f64) -> f64) -> f64 {

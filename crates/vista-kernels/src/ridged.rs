@@ -1,8 +1,9 @@
 //! `ridged`: Musgrave's ridged multifractal (SPEC 3.3), normalised to [0, 1].
 
-use crate::fbm::{BASIS, LACUNARITY, OCTAVES, SEED, noise_of, noise_table};
-use crate::noise::{BASIS_NAMES, PERLIN_MAX_ABS, Ridged};
-use crate::{Kernel, Kind, ParamSet, ParamSpec, Preset, Uniforms, render_cpu};
+pub use crate::cpu64::ridged::{ridged_max, ridged_of};
+use crate::fbm::{BASIS, LACUNARITY, OCTAVES, SEED, noise_table};
+use crate::noise::BASIS_NAMES;
+use crate::{Kernel, Kind, ParamSet, ParamSpec, Preset, Uniforms};
 use vista_image::Image;
 
 const PARAMS: &[ParamSpec] = &[
@@ -23,25 +24,6 @@ const PRESETS: &[Preset] = &[
     Preset { name: "sharp", doc: "H 0.5 keeps high octaves strong", set: &[("h", "0.5"), ("octaves", "10")] },
     Preset { name: "soft", doc: "offset 1.2, gain 1", set: &[("offset", "1.2"), ("gain", "1.0")] },
 ];
-
-pub fn ridged_of(p: &ParamSet) -> Ridged {
-    Ridged {
-        octaves: p.u32("octaves"),
-        lacunarity: p.f64("lacunarity"),
-        h: p.f64("h"),
-        offset: p.f64("offset"),
-        gain: p.f64("gain"),
-    }
-}
-
-/// Normaliser: the largest raw value possible. With |N| <= M (M =
-/// PERLIN_MAX_ABS bounds both bases) each signal is at most
-/// max(offset, M - offset)^2 (offset^2 when offset >= 1, SPEC 3.3) and each
-/// weight at most 1.
-pub fn ridged_max(r: &Ridged) -> f64 {
-    let peak = r.offset.max(PERLIN_MAX_ABS - r.offset);
-    peak * peak * (0..r.octaves).map(|i| r.weight(i)).sum::<f64>()
-}
 
 pub struct RidgedKernel;
 
@@ -86,11 +68,9 @@ impl Kernel for RidgedKernel {
         &[("octaves", "16")]
     }
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
-        let (n, r) = (noise_of(p), ridged_of(p));
-        let (freq, z, inv) = (p.f64("frequency"), p.f64("z_slice"), 1.0 / ridged_max(&r));
-        render_cpu(width, height, |u, v, _, _| {
-            let value = r.eval(&n, [freq * u, freq * v], z) * inv;
-            [value, value, value, 1.0]
-        })
+        crate::cpu64::ridged::render(p, width, height)
+    }
+    fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image {
+        crate::cpu32::ridged::render(p, width, height)
     }
 }

@@ -1,0 +1,355 @@
+//! The `clouds` kernel's reference (SPEC 3.6), written from the formulas in
+//! `crate::clouds`; built in f64 (the oracle) and f32.
+
+use super::geometry::{Camera, V3, add, direction, dot, scale, smoothstep};
+use super::noise::{Fbm, Noise};
+use super::phase::dual_hg;
+use super::{Real, pixel_uv, real, real3, render_cpu};
+use crate::ParamSet;
+use crate::clouds::{Integrator, Jitter, Profile};
+use crate::noise::{Basis, pcg3d};
+use vista_image::Image;
+
+/// A ray stops once its transmittance falls below this; the remainder is
+/// then treated as fully opaque (T = 0), which keeps T monotone in density.
+pub const T_CUTOFF: Real = 1e-4;
+/// The light march stops once the optical depth toward the sun exceeds this
+/// (T_sun < 1.1e-7: no visible contribution left).
+pub const TAU_SUN_CUTOFF: Real = 16.0;
+
+
+/// remap(x, a, b, c, d) = c + (x - a)(d - c)/(b - a); with b == a (no
+/// interval) it is the step c below and d above a. Clouds only use it with
+/// a = 1 - coverage, b = 1, so coverage 0 gives c = 0 for every G <= 1.
+pub fn remap(x: Real, a: Real, b: Real, c: Real, d: Real) -> Real {
+    if b == a {
+        return if x > a { d } else { c };
+    }
+    c + (x - a) * (d - c) / (b - a)
+}
+
+/// Height profile in [0, 1] of the normalised height h in the slab:
+/// a plateau smoothstep(0, bottom, h) * smoothstep(0, top, 1 - h), times
+/// 1 for stratiform, (1 - 0.5 h) for cumuliform (dense base, thinner top),
+/// and 0.45 + 0.55 smoothstep(0.5, 0.7, h) for anvil (a dense band in the
+/// upper part, the anvil of a cumulonimbus).
+pub fn height_profile(profile: Profile, bottom: Real, top: Real, h: Real) -> Real {
+    let h = h.clamp(0.0, 1.0);
+    let plateau = smoothstep(0.0, bottom, h) * smoothstep(0.0, top, 1.0 - h);
+    plateau
+        * match profile {
+            Profile::Stratiform => 1.0,
+            Profile::Cumuliform => 1.0 - 0.5 * h,
+            Profile::Anvil => 0.45 + 0.55 * smoothstep(0.5, 0.7, h),
+        }
+}
+
+/// Interleaved gradient noise (Jimenez 2014) at pixel (x, y) in [0, 1);
+/// the seed shifts the pattern by 5.588238 pixels per step (period 64).
+// The published constants; the f32 build rounds them as the WGSL does.
+#[allow(clippy::excessive_precision)]
+pub fn ign(x: u32, y: u32, seed: u32) -> Real {
+    let shift = 5.588238 * (seed % 64) as Real;
+    let (px, py) = (x as Real + shift, y as Real + shift);
+    let inner = (0.06711056 * px + 0.00583715 * py).fract();
+    (52.9829189 * inner).fract()
+}
+
+/// White-noise jitter in [0, 1): pcg3d of (x, y, seed), top 24 bits.
+pub fn white(x: u32, y: u32, seed: u32) -> Real {
+    (pcg3d([x, y, seed])[0] >> 8) as Real / 16_777_216.0
+}
+
+/// (1 - exp(-x)) / x, the analytic integrator's weight per unit dt; 1 at 0.
+pub fn analytic_weight(x: Real) -> Real {
+    if x <= 0.0 { 1.0 } else { -(-x).exp_m1() / x }
+}
+
+/// (first step as a fraction of the light path, growth ratio) for `n`
+/// light steps whose last step is `spread` times the first.
+pub fn light_step_layout(n: u32, spread: Real) -> (Real, Real) {
+    if n <= 1 || spread == 1.0 {
+        return (1.0 / n as Real, 1.0);
+    }
+    let log_r = spread.ln() / (n - 1) as Real;
+    // (r - 1) / (r^n - 1) via expm1: exact as r -> 1.
+    ((log_r).exp_m1() / (n as Real * log_r).exp_m1(), log_r.exp())
+}
+
+/// One marched ray.
+#[derive(Debug, Clone)]
+pub struct RayResult {
+    /// In-scattered radiance L_cloud (not including the background).
+    pub radiance: V3,
+    /// Transmittance T of the whole ray (0 after the cutoff).
+    pub transmittance: Real,
+    /// Transmittance after each step (filled when asked for).
+    pub trace: Vec<Real>,
+    /// Density evaluations (primary and light samples): the cost.
+    pub density_evals: u32,
+}
+
+/// Everything the march needs, resolved from a parameter set in Real.
+#[derive(Debug, Clone)]
+pub struct Clouds {
+    pub base: Real,
+    pub top: Real,
+    pub coverage: Real,
+    pub density_scale: Real,
+    pub absorption: Real,
+    pub profile: Profile,
+    pub profile_bottom: Real,
+    pub profile_top: Real,
+    /// Noise frequency per axis: noise_scale * noise_stretch.
+    pub frequency: V3,
+    pub wind: V3,
+    pub fbm: Fbm,
+    pub noise: Noise,
+    pub inv_amplitude: Real,
+    /// Position and basis; the aspect is set per image in [`Clouds::ray`].
+    pub view: Camera,
+    pub max_distance: Real,
+    pub sun_dir: V3,
+    /// sun_color * sun_intensity.
+    pub sun: V3,
+    pub g1: Real,
+    pub g2: Real,
+    pub blend: Real,
+    pub powder: Real,
+    pub ambient: V3,
+    pub ambient_bottom: Real,
+    pub sky_zenith: V3,
+    pub sky_horizon: V3,
+    pub steps: u32,
+    pub light_steps: u32,
+    /// Last light step / first light step (1 = uniform).
+    pub light_spread: Real,
+    pub integrator: Integrator,
+    pub jitter: Jitter,
+    pub jitter_seed: u32,
+}
+
+impl Clouds {
+    pub fn from_params(p: &ParamSet) -> Clouds {
+        let fbm = Fbm { octaves: p.u32("octaves"), lacunarity: real(p, "lacunarity"), gain: real(p, "gain"), theta: 0.0 };
+        let stretch = real3(p, "noise_stretch");
+        let ns = real(p, "noise_scale");
+        // pitch is within +-89 deg, so forward is never vertical.
+        let forward = direction(real(p, "yaw_deg").to_radians(), real(p, "pitch_deg").to_radians());
+        let sun_color = real3(p, "sun_color");
+        Clouds {
+            base: real(p, "cloud_base_km"),
+            top: real(p, "cloud_top_km"),
+            coverage: real(p, "coverage"),
+            density_scale: real(p, "density_scale"),
+            absorption: real(p, "absorption"),
+            profile: match p.choice("profile") {
+                "stratiform" => Profile::Stratiform,
+                "anvil" => Profile::Anvil,
+                _ => Profile::Cumuliform,
+            },
+            profile_bottom: real(p, "profile_bottom"),
+            profile_top: real(p, "profile_top"),
+            frequency: stretch.map(|s| s * ns),
+            wind: real3(p, "wind_offset"),
+            fbm,
+            noise: Noise::new(Basis::Perlin, p.u32("seed")),
+            inv_amplitude: 1.0 / fbm.amplitude_sum(),
+            view: Camera::looking(real3(p, "camera_pos"), forward, real(p, "fov_deg"), 1.0),
+            max_distance: real(p, "max_distance_km"),
+            sun_dir: direction(real(p, "sun_azimuth_deg").to_radians(), real(p, "sun_elevation_deg").to_radians()),
+            sun: sun_color.map(|c| c * real(p, "sun_intensity")),
+            g1: real(p, "g1"),
+            g2: real(p, "g2"),
+            blend: real(p, "phase_blend"),
+            powder: real(p, "powder"),
+            ambient: real3(p, "ambient"),
+            ambient_bottom: real(p, "ambient_bottom"),
+            sky_zenith: real3(p, "sky_zenith"),
+            sky_horizon: real3(p, "sky_horizon"),
+            steps: p.u32("steps"),
+            light_steps: p.u32("light_steps"),
+            light_spread: real(p, "light_spread"),
+            integrator: if p.choice("integrator") == "analytic" { Integrator::Analytic } else { Integrator::Riemann },
+            jitter: match p.choice("jitter") {
+                "white" => Jitter::White,
+                "ign" => Jitter::Ign,
+                _ => Jitter::None,
+            },
+            jitter_seed: p.u32("jitter_seed"),
+        }
+    }
+
+    /// Normalised height in the slab (unclamped).
+    pub fn height01(&self, y: Real) -> Real {
+        (y - self.base) / (self.top - self.base)
+    }
+
+    /// The density d(p) (1/km), i.e. sigma_s.
+    pub fn density(&self, p: V3) -> Real {
+        let h = self.height01(p[1]);
+        if !(0.0..=1.0).contains(&h) {
+            return 0.0;
+        }
+        let profile = height_profile(self.profile, self.profile_bottom, self.profile_top, h);
+        if profile <= 0.0 || self.coverage <= 0.0 {
+            return 0.0;
+        }
+        let q = [0, 1, 2].map(|i| p[i] * self.frequency[i] + self.wind[i]);
+        let g = 0.5 + 0.5 * self.fbm.eval3(&self.noise, q) * self.inv_amplitude;
+        let shape = remap(g, 1.0 - self.coverage, 1.0, 0.0, 1.0).max(0.0);
+        self.density_scale * profile * shape
+    }
+
+    /// The camera ray through the centre of pixel (x, y).
+    pub fn ray(&self, x: u32, y: u32, width: u32, height: u32) -> (V3, V3) {
+        let (u, v) = pixel_uv(x, y, width, height);
+        let camera = Camera { aspect: width as Real / height as Real, ..self.view };
+        (camera.pos, camera.ray(u, v))
+    }
+
+    /// Background sky: horizon + (zenith - horizon) * clamp(d.y, 0, 1).
+    pub fn background(&self, d: V3) -> V3 {
+        let t = d[1].clamp(0.0, 1.0);
+        [0, 1, 2].map(|i| self.sky_horizon[i] + (self.sky_zenith[i] - self.sky_horizon[i]) * t)
+    }
+
+    /// Part [t0, t1] of the ray o + t d inside the slab and within
+    /// max_distance, or None.
+    pub fn slab_segment(&self, o: V3, d: V3) -> Option<(Real, Real)> {
+        let (t0, t1) = if d[1].abs() < 1e-6 {
+            if o[1] < self.base || o[1] > self.top {
+                return None;
+            }
+            (0.0, self.max_distance)
+        } else {
+            let ta = (self.base - o[1]) / d[1];
+            let tb = (self.top - o[1]) / d[1];
+            (ta.min(tb).max(0.0), ta.max(tb).min(self.max_distance))
+        };
+        (t1 > t0).then_some((t0, t1))
+    }
+
+    /// Light-march steps grow geometrically so the last is `light_spread`
+    /// times the first: ratio r = spread^(1 / (n - 1)), first step a
+    /// fraction (r - 1) / (r^n - 1) of the path (1 / n when spread = 1).
+    /// Short steps near the sample resolve the self-shadowing that dominates
+    /// the look; the far part of the path matters less once light is
+    /// attenuated. As n grows every step shrinks, so it converges to the
+    /// same integral as uniform steps.
+    pub fn light_step_layout(&self) -> (Real, Real) {
+        light_step_layout(self.light_steps, self.light_spread)
+    }
+
+    /// Optical depth from p toward the sun to the slab's top (midpoint rule
+    /// on `light_steps` geometrically growing steps, cut at max_distance
+    /// and at TAU_SUN_CUTOFF).
+    pub fn sun_optical_depth(&self, p: V3) -> Real {
+        self.sun_march(p).0
+    }
+
+    /// (optical depth toward the sun, density evaluations spent).
+    fn sun_march(&self, p: V3) -> (Real, u32) {
+        let s = self.sun_dir;
+        let len = ((self.top - p[1]) / s[1]).clamp(0.0, self.max_distance);
+        let (first, growth) = self.light_step_layout();
+        let mut dt = len * first;
+        let mut t = 0.0;
+        let mut tau = 0.0;
+        let mut evals = 0;
+        for _ in 0..self.light_steps {
+            let q = add(p, scale(s, t + 0.5 * dt));
+            tau += self.density(q) * (1.0 + self.absorption) * dt;
+            evals += 1;
+            if tau > TAU_SUN_CUTOFF {
+                break;
+            }
+            t += dt;
+            dt *= growth;
+        }
+        (tau, evals)
+    }
+
+    /// Dual-lobe HG phase for the cosine mu between view ray and sun.
+    pub fn phase(&self, mu: Real) -> Real {
+        dual_hg(mu, self.g1, self.g2, self.blend)
+    }
+
+    /// Jitter xi in [0, 1) of pixel (x, y); 0.5 (midpoint) without jitter.
+    pub fn jitter_offset(&self, x: u32, y: u32) -> Real {
+        match self.jitter {
+            Jitter::None => 0.5,
+            Jitter::White => white(x, y, self.jitter_seed),
+            Jitter::Ign => ign(x, y, self.jitter_seed),
+        }
+    }
+
+    /// Marches the ray o + t d with first-sample offset `xi` (in steps).
+    /// With `trace`, records the transmittance after every step.
+    pub fn march(&self, o: V3, d: V3, xi: Real, trace: bool) -> RayResult {
+        let mut out = RayResult { radiance: [0.0; 3], transmittance: 1.0, trace: Vec::new(), density_evals: 0 };
+        let Some((t0, t1)) = self.slab_segment(o, d) else {
+            return out;
+        };
+        let dt = (t1 - t0) / self.steps as Real;
+        let phase = self.phase(dot(d, self.sun_dir));
+        let ext = 1.0 + self.absorption;
+        let mut t_view = 1.0;
+        for k in 0..self.steps {
+            let p = add(o, scale(d, t0 + (k as Real + xi) * dt));
+            let sigma_s = self.density(p);
+            out.density_evals += 1;
+            if sigma_s > 0.0 {
+                let (tau_sun, evals) = self.sun_march(p);
+                out.density_evals += evals;
+                let sun_vis = (-tau_sun).exp() * (1.0 - self.powder * (-2.0 * tau_sun).exp());
+                let amb = self.ambient_bottom + (1.0 - self.ambient_bottom) * self.height01(p[1]).clamp(0.0, 1.0);
+                let x = sigma_s * ext * dt;
+                // Riemann: S dt; analytic: S (1 - exp(-x)) / sigma_t.
+                let w = match self.integrator {
+                    Integrator::Riemann => dt,
+                    Integrator::Analytic => dt * analytic_weight(x),
+                };
+                for c in 0..3 {
+                    let l_in = self.sun[c] * phase * sun_vis + self.ambient[c] * amb;
+                    out.radiance[c] += t_view * sigma_s * l_in * w;
+                }
+                t_view *= (-x).exp();
+                if t_view < T_CUTOFF {
+                    t_view = 0.0;
+                }
+            }
+            if trace {
+                out.trace.push(t_view);
+            }
+            if t_view == 0.0 {
+                break;
+            }
+        }
+        out.transmittance = t_view;
+        out
+    }
+
+    /// Final pixel value: (L + T * background, 1 - T).
+    pub fn pixel(&self, x: u32, y: u32, width: u32, height: u32) -> [Real; 4] {
+        let (o, d) = self.ray(x, y, width, height);
+        let r = self.march(o, d, self.jitter_offset(x, y), false);
+        let bg = self.background(d);
+        let t = r.transmittance;
+        [r.radiance[0] + t * bg[0], r.radiance[1] + t * bg[1], r.radiance[2] + t * bg[2], 1.0 - t]
+    }
+
+    /// Largest in-scattered radiance per unit sigma_s, for output_bounds.
+    pub fn max_l_in(&self) -> Real {
+        let p_max = self.phase(1.0).max(self.phase(-1.0));
+        let sun = self.sun.iter().cloned().fold(0.0, Real::max);
+        let amb = self.ambient.iter().cloned().fold(0.0, Real::max);
+        sun * p_max + amb
+    }
+}
+
+/// The raw output (linear radiance, alpha = 1 - T) of the `clouds` kernel.
+pub fn render(p: &ParamSet, width: u32, height: u32) -> Image {
+    let c = Clouds::from_params(p);
+    render_cpu(width, height, |_, _, x, y| c.pixel(x, y, width, height))
+}

@@ -1,0 +1,6 @@
+//! The same CPU references (`src/cpu/`) compiled with f32 arithmetic: the
+//! CPU doing the GPU's work at the GPU's precision, the baseline of the
+//! throughput benches, and a measure of what the f64 oracles buy (see
+//! `tests/precision.rs`). Not an oracle: nothing is checked against it.
+
+cpu_references!(f32, glam::Vec3);

@@ -1,0 +1,60 @@
+//! The f32 build of the CPU references (`vista_kernels::cpu32`, the
+//! throughput baseline of `cargo bench --bench kernels`) computes the same
+//! images as the f64 oracles: every preset of every kernel, within the bars
+//! the GPU itself must meet against the oracle (display PSNR >= 70 dB; noise
+//! fields within 1e-4). Also checks that it really is a different build.
+
+use vista_image::metrics::psnr;
+use vista_kernels::Kernel;
+
+/// Small sizes: the f64 heightfield oracle is the slow one.
+fn size_of_test(k: &dyn Kernel) -> (u32, u32) {
+    if k.name() == "heightfield" { (32, 20) } else { (48, 32) }
+}
+
+#[test]
+fn f32_build_matches_the_f64_oracle_on_every_preset() {
+    let mut failures = vec![];
+    for k in vista_kernels::registry() {
+        let (w, h) = size_of_test(*k);
+        for preset in k.presets() {
+            let p = k.resolve(Some(preset.name), &[]).expect("presets are valid");
+            let (r64, r32) = (k.reference(&p, w, h), k.reference_f32(&p, w, h));
+            let nonfinite = r32.nonfinite_count();
+            let max_abs = r64
+                .data
+                .iter()
+                .zip(&r32.data)
+                .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs()))
+                .fold(0.0f32, f32::max);
+            let db = psnr(&k.display(&r64, &p), &k.display(&r32, &p));
+            eprintln!("{} {}: f32 vs f64 display PSNR {db:.1} dB, raw max |diff| {max_abs:.2e}", k.name(), preset.name);
+            let noise = matches!(k.name(), "fbm" | "ridged");
+            if nonfinite > 0 || db < 70.0 || (noise && max_abs > 1e-4) {
+                failures.push(format!(
+                    "{} {}: {nonfinite} non-finite, PSNR {db:.1} dB, max |diff| {max_abs:.2e}",
+                    k.name(),
+                    preset.name
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "f32 build differs from the f64 oracle:\n{}", failures.join("\n"));
+}
+
+#[test]
+fn f32_build_is_a_separate_f32_computation() {
+    assert_eq!(size_of::<vista_kernels::cpu32::Real>(), 4);
+    assert_eq!(size_of::<vista_kernels::cpu64::Real>(), 8);
+    // f32 rounding shows in the output: reference_f32 is not the f64 image.
+    for name in ["fbm", "atmosphere"] {
+        let k = vista_kernels::find(name).unwrap();
+        let p = k.resolve(None, &[]).unwrap();
+        assert!(!k.reference(&p, 32, 16).bit_identical(&k.reference_f32(&p, 32, 16)), "{name}");
+    }
+    // Perlin's reference value holds in f32 to f32 precision.
+    let p = vista_kernels::noise::permutation(0);
+    #[allow(clippy::approx_constant)] // SPEC 3.1's input, not pi
+    let v = vista_kernels::cpu32::noise::perlin(&p, 3.14, 42.0, 7.0);
+    assert!((v - 0.136_919_96).abs() < 1e-6, "f32 perlin(3.14, 42, 7) = {v}");
+}
