@@ -1,22 +1,84 @@
 //! Every kernel's default preset at 256 x 256: GPU (lavapipe by default,
-//! `VISTA_ADAPTER=gpu` for hardware) beside its f64 CPU reference on all
-//! cores, so the ratio is visible. Device creation and shader compilation
-//! happen before measurement.
+//! `VISTA_ADAPTER=gpu` for hardware) beside its CPU reference on all cores,
+//! built in f32 (the CPU doing the GPU's work at the GPU's precision) and in
+//! f64 (the oracle). The heightfield reference is a brute-force oracle, so
+//! heightfield also runs the shader's own relax march on the CPU in f32: the
+//! like-for-like ratio. Device creation and shader compilation happen before
+//! measurement. Prints the medians and ratios after each kernel.
+//!
+//! The heightfield oracle takes about 20 s per 256 x 256 image on 2 cores,
+//! so a full run takes several minutes; filter with `-- fbm` etc.
 
-use criterion::{Criterion, criterion_group, criterion_main};
-use std::time::Duration;
+use criterion::{Bencher, Criterion, criterion_group, criterion_main};
+use std::time::{Duration, Instant};
+use vista_kernels::Kernel;
+use vista_kernels::heightfield::HitSearch;
+
+const SIZE: (u32, u32) = (256, 256);
+
+/// Times every iteration criterion asks for and keeps the durations (s), so
+/// the ratio can be printed from the same measurements.
+fn timed(b: &mut Bencher, seen: &mut Vec<f64>, mut f: impl FnMut()) {
+    b.iter_custom(|iters| {
+        let mut total = Duration::ZERO;
+        for _ in 0..iters {
+            let t = Instant::now();
+            f();
+            let d = t.elapsed();
+            seen.push(d.as_secs_f64());
+            total += d;
+        }
+        total
+    });
+}
+
+fn median_ms(mut v: Vec<f64>) -> Option<f64> {
+    v.sort_by(f64::total_cmp);
+    (!v.is_empty()).then(|| v[v.len() / 2] * 1e3)
+}
 
 fn kernels(c: &mut Criterion) {
     let ctx = vista_gpu::Context::shared().expect("GPU adapter (bash ci/install-lavapipe.sh)");
-    let (w, h) = (256, 256);
+    let (w, h) = SIZE;
+    let threads = rayon::current_num_threads();
     for k in vista_kernels::registry() {
+        let k: &dyn Kernel = *k;
         let p = k.resolve(None, &[]).expect("defaults are valid");
-        vista_golden::render(ctx, *k, &p, w, h).expect("warm-up render");
         let mut g = c.benchmark_group(k.name());
         g.sample_size(10).warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(3));
-        g.bench_function("gpu 256x256", |b| b.iter(|| vista_golden::render(ctx, *k, &p, w, h).expect("render")));
-        g.bench_function("cpu f64 reference 256x256 (all cores)", |b| b.iter(|| k.reference(&p, w, h)));
+        let (mut gpu, mut f32_ref, mut f64_ref, mut march) = (vec![], vec![], vec![], vec![]);
+        vista_golden::render(ctx, k, &p, w, h).expect("warm-up render");
+        g.bench_function("gpu 256x256", |b| {
+            timed(b, &mut gpu, || {
+                vista_golden::render(ctx, k, &p, w, h).expect("render");
+            })
+        });
+        g.bench_function(format!("cpu f32 reference 256x256 ({threads} threads)"), |b| {
+            timed(b, &mut f32_ref, || {
+                k.reference_f32(&p, w, h);
+            })
+        });
+        g.bench_function(format!("cpu f64 reference 256x256 ({threads} threads)"), |b| {
+            timed(b, &mut f64_ref, || {
+                k.reference(&p, w, h);
+            })
+        });
+        if k.name() == "heightfield" {
+            g.bench_function(format!("cpu f32 relax march 256x256 ({threads} threads)"), |b| {
+                timed(b, &mut march, || {
+                    vista_kernels::cpu32::heightfield::render(&p, w, h, HitSearch::RelaxMarch).expect("valid");
+                })
+            });
+        }
         g.finish();
+        let Some(gpu) = median_ms(gpu) else { continue };
+        let mut line = format!("{}: gpu {gpu:.2} ms ({})", k.name(), ctx.adapter_description());
+        for (what, v) in [("cpu f32 reference", f32_ref), ("cpu f64 reference", f64_ref), ("cpu f32 relax march", march)] {
+            if let Some(ms) = median_ms(v) {
+                line += &format!("; {what} {ms:.2} ms = {:.2}x the gpu time", ms / gpu);
+            }
+        }
+        println!("{line}");
     }
 }
 

@@ -1,11 +1,21 @@
-//! `vista bench`: median kernel throughput after a warm-up run.
+//! `vista bench`: median kernel throughput after a warm-up run, optionally
+//! beside the f32 CPU reference on all cores.
 
+use std::time::Instant;
 use vista_golden::GoldenError;
 use vista_gpu::Context;
 
 use crate::{bad, parse_sets};
 
-pub fn bench(kernel: &str, preset: Option<&str>, set: &[String], size: &str, runs: u32, json: bool) -> Result<i32, GoldenError> {
+pub fn bench(
+    kernel: &str,
+    preset: Option<&str>,
+    set: &[String],
+    size: &str,
+    runs: u32,
+    json: bool,
+    cpu: bool,
+) -> Result<i32, GoldenError> {
     if !(1..=1000).contains(&runs) {
         return Err(bad(format!("--runs {runs} is out of range; allowed: [1, 1000]")));
     }
@@ -19,17 +29,33 @@ pub fn bench(kernel: &str, preset: Option<&str>, set: &[String], size: &str, run
     let first = vista_golden::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
     let median = vista_golden::render_median(ctx, k, &p, w, h, runs)?.1.as_secs_f64();
     let mpix = (w as f64 * h as f64) / 1e6 / median;
-    if json {
-        println!(
-            "{}",
-            serde_json::json!({
-                "kernel": kernel, "width": w, "height": h, "runs": runs,
-                "median_ms": median * 1e3, "mpix_per_s": mpix,
-                "device_creation_ms": ctx.creation_time.as_secs_f64() * 1e3,
-                "first_dispatch_ms": first * 1e3,
-                "adapter": ctx.adapter_description(), "params": p.canonical(),
+    // The CPU side: the reference in f32 on every core (rayon), median of
+    // up to 3 runs since the slow ones take seconds per image.
+    let cpu_ms = cpu.then(|| {
+        let mut t: Vec<f64> = (0..runs.min(3))
+            .map(|_| {
+                let start = Instant::now();
+                k.reference_f32(&p, w, h);
+                start.elapsed().as_secs_f64() * 1e3
             })
-        );
+            .collect();
+        t.sort_by(f64::total_cmp);
+        t[t.len() / 2]
+    });
+    if json {
+        let mut out = serde_json::json!({
+            "kernel": kernel, "width": w, "height": h, "runs": runs,
+            "median_ms": median * 1e3, "mpix_per_s": mpix,
+            "device_creation_ms": ctx.creation_time.as_secs_f64() * 1e3,
+            "first_dispatch_ms": first * 1e3,
+            "adapter": ctx.adapter_description(), "params": p.canonical(),
+        });
+        if let Some(ms) = cpu_ms {
+            out["cpu_f32_ms"] = ms.into();
+            out["cpu_threads"] = rayon::current_num_threads().into();
+            out["cpu_over_gpu"] = (ms / (median * 1e3)).into();
+        }
+        println!("{out}");
     } else {
         println!("{kernel} {w}x{h}: median {:.2} ms over {runs} runs, {mpix:.2} Mpix/s on {}", median * 1e3, ctx.adapter_description());
         println!(
@@ -37,6 +63,13 @@ pub fn bench(kernel: &str, preset: Option<&str>, set: &[String], size: &str, run
             ctx.creation_time.as_secs_f64() * 1e3,
             first * 1e3
         );
+        if let Some(ms) = cpu_ms {
+            println!(
+                "f32 CPU reference on {} threads: {ms:.2} ms = {:.2}x the GPU time",
+                rayon::current_num_threads(),
+                ms / (median * 1e3)
+            );
+        }
     }
     Ok(0)
 }

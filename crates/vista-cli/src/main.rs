@@ -118,6 +118,10 @@ enum Command {
         runs: u32,
         #[arg(long)]
         json: bool,
+        /// Also time the kernel's CPU reference built in f32 on all cores
+        /// (median of up to 3 runs) and print the CPU / GPU ratio.
+        #[arg(long)]
+        cpu: bool,
     },
 }
 
@@ -238,7 +242,9 @@ fn run(cmd: Command) -> Result<i32, GoldenError> {
                 out,
             })
         }
-        Command::Bench { kernel, preset, set, size, runs, json } => bench::bench(&kernel, preset.as_deref(), &set, &size, runs, json),
+        Command::Bench { kernel, preset, set, size, runs, json, cpu } => {
+            bench::bench(&kernel, preset.as_deref(), &set, &size, runs, json, cpu)
+        }
     }
 }
 

@@ -419,4 +419,18 @@ fn bench_json_reports_throughput() {
         assert!(r.stdout.contains(field), "{field} missing: {}", r.stdout);
     }
     assert_rejected(&vista(&["bench", "fbm", "--runs", "0"]), 2, &["--runs 0", "[1, 1000]"]);
+    assert!(!r.stdout.contains("cpu_f32_ms"), "the CPU side runs only with --cpu");
+}
+
+#[test]
+fn bench_cpu_reports_the_f32_reference_and_ratio() {
+    let r = vista(&["bench", "ridged", "--size", "48x32", "--runs", "2", "--json", "--cpu"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(r.stdout.trim()).expect("one JSON object");
+    let (gpu, cpu) = (v["median_ms"].as_f64().unwrap(), v["cpu_f32_ms"].as_f64().unwrap());
+    assert!(gpu > 0.0 && cpu > 0.0, "{v}");
+    assert!((v["cpu_over_gpu"].as_f64().unwrap() - cpu / gpu).abs() < 1e-9, "{v}");
+    assert!(v["cpu_threads"].as_u64().unwrap() >= 1, "{v}");
+    let text = vista(&["bench", "ridged", "--size", "48x32", "--runs", "1", "--cpu"]);
+    assert!(text.stdout.contains("f32 CPU reference on"), "{}", text.stdout);
 }
