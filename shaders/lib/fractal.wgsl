@@ -1,4 +1,5 @@
-// Fractal sums over a basis: fBm (SPEC 3.2), ridged multifractal (SPEC 3.3), 3D fBm (clouds).
+// Fractal sums over a basis: fBm (SPEC 3.2), ridged multifractal (SPEC 3.3).
+// (The clouds kernel sums its 3D fBm itself, to stop early; see clouds.wgsl.)
 #define_import_path vista::fractal
 
 #import vista::noise::basis_noise
@@ -52,17 +53,4 @@ fn ridged2(s: RidgedSettings, p0: vec2<f32>, z: f32) -> f32 {
         result += signal * pow(s.lacunarity, -f32(i) * s.h);
     }
     return result;
-}
-
-// 3D fBm without rotation: sum_i gain^i N(lacunarity^i p).
-fn fbm3(s: FbmSettings, p0: vec3<f32>) -> f32 {
-    var p = p0;
-    var amplitude = 1.0;
-    var sum = 0.0;
-    for (var i = 0u; i < s.octaves; i++) {
-        sum += amplitude * basis_noise(s.basis, s.seed, p);
-        amplitude *= s.gain;
-        p *= s.lacunarity;
-    }
-    return sum;
 }
