@@ -125,7 +125,21 @@ enum Command {
     },
 }
 
+/// A closed stdout (`vista list | head -1`) ends vista quietly like other
+/// Unix tools: Rust ignores SIGPIPE, which turns every println! after the
+/// reader left into a panic.
+#[cfg(unix)]
+fn die_quietly_on_closed_pipe() {
+    // SAFETY: called first thing in main, before any thread starts; SIG_DFL
+    // is a valid disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    die_quietly_on_closed_pipe();
     let cli = Cli::parse();
     if let Some(a) = &cli.adapter {
         // SAFETY: single-threaded at this point; read once by Context::shared.

@@ -434,3 +434,23 @@ fn bench_cpu_reports_the_f32_reference_and_ratio() {
     let text = vista(&["bench", "ridged", "--size", "48x32", "--runs", "1", "--cpu"]);
     assert!(text.stdout.contains("f32 CPU reference on"), "{}", text.stdout);
 }
+
+/// `vista list | head -1`: a reader that goes away ends vista quietly, as it
+/// does other Unix tools, instead of a "failed printing to stdout" panic.
+#[cfg(unix)]
+#[test]
+fn closed_stdout_pipe_is_not_a_panic() {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vista"))
+        .arg("list")
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run vista");
+    // Close the read end before vista writes anything.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "panic on a closed pipe: {stderr}");
+}
