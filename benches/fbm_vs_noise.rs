@@ -5,7 +5,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 const SIZE: u32 = 1024;
 
@@ -19,11 +19,6 @@ fn noise_crate_fbm(f: &Fbm<Perlin>) -> Vec<f64> {
         .collect()
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 fn fbm_vs_noise(c: &mut Criterion) {
     let ctx = vista_gpu::Context::shared().expect("GPU adapter (bash ci/install-lavapipe.sh)");
     let k = vista_kernels::find("fbm").unwrap();
@@ -32,12 +27,11 @@ fn fbm_vs_noise(c: &mut Criterion) {
     vista_golden::render(ctx, k, &p, SIZE, SIZE).unwrap();
 
     // Direct side-by-side medians (what the closing note reports).
-    let gpu = median((0..7).map(|_| vista_golden::render(ctx, k, &p, SIZE, SIZE).unwrap().stats.gpu_wall.as_secs_f64()).collect());
-    let cpu = median((0..7).map(|_| {
-        let t = Instant::now();
+    let gpu = vista_golden::render_median(ctx, k, &p, SIZE, SIZE, 7).unwrap().1.as_secs_f64();
+    let cpu = vista_golden::median_wall(7, || {
         std::hint::black_box(noise_crate_fbm(&noise_fbm));
-        t.elapsed().as_secs_f64()
-    }).collect());
+    })
+    .as_secs_f64();
     let mpix = (SIZE * SIZE) as f64 / 1e6;
     println!(
         "fbm perlin 8 oct 1024x1024: vista on {} {:.1} Mpix/s ({:.1} ms) | noise::Fbm<Perlin> on {} cores {:.1} Mpix/s ({:.1} ms) | ratio {:.1}x (target >= 10x)",

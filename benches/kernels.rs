@@ -16,25 +16,25 @@ use vista_kernels::heightfield::HitSearch;
 
 const SIZE: (u32, u32) = (256, 256);
 
-/// Times every iteration criterion asks for and keeps the durations (s), so
+/// Times every iteration criterion asks for and keeps the durations, so
 /// the ratio can be printed from the same measurements.
-fn timed(b: &mut Bencher, seen: &mut Vec<f64>, mut f: impl FnMut()) {
+fn timed(b: &mut Bencher, seen: &mut Vec<Duration>, mut f: impl FnMut()) {
     b.iter_custom(|iters| {
         let mut total = Duration::ZERO;
         for _ in 0..iters {
             let t = Instant::now();
             f();
             let d = t.elapsed();
-            seen.push(d.as_secs_f64());
+            seen.push(d);
             total += d;
         }
         total
     });
 }
 
-fn median_ms(mut v: Vec<f64>) -> Option<f64> {
-    v.sort_by(f64::total_cmp);
-    (!v.is_empty()).then(|| v[v.len() / 2] * 1e3)
+/// Median in ms; None when a filter skipped the benchmark.
+fn median_ms(v: Vec<Duration>) -> Option<f64> {
+    (!v.is_empty()).then(|| vista_golden::median(v).as_secs_f64() * 1e3)
 }
 
 fn kernels(c: &mut Criterion) {

@@ -1,7 +1,6 @@
 //! `vista bench`: median kernel throughput after a warm-up run, optionally
 //! beside the f32 CPU reference on all cores.
 
-use std::time::Instant;
 use vista_golden::GoldenError;
 use vista_gpu::Context;
 
@@ -32,15 +31,10 @@ pub fn bench(
     // The CPU side: the reference in f32 on every core (rayon), median of
     // up to 3 runs since the slow ones take seconds per image.
     let cpu_ms = cpu.then(|| {
-        let mut t: Vec<f64> = (0..runs.min(3))
-            .map(|_| {
-                let start = Instant::now();
-                k.reference_f32(&p, w, h);
-                start.elapsed().as_secs_f64() * 1e3
-            })
-            .collect();
-        t.sort_by(f64::total_cmp);
-        t[t.len() / 2]
+        let t = vista_golden::median_wall(runs.min(3), || {
+            k.reference_f32(&p, w, h);
+        });
+        t.as_secs_f64() * 1e3
     });
     if json {
         let mut out = serde_json::json!({

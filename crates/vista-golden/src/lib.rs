@@ -16,7 +16,7 @@ pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, load_cases, parse_cases, select};
 pub use check::{CheckOptions, Outcome, Verdict, check_case};
 pub use report::{default_report_dir, write_report};
-pub use render::{Rendered, check_request, quantize16, render, render_median};
+pub use render::{Rendered, check_request, median, median_wall, quantize16, render, render_median};
 pub use store::{Manifest, ManifestEntry, Store};
 
 use vista_gpu::GpuError;

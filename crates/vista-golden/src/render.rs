@@ -1,5 +1,7 @@
 //! case -> kernel -> GPU run -> image: the one path every render takes.
 
+use std::time::{Duration, Instant};
+
 use vista_gpu::{Context, Dispatch, RunStats};
 use vista_image::Image;
 use vista_kernels::{Kernel, ParamSet};
@@ -60,14 +62,36 @@ pub fn render_median(
     width: u32,
     height: u32,
     runs: u32,
-) -> Result<(Rendered, std::time::Duration), GoldenError> {
+) -> Result<(Rendered, Duration), GoldenError> {
     let first = render(ctx, kernel, p, width, height)?;
     let mut times = vec![first.stats.gpu_wall];
     for _ in 1..runs {
         times.push(render(ctx, kernel, p, width, height)?.stats.gpu_wall);
     }
+    Ok((first, median(times)))
+}
+
+/// The middle time (the upper one for an even count) of a non-empty list.
+///
+/// # Panics
+/// If `times` is empty.
+pub fn median(mut times: Vec<Duration>) -> Duration {
     times.sort();
-    Ok((first, times[times.len() / 2]))
+    times[times.len() / 2]
+}
+
+/// Median wall-clock time of `runs` calls of `f` (at least one): the
+/// CPU-side twin of [`render_median`], for baselines timed beside it.
+pub fn median_wall(runs: u32, mut f: impl FnMut()) -> Duration {
+    median(
+        (0..runs.max(1))
+            .map(|_| {
+                let start = Instant::now();
+                f();
+                start.elapsed()
+            })
+            .collect(),
+    )
 }
 
 /// Display values as a 16-bit PNG stores them, so a fresh render compares

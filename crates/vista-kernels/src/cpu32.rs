@@ -3,4 +3,7 @@
 //! throughput benches, and a measure of what the f64 oracles buy (see
 //! `tests/precision.rs`). Not an oracle: nothing is checked against it.
 
+// Both builds load the same files, on purpose.
+#![allow(clippy::duplicate_mod)]
+
 cpu_references!(f32, glam::Vec3);

@@ -18,32 +18,23 @@ macro_rules! cpu_references {
         /// glam's 3-vector of [`Real`].
         pub type Vec3 = $vec3;
         pub use std::$real::consts;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/common.rs"]
         mod common;
         pub use common::*;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/geometry.rs"]
         pub mod geometry;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/phase.rs"]
         pub mod phase;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/noise.rs"]
         pub mod noise;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/fbm.rs"]
         pub mod fbm;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/ridged.rs"]
         pub mod ridged;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/atmosphere.rs"]
         pub mod atmosphere;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/clouds.rs"]
         pub mod clouds;
-        #[allow(clippy::duplicate_mod)]
         #[path = "cpu/heightfield.rs"]
         pub mod heightfield;
     };

@@ -21,12 +21,7 @@ fn f32_build_matches_the_f64_oracle_on_every_preset() {
             let p = k.resolve(Some(preset.name), &[]).expect("presets are valid");
             let (r64, r32) = (k.reference(&p, w, h), k.reference_f32(&p, w, h));
             let nonfinite = r32.nonfinite_count();
-            let max_abs = r64
-                .data
-                .iter()
-                .zip(&r32.data)
-                .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs()))
-                .fold(0.0f32, f32::max);
+            let max_abs = vista_image::metrics::max_abs(&r64, &r32);
             let db = psnr(&k.display(&r64, &p), &k.display(&r32, &p));
             eprintln!("{} {}: f32 vs f64 display PSNR {db:.1} dB, raw max |diff| {max_abs:.2e}", k.name(), preset.name);
             let noise = matches!(k.name(), "fbm" | "ridged");
