@@ -2,6 +2,9 @@
 //! the `noise` crate's `Fbm<Perlin>` (8 octaves, all cores) on the same
 //! machine, side by side in one run. Prints the throughput ratio.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
@@ -20,7 +23,7 @@ fn noise_crate_fbm(f: &Fbm<Perlin>) -> Vec<f64> {
 }
 
 fn fbm_vs_noise(c: &mut Criterion) {
-    let ctx = vista_gpu::Context::shared().expect("GPU adapter (bash ci/install-lavapipe.sh)");
+    let ctx = common::gpu_for_test("bench").expect("a GPU adapter (bash ci/install-lavapipe.sh)");
     let k = vista_kernels::find("fbm").unwrap();
     let p = k.resolve(None, &[("basis".into(), "perlin".into()), ("octaves".into(), "8".into())]).unwrap();
     let noise_fbm = Fbm::<Perlin>::new(0).set_octaves(8).set_frequency(1.0).set_lacunarity(2.0).set_persistence(0.5);

@@ -9,6 +9,9 @@
 //! The heightfield oracle takes about 20 s per 256 x 256 image on 2 cores,
 //! so a full run takes several minutes; filter with `-- fbm` etc.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use criterion::{Bencher, Criterion, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
 use vista_kernels::Kernel;
@@ -38,7 +41,7 @@ fn median_ms(v: Vec<Duration>) -> Option<f64> {
 }
 
 fn kernels(c: &mut Criterion) {
-    let ctx = vista_gpu::Context::shared().expect("GPU adapter (bash ci/install-lavapipe.sh)");
+    let ctx = common::gpu_for_test("bench").expect("a GPU adapter (bash ci/install-lavapipe.sh)");
     let (w, h) = SIZE;
     let threads = rayon::current_num_threads();
     for k in vista_kernels::registry() {
@@ -73,7 +76,9 @@ fn kernels(c: &mut Criterion) {
         g.finish();
         let Some(gpu) = median_ms(gpu) else { continue };
         let mut line = format!("{}: gpu {gpu:.2} ms ({})", k.name(), ctx.adapter_description());
-        for (what, v) in [("cpu f32 reference", f32_ref), ("cpu f64 reference", f64_ref), ("cpu f32 relax march", march)] {
+        for (what, v) in
+            [("cpu f32 reference", f32_ref), ("cpu f64 reference", f64_ref), ("cpu f32 relax march", march)]
+        {
             if let Some(ms) = median_ms(v) {
                 line += &format!("; {what} {ms:.2} ms = {:.2}x the gpu time", ms / gpu);
             }

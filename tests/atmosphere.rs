@@ -3,7 +3,8 @@
 //! rendered images, finiteness over the whole sun/altitude range, EXR round
 //! trip (the uniform layout is checked for every kernel in tests/shaders.rs).
 
-use vista_gpu::Context;
+mod common;
+
 use vista_image::Image;
 use vista_image::metrics::{compare_hdr, hdr_peak, psnr_with_peak};
 use vista_kernels::atmosphere::AtmosphereKernel;
@@ -12,32 +13,23 @@ use vista_kernels::{Kernel, ParamSet};
 const K: AtmosphereKernel = AtmosphereKernel;
 
 fn params(preset: Option<&str>, set: &[(&str, String)]) -> ParamSet {
-    let o: Vec<(String, String)> = set
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.clone()))
-        .collect();
+    let o: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.clone())).collect();
     K.resolve(preset, &o).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn gpu(ctx: &Context, p: &ParamSet, w: u32, h: u32) -> Image {
-    vista_golden::render(ctx, &K, p, w, h)
-        .unwrap_or_else(|e| panic!("render failed: {e}"))
-        .raw
+fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
+    vista_golden::render(ctx, &K, p, w, h).unwrap_or_else(|e| panic!("render failed: {e}")).raw
 }
 
 fn samples(view: u32, light: u32) -> [(&'static str, String); 2] {
-    [
-        ("view_samples", view.to_string()),
-        ("light_samples", light.to_string()),
-    ]
+    [("view_samples", view.to_string()), ("light_samples", light.to_string())]
 }
 
 /// Same discrete scheme on both sides: only f32 vs f64 (and the GPU's
 /// camera-relative altitude formula vs the CPU's |p| - R_ground) differ.
 #[test]
 fn gpu_matches_cpu_at_the_same_settings() {
-    let Some(ctx) = vista_golden::gpu_for_test("atmosphere::gpu_matches_cpu_at_the_same_settings")
-    else {
+    let Some(ctx) = common::gpu_for_test("atmosphere::gpu_matches_cpu_at_the_same_settings") else {
         return;
     };
     for preset in ["noon", "afternoon", "sunset", "twilight", "high_altitude"] {
@@ -52,11 +44,7 @@ fn gpu_matches_cpu_at_the_same_settings() {
         );
         assert_eq!(m.nan, 0);
         // Lavapipe gives ~140 dB; 90 leaves room for other drivers' exp/sin.
-        assert!(
-            m.psnr >= 90.0,
-            "{preset}: GPU vs CPU at the same settings {:.2} dB < 90",
-            m.psnr
-        );
+        assert!(m.psnr >= 90.0, "{preset}: GPU vs CPU at the same settings {:.2} dB < 90", m.psnr);
     }
     let p = params(Some("noon"), &[("projection", "fisheye".into())]);
     let m = compare_hdr(&K.reference(&p, 32, 32), &gpu(ctx, &p, 32, 32)).unwrap();
@@ -70,9 +58,7 @@ fn gpu_matches_cpu_at_the_same_settings() {
 /// here, at a quarter of the cost (1024 x 256 takes ~1.5 s per preset).
 #[test]
 fn gpu_high_quality_matches_converged_cpu() {
-    let Some(ctx) =
-        vista_golden::gpu_for_test("atmosphere::gpu_high_quality_matches_converged_cpu")
-    else {
+    let Some(ctx) = common::gpu_for_test("atmosphere::gpu_high_quality_matches_converged_cpu") else {
         return;
     };
     let (w, h) = (32, 16);
@@ -81,14 +67,8 @@ fn gpu_high_quality_matches_converged_cpu() {
         let reference = K.reference(&params(Some(preset), &samples(512, 128)), w, h);
         let actual = gpu(ctx, &params(Some(preset), &samples(256, 64)), w, h);
         let psnr = psnr_with_peak(&reference, &actual, hdr_peak(&reference));
-        eprintln!(
-            "{preset}: GPU 256x64 vs CPU 512x128 {psnr:.2} dB (peak {:.3})",
-            hdr_peak(&reference)
-        );
-        assert!(
-            psnr >= 45.0,
-            "{preset}: GPU 256x64 vs converged CPU {psnr:.2} dB < 45"
-        );
+        eprintln!("{preset}: GPU 256x64 vs CPU 512x128 {psnr:.2} dB (peak {:.3})", hdr_peak(&reference));
+        assert!(psnr >= 45.0, "{preset}: GPU 256x64 vs converged CPU {psnr:.2} dB < 45");
     }
 }
 
@@ -105,29 +85,18 @@ fn mean_rgb(img: &Image, rows: std::ops::Range<u32>) -> [f64; 3] {
 
 #[test]
 fn gpu_sky_invariants() {
-    let Some(ctx) = vista_golden::gpu_for_test("atmosphere::gpu_sky_invariants") else {
+    let Some(ctx) = common::gpu_for_test("atmosphere::gpu_sky_invariants") else {
         return;
     };
     let (w, h) = (64, 32);
     let render = |preset: &str| gpu(ctx, &params(Some(preset), &[]), w, h);
-    let (noon, afternoon, sunset, twilight) = (
-        render("noon"),
-        render("afternoon"),
-        render("sunset"),
-        render("twilight"),
-    );
+    let (noon, afternoon, sunset, twilight) =
+        (render("noon"), render("afternoon"), render("sunset"), render("twilight"));
 
-    for (name, img) in [
-        ("noon", &noon),
-        ("afternoon", &afternoon),
-        ("sunset", &sunset),
-        ("twilight", &twilight),
-    ] {
+    for (name, img) in [("noon", &noon), ("afternoon", &afternoon), ("sunset", &sunset), ("twilight", &twilight)] {
         // L >= 0 and finite.
         assert!(
-            img.data
-                .iter()
-                .all(|p| p[..3].iter().all(|c| c.is_finite() && *c >= 0.0)),
+            img.data.iter().all(|p| p[..3].iter().all(|c| c.is_finite() && *c >= 0.0)),
             "{name}: negative or non-finite L"
         );
         // Mirror symmetry about the sun's azimuth: u -> 1 - u maps pixel x to
@@ -138,10 +107,7 @@ fn gpu_sky_invariants() {
                 let (a, b) = (img.get(x, y), img.get(w - 1 - x, y));
                 for k in 0..3 {
                     let tol = 1e-4 * a[k].abs() + 1e-6 * peak;
-                    assert!(
-                        (a[k] - b[k]).abs() <= tol,
-                        "{name}: ({x},{y}) {a:?} vs mirror {b:?}"
-                    );
+                    assert!((a[k] - b[k]).abs() <= tol, "{name}: ({x},{y}) {a:?} vs mirror {b:?}");
                 }
             }
         }
@@ -159,83 +125,43 @@ fn gpu_sky_invariants() {
         [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]) as f64)
     };
     let (s, n) = (toward_sun(&sunset), toward_sun(&noon));
-    eprintln!(
-        "horizon toward the sun: sunset {s:.4?} (R/B {:.2}), noon {n:.4?} (R/B {:.2})",
-        s[0] / s[2],
-        n[0] / n[2]
-    );
-    assert!(
-        s[0] > s[1] && s[1] > s[2],
-        "sunset horizon toward the sun must be R > G > B: {s:?}"
-    );
-    assert!(
-        s[0] / s[2] > 5.0 * (n[0] / n[2]),
-        "sunset R/B {} vs noon {}",
-        s[0] / s[2],
-        n[0] / n[2]
-    );
+    eprintln!("horizon toward the sun: sunset {s:.4?} (R/B {:.2}), noon {n:.4?} (R/B {:.2})", s[0] / s[2], n[0] / n[2]);
+    assert!(s[0] > s[1] && s[1] > s[2], "sunset horizon toward the sun must be R > G > B: {s:?}");
+    assert!(s[0] / s[2] > 5.0 * (n[0] / n[2]), "sunset R/B {} vs noon {}", s[0] / s[2], n[0] / n[2]);
 
     // Zenith at sun 45 deg: B > G > R.
-    let z = mean_rgb(
-        &gpu(
-            ctx,
-            &params(None, &[("sun_elevation_deg", "45".into())]),
-            w,
-            h,
-        ),
-        0..1,
-    );
+    let z = mean_rgb(&gpu(ctx, &params(None, &[("sun_elevation_deg", "45".into())]), w, h), 0..1);
     assert!(z[2] > z[1] && z[1] > z[0], "zenith at sun 45 deg: {z:?}");
 
     // Radiance peaks toward the sun: in every row (elevation) the brightest
     // column is one of the two next to azimuth 0. (The image maximum itself
     // is on the horizon below the sun, where the path is longest.)
-    for (name, img) in [
-        ("noon", &noon),
-        ("afternoon", &afternoon),
-        ("sunset", &sunset),
-    ] {
+    for (name, img) in [("noon", &noon), ("afternoon", &afternoon), ("sunset", &sunset)] {
         for y in 0..h {
             let sum = |x: u32| img.get(x, y)[..3].iter().sum::<f32>();
             let brightest = (0..w).max_by(|&a, &b| sum(a).total_cmp(&sum(b))).unwrap();
-            assert!(
-                brightest == 0 || brightest == w - 1,
-                "{name}: row {y} peaks at column {brightest}"
-            );
+            assert!(brightest == 0 || brightest == w - 1, "{name}: row {y} peaks at column {brightest}");
         }
     }
 
     // Earth shadow: the sun 4 deg below the horizon dims the sky > 10x
     // against the sun on the horizon.
     let mean = |img: &Image| mean_rgb(img, 0..h).iter().sum::<f64>();
-    let horizon_sun = gpu(
-        ctx,
-        &params(None, &[("sun_elevation_deg", "0".into())]),
-        w,
-        h,
-    );
+    let horizon_sun = gpu(ctx, &params(None, &[("sun_elevation_deg", "0".into())]), w, h);
     let ratio = mean(&horizon_sun) / mean(&twilight);
     eprintln!("Earth shadow: mean L at sun 0 deg / sun -4 deg = {ratio:.1}");
-    assert!(
-        ratio >= 10.0,
-        "sun -4 deg only {ratio:.2}x darker than sun 0 deg"
-    );
+    assert!(ratio >= 10.0, "sun -4 deg only {ratio:.2}x darker than sun 0 deg");
 }
 
 /// Finite, non-negative and within `output_bounds` over the whole range of
 /// sun elevations and camera altitudes (and the extreme mie_g), tiny images.
 #[test]
 fn gpu_finite_over_the_parameter_grid() {
-    let Some(ctx) = vista_golden::gpu_for_test("atmosphere::gpu_finite_over_the_parameter_grid")
-    else {
+    let Some(ctx) = common::gpu_for_test("atmosphere::gpu_finite_over_the_parameter_grid") else {
         return;
     };
-    let suns = [
-        -10.0, -6.0, -2.0, -0.01, 0.0, 0.01, 1.0, 5.0, 20.0, 45.0, 75.0, 89.99, 90.0,
-    ];
-    let alts = [
-        0.0, 0.5, 10.0, 1000.0, 8000.0, 30_000.0, 59_990.0, 60_000.0, 60_010.0, 100_000.0,
-    ];
+    let suns = [-10.0, -6.0, -2.0, -0.01, 0.0, 0.01, 1.0, 5.0, 20.0, 45.0, 75.0, 89.99, 90.0];
+    let alts = [0.0, 0.5, 10.0, 1000.0, 8000.0, 30_000.0, 59_990.0, 60_000.0, 60_010.0, 100_000.0];
     for sun in suns {
         for alt in alts {
             for (g, proj) in [(0.8, "latlong"), (0.99, "fisheye"), (-0.99, "latlong")] {
@@ -263,33 +189,21 @@ fn gpu_finite_over_the_parameter_grid() {
                 }
                 if alt >= 60_000.0 {
                     // At or above the top, upward rays meet no air.
-                    assert!(
-                        img.data.iter().all(|p| p[..3] == [0.0; 3]),
-                        "alt {alt}: upward rays miss the atmosphere"
-                    );
+                    assert!(img.data.iter().all(|p| p[..3] == [0.0; 3]), "alt {alt}: upward rays miss the atmosphere");
                 } else if sun >= 0.0 && alt < 60_000.0 {
-                    assert!(
-                        img.data.iter().any(|p| p[2] > 0.0),
-                        "sun {sun} alt {alt}: sky is black"
-                    );
+                    assert!(img.data.iter().any(|p| p[2] > 0.0), "sun {sun} alt {alt}: sky is black");
                 }
             }
         }
     }
     // Fewest steps possible.
     let p = params(Some("sunset"), &samples(1, 1));
-    assert!(
-        gpu(ctx, &p, 8, 4)
-            .data
-            .iter()
-            .all(|px| px.iter().all(|c| c.is_finite()))
-    );
+    assert!(gpu(ctx, &p, 8, 4).data.iter().all(|px| px.iter().all(|c| c.is_finite())));
 }
 
 #[test]
 fn exr_round_trip_is_bit_identical() {
-    let Some(ctx) = vista_golden::gpu_for_test("atmosphere::exr_round_trip_is_bit_identical")
-    else {
+    let Some(ctx) = common::gpu_for_test("atmosphere::exr_round_trip_is_bit_identical") else {
         return;
     };
     let raw = gpu(ctx, &params(Some("sunset"), &[]), 32, 16);
@@ -297,12 +211,6 @@ fn exr_round_trip_is_bit_identical() {
     let path = dir.path().join("sunset.exr");
     vista_image::save(&path, &raw).unwrap();
     let back = vista_image::load(&path).unwrap();
-    assert!(
-        back.bit_identical(&raw),
-        "EXR round trip changed the radiance"
-    );
-    assert!(
-        raw.data.iter().any(|p| p[0] > 1.0),
-        "the sunset render should hold HDR values above 1"
-    );
+    assert!(back.bit_identical(&raw), "EXR round trip changed the radiance");
+    assert!(raw.data.iter().any(|p| p[0] > 1.0), "the sunset render should hold HDR values above 1");
 }

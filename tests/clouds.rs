@@ -1,6 +1,8 @@
 //! clouds (SPEC 3.6) on the GPU: against the f64 CPU reference, the
 //! invariants that need a render, and the seed experiment of SPEC 7/8.
 
+mod common;
+
 use std::time::Instant;
 
 use vista_golden::render;
@@ -14,7 +16,7 @@ fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
     CloudsKernel.resolve(Some(preset), &set).expect("valid test params")
 }
 
-fn gpu(ctx: &vista_gpu::Context, p: &ParamSet, w: u32, h: u32) -> Image {
+fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
     render(ctx, &CloudsKernel, p, w, h).expect("render").raw
 }
 
@@ -22,7 +24,7 @@ fn gpu(ctx: &vista_gpu::Context, p: &ParamSet, w: u32, h: u32) -> Image {
 /// (vista_image::metrics::compare_hdr).
 #[test]
 fn gpu_matches_f64_reference() {
-    let Some(ctx) = vista_golden::gpu_for_test("clouds gpu vs cpu") else {
+    let Some(ctx) = common::gpu_for_test("clouds gpu vs cpu") else {
         return;
     };
     let (w, h) = (48, 48);
@@ -54,7 +56,7 @@ fn gpu_matches_f64_reference() {
 /// Coverage 0: exactly the background (bit for bit) and alpha exactly 0.
 #[test]
 fn zero_coverage_is_exactly_the_background() {
-    let Some(ctx) = vista_golden::gpu_for_test("clouds zero coverage") else {
+    let Some(ctx) = common::gpu_for_test("clouds zero coverage") else {
         return;
     };
     let sky = [0.3f32, 0.5, 0.9];
@@ -87,7 +89,7 @@ fn zero_coverage_is_exactly_the_background() {
 /// Doubling density_scale never raises T: alpha = 1 - T never falls.
 #[test]
 fn doubling_density_never_raises_transmittance() {
-    let Some(ctx) = vista_golden::gpu_for_test("clouds density monotone") else {
+    let Some(ctx) = common::gpu_for_test("clouds density monotone") else {
         return;
     };
     for (preset, d) in [("cumulus", "40"), ("cirrostratus", "0.25"), ("stratocumulus", "4")] {
@@ -111,7 +113,7 @@ fn doubling_density_never_raises_transmittance() {
 /// With the sun behind the camera the backward lobe keeps clouds lit.
 #[test]
 fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind() {
-    let Some(ctx) = vista_golden::gpu_for_test("clouds dual lobe") else {
+    let Some(ctx) = common::gpu_for_test("clouds dual lobe") else {
         return;
     };
     let sun_behind = [("sun_azimuth_deg", "180"), ("sun_elevation_deg", "30"), ("yaw_deg", "0")];
@@ -135,7 +137,7 @@ fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind() {
 
 #[test]
 fn renders_are_deterministic_and_jitter_follows_its_seed() {
-    let Some(ctx) = vista_golden::gpu_for_test("clouds determinism") else {
+    let Some(ctx) = common::gpu_for_test("clouds determinism") else {
         return;
     };
     let (w, h) = (32, 32);
@@ -157,7 +159,7 @@ fn renders_are_deterministic_and_jitter_follows_its_seed() {
 /// `seed_experiment_analytic_ign_at_half_the_steps_beats_riemann_64x12`.
 #[test]
 fn seed_experiment_on_the_gpu() {
-    let Some(ctx) = vista_golden::gpu_for_test("clouds seed experiment") else {
+    let Some(ctx) = common::gpu_for_test("clouds seed experiment") else {
         return;
     };
     let (w, h) = (48, 48);

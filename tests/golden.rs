@@ -5,36 +5,45 @@
 use std::sync::{Arc, Mutex};
 
 use libtest_mimic::{Arguments, Failed, Trial};
-use vista_golden::{CheckOptions, Store, allow_no_gpu, default_report_dir};
+use vista_golden::{CheckOptions, Renderer, Store, allow_no_gpu};
 use vista_gpu::Context;
+
+mod common;
 
 fn main() {
     let args = Arguments::from_args();
-    let store = Store::open_default();
+    let project = common::project();
+    let store = Store::of_project(&project, "the golden tests").expect("repository root");
     let cases = store.load_cases().unwrap_or_else(|e| panic!("cannot load golden cases: {e}"));
     let manifest = Arc::new(store.manifest().unwrap_or_else(|e| panic!("cannot load manifest: {e}")));
-    let report_dir = default_report_dir();
+    let report_dir = project.report_dir().expect("repository root");
     let outcomes = Arc::new(Mutex::new(Vec::new()));
 
     // Listing must work without a device (nextest lists before it runs).
     let gpu = if args.list { None } else { Some(Context::shared()) };
+    let shaders = vista_golden::shader_set(&project).unwrap_or_else(|e| panic!("cannot load shaders: {e}"));
     let no_gpu = matches!(&gpu, Some(Err(_)));
     if no_gpu {
         let e = gpu.as_ref().and_then(|g| g.as_ref().err()).expect("error");
         if allow_no_gpu() {
             eprintln!("\n!!! VISTA_ALLOW_NO_GPU=1 and no adapter: {e}");
-            eprintln!("!!! SKIPPING all {} golden cases: {}\n", cases.len(), cases.iter().map(|c| c.id.as_str()).collect::<Vec<_>>().join(", "));
+            eprintln!(
+                "!!! SKIPPING all {} golden cases: {}\n",
+                cases.len(),
+                cases.iter().map(|c| c.id.as_str()).collect::<Vec<_>>().join(", ")
+            );
         }
     }
 
     let trials: Vec<Trial> = cases
         .iter()
         .map(|case| {
-            let (case, store, manifest, outcomes, report_dir) =
-                (case.clone(), store.clone(), manifest.clone(), outcomes.clone(), report_dir.clone());
+            let (case, store, manifest, outcomes, report_dir, shaders) =
+                (case.clone(), store.clone(), manifest.clone(), outcomes.clone(), report_dir.clone(), shaders.clone());
             let name = format!("golden::{}::{}", case.kernel.name(), case.id);
             Trial::test(name, move || {
                 let ctx = Context::shared().map_err(|e| Failed::from(format!("no GPU adapter: {e}")))?;
+                let ctx = &Renderer { ctx, shaders };
                 let opts = CheckOptions { report_dir: report_dir.clone(), twice: true };
                 let o = vista_golden::check_case(ctx, &store, &manifest, &case, &opts);
                 let result = if o.passed() { Ok(()) } else { Err(Failed::from(o.explain(&report_dir))) };

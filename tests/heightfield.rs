@@ -4,6 +4,8 @@
 //! the analytic terrains. World unit: 1 km. Images are small (64 x 40) so
 //! every test stays within a few seconds on lavapipe.
 
+mod common;
+
 use vista_image::Image;
 use vista_kernels::heightfield::{Camera, HeightfieldKernel, HitSearch, Terrain, brute_force_hit, camera_of};
 use vista_kernels::{Kernel, ParamSet, pixel_uv};
@@ -16,7 +18,7 @@ fn params(preset: &str, sets: &[(&str, &str)]) -> ParamSet {
     HeightfieldKernel.resolve(Some(preset), &o).unwrap_or_else(|e| panic!("{preset} {sets:?}: {e}"))
 }
 
-fn gpu(ctx: &vista_gpu::Context, p: &ParamSet) -> Image {
+fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet) -> Image {
     vista_golden::render(ctx, &HeightfieldKernel, p, W, H).expect("render").raw
 }
 
@@ -43,7 +45,9 @@ fn agreement(gpu: &Image, reference: &Image) -> (usize, usize) {
 
 #[test]
 fn depth_agrees_with_brute_force_reference() {
-    let Some(ctx) = vista_golden::gpu_for_test("heightfield depth_agrees_with_brute_force_reference") else { return };
+    let Some(ctx) = common::gpu_for_test("heightfield depth_agrees_with_brute_force_reference") else {
+        return;
+    };
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[("view", "depth")]);
         let g = gpu(ctx, &p);
@@ -66,7 +70,9 @@ fn depth_agrees_with_brute_force_reference() {
 
 #[test]
 fn refined_hits_satisfy_eps_rule() {
-    let Some(ctx) = vista_golden::gpu_for_test("heightfield refined_hits_satisfy_eps_rule") else { return };
+    let Some(ctx) = common::gpu_for_test("heightfield refined_hits_satisfy_eps_rule") else {
+        return;
+    };
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[("view", "depth")]);
         let g = gpu(ctx, &p);
@@ -75,7 +81,9 @@ fn refined_hits_satisfy_eps_rule() {
         let (t_max, eps) = (p.f64("t_max"), p.f64("eps"));
         let (mut hits, mut worst) = (0, 0.0_f64);
         for (i, px) in g.data.iter().enumerate() {
-            let Some(t) = hit_t(px[0], t_max) else { continue };
+            let Some(t) = hit_t(px[0], t_max) else {
+                continue;
+            };
             let (u, v) = pixel_uv(i as u32 % W, i as u32 / W, W, H);
             let d = cam.ray(u, v);
             let above = terrain.above(cam.pos, d, t);
@@ -98,7 +106,9 @@ fn refined_hits_satisfy_eps_rule() {
 
 #[test]
 fn raising_max_steps_never_removes_hits() {
-    let Some(ctx) = vista_golden::gpu_for_test("heightfield raising_max_steps_never_removes_hits") else { return };
+    let Some(ctx) = common::gpu_for_test("heightfield raising_max_steps_never_removes_hits") else {
+        return;
+    };
     for preset in ["valley", "grazing"] {
         let renders: Vec<Image> = ["64", "128", "256"]
             .iter()
@@ -131,7 +141,7 @@ fn oversteps(gpu: &Image, reference: &Image) -> usize {
 /// twice the cost in steps.
 #[test]
 fn relax_one_oversteps_on_grazing_where_half_does_not() {
-    let Some(ctx) = vista_golden::gpu_for_test("heightfield relax_one_oversteps_on_grazing_where_half_does_not") else {
+    let Some(ctx) = common::gpu_for_test("heightfield relax_one_oversteps_on_grazing_where_half_does_not") else {
         return;
     };
     let p = params("grazing", &[("view", "depth")]);
@@ -154,7 +164,9 @@ fn relax_one_oversteps_on_grazing_where_half_does_not() {
 
 #[test]
 fn analytic_plane_depth_and_ramp_normals() {
-    let Some(ctx) = vista_golden::gpu_for_test("heightfield analytic_plane_depth_and_ramp_normals") else { return };
+    let Some(ctx) = common::gpu_for_test("heightfield analytic_plane_depth_and_ramp_normals") else {
+        return;
+    };
     // Flat plane h0 = 0.2: t* = (o.y - h0) / (-d.y) within eps t. Near the
     // horizon D shrinks by (1 - relax |d.y|) per step, so those rays need
     // more than the default 256 steps.
@@ -200,7 +212,7 @@ fn analytic_plane_depth_and_ramp_normals() {
 
 #[test]
 fn sine_terrain_matches_bisection_and_normals_face_up() {
-    let Some(ctx) = vista_golden::gpu_for_test("heightfield sine_terrain_matches_bisection_and_normals_face_up") else {
+    let Some(ctx) = common::gpu_for_test("heightfield sine_terrain_matches_bisection_and_normals_face_up") else {
         return;
     };
     let sets = [("terrain", "sine"), ("amplitude", "0.4"), ("scale", "1.3"), ("camera_pos", "0.2,1.6,0.1")];
@@ -234,7 +246,9 @@ fn sine_terrain_matches_bisection_and_normals_face_up() {
 
 #[test]
 fn color_and_steps_match_reference() {
-    let Some(ctx) = vista_golden::gpu_for_test("heightfield color_and_steps_match_reference") else { return };
+    let Some(ctx) = common::gpu_for_test("heightfield color_and_steps_match_reference") else {
+        return;
+    };
     // Smaller than the other tests: the f64 reference shades every hit
     // (normal, shadow march) on top of the brute-force search.
     let (w, h) = (48, 30);
@@ -263,7 +277,9 @@ fn color_and_steps_match_reference() {
 /// hits), or the throughput ratio would compare different algorithms.
 #[test]
 fn cpu_f32_relax_march_matches_the_gpu() {
-    let Some(ctx) = vista_golden::gpu_for_test("heightfield cpu_f32_relax_march_matches_the_gpu") else { return };
+    let Some(ctx) = common::gpu_for_test("heightfield cpu_f32_relax_march_matches_the_gpu") else {
+        return;
+    };
     let (w, h) = (48, 30);
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[]);

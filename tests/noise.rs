@@ -1,5 +1,7 @@
 //! fbm and ridged on the GPU against their f64 CPU references (SPEC 3.1-3.3).
 
+mod common;
+
 use vista_image::Image;
 use vista_kernels::{Kernel, ParamSet, noise};
 
@@ -26,7 +28,9 @@ fn max_field_error(gpu: &Image, cpu: &Image) -> (f32, (u32, u32)) {
 type Setting<'a> = (Option<&'a str>, &'a [(&'a str, &'a str)]);
 
 fn gpu_vs_cpu(kernel_name: &str, cases: &[Setting]) {
-    let Some(ctx) = vista_golden::gpu_for_test(kernel_name) else { return };
+    let Some(ctx) = common::gpu_for_test(kernel_name) else {
+        return;
+    };
     let k = vista_kernels::find(kernel_name).unwrap();
     for (preset, set) in cases {
         let p = params(k, *preset, set);
@@ -63,7 +67,9 @@ fn fbm_gpu_matches_f64_reference() {
 /// 1e-4 band, but stays within the f32 estimate sum_i gain^i eps |p_i| L_N / A.
 #[test]
 fn fbm_f32_error_follows_the_coordinate_precision_estimate() {
-    let Some(ctx) = vista_golden::gpu_for_test("fbm precision") else { return };
+    let Some(ctx) = common::gpu_for_test("fbm precision") else {
+        return;
+    };
     let k = vista_kernels::find("fbm").unwrap();
     let p = params(k, None, &[("octaves", "16"), ("gain", "0.9"), ("lacunarity", "1.7"), ("frequency", "9")]);
     let gpu = vista_golden::render(ctx, k, &p, 96, 96).unwrap().raw;
@@ -71,7 +77,8 @@ fn fbm_f32_error_follows_the_coordinate_precision_estimate() {
     let (err, _) = max_field_error(&gpu, &cpu);
     let a: f64 = (0..16).map(|i| 0.9f64.powi(i)).sum();
     // Per-axis Lipschitz bound of the basis (see crates/vista-kernels/tests/noise.rs) ~ 8.5, two axes.
-    let estimate: f64 = (0..16).map(|i| 0.9f64.powi(i) * f32::EPSILON as f64 * 9.0 * 1.7f64.powi(i) * 17.0).sum::<f64>() / a;
+    let estimate: f64 =
+        (0..16).map(|i| 0.9f64.powi(i) * f32::EPSILON as f64 * 9.0 * 1.7f64.powi(i) * 17.0).sum::<f64>() / a;
     eprintln!("16 octaves, gain 0.9, lacunarity 1.7: max error {err:.3e}, f32 estimate {estimate:.3e}");
     assert!(err > 1e-4, "precision loss expected here; if it vanished, tighten the documented limit");
     assert!((err as f64) < 0.5 * estimate + 1e-4, "error {err} exceeds the f32 coordinate estimate {estimate}");
@@ -100,7 +107,9 @@ fn lattice_params(k: &dyn Kernel, basis: &str, seed: &str, w: u32) -> ParamSet {
 
 #[test]
 fn value_noise_is_bit_identical_to_cpu_at_lattice_points() {
-    let Some(ctx) = vista_golden::gpu_for_test("value lattice") else { return };
+    let Some(ctx) = common::gpu_for_test("value lattice") else {
+        return;
+    };
     let k = vista_kernels::find("fbm").unwrap();
     let w = 64;
     for seed in [0u32, 1, 123_456] {
@@ -120,7 +129,9 @@ fn value_noise_is_bit_identical_to_cpu_at_lattice_points() {
 
 #[test]
 fn perlin_is_zero_at_lattice_points_on_gpu() {
-    let Some(ctx) = vista_golden::gpu_for_test("perlin lattice") else { return };
+    let Some(ctx) = common::gpu_for_test("perlin lattice") else {
+        return;
+    };
     let k = vista_kernels::find("fbm").unwrap();
     for seed in ["0", "17"] {
         let p = lattice_params(k, "perlin", seed, 32);
@@ -131,12 +142,15 @@ fn perlin_is_zero_at_lattice_points_on_gpu() {
 
 #[test]
 fn seed_changes_the_gpu_image() {
-    let Some(ctx) = vista_golden::gpu_for_test("seed changes") else { return };
+    let Some(ctx) = common::gpu_for_test("seed changes") else {
+        return;
+    };
     for kernel in ["fbm", "ridged"] {
         let k = vista_kernels::find(kernel).unwrap();
         for basis in ["perlin", "value"] {
             let a = vista_golden::render(ctx, k, &params(k, None, &[("basis", basis)]), 64, 64).unwrap().raw;
-            let b = vista_golden::render(ctx, k, &params(k, None, &[("basis", basis), ("seed", "1")]), 64, 64).unwrap().raw;
+            let b =
+                vista_golden::render(ctx, k, &params(k, None, &[("basis", basis), ("seed", "1")]), 64, 64).unwrap().raw;
             let psnr = vista_image::metrics::psnr(&a, &b);
             assert!(psnr < 30.0, "{kernel}/{basis}: seed 0 and 1 give nearly the same image (PSNR {psnr})");
         }
@@ -145,7 +159,9 @@ fn seed_changes_the_gpu_image() {
 
 #[test]
 fn one_octave_fbm_equals_the_basis_on_gpu() {
-    let Some(ctx) = vista_golden::gpu_for_test("octaves=1") else { return };
+    let Some(ctx) = common::gpu_for_test("octaves=1") else {
+        return;
+    };
     let k = vista_kernels::find("fbm").unwrap();
     let p = params(k, None, &[("octaves", "1"), ("seed", "3")]);
     let gpu = vista_golden::render(ctx, k, &p, 48, 48).unwrap().raw;

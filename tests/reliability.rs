@@ -2,6 +2,8 @@
 //! pixel; NaN renders are never blessed; random in-range parameters for every
 //! kernel (proptest) give finite output inside each kernel's documented range.
 
+mod common;
+
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 use vista_golden::{Case, CheckOptions, Store};
@@ -61,7 +63,9 @@ fn nan_case() -> Case {
 
 #[test]
 fn injected_nan_fails_the_case_naming_count_and_first_pixel() {
-    let Some(ctx) = vista_golden::gpu_for_test("NaN injection") else { return };
+    let Some(ctx) = common::gpu_for_test("NaN injection") else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     let store = Store { dir: dir.path().to_path_buf() };
     // A golden that would otherwise match: NaN must fail on its own.
@@ -78,7 +82,9 @@ fn injected_nan_fails_the_case_naming_count_and_first_pixel() {
 
 #[test]
 fn render_path_reports_nan_from_the_gpu_bit_exactly() {
-    let Some(ctx) = vista_golden::gpu_for_test("NaN readback") else { return };
+    let Some(ctx) = common::gpu_for_test("NaN readback") else {
+        return;
+    };
     let r = vista_golden::render(ctx, &NAN, &nan_case().params, 16, 8).unwrap();
     assert!(r.raw.get(5, 3)[0].is_nan());
     assert_eq!(r.raw.get(7, 3)[0], f32::INFINITY);
@@ -124,7 +130,9 @@ const FUZZ_SIZE: (u32, u32) = (8, 8);
 
 #[test]
 fn random_in_range_params_give_finite_output_within_documented_bounds() {
-    let Some(ctx) = vista_golden::gpu_for_test("parameter fuzzing") else { return };
+    let Some(ctx) = common::gpu_for_test("parameter fuzzing") else {
+        return;
+    };
     let mut total = 0;
     for kernel in vista_kernels::registry() {
         let specs = kernel.params();
@@ -141,7 +149,9 @@ fn random_in_range_params_give_finite_output_within_documented_bounds() {
             let overrides: Vec<(String, String)> =
                 specs.iter().zip(&values).map(|(s, v)| (s.name.to_string(), v.clone())).collect();
             // Cross-parameter rules (e.g. a camera looking straight up) may reject a draw.
-            let Ok(p) = kernel.resolve(None, &overrides) else { return Ok(()) };
+            let Ok(p) = kernel.resolve(None, &overrides) else {
+                return Ok(());
+            };
             let (w, h) = FUZZ_SIZE;
             if vista_golden::check_request(*kernel, &p, w, h).is_err() {
                 return Ok(());

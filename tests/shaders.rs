@@ -1,12 +1,36 @@
 //! Every WGSL file composes and validates with naga alone (no device), and
 //! every kernel's uniform block matches the `Params` struct naga reflects.
 
-use vista_gpu::{ShaderSet, binding_struct_layout, default_shader_dir};
+use vista_gpu::{ShaderSet, binding_struct_layout};
+
+mod common;
+
+fn repo_shaders() -> ShaderSet {
+    vista_golden::shader_set(&common::project()).unwrap()
+}
+
+/// A set over the `.wgsl` files of a directory tree (paths relative to it).
+fn set_of_dir(dir: &std::path::Path) -> ShaderSet {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "wgsl") {
+                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().replace('\\', "/");
+                files.push((rel, std::fs::read_to_string(&p).unwrap(), p.display().to_string()));
+            }
+        }
+    }
+    ShaderSet::from_files(&dir.display().to_string(), files)
+}
 
 #[test]
 fn every_kernel_shader_composes_and_validates_without_a_device() {
-    let set = ShaderSet::load(&default_shader_dir()).unwrap();
-    let files = set.kernel_files().unwrap();
+    let set = repo_shaders();
+    let files = set.kernel_files();
     assert!(files.len() >= 2, "expected kernel shaders, found {files:?}");
     for f in &files {
         set.compose(f).unwrap_or_else(|e| panic!("{f}: {e}"));
@@ -15,8 +39,8 @@ fn every_kernel_shader_composes_and_validates_without_a_device() {
 
 #[test]
 fn every_registered_kernel_has_a_shader_file() {
-    let set = ShaderSet::load(&default_shader_dir()).unwrap();
-    let files = set.kernel_files().unwrap();
+    let set = repo_shaders();
+    let files = set.kernel_files();
     for k in vista_kernels::registry() {
         assert!(files.iter().any(|f| f == k.shader()), "{}: shader {} missing", k.name(), k.shader());
     }
@@ -24,7 +48,7 @@ fn every_registered_kernel_has_a_shader_file() {
 
 #[test]
 fn uniform_layouts_match_the_wgsl_params_struct() {
-    let set = ShaderSet::load(&default_shader_dir()).unwrap();
+    let set = repo_shaders();
     for k in vista_kernels::registry() {
         let p = k.resolve(None, &[]).unwrap();
         let u = k.uniforms(&p, 64, 32);
@@ -48,7 +72,7 @@ fn a_broken_shader_reports_file_and_line() {
         "#import vista::x::one\n\n@compute @workgroup_size(1)\nfn main() {\n    let a: f32 = one() + undefined_name;\n}\n",
     )
     .unwrap();
-    let set = ShaderSet::load(dir.path()).unwrap();
+    let set = set_of_dir(dir.path());
     let err = set.compose("bad.wgsl").unwrap_err().to_string();
     assert!(err.contains("bad.wgsl"), "error does not name the file: {err}");
     assert!(err.contains(":5:") || err.contains("5 │") || err.contains("5 |"), "error does not name line 5: {err}");
@@ -60,7 +84,7 @@ fn a_broken_shader_reports_file_and_line() {
 #[test]
 fn shader_hash_covers_transitive_imports_only() {
     let tmp = tempfile::tempdir().unwrap();
-    let src = default_shader_dir();
+    let src = common::project().root().unwrap().join("shaders");
     for sub in ["", "lib"] {
         std::fs::create_dir_all(tmp.path().join(sub)).unwrap();
         for e in std::fs::read_dir(src.join(sub)).unwrap().flatten() {
@@ -69,7 +93,7 @@ fn shader_hash_covers_transitive_imports_only() {
             }
         }
     }
-    let hash = |name: &str| ShaderSet::load(tmp.path()).unwrap().source_hash(name).unwrap();
+    let hash = |name: &str| set_of_dir(tmp.path()).source_hash(name).unwrap();
     let (fbm0, atmo0) = (hash("fbm.wgsl"), hash("atmosphere.wgsl"));
     let append = |file: &str| {
         let p = tmp.path().join(file);

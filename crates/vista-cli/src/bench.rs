@@ -1,12 +1,15 @@
 //! `vista bench`: median kernel throughput after a warm-up run, optionally
 //! beside the f32 CPU reference on all cores.
 
-use vista_golden::GoldenError;
+use vista_golden::{GoldenError, Renderer};
 use vista_gpu::Context;
+use vista_project::Project;
 
 use crate::{bad, parse_sets};
 
+#[allow(clippy::too_many_arguments)]
 pub fn bench(
+    project: &Project,
     kernel: &str,
     preset: Option<&str>,
     set: &[String],
@@ -22,7 +25,7 @@ pub fn bench(
     let p = k.resolve(preset, &parse_sets(set)?).map_err(bad)?;
     let (w, h) = vista_kernels::parse_size(size).map_err(bad)?;
     vista_golden::check_request(k, &p, w, h)?;
-    let ctx = Context::shared()?;
+    let ctx = &Renderer::new(Context::shared()?, project)?;
     // Warm-up: compiles the pipeline and touches every allocation path once.
     // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
     let first = vista_golden::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
@@ -51,7 +54,11 @@ pub fn bench(
         }
         println!("{out}");
     } else {
-        println!("{kernel} {w}x{h}: median {:.2} ms over {runs} runs, {mpix:.2} Mpix/s on {}", median * 1e3, ctx.adapter_description());
+        println!(
+            "{kernel} {w}x{h}: median {:.2} ms over {runs} runs, {mpix:.2} Mpix/s on {}",
+            median * 1e3,
+            ctx.adapter_description()
+        );
         println!(
             "device creation {:.1} ms, first call (compose + pipeline compile + dispatch + readback) {:.1} ms",
             ctx.creation_time.as_secs_f64() * 1e3,

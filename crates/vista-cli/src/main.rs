@@ -5,9 +5,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use vista_golden::{BlessOptions, CheckOptions, GoldenError, Store};
+use vista_golden::{BlessOptions, CheckOptions, GoldenError, Renderer, Store};
 use vista_gpu::Context;
 use vista_image::metrics;
+use vista_project::Project;
 
 mod bench;
 mod sweep;
@@ -18,6 +19,10 @@ struct Cli {
     /// Adapter: cpu (lavapipe, default) or gpu (hardware). Same as VISTA_ADAPTER.
     #[arg(long, global = true)]
     adapter: Option<String>,
+    /// Project root (a directory holding vista.toml). Default: VISTA_ROOT,
+    /// else the nearest vista.toml at or above the current directory.
+    #[arg(long, global = true, value_name = "DIR")]
+    root: Option<PathBuf>,
     #[command(subcommand)]
     command: Command,
 }
@@ -57,6 +62,9 @@ enum Command {
     Check {
         #[arg(long = "case", value_name = "GLOB")]
         case: Option<String>,
+        /// Where the HTML report and case images go (default: <root>/target/vista-report).
+        #[arg(long, value_name = "DIR")]
+        report_dir: Option<PathBuf>,
     },
     /// Re-render cases and write their goldens (refused under CI=true without --force).
     Bless {
@@ -145,7 +153,17 @@ fn main() -> ExitCode {
         // SAFETY: single-threaded at this point; read once by Context::shared.
         unsafe { std::env::set_var("VISTA_ADAPTER", a) };
     }
-    match run(cli.command) {
+    let project = match std::env::current_dir()
+        .map_err(|e| GoldenError::BadInput(format!("cannot read the current directory: {e}")))
+        .and_then(|cwd| Ok(Project::discover(cli.root.as_deref(), std::env::var_os("VISTA_ROOT"), &cwd)?))
+    {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(e.exit_code() as u8);
+        }
+    };
+    match run(&project, cli.command) {
         Ok(code) => ExitCode::from(code as u8),
         Err(e) => {
             eprintln!("error: {e}");
@@ -169,7 +187,7 @@ fn bad(e: impl std::fmt::Display) -> GoldenError {
     GoldenError::BadInput(e.to_string())
 }
 
-fn run(cmd: Command) -> Result<i32, GoldenError> {
+fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
     match cmd {
         Command::List { names } => {
             if names {
@@ -189,7 +207,7 @@ fn run(cmd: Command) -> Result<i32, GoldenError> {
             let (w, h) = vista_kernels::parse_size(&size).map_err(bad)?;
             check_output_path(&out)?;
             vista_golden::check_request(k, &p, w, h)?;
-            let ctx = Context::shared()?;
+            let ctx = &Renderer::new(Context::shared()?, project)?;
             let r = vista_golden::render(ctx, k, &p, w, h)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
             vista_image::save(&out, if is_exr { &r.raw } else { &r.display })?;
@@ -224,23 +242,42 @@ fn run(cmd: Command) -> Result<i32, GoldenError> {
             }
             Ok(0)
         }
-        Command::Check { case } => check(case.as_deref()),
+        Command::Check { case, report_dir } => check(project, case.as_deref(), report_dir),
         Command::Bless { case, force, prune } => {
-            let store = Store::open_default();
-            let ctx = Context::shared()?;
+            let store = Store::of_project(project, "vista bless")?;
+            let ctx = &Renderer::new(Context::shared()?, project)?;
             let summary = vista_golden::bless(ctx, &store, &BlessOptions { glob: case, force, prune })?;
             println!("{:<40} {:<10} PSNR new vs old", "case", "status");
             for r in &summary.rows {
                 println!("{:<40} {:<10} {}", r.id, r.status, r.psnr_vs_previous);
             }
             for o in &summary.orphans {
-                println!("{} golden with no case: {}", if summary.pruned { "deleted" } else { "orphaned" }, o.display());
+                println!(
+                    "{} golden with no case: {}",
+                    if summary.pruned { "deleted" } else { "orphaned" },
+                    o.display()
+                );
             }
             println!("blessed {} cases on {}", summary.rows.len(), ctx.adapter_description());
             Ok(0)
         }
-        Command::Sweep { kernel, preset, set, param, values, param2, values2, reference_set, target_psnr, size, runs, metric, out } => {
-            sweep::sweep(sweep::Args {
+        Command::Sweep {
+            kernel,
+            preset,
+            set,
+            param,
+            values,
+            param2,
+            values2,
+            reference_set,
+            target_psnr,
+            size,
+            runs,
+            metric,
+            out,
+        } => sweep::sweep(
+            project,
+            sweep::Args {
                 kernel,
                 preset,
                 set,
@@ -254,10 +291,10 @@ fn run(cmd: Command) -> Result<i32, GoldenError> {
                 runs,
                 metric,
                 out,
-            })
-        }
+            },
+        ),
         Command::Bench { kernel, preset, set, size, runs, json, cpu } => {
-            bench::bench(&kernel, preset.as_deref(), &set, &size, runs, json, cpu)
+            bench::bench(project, &kernel, preset.as_deref(), &set, &size, runs, json, cpu)
         }
     }
 }
@@ -298,13 +335,17 @@ fn probe_writable(dir: &Path) -> Result<(), GoldenError> {
     Ok(())
 }
 
-fn check(glob: Option<&str>) -> Result<i32, GoldenError> {
-    let store = Store::open_default();
+fn check(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> Result<i32, GoldenError> {
+    let store = Store::of_project(project, "vista check")?;
     let cases = store.load_cases()?;
     let picked = vista_golden::select(&cases, glob)?;
     let manifest = store.manifest()?;
-    let ctx = Context::shared()?;
-    let opts = CheckOptions { report_dir: vista_golden::default_report_dir(), twice: false };
+    let ctx = &Renderer::new(Context::shared()?, project)?;
+    let report_dir = match report_dir {
+        Some(d) => d,
+        None => project.report_dir().expect("a store implies a root"),
+    };
+    let opts = CheckOptions { report_dir, twice: false };
     let mut outcomes = Vec::new();
     for case in picked {
         let o = vista_golden::check_case(ctx, &store, &manifest, case, &opts);
@@ -332,7 +373,12 @@ fn list() {
         println!("  presets:");
         for p in k.presets() {
             let set = p.set.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
-            println!("    {:<22} {}{}", p.name, p.doc, if set.is_empty() { String::new() } else { format!("  [{set}]") });
+            println!(
+                "    {:<22} {}{}",
+                p.name,
+                p.doc,
+                if set.is_empty() { String::new() } else { format!("  [{set}]") }
+            );
         }
         println!();
     }

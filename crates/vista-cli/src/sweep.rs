@@ -4,8 +4,9 @@
 use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use vista_golden::GoldenError;
+use vista_golden::{GoldenError, Renderer};
 use vista_gpu::Context;
+use vista_project::Project;
 use vista_sweep::{Axis, Metric, SweepSpec};
 
 use crate::{bad, parse_sets};
@@ -26,7 +27,7 @@ pub struct Args {
     pub out: PathBuf,
 }
 
-pub fn sweep(a: Args) -> Result<i32, GoldenError> {
+pub fn sweep(project: &Project, a: Args) -> Result<i32, GoldenError> {
     let kernel = vista_kernels::find(&a.kernel).map_err(bad)?;
     let (width, height) = vista_kernels::parse_size(&a.size).map_err(bad)?;
     let y = match (a.param2, a.values2) {
@@ -54,7 +55,7 @@ pub fn sweep(a: Args) -> Result<i32, GoldenError> {
     // Every value is checked before the device is touched.
     spec.resolve()?;
     crate::check_output_dir(&a.out)?;
-    let ctx = Context::shared()?;
+    let ctx = &Renderer::new(Context::shared()?, project)?;
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{bar:30}] {pos}/{len} {msg} ({elapsed})")

@@ -11,12 +11,13 @@ struct Run {
     stderr: String,
 }
 
-fn vista_in(golden: Option<&Path>, env: &[(&str, &str)], args: &[&str]) -> Run {
+/// Runs the binary inside `project` (found by walking up from it), or, with
+/// `None`, in an empty directory outside any project (built-ins only).
+fn vista_in(project: Option<&Path>, env: &[(&str, &str)], args: &[&str]) -> Run {
+    let outside = tmp();
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_vista"));
-    cmd.args(args).env("XDG_RUNTIME_DIR", "/tmp").env_remove("CI");
-    if let Some(g) = golden {
-        cmd.env("VISTA_GOLDEN_DIR", g).env("VISTA_REPORT_DIR", g.join("report"));
-    }
+    cmd.args(args).env("XDG_RUNTIME_DIR", "/tmp").env_remove("CI").env_remove("VISTA_ROOT");
+    cmd.current_dir(project.unwrap_or(outside.path()));
     for (k, v) in env {
         cmd.env(k, v);
     }
@@ -54,34 +55,66 @@ fn out_png(dir: &Path) -> String {
 #[test]
 fn unknown_kernel_lists_valid_kernels() {
     let d = tmp();
-    assert_rejected(&vista(&["render", "nope", "-o", &out_png(d.path())]), 2, &["unknown kernel 'nope'", "fbm", "ridged"]);
+    assert_rejected(
+        &vista(&["render", "nope", "-o", &out_png(d.path())]),
+        2,
+        &["unknown kernel 'nope'", "fbm", "ridged"],
+    );
 }
 
 #[test]
 fn unknown_preset_lists_valid_presets() {
     let d = tmp();
-    assert_rejected(&vista(&["render", "fbm", "--preset", "zzz", "-o", &out_png(d.path())]), 2, &["'zzz'", "default", "value"]);
+    assert_rejected(
+        &vista(&["render", "fbm", "--preset", "zzz", "-o", &out_png(d.path())]),
+        2,
+        &["'zzz'", "default", "value"],
+    );
 }
 
 #[test]
 fn unknown_param_lists_valid_params() {
     let d = tmp();
-    assert_rejected(&vista(&["render", "fbm", "--set", "octavez=3", "-o", &out_png(d.path())]), 2, &["'octavez'", "octaves", "lacunarity"]);
+    assert_rejected(
+        &vista(&["render", "fbm", "--set", "octavez=3", "-o", &out_png(d.path())]),
+        2,
+        &["'octavez'", "octaves", "lacunarity"],
+    );
 }
 
 #[test]
 fn out_of_range_value_names_value_and_range() {
     let d = tmp();
-    assert_rejected(&vista(&["render", "fbm", "--set", "octaves=17", "-o", &out_png(d.path())]), 2, &["octaves=17", "[1, 16]"]);
-    assert_rejected(&vista(&["render", "fbm", "--set", "gain=1.5", "-o", &out_png(d.path())]), 2, &["gain=1.5", "[0, 1]"]);
+    assert_rejected(
+        &vista(&["render", "fbm", "--set", "octaves=17", "-o", &out_png(d.path())]),
+        2,
+        &["octaves=17", "[1, 16]"],
+    );
+    assert_rejected(
+        &vista(&["render", "fbm", "--set", "gain=1.5", "-o", &out_png(d.path())]),
+        2,
+        &["gain=1.5", "[0, 1]"],
+    );
 }
 
 #[test]
 fn wrong_type_names_value_and_expected_kind() {
     let d = tmp();
-    assert_rejected(&vista(&["render", "fbm", "--set", "octaves=many", "-o", &out_png(d.path())]), 2, &["octaves=many", "integer"]);
-    assert_rejected(&vista(&["render", "fbm", "--set", "basis=simplex", "-o", &out_png(d.path())]), 2, &["basis=simplex", "perlin|value"]);
-    assert_rejected(&vista(&["render", "fbm", "--set", "offset=1", "-o", &out_png(d.path())]), 2, &["offset=1", "2 comma-separated"]);
+    assert_rejected(
+        &vista(&["render", "fbm", "--set", "octaves=many", "-o", &out_png(d.path())]),
+        2,
+        &["octaves=many", "integer"],
+    );
+    assert_rejected(
+        &vista(&["render", "fbm", "--set", "basis=simplex", "-o", &out_png(d.path())]),
+        2,
+        &["basis=simplex", "perlin|value"],
+    );
+    assert_rejected(
+        &vista(&["render", "fbm", "--set", "offset=1", "-o", &out_png(d.path())]),
+        2,
+        &["offset=1", "2 comma-separated"],
+    );
     assert_rejected(&vista(&["render", "fbm", "--set", "gain=nan", "-o", &out_png(d.path())]), 2, &["gain=nan"]);
     assert_rejected(&vista(&["render", "fbm", "--set", "gain", "-o", &out_png(d.path())]), 2, &["NAME=VALUE"]);
 }
@@ -91,7 +124,13 @@ fn bad_sizes_are_rejected_before_gpu_work() {
     let d = tmp();
     // VISTA_ADAPTER=nonsense would fail at device creation: these never get there.
     let env = [("VISTA_ADAPTER", "nonsense")];
-    for (size, needle) in [("0x16", "width=0"), ("16x0", "height=0"), ("axb", "WIDTHxHEIGHT"), ("9000x16", "[1, 8192]"), ("64", "WIDTHxHEIGHT")] {
+    for (size, needle) in [
+        ("0x16", "width=0"),
+        ("16x0", "height=0"),
+        ("axb", "WIDTHxHEIGHT"),
+        ("9000x16", "[1, 8192]"),
+        ("64", "WIDTHxHEIGHT"),
+    ] {
         let r = vista_in(None, &env, &["render", "fbm", "--size", size, "-o", &out_png(d.path())]);
         assert_rejected(&r, 2, &[needle]);
     }
@@ -192,10 +231,35 @@ fn sweep_rejects_bad_input_before_rendering() {
         (&["sweep", "fbm", "--param", "basis", "--values", "perlin,value", "--out", o], &["basis", "numeric"]),
         (&["sweep", "fbm", "--param", "octaves", "--values", "1,99", "--out", o], &["octaves=99", "[1, 16]"]),
         (&["sweep", "fbm", "--param", "octaves", "--values", "1,,2", "--out", o], &["empty value"]),
-        (&["sweep", "fbm", "--param", "octaves", "--values", "1,2", "--target-psnr", "-3", "--out", o], &["-3", "[0, 200]"]),
-        (&["sweep", "fbm", "--param", "octaves", "--values", "2", "--param2", "octaves", "--values2", "3", "--out", o], &["both 'octaves'"]),
-        (&["sweep", "clouds", "--param", "steps", "--values", "8", "--reference-set", "light_steps=0", "--out", o], &["light_steps=0"]),
-        (&["sweep", "fbm", "--param", "octaves", "--values", "2", "--metric", "log", "--out", o], &["--metric=log", "display|linear"]),
+        (
+            &["sweep", "fbm", "--param", "octaves", "--values", "1,2", "--target-psnr", "-3", "--out", o],
+            &["-3", "[0, 200]"],
+        ),
+        (
+            &[
+                "sweep",
+                "fbm",
+                "--param",
+                "octaves",
+                "--values",
+                "2",
+                "--param2",
+                "octaves",
+                "--values2",
+                "3",
+                "--out",
+                o,
+            ],
+            &["both 'octaves'"],
+        ),
+        (
+            &["sweep", "clouds", "--param", "steps", "--values", "8", "--reference-set", "light_steps=0", "--out", o],
+            &["light_steps=0"],
+        ),
+        (
+            &["sweep", "fbm", "--param", "octaves", "--values", "2", "--metric", "log", "--out", o],
+            &["--metric=log", "display|linear"],
+        ),
     ];
     for (args, needles) in cases {
         assert_rejected(&vista(args), 2, needles);
@@ -208,7 +272,17 @@ fn sweep_writes_csv_plots_and_names_the_cheapest_setting() {
     let d = tmp();
     let out = d.path().join("sw");
     let r = vista(&[
-        "sweep", "fbm", "--param", "octaves", "--values", "1,2,4,8,16", "--size", "48x48", "--runs", "1", "--out",
+        "sweep",
+        "fbm",
+        "--param",
+        "octaves",
+        "--values",
+        "1,2,4,8,16",
+        "--size",
+        "48x48",
+        "--runs",
+        "1",
+        "--out",
         out.to_str().unwrap(),
     ]);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -236,8 +310,22 @@ fn sweep_grid_has_one_row_per_point() {
     let d = tmp();
     let out = d.path().join("grid");
     let r = vista(&[
-        "sweep", "atmosphere", "--param", "view_samples", "--values", "4,16", "--param2", "light_samples", "--values2",
-        "2,8,32", "--size", "32x16", "--runs", "1", "--out", out.to_str().unwrap(),
+        "sweep",
+        "atmosphere",
+        "--param",
+        "view_samples",
+        "--values",
+        "4,16",
+        "--param2",
+        "light_samples",
+        "--values2",
+        "2,8,32",
+        "--size",
+        "32x16",
+        "--runs",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
     ]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     let csv = std::fs::read_to_string(out.join("curve.csv")).unwrap();
@@ -245,7 +333,7 @@ fn sweep_grid_has_one_row_per_point() {
     assert_eq!(csv.lines().count(), 1 + 6, "{csv}");
 }
 
-// ---- golden store: a private golden dir per test --------------------------
+// ---- golden store: a private project per test ------------------------------
 
 const CASES: &str = r#"
 [[case]]
@@ -265,14 +353,25 @@ kernel = "ridged"
 size = "32x32"
 "#;
 
+/// A project holding only `vista.toml` and `golden/cases.toml`.
 fn golden_dir(cases: &str) -> tempfile::TempDir {
     let d = tmp();
-    std::fs::write(d.path().join("cases.toml"), cases).unwrap();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    std::fs::write(cases_path(d.path()), cases).unwrap();
     d
 }
 
+fn cases_path(root: &Path) -> PathBuf {
+    root.join("golden/cases.toml")
+}
+
+fn report(root: &Path) -> PathBuf {
+    root.join("target/vista-report")
+}
+
 fn golden(d: &Path, kernel: &str, id: &str) -> PathBuf {
-    d.join(kernel).join(format!("{id}.png"))
+    d.join("golden").join(kernel).join(format!("{id}.png"))
 }
 
 #[test]
@@ -297,7 +396,7 @@ fn bless_then_check_passes_and_bless_is_refused_in_ci() {
     let c = vista_in(Some(d.path()), &[], &["check"]);
     assert_eq!(c.code, 0, "{}{}", c.stdout, c.stderr);
     assert!(c.stdout.contains("3 passed, 0 failed"), "{}", c.stdout);
-    assert!(d.path().join("report/index.html").exists());
+    assert!(report(d.path()).join("index.html").exists());
     let forced = vista_in(Some(d.path()), &[("CI", "true")], &["bless", "--force", "--case", "a"]);
     assert_eq!(forced.code, 0, "{}", forced.stderr);
     assert!(forced.stdout.contains("unchanged"), "{}", forced.stdout);
@@ -307,13 +406,24 @@ fn bless_then_check_passes_and_bless_is_refused_in_ci() {
 fn a_changed_render_fails_check_with_metrics_and_images() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
-    std::fs::write(d.path().join("cases.toml"), CASES.replace("set = { basis = \"value\" }", "set = { basis = \"value\", seed = 9 }")).unwrap();
+    std::fs::write(
+        cases_path(d.path()),
+        CASES.replace("set = { basis = \"value\" }", "set = { basis = \"value\", seed = 9 }"),
+    )
+    .unwrap();
     let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
     assert_eq!(r.code, 1, "{}", r.stdout);
-    for needle in ["PSNR", "below the threshold 60.0 dB", "expected: ", "actual: ", "diff: ", "parameters changed since the last bless"] {
+    for needle in [
+        "PSNR",
+        "below the threshold 60.0 dB",
+        "expected: ",
+        "actual: ",
+        "diff: ",
+        "parameters changed since the last bless",
+    ] {
         assert!(r.stdout.contains(needle), "missing '{needle}' in: {}", r.stdout);
     }
-    assert!(d.path().join("report/b/diff.png").exists());
+    assert!(report(d.path()).join("b/diff.png").exists());
 }
 
 #[test]
@@ -324,7 +434,14 @@ fn corrupt_and_wrong_size_goldens_fail_clearly() {
     let r = vista_in(Some(d.path()), &[], &["check", "--case", "a"]);
     assert_eq!(r.code, 1);
     assert!(r.stdout.contains("a.png") && r.stdout.contains("not a valid PNG"), "{}", r.stdout);
-    std::fs::write(d.path().join("cases.toml"), CASES.replace("id = \"b\"\nkernel = \"fbm\"\nsize = \"32x32\"", "id = \"b\"\nkernel = \"fbm\"\nsize = \"48x32\"")).unwrap();
+    std::fs::write(
+        cases_path(d.path()),
+        CASES.replace(
+            "id = \"b\"\nkernel = \"fbm\"\nsize = \"32x32\"",
+            "id = \"b\"\nkernel = \"fbm\"\nsize = \"48x32\"",
+        ),
+    )
+    .unwrap();
     let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
     assert_eq!(r.code, 1);
     assert!(r.stdout.contains("is 32x32 but the case renders 48x32"), "{}", r.stdout);
@@ -351,7 +468,13 @@ fn interrupted_bless_leaves_every_golden_old_or_new() {
     let ids = [("fbm", "a"), ("fbm", "b"), ("ridged", "c")];
     let old: Vec<Vec<u8>> = ids.iter().map(|(k, i)| std::fs::read(golden(d.path(), k, i)).unwrap()).collect();
     // Change every case, then kill bless after its first golden write.
-    std::fs::write(d.path().join("cases.toml"), CASES.replace("size = \"32x32\"", "size = \"32x32\"\nset = { seed = 5 }").replace("set = { seed = 5 }\nset = { basis = \"value\" }", "set = { basis = \"value\", seed = 5 }")).unwrap();
+    std::fs::write(
+        cases_path(d.path()),
+        CASES
+            .replace("size = \"32x32\"", "size = \"32x32\"\nset = { seed = 5 }")
+            .replace("set = { seed = 5 }\nset = { basis = \"value\" }", "set = { basis = \"value\", seed = 5 }"),
+    )
+    .unwrap();
     let r = vista_in(Some(d.path()), &[("VISTA_FAULT_ABORT_AFTER_WRITES", "1")], &["bless"]);
     assert_ne!(r.code, 0, "the fault hook must abort the bless");
     assert!(r.stderr.contains("aborting after 1 golden writes"), "{}", r.stderr);
@@ -396,7 +519,11 @@ fn bless_keeps_orphans_unless_pruned() {
 #[test]
 fn gpu_watchdog_turns_a_long_wait_into_a_clear_error() {
     let d = tmp();
-    let r = vista_in(None, &[("VISTA_GPU_TIMEOUT_S", "0.001")], &["render", "fbm", "--set", "octaves=16", "--size", "4096x4096", "-o", &out_png(d.path())]);
+    let r = vista_in(
+        None,
+        &[("VISTA_GPU_TIMEOUT_S", "0.001")],
+        &["render", "fbm", "--set", "octaves=16", "--size", "4096x4096", "-o", &out_png(d.path())],
+    );
     assert_rejected(&r, 1, &["GPU wait exceeded", "VISTA_GPU_TIMEOUT_S"]);
 }
 
@@ -453,4 +580,143 @@ fn closed_stdout_pipe_is_not_a_panic() {
     let out = child.wait_with_output().expect("wait");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("panicked"), "panic on a closed pipe: {stderr}");
+}
+
+// ---- projects found at run time --------------------------------------------
+
+/// The checkout these tests were built from (test code only).
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).unwrap().to_path_buf()
+}
+
+fn run_in(bin: &Path, cwd: &Path, env: &[(&str, &str)], args: &[&str]) -> Run {
+    let mut cmd = Command::new(bin);
+    cmd.args(args).current_dir(cwd).env("XDG_RUNTIME_DIR", "/tmp").env_remove("CI").env_remove("VISTA_ROOT");
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let Output { status, stdout, stderr } = cmd.output().expect("run vista");
+    Run {
+        code: status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&stderr).into_owned(),
+    }
+}
+
+/// A copied binary inside a `git clone` whose fbm shader was edited checks
+/// the clone's files: the case fails there, passes in the original, and a
+/// bless in the clone writes the clone's golden, never the original's.
+#[test]
+fn a_copied_binary_checks_the_checkout_it_runs_in() {
+    let t = tmp();
+    let bin = t.path().join("bin/vista");
+    std::fs::create_dir_all(bin.parent().unwrap()).unwrap();
+    std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
+    let clone = t.path().join("clone");
+    let git = Command::new("git").args(["clone", "-q"]).arg(repo()).arg(&clone).output().expect("git");
+    assert!(git.status.success(), "git clone: {}", String::from_utf8_lossy(&git.stderr));
+    let shader = clone.join("shaders/fbm.wgsl");
+    let text = std::fs::read_to_string(&shader).unwrap();
+    let store = "textureStore(output, id.xy, vec4(value, value, value, 1.0));";
+    assert!(text.contains(store), "fbm.wgsl changed shape; update this test's edit");
+    std::fs::write(&shader, text.replace(store, "textureStore(output, id.xy, vec4(vec3(0.9 * value), 1.0));")).unwrap();
+
+    let case = ["check", "--case", "fbm-perlin-default"];
+    let there = run_in(&bin, &clone.join("golden"), &[], &case);
+    assert_eq!(there.code, 1, "the edited clone must fail: {}{}", there.stdout, there.stderr);
+    assert!(
+        there.stdout.contains("below the threshold") && there.stdout.contains("shader changed"),
+        "{}",
+        there.stdout
+    );
+    assert!(there.stdout.contains(&clone.join("target/vista-report").display().to_string()), "{}", there.stdout);
+    let here = run_in(&bin, &repo(), &[], &case);
+    assert_eq!(here.code, 0, "the original must pass: {}{}", here.stdout, here.stderr);
+
+    let golden_rel = "golden/fbm/fbm-perlin-default.png";
+    let original = std::fs::read(repo().join(golden_rel)).unwrap();
+    let blessed = run_in(&bin, &clone, &[], &["bless", "--case", "fbm-perlin-default"]);
+    assert_eq!(blessed.code, 0, "{}", blessed.stderr);
+    assert_eq!(std::fs::read(repo().join(golden_rel)).unwrap(), original, "bless in a clone wrote the original");
+    assert_ne!(std::fs::read(clone.join(golden_rel)).unwrap(), original, "bless did not write the clone's golden");
+    // --root and VISTA_ROOT point at a project from anywhere.
+    let outside = tmp();
+    let by_flag = run_in(
+        &bin,
+        outside.path(),
+        &[],
+        &["--root", clone.to_str().unwrap(), "check", "--case", "fbm-perlin-default"],
+    );
+    assert_eq!(by_flag.code, 0, "{}{}", by_flag.stdout, by_flag.stderr);
+    let by_env = run_in(&bin, outside.path(), &[("VISTA_ROOT", repo().to_str().unwrap())], &case);
+    assert_eq!(by_env.code, 0, "{}{}", by_env.stdout, by_env.stderr);
+}
+
+#[test]
+fn check_and_bless_without_a_project_name_what_was_looked_for_and_where() {
+    let outside = tmp();
+    let cwd = outside.path().display().to_string();
+    for cmd in ["check", "bless"] {
+        let r = vista(&[cmd]);
+        assert_rejected(
+            &r,
+            2,
+            &[&format!("vista {cmd} needs a vista project"), "no vista.toml in", "--root", "VISTA_ROOT"],
+        );
+        let r = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), outside.path(), &[], &[cmd]);
+        assert_rejected(&r, 2, &[&cwd]);
+    }
+    let r = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), outside.path(), &[], &["--root", &cwd, "list"]);
+    assert_rejected(&r, 2, &["--root", &cwd, "no vista.toml there"]);
+    let r = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), outside.path(), &[("VISTA_ROOT", &cwd)], &["list"]);
+    assert_rejected(&r, 2, &["VISTA_ROOT", &cwd]);
+    std::fs::write(outside.path().join("vista.toml"), "nmae = 1\n").unwrap();
+    let r = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), outside.path(), &[], &["check"]);
+    assert_rejected(&r, 2, &["vista.toml: line 1, column 1", "nmae"]);
+}
+
+#[test]
+fn builtin_kernels_render_outside_any_project_from_the_embedded_sources() {
+    let outside = tmp();
+    let bin = outside.path().join("vista");
+    std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
+    let list = run_in(&bin, outside.path(), &[], &["list", "--names"]);
+    assert_eq!(list.code, 0, "{}", list.stderr);
+    for k in ["fbm", "ridged", "atmosphere", "heightfield", "clouds"] {
+        let out = outside.path().join(format!("{k}.png"));
+        assert!(list.stdout.lines().any(|l| l.starts_with(&format!("{k} "))), "{}", list.stdout);
+        let r = run_in(&bin, outside.path(), &[], &["render", k, "--size", "16x16", "-o", out.to_str().unwrap()]);
+        assert_eq!(r.code, 0, "{k}: {}", r.stderr);
+        assert!(out.exists());
+    }
+}
+
+/// No library or binary source finds files through build-time paths
+/// (`CARGO_MANIFEST_DIR`, `env!`, `option_env!`) or the old per-directory
+/// variables; only test code and benches may name the checkout.
+#[test]
+fn no_build_time_paths_in_non_test_code() {
+    let mut offenders = Vec::new();
+    let mut stack = vec![repo().join("src"), repo().join("crates")];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            if p.is_dir() {
+                if name != "tests" && name != "target" {
+                    stack.push(p);
+                }
+            } else if name.ends_with(".rs") {
+                let text = std::fs::read_to_string(&p).unwrap();
+                // Unit-test modules sit at the end of a file, after `#[cfg(test)]`.
+                let code = text.split("#[cfg(test)]").next().unwrap();
+                for needle in ["CARGO_MANIFEST_DIR", "env!(", "option_env!(", "VISTA_SHADERS", "VISTA_GOLDEN_DIR"] {
+                    if code.contains(needle) {
+                        offenders.push(format!("{}: {needle}", p.display()));
+                    }
+                }
+            }
+        }
+    }
+    assert!(offenders.is_empty(), "build-time paths in non-test code: {offenders:?}");
 }

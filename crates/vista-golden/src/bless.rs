@@ -7,10 +7,9 @@
 
 use std::path::PathBuf;
 
-use vista_gpu::Context;
 use vista_image::metrics;
 
-use crate::render::{Rendered, quantize16, render};
+use crate::render::{Rendered, Renderer, quantize16, render};
 use crate::store::{ManifestEntry, Store, params_hash};
 use crate::{GoldenError, now_utc, select};
 
@@ -52,7 +51,7 @@ fn fault_after() -> Option<usize> {
     std::env::var("VISTA_FAULT_ABORT_AFTER_WRITES").ok().and_then(|s| s.parse().ok())
 }
 
-pub fn bless(ctx: &Context, store: &Store, opts: &BlessOptions) -> Result<BlessSummary, GoldenError> {
+pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<BlessSummary, GoldenError> {
     if in_ci() && !opts.force {
         return Err(GoldenError::Refused(
             "CI=true: refusing to bless goldens in CI (a failing golden must be reviewed, not overwritten); \
@@ -106,7 +105,7 @@ pub fn bless(ctx: &Context, store: &Store, opts: &BlessOptions) -> Result<BlessS
                 kernel: case.kernel.name().to_string(),
                 size: format!("{}x{}", case.width, case.height),
                 params_hash: params_hash(case),
-                shader_hash: ctx.shaders().source_hash(case.kernel.shader())?,
+                shader_hash: ctx.shader_hash(case.kernel.shader())?,
                 adapter: adapter.clone(),
                 date: now_utc(),
                 raw_hash: r.raw.content_hash(),
@@ -121,7 +120,8 @@ pub fn bless(ctx: &Context, store: &Store, opts: &BlessOptions) -> Result<BlessS
     let orphans = store.orphans(&cases);
     if opts.prune {
         for o in &orphans {
-            std::fs::remove_file(o).map_err(|e| GoldenError::Io { path: o.display().to_string(), message: e.to_string() })?;
+            std::fs::remove_file(o)
+                .map_err(|e| GoldenError::Io { path: o.display().to_string(), message: e.to_string() })?;
         }
         let live: std::collections::HashSet<&str> = cases.iter().map(|c| c.id.as_str()).collect();
         manifest.case.retain(|id, _| live.contains(id.as_str()));

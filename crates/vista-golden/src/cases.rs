@@ -87,10 +87,8 @@ impl Case {
 /// Parses and validates a case file. Errors name the file, the line (for
 /// TOML syntax) or the case id and the bad value.
 pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
-    let file: CaseFile = toml::from_str(text).map_err(|e| GoldenError::Cases {
-        path: path.display().to_string(),
-        message: one_line_toml_error(text, &e),
-    })?;
+    let file: CaseFile = toml::from_str(text)
+        .map_err(|e| GoldenError::Cases { path: path.display().to_string(), message: one_line_toml_error(text, &e) })?;
     let mut seen = std::collections::HashSet::new();
     let mut out = Vec::new();
     for raw in file.case {
@@ -119,9 +117,10 @@ pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
             }
         }
         if let Some(s) = raw.min_ssim
-            && !(-1.0..=1.0).contains(&s) {
-                return Err(bad(format!("min_ssim={s} is out of range; allowed: [-1, 1]")));
-            }
+            && !(-1.0..=1.0).contains(&s)
+        {
+            return Err(bad(format!("min_ssim={s} is out of range; allowed: [-1, 1]")));
+        }
         out.push(Case {
             id: raw.id,
             kernel,
@@ -155,16 +154,16 @@ pub fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
 }
 
 pub fn load_cases(path: &Path) -> Result<Vec<Case>, GoldenError> {
-    let text = std::fs::read_to_string(path).map_err(|e| GoldenError::Cases {
-        path: path.display().to_string(),
-        message: format!("cannot read: {e}"),
-    })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| GoldenError::Cases { path: path.display().to_string(), message: format!("cannot read: {e}") })?;
     parse_cases(path, &text)
 }
 
 /// Cases whose id matches the glob (all when `None`).
 pub fn select<'a>(cases: &'a [Case], glob: Option<&str>) -> Result<Vec<&'a Case>, GoldenError> {
-    let Some(pattern) = glob else { return Ok(cases.iter().collect()) };
+    let Some(pattern) = glob else {
+        return Ok(cases.iter().collect());
+    };
     let matcher = globset::Glob::new(pattern)
         .map_err(|e| GoldenError::BadInput(format!("--case '{pattern}' is not a valid glob: {e}")))?
         .compile_matcher();

@@ -2,11 +2,10 @@
 
 use std::path::PathBuf;
 
-use vista_gpu::Context;
 use vista_image::Image;
 use vista_image::metrics::{self, Metrics};
 
-use crate::render::{quantize16, render};
+use crate::render::{Renderer, quantize16, render};
 use crate::store::{Manifest, Store, params_hash};
 use crate::{Case, GoldenError};
 
@@ -77,7 +76,9 @@ impl Outcome {
         for n in &self.notes {
             s += &format!("  note: {n}\n");
         }
-        for (what, f) in [("expected", &self.files.expected), ("actual", &self.files.actual), ("diff", &self.files.diff)] {
+        for (what, f) in
+            [("expected", &self.files.expected), ("actual", &self.files.actual), ("diff", &self.files.diff)]
+        {
             if let Some(f) = f {
                 s += &format!("  {what}: {}\n", report_dir.join(f).display());
             }
@@ -101,7 +102,7 @@ pub struct CheckOptions {
 
 /// Renders `case`, compares it with its golden and manifest entry, writes
 /// report images, and returns the outcome (errors become `Verdict::Error`).
-pub fn check_case(ctx: &Context, store: &Store, manifest: &Manifest, case: &Case, opts: &CheckOptions) -> Outcome {
+pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Case, opts: &CheckOptions) -> Outcome {
     let mut out = Outcome {
         id: case.id.clone(),
         kernel: case.kernel.name().to_string(),
@@ -126,7 +127,7 @@ pub fn check_case(ctx: &Context, store: &Store, manifest: &Manifest, case: &Case
 }
 
 fn judge(
-    ctx: &Context,
+    ctx: &Renderer,
     store: &Store,
     manifest: &Manifest,
     case: &Case,
@@ -168,7 +169,7 @@ fn judge(
 
     let entry = manifest.case.get(&case.id);
     let adapter = ctx.adapter_description();
-    let shader_hash = ctx.shaders().source_hash(case.kernel.shader())?;
+    let shader_hash = ctx.shader_hash(case.kernel.shader())?;
     match entry {
         Some(e) => {
             out.same_driver = e.adapter == adapter;
@@ -230,9 +231,10 @@ fn judge(
         ));
     }
     if let Some(t) = case.min_ssim
-        && m.ssim < t {
-            out.problems.push(format!("SSIM {:.5} is below the threshold {t}", m.ssim));
-        }
+        && m.ssim < t
+    {
+        out.problems.push(format!("SSIM {:.5} is below the threshold {t}", m.ssim));
+    }
     out.metrics = Some(m);
     Ok(())
 }

@@ -15,8 +15,10 @@ pub mod store;
 pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, load_cases, parse_cases, select};
 pub use check::{CheckOptions, Outcome, Verdict, check_case};
-pub use report::{default_report_dir, write_report};
-pub use render::{Rendered, check_request, median, median_wall, quantize16, render, render_median};
+pub use render::{
+    Rendered, Renderer, check_request, median, median_wall, quantize16, render, render_median, shader_set,
+};
+pub use report::write_report;
 pub use store::{Manifest, ManifestEntry, Store};
 
 use vista_gpu::GpuError;
@@ -33,6 +35,8 @@ pub enum GoldenError {
     #[error(transparent)]
     Gpu(#[from] GpuError),
     #[error(transparent)]
+    Project(#[from] vista_project::ProjectError),
+    #[error(transparent)]
     Image(#[from] ImageError),
     #[error("{path}: {message}")]
     Io { path: String, message: String },
@@ -48,6 +52,7 @@ impl GoldenError {
             // Unreadable, corrupt or unwritable image paths are the user's to fix.
             GoldenError::Image(_) => 2,
             GoldenError::Io { .. } => 2,
+            GoldenError::Project(_) => 2,
             _ => 1,
         }
     }
@@ -66,25 +71,4 @@ pub fn short_hash(text: &str) -> String {
 /// True when the user set `VISTA_ALLOW_NO_GPU=1`.
 pub fn allow_no_gpu() -> bool {
     std::env::var("VISTA_ALLOW_NO_GPU").is_ok_and(|v| v == "1" || v.eq_ignore_ascii_case("true"))
-}
-
-/// The shared GPU context for a test. Without an adapter this panics with
-/// the install hint, unless `VISTA_ALLOW_NO_GPU=1`, in which case it prints a
-/// loud SKIPPED line naming the test and returns `None`.
-pub fn gpu_for_test(test: &str) -> Option<&'static vista_gpu::Context> {
-    match vista_gpu::Context::shared() {
-        Ok(ctx) => Some(ctx),
-        Err(e) if allow_no_gpu() => {
-            eprintln!("!!! VISTA_ALLOW_NO_GPU=1: SKIPPED GPU test '{test}': {e}");
-            None
-        }
-        Err(e) => panic!("GPU test '{test}' cannot run: {e}"),
-    }
-}
-
-/// The repository root (two levels above this crate), where `golden/`,
-/// `shaders/` and `target/` live.
-pub fn repo_root() -> std::path::PathBuf {
-    let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    here.ancestors().nth(2).unwrap_or(here).to_path_buf()
 }

@@ -2,7 +2,7 @@
 
 use std::time::{Duration, Instant};
 
-use vista_gpu::{Context, Dispatch, RunStats};
+use vista_gpu::{Context, Dispatch, RunStats, ShaderSet};
 use vista_image::Image;
 use vista_kernels::{Kernel, ParamSet};
 
@@ -43,12 +43,57 @@ pub fn check_request(kernel: &dyn Kernel, p: &ParamSet, width: u32, height: u32)
     Ok(())
 }
 
+/// The GPU context and the WGSL of one project: everything a render needs
+/// besides the kernel and its params. Derefs to the [`Context`].
+pub struct Renderer<'a> {
+    pub ctx: &'a Context,
+    pub shaders: ShaderSet,
+}
+
+impl std::ops::Deref for Renderer<'_> {
+    type Target = Context;
+    fn deref(&self) -> &Context {
+        self.ctx
+    }
+}
+
+impl<'a> Renderer<'a> {
+    /// A renderer over the project's shaders (its `shaders/` layered over the
+    /// built-ins).
+    pub fn new(ctx: &'a Context, project: &vista_project::Project) -> Result<Renderer<'a>, GoldenError> {
+        Ok(Renderer { ctx, shaders: shader_set(project)? })
+    }
+
+    /// Provenance hash of a kernel file and its imports.
+    pub fn shader_hash(&self, shader: &str) -> Result<String, GoldenError> {
+        Ok(self.shaders.source_hash(shader)?)
+    }
+}
+
+/// The project's WGSL as one [`ShaderSet`].
+pub fn shader_set(project: &vista_project::Project) -> Result<ShaderSet, GoldenError> {
+    let label = match project.root() {
+        Some(r) => format!("project {}", r.display()),
+        None => "built-in shaders".to_string(),
+    };
+    let files = project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin));
+    Ok(ShaderSet::from_files(&label, files))
+}
+
 /// Renders `kernel` with `p` at `width` x `height` on the GPU.
-pub fn render(ctx: &Context, kernel: &dyn Kernel, p: &ParamSet, width: u32, height: u32) -> Result<Rendered, GoldenError> {
+pub fn render(
+    gpu: &Renderer,
+    kernel: &dyn Kernel,
+    p: &ParamSet,
+    width: u32,
+    height: u32,
+) -> Result<Rendered, GoldenError> {
     check_request(kernel, p, width, height)?;
     let uniforms = kernel.uniforms(p, width, height).to_bytes();
     let table = kernel.table(p);
-    let (raw, stats) = ctx.run(&Dispatch { shader: kernel.shader(), uniforms: &uniforms, table: &table, width, height })?;
+    let job =
+        Dispatch { shaders: &gpu.shaders, shader: kernel.shader(), uniforms: &uniforms, table: &table, width, height };
+    let (raw, stats) = gpu.ctx.run(&job)?;
     let display = kernel.display(&raw, p);
     Ok(Rendered { raw, display, stats })
 }
@@ -56,17 +101,17 @@ pub fn render(ctx: &Context, kernel: &dyn Kernel, p: &ParamSet, width: u32, heig
 /// Renders `runs` (at least 1) times; returns the first render and the
 /// median GPU wall time, for benchmarks and sweeps.
 pub fn render_median(
-    ctx: &Context,
+    gpu: &Renderer,
     kernel: &dyn Kernel,
     p: &ParamSet,
     width: u32,
     height: u32,
     runs: u32,
 ) -> Result<(Rendered, Duration), GoldenError> {
-    let first = render(ctx, kernel, p, width, height)?;
+    let first = render(gpu, kernel, p, width, height)?;
     let mut times = vec![first.stats.gpu_wall];
     for _ in 1..runs {
-        times.push(render(ctx, kernel, p, width, height)?.stats.gpu_wall);
+        times.push(render(gpu, kernel, p, width, height)?.stats.gpu_wall);
     }
     Ok((first, median(times)))
 }

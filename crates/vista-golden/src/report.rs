@@ -8,19 +8,6 @@ use vista_image::metrics::format_psnr;
 
 use crate::check::{Outcome, Verdict};
 
-/// `$VISTA_REPORT_DIR`, else `<repo>/target/vista-report`.
-pub fn default_report_dir() -> PathBuf {
-    match std::env::var_os("VISTA_REPORT_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => {
-            let target = std::env::var_os("CARGO_TARGET_DIR")
-                .map(PathBuf::from)
-                .unwrap_or_else(|| crate::repo_root().join("target"));
-            target.join("vista-report")
-        }
-    }
-}
-
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
@@ -44,7 +31,13 @@ pub fn write_report(dir: &Path, adapter: &str, outcomes: &[Outcome]) -> Result<P
             _ => "fail",
         };
         let (psnr, ssim, max_abs, bad, nan) = match &o.metrics {
-            Some(m) => (format_psnr(m.psnr), format!("{:.5}", m.ssim), format!("{:.2e}", m.max_abs), m.bad_pixels.to_string(), m.nan.to_string()),
+            Some(m) => (
+                format_psnr(m.psnr),
+                format!("{:.5}", m.ssim),
+                format!("{:.2e}", m.max_abs),
+                m.bad_pixels.to_string(),
+                m.nan.to_string(),
+            ),
             None => ("-".into(), "-".into(), "-".into(), "-".into(), "-".into()),
         };
         let threshold = format!(

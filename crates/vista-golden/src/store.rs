@@ -44,16 +44,10 @@ pub struct Store {
 }
 
 impl Store {
-    /// `$VISTA_GOLDEN_DIR`, else the repository's `golden/`.
-    pub fn default_dir() -> PathBuf {
-        match std::env::var_os("VISTA_GOLDEN_DIR") {
-            Some(d) => PathBuf::from(d),
-            None => crate::repo_root().join("golden"),
-        }
-    }
-
-    pub fn open_default() -> Store {
-        Store { dir: Self::default_dir() }
+    /// The project's `golden/`; a project without a root has no store, and
+    /// the error says what `command` looked for and from where.
+    pub fn of_project(project: &vista_project::Project, command: &str) -> Result<Store, GoldenError> {
+        Ok(Store { dir: project.require_root(command)?.join("golden") })
     }
 
     pub fn cases_path(&self) -> PathBuf {
@@ -98,9 +92,13 @@ impl Store {
     pub fn orphans(&self, cases: &[Case]) -> Vec<PathBuf> {
         let known: std::collections::HashSet<PathBuf> = cases.iter().map(|c| self.golden_path(c)).collect();
         let mut out = Vec::new();
-        let Ok(kernels) = std::fs::read_dir(&self.dir) else { return out };
+        let Ok(kernels) = std::fs::read_dir(&self.dir) else {
+            return out;
+        };
         for k in kernels.flatten().filter(|e| e.path().is_dir()) {
-            let Ok(files) = std::fs::read_dir(k.path()) else { continue };
+            let Ok(files) = std::fs::read_dir(k.path()) else {
+                continue;
+            };
             for f in files.flatten() {
                 let p = f.path();
                 if p.extension().is_some_and(|e| e == "png") && !known.contains(&p) {

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use vista_image::Image;
 use wgpu::util::DeviceExt;
 
-use crate::shaders::{ShaderSet, default_shader_dir};
+use crate::shaders::ShaderSet;
 use crate::{GpuError, INSTALL_HINT};
 
 /// Which adapter to ask for.
@@ -26,15 +26,14 @@ impl AdapterChoice {
     /// `WGPU_ADAPTER_NAME` wins, then `VISTA_ADAPTER=gpu|cpu`, else software.
     pub fn from_env() -> Result<AdapterChoice, GpuError> {
         if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME")
-            && !name.is_empty() {
-                return Ok(AdapterChoice::Named(name));
-            }
+            && !name.is_empty()
+        {
+            return Ok(AdapterChoice::Named(name));
+        }
         match std::env::var("VISTA_ADAPTER").as_deref() {
             Err(_) | Ok("") | Ok("cpu") | Ok("software") | Ok("lavapipe") => Ok(AdapterChoice::Software),
             Ok("gpu") | Ok("hardware") => Ok(AdapterChoice::Hardware),
-            Ok(other) => Err(GpuError::Request(format!(
-                "VISTA_ADAPTER={other} is not valid; expected one of cpu|gpu"
-            ))),
+            Ok(other) => Err(GpuError::Request(format!("VISTA_ADAPTER={other} is not valid; expected one of cpu|gpu"))),
         }
     }
 
@@ -50,7 +49,9 @@ impl AdapterChoice {
 /// One compute job over a W x H image.
 #[derive(Debug, Clone)]
 pub struct Dispatch<'a> {
-    /// Kernel WGSL file relative to the shader dir; entry point `main`.
+    /// The project's WGSL sources.
+    pub shaders: &'a ShaderSet,
+    /// Kernel WGSL file relative to `shaders/`; entry point `main`.
     pub shader: &'a str,
     /// Uniform block for binding 0 (padded to 16 bytes by the caller).
     pub uniforms: &'a [u8],
@@ -76,7 +77,6 @@ pub struct Context {
     device: wgpu::Device,
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
-    shaders: ShaderSet,
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
@@ -91,10 +91,7 @@ static SHARED: OnceLock<Result<Context, GpuError>> = OnceLock::new();
 impl Context {
     /// The process-wide context, created on first use from the environment.
     pub fn shared() -> Result<&'static Context, GpuError> {
-        SHARED
-            .get_or_init(|| Context::new(AdapterChoice::from_env()?))
-            .as_ref()
-            .map_err(Clone::clone)
+        SHARED.get_or_init(|| Context::new(AdapterChoice::from_env()?)).as_ref().map_err(Clone::clone)
     }
 
     pub fn new(choice: AdapterChoice) -> Result<Context, GpuError> {
@@ -124,25 +121,33 @@ impl Context {
             ..Default::default()
         }))
         .map_err(|e| GpuError::Device { adapter: info.name.clone(), message: e.to_string() })?;
-        let shaders = ShaderSet::load(&default_shader_dir())?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("vista kernel io"),
             entries: &[
-                entry(0, wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                }),
-                entry(1, wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: wgpu::TextureFormat::Rgba32Float,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                }),
-                entry(2, wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                }),
+                entry(
+                    0,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
+                entry(
+                    1,
+                    wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba32Float,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                ),
+                entry(
+                    2,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -159,7 +164,6 @@ impl Context {
             device,
             queue,
             info,
-            shaders,
             layout,
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
@@ -185,21 +189,20 @@ impl Context {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
 
-    pub fn shaders(&self) -> &ShaderSet {
-        &self.shaders
-    }
-
     /// Largest width/height a storage texture may have on this device.
     pub fn max_dimension(&self) -> u32 {
         self.device.limits().max_texture_dimension_2d
     }
 
-    /// Compiles (once) the pipeline of a kernel file.
-    pub fn pipeline(&self, shader: &str) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
-        if let Some(p) = self.pipelines.lock().expect("pipeline cache").get(shader) {
+    /// Compiles (once per source hash) the pipeline of a kernel file. The
+    /// cache is keyed by the hash of the file and its imports, so two
+    /// projects (or an edited copy) never share a stale pipeline.
+    pub fn pipeline(&self, shaders: &ShaderSet, shader: &str) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+        let key = format!("{shader}#{}", shaders.source_hash(shader)?);
+        if let Some(p) = self.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
         }
-        let module = self.shaders.compose(shader)?;
+        let module = shaders.compose(shader)?;
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let sm = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(shader),
@@ -217,7 +220,7 @@ impl Context {
             return Err(GpuError::Validation { what: shader.to_string(), message: e.to_string() });
         }
         let pipeline = Arc::new(pipeline);
-        self.pipelines.lock().expect("pipeline cache").insert(shader.to_string(), pipeline.clone());
+        self.pipelines.lock().expect("pipeline cache").insert(key, pipeline.clone());
         Ok(pipeline)
     }
 
@@ -230,7 +233,7 @@ impl Context {
                 job.width, job.height
             )));
         }
-        let pipeline = self.pipeline(job.shader)?;
+        let pipeline = self.pipeline(job.shaders, job.shader)?;
         let start = Instant::now();
         let d = &self.device;
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -308,8 +311,12 @@ impl Context {
         let gpu_wall = gpu_start.elapsed();
         match rx.recv_timeout(self.timeout) {
             Ok(Ok(())) => {}
-            Ok(Err(e)) => return Err(GpuError::Validation { what: "readback map".into(), message: e.to_string() }),
-            Err(_) => return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs_f64() }),
+            Ok(Err(e)) => {
+                return Err(GpuError::Validation { what: "readback map".into(), message: e.to_string() });
+            }
+            Err(_) => {
+                return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs_f64() });
+            }
         }
         let image = {
             let mapped = readback

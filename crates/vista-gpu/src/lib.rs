@@ -1,5 +1,5 @@
 //! Headless wgpu compute for vista: one shared context per process (instance,
-//! adapter choice, device, queue), WGSL composition from `shaders/`, dispatch
+//! adapter choice, device, queue), WGSL composition of a [`ShaderSet`], dispatch
 //! of a compute entry point over a W x H image, and readback into an f32 RGBA
 //! [`Image`](vista_image::Image).
 //!
@@ -10,7 +10,7 @@ mod context;
 mod shaders;
 
 pub use context::{AdapterChoice, Context, Dispatch, RunStats};
-pub use shaders::{ShaderSet, binding_struct_layout, default_shader_dir, validate};
+pub use shaders::{ShaderSet, binding_struct_layout, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
 pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \
@@ -26,7 +26,9 @@ pub enum GpuError {
     Shader(String),
     #[error("GPU validation error in {what}: {message}")]
     Validation { what: String, message: String },
-    #[error("GPU wait exceeded {seconds} s ({what}); the dispatch is too heavy for this device or the driver hung; lower the size or step counts, or raise VISTA_GPU_TIMEOUT_S")]
+    #[error(
+        "GPU wait exceeded {seconds} s ({what}); the dispatch is too heavy for this device or the driver hung; lower the size or step counts, or raise VISTA_GPU_TIMEOUT_S"
+    )]
     Timeout { what: String, seconds: f64 },
     #[error("{0}")]
     Request(String),

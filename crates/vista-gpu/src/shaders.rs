@@ -1,78 +1,66 @@
 //! WGSL loading and composition.
 //!
-//! Kernel files in `shaders/` import shared pieces from `shaders/lib/` with
+//! Kernel files import shared pieces from `lib/` with
 //! naga_oil's `#import` (each lib file declares `#define_import_path
 //! vista::NAME`). Composition yields a validated `naga::Module`; errors carry
 //! the file and line.
 
-use std::collections::HashMap;
-use std::fs;
-use std::path::{Path, PathBuf};
+use std::collections::{BTreeMap, HashMap};
 
 use naga_oil::compose::{ComposableModuleDescriptor, Composer, ComposerError, NagaModuleDescriptor, ShaderLanguage};
 
 use crate::GpuError;
 
-/// Where the WGSL lives: `$VISTA_SHADERS`, else the repository's `shaders/`.
-pub fn default_shader_dir() -> PathBuf {
-    match std::env::var_os("VISTA_SHADERS") {
-        Some(dir) => PathBuf::from(dir),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).unwrap_or(Path::new(".")).join("shaders"),
-    }
-}
-
-/// The set of WGSL sources: library modules plus kernel files.
+/// The set of WGSL sources a project has: library modules (`lib/...`,
+/// each declaring `#define_import_path vista::NAME`) and kernel files.
+/// Built from text the caller read (the project layer over the built-ins),
+/// so this crate reads no files.
 #[derive(Debug, Clone)]
 pub struct ShaderSet {
-    dir: PathBuf,
-    /// (path relative to `dir`, source) of every file under `lib/`, sorted.
+    /// Names the set in errors (a project root, or "built-in").
+    label: String,
+    /// (path relative to `shaders/`, source) of every file under `lib/`, sorted.
     lib: Vec<(String, String)>,
-}
-
-fn read(path: &Path) -> Result<String, GpuError> {
-    fs::read_to_string(path).map_err(|e| GpuError::Shader(format!("cannot read {}: {e}", path.display())))
-}
-
-fn wgsl_files(dir: &Path) -> Result<Vec<PathBuf>, GpuError> {
-    let mut out = Vec::new();
-    let entries =
-        fs::read_dir(dir).map_err(|e| GpuError::Shader(format!("cannot list shader dir {}: {e}", dir.display())))?;
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            out.extend(wgsl_files(&path)?);
-        } else if path.extension().is_some_and(|e| e == "wgsl") {
-            out.push(path);
-        }
-    }
-    out.sort();
-    Ok(out)
-}
-
-fn rel(dir: &Path, path: &Path) -> String {
-    path.strip_prefix(dir).unwrap_or(path).to_string_lossy().replace('\\', "/")
+    /// Kernel files (not under `lib/`): relative path -> (source, origin path).
+    kernels: BTreeMap<String, (String, String)>,
 }
 
 impl ShaderSet {
-    pub fn load(dir: &Path) -> Result<ShaderSet, GpuError> {
-        let lib = wgsl_files(&dir.join("lib"))?
-            .into_iter()
-            .map(|p| Ok((rel(dir, &p), read(&p)?)))
-            .collect::<Result<Vec<_>, GpuError>>()?;
-        Ok(ShaderSet { dir: dir.to_path_buf(), lib })
+    /// A set from `(relative path, text, origin)` triples; files under
+    /// `lib/` are import modules, the rest kernel files. `origin` (a real
+    /// path or `<built-in>/...`) is what errors name.
+    pub fn from_files(label: &str, files: impl IntoIterator<Item = (String, String, String)>) -> ShaderSet {
+        let mut lib = Vec::new();
+        let mut kernels = BTreeMap::new();
+        for (rel, text, origin) in files {
+            if rel.starts_with("lib/") {
+                lib.push((rel, text));
+            } else {
+                kernels.insert(rel, (text, origin));
+            }
+        }
+        lib.sort();
+        ShaderSet { label: label.to_string(), lib, kernels }
     }
 
-    pub fn dir(&self) -> &Path {
-        &self.dir
+    /// What this set is (a project root, or "built-in").
+    pub fn label(&self) -> &str {
+        &self.label
     }
 
-    /// Every kernel file (top-level `.wgsl`, not `lib/`), relative names.
-    pub fn kernel_files(&self) -> Result<Vec<String>, GpuError> {
-        Ok(wgsl_files(&self.dir)?
-            .into_iter()
-            .map(|p| rel(&self.dir, &p))
-            .filter(|r| !r.starts_with("lib/"))
-            .collect())
+    /// Every kernel file (not `lib/`), relative names, sorted.
+    pub fn kernel_files(&self) -> Vec<String> {
+        self.kernels.keys().cloned().collect()
+    }
+
+    fn kernel_source(&self, name: &str) -> Result<&(String, String), GpuError> {
+        self.kernels.get(name).ok_or_else(|| {
+            GpuError::Shader(format!(
+                "shader {name} not found in {} (kernel files: {})",
+                self.label,
+                self.kernels.keys().cloned().collect::<Vec<_>>().join(", ")
+            ))
+        })
     }
 
     /// A composer holding every library module. naga_oil wants a module's
@@ -94,7 +82,7 @@ impl ShaderSet {
                     shader_defs: HashMap::new(),
                 };
                 if let Err(e) = composer.add_composable_module(desc) {
-                    last_error = Some(describe(&composer, &self.dir, &e));
+                    last_error = Some(describe(&composer, &self.label, &e));
                     failed.push(*entry);
                 }
             }
@@ -106,18 +94,13 @@ impl ShaderSet {
         Ok(composer)
     }
 
-    /// Composes and validates the kernel file `name` (relative to the shader dir).
+    /// Composes and validates the kernel file `name` (relative to `shaders/`).
     pub fn compose(&self, name: &str) -> Result<naga::Module, GpuError> {
-        let path = self.dir.join(name);
-        let source = read(&path)?;
+        let (source, origin) = self.kernel_source(name)?;
         let mut composer = self.composer()?;
         let module = composer
-            .make_naga_module(NagaModuleDescriptor {
-                source: &source,
-                file_path: name,
-                ..Default::default()
-            })
-            .map_err(|e| GpuError::Shader(describe(&composer, &self.dir, &e)))?;
+            .make_naga_module(NagaModuleDescriptor { source, file_path: origin, ..Default::default() })
+            .map_err(|e| GpuError::Shader(describe(&composer, &self.label, &e)))?;
         validate(name, &module)?;
         Ok(module)
     }
@@ -127,11 +110,11 @@ impl ShaderSet {
     /// kernel's output changes it, and edits to unrelated modules do not
     /// (so they do not mark every golden's provenance stale).
     pub fn source_hash(&self, name: &str) -> Result<String, GpuError> {
-        let source = read(&self.dir.join(name))?;
+        let (source, _) = self.kernel_source(name)?;
         let mut h = blake3::Hasher::new();
         h.update(name.as_bytes());
         h.update(source.as_bytes());
-        for (path, source) in self.imported_lib(&source) {
+        for (path, source) in self.imported_lib(source) {
             h.update(path.as_bytes());
             h.update(source.as_bytes());
         }
@@ -176,8 +159,8 @@ fn imports(source: &str) -> Vec<String> {
         .collect()
 }
 
-fn describe(composer: &Composer, dir: &Path, e: &ComposerError) -> String {
-    format!("WGSL error (shader dir {}):\n{}", dir.display(), e.emit_to_string(composer))
+fn describe(composer: &Composer, label: &str, e: &ComposerError) -> String {
+    format!("WGSL error ({label}):\n{}", e.emit_to_string(composer))
 }
 
 /// Validates a composed module with naga alone (no device needed).
@@ -196,10 +179,9 @@ pub fn binding_struct_layout(module: &naga::Module, binding: u32) -> Option<(u32
         .find(|(_, v)| v.binding.as_ref().is_some_and(|b| b.group == 0 && b.binding == binding))?;
     let ty = &module.types[var.ty];
     match &ty.inner {
-        naga::TypeInner::Struct { members, span } => Some((
-            *span,
-            members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(),
-        )),
+        naga::TypeInner::Struct { members, span } => {
+            Some((*span, members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect()))
+        }
         _ => None,
     }
 }

@@ -17,11 +17,7 @@ pub struct Image {
 impl Image {
     /// An all-zero (transparent black) image.
     pub fn new(width: u32, height: u32) -> Image {
-        Image {
-            width,
-            height,
-            data: vec![[0.0; 4]; pixel_count(width, height)],
-        }
+        Image { width, height, data: vec![[0.0; 4]; pixel_count(width, height)] }
     }
 
     /// Builds an image by evaluating `f(x, y)` for every pixel in row-major order.
@@ -32,29 +28,16 @@ impl Image {
                 data.push(f(x, y));
             }
         }
-        Image {
-            width,
-            height,
-            data,
-        }
+        Image { width, height, data }
     }
 
     /// Wraps an existing pixel buffer, checking that its length is `width * height`.
     pub fn from_raw(width: u32, height: u32, data: Vec<[f32; 4]>) -> Result<Image, ImageError> {
         let expected = u64::from(width) * u64::from(height);
         if data.len() as u64 != expected {
-            return Err(ImageError::BadDimensions {
-                width,
-                height,
-                expected,
-                len: data.len(),
-            });
+            return Err(ImageError::BadDimensions { width, height, expected, len: data.len() });
         }
-        Ok(Image {
-            width,
-            height,
-            data,
-        })
+        Ok(Image { width, height, data })
     }
 
     /// `(width, height)`.
@@ -113,11 +96,7 @@ impl Image {
     /// `0.0` / `-0.0` as different.
     pub fn bit_identical(&self, other: &Image) -> bool {
         self.dimensions() == other.dimensions()
-            && self
-                .data
-                .iter()
-                .zip(&other.data)
-                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
+            && self.data.iter().zip(&other.data).all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
     }
 
     fn index(&self, x: u32, y: u32) -> usize {

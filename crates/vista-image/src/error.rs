@@ -8,10 +8,7 @@ use std::path::PathBuf;
 pub enum ImageError {
     /// The file could not be read, created, written or renamed into place.
     #[error("I/O error on {}: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     /// The file exists but is not a decodable image of the expected format.
     #[error("{} is not a valid {format}: {msg}", path.display())]
     Decode {
@@ -33,10 +30,7 @@ pub enum ImageError {
         "image size mismatch: expected {}x{}, got {}x{}",
         expected.0, expected.1, actual.0, actual.1
     )]
-    SizeMismatch {
-        expected: (u32, u32),
-        actual: (u32, u32),
-    },
+    SizeMismatch { expected: (u32, u32), actual: (u32, u32) },
     /// [`crate::save`] / [`crate::load`] only know `.png` and `.exr`.
     #[error(
         "{}: unsupported image extension (expected .png or .exr)",
@@ -45,10 +39,5 @@ pub enum ImageError {
     UnsupportedExtension { path: PathBuf },
     /// A pixel buffer whose length does not match `width * height`.
     #[error("bad image dimensions {width}x{height}: expected {expected} pixels, got {len}")]
-    BadDimensions {
-        width: u32,
-        height: u32,
-        expected: u64,
-        len: usize,
-    },
+    BadDimensions { width: u32, height: u32, expected: u64, len: usize },
 }

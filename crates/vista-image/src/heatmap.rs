@@ -12,13 +12,7 @@ const MIN_SCALE: f32 = 1.0 / 255.0;
 
 /// Colormap stops: black → blue → magenta → yellow → white (monotonic in
 /// brightness, readable without a legend).
-const STOPS: [[f32; 3]; 5] = [
-    [0.0, 0.0, 0.0],
-    [0.0, 0.0, 1.0],
-    [1.0, 0.0, 1.0],
-    [1.0, 1.0, 0.0],
-    [1.0, 1.0, 1.0],
-];
+const STOPS: [[f32; 3]; 5] = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1.0, 0.0], [1.0, 1.0, 1.0]];
 
 /// Visualises where and how much `actual` differs from `reference`.
 ///
@@ -42,11 +36,7 @@ pub fn diff_heatmap(reference: &Image, actual: &Image, scale: Option<f32>) -> Im
             None => INVALID,
         })
         .collect();
-    Image {
-        width: reference.width,
-        height: reference.height,
-        data,
-    }
+    Image { width: reference.width, height: reference.height, data }
 }
 
 /// Per reference pixel: `Some(max RGB |diff|)`, or `None` when non-finite or
@@ -56,11 +46,7 @@ fn pixel_diffs(reference: &Image, actual: &Image) -> Vec<Option<f32>> {
     for y in 0..reference.height {
         for x in 0..reference.width {
             let inside = x < actual.width && y < actual.height;
-            out.push(
-                inside
-                    .then(|| max_rgb_diff(reference.get(x, y), actual.get(x, y)))
-                    .flatten(),
-            );
+            out.push(inside.then(|| max_rgb_diff(reference.get(x, y), actual.get(x, y))).flatten());
         }
     }
     out

@@ -17,9 +17,7 @@ pub fn write_png16(path: &Path, img: &Image) -> Result<(), ImageError> {
     let buf = ImageBuffer::<Rgba<u16>, Vec<u16>>::from_raw(img.width, img.height, samples)
         .ok_or_else(|| encode_error(path, "PNG", "pixel buffer does not match image size"))?;
     let mut bytes = Cursor::new(Vec::new());
-    DynamicImage::ImageRgba16(buf)
-        .write_to(&mut bytes, ImageFormat::Png)
-        .map_err(|e| encode_error(path, "PNG", e))?;
+    DynamicImage::ImageRgba16(buf).write_to(&mut bytes, ImageFormat::Png).map_err(|e| encode_error(path, "PNG", e))?;
     atomic_write(path, bytes.get_ref())
 }
 
@@ -27,8 +25,8 @@ pub fn write_png16(path: &Path, img: &Image) -> Result<(), ImageError> {
 /// `[0, 1]`; missing alpha becomes 1 and grey is replicated to RGB.
 pub fn read_png16(path: &Path) -> Result<Image, ImageError> {
     let bytes = read_file(path)?;
-    let decoded = image::load_from_memory_with_format(&bytes, ImageFormat::Png)
-        .map_err(|e| decode_error(path, "PNG", e))?;
+    let decoded =
+        image::load_from_memory_with_format(&bytes, ImageFormat::Png).map_err(|e| decode_error(path, "PNG", e))?;
     Ok(normalize_png(decoded))
 }
 
@@ -47,14 +45,9 @@ pub fn write_exr(path: &Path, img: &Image) -> Result<(), ImageError> {
         let [r, g, b, a] = img.data[pos.y() * w + pos.x()];
         (r, g, b, a)
     });
-    let exr_image =
-        exr::image::Image::from_encoded_channels((w, h), Encoding::SMALL_LOSSLESS, channels);
+    let exr_image = exr::image::Image::from_encoded_channels((w, h), Encoding::SMALL_LOSSLESS, channels);
     let mut bytes = Cursor::new(Vec::new());
-    exr_image
-        .write()
-        .non_parallel()
-        .to_buffered(&mut bytes)
-        .map_err(|e| encode_error(path, "EXR", e))?;
+    exr_image.write().non_parallel().to_buffered(&mut bytes).map_err(|e| encode_error(path, "EXR", e))?;
     atomic_write(path, bytes.get_ref())
 }
 
@@ -62,8 +55,8 @@ pub fn write_exr(path: &Path, img: &Image) -> Result<(), ImageError> {
 /// RGBA; missing alpha becomes 1, half-float channels are widened exactly.
 pub fn read_exr(path: &Path) -> Result<Image, ImageError> {
     let bytes = read_file(path)?;
-    let decoded = image::load_from_memory_with_format(&bytes, ImageFormat::OpenExr)
-        .map_err(|e| decode_error(path, "EXR", e))?;
+    let decoded =
+        image::load_from_memory_with_format(&bytes, ImageFormat::OpenExr).map_err(|e| decode_error(path, "EXR", e))?;
     Ok(from_rgba32f(decoded.into_rgba32f()))
 }
 
@@ -87,10 +80,7 @@ pub fn load(path: &Path) -> Result<Image, ImageError> {
 /// same directory, fsyncs it and renames it over `path`. On failure the
 /// temporary file is removed and any existing `path` is left untouched.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
-    let io_err = |source| ImageError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+    let io_err = |source| ImageError::Io { path: path.to_path_buf(), source };
     let dir = parent_dir(path);
     let mut tmp = create_temp(&dir, path).map_err(io_err)?;
     tmp.write_all(bytes).map_err(io_err)?;
@@ -106,16 +96,11 @@ enum Kind {
 }
 
 fn kind_of(path: &Path) -> Result<Kind, ImageError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("png") => Ok(Kind::Png),
         Some("exr") => Ok(Kind::Exr),
-        _ => Err(ImageError::UnsupportedExtension {
-            path: path.to_path_buf(),
-        }),
+        _ => Err(ImageError::UnsupportedExtension { path: path.to_path_buf() }),
     }
 }
 
@@ -134,53 +119,30 @@ fn normalize_png(decoded: DynamicImage) -> Image {
     let (width, height) = (decoded.width(), decoded.height());
     let data = if ct.bytes_per_pixel() > ct.channel_count() {
         let buf = decoded.into_rgba16();
-        buf.pixels()
-            .map(|p| p.0.map(|v| f32::from(v) / 65535.0))
-            .collect()
+        buf.pixels().map(|p| p.0.map(|v| f32::from(v) / 65535.0)).collect()
     } else {
         let buf = decoded.into_rgba8();
-        buf.pixels()
-            .map(|p| p.0.map(|v| f32::from(v) / 255.0))
-            .collect()
+        buf.pixels().map(|p| p.0.map(|v| f32::from(v) / 255.0)).collect()
     };
-    Image {
-        width,
-        height,
-        data,
-    }
+    Image { width, height, data }
 }
 
 fn from_rgba32f(buf: image::Rgba32FImage) -> Image {
     let (width, height) = buf.dimensions();
     let data = buf.pixels().map(|p| p.0).collect();
-    Image {
-        width,
-        height,
-        data,
-    }
+    Image { width, height, data }
 }
 
 fn read_file(path: &Path) -> Result<Vec<u8>, ImageError> {
-    std::fs::read(path).map_err(|source| ImageError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    std::fs::read(path).map_err(|source| ImageError::Io { path: path.to_path_buf(), source })
 }
 
 fn decode_error(path: &Path, format: &'static str, e: impl ToString) -> ImageError {
-    ImageError::Decode {
-        path: path.to_path_buf(),
-        format,
-        msg: e.to_string(),
-    }
+    ImageError::Decode { path: path.to_path_buf(), format, msg: e.to_string() }
 }
 
 fn encode_error(path: &Path, format: &'static str, e: impl ToString) -> ImageError {
-    ImageError::Encode {
-        path: path.to_path_buf(),
-        format,
-        msg: e.to_string(),
-    }
+    ImageError::Encode { path: path.to_path_buf(), format, msg: e.to_string() }
 }
 
 /// The directory the temp file must live in so the final rename stays on one
@@ -195,10 +157,7 @@ fn parent_dir(path: &Path) -> PathBuf {
 /// Creates the temp file as `.<target>.XXXXXX.tmp` so a stray one (after a
 /// hard kill) is recognisable and hidden.
 fn create_temp(dir: &Path, path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let prefix = format!(".{name}.");
     let mut b = tempfile::Builder::new();
     b.prefix(&prefix).suffix(".tmp");

@@ -63,9 +63,7 @@ pub fn compare_hdr(reference: &Image, actual: &Image) -> Result<Metrics, ImageEr
 /// The largest finite RGB value of `reference`, or 1 when there is no
 /// positive finite value (an all-black reference would otherwise give peak 0).
 pub fn hdr_peak(reference: &Image) -> f64 {
-    let peak = rgb_values(reference)
-        .filter(|v| v.is_finite())
-        .fold(f64::NEG_INFINITY, f64::max);
+    let peak = rgb_values(reference).filter(|v| v.is_finite()).fold(f64::NEG_INFINITY, f64::max);
     if peak > 0.0 { peak } else { 1.0 }
 }
 
@@ -125,9 +123,7 @@ pub fn ssim(a: &Image, b: &Image) -> f64 {
 /// If the images differ in size.
 pub fn max_abs(a: &Image, b: &Image) -> f64 {
     assert_same_size(a, b);
-    channel_pairs(a, b)
-        .map(|(x, y)| abs_diff(x, y))
-        .fold(0.0, f64::max)
+    channel_pairs(a, b).map(|(x, y)| abs_diff(x, y)).fold(0.0, f64::max)
 }
 
 /// Number of pixels where any RGB channel differs by more than 1/255
@@ -137,20 +133,13 @@ pub fn max_abs(a: &Image, b: &Image) -> f64 {
 /// If the images differ in size.
 pub fn bad_pixels(a: &Image, b: &Image) -> u64 {
     assert_same_size(a, b);
-    a.data
-        .iter()
-        .zip(&b.data)
-        .filter(|(p, q)| (0..3).any(|c| abs_diff(p[c], q[c]) > BAD_PIXEL_THRESHOLD))
-        .count() as u64
+    a.data.iter().zip(&b.data).filter(|(p, q)| (0..3).any(|c| abs_diff(p[c], q[c]) > BAD_PIXEL_THRESHOLD)).count()
+        as u64
 }
 
 /// `"identical"` for `+inf`, otherwise e.g. `"42.13 dB"`.
 pub fn format_psnr(psnr: f64) -> String {
-    if psnr == f64::INFINITY {
-        "identical".to_string()
-    } else {
-        format!("{psnr:.2} dB")
-    }
+    if psnr == f64::INFINITY { "identical".to_string() } else { format!("{psnr:.2} dB") }
 }
 
 fn all_metrics(reference: &Image, actual: &Image, peak: f64) -> Metrics {
@@ -166,11 +155,7 @@ fn all_metrics(reference: &Image, actual: &Image, peak: f64) -> Metrics {
 }
 
 fn psnr_from_mse(mse: f64, peak: f64) -> f64 {
-    if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (peak * peak / mse).log10()
-    }
+    if mse == 0.0 { f64::INFINITY } else { 10.0 * (peak * peak / mse).log10() }
 }
 
 /// `|a - b|` in f64; 0 for identical bit patterns, `+inf` when non-finite.
@@ -189,35 +174,24 @@ fn squared_error(a: f32, b: f32) -> f64 {
 }
 
 fn channel_pairs<'a>(a: &'a Image, b: &'a Image) -> impl Iterator<Item = (f32, f32)> + 'a {
-    a.data
-        .iter()
-        .zip(&b.data)
-        .flat_map(|(p, q)| (0..3).map(move |c| (p[c], q[c])))
+    a.data.iter().zip(&b.data).flat_map(|(p, q)| (0..3).map(move |c| (p[c], q[c])))
 }
 
 fn rgb_values(img: &Image) -> impl Iterator<Item = f64> + '_ {
-    img.data
-        .iter()
-        .flat_map(|p| p[..3].iter().map(|&v| f64::from(v)))
+    img.data.iter().flat_map(|p| p[..3].iter().map(|&v| f64::from(v)))
 }
 
 /// Rec. 709 luma with non-finite channels replaced by 0 (see module docs).
 fn luma(img: &Image) -> Vec<f64> {
     let finite = |v: f32| if v.is_finite() { f64::from(v) } else { 0.0 };
-    img.data
-        .iter()
-        .map(|p| 0.2126 * finite(p[0]) + 0.7152 * finite(p[1]) + 0.0722 * finite(p[2]))
-        .collect()
+    img.data.iter().map(|p| 0.2126 * finite(p[0]) + 0.7152 * finite(p[1]) + 0.0722 * finite(p[2])).collect()
 }
 
 fn check_same_size(reference: &Image, actual: &Image) -> Result<(), ImageError> {
     if reference.dimensions() == actual.dimensions() {
         Ok(())
     } else {
-        Err(ImageError::SizeMismatch {
-            expected: reference.dimensions(),
-            actual: actual.dimensions(),
-        })
+        Err(ImageError::SizeMismatch { expected: reference.dimensions(), actual: actual.dimensions() })
     }
 }
 
@@ -255,11 +229,9 @@ mod float_repr {
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
         match Repr::deserialize(d)? {
             Repr::Num(v) => Ok(v),
-            Repr::Text(t) => t.parse::<f64>().map_err(|_| {
-                D::Error::custom(format!(
-                    "expected a number, \"inf\", \"-inf\" or \"nan\", got {t:?}"
-                ))
-            }),
+            Repr::Text(t) => t
+                .parse::<f64>()
+                .map_err(|_| D::Error::custom(format!("expected a number, \"inf\", \"-inf\" or \"nan\", got {t:?}"))),
             Repr::Null(()) => Ok(f64::NAN),
         }
     }

@@ -23,11 +23,7 @@ type Moments = [f64; 5];
 pub(crate) fn ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
     debug_assert_eq!(x.len(), w * h);
     debug_assert_eq!(y.len(), w * h);
-    if w >= WIN && h >= WIN {
-        windowed_ssim(x, y, w, h)
-    } else {
-        global_ssim(x, y)
-    }
+    if w >= WIN && h >= WIN { windowed_ssim(x, y, w, h) } else { global_ssim(x, y) }
 }
 
 /// Normalised 11-tap Gaussian, as `scipy.ndimage.gaussian_filter` builds it.
@@ -44,16 +40,13 @@ fn gaussian_kernel() -> [f64; WIN] {
 fn windowed_ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
     let k = gaussian_kernel();
     let filter = |plane: &[f64]| filter_valid(plane, w, h, &k);
-    let product =
-        |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(p, q)| p * q).collect() };
+    let product = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(p, q)| p * q).collect() };
     let mx = filter(x);
     let my = filter(y);
     let mxx = filter(&product(x, x));
     let myy = filter(&product(y, y));
     let mxy = filter(&product(x, y));
-    let total: f64 = (0..mx.len())
-        .map(|i| ssim_from_moments(&[mx[i], my[i], mxx[i], myy[i], mxy[i]]))
-        .sum();
+    let total: f64 = (0..mx.len()).map(|i| ssim_from_moments(&[mx[i], my[i], mxx[i], myy[i], mxy[i]])).sum();
     total / mx.len() as f64
 }
 
@@ -128,9 +121,7 @@ mod tests {
 
     #[test]
     fn identical_inputs_score_one() {
-        let x: Vec<f64> = (0..20 * 13)
-            .map(|i| (i as f64 * 0.37).sin() * 0.5 + 0.5)
-            .collect();
+        let x: Vec<f64> = (0..20 * 13).map(|i| (i as f64 * 0.37).sin() * 0.5 + 0.5).collect();
         assert!((ssim(&x, &x, 20, 13) - 1.0).abs() < 1e-12);
         assert!((ssim(&x[..50], &x[..50], 10, 5) - 1.0).abs() < 1e-12);
         assert_eq!(ssim(&[], &[], 0, 0), 1.0);

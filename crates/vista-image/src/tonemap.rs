@@ -17,26 +17,14 @@ pub fn tonemap(img: &Image, exposure: f32) -> Image {
             [map(r), map(g), map(b), a]
         })
         .collect();
-    Image {
-        width: img.width,
-        height: img.height,
-        data,
-    }
+    Image { width: img.width, height: img.height, data }
 }
 
 /// The exact piecewise sRGB OETF: `12.92 x` below 0.0031308, otherwise
 /// `1.055 x^(1/2.4) - 0.055`. Input is clamped to `[0, 1]` (NaN → 0).
 /// Evaluated in f64 so the endpoints come out exactly 0 and 1.
 pub fn srgb_encode(x: f32) -> f32 {
-    let x = if x.is_nan() {
-        0.0
-    } else {
-        f64::from(x.clamp(0.0, 1.0))
-    };
-    let y = if x < 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
+    let x = if x.is_nan() { 0.0 } else { f64::from(x.clamp(0.0, 1.0)) };
+    let y = if x < 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
     y.clamp(0.0, 1.0) as f32
 }

@@ -37,12 +37,7 @@ fn tonemap_is_strictly_increasing_and_below_one() {
     });
     let out = tonemap(&img, 1.0);
     for w in out.data.windows(2) {
-        assert!(
-            w[1][0] > w[0][0],
-            "not increasing: {:?} -> {:?}",
-            w[0],
-            w[1]
-        );
+        assert!(w[1][0] > w[0][0], "not increasing: {:?} -> {:?}", w[0], w[1]);
     }
     assert!(out.data.iter().all(|p| p[0] < 1.0 && p[0] >= 0.0));
     // Hand-computed: L = 1 -> 1 - e^-1 = 0.632121 -> 1.055 * 0.632121^(1/2.4) - 0.055.
@@ -60,10 +55,7 @@ fn tonemap_exposure_scales_luminance_and_clamps_bad_input() {
         assert_eq!(a.get(x, 0)[2], 0.0); // NaN -> 0
         assert!(a.get(x, 0)[3].is_nan()); // alpha copied untouched
     }
-    let inf = tonemap(
-        &Image::from_fn(1, 1, |_, _| [f32::INFINITY, 0.0, 0.0, 1.0]),
-        1.0,
-    );
+    let inf = tonemap(&Image::from_fn(1, 1, |_, _| [f32::INFINITY, 0.0, 0.0, 1.0]), 1.0);
     assert_eq!(inf.get(0, 0)[0], 1.0);
     let dark = tonemap(&Image::from_fn(1, 1, |_, _| [3.0, 3.0, 3.0, 1.0]), -1.0);
     assert_eq!(dark.get(0, 0)[..3], [0.0, 0.0, 0.0]);
@@ -97,10 +89,7 @@ fn heatmap_explicit_and_minimum_scale() {
     let mut a = r.clone();
     a.set(0, 0, [0.25, 0.0, 0.0, 1.0]);
     // With scale 1, a 0.25 diff is a quarter of the way: pure blue.
-    assert_eq!(
-        diff_heatmap(&r, &a, Some(1.0)).get(0, 0),
-        [0.0, 0.0, 1.0, 1.0]
-    );
+    assert_eq!(diff_heatmap(&r, &a, Some(1.0)).get(0, 0), [0.0, 0.0, 1.0, 1.0]);
     // Invalid scales fall back to the default (max diff -> white).
     assert_eq!(diff_heatmap(&r, &a, Some(0.0)).get(0, 0), [1.0; 4]);
     assert_eq!(diff_heatmap(&r, &a, Some(f32::NAN)).get(0, 0), [1.0; 4]);

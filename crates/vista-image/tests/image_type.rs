@@ -37,20 +37,9 @@ fn get_out_of_bounds_panics_with_message() {
 fn from_raw_checks_length() {
     assert!(Image::from_raw(2, 2, vec![[0.0; 4]; 4]).is_ok());
     let err = Image::from_raw(2, 3, vec![[0.0; 4]; 5]).unwrap_err();
-    assert!(matches!(
-        err,
-        ImageError::BadDimensions {
-            width: 2,
-            height: 3,
-            expected: 6,
-            len: 5
-        }
-    ));
+    assert!(matches!(err, ImageError::BadDimensions { width: 2, height: 3, expected: 6, len: 5 }));
     let msg = err.to_string();
-    assert!(
-        msg.contains("2x3") && msg.contains('6') && msg.contains('5'),
-        "{msg}"
-    );
+    assert!(msg.contains("2x3") && msg.contains('6') && msg.contains('5'), "{msg}");
 }
 
 #[test]
@@ -87,11 +76,7 @@ fn content_hash_sees_bit_level_changes() {
     let a = Image::from_fn(8, 8, |x, y| [x as f32 / 8.0, y as f32 / 8.0, 0.0, 1.0]);
     let mut b = a.clone();
     assert_eq!(a.content_hash(), b.content_hash());
-    b.set(
-        7,
-        7,
-        [0.875, f32::from_bits(0.875f32.to_bits() + 1), 0.0, 1.0],
-    );
+    b.set(7, 7, [0.875, f32::from_bits(0.875f32.to_bits() + 1), 0.0, 1.0]);
     assert_ne!(a.content_hash(), b.content_hash());
     let mut c = a.clone();
     c.set(0, 0, [-0.0, 0.0, 0.0, 1.0]);

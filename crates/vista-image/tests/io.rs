@@ -2,19 +2,15 @@
 
 use std::path::Path;
 
-use vista_image::{
-    Image, ImageError, atomic_write, load, read_exr, read_png16, save, write_exr, write_png16,
-};
+use vista_image::{Image, ImageError, atomic_write, load, read_exr, read_png16, save, write_exr, write_png16};
 
 fn tempdir() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
 }
 
 fn dir_entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
     names
 }
@@ -38,12 +34,7 @@ fn png16_round_trip_within_half_a_step() {
     for (p, q) in img.data.iter().zip(&back.data) {
         for c in 0..4 {
             let err = (p[c] - q[c]).abs();
-            assert!(
-                err <= 0.5 / 65535.0 + 1e-7,
-                "{} vs {} (err {err})",
-                p[c],
-                q[c]
-            );
+            assert!(err <= 0.5 / 65535.0 + 1e-7, "{} vs {} (err {err})", p[c], q[c]);
             // Read values sit exactly on the 16-bit grid.
             let level = q[c] * 65535.0;
             assert!((level - level.round()).abs() < 1e-3);
@@ -52,10 +43,7 @@ fn png16_round_trip_within_half_a_step() {
     // Writing what was read reproduces the file byte for byte.
     let again = dir.path().join("again.png");
     write_png16(&again, &back).unwrap();
-    assert_eq!(
-        std::fs::read(&path).unwrap(),
-        std::fs::read(&again).unwrap()
-    );
+    assert_eq!(std::fs::read(&path).unwrap(), std::fs::read(&again).unwrap());
 }
 
 #[test]
@@ -92,9 +80,7 @@ fn reads_8_bit_rgb_and_grey_png() {
     assert_eq!(img.get(0, 0), [0.0, 0.0, 17.0 / 255.0, 1.0]);
 
     let grey_path = dir.path().join("grey8.png");
-    image::GrayImage::from_fn(2, 2, |x, _| image::Luma([x as u8 * 51]))
-        .save(&grey_path)
-        .unwrap();
+    image::GrayImage::from_fn(2, 2, |x, _| image::Luma([x as u8 * 51])).save(&grey_path).unwrap();
     let img = read_png16(&grey_path).unwrap();
     assert_eq!(img.get(1, 0), [0.2, 0.2, 0.2, 1.0]);
 }
@@ -115,12 +101,7 @@ fn exr_round_trip_is_bit_exact() {
     ];
     let img = Image::from_fn(19, 7, |x, y| {
         let i = (x + 19 * y) as usize;
-        [
-            specials[i % specials.len()],
-            x as f32 * 0.1 - 0.7,
-            (y as f32).exp(),
-            1.0 / (1.0 + i as f32),
-        ]
+        [specials[i % specials.len()], x as f32 * 0.1 - 0.7, (y as f32).exp(), 1.0 / (1.0 + i as f32)]
     });
     write_exr(&path, &img).unwrap();
     let back = read_exr(&path).unwrap();
@@ -144,10 +125,7 @@ fn corrupt_files_give_decode_errors_naming_the_path() {
     let png = dir.path().join("corrupt.png");
     std::fs::write(&png, b"definitely not a png").unwrap();
     let err = read_png16(&png).unwrap_err();
-    assert!(
-        matches!(err, ImageError::Decode { format: "PNG", .. }),
-        "{err:?}"
-    );
+    assert!(matches!(err, ImageError::Decode { format: "PNG", .. }), "{err:?}");
     let msg = err.to_string();
     assert!(msg.contains(&png.display().to_string()), "{msg}");
     assert!(msg.contains("is not a valid PNG"), "{msg}");
@@ -158,25 +136,16 @@ fn corrupt_files_give_decode_errors_naming_the_path() {
     let bytes = std::fs::read(&good).unwrap();
     let truncated = dir.path().join("truncated.png");
     std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
-    assert!(matches!(
-        read_png16(&truncated),
-        Err(ImageError::Decode { .. })
-    ));
+    assert!(matches!(read_png16(&truncated), Err(ImageError::Decode { .. })));
 
     let exr = dir.path().join("corrupt.exr");
     std::fs::write(&exr, b"\x76\x2f\x31\x01garbage").unwrap();
     let err = read_exr(&exr).unwrap_err();
     let msg = err.to_string();
-    assert!(
-        msg.contains(&exr.display().to_string()) && msg.contains("is not a valid EXR"),
-        "{msg}"
-    );
+    assert!(msg.contains(&exr.display().to_string()) && msg.contains("is not a valid EXR"), "{msg}");
 
     // A PNG is not an EXR.
-    assert!(matches!(
-        read_exr(&good),
-        Err(ImageError::Decode { format: "EXR", .. })
-    ));
+    assert!(matches!(read_exr(&good), Err(ImageError::Decode { format: "EXR", .. })));
 }
 
 #[test]
@@ -216,14 +185,8 @@ fn save_and_load_dispatch_on_extension() {
         let err = save(&path, &img).unwrap_err();
         assert!(matches!(err, ImageError::UnsupportedExtension { .. }));
         let msg = err.to_string();
-        assert!(
-            msg.contains(name) && msg.contains(".png") && msg.contains(".exr"),
-            "{msg}"
-        );
-        assert!(matches!(
-            load(&path),
-            Err(ImageError::UnsupportedExtension { .. })
-        ));
+        assert!(msg.contains(name) && msg.contains(".png") && msg.contains(".exr"), "{msg}");
+        assert!(matches!(load(&path), Err(ImageError::UnsupportedExtension { .. })));
     }
     assert!(!dir.path().join("e.jpg").exists());
 }
@@ -270,9 +233,6 @@ fn encoding_an_empty_image_is_an_error_not_a_panic() {
     assert!(!path.exists());
     let exr = dir.path().join("empty.exr");
     let err = write_exr(&exr, &Image::new(0, 3)).unwrap_err();
-    assert!(
-        matches!(err, ImageError::Encode { format: "EXR", .. }),
-        "{err:?}"
-    );
+    assert!(matches!(err, ImageError::Encode { format: "EXR", .. }), "{err:?}");
     assert!(dir_entries(dir.path()).is_empty());
 }

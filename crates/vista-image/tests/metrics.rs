@@ -43,11 +43,7 @@ fn constant_offset_gives_20_db() {
     let (mx, my) = (0.25f64, f64::from(0.35f32));
     let c1 = 1e-4;
     let expected = (2.0 * mx * my + c1) / (mx * mx + my * my + c1);
-    assert!(
-        (m.ssim - expected).abs() < 1e-9,
-        "ssim {} vs {expected}",
-        m.ssim
-    );
+    assert!((m.ssim - expected).abs() < 1e-9, "ssim {} vs {expected}", m.ssim);
 }
 
 #[test]
@@ -132,17 +128,8 @@ fn hdr_psnr_uses_reference_peak() {
 #[test]
 fn size_mismatch_is_an_error() {
     let err = compare(&Image::new(16, 16), &Image::new(16, 8)).unwrap_err();
-    assert!(matches!(
-        err,
-        ImageError::SizeMismatch {
-            expected: (16, 16),
-            actual: (16, 8)
-        }
-    ));
-    assert!(
-        err.to_string().contains("expected 16x16, got 16x8"),
-        "{err}"
-    );
+    assert!(matches!(err, ImageError::SizeMismatch { expected: (16, 16), actual: (16, 8) }));
+    assert!(err.to_string().contains("expected 16x16, got 16x8"), "{err}");
     assert!(compare_hdr(&Image::new(2, 2), &Image::new(3, 2)).is_err());
 }
 
@@ -191,14 +178,7 @@ fn format_psnr_rounds_to_two_decimals() {
 
 #[test]
 fn metrics_json_round_trip_keeps_infinity() {
-    let m = Metrics {
-        psnr: f64::INFINITY,
-        ssim: 1.0,
-        max_abs: 0.0,
-        bad_pixels: 0,
-        nan: 0,
-        mse: 0.0,
-    };
+    let m = Metrics { psnr: f64::INFINITY, ssim: 1.0, max_abs: 0.0, bad_pixels: 0, nan: 0, mse: 0.0 };
     let json = serde_json::to_string(&m).unwrap();
     assert!(json.contains(r#""psnr":"inf""#), "{json}");
     let back: Metrics = serde_json::from_str(&json).unwrap();
@@ -209,17 +189,13 @@ fn metrics_json_round_trip_keeps_infinity() {
     assert_eq!(back, finite);
 
     // serde_json's own encoding of non-finite floats (null) is accepted as NaN.
-    let from_null: Metrics = serde_json::from_str(
-        r#"{"psnr":null,"ssim":1,"max_abs":"-inf","bad_pixels":0,"nan":0,"mse":0.0}"#,
-    )
-    .unwrap();
+    let from_null: Metrics =
+        serde_json::from_str(r#"{"psnr":null,"ssim":1,"max_abs":"-inf","bad_pixels":0,"nan":0,"mse":0.0}"#).unwrap();
     assert!(from_null.psnr.is_nan());
     assert_eq!(from_null.max_abs, f64::NEG_INFINITY);
     assert!(
-        serde_json::from_str::<Metrics>(
-            r#"{"psnr":"lots","ssim":1,"max_abs":0,"bad_pixels":0,"nan":0,"mse":0}"#
-        )
-        .is_err()
+        serde_json::from_str::<Metrics>(r#"{"psnr":"lots","ssim":1,"max_abs":0,"bad_pixels":0,"nan":0,"mse":0}"#)
+            .is_err()
     );
 }
 

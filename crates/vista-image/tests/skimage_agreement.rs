@@ -55,27 +55,9 @@ fn psnr_and_ssim_match_scikit_image() {
             p.ssim,
             (m.ssim - p.ssim).abs()
         );
-        assert!(
-            (m.psnr - p.psnr).abs() < TOLERANCE,
-            "{}: psnr {} vs {}",
-            p.name,
-            m.psnr,
-            p.psnr
-        );
-        assert!(
-            (m.ssim - p.ssim).abs() < TOLERANCE,
-            "{}: ssim {} vs {}",
-            p.name,
-            m.ssim,
-            p.ssim
-        );
-        assert!(
-            (m.mse - p.mse).abs() < 1e-9,
-            "{}: mse {} vs {}",
-            p.name,
-            m.mse,
-            p.mse
-        );
+        assert!((m.psnr - p.psnr).abs() < TOLERANCE, "{}: psnr {} vs {}", p.name, m.psnr, p.psnr);
+        assert!((m.ssim - p.ssim).abs() < TOLERANCE, "{}: ssim {} vs {}", p.name, m.ssim, p.ssim);
+        assert!((m.mse - p.mse).abs() < 1e-9, "{}: mse {} vs {}", p.name, m.mse, p.mse);
         assert!((m.max_abs - p.max_abs).abs() < 1e-6, "{}: max_abs", p.name);
         // The pairs are far from identical, so a broken metric cannot pass by accident.
         assert!(m.ssim < 0.99 && m.psnr < 40.0, "{}", p.name);

@@ -23,48 +23,13 @@ use crate::{Kernel, Kind, Output, ParamSet, ParamSpec, Preset, Uniforms};
 pub const PROJECTIONS: &[&str] = &["latlong", "fisheye"];
 
 const PARAMS: &[ParamSpec] = &[
-    ParamSpec::new(
-        "view_samples",
-        Kind::int(1, 1024),
-        "32",
-        "midpoint steps along the view ray",
-    ),
-    ParamSpec::new(
-        "light_samples",
-        Kind::int(1, 256),
-        "8",
-        "midpoint steps toward the sun per view step",
-    ),
-    ParamSpec::new(
-        "sun_elevation_deg",
-        Kind::float(-10.0, 90.0),
-        "30",
-        "sun elevation at azimuth 0 (degrees)",
-    ),
-    ParamSpec::new(
-        "camera_altitude_m",
-        Kind::float(0.0, 100_000.0),
-        "1000",
-        "camera height above the ground (m)",
-    ),
-    ParamSpec::new(
-        "sun_intensity",
-        Kind::float(0.0, 1000.0),
-        "20",
-        "E_sun, irradiance of the sun",
-    ),
-    ParamSpec::new(
-        "mie_g",
-        Kind::float(-0.99, 0.99),
-        "0.8",
-        "Henyey-Greenstein asymmetry g of the Mie phase",
-    ),
-    ParamSpec::new(
-        "exposure",
-        Kind::float(0.0, 1000.0),
-        "1.5",
-        "display = 1 - exp(-exposure * L), then sRGB",
-    ),
+    ParamSpec::new("view_samples", Kind::int(1, 1024), "32", "midpoint steps along the view ray"),
+    ParamSpec::new("light_samples", Kind::int(1, 256), "8", "midpoint steps toward the sun per view step"),
+    ParamSpec::new("sun_elevation_deg", Kind::float(-10.0, 90.0), "30", "sun elevation at azimuth 0 (degrees)"),
+    ParamSpec::new("camera_altitude_m", Kind::float(0.0, 100_000.0), "1000", "camera height above the ground (m)"),
+    ParamSpec::new("sun_intensity", Kind::float(0.0, 1000.0), "20", "E_sun, irradiance of the sun"),
+    ParamSpec::new("mie_g", Kind::float(-0.99, 0.99), "0.8", "Henyey-Greenstein asymmetry g of the Mie phase"),
+    ParamSpec::new("exposure", Kind::float(0.0, 1000.0), "1.5", "display = 1 - exp(-exposure * L), then sRGB"),
     ParamSpec::new(
         "projection",
         Kind::Enum(PROJECTIONS),
@@ -74,16 +39,8 @@ const PARAMS: &[ParamSpec] = &[
 ];
 
 const PRESETS: &[Preset] = &[
-    Preset {
-        name: "noon",
-        doc: "sun at 60 deg",
-        set: &[("sun_elevation_deg", "60")],
-    },
-    Preset {
-        name: "afternoon",
-        doc: "sun at 30 deg (the defaults)",
-        set: &[("sun_elevation_deg", "30")],
-    },
+    Preset { name: "noon", doc: "sun at 60 deg", set: &[("sun_elevation_deg", "60")] },
+    Preset { name: "afternoon", doc: "sun at 30 deg (the defaults)", set: &[("sun_elevation_deg", "30")] },
     Preset {
         name: "sunset",
         doc: "sun at 2 deg: red horizon toward the sun, exposure 2.5",
@@ -97,11 +54,7 @@ const PRESETS: &[Preset] = &[
     Preset {
         name: "high_altitude",
         doc: "camera at 20 km, sun at 30 deg: darker, deeper blue sky",
-        set: &[
-            ("camera_altitude_m", "20000"),
-            ("sun_elevation_deg", "30"),
-            ("exposure", "4"),
-        ],
+        set: &[("camera_altitude_m", "20000"), ("sun_elevation_deg", "30"), ("exposure", "4")],
     },
 ];
 
@@ -154,10 +107,7 @@ impl Kernel for AtmosphereKernel {
     /// most sigma dt exp(-sigma dt / 2) <= 1 - exp(-sigma dt) of the remaining
     /// transmittance (scattering <= extinction, T_sun <= 1). 1% slack for f32.
     fn output_bounds(&self, p: &ParamSet) -> (f32, f32) {
-        (
-            0.0,
-            (1.01 * p.f64("sun_intensity") * max_phase(p.f64("mie_g"))) as f32,
-        )
+        (0.0, (1.01 * p.f64("sun_intensity") * max_phase(p.f64("mie_g"))) as f32)
     }
     fn high_quality(&self) -> &'static [(&'static str, &'static str)] {
         &[("view_samples", "512"), ("light_samples", "128")]

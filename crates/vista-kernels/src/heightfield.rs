@@ -45,9 +45,9 @@
 //! smoothstep(clamp(min_i softness * D_i / t_i, 0, 1)); fixed sample
 //! positions keep the GPU and the f64 reference on the same function.
 
-use crate::fbm::{BASIS, LACUNARITY, OCTAVES, SEED};
 pub use crate::cpu64::geometry::{Camera, V3};
 pub use crate::cpu64::heightfield::*;
+use crate::fbm::{BASIS, LACUNARITY, OCTAVES, SEED};
 use crate::noise::BASIS_NAMES;
 use crate::{Kernel, Kind, ParamError, ParamSet, ParamSpec, Preset, Uniforms};
 use vista_image::Image;

@@ -21,22 +21,22 @@ macro_rules! cpu_references {
         #[path = "cpu/common.rs"]
         mod common;
         pub use common::*;
-        #[path = "cpu/geometry.rs"]
-        pub mod geometry;
-        #[path = "cpu/phase.rs"]
-        pub mod phase;
-        #[path = "cpu/noise.rs"]
-        pub mod noise;
-        #[path = "cpu/fbm.rs"]
-        pub mod fbm;
-        #[path = "cpu/ridged.rs"]
-        pub mod ridged;
         #[path = "cpu/atmosphere.rs"]
         pub mod atmosphere;
         #[path = "cpu/clouds.rs"]
         pub mod clouds;
+        #[path = "cpu/fbm.rs"]
+        pub mod fbm;
+        #[path = "cpu/geometry.rs"]
+        pub mod geometry;
         #[path = "cpu/heightfield.rs"]
         pub mod heightfield;
+        #[path = "cpu/noise.rs"]
+        pub mod noise;
+        #[path = "cpu/phase.rs"]
+        pub mod phase;
+        #[path = "cpu/ridged.rs"]
+        pub mod ridged;
     };
 }
 
@@ -149,7 +149,13 @@ impl std::fmt::Debug for dyn Kernel {
 
 /// All kernels, in the order `vista list` shows them.
 pub fn registry() -> &'static [&'static dyn Kernel] {
-    &[&fbm::FbmKernel, &ridged::RidgedKernel, &atmosphere::AtmosphereKernel, &clouds::CloudsKernel, &heightfield::HeightfieldKernel]
+    &[
+        &fbm::FbmKernel,
+        &ridged::RidgedKernel,
+        &atmosphere::AtmosphereKernel,
+        &clouds::CloudsKernel,
+        &heightfield::HeightfieldKernel,
+    ]
 }
 
 /// Looks a kernel up by name.

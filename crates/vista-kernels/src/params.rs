@@ -41,7 +41,9 @@ impl Kind {
                 format!("{}{min}, {max}]", if open_min { "(" } else { "[" })
             }
             Kind::Int { min, max } => format!("integer in [{min}, {max}]"),
-            Kind::Vector { n, min, max } => format!("{n} comma-separated numbers each in [{min}, {max}]"),
+            Kind::Vector { n, min, max } => {
+                format!("{n} comma-separated numbers each in [{min}, {max}]")
+            }
             Kind::Enum(names) => format!("one of {}", names.join("|")),
         }
     }
@@ -84,9 +86,7 @@ impl fmt::Display for Value {
         match self {
             Value::Float(v) => write!(f, "{v}"),
             Value::Int(v) => write!(f, "{v}"),
-            Value::Vector(v) => {
-                f.write_str(&v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","))
-            }
+            Value::Vector(v) => f.write_str(&v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(",")),
             Value::Enum(s) => f.write_str(s),
         }
     }
@@ -95,11 +95,8 @@ impl fmt::Display for Value {
 /// Parses `text` as a value of `spec`, checking its range.
 pub fn parse_value(spec: &ParamSpec, text: &str) -> Result<Value, ParamError> {
     let t = text.trim();
-    let bad = |expected: String| ParamError::BadValue {
-        param: spec.name.to_string(),
-        value: text.to_string(),
-        expected,
-    };
+    let bad =
+        |expected: String| ParamError::BadValue { param: spec.name.to_string(), value: text.to_string(), expected };
     let out_of_range = || ParamError::OutOfRange {
         param: spec.name.to_string(),
         value: text.to_string(),
@@ -188,9 +185,7 @@ impl ParamSet {
     }
 
     fn get(&self, name: &str) -> &Value {
-        self.values
-            .get(name)
-            .unwrap_or_else(|| panic!("kernel {} has no parameter {name}", self.kernel))
+        self.values.get(name).unwrap_or_else(|| panic!("kernel {} has no parameter {name}", self.kernel))
     }
 
     pub fn f64(&self, name: &str) -> f64 {

@@ -24,10 +24,7 @@ fn dir(az: f64, el: f64) -> DVec3 {
 }
 
 fn resolve(preset: Option<&str>, set: &[(&str, &str)]) -> Result<ParamSet, ParamError> {
-    let o: Vec<(String, String)> = set
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect();
+    let o: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
     AtmosphereKernel.resolve(preset, &o)
 }
 
@@ -38,14 +35,9 @@ fn zenith_optical_depth_matches_closed_form() {
     let depth = optical_depth(ground, DVec3::Y, R_TOP - R_GROUND, 4096);
     let top = R_TOP - R_GROUND;
     for k in 0..3 {
-        let spec = BETA_R[k] * H_R * (1.0 - (-top / H_R).exp())
-            + BETA_M_EXT * H_M * (1.0 - (-top / H_M).exp());
+        let spec = BETA_R[k] * H_R * (1.0 - (-top / H_R).exp()) + BETA_M_EXT * H_M * (1.0 - (-top / H_M).exp());
         let rel = (depth[k] - spec).abs() / spec;
-        assert!(
-            rel < 1e-4,
-            "channel {k}: integrated {} vs closed form {spec} (rel {rel:e})",
-            depth[k]
-        );
+        assert!(rel < 1e-4, "channel {k}: integrated {} vs closed form {spec} (rel {rel:e})", depth[k]);
     }
     // Above the ground the density at the start is exp(-alt / H), so the
     // closed form carries that factor (SPEC's text omits it; equal at alt 0).
@@ -55,19 +47,11 @@ fn zenith_optical_depth_matches_closed_form() {
         let exact = zenith_column_closed_form(alt);
         for i in 0..2 {
             let rel = (col[i] - exact[i]).abs() / exact[i];
-            assert!(
-                rel < 1e-4,
-                "alt {alt}: column {i} {} vs closed form {} (rel {rel:e})",
-                col[i],
-                exact[i]
-            );
+            assert!(rel < 1e-4, "alt {alt}: column {i} {} vs closed form {} (rel {rel:e})", col[i], exact[i]);
         }
     }
     // Sanity of the numbers themselves: Rayleigh blue ~0.265, red ~0.046 at the ground.
-    assert!(
-        (depth[2] - 0.265).abs() < 0.01 && depth[0] < depth[1] && depth[1] < depth[2],
-        "{depth:?}"
-    );
+    assert!((depth[2] - 0.265).abs() < 0.01 && depth[0] < depth[1] && depth[1] < depth[2], "{depth:?}");
 }
 
 #[test]
@@ -83,15 +67,9 @@ fn transmittance_invariants() {
         let t = transmittance(a, d, len, (len / 50.0) as u32); // 50 m steps
         for k in 0..3 {
             assert!((0.0..=1.0).contains(&t[k]), "T = {t:?} at {len} m");
-            assert!(
-                t[k] <= prev[k],
-                "T rose along the ray: {prev:?} -> {t:?} at {len} m"
-            );
+            assert!(t[k] <= prev[k], "T rose along the ray: {prev:?} -> {t:?} at {len} m");
         }
-        assert!(
-            t[0] >= t[1] && t[1] >= t[2],
-            "T_R >= T_G >= T_B fails at {len} m: {t:?}"
-        );
+        assert!(t[0] >= t[1] && t[1] >= t[2], "T_R >= T_G >= T_B fails at {len} m: {t:?}");
         prev = t;
     }
     // Multiplicative: T(a, c) = T(a, b) T(b, c), each segment integrated finely.
@@ -102,15 +80,8 @@ fn transmittance_invariants() {
     let t_bc = transmittance(b, d, bc, 25_000);
     for k in 0..3 {
         let prod = t_ab[k] * t_bc[k];
-        assert!(
-            (t_ac[k] - prod).abs() <= 1e-6 * t_ac[k],
-            "channel {k}: T(a,c) {} vs T(a,b) T(b,c) {prod}",
-            t_ac[k]
-        );
-        assert!(
-            t_ac[k] < 0.99 * t_ab[k],
-            "segment b-c must attenuate: {t_ac:?} vs {t_ab:?}"
-        );
+        assert!((t_ac[k] - prod).abs() <= 1e-6 * t_ac[k], "channel {k}: T(a,c) {} vs T(a,b) T(b,c) {prod}", t_ac[k]);
+        assert!(t_ac[k] < 0.99 * t_ab[k], "segment b-c must attenuate: {t_ac:?} vs {t_ab:?}");
     }
 }
 
@@ -130,14 +101,8 @@ fn horizontal_ray_sees_about_35_air_masses() {
     let x = R_GROUND / H_R;
     let chapman = (std::f64::consts::PI * x / 2.0).sqrt() * (1.0 + 1.0 / (8.0 * x));
     eprintln!("horizontal / vertical Rayleigh column: {air_masses:.3} (Chapman {chapman:.3})");
-    assert!(
-        (35.0..36.0).contains(&air_masses),
-        "Rayleigh air masses {air_masses}"
-    );
-    assert!(
-        (air_masses - chapman).abs() / chapman < 2e-3,
-        "air masses {air_masses} vs Chapman {chapman}"
-    );
+    assert!((35.0..36.0).contains(&air_masses), "Rayleigh air masses {air_masses}");
+    assert!((air_masses - chapman).abs() / chapman < 2e-3, "air masses {air_masses} vs Chapman {chapman}");
 }
 
 /// Midpoint rule: halving the step divides the error by about 4.
@@ -155,37 +120,22 @@ fn midpoint_rule_is_second_order() {
     let errors: Vec<f64> = [32, 64, 128, 256].map(err).to_vec();
     for w in errors.windows(2) {
         let ratio = w[0] / w[1];
-        eprintln!(
-            "midpoint error {:.3e} -> {:.3e}: ratio {ratio:.3}",
-            w[0], w[1]
-        );
-        assert!(
-            (3.0..=5.0).contains(&ratio),
-            "error ratio {ratio} for doubled samples: {errors:?}"
-        );
+        eprintln!("midpoint error {:.3e} -> {:.3e}: ratio {ratio:.3}", w[0], w[1]);
+        assert!((3.0..=5.0).contains(&ratio), "error ratio {ratio} for doubled samples: {errors:?}");
     }
     // Error shrinks as samples grow (SPEC 3.5), and is visible at 32 x 8.
-    assert!(
-        errors[0] > 1e-3 && errors[3] < errors[0] / 40.0,
-        "{errors:?}"
-    );
+    assert!(errors[0] > 1e-3 && errors[3] < errors[0] / 40.0, "{errors:?}");
 }
 
 #[test]
 fn sky_colours() {
     let s45 = sky(45.0, 1000.0, 256, 64).radiance(DVec3::Y);
-    assert!(
-        s45[2] > s45[1] && s45[1] > s45[0],
-        "zenith at sun 45 deg must have B > G > R: {s45:?}"
-    );
+    assert!(s45[2] > s45[1] && s45[1] > s45[0], "zenith at sun 45 deg must have B > G > R: {s45:?}");
 
     let noon = sky(60.0, 1000.0, 256, 64);
     let (zenith, horizon) = (noon.radiance(DVec3::Y), noon.radiance(dir(90.0, 1.0)));
     let (bz, bh) = (zenith[2] / zenith[0], horizon[2] / horizon[0]);
-    assert!(
-        bz > 1.5 * bh,
-        "noon zenith B/R {bz} must exceed horizon B/R {bh}"
-    );
+    assert!(bz > 1.5 * bh, "noon zenith B/R {bz} must exceed horizon B/R {bh}");
 
     let toward_sun = |sun: f64| sky(sun, 1000.0, 256, 64).radiance(dir(0.0, 1.0));
     let sunset = toward_sun(2.0);
@@ -193,14 +143,8 @@ fn sky_colours() {
         sunset[0] > sunset[1] && sunset[1] > sunset[2],
         "horizon toward a 2 deg sun must have R > G > B: {sunset:?}"
     );
-    let (rs, rn) = (
-        sunset[0] / sunset[2],
-        toward_sun(60.0)[0] / toward_sun(60.0)[2],
-    );
-    assert!(
-        rs > 5.0 * rn,
-        "sunset horizon R/B {rs} must exceed noon's {rn}"
-    );
+    let (rs, rn) = (sunset[0] / sunset[2], toward_sun(60.0)[0] / toward_sun(60.0)[2]);
+    assert!(rs > 5.0 * rn, "sunset horizon R/B {rs} must exceed noon's {rn}");
 }
 
 /// Below the horizon the planet shadows the low atmosphere: a 4 deg drop of
@@ -208,35 +152,16 @@ fn sky_colours() {
 #[test]
 fn earth_shadow_darkens_the_sky() {
     let mean = |sun: f64| {
-        let p = resolve(
-            None,
-            &[
-                ("sun_elevation_deg", &sun.to_string()),
-                ("view_samples", "64"),
-                ("light_samples", "16"),
-            ],
-        )
-        .unwrap();
+        let p =
+            resolve(None, &[("sun_elevation_deg", &sun.to_string()), ("view_samples", "64"), ("light_samples", "16")])
+                .unwrap();
         let img = AtmosphereKernel.reference(&p, 32, 16);
-        img.data
-            .iter()
-            .map(|p| (p[0] + p[1] + p[2]) as f64)
-            .sum::<f64>()
-            / img.data.len() as f64
+        img.data.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / img.data.len() as f64
     };
     let (at_horizon, below) = (mean(0.0), mean(-4.0));
-    eprintln!(
-        "mean radiance: sun 0 deg {at_horizon:.4e}, sun -4 deg {below:.4e}, ratio {:.1}",
-        at_horizon / below
-    );
-    assert!(
-        below > 0.0,
-        "the upper atmosphere still sees the sun at -4 deg"
-    );
-    assert!(
-        at_horizon > 10.0 * below,
-        "sun 0 deg {at_horizon} vs -4 deg {below}: less than 10x"
-    );
+    eprintln!("mean radiance: sun 0 deg {at_horizon:.4e}, sun -4 deg {below:.4e}, ratio {:.1}", at_horizon / below);
+    assert!(below > 0.0, "the upper atmosphere still sees the sun at -4 deg");
+    assert!(at_horizon > 10.0 * below, "sun 0 deg {at_horizon} vs -4 deg {below}: less than 10x");
     // A point whose sun ray grazes into the ground is exactly dark.
     let s = sky(-4.0, 1000.0, 32, 8);
     assert_eq!(s.sun_transmittance(s.camera()), [0.0; 3]);
@@ -270,10 +195,7 @@ fn radiance_is_non_negative_finite_and_bounded() {
                 }
                 if alt > 60_000.0 {
                     // Upward rays from above the top never enter the atmosphere.
-                    assert!(
-                        img.data.iter().all(|p| p[..3] == [0.0; 3]),
-                        "alt {alt}: sky must be black"
-                    );
+                    assert!(img.data.iter().all(|p| p[..3] == [0.0; 3]), "alt {alt}: sky must be black");
                 }
             }
         }
@@ -294,15 +216,9 @@ fn params_are_validated() {
     ] {
         let e = resolve(None, &[(k, v)]).unwrap_err();
         let msg = e.to_string();
-        assert!(
-            matches!(e, ParamError::OutOfRange { .. }) && msg.contains(k) && msg.contains(v),
-            "{k}={v}: {msg}"
-        );
+        assert!(matches!(e, ParamError::OutOfRange { .. }) && msg.contains(k) && msg.contains(v), "{k}={v}: {msg}");
     }
-    assert!(matches!(
-        resolve(None, &[("projection", "cube")]),
-        Err(ParamError::BadValue { .. })
-    ));
+    assert!(matches!(resolve(None, &[("projection", "cube")]), Err(ParamError::BadValue { .. })));
     for preset in ["noon", "afternoon", "sunset", "twilight", "high_altitude"] {
         resolve(Some(preset), &[]).unwrap();
     }
@@ -327,10 +243,7 @@ fn latlong_layout_and_symmetry() {
         for x in 0..24 {
             let (a, b) = (img.get(x, y), img.get(23 - x, y));
             for k in 0..3 {
-                assert!(
-                    (a[k] - b[k]).abs() <= 1e-6 * a[k].abs().max(1e-6),
-                    "({x},{y}) {a:?} vs mirror {b:?}"
-                );
+                assert!((a[k] - b[k]).abs() <= 1e-6 * a[k].abs().max(1e-6), "({x},{y}) {a:?} vs mirror {b:?}");
             }
         }
     }

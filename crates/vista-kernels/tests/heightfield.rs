@@ -104,7 +104,9 @@ fn relax_below_slope_bound_never_tunnels() {
     for down in [0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 12.0] {
         for az in (0..24).map(|i| i as f64 * 15.0 + 3.0) {
             let d = dir(down, az);
-            let Some(first) = brute_force_hit(&sine, o, d, 8.0, 0.0, 200_000) else { continue };
+            let Some(first) = brute_force_hit(&sine, o, d, 8.0, 0.0, 200_000) else {
+                continue;
+            };
             rays += 1;
             let late = |m: March| !m.hit || m.t > first * (1.0 + 1e-6) + 1e-9;
             let m = relax_march(&sine, o, d, &settings(safe, 1e-4, 8.0, 200_000));

@@ -19,7 +19,6 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use vista_golden::GoldenError;
-use vista_gpu::Context;
 use vista_image::metrics::{self, Metrics};
 use vista_kernels::{Kernel, Kind, ParamSet};
 
@@ -178,7 +177,11 @@ impl SweepSpec {
 }
 
 /// Runs the sweep. `progress(done, total, label)` is called before each render group.
-pub fn run(ctx: &Context, spec: &SweepSpec, mut progress: impl FnMut(usize, usize, &str)) -> Result<Sweep, GoldenError> {
+pub fn run(
+    ctx: &vista_golden::Renderer,
+    spec: &SweepSpec,
+    mut progress: impl FnMut(usize, usize, &str),
+) -> Result<Sweep, GoldenError> {
     let (reference_params, points) = spec.resolve()?;
     let (k, w, h) = (spec.kernel, spec.width, spec.height);
     let total = points.len() + 1;

@@ -133,7 +133,8 @@ fn curve<DB: DrawingBackend>(sweep: &Sweep, root: &DrawingArea<DB, Shift>) -> Re
     let psnr: Vec<f64> = sweep.points.iter().map(psnr_of).collect();
     let ms: Vec<f64> = sweep.points.iter().map(|p| p.gpu_ms).collect();
     let target = sweep.spec.target_psnr;
-    let x_range = padded(xs.iter().cloned().fold(f64::INFINITY, f64::min), xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max));
+    let x_range =
+        padded(xs.iter().cloned().fold(f64::INFINITY, f64::min), xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max));
     let y_lo = psnr.iter().cloned().fold(target, f64::min).min(target) - 3.0;
     let y_hi = psnr.iter().cloned().fold(target, f64::max) + 3.0;
     let t_hi = ms.iter().cloned().fold(0.0, f64::max) * 1.1 + 1e-3;
@@ -170,7 +171,10 @@ fn curve<DB: DrawingBackend>(sweep: &Sweep, root: &DrawingArea<DB, Shift>) -> Re
     let blue = RGBColor(31, 119, 180);
     let orange = RGBColor(230, 120, 20);
     chart
-        .draw_series(LineSeries::new(vec![(x_range.start, target), (x_range.end, target)], BLACK.mix(0.45).stroke_width(1)))
+        .draw_series(LineSeries::new(
+            vec![(x_range.start, target), (x_range.end, target)],
+            BLACK.mix(0.45).stroke_width(1),
+        ))
         .map_err(err)?
         .label(format!("target {target:.0} dB"))
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.45)));
@@ -232,7 +236,10 @@ fn heat_map<DB: DrawingBackend>(sweep: &Sweep, root: &DrawingArea<DB, Shift>) ->
     let best = sweep.cheapest().map(|b| (b.x.clone(), b.y.clone()));
 
     let mut chart = ChartBuilder::on(root)
-        .caption(format!("{} (cells: PSNR dB / GPU ms; bold: >= {:.0} dB)", title(sweep), s.target_psnr), ("sans-serif", 18))
+        .caption(
+            format!("{} (cells: PSNR dB / GPU ms; bold: >= {:.0} dB)", title(sweep), s.target_psnr),
+            ("sans-serif", 18),
+        )
         .margin(14)
         .x_label_area_size(44)
         .y_label_area_size(64)
@@ -261,7 +268,10 @@ fn heat_map<DB: DrawingBackend>(sweep: &Sweep, root: &DrawingArea<DB, Shift>) ->
         let (i, j) = (k as i32 % nx, k as i32 / nx);
         let t = (psnr[k] - lo) / (hi - lo);
         let fill = ramp(t);
-        let cell = [(SegmentValue::Exact(i), SegmentValue::Exact(j)), (SegmentValue::Exact(i + 1), SegmentValue::Exact(j + 1))];
+        let cell = [
+            (SegmentValue::Exact(i), SegmentValue::Exact(j)),
+            (SegmentValue::Exact(i + 1), SegmentValue::Exact(j + 1)),
+        ];
         chart.draw_series(std::iter::once(Rectangle::new(cell.clone(), fill.filled()))).map_err(err)?;
         let reached = p.metrics.psnr >= s.target_psnr;
         let is_best = best.as_ref().is_some_and(|(bx, by)| *bx == p.x && *by == p.y);

@@ -27,7 +27,14 @@ fn sweep(y: Option<Axis>, points: Vec<Point>) -> Sweep {
 
 #[test]
 fn cheapest_is_the_least_work_point_reaching_the_target() {
-    let s = sweep(None, vec![point("16", None, 35.0, 1.0, 16.0), point("32", None, 41.0, 2.0, 32.0), point("64", None, 50.0, 4.0, 64.0)]);
+    let s = sweep(
+        None,
+        vec![
+            point("16", None, 35.0, 1.0, 16.0),
+            point("32", None, 41.0, 2.0, 32.0),
+            point("64", None, 50.0, 4.0, 64.0),
+        ],
+    );
     assert_eq!(s.cheapest().unwrap().x, "32");
     assert!(s.table().contains("cheapest reaching 40.0 dB: steps=32 (41.00 dB, 2.00 ms)"), "{}", s.table());
 }
@@ -48,7 +55,10 @@ fn no_point_reaching_the_target_is_said_plainly() {
 #[test]
 fn csv_has_one_row_per_point_and_writes_inf() {
     let y = Axis { name: "light_steps".into(), values: vec!["2".into()] };
-    let s = sweep(Some(y), vec![point("16", Some("2"), 30.5, 1.25, 48.0), point("512", Some("2"), f64::INFINITY, 9.0, 1536.0)]);
+    let s = sweep(
+        Some(y),
+        vec![point("16", Some("2"), 30.5, 1.25, 48.0), point("512", Some("2"), f64::INFINITY, 9.0, 1536.0)],
+    );
     let csv = s.csv();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "steps,light_steps,psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel");
