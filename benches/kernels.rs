@@ -45,7 +45,7 @@ fn kernels(c: &mut Criterion) {
     let (w, h) = SIZE;
     let threads = rayon::current_num_threads();
     for k in vista_kernels::registry() {
-        let k: &dyn Kernel = *k;
+        let k: &Kernel = k;
         let p = k.resolve(None, &[]).expect("defaults are valid");
         let mut g = c.benchmark_group(k.name());
         g.sample_size(10).warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(3));

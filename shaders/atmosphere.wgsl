@@ -11,16 +11,15 @@
 #import vista::geometry::{ray_sphere_bc, latlong_direction}
 #import vista::phase::{rayleigh_phase, hg_phase}
 
+// Packed by name from kernels/atmosphere.toml (exposure is the host's tone map).
 struct Params {
     width: u32,
     height: u32,
     projection: u32,
     view_samples: u32,
     light_samples: u32,
-    camera_radius: f32,
-    camera_k: f32,
-    sun_y: f32,
-    sun_z: f32,
+    sun_elevation_deg: f32,
+    camera_altitude_m: f32,
     sun_intensity: f32,
     mie_g: f32,
 }
@@ -37,6 +36,23 @@ const BETA_M: f32 = 3.996e-6;
 const BETA_M_EXT: f32 = 4.43556e-6; // 1.11 * BETA_M
 const H_M: f32 = 1200.0;
 const PI: f32 = 3.141592653589793;
+
+// The camera sits at (0, R_ground + altitude, 0); the sun at azimuth 0.
+fn camera_radius() -> f32 {
+    return R_GROUND + params.camera_altitude_m;
+}
+
+// k_c = |c|^2 - R_ground^2 = alt (2 R_ground + alt): a product, so f32 forms
+// it to within one rounding (the difference of squares would cancel).
+fn camera_k() -> f32 {
+    let alt = params.camera_altitude_m;
+    return alt * (2.0 * R_GROUND + alt);
+}
+
+fn sun_direction() -> vec3<f32> {
+    let e = radians(params.sun_elevation_deg);
+    return vec3(0.0, sin(e), cos(e));
+}
 
 // Altitude of the point with |p|^2 - R_ground^2 = k.
 fn altitude(k: f32) -> f32 {
@@ -71,8 +87,8 @@ fn sun_transmittance(k: f32, bs: f32) -> vec3<f32> {
 }
 
 fn radiance(v: vec3<f32>) -> vec3<f32> {
-    let rc = params.camera_radius;
-    let kc = params.camera_k;
+    let rc = camera_radius();
+    let kc = camera_k();
     let b = rc * v.y; // c . v
     let top = ray_sphere_bc(b, kc - TOP_K);
     if top.y <= 0.0 {
@@ -85,10 +101,10 @@ fn radiance(v: vec3<f32>) -> vec3<f32> {
     if ground.x >= 0.0 && ground.y > 0.0 {
         t1 = min(t1, ground.x);
     }
-    let s = vec3(0.0, params.sun_y, params.sun_z);
+    let s = sun_direction();
     let mu = dot(v, s);
     let phase = vec2(rayleigh_phase(mu), hg_phase(mu, params.mie_g));
-    let bs0 = rc * params.sun_y; // c . s
+    let bs0 = rc * s.y; // c . s
     let dt = (t1 - t0) / f32(params.view_samples);
     var before = vec2(0.0); // density integrals over the finished steps
     var sum = vec3(0.0);

@@ -1,12 +1,16 @@
 // clouds kernel (SPEC 3.6): a cloud slab between cloud_base and cloud_top
 // (km, y up), ray marched with a light march toward the sun at each sample.
 // rgb = L_cloud + T * background (linear radiance), alpha = 1 - T.
-// The f64 reference with the same formulas is crates/vista-kernels/src/clouds.rs.
-#import vista::noise::basis_noise
+// The f64 reference, written from the same formulas, is crates/vista-kernels/src/cpu/clouds.rs.
+#import vista::noise::{basis_noise, PERLIN_MAX_ABS}
 #import vista::hash::{pcg3d, unit_from_hash}
 #import vista::phase::dual_hg_phase
-#import vista::geometry::pinhole_ray
+#import vista::fractal::fbm_amplitude
+#import vista::geometry::{direction, pinhole_looking, pinhole_ray}
 
+// Packed by name from kernels/clouds.toml (exposure is the host's tone map).
+// Everything derived from them (camera basis, sun direction and colour, noise
+// frequency, fBm normaliser, light-step layout) is computed in this file.
 struct Params {
     width: u32,
     height: u32,
@@ -20,56 +24,34 @@ struct Params {
     seed: u32,
     lacunarity: f32,
     gain: f32,
-    inv_amplitude: f32,
-    cloud_base: f32,
-    cloud_top: f32,
+    cloud_base_km: f32,
+    cloud_top_km: f32,
     coverage: f32,
     density_scale: f32,
     absorption: f32,
     profile_bottom: f32,
     profile_top: f32,
-    freq_x: f32,
-    freq_y: f32,
-    freq_z: f32,
-    wind_x: f32,
-    wind_y: f32,
-    wind_z: f32,
-    cam_x: f32,
-    cam_y: f32,
-    cam_z: f32,
-    fwd_x: f32,
-    fwd_y: f32,
-    fwd_z: f32,
-    right_x: f32,
-    right_y: f32,
-    right_z: f32,
-    up_x: f32,
-    up_y: f32,
-    up_z: f32,
-    tan_half_fov: f32,
-    max_distance: f32,
-    light_first: f32,
-    light_growth: f32,
-    sun_dir_x: f32,
-    sun_dir_y: f32,
-    sun_dir_z: f32,
-    sun_r: f32,
-    sun_g: f32,
-    sun_b: f32,
+    noise_scale: f32,
+    noise_stretch: vec3<f32>,
+    yaw_deg: f32,
+    wind_offset: vec3<f32>,
+    pitch_deg: f32,
+    camera_pos: vec3<f32>,
+    fov_deg: f32,
+    sun_color: vec3<f32>,
+    max_distance_km: f32,
+    ambient: vec3<f32>,
+    sun_azimuth_deg: f32,
+    sky_zenith: vec3<f32>,
+    sun_elevation_deg: f32,
+    sky_horizon: vec3<f32>,
+    sun_intensity: f32,
     g1: f32,
     g2: f32,
     phase_blend: f32,
     powder: f32,
-    ambient_r: f32,
-    ambient_g: f32,
-    ambient_b: f32,
     ambient_bottom: f32,
-    zenith_r: f32,
-    zenith_g: f32,
-    zenith_b: f32,
-    horizon_r: f32,
-    horizon_g: f32,
-    horizon_b: f32,
+    light_spread: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -84,8 +66,33 @@ const PROFILE_ANVIL: u32 = 2u;
 const T_CUTOFF: f32 = 1e-4;
 const TAU_SUN_CUTOFF: f32 = 16.0;
 
+// Derived once per invocation in main (the same for every pixel).
+var<private> amplitude_sum: f32; // A = sum gain^i
+var<private> inv_amplitude: f32; // 1 / A
+var<private> frequency: vec3<f32>; // noise_scale * noise_stretch
+var<private> light_first: f32; // first light step, fraction of the path
+var<private> light_growth: f32; // ratio of consecutive light steps
+
+// e^x - 1 without the cancellation of exp(x) - 1 near 0.
+fn expm1(x: f32) -> f32 {
+    if abs(x) < 1e-3 {
+        return x * (1.0 + x * (0.5 + x / 6.0));
+    }
+    return exp(x) - 1.0;
+}
+
+// n light steps whose last is `spread` times the first: ratio r =
+// spread^(1 / (n - 1)), first = (r - 1) / (r^n - 1) of the path (1 / n when uniform).
+fn light_step_layout(n: u32, spread: f32) -> vec2<f32> {
+    if n <= 1u || spread == 1.0 {
+        return vec2(1.0 / f32(n), 1.0);
+    }
+    let log_r = log(spread) / f32(n - 1u);
+    return vec2(expm1(log_r) / expm1(f32(n) * log_r), exp(log_r));
+}
+
 fn height01(y: f32) -> f32 {
-    return (y - params.cloud_base) / (params.cloud_top - params.cloud_base);
+    return (y - params.cloud_base_km) / (params.cloud_top_km - params.cloud_base_km);
 }
 
 // Plateau smoothstep(0, bottom, h) * smoothstep(0, top, 1 - h) times the genus shape.
@@ -100,8 +107,6 @@ fn height_profile(h: f32) -> f32 {
     return plateau;
 }
 
-// Upper bound of |N| for 3D perlin (PERLIN_MAX_ABS in the CPU reference).
-const PERLIN_MAX_ABS: f32 = 1.0364;
 // Slack for f32 rounding in the skip test below (G is in [0, 1]).
 const SKIP_MARGIN: f32 = 1e-4;
 
@@ -121,23 +126,23 @@ fn density(p: vec3<f32>) -> f32 {
     if profile <= 0.0 {
         return 0.0;
     }
-    var q = p * vec3(params.freq_x, params.freq_y, params.freq_z) + vec3(params.wind_x, params.wind_y, params.wind_z);
+    var q = p * frequency + params.wind_offset;
     let threshold = 1.0 - params.coverage;
     var amplitude = 1.0;
     // Sum of the amplitudes of the octaves not yet added (A at the start).
-    var left = 1.0 / params.inv_amplitude;
+    var left = amplitude_sum;
     var sum = 0.0;
     for (var i = 0u; i < params.octaves; i++) {
         sum += amplitude * basis_noise(0u, params.seed, q);
         left = max(0.0, left - amplitude);
-        let g_max = 0.5 + 0.5 * (sum + PERLIN_MAX_ABS * left) * params.inv_amplitude;
+        let g_max = 0.5 + 0.5 * (sum + PERLIN_MAX_ABS * left) * inv_amplitude;
         if g_max < threshold - SKIP_MARGIN {
             return 0.0;
         }
         amplitude *= params.gain;
         q *= params.lacunarity;
     }
-    let g = 0.5 + 0.5 * sum * params.inv_amplitude;
+    let g = 0.5 + 0.5 * sum * inv_amplitude;
     // remap(g, 1 - c, 1, 0, 1); coverage > 0 here, so the interval is never empty.
     let shape = max(0.0, (g - threshold) / params.coverage);
     return params.density_scale * profile * shape;
@@ -146,9 +151,9 @@ fn density(p: vec3<f32>) -> f32 {
 // Optical depth toward the sun up to the slab top: midpoint rule on steps
 // growing geometrically (first = light_first of the path, ratio light_growth).
 fn sun_optical_depth(p: vec3<f32>, s: vec3<f32>) -> f32 {
-    let len = clamp((params.cloud_top - p.y) / s.y, 0.0, params.max_distance);
+    let len = clamp((params.cloud_top_km - p.y) / s.y, 0.0, params.max_distance_km);
     let ext = 1.0 + params.absorption;
-    var dt = len * params.light_first;
+    var dt = len * light_first;
     var t = 0.0;
     var tau = 0.0;
     for (var j = 0u; j < params.light_steps; j++) {
@@ -157,7 +162,7 @@ fn sun_optical_depth(p: vec3<f32>, s: vec3<f32>) -> f32 {
             break;
         }
         t += dt;
-        dt *= params.light_growth;
+        dt *= light_growth;
     }
     return tau;
 }
@@ -190,36 +195,43 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= params.width || id.y >= params.height {
         return;
     }
+    amplitude_sum = fbm_amplitude(params.octaves, params.gain);
+    inv_amplitude = 1.0 / amplitude_sum;
+    frequency = params.noise_scale * params.noise_stretch;
+    let light = light_step_layout(params.light_steps, params.light_spread);
+    light_first = light.x;
+    light_growth = light.y;
     let size = vec2<f32>(f32(params.width), f32(params.height));
     let uv = (vec2<f32>(id.xy) + 0.5) / size;
-    let d = pinhole_ray(uv, params.tan_half_fov, size.x / size.y, vec3(params.fwd_x, params.fwd_y, params.fwd_z),
-                        vec3(params.right_x, params.right_y, params.right_z), vec3(params.up_x, params.up_y, params.up_z));
-    let o = vec3(params.cam_x, params.cam_y, params.cam_z);
+    // pitch is within +-89 deg (manifest range), so forward is never vertical.
+    let forward = direction(radians(params.yaw_deg), radians(params.pitch_deg));
+    let d = pinhole_ray(pinhole_looking(params.camera_pos, forward, params.fov_deg, size.x / size.y), uv);
+    let o = params.camera_pos;
 
-    let zenith = vec3(params.zenith_r, params.zenith_g, params.zenith_b);
-    let horizon = vec3(params.horizon_r, params.horizon_g, params.horizon_b);
+    let zenith = params.sky_zenith;
+    let horizon = params.sky_horizon;
     let background = horizon + (zenith - horizon) * clamp(d.y, 0.0, 1.0);
 
     // Segment of the ray inside the slab and within max_distance.
     var t0 = 0.0;
     var t1 = 0.0;
     if abs(d.y) < 1e-6 {
-        if o.y >= params.cloud_base && o.y <= params.cloud_top {
-            t1 = params.max_distance;
+        if o.y >= params.cloud_base_km && o.y <= params.cloud_top_km {
+            t1 = params.max_distance_km;
         }
     } else {
-        let ta = (params.cloud_base - o.y) / d.y;
-        let tb = (params.cloud_top - o.y) / d.y;
+        let ta = (params.cloud_base_km - o.y) / d.y;
+        let tb = (params.cloud_top_km - o.y) / d.y;
         t0 = max(min(ta, tb), 0.0);
-        t1 = min(max(ta, tb), params.max_distance);
+        t1 = min(max(ta, tb), params.max_distance_km);
     }
 
     var radiance = vec3(0.0);
     var transmittance = 1.0;
     if t1 > t0 {
-        let s = vec3(params.sun_dir_x, params.sun_dir_y, params.sun_dir_z);
-        let sun = vec3(params.sun_r, params.sun_g, params.sun_b);
-        let ambient = vec3(params.ambient_r, params.ambient_g, params.ambient_b);
+        let s = direction(radians(params.sun_azimuth_deg), radians(params.sun_elevation_deg));
+        let sun = params.sun_color * params.sun_intensity;
+        let ambient = params.ambient;
         let phase = dual_hg_phase(dot(d, s), params.g1, params.g2, params.phase_blend);
         let ext = 1.0 + params.absorption;
         let dt = (t1 - t0) / f32(params.steps);

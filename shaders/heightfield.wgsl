@@ -2,8 +2,11 @@
 // h(x, z) = amplitude * T(x * scale, z * scale); march t += relax * (p.y - h),
 // hit at p.y - h < eps * t, refined by interpolation; Lambert sun, soft
 // shadow, sky ambient, fog with extinction sigma = 3.912 / visibility.
-#import vista::fractal::{FbmSettings, RidgedSettings, fbm2, ridged2}
-#import vista::geometry::pinhole_ray
+// Params are packed by name from kernels/heightfield.toml; the camera basis,
+// sun direction, octave rotation, terrain normaliser and fog extinction are
+// derived here, never on the host.
+#import vista::fractal::{FbmSettings, RidgedSettings, fbm2, fbm_amplitude, ridged2, ridged_max}
+#import vista::geometry::{direction, pinhole_look_at, pinhole_ray}
 
 struct Params {
     width: u32,
@@ -17,40 +20,25 @@ struct Params {
     shadow_steps: u32,
     lacunarity: f32,
     gain: f32,
-    rot_cos: f32,
-    rot_sin: f32,
+    octave_rotation_deg: f32,
     ridge_h: f32,
     ridge_offset: f32,
     ridge_gain: f32,
-    inv_norm: f32,
     amplitude: f32,
     scale: f32,
-    slope_x: f32,
-    slope_z: f32,
-    cam_x: f32,
-    cam_y: f32,
-    cam_z: f32,
-    fwd_x: f32,
-    fwd_y: f32,
-    fwd_z: f32,
-    right_x: f32,
-    right_y: f32,
-    right_z: f32,
-    up_x: f32,
-    up_y: f32,
-    up_z: f32,
-    tan_half_fov: f32,
-    aspect: f32,
+    plane_slope: vec2<f32>,
+    camera_pos: vec3<f32>,
+    camera_target: vec3<f32>,
+    fov_deg: f32,
     t_max: f32,
     relax: f32,
     eps: f32,
     shadow_distance: f32,
     shadow_softness: f32,
-    sun_x: f32,
-    sun_y: f32,
-    sun_z: f32,
-    sigma: f32,
+    sun_azimuth_deg: f32,
+    sun_elevation_deg: f32,
     snow_line: f32,
+    visibility_km: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -74,21 +62,33 @@ const ROCK = vec3(0.36, 0.31, 0.27);
 const GRASS = vec3(0.16, 0.26, 0.08);
 const SNOW = vec3(0.85, 0.87, 0.90);
 const SNOW_FADE: f32 = 0.2;
+// Koschmieder: contrast falls to 2% at the visibility distance, ln 50 = 3.912.
+const KOSCHMIEDER: f32 = 3.912;
+
+fn fbm_settings() -> FbmSettings {
+    let theta = radians(params.octave_rotation_deg);
+    return FbmSettings(params.basis, params.seed, params.octaves, params.lacunarity, params.gain,
+                       cos(theta), sin(theta));
+}
+
+fn ridged_settings() -> RidgedSettings {
+    return RidgedSettings(params.basis, params.seed, params.octaves, params.lacunarity, params.ridge_h,
+                          params.ridge_offset, params.ridge_gain);
+}
+
+// T's normaliser, once per invocation: 1 / A (fbm) or 1 / max (ridged).
+var<private> inv_norm: f32 = 1.0;
 
 fn terrain_height(xz: vec2<f32>) -> f32 {
     let q = xz * params.scale;
     if params.terrain == TERRAIN_FBM {
-        let s = FbmSettings(params.basis, params.seed, params.octaves, params.lacunarity, params.gain,
-                            params.rot_cos, params.rot_sin);
-        return params.amplitude * fbm2(s, q, 0.0) * params.inv_norm;
+        return params.amplitude * fbm2(fbm_settings(), q, 0.0) * inv_norm;
     }
     if params.terrain == TERRAIN_RIDGED {
-        let s = RidgedSettings(params.basis, params.seed, params.octaves, params.lacunarity, params.ridge_h,
-                               params.ridge_offset, params.ridge_gain);
-        return params.amplitude * ridged2(s, q, 0.0) * params.inv_norm;
+        return params.amplitude * ridged2(ridged_settings(), q, 0.0) * inv_norm;
     }
     if params.terrain == TERRAIN_PLANE {
-        return params.amplitude + params.slope_x * xz.x + params.slope_z * xz.y;
+        return params.amplitude + dot(params.plane_slope, xz);
     }
     return params.amplitude * sin(q.x) * cos(q.y);
 }
@@ -205,14 +205,14 @@ fn shade(o: vec3<f32>, d: vec3<f32>, t: f32) -> vec3<f32> {
     let flat_ground = smoothstep(0.75, 0.92, n.y);
     let snow = smoothstep(params.snow_line, params.snow_line + SNOW_FADE, h) * smoothstep(0.55, 0.75, n.y);
     let albedo = mix(mix(ROCK, GRASS, flat_ground), SNOW, snow);
-    let sun = vec3(params.sun_x, params.sun_y, params.sun_z);
+    let sun = direction(radians(params.sun_azimuth_deg), radians(params.sun_elevation_deg));
     let lambert = max(dot(n, sun), 0.0);
     var shadow = 0.0;
     if lambert > 0.0 {
         shadow = soft_shadow(p, sun);
     }
     let light = SUN_COLOR * (lambert * shadow) + AMBIENT * (0.5 + 0.5 * n.y);
-    let fog = exp(-params.sigma * t);
+    let fog = exp(-(KOSCHMIEDER / params.visibility_km) * t);
     return albedo * light * fog + SKY_HORIZON * (1.0 - fog);
 }
 
@@ -225,10 +225,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= params.width || id.y >= params.height {
         return;
     }
-    let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(f32(params.width), f32(params.height));
-    let o = vec3(params.cam_x, params.cam_y, params.cam_z);
-    let d = pinhole_ray(uv, params.tan_half_fov, params.aspect, vec3(params.fwd_x, params.fwd_y, params.fwd_z),
-                        vec3(params.right_x, params.right_y, params.right_z), vec3(params.up_x, params.up_y, params.up_z));
+    let size = vec2<f32>(f32(params.width), f32(params.height));
+    let uv = (vec2<f32>(id.xy) + 0.5) / size;
+    if params.terrain == TERRAIN_FBM {
+        inv_norm = 1.0 / fbm_amplitude(params.octaves, params.gain);
+    } else if params.terrain == TERRAIN_RIDGED {
+        inv_norm = 1.0 / ridged_max(ridged_settings());
+    }
+    let camera = pinhole_look_at(params.camera_pos, params.camera_target, params.fov_deg, size.x / size.y);
+    let o = camera.pos;
+    let d = pinhole_ray(camera, uv);
     let m = march(o, d);
     var rgb: vec3<f32>;
     if params.view == VIEW_STEPS {

@@ -1,5 +1,6 @@
 // ridged kernel (SPEC 3.3): Musgrave's ridged multifractal / its analytic maximum.
-#import vista::fractal::{RidgedSettings, ridged2}
+// Params are packed by name from kernels/ridged.toml; the normaliser is computed here.
+#import vista::fractal::{RidgedSettings, ridged2, ridged_max}
 
 struct Params {
     width: u32,
@@ -13,7 +14,6 @@ struct Params {
     gain: f32,
     frequency: f32,
     z_slice: f32,
-    inv_max: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -27,6 +27,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(f32(params.width), f32(params.height));
     let settings = RidgedSettings(params.basis, params.seed, params.octaves, params.lacunarity,
                                   params.h, params.offset, params.gain);
-    let value = ridged2(settings, params.frequency * uv, params.z_slice) * params.inv_max;
+    let value = ridged2(settings, params.frequency * uv, params.z_slice) / ridged_max(settings);
     textureStore(output, id.xy, vec4(value, value, value, 1.0));
 }

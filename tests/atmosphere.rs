@@ -7,8 +7,8 @@ mod common;
 
 use vista_image::Image;
 use vista_image::metrics::{compare_hdr, hdr_peak, psnr_with_peak};
+use vista_kernels::ParamSet;
 use vista_kernels::atmosphere::AtmosphereKernel;
-use vista_kernels::{Kernel, ParamSet};
 
 const K: AtmosphereKernel = AtmosphereKernel;
 

@@ -8,8 +8,8 @@ use std::time::Instant;
 use vista_golden::render;
 use vista_image::Image;
 use vista_image::metrics::{compare_hdr, hdr_peak, psnr_with_peak};
+use vista_kernels::ParamSet;
 use vista_kernels::clouds::CloudsKernel;
-use vista_kernels::{Kernel, ParamSet};
 
 fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
     let set: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();

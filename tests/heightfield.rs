@@ -8,7 +8,7 @@ mod common;
 
 use vista_image::Image;
 use vista_kernels::heightfield::{Camera, HeightfieldKernel, HitSearch, Terrain, brute_force_hit, camera_of};
-use vista_kernels::{Kernel, ParamSet, pixel_uv};
+use vista_kernels::{ParamSet, pixel_uv};
 
 const W: u32 = 64;
 const H: u32 = 40;
@@ -271,10 +271,14 @@ fn color_and_steps_match_reference() {
     assert!(close * 100 >= diffs.len() * 97);
 }
 
-/// The bench's like-for-like CPU baseline (the shader's relax march, in f32)
-/// must do the GPU's work: its colours must match the GPU's far more
-/// closely than the brute-force oracle's do (which find slightly different
-/// hits), or the throughput ratio would compare different algorithms.
+/// The f32 CPU port of the shader's march (`HitSearch::RelaxMarch`, the
+/// bench baseline) must do the GPU's work: its colours must match the GPU's
+/// far more closely than the brute-force oracle's do (which find slightly
+/// different hits), or the throughput ratio would compare different
+/// algorithms. Both derive the camera basis in f32 with their own rounding,
+/// so a ray that grazes a crest can land on its near or far side (measured:
+/// one pixel of 1440 on valley, 13 m apart in depth); at most one pixel per
+/// 1000 may differ by more than 1/255, and the rest must agree at >= 60 dB.
 #[test]
 fn cpu_f32_relax_march_matches_the_gpu() {
     let Some(ctx) = common::gpu_for_test("heightfield cpu_f32_relax_march_matches_the_gpu") else {
@@ -286,8 +290,23 @@ fn cpu_f32_relax_march_matches_the_gpu() {
         let g = vista_golden::render(ctx, &HeightfieldKernel, &p, w, h).expect("render").raw;
         let march = vista_kernels::cpu32::heightfield::render(&p, w, h, HitSearch::RelaxMarch).expect("valid");
         let oracle = HeightfieldKernel.reference(&p, w, h);
-        let (to_march, to_oracle) = (vista_image::metrics::psnr(&march, &g), vista_image::metrics::psnr(&oracle, &g));
-        eprintln!("heightfield {preset}: GPU vs f32 CPU relax march {to_march:.1} dB, vs f64 oracle {to_oracle:.1} dB");
+        let differs = |a: &[f32; 4], b: &[f32; 4]| (0..3).any(|c| (a[c] - b[c]).abs() > 1.0 / 255.0);
+        let flipped: Vec<usize> = (0..g.data.len()).filter(|&i| differs(&g.data[i], &march.data[i])).collect();
+        let keep = |img: &vista_image::Image| {
+            let mut out = img.clone();
+            for &i in &flipped {
+                out.data[i] = g.data[i];
+            }
+            out
+        };
+        let to_march = vista_image::metrics::psnr(&keep(&march), &g);
+        let to_oracle = vista_image::metrics::psnr(&oracle, &g);
+        eprintln!(
+            "heightfield {preset}: GPU vs f32 CPU relax march {to_march:.1} dB on all but {} crest pixels, \
+             vs f64 oracle {to_oracle:.1} dB",
+            flipped.len()
+        );
+        assert!(flipped.len() <= (g.data.len() / 1000).max(1), "{preset}: {} pixels differ by > 1/255", flipped.len());
         // 60 dB: an RMS difference of 1/1000 of the range, far below one
         // 8-bit step; the oracle sits at 34-47 dB on these presets.
         assert!(to_march >= 60.0, "{preset}: GPU vs f32 CPU relax march only {to_march:.1} dB");

@@ -5,7 +5,7 @@ mod common;
 use vista_image::Image;
 use vista_kernels::{Kernel, ParamSet, noise};
 
-fn params(kernel: &dyn Kernel, preset: Option<&str>, set: &[(&str, &str)]) -> ParamSet {
+fn params(kernel: &Kernel, preset: Option<&str>, set: &[(&str, &str)]) -> ParamSet {
     let set: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
     kernel.resolve(preset, &set).expect("valid test params")
 }
@@ -100,7 +100,7 @@ fn ridged_gpu_matches_f64_reference() {
 
 /// Pixel centres land on integer lattice points when frequency = W and
 /// offset = -0.5: p = W (x + 0.5) / W - 0.5 = x.
-fn lattice_params(k: &dyn Kernel, basis: &str, seed: &str, w: u32) -> ParamSet {
+fn lattice_params(k: &Kernel, basis: &str, seed: &str, w: u32) -> ParamSet {
     let f = w.to_string();
     params(k, None, &[("basis", basis), ("seed", seed), ("octaves", "1"), ("frequency", &f), ("offset", "-0.5,-0.5")])
 }

@@ -8,50 +8,25 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 use vista_golden::{Case, CheckOptions, Store};
 use vista_image::Image;
-use vista_kernels::{Kernel, Kind, ParamSet, ParamSpec, Preset, Uniforms};
+use vista_kernels::{Kernel, Kind, ParamSpec};
 
-/// Test-only kernel backed by `shaders/test/nan.wgsl`.
-struct NanKernel;
-
-impl Kernel for NanKernel {
-    fn name(&self) -> &'static str {
-        "test-nan"
-    }
-    fn summary(&self) -> &'static str {
-        "writes NaN at (5, 3) and +Inf at (7, 3)"
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &[]
-    }
-    fn presets(&self) -> &'static [Preset] {
-        &[]
-    }
-    fn shader(&self) -> &'static str {
-        "test/nan.wgsl"
-    }
-    fn uniforms(&self, _p: &ParamSet, width: u32, height: u32) -> Uniforms {
-        Uniforms::new(width, height)
-    }
-    fn work_per_pixel(&self, _p: &ParamSet) -> f64 {
-        1.0
-    }
-    fn reference(&self, _p: &ParamSet, width: u32, height: u32) -> Image {
-        Image::from_fn(width, height, |_, _| [0.5, 0.5, 0.5, 1.0])
-    }
-    fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image {
-        self.reference(p, width, height)
-    }
+/// Test-only kernel backed by `shaders/test/nan.wgsl`, described as data
+/// like any project's kernel (no params, no CPU reference).
+fn nan_kernel() -> &'static Kernel {
+    static NAN: std::sync::OnceLock<Kernel> = std::sync::OnceLock::new();
+    NAN.get_or_init(|| {
+        let manifest = "summary = \"writes NaN at (5, 3) and +Inf at (7, 3)\"\nshader = \"test/nan.wgsl\"\n";
+        Kernel::from_manifest("test-nan", "tests/reliability.rs", manifest).expect("valid manifest")
+    })
 }
-
-static NAN: NanKernel = NanKernel;
 
 fn nan_case() -> Case {
     Case {
         id: "nan-injected".into(),
-        kernel: &NAN,
+        kernel: nan_kernel(),
         preset: None,
         overrides: vec![],
-        params: ParamSet::resolve("test-nan", &[], &[], None, &[]).unwrap(),
+        params: nan_kernel().resolve(None, &[]).unwrap(),
         width: 16,
         height: 8,
         psnr_same_driver: 60.0,
@@ -67,7 +42,7 @@ fn injected_nan_fails_the_case_naming_count_and_first_pixel() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let store = Store { dir: dir.path().to_path_buf() };
+    let store = Store { dir: dir.path().to_path_buf(), kernels: vista_kernels::Registry::builtin().clone() };
     // A golden that would otherwise match: NaN must fail on its own.
     let golden = store.golden_path(&nan_case());
     std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
@@ -85,7 +60,7 @@ fn render_path_reports_nan_from_the_gpu_bit_exactly() {
     let Some(ctx) = common::gpu_for_test("NaN readback") else {
         return;
     };
-    let r = vista_golden::render(ctx, &NAN, &nan_case().params, 16, 8).unwrap();
+    let r = vista_golden::render(ctx, nan_kernel(), &nan_case().params, 16, 8).unwrap();
     assert!(r.raw.get(5, 3)[0].is_nan());
     assert_eq!(r.raw.get(7, 3)[0], f32::INFINITY);
     assert_eq!(r.raw.first_nonfinite(), Some((5, 3)));
@@ -118,6 +93,7 @@ fn value_strategy(spec: &ParamSpec) -> BoxedStrategy<String> {
             .prop_map(|v| v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","))
             .boxed(),
         Kind::Enum(names) => proptest::sample::select(names.to_vec()).prop_map(str::to_string).boxed(),
+        Kind::Bool => proptest::bool::ANY.prop_map(|b| b.to_string()).boxed(),
     }
 }
 
@@ -153,11 +129,11 @@ fn random_in_range_params_give_finite_output_within_documented_bounds() {
                 return Ok(());
             };
             let (w, h) = FUZZ_SIZE;
-            if vista_golden::check_request(*kernel, &p, w, h).is_err() {
+            if vista_golden::check_request(kernel, &p, w, h).is_err() {
                 return Ok(());
             }
             tried.set(tried.get() + 1);
-            let r = vista_golden::render(ctx, *kernel, &p, w, h)
+            let r = vista_golden::render(ctx, kernel, &p, w, h)
                 .map_err(|e| TestCaseError::fail(format!("{}: {e}", kernel.name())))?;
             if let Some((x, y)) = r.raw.first_nonfinite() {
                 return Err(TestCaseError::fail(format!(

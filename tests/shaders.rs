@@ -1,7 +1,8 @@
 //! Every WGSL file composes and validates with naga alone (no device), and
 //! every kernel's uniform block matches the `Params` struct naga reflects.
 
-use vista_gpu::{ShaderSet, binding_struct_layout};
+use vista_gpu::ShaderSet;
+use vista_kernels::{Kind, Value};
 
 mod common;
 
@@ -46,18 +47,50 @@ fn every_registered_kernel_has_a_shader_file() {
     }
 }
 
+/// Every built-in kernel's `Params` struct passes the name-and-type check
+/// against its manifest, and the packed bytes hold each param's value at
+/// the offset naga reflects (vec3 fields included).
 #[test]
-fn uniform_layouts_match_the_wgsl_params_struct() {
+fn uniform_blocks_are_packed_by_name_at_naga_offsets() {
     let set = repo_shaders();
     for k in vista_kernels::registry() {
-        let p = k.resolve(None, &[]).unwrap();
-        let u = k.uniforms(&p, 64, 32);
         let module = set.compose(k.shader()).unwrap();
-        let (size, members) = binding_struct_layout(&module, 0)
-            .unwrap_or_else(|| panic!("{}: no struct at @group(0) @binding(0)", k.name()));
-        let ours: Vec<(String, u32)> = u.fields().iter().map(|f| (f.name.to_string(), f.offset)).collect();
-        assert_eq!(ours, members, "{}: uniform fields differ from the WGSL Params struct", k.name());
-        assert_eq!(u.len() as u32, size, "{}: uniform size differs from the WGSL struct", k.name());
+        let layout = k.layout(&module).unwrap_or_else(|e| panic!("{e}"));
+        let p = k.resolve(k.presets().last().map(|p| p.name), &[]).unwrap();
+        let bytes = k.uniforms(&layout, &p, 64, 32);
+        assert_eq!(bytes.len() % 16, 0);
+        assert!(bytes.len() as u32 >= layout.size);
+        let word = |at: u32| u32::from_le_bytes(bytes[at as usize..at as usize + 4].try_into().unwrap());
+        let float = |at: u32| f32::from_bits(word(at));
+        for f in &layout.fields {
+            let expect: Vec<u32> = match f.name.as_str() {
+                "width" => vec![64],
+                "height" => vec![32],
+                name => match p.value(name).unwrap() {
+                    Value::Float(v) => vec![(*v as f32).to_bits()],
+                    Value::Int(v) => vec![*v as u32],
+                    Value::Bool(b) => vec![*b as u32],
+                    Value::Vector(v) => v.iter().map(|c| (*c as f32).to_bits()).collect(),
+                    Value::Enum(e) => {
+                        let Kind::Enum(names) = k.params().iter().find(|s| s.name == name).unwrap().kind else {
+                            unreachable!()
+                        };
+                        vec![names.iter().position(|n| n == e).unwrap() as u32]
+                    }
+                },
+            };
+            let got: Vec<u32> = (0..expect.len() as u32).map(|i| word(f.offset + 4 * i)).collect();
+            assert_eq!(got, expect, "{}: field {} at offset {} ({})", k.name(), f.path, f.offset, float(f.offset));
+        }
+        // Every param but the host's exposure reaches the shader.
+        for spec in k.params() {
+            assert!(
+                layout.fields.iter().any(|f| f.name == spec.name) || spec.name == "exposure",
+                "{}: {} not in Params",
+                k.name(),
+                spec.name
+            );
+        }
     }
 }
 

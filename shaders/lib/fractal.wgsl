@@ -2,7 +2,7 @@
 // (The clouds kernel sums its 3D fBm itself, to stop early; see clouds.wgsl.)
 #define_import_path vista::fractal
 
-#import vista::noise::basis_noise
+#import vista::noise::{basis_noise, PERLIN_MAX_ABS}
 
 struct FbmSettings {
     basis: u32,
@@ -12,6 +12,17 @@ struct FbmSettings {
     gain: f32,
     rot_cos: f32,
     rot_sin: f32,
+}
+
+// A = sum_{i < octaves} gain^i, the fBm amplitude normaliser (SPEC 3.2).
+fn fbm_amplitude(octaves: u32, gain: f32) -> f32 {
+    var sum = 0.0;
+    var amplitude = 1.0;
+    for (var i = 0u; i < octaves; i++) {
+        sum += amplitude;
+        amplitude *= gain;
+    }
+    return sum;
 }
 
 // f(p) = sum_i gain^i N(p_i, z), p_{i+1} = lacunarity * R(theta) * p_i.
@@ -36,6 +47,18 @@ struct RidgedSettings {
     h: f32,
     offset: f32,
     gain: f32,
+}
+
+// The largest value ridged2 can reach: with |N| <= PERLIN_MAX_ABS (a bound
+// for both bases) each signal is at most max(offset, M - offset)^2 and each
+// weight at most 1, so max = that square times sum_i lacunarity^(-i H).
+fn ridged_max(s: RidgedSettings) -> f32 {
+    let peak = max(s.offset, PERLIN_MAX_ABS - s.offset);
+    var weights = 0.0;
+    for (var i = 0u; i < s.octaves; i++) {
+        weights += pow(s.lacunarity, -f32(i) * s.h);
+    }
+    return peak * peak * weights;
 }
 
 // Musgrave: each octave's squared ridge signal is weighted by the previous

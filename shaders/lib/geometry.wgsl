@@ -1,13 +1,38 @@
 // Ray geometry shared by the sky, cloud and heightfield kernels.
 #define_import_path vista::geometry
 
-// SPEC 3.4 pinhole camera: the unit ray through the pixel-centre coordinates
-// uv (v down) for the basis fwd/right/up, tan(fov / 2) and aspect W / H.
-// Twin of `Camera::ray` in crates/vista-kernels/src/geometry.rs.
-fn pinhole_ray(uv: vec2<f32>, tan_half_fov: f32, aspect: f32, fwd: vec3<f32>, right: vec3<f32>, up: vec3<f32>) -> vec3<f32> {
-    let sx = (2.0 * uv.x - 1.0) * tan_half_fov * aspect;
-    let sy = (1.0 - 2.0 * uv.y) * tan_half_fov;
-    return normalize(fwd + sx * right + sy * up);
+// Unit vector at azimuth `az` (from +z toward +x) and elevation `el`, radians.
+fn direction(az: f32, el: f32) -> vec3<f32> {
+    return vec3(cos(el) * sin(az), sin(el), cos(el) * cos(az));
+}
+
+// The SPEC 3.4 pinhole camera: position, basis, tan(fov / 2) and W / H.
+struct Pinhole {
+    pos: vec3<f32>,
+    forward: vec3<f32>,
+    right: vec3<f32>,
+    up: vec3<f32>,
+    tan_half_fov: f32,
+    aspect: f32,
+}
+
+// Looking along the unit, non-vertical `forward` (the host refuses vertical
+// views before any GPU work): r = normalize(cross(f, (0,1,0))), up = cross(r, f).
+fn pinhole_looking(pos: vec3<f32>, forward: vec3<f32>, fov_deg: f32, aspect: f32) -> Pinhole {
+    let right = normalize(cross(forward, vec3(0.0, 1.0, 0.0)));
+    return Pinhole(pos, forward, right, cross(right, forward), tan(0.5 * radians(fov_deg)), aspect);
+}
+
+// f = normalize(look_at - pos), then pinhole_looking.
+fn pinhole_look_at(pos: vec3<f32>, look_at: vec3<f32>, fov_deg: f32, aspect: f32) -> Pinhole {
+    return pinhole_looking(pos, normalize(look_at - pos), fov_deg, aspect);
+}
+
+// The unit ray through the pixel-centre coordinates uv (v down).
+fn pinhole_ray(c: Pinhole, uv: vec2<f32>) -> vec3<f32> {
+    let sx = (2.0 * uv.x - 1.0) * c.tan_half_fov * c.aspect;
+    let sy = (1.0 - 2.0 * uv.y) * c.tan_half_fov;
+    return normalize(c.forward + sx * c.right + sy * c.up);
 }
 
 // Distances (t0, t1), t0 <= t1, where the ray o + t d (d unit) meets the

@@ -21,11 +21,15 @@ pub fn bench(
     if !(1..=1000).contains(&runs) {
         return Err(bad(format!("--runs {runs} is out of range; allowed: [1, 1000]")));
     }
-    let k = vista_kernels::find(kernel).map_err(bad)?;
+    let k = crate::registry(project)?.find(kernel).map_err(bad)?;
     let p = k.resolve(preset, &parse_sets(set)?).map_err(bad)?;
     let (w, h) = vista_kernels::parse_size(size).map_err(bad)?;
-    vista_golden::check_request(k, &p, w, h)?;
-    let ctx = &Renderer::new(Context::shared()?, project)?;
+    let shaders = vista_golden::shader_set(project)?;
+    vista_golden::prepare(&shaders, k, &p, w, h)?;
+    if cpu && !k.has_reference() {
+        return Err(bad(format!("--cpu: kernel {kernel} has no CPU reference (only built-in kernels have one)")));
+    }
+    let ctx = &Renderer { ctx: Context::shared()?, shaders };
     // Warm-up: compiles the pipeline and touches every allocation path once.
     // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
     let first = vista_golden::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();

@@ -190,24 +190,26 @@ fn bad(e: impl std::fmt::Display) -> GoldenError {
 fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
     match cmd {
         Command::List { names } => {
+            let kernels = registry(project)?;
             if names {
-                for k in vista_kernels::registry() {
+                for k in kernels.kernels() {
                     for p in k.presets() {
                         println!("{} {}", k.name(), p.name);
                     }
                 }
             } else {
-                list();
+                list(&kernels);
             }
             Ok(0)
         }
         Command::Render { kernel, preset, set, size, out } => {
-            let k = vista_kernels::find(&kernel).map_err(bad)?;
+            let k = registry(project)?.find(&kernel).map_err(bad)?;
             let p = k.resolve(preset.as_deref(), &parse_sets(&set)?).map_err(bad)?;
             let (w, h) = vista_kernels::parse_size(&size).map_err(bad)?;
             check_output_path(&out)?;
-            vista_golden::check_request(k, &p, w, h)?;
-            let ctx = &Renderer::new(Context::shared()?, project)?;
+            let shaders = vista_golden::shader_set(project)?;
+            vista_golden::prepare(&shaders, k, &p, w, h)?;
+            let ctx = &Renderer { ctx: Context::shared()?, shaders };
             let r = vista_golden::render(ctx, k, &p, w, h)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
             vista_image::save(&out, if is_exr { &r.raw } else { &r.display })?;
@@ -363,8 +365,13 @@ fn check(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> 
     Ok(if failed == 0 { 0 } else { 1 })
 }
 
-fn list() {
-    for k in vista_kernels::registry() {
+/// The project's kernels (its manifests over the built-ins).
+pub fn registry(project: &Project) -> Result<vista_kernels::Registry, GoldenError> {
+    vista_kernels::Registry::of_project(project).map_err(bad)
+}
+
+fn list(kernels: &vista_kernels::Registry) {
+    for k in kernels.kernels() {
         println!("{} — {}", k.name(), k.summary());
         println!("  params:");
         for p in k.params() {

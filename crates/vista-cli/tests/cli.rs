@@ -720,3 +720,147 @@ fn no_build_time_paths_in_non_test_code() {
     }
     assert!(offenders.is_empty(), "build-time paths in non-test code: {offenders:?}");
 }
+
+// ---- kernels as data: refusals before any GPU work -------------------------
+
+const K_MANIFEST: &str = r#"summary = "test kernel: a flat grey"
+[[param]]
+name = "gain"
+type = "f32"
+range = [0.0, 1.0]
+default = 0.5
+doc = "grey level"
+"#;
+
+const K_SHADER: &str = r#"struct Params {
+    width: u32,
+    height: u32,
+    gain: f32,
+}
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    textureStore(output, id.xy, vec4(vec3(params.gain), 1.0));
+}
+"#;
+
+/// A project outside the repository with one kernel `k`.
+fn kernel_project(manifest: &str, shader: &str) -> tempfile::TempDir {
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    for sub in ["kernels", "shaders"] {
+        std::fs::create_dir(d.path().join(sub)).unwrap();
+    }
+    std::fs::write(d.path().join("kernels/k.toml"), manifest).unwrap();
+    std::fs::write(d.path().join("shaders/k.wgsl"), shader).unwrap();
+    d
+}
+
+/// `vista render k` in a project with this manifest and shader.
+fn render_k(manifest: &str, shader: &str) -> Run {
+    let d = kernel_project(manifest, shader);
+    let out = d.path().join("k.png");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    assert!(!out.exists() || r.code == 0, "a refused render wrote its output");
+    r
+}
+
+#[test]
+fn a_kernel_described_as_data_renders() {
+    let r = render_k(K_MANIFEST, K_SHADER);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let r = render_k(K_MANIFEST, K_SHADER);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
+#[test]
+fn params_field_without_a_param_is_refused() {
+    let shader = K_SHADER.replace("    gain: f32,\n", "    gain: f32,\n    rot_cos: f32,\n");
+    assert_rejected(&render_k(K_MANIFEST, &shader), 2, &["kernel k", "Params field rot_cos (WGSL f32) has no param"]);
+}
+
+#[test]
+fn param_without_a_params_field_is_refused() {
+    let manifest =
+        format!("{K_MANIFEST}[[param]]\nname = \"unused\"\ntype = \"vec3\"\nrange = [0, 1]\ndefault = [0, 0, 0]\n");
+    assert_rejected(
+        &render_k(&manifest, K_SHADER),
+        2,
+        &["kernel k", "param unused (vec3) has no field", "unused: vec3<f32>"],
+    );
+}
+
+#[test]
+fn params_type_mismatch_is_refused() {
+    let manifest = K_MANIFEST
+        .replace("type = \"f32\"\nrange = [0.0, 1.0]\ndefault = 0.5", "type = \"u32\"\nrange = [0, 1]\ndefault = 0");
+    assert_rejected(
+        &render_k(&manifest, K_SHADER),
+        2,
+        &["kernel k", "Params field gain is WGSL f32", "declares param gain as u32 (WGSL u32)"],
+    );
+}
+
+#[test]
+fn unknown_manifest_key_names_file_line_and_key() {
+    let manifest = format!("{K_MANIFEST}colour = 3\n");
+    assert_rejected(&render_k(&manifest, K_SHADER), 2, &["kernels/k.toml", "unknown field `colour`"]);
+    let manifest = K_MANIFEST.replace("doc = \"grey level\"", "dco = \"grey level\"");
+    assert_rejected(&render_k(&manifest, K_SHADER), 2, &["kernels/k.toml: line 7, column 1", "unknown field `dco`"]);
+}
+
+#[test]
+fn bad_range_default_or_enum_value_is_refused() {
+    let m = K_MANIFEST.replace("range = [0.0, 1.0]", "range = [1.0, 0.0]");
+    assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k: param gain", "range = [1, 0] is not valid"]);
+    let m = K_MANIFEST.replace("default = 0.5", "default = 2.0");
+    assert_rejected(
+        &render_k(&m, K_SHADER),
+        2,
+        &["kernel k: param gain", "default: gain=2.0 is out of range", "[0, 1]"],
+    );
+    let m = K_MANIFEST.replace("range = [0.0, 1.0]\n", "");
+    assert_rejected(&render_k(&m, K_SHADER), 2, &["param gain", "type f32 needs range = [min, max]"]);
+    let m =
+        format!("{K_MANIFEST}[[param]]\nname = \"mode\"\ntype = \"enum\"\nvalues = [\"a\", \"b\"]\ndefault = \"c\"\n");
+    assert_rejected(&render_k(&m, K_SHADER), 2, &["param mode", "default: mode=c is not valid; expected one of a|b"]);
+    let m = K_MANIFEST.replace("type = \"f32\"", "type = \"float\"");
+    assert_rejected(
+        &render_k(&m, K_SHADER),
+        2,
+        &["param gain", "type = \"float\" is not valid", "u32|i32|f32|bool|vec2|vec3|vec4|enum"],
+    );
+}
+
+#[test]
+fn preset_naming_an_unknown_param_is_refused() {
+    let m = format!("{K_MANIFEST}[preset.dim]\ngian = 0.1\n");
+    assert_rejected(
+        &render_k(&m, K_SHADER),
+        2,
+        &["kernel k", "preset dim names unknown param 'gian'", "valid params: gain"],
+    );
+    let m = format!("{K_MANIFEST}[preset.dim]\ngain = 7\n");
+    assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "preset dim: gain=7 is out of range"]);
+}
+
+#[test]
+fn missing_shader_file_is_refused() {
+    let m = format!("shader = \"nope.wgsl\"\n{K_MANIFEST}");
+    assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "shader nope.wgsl not found", "k.wgsl"]);
+}
+
+#[test]
+fn malformed_manifest_names_file_line_and_column() {
+    let m = K_MANIFEST.replace("default = 0.5", "default = 0.5.5");
+    assert_rejected(&render_k(&m, K_SHADER), 2, &["kernels/k.toml: line 6, column 14"]);
+    let d = kernel_project(
+        &K_MANIFEST.replace("summary = \"test kernel: a flat grey\"", "summary = \"unterminated"),
+        K_SHADER,
+    );
+    assert_rejected(&vista_in(Some(d.path()), &[], &["list"]), 2, &["kernels/k.toml: line 1"]);
+}

@@ -51,7 +51,7 @@ struct RawCase {
 #[derive(Debug, Clone)]
 pub struct Case {
     pub id: String,
-    pub kernel: &'static dyn vista_kernels::Kernel,
+    pub kernel: &'static vista_kernels::Kernel,
     pub preset: Option<String>,
     pub overrides: Vec<(String, String)>,
     pub params: ParamSet,
@@ -61,15 +61,6 @@ pub struct Case {
     pub psnr_other_driver: f64,
     pub min_ssim: Option<f64>,
     pub doc: String,
-}
-
-/// Text form of a TOML value as `--set` would take it.
-fn value_text(v: &toml::Value) -> String {
-    match v {
-        toml::Value::String(s) => s.clone(),
-        toml::Value::Array(items) => items.iter().map(value_text).collect::<Vec<_>>().join(","),
-        other => other.to_string(),
-    }
 }
 
 impl Case {
@@ -86,7 +77,7 @@ impl Case {
 
 /// Parses and validates a case file. Errors name the file, the line (for
 /// TOML syntax) or the case id and the bad value.
-pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
+pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -> Result<Vec<Case>, GoldenError> {
     let file: CaseFile = toml::from_str(text)
         .map_err(|e| GoldenError::Cases { path: path.display().to_string(), message: one_line_toml_error(text, &e) })?;
     let mut seen = std::collections::HashSet::new();
@@ -102,8 +93,9 @@ pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
         if !seen.insert(raw.id.clone()) {
             return Err(bad("duplicate id".into()));
         }
-        let kernel = vista_kernels::find(&raw.kernel).map_err(|e| bad(e.to_string()))?;
-        let overrides: Vec<(String, String)> = raw.set.iter().map(|(k, v)| (k.clone(), value_text(v))).collect();
+        let kernel = kernels.find(&raw.kernel).map_err(|e| bad(e.to_string()))?;
+        let overrides: Vec<(String, String)> =
+            raw.set.iter().map(|(k, v)| (k.clone(), vista_kernels::manifest::value_text(v))).collect();
         let params = kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?;
         let (width, height) = match &raw.size {
             Some(s) => vista_kernels::parse_size(s).map_err(|e| bad(e.to_string()))?,
@@ -138,25 +130,12 @@ pub fn parse_cases(path: &Path, text: &str) -> Result<Vec<Case>, GoldenError> {
     Ok(out)
 }
 
-/// toml's errors span several lines (with a source excerpt); users get one:
-/// "line L, column C: message".
-pub fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
-    let msg = e.message().trim().replace('\n', " ");
-    match e.span() {
-        Some(span) => {
-            let before = &text[..span.start.min(text.len())];
-            let line = before.matches('\n').count() + 1;
-            let column = before.len() - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
-            format!("line {line}, column {column}: {msg}")
-        }
-        None => msg,
-    }
-}
+pub use vista_project::one_line_toml_error;
 
-pub fn load_cases(path: &Path) -> Result<Vec<Case>, GoldenError> {
+pub fn load_cases(path: &Path, kernels: &vista_kernels::Registry) -> Result<Vec<Case>, GoldenError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| GoldenError::Cases { path: path.display().to_string(), message: format!("cannot read: {e}") })?;
-    parse_cases(path, &text)
+    parse_cases(path, &text, kernels)
 }
 
 /// Cases whose id matches the glob (all when `None`).

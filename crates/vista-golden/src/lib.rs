@@ -16,7 +16,8 @@ pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, load_cases, parse_cases, select};
 pub use check::{CheckOptions, Outcome, Verdict, check_case};
 pub use render::{
-    Rendered, Renderer, check_request, median, median_wall, quantize16, render, render_median, shader_set,
+    Prepared, Rendered, Renderer, check_request, median, median_wall, prepare, quantize16, render, render_median,
+    shader_set,
 };
 pub use report::write_report;
 pub use store::{Manifest, ManifestEntry, Store};

@@ -26,7 +26,7 @@ pub struct Rendered {
 }
 
 /// Checks size and work bounds before any GPU work.
-pub fn check_request(kernel: &dyn Kernel, p: &ParamSet, width: u32, height: u32) -> Result<(), GoldenError> {
+pub fn check_request(kernel: &Kernel, p: &ParamSet, width: u32, height: u32) -> Result<(), GoldenError> {
     vista_kernels::check_size(width, height).map_err(|e| GoldenError::BadInput(e.to_string()))?;
     let work = kernel.work_per_pixel(p) * width as f64 * height as f64;
     let cap = max_work();
@@ -80,17 +80,37 @@ pub fn shader_set(project: &vista_project::Project) -> Result<ShaderSet, GoldenE
     Ok(ShaderSet::from_files(&label, files))
 }
 
-/// Renders `kernel` with `p` at `width` x `height` on the GPU.
-pub fn render(
-    gpu: &Renderer,
-    kernel: &dyn Kernel,
+/// What a dispatch needs besides the device: the uniform bytes packed from
+/// naga's reflection of the composed module, and the binding-2 table.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    pub uniforms: Vec<u8>,
+    pub table: Vec<u32>,
+}
+
+/// Every check that needs no device: size and work bounds, composition of
+/// the kernel's WGSL, and its `Params` struct against the manifest (a field
+/// with no param, a param with no field, a type mismatch are bad input).
+pub fn prepare(
+    shaders: &ShaderSet,
+    kernel: &Kernel,
     p: &ParamSet,
     width: u32,
     height: u32,
-) -> Result<Rendered, GoldenError> {
+) -> Result<Prepared, GoldenError> {
     check_request(kernel, p, width, height)?;
-    let uniforms = kernel.uniforms(p, width, height).to_bytes();
-    let table = kernel.table(p);
+    let module = shaders.compose(kernel.shader()).map_err(|e| match e {
+        // A missing or broken shader file is the user's to fix.
+        vista_gpu::GpuError::Shader(m) => GoldenError::BadInput(format!("kernel {}: {m}", kernel.name())),
+        other => GoldenError::Gpu(other),
+    })?;
+    let layout = kernel.layout(&module).map_err(|e| GoldenError::BadInput(e.to_string()))?;
+    Ok(Prepared { uniforms: kernel.uniforms(&layout, p, width, height), table: kernel.table(&layout, p) })
+}
+
+/// Renders `kernel` with `p` at `width` x `height` on the GPU.
+pub fn render(gpu: &Renderer, kernel: &Kernel, p: &ParamSet, width: u32, height: u32) -> Result<Rendered, GoldenError> {
+    let Prepared { uniforms, table } = prepare(&gpu.shaders, kernel, p, width, height)?;
     let job =
         Dispatch { shaders: &gpu.shaders, shader: kernel.shader(), uniforms: &uniforms, table: &table, width, height };
     let (raw, stats) = gpu.ctx.run(&job)?;
@@ -102,7 +122,7 @@ pub fn render(
 /// median GPU wall time, for benchmarks and sweeps.
 pub fn render_median(
     gpu: &Renderer,
-    kernel: &dyn Kernel,
+    kernel: &Kernel,
     p: &ParamSet,
     width: u32,
     height: u32,

@@ -15,7 +15,8 @@ pub struct ManifestEntry {
     pub size: String,
     /// Hash of the case's canonical resolved parameters.
     pub params_hash: String,
-    /// Hash of the kernel's WGSL and every `shaders/lib` file.
+    /// Hash of the kernel's WGSL file and the lib modules it reaches
+    /// through `#import` (see `ShaderSet::source_hash`).
     pub shader_hash: String,
     /// Adapter name | driver | backend | device type.
     pub adapter: String,
@@ -37,17 +38,20 @@ pub struct Manifest {
     pub case: BTreeMap<String, ManifestEntry>,
 }
 
-/// A golden directory.
+/// A golden directory and the kernels its cases may name.
 #[derive(Debug, Clone)]
 pub struct Store {
     pub dir: PathBuf,
+    pub kernels: vista_kernels::Registry,
 }
 
 impl Store {
     /// The project's `golden/`; a project without a root has no store, and
     /// the error says what `command` looked for and from where.
     pub fn of_project(project: &vista_project::Project, command: &str) -> Result<Store, GoldenError> {
-        Ok(Store { dir: project.require_root(command)?.join("golden") })
+        let dir = project.require_root(command)?.join("golden");
+        let kernels = vista_kernels::Registry::of_project(project).map_err(|e| GoldenError::BadInput(e.to_string()))?;
+        Ok(Store { dir, kernels })
     }
 
     pub fn cases_path(&self) -> PathBuf {
@@ -63,7 +67,7 @@ impl Store {
     }
 
     pub fn load_cases(&self) -> Result<Vec<Case>, GoldenError> {
-        crate::load_cases(&self.cases_path())
+        crate::load_cases(&self.cases_path(), &self.kernels)
     }
 
     /// The manifest; empty if the file does not exist yet.

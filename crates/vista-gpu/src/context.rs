@@ -206,7 +206,7 @@ impl Context {
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let sm = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(shader),
-            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module)),
+            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned((*module).clone())),
         });
         let pipeline = self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(shader),

@@ -10,7 +10,7 @@ mod context;
 mod shaders;
 
 pub use context::{AdapterChoice, Context, Dispatch, RunStats};
-pub use shaders::{ShaderSet, binding_struct_layout, validate};
+pub use shaders::{ShaderSet, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
 pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \

@@ -6,6 +6,7 @@
 //! the file and line.
 
 use std::collections::{BTreeMap, HashMap};
+use std::sync::{Arc, Mutex};
 
 use naga_oil::compose::{ComposableModuleDescriptor, Composer, ComposerError, NagaModuleDescriptor, ShaderLanguage};
 
@@ -23,6 +24,9 @@ pub struct ShaderSet {
     lib: Vec<(String, String)>,
     /// Kernel files (not under `lib/`): relative path -> (source, origin path).
     kernels: BTreeMap<String, (String, String)>,
+    /// Composed modules by kernel file: the sources never change once the
+    /// set is built, so each file is composed once per set.
+    composed: Arc<Mutex<HashMap<String, Arc<naga::Module>>>>,
 }
 
 impl ShaderSet {
@@ -40,7 +44,7 @@ impl ShaderSet {
             }
         }
         lib.sort();
-        ShaderSet { label: label.to_string(), lib, kernels }
+        ShaderSet { label: label.to_string(), lib, kernels, composed: Default::default() }
     }
 
     /// What this set is (a project root, or "built-in").
@@ -94,8 +98,18 @@ impl ShaderSet {
         Ok(composer)
     }
 
-    /// Composes and validates the kernel file `name` (relative to `shaders/`).
-    pub fn compose(&self, name: &str) -> Result<naga::Module, GpuError> {
+    /// Composes and validates the kernel file `name` (relative to
+    /// `shaders/`), once per set.
+    pub fn compose(&self, name: &str) -> Result<Arc<naga::Module>, GpuError> {
+        if let Some(m) = self.composed.lock().expect("compose cache").get(name) {
+            return Ok(m.clone());
+        }
+        let module = Arc::new(self.compose_uncached(name)?);
+        self.composed.lock().expect("compose cache").insert(name.to_string(), module.clone());
+        Ok(module)
+    }
+
+    fn compose_uncached(&self, name: &str) -> Result<naga::Module, GpuError> {
         let (source, origin) = self.kernel_source(name)?;
         let mut composer = self.composer()?;
         let module = composer
@@ -168,20 +182,4 @@ pub fn validate(name: &str, module: &naga::Module) -> Result<naga::valid::Module
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
         .validate(module)
         .map_err(|e| GpuError::Shader(format!("{name}: naga validation failed: {}", e.emit_to_string(""))))
-}
-
-/// Byte size and `(name, offset)` members of the struct bound at
-/// `@group(0) @binding(binding)`: lets tests check a kernel's uniform layout.
-pub fn binding_struct_layout(module: &naga::Module, binding: u32) -> Option<(u32, Vec<(String, u32)>)> {
-    let (_, var) = module
-        .global_variables
-        .iter()
-        .find(|(_, v)| v.binding.as_ref().is_some_and(|b| b.group == 0 && b.binding == binding))?;
-    let ty = &module.types[var.ty];
-    match &ty.inner {
-        naga::TypeInner::Struct { members, span } => {
-            Some((*span, members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect()))
-        }
-        _ => None,
-    }
 }

@@ -1,11 +1,13 @@
-//! vista's kernels: one module per kernel with its typed parameters, presets,
-//! range validation and uniform layout for its WGSL entry point; and the CPU
-//! references written from the math in SPEC (`src/cpu/`), built twice: in
-//! f64 as the oracles ([`cpu64`], re-exported by each kernel module) and in
-//! f32 as the throughput baseline ([`cpu32`]).
+//! vista's kernels: each described as data by its manifest
+//! (`kernels/<name>.toml`, [`manifest`]) with its WGSL; the uniform block
+//! packed from naga's reflection of the composed module ([`layout`]); and,
+//! for the built-ins, the CPU references written from the math in SPEC
+//! (`src/cpu/`), built twice: in f64 as the oracles ([`cpu64`], re-exported
+//! by each kernel module) and in f32 as the throughput baseline ([`cpu32`]),
+//! registered by kernel name ([`CpuReference`]).
 //!
 //! Not for: GPU work (see `vista-gpu`), files or goldens (see `vista-golden`).
-//! Kernels never touch the file system.
+//! Kernels never touch the file system: manifests arrive as text.
 
 /// Declares the CPU reference modules of `src/cpu/` for one float type: the
 /// same source compiled once per precision, so the f32 baseline cannot drift
@@ -40,6 +42,20 @@ macro_rules! cpu_references {
     };
 }
 
+/// A handle that derefs to the built-in kernel of its name, so the Rust
+/// side of a built-in reads `FbmKernel.resolve(...)`, `&FbmKernel`.
+macro_rules! builtin_handle {
+    ($handle:ident, $name:literal) => {
+        impl std::ops::Deref for $handle {
+            type Target = $crate::Kernel;
+            fn deref(&self) -> &$crate::Kernel {
+                $crate::find($name).expect(concat!("built-in kernel ", $name))
+            }
+        }
+    };
+}
+pub(crate) use builtin_handle;
+
 pub mod cpu32;
 pub mod cpu64;
 
@@ -47,20 +63,24 @@ pub mod atmosphere;
 pub mod clouds;
 pub mod fbm;
 pub mod heightfield;
+pub mod layout;
+pub mod manifest;
 pub mod noise;
 pub mod params;
 pub mod phase;
 pub mod ridged;
-mod uniforms;
+
+use std::sync::OnceLock;
 
 pub use cpu64::geometry;
 pub use cpu64::{pixel_uv, render_cpu};
-pub use params::{Kind, ParamSet, ParamSpec, Preset, Value};
-pub use uniforms::{Field, Uniforms};
+pub use layout::UniformLayout;
+pub use params::{Kind, ParamSet, ParamSpec, ParamType, Preset, Value};
 use vista_image::Image;
 
-/// Everything that can be wrong with a kernel, preset, parameter or size
-/// request. Messages name the bad value and what is allowed.
+/// Everything that can be wrong with a kernel, its manifest or layout, a
+/// preset, a parameter or a size request. Messages name the bad value and
+/// what is allowed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
     #[error("unknown kernel '{name}'; valid kernels: {valid}")]
@@ -73,6 +93,10 @@ pub enum ParamError {
     OutOfRange { param: String, value: String, range: String },
     #[error("{param}={value} is not valid; expected {expected}")]
     BadValue { param: String, value: String, expected: String },
+    #[error("{file}: {message}")]
+    Manifest { file: String, message: String },
+    #[error("kernel {kernel}: {message}")]
+    Layout { kernel: String, message: String },
     #[error("{0}")]
     Invalid(String),
 }
@@ -86,84 +110,238 @@ pub enum Output {
     Hdr,
 }
 
-/// One kernel. Implementations are stateless unit structs in the registry.
-pub trait Kernel: Send + Sync {
-    fn name(&self) -> &'static str;
-    /// One line for `vista list`.
-    fn summary(&self) -> &'static str;
-    fn params(&self) -> &'static [ParamSpec];
-    fn presets(&self) -> &'static [Preset];
-    /// WGSL file under `shaders/` holding the `main` compute entry point.
-    fn shader(&self) -> &'static str;
-    fn output(&self) -> Output {
-        Output::Display
-    }
+/// What Rust keeps for a built-in kernel because data cannot say it: the
+/// CPU references, cross-parameter checks and a tighter output guard.
+pub trait CpuReference: Send + Sync {
+    /// The f64 CPU reference of the raw output (what the GPU writes).
+    fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image;
+    /// The same reference computed in f32 ([`cpu32`]): a throughput
+    /// baseline for benches (checked against f64 in `tests/precision.rs`).
+    fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image;
     /// Cross-parameter checks beyond each value's own range.
     fn check(&self, _p: &ParamSet) -> Result<(), ParamError> {
         Ok(())
     }
-    /// Uniform block (binding 0) for the WGSL `Params` struct.
-    fn uniforms(&self, p: &ParamSet, width: u32, height: u32) -> Uniforms;
-    /// Read-only u32 table (binding 2); the Perlin permutation for noise kernels.
-    fn table(&self, _p: &ParamSet) -> Vec<u32> {
-        vec![0; 4]
-    }
-    /// Rough count of inner-loop evaluations per pixel, used to refuse absurd
-    /// dispatches before they can stall the device.
-    fn work_per_pixel(&self, p: &ParamSet) -> f64;
-    /// The f64 CPU reference of the raw output (what the GPU writes).
-    fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image;
-    /// The same reference computed in f32 ([`cpu32`]): a throughput
-    /// baseline for benches, not an oracle.
-    fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image;
-    /// Inclusive bounds every RGB value of the raw output must respect.
-    fn output_bounds(&self, _p: &ParamSet) -> (f32, f32) {
-        (0.0, 1.0)
-    }
-    /// Settings of the high-quality reference that sweeps compare against.
-    fn high_quality(&self) -> &'static [(&'static str, &'static str)] {
-        &[]
-    }
-
-    /// Defaults, preset and overrides, validated (ranges and `check`).
-    fn resolve(&self, preset: Option<&str>, overrides: &[(String, String)]) -> Result<ParamSet, ParamError> {
-        let set = ParamSet::resolve(self.name(), self.params(), self.presets(), preset, overrides)?;
-        self.check(&set)?;
-        Ok(set)
-    }
-
-    /// Raw output to display values in [0, 1].
-    fn display(&self, raw: &Image, p: &ParamSet) -> Image {
-        match self.output() {
-            Output::Display => raw.clone(),
-            Output::Hdr => vista_image::tonemap(raw, p.f32("exposure")),
-        }
+    /// Inclusive bounds every RGB value of the raw output must respect,
+    /// when the math gives tighter ones than the manifest's `output_range`.
+    fn output_bounds(&self, _p: &ParamSet) -> Option<(f32, f32)> {
+        None
     }
 }
 
-impl std::fmt::Debug for dyn Kernel {
+/// The CPU reference registered for a kernel name, if any.
+pub fn cpu_reference(name: &str) -> Option<&'static dyn CpuReference> {
+    Some(match name {
+        "fbm" => &fbm::FbmKernel,
+        "ridged" => &ridged::RidgedKernel,
+        "atmosphere" => &atmosphere::AtmosphereKernel,
+        "clouds" => &clouds::CloudsKernel,
+        "heightfield" => &heightfield::HeightfieldKernel,
+        _ => return None,
+    })
+}
+
+/// One kernel: its manifest, where it came from, and its CPU reference if
+/// one is registered under its name. Kernels live for the whole process.
+#[derive(Clone)]
+pub struct Kernel {
+    manifest: manifest::Manifest,
+    origin: &'static str,
+    cpu: Option<&'static dyn CpuReference>,
+}
+
+impl std::fmt::Debug for Kernel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
 }
 
-/// All kernels, in the order `vista list` shows them.
-pub fn registry() -> &'static [&'static dyn Kernel] {
-    &[
-        &fbm::FbmKernel,
-        &ridged::RidgedKernel,
-        &atmosphere::AtmosphereKernel,
-        &clouds::CloudsKernel,
-        &heightfield::HeightfieldKernel,
-    ]
+impl Kernel {
+    /// Parses a manifest (`origin` names it in errors) and attaches the CPU
+    /// reference registered under `name`.
+    pub fn from_manifest(name: &str, origin: &str, text: &str) -> Result<Kernel, ParamError> {
+        let manifest = manifest::parse(name, origin, text)?;
+        Ok(Kernel { cpu: cpu_reference(manifest.name), manifest, origin: Box::leak(origin.into()) })
+    }
+
+    pub fn name(&self) -> &'static str {
+        self.manifest.name
+    }
+    /// One line for `vista list`.
+    pub fn summary(&self) -> &'static str {
+        self.manifest.summary
+    }
+    /// The manifest's path (or `<built-in>/kernels/...`).
+    pub fn origin(&self) -> &'static str {
+        self.origin
+    }
+    pub fn params(&self) -> &'static [ParamSpec] {
+        self.manifest.params
+    }
+    pub fn presets(&self) -> &'static [Preset] {
+        self.manifest.presets
+    }
+    /// WGSL file under `shaders/` holding the `main` compute entry point.
+    pub fn shader(&self) -> &'static str {
+        self.manifest.shader
+    }
+    pub fn output(&self) -> Output {
+        self.manifest.output
+    }
+    /// Whether a CPU reference is registered for this kernel.
+    pub fn has_reference(&self) -> bool {
+        self.cpu.is_some()
+    }
+
+    /// Defaults, preset and overrides, validated (ranges and cross-parameter checks).
+    pub fn resolve(&self, preset: Option<&str>, overrides: &[(String, String)]) -> Result<ParamSet, ParamError> {
+        let set = ParamSet::resolve(self.name(), self.params(), self.presets(), preset, overrides)?;
+        if let Some(cpu) = self.cpu {
+            cpu.check(&set)?;
+        }
+        Ok(set)
+    }
+
+    /// Raw output to display values in [0, 1].
+    pub fn display(&self, raw: &Image, p: &ParamSet) -> Image {
+        let mut out = match self.output() {
+            Output::Display => raw.clone(),
+            Output::Hdr => vista_image::tonemap(raw, p.f32("exposure")),
+        };
+        if self.manifest.opaque_display {
+            for px in &mut out.data {
+                px[3] = 1.0;
+            }
+        }
+        out
+    }
+
+    /// The manifest's work estimate per pixel (product of its `work`
+    /// entries; 1 without any), used to refuse absurd dispatches.
+    pub fn work_per_pixel(&self, p: &ParamSet) -> f64 {
+        self.manifest.work.iter().map(|f| f.constant + f.params.iter().map(|n| p.f64(n)).sum::<f64>()).product()
+    }
+
+    /// Inclusive bounds every RGB value of the raw output must respect.
+    pub fn output_bounds(&self, p: &ParamSet) -> (f32, f32) {
+        if let Some(b) = self.cpu.and_then(|c| c.output_bounds(p)) {
+            return b;
+        }
+        match (self.manifest.output_range, self.output()) {
+            (Some((lo, hi)), _) => (lo as f32, hi as f32),
+            (None, Output::Display) => (0.0, 1.0),
+            (None, Output::Hdr) => (0.0, f32::INFINITY),
+        }
+    }
+
+    /// Settings of the high-quality reference that sweeps compare against.
+    pub fn high_quality(&self) -> &'static [(&'static str, &'static str)] {
+        self.manifest.sweep_reference
+    }
+
+    /// Read-only u32 table for binding 2: Perlin's permutation for the
+    /// kernel's `seed` param (seed 0 without one), if the module declares it.
+    pub fn table(&self, layout: &UniformLayout, p: &ParamSet) -> Vec<u32> {
+        if !layout.uses_table {
+            return vec![0; 4];
+        }
+        let seed = match p.value("seed") {
+            Some(Value::Int(s)) => *s as u32,
+            _ => 0,
+        };
+        noise::permutation(seed)
+    }
+
+    /// Reflects and checks the uniform layout of this kernel's composed module.
+    pub fn layout(&self, module: &naga::Module) -> Result<UniformLayout, ParamError> {
+        let l = layout::reflect(self.name(), self.shader(), module)?;
+        layout::check(self, &l)?;
+        Ok(l)
+    }
+
+    /// The uniform block for `p` at `width` x `height`.
+    pub fn uniforms(&self, layout: &UniformLayout, p: &ParamSet, width: u32, height: u32) -> Vec<u8> {
+        layout::pack(self, layout, p, width, height)
+    }
+
+    /// The f64 CPU reference of the raw output.
+    ///
+    /// # Panics
+    /// If no reference is registered (check [`Kernel::has_reference`]).
+    pub fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
+        self.cpu.unwrap_or_else(|| panic!("kernel {} has no CPU reference", self.name())).reference(p, width, height)
+    }
+
+    /// The f32 build of the CPU reference (bench baseline).
+    ///
+    /// # Panics
+    /// If no reference is registered.
+    pub fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image {
+        self.cpu
+            .unwrap_or_else(|| panic!("kernel {} has no CPU reference", self.name()))
+            .reference_f32(p, width, height)
+    }
 }
 
-/// Looks a kernel up by name.
-pub fn find(name: &str) -> Result<&'static dyn Kernel, ParamError> {
-    registry().iter().copied().find(|k| k.name() == name).ok_or_else(|| ParamError::UnknownKernel {
-        name: name.to_string(),
-        valid: registry().iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),
-    })
+/// A project's kernels: its `kernels/*.toml` over the built-ins, by name.
+#[derive(Debug, Clone)]
+pub struct Registry {
+    kernels: Vec<&'static Kernel>,
+}
+
+impl Registry {
+    /// Parses every manifest (`<name>.toml` files; the name is the stem).
+    pub fn from_files(files: &[vista_project::SourceFile]) -> Result<Registry, ParamError> {
+        let mut kernels = Vec::new();
+        for f in files {
+            let Some(name) = f.rel.strip_suffix(".toml") else { continue };
+            if name.contains('/') {
+                continue;
+            }
+            let k = Kernel::from_manifest(name, &f.origin, &f.text)?;
+            kernels.push(&*Box::leak(Box::new(k)));
+        }
+        Ok(Registry { kernels })
+    }
+
+    /// The project's kernels (its manifests layered over the built-ins).
+    pub fn of_project(project: &vista_project::Project) -> Result<Registry, ParamError> {
+        let files = project
+            .kernel_files()
+            .map_err(|e| ParamError::Manifest { file: "kernels/".into(), message: e.to_string() })?;
+        Registry::from_files(&files)
+    }
+
+    /// The built-in kernels from the manifests embedded in the binary.
+    pub fn builtin() -> &'static Registry {
+        static BUILTIN: OnceLock<Registry> = OnceLock::new();
+        BUILTIN.get_or_init(|| {
+            Registry::of_project(&vista_project::Project::builtin_only())
+                .unwrap_or_else(|e| panic!("a built-in manifest is invalid: {e}"))
+        })
+    }
+
+    pub fn kernels(&self) -> &[&'static Kernel] {
+        &self.kernels
+    }
+
+    /// Looks a kernel up by name.
+    pub fn find(&self, name: &str) -> Result<&'static Kernel, ParamError> {
+        self.kernels.iter().copied().find(|k| k.name() == name).ok_or_else(|| ParamError::UnknownKernel {
+            name: name.to_string(),
+            valid: self.kernels.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),
+        })
+    }
+}
+
+/// The built-in kernels, in the order `vista list` shows them.
+pub fn registry() -> &'static [&'static Kernel] {
+    Registry::builtin().kernels()
+}
+
+/// Looks a built-in kernel up by name.
+pub fn find(name: &str) -> Result<&'static Kernel, ParamError> {
+    Registry::builtin().find(name)
 }
 
 /// Largest width or height any request may ask for. Devices limit 2D storage

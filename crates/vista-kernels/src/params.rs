@@ -1,9 +1,10 @@
 //! Named, typed, range-checked kernel parameters.
 //!
-//! Every kernel declares its parameters as data (`ParamSpec`): name, kind with
-//! its allowed range, default and a one-line doc. `vista list`, `--set`,
-//! presets, golden cases and the manifest's params hash all go through this
-//! one table, so a value is validated the same way wherever it comes from.
+//! Every kernel declares its parameters as data in its manifest
+//! (`ParamSpec`: name, WGSL-facing type, kind with its allowed range,
+//! default and a one-line doc). `vista list`, `--set`, presets, golden cases
+//! and the manifest's params hash all go through this one table, so a value
+//! is validated the same way wherever it comes from.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -21,6 +22,52 @@ pub enum Kind {
     Vector { n: usize, min: f64, max: f64 },
     /// One name out of a fixed list.
     Enum(&'static [&'static str]),
+    /// true | false (also 1 | 0).
+    Bool,
+}
+
+/// The manifest's `type`: what the WGSL `Params` field must be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParamType {
+    U32,
+    I32,
+    F32,
+    /// Carried as u32 (0 or 1).
+    Bool,
+    /// `vecN<f32>`, N in 2..=4.
+    Vec(u8),
+    /// Carried as the u32 index of the value in its list.
+    Enum,
+}
+
+impl ParamType {
+    pub fn from_name(name: &str) -> Option<ParamType> {
+        Some(match name {
+            "u32" => ParamType::U32,
+            "i32" => ParamType::I32,
+            "f32" => ParamType::F32,
+            "bool" => ParamType::Bool,
+            "vec2" => ParamType::Vec(2),
+            "vec3" => ParamType::Vec(3),
+            "vec4" => ParamType::Vec(4),
+            "enum" => ParamType::Enum,
+            _ => return None,
+        })
+    }
+
+    /// The manifest's name of this type.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ParamType::U32 => "u32",
+            ParamType::I32 => "i32",
+            ParamType::F32 => "f32",
+            ParamType::Bool => "bool",
+            ParamType::Vec(2) => "vec2",
+            ParamType::Vec(3) => "vec3",
+            ParamType::Vec(_) => "vec4",
+            ParamType::Enum => "enum",
+        }
+    }
 }
 
 impl Kind {
@@ -45,6 +92,7 @@ impl Kind {
                 format!("{n} comma-separated numbers each in [{min}, {max}]")
             }
             Kind::Enum(names) => format!("one of {}", names.join("|")),
+            Kind::Bool => "true|false".into(),
         }
     }
 }
@@ -53,15 +101,10 @@ impl Kind {
 #[derive(Debug, Clone, Copy)]
 pub struct ParamSpec {
     pub name: &'static str,
+    pub ty: ParamType,
     pub kind: Kind,
     pub default: &'static str,
     pub doc: &'static str,
-}
-
-impl ParamSpec {
-    pub const fn new(name: &'static str, kind: Kind, default: &'static str, doc: &'static str) -> Self {
-        ParamSpec { name, kind, default, doc }
-    }
 }
 
 /// A named set of overrides on top of the defaults.
@@ -79,6 +122,7 @@ pub enum Value {
     Int(i64),
     Vector(Vec<f64>),
     Enum(&'static str),
+    Bool(bool),
 }
 
 impl fmt::Display for Value {
@@ -88,6 +132,7 @@ impl fmt::Display for Value {
             Value::Int(v) => write!(f, "{v}"),
             Value::Vector(v) => f.write_str(&v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(",")),
             Value::Enum(s) => f.write_str(s),
+            Value::Bool(b) => write!(f, "{b}"),
         }
     }
 }
@@ -129,6 +174,11 @@ pub fn parse_value(spec: &ParamSpec, text: &str) -> Result<Value, ParamError> {
             .find(|n| n.eq_ignore_ascii_case(t))
             .map(|n| Value::Enum(n))
             .ok_or_else(|| bad(spec.kind.range_text())),
+        Kind::Bool => match t {
+            "true" | "1" => Ok(Value::Bool(true)),
+            "false" | "0" => Ok(Value::Bool(false)),
+            _ => Err(bad(spec.kind.range_text())),
+        },
     }
 }
 
@@ -150,11 +200,13 @@ impl ParamSet {
     ) -> Result<ParamSet, ParamError> {
         let mut set = ParamSet { kernel, values: BTreeMap::new() };
         for spec in specs {
+            // Manifests are validated when parsed, defaults included.
             let v = parse_value(spec, spec.default)
                 .unwrap_or_else(|e| panic!("kernel {kernel}: default of {} is invalid: {e}", spec.name));
             set.values.insert(spec.name, v);
         }
-        if let Some(name) = preset {
+        // `default` always resolves: to the declared preset of that name, else the defaults.
+        if let Some(name) = preset.filter(|n| *n != "default" || presets.iter().any(|p| p.name == *n)) {
             let p = presets.iter().find(|p| p.name == name).ok_or_else(|| ParamError::UnknownPreset {
                 kernel: kernel.to_string(),
                 name: name.to_string(),
@@ -227,10 +279,15 @@ impl ParamSet {
             v => panic!("{}.{name} is {v:?}, not an enum", self.kernel),
         }
     }
-    /// Index of an enum value in its declared list (what the WGSL side sees).
-    pub fn choice_index(&self, name: &str, names: &[&str]) -> u32 {
-        let c = self.choice(name);
-        names.iter().position(|n| *n == c).expect("validated enum value") as u32
+    pub fn flag(&self, name: &str) -> bool {
+        match self.get(name) {
+            Value::Bool(b) => *b,
+            v => panic!("{}.{name} is {v:?}, not a bool", self.kernel),
+        }
+    }
+    /// The value of `name`, if the kernel has that param.
+    pub fn value(&self, name: &str) -> Option<&Value> {
+        self.values.get(name)
     }
 
     /// Sets one value by text (validated), for sweeps and tests.

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use vista_kernels::atmosphere::*;
-use vista_kernels::{Kernel, ParamError, ParamSet};
+use vista_kernels::{ParamError, ParamSet};
 
 fn sky(sun_deg: f64, alt: f64, view: u32, light: u32) -> Sky {
     Sky {

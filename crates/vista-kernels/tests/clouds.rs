@@ -3,7 +3,7 @@
 use vista_kernels::clouds::{
     Clouds, CloudsKernel, Profile, T_CUTOFF, analytic_weight, height_profile, ign, remap, white,
 };
-use vista_kernels::{Kernel, ParamError, ParamSet};
+use vista_kernels::{ParamError, ParamSet};
 
 fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
     let set: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();

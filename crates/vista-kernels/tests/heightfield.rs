@@ -2,7 +2,7 @@
 //! and fog (SPEC 3.4 and the heightfield line of SPEC 9). World unit: 1 km.
 
 use vista_kernels::heightfield::*;
-use vista_kernels::{Kernel, ParamError, ParamSet, pixel_uv};
+use vista_kernels::{ParamError, ParamSet, pixel_uv};
 
 fn params(preset: &str, sets: &[(&str, &str)]) -> Result<ParamSet, ParamError> {
     let o: Vec<(String, String)> = sets.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();

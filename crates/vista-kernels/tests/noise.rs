@@ -30,7 +30,7 @@ fn points3(tag: u64, n: usize, lo: f64, hi: f64) -> Vec<[f64; 3]> {
     (0..n).map(|_| [r.random_range(lo..hi), r.random_range(lo..hi), r.random_range(lo..hi)]).collect()
 }
 
-fn with(kernel: &dyn Kernel, set: &[(&str, &str)]) -> Result<ParamSet, ParamError> {
+fn with(kernel: &Kernel, set: &[(&str, &str)]) -> Result<ParamSet, ParamError> {
     let overrides: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
     kernel.resolve(None, &overrides)
 }

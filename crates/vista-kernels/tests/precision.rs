@@ -8,7 +8,7 @@ use vista_image::metrics::psnr;
 use vista_kernels::Kernel;
 
 /// Small sizes: the f64 heightfield oracle is the slow one.
-fn size_of_test(k: &dyn Kernel) -> (u32, u32) {
+fn size_of_test(k: &Kernel) -> (u32, u32) {
     if k.name() == "heightfield" { (32, 20) } else { (48, 32) }
 }
 
@@ -16,7 +16,7 @@ fn size_of_test(k: &dyn Kernel) -> (u32, u32) {
 fn f32_build_matches_the_f64_oracle_on_every_preset() {
     let mut failures = vec![];
     for k in vista_kernels::registry() {
-        let (w, h) = size_of_test(*k);
+        let (w, h) = size_of_test(k);
         for preset in k.presets() {
             let p = k.resolve(Some(preset.name), &[]).expect("presets are valid");
             let (r64, r32) = (k.reference(&p, w, h), k.reference_f32(&p, w, h));

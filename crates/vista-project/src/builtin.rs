@@ -25,4 +25,10 @@ pub const SHADERS: &[(&str, &str)] = embed!("shaders":
 );
 
 /// `kernels/` manifests: `(path relative to kernels/, text)`.
-pub const KERNELS: &[(&str, &str)] = &[];
+pub const KERNELS: &[(&str, &str)] = embed!("kernels":
+    "fbm.toml",
+    "ridged.toml",
+    "atmosphere.toml",
+    "clouds.toml",
+    "heightfield.toml",
+);

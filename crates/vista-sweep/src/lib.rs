@@ -65,7 +65,7 @@ pub type SweepPoint = (String, Option<String>, ParamSet);
 /// What to sweep.
 #[derive(Debug, Clone)]
 pub struct SweepSpec {
-    pub kernel: &'static dyn Kernel,
+    pub kernel: &'static Kernel,
     pub preset: Option<String>,
     /// Fixed overrides applied to every point and to the reference.
     pub base: Vec<(String, String)>,

@@ -1,0 +1,295 @@
+//! Kernel manifests (`kernels/<name>.toml`, SPEC 10): a kernel described as
+//! data. Parsing validates everything that data can get wrong (unknown keys,
+//! types, ranges, defaults, enum values, presets naming unknown params) and
+//! names the file, the kernel and the key.
+//!
+//! ```toml
+//! summary = "one line"             # shown by vista list
+//! shader = "hybrid.wgsl"           # under shaders/; default "<name>.wgsl"
+//! output = "display"               # display | hdr (PNG = 1 - exp(-exposure L), sRGB)
+//! display_alpha = "keep"           # keep | opaque (PNG alpha = 1; the RGB is already composited)
+//! work = ["octaves"]               # product of entries, each `name` or a sum `a + b + 3`
+//! output_range = [0.0, 1.0]        # NaN/range guard of the raw RGB (default: display [0, 1], hdr [0, inf))
+//! [[param]]
+//! name = "octaves"
+//! type = "u32"                     # u32 | i32 | f32 | bool | vec2 | vec3 | vec4 | enum
+//! range = [1, 16]                  # inclusive; required for numbers, per component for vectors
+//! open_min = false                 # optional: the lower bound is excluded
+//! default = 8
+//! doc = "number of octaves"
+//! [sweep_reference]                # optional: the high-quality settings sweeps compare against
+//! octaves = 16
+//! [preset.rough]                   # presets override defaults; `default` (the defaults) always resolves
+//! doc = "what it shows"            # optional
+//! octaves = 12
+//! ```
+
+use serde::Deserialize;
+
+use crate::params::{Kind, ParamSpec, ParamType, Preset, parse_value};
+use crate::{Output, ParamError};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawManifest {
+    summary: String,
+    shader: Option<String>,
+    #[serde(default = "default_output")]
+    output: String,
+    display_alpha: Option<String>,
+    #[serde(default)]
+    work: Vec<String>,
+    output_range: Option<[f64; 2]>,
+    #[serde(default, rename = "param")]
+    params: Vec<RawParam>,
+    #[serde(default)]
+    sweep_reference: toml::Table,
+    /// Ordered as written (toml's `preserve_order`), which `vista list` keeps.
+    #[serde(default)]
+    preset: toml::Table,
+}
+
+fn default_output() -> String {
+    "display".into()
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawParam {
+    name: String,
+    #[serde(rename = "type")]
+    ty: String,
+    range: Option<[f64; 2]>,
+    #[serde(default)]
+    open_min: bool,
+    values: Option<Vec<String>>,
+    default: toml::Value,
+    #[serde(default)]
+    doc: String,
+}
+
+/// One factor of the work estimate: a sum of params and constants.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WorkFactor {
+    pub params: Vec<&'static str>,
+    pub constant: f64,
+}
+
+/// A parsed, validated manifest. Strings are leaked: a process loads each
+/// project's manifests once and keeps its kernels for its whole life.
+#[derive(Debug, Clone)]
+pub struct Manifest {
+    pub name: &'static str,
+    pub summary: &'static str,
+    pub shader: &'static str,
+    pub output: Output,
+    pub opaque_display: bool,
+    pub work: Vec<WorkFactor>,
+    pub output_range: Option<(f64, f64)>,
+    pub params: &'static [ParamSpec],
+    pub presets: &'static [Preset],
+    pub sweep_reference: &'static [(&'static str, &'static str)],
+}
+
+fn leak(s: impl Into<String>) -> &'static str {
+    Box::leak(s.into().into_boxed_str())
+}
+
+/// Text form of a TOML value as `--set` would take it (vectors comma-separated).
+pub fn value_text(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Array(items) => items.iter().map(value_text).collect::<Vec<_>>().join(","),
+        other => other.to_string(),
+    }
+}
+
+/// Reserved names: the image size fields of every `Params` struct, and the
+/// preset table's doc key.
+const RESERVED: &[&str] = &["width", "height", "doc"];
+
+/// Parses `kernels/<name>.toml`. `origin` (a path, or `<built-in>/...`)
+/// prefixes every error, with line and column for TOML errors.
+pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamError> {
+    let fail = |message: String| ParamError::Manifest { file: origin.to_string(), message };
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        return Err(fail(format!("kernel name '{name}' must use only letters, digits, '-' and '_'")));
+    }
+    let raw: RawManifest = toml::from_str(text).map_err(|e| fail(vista_project::one_line_toml_error(text, &e)))?;
+    let kfail = |message: String| fail(format!("kernel {name}: {message}"));
+
+    let output = match raw.output.as_str() {
+        "display" => Output::Display,
+        "hdr" => Output::Hdr,
+        other => return Err(kfail(format!("output = \"{other}\" is not valid; expected display|hdr"))),
+    };
+    let opaque_display = match raw.display_alpha.as_deref() {
+        None | Some("keep") => false,
+        Some("opaque") => true,
+        Some(other) => return Err(kfail(format!("display_alpha = \"{other}\" is not valid; expected keep|opaque"))),
+    };
+
+    let mut params: Vec<ParamSpec> = Vec::new();
+    for p in &raw.params {
+        let pfail = |message: String| kfail(format!("param {}: {message}", p.name));
+        if p.name.is_empty() || !p.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(pfail("a name uses only letters, digits and '_' (it names a WGSL field)".into()));
+        }
+        if RESERVED.contains(&p.name.as_str()) {
+            return Err(pfail(format!("'{}' is reserved (width and height are the image size)", p.name)));
+        }
+        if params.iter().any(|q| q.name == p.name) {
+            return Err(pfail("declared twice".into()));
+        }
+        let ty = ParamType::from_name(&p.ty).ok_or_else(|| {
+            pfail(format!("type = \"{}\" is not valid; expected u32|i32|f32|bool|vec2|vec3|vec4|enum", p.ty))
+        })?;
+        let range = |limits: (f64, f64)| -> Result<(f64, f64), ParamError> {
+            let [lo, hi] = p.range.ok_or_else(|| pfail(format!("type {} needs range = [min, max]", p.ty)))?;
+            if !(lo.is_finite() && hi.is_finite()) || lo > hi {
+                return Err(pfail(format!("range = [{lo}, {hi}] is not valid; expected finite min <= max")));
+            }
+            if lo < limits.0 || hi > limits.1 {
+                return Err(pfail(format!(
+                    "range = [{lo}, {hi}] exceeds what {} holds: [{}, {}]",
+                    p.ty, limits.0, limits.1
+                )));
+            }
+            Ok((lo, hi))
+        };
+        let no_range = |what: &str| -> Result<(), ParamError> {
+            match p.range {
+                Some(_) => Err(pfail(format!("type {what} takes no range"))),
+                None => Ok(()),
+            }
+        };
+        let int = |r: (f64, f64)| -> Result<(i64, i64), ParamError> {
+            if r.0.fract() != 0.0 || r.1.fract() != 0.0 {
+                return Err(pfail(format!("range = [{}, {}] of an integer type must be whole numbers", r.0, r.1)));
+            }
+            Ok((r.0 as i64, r.1 as i64))
+        };
+        let kind = match ty {
+            ParamType::U32 => {
+                let (min, max) = int(range((0.0, u32::MAX as f64))?)?;
+                Kind::Int { min, max }
+            }
+            ParamType::I32 => {
+                let (min, max) = int(range((i32::MIN as f64, i32::MAX as f64))?)?;
+                Kind::Int { min, max }
+            }
+            ParamType::F32 => {
+                let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
+                Kind::Float { min, max, open_min: p.open_min }
+            }
+            ParamType::Vec(n) => {
+                let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
+                Kind::Vector { n: n as usize, min, max }
+            }
+            ParamType::Bool => {
+                no_range("bool")?;
+                Kind::Bool
+            }
+            ParamType::Enum => {
+                no_range("enum")?;
+                let values = p.values.as_ref().filter(|v| !v.is_empty()).ok_or_else(|| {
+                    pfail("type enum needs values = [\"a\", \"b\", ...] (WGSL receives the index as u32)".into())
+                })?;
+                for (i, v) in values.iter().enumerate() {
+                    if v.is_empty() || values[..i].contains(v) {
+                        return Err(pfail(format!("values: '{v}' is empty or repeated")));
+                    }
+                }
+                Kind::Enum(Box::leak(values.iter().map(|v| leak(v.as_str())).collect::<Vec<_>>().into_boxed_slice()))
+            }
+        };
+        if p.values.is_some() && ty != ParamType::Enum {
+            return Err(pfail(format!("values is only for type enum, not {}", p.ty)));
+        }
+        if p.open_min && !matches!(ty, ParamType::F32) {
+            return Err(pfail("open_min is only for type f32".into()));
+        }
+        let spec = ParamSpec {
+            name: leak(p.name.as_str()),
+            ty,
+            kind,
+            default: leak(value_text(&p.default)),
+            doc: leak(p.doc.as_str()),
+        };
+        parse_value(&spec, spec.default).map_err(|e| pfail(format!("default: {e}")))?;
+        params.push(spec);
+    }
+    let params: &'static [ParamSpec] = Box::leak(params.into_boxed_slice());
+    let find = |pname: &str, context: &str| -> Result<&'static ParamSpec, ParamError> {
+        params.iter().find(|s| s.name == pname).ok_or_else(|| {
+            kfail(format!(
+                "{context} names unknown param '{pname}'; valid params: {}",
+                params.iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+            ))
+        })
+    };
+    let settings =
+        |table: &toml::Table, context: &str| -> Result<&'static [(&'static str, &'static str)], ParamError> {
+            let mut out = Vec::new();
+            for (k, v) in table {
+                let spec = find(k, context)?;
+                let text = value_text(v);
+                parse_value(spec, &text).map_err(|e| kfail(format!("{context}: {e}")))?;
+                out.push((spec.name, leak(text)));
+            }
+            Ok(Box::leak(out.into_boxed_slice()))
+        };
+
+    let mut presets = Vec::new();
+    for (pname, table) in &raw.preset {
+        let Some(mut table) = table.as_table().cloned() else {
+            return Err(kfail(format!("preset {pname} must be a table ([preset.{pname}] with name = value lines)")));
+        };
+        let doc = match table.remove("doc") {
+            None => String::new(),
+            Some(toml::Value::String(s)) => s,
+            Some(other) => return Err(kfail(format!("preset {pname}: doc = {other} must be a string"))),
+        };
+        let set = settings(&table, &format!("preset {pname}"))?;
+        presets.push(Preset { name: leak(pname.as_str()), doc: leak(doc), set });
+    }
+    let sweep_reference = settings(&raw.sweep_reference, "sweep_reference")?;
+
+    let mut work = Vec::new();
+    for entry in &raw.work {
+        let mut factor = WorkFactor { params: Vec::new(), constant: 0.0 };
+        for term in entry.split('+').map(str::trim) {
+            if let Ok(c) = term.parse::<f64>() {
+                factor.constant += c;
+                continue;
+            }
+            let spec = find(term, &format!("work entry \"{entry}\""))?;
+            if !matches!(spec.kind, Kind::Int { .. } | Kind::Float { .. }) {
+                return Err(kfail(format!("work entry \"{entry}\": '{term}' is not a number param")));
+            }
+            factor.params.push(spec.name);
+        }
+        work.push(factor);
+    }
+    if let Some([lo, hi]) = raw.output_range
+        && (lo.is_nan() || hi.is_nan() || lo > hi)
+    {
+        return Err(kfail(format!("output_range = [{lo}, {hi}] is not valid; expected min <= max")));
+    }
+    if output == Output::Hdr && !params.iter().any(|p| p.name == "exposure" && matches!(p.kind, Kind::Float { .. })) {
+        return Err(kfail("output = \"hdr\" needs an f32 param named exposure (the PNG tone map)".into()));
+    }
+    let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
+    Ok(Manifest {
+        name: leak(name),
+        summary: leak(raw.summary),
+        shader: leak(shader),
+        output,
+        opaque_display,
+        work,
+        output_range: raw.output_range.map(|[a, b]| (a, b)),
+        params,
+        presets: Box::leak(presets.into_boxed_slice()),
+        sweep_reference,
+    })
+}
