@@ -25,6 +25,8 @@ macro_rules! cpu_references {
         pub use common::*;
         #[path = "cpu/atmosphere.rs"]
         pub mod atmosphere;
+        #[path = "cpu/cloudmap.rs"]
+        pub mod cloudmap;
         #[path = "cpu/clouds.rs"]
         pub mod clouds;
         #[path = "cpu/fbm.rs"]
@@ -60,6 +62,7 @@ pub mod cpu32;
 pub mod cpu64;
 
 pub mod atmosphere;
+pub mod cloudmap;
 pub mod clouds;
 pub mod fbm;
 pub mod heightfield;
@@ -137,6 +140,7 @@ pub fn cpu_reference(name: &str) -> Option<&'static dyn CpuReference> {
         "atmosphere" => &atmosphere::AtmosphereKernel,
         "clouds" => &clouds::CloudsKernel,
         "heightfield" => &heightfield::HeightfieldKernel,
+        "cloudmap" => &cloudmap::CloudmapKernel,
         _ => return None,
     })
 }

@@ -22,6 +22,7 @@ pub const SHADERS: &[(&str, &str)] = embed!("shaders":
     "atmosphere.wgsl",
     "heightfield.wgsl",
     "clouds.wgsl",
+    "cloudmap.wgsl",
 );
 
 /// `kernels/` manifests: `(path relative to kernels/, text)`.
@@ -31,4 +32,5 @@ pub const KERNELS: &[(&str, &str)] = embed!("kernels":
     "atmosphere.toml",
     "clouds.toml",
     "heightfield.toml",
+    "cloudmap.toml",
 );
