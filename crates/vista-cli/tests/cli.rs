@@ -864,3 +864,76 @@ fn malformed_manifest_names_file_line_and_column() {
     );
     assert_rejected(&vista_in(Some(d.path()), &[], &["list"]), 2, &["kernels/k.toml: line 1"]);
 }
+
+// ---- examples/project: a project outside the built-ins ---------------------
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let (src, dst) = (e.path(), to.join(e.file_name()));
+        if e.file_name() == "target" {
+            continue;
+        }
+        if src.is_dir() { copy_tree(&src, &dst) } else { std::fs::copy(&src, &dst).map(|_| ()).unwrap() }
+    }
+}
+
+/// The shipped example, copied with a copied binary to a directory outside
+/// the repository: list, render (PNG and EXR), check against its committed
+/// goldens, bless, sweep, bench, and its params range-checked like the
+/// built-ins'.
+#[test]
+fn the_example_project_works_with_a_copied_binary() {
+    let t = tmp();
+    let (bin, root) = (t.path().join("vista"), t.path().join("project"));
+    std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
+    copy_tree(&repo().join("examples/project"), &root);
+    let run = |args: &[&str]| run_in(&bin, &root, &[], args);
+
+    let list = run(&["list"]);
+    assert_eq!(list.code, 0, "{}", list.stderr);
+    assert!(list.stdout.contains("marble — ") && list.stdout.contains("turbulence"), "{}", list.stdout);
+    for out in ["m.png", "m.exr"] {
+        let r = run(&["render", "marble", "--preset", "calm", "--set", "base=1,0.9,0.8", "--size", "64x48", "-o", out]);
+        assert_eq!(r.code, 0, "{out}: {}", r.stderr);
+        let img = vista_image::load(&root.join(out)).unwrap();
+        assert_eq!((img.width, img.height), (64, 48));
+    }
+    let check = run(&["check"]);
+    assert_eq!(check.code, 0, "committed goldens: {}{}", check.stdout, check.stderr);
+    assert!(check.stdout.contains("2 passed, 0 failed"), "{}", check.stdout);
+    assert!(root.join("target/vista-report/index.html").exists());
+    let bless = run(&["bless", "--case", "marble-calm"]);
+    assert_eq!(bless.code, 0, "{}", bless.stderr);
+    assert!(bless.stdout.contains("marble-calm") && bless.stdout.contains("unchanged"), "{}", bless.stdout);
+    let sweep = run(&[
+        "sweep",
+        "marble",
+        "--param",
+        "turbulence",
+        "--values",
+        "0.5,1,2",
+        "--reference-set",
+        "turbulence=2",
+        "--size",
+        "32x32",
+        "--runs",
+        "1",
+        "--out",
+        "sweep",
+    ]);
+    assert_eq!(sweep.code, 0, "{}", sweep.stderr);
+    assert!(root.join("sweep/curve.csv").exists());
+    let bench = run(&["bench", "marble", "--size", "64x64", "--runs", "2", "--json"]);
+    assert_eq!(bench.code, 0, "{}", bench.stderr);
+    assert!(bench.stdout.contains("\"mpix_per_s\":"), "{}", bench.stdout);
+    assert_rejected(&run(&["render", "marble", "--set", "stripes=100", "-o", "x.png"]), 2, &["stripes=100", "[0, 64]"]);
+    assert_rejected(
+        &run(&["render", "marble", "--set", "base=1,2", "-o", "x.png"]),
+        2,
+        &["base=1,2", "3 comma-separated"],
+    );
+    assert_rejected(&run(&["bench", "marble", "--cpu", "--size", "8x8"]), 2, &["marble has no CPU reference"]);
+    // The built-ins are still there, from the embedded sources.
+    assert_eq!(run(&["render", "fbm", "--size", "16x16", "-o", "f.png"]).code, 0);
+}
