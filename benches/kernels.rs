@@ -1,9 +1,9 @@
 //! Every kernel's default preset at 256 x 256: GPU (lavapipe by default,
 //! `VISTA_ADAPTER=gpu` for hardware) beside its CPU reference on all cores,
 //! built in f32 (the CPU doing the GPU's work at the GPU's precision) and in
-//! f64 (the oracle). The heightfield reference is a brute-force oracle, so
-//! heightfield also runs the shader's own relax march on the CPU in f32: the
-//! like-for-like ratio. Device creation and shader compilation happen before
+//! f64 (the oracle). A kernel whose reference is a different algorithm
+//! (heightfield's brute-force oracle) also runs the shader's own algorithm on
+//! the CPU in f32 (`Kernel::shader_algorithm_f32`): the like-for-like ratio. Device creation and shader compilation happen before
 //! measurement. Prints the medians and ratios after each kernel.
 //!
 //! The heightfield oracle takes about 20 s per 256 x 256 image on 2 cores,
@@ -15,7 +15,6 @@ mod common;
 use criterion::{Bencher, Criterion, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
 use vista_kernels::Kernel;
-use vista_kernels::heightfield::HitSearch;
 
 const SIZE: (u32, u32) = (256, 256);
 
@@ -66,10 +65,10 @@ fn kernels(c: &mut Criterion) {
                 k.reference(&p, w, h);
             })
         });
-        if k.name() == "heightfield" {
-            g.bench_function(format!("cpu f32 relax march 256x256 ({threads} threads)"), |b| {
+        if k.shader_algorithm_f32(&p, 1, 1).is_some() {
+            g.bench_function(format!("cpu f32 shader algorithm 256x256 ({threads} threads)"), |b| {
                 timed(b, &mut march, || {
-                    vista_kernels::cpu32::heightfield::render(&p, w, h, HitSearch::RelaxMarch).expect("valid");
+                    k.shader_algorithm_f32(&p, w, h);
                 })
             });
         }
@@ -77,7 +76,7 @@ fn kernels(c: &mut Criterion) {
         let Some(gpu) = median_ms(gpu) else { continue };
         let mut line = format!("{}: gpu {gpu:.2} ms ({})", k.name(), ctx.adapter_description());
         for (what, v) in
-            [("cpu f32 reference", f32_ref), ("cpu f64 reference", f64_ref), ("cpu f32 relax march", march)]
+            [("cpu f32 reference", f32_ref), ("cpu f64 reference", f64_ref), ("cpu f32 shader algorithm", march)]
         {
             if let Some(ms) = median_ms(v) {
                 line += &format!("; {what} {ms:.2} ms = {:.2}x the gpu time", ms / gpu);

@@ -53,7 +53,7 @@ const TERRAIN_PLANE: u32 = 2u;
 const REFINE_ITERS: u32 = 16u;
 const REFINE_TOL: f32 = 0.01;
 
-// Shading colours (linear), as in heightfield.rs.
+// Shading colours (linear), the same constants as crates/vista-kernels/src/cpu/heightfield.rs.
 const SUN_COLOR = vec3(1.0, 0.92, 0.78);
 const AMBIENT = vec3(0.16, 0.22, 0.32);
 const SKY_HORIZON = vec3(0.60, 0.70, 0.82);

@@ -8,8 +8,7 @@ use vista_kernels::ParamSet;
 use vista_kernels::cloudmap::{CloudmapKernel, frame_change_bound};
 
 fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
-    let o: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-    CloudmapKernel.resolve(Some(preset), &o).unwrap()
+    common::params(&CloudmapKernel, Some(preset), set)
 }
 
 #[test]

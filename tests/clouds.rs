@@ -12,8 +12,7 @@ use vista_kernels::ParamSet;
 use vista_kernels::clouds::CloudsKernel;
 
 fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
-    let set: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-    CloudsKernel.resolve(Some(preset), &set).expect("valid test params")
+    common::params(&CloudsKernel, Some(preset), set)
 }
 
 fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {

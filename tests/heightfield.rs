@@ -14,8 +14,7 @@ const W: u32 = 64;
 const H: u32 = 40;
 
 fn params(preset: &str, sets: &[(&str, &str)]) -> ParamSet {
-    let o: Vec<(String, String)> = sets.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-    HeightfieldKernel.resolve(Some(preset), &o).unwrap_or_else(|e| panic!("{preset} {sets:?}: {e}"))
+    common::params(&HeightfieldKernel, Some(preset), sets)
 }
 
 fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet) -> Image {

@@ -5,10 +5,7 @@ mod common;
 use vista_image::Image;
 use vista_kernels::{Kernel, ParamSet, noise};
 
-fn params(kernel: &Kernel, preset: Option<&str>, set: &[(&str, &str)]) -> ParamSet {
-    let set: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-    kernel.resolve(preset, &set).expect("valid test params")
-}
+use common::params;
 
 /// Max |GPU - CPU| over the raw R channel (the field itself).
 fn max_field_error(gpu: &Image, cpu: &Image) -> (f32, (u32, u32)) {

@@ -7,7 +7,15 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use vista_golden::{Renderer, allow_no_gpu};
+use vista_kernels::{Kernel, ParamSet};
 use vista_project::Project;
+
+/// `kernel`'s params from a preset and `name=value` overrides; panics with
+/// the error on bad test input.
+pub fn params(kernel: &Kernel, preset: Option<&str>, set: &[(&str, &str)]) -> ParamSet {
+    let o: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    kernel.resolve(preset, &o).unwrap_or_else(|e| panic!("{} {preset:?} {set:?}: {e}", kernel.name()))
+}
 
 /// This checkout as a project (its `vista.toml`, `shaders/`, `golden/`).
 pub fn project() -> Project {

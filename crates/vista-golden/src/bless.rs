@@ -110,7 +110,6 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
                 date: now_utc(),
                 raw_hash: r.raw.content_hash(),
                 psnr_vs_previous: psnr.clone(),
-                psnr_vs_cpu: None,
             },
         );
         store.write_manifest(&manifest)?;

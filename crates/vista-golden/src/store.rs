@@ -26,10 +26,6 @@ pub struct ManifestEntry {
     pub raw_hash: String,
     /// PSNR of this golden against the one it replaced ("new" if none).
     pub psnr_vs_previous: String,
-    /// PSNR / max-abs of the GPU raw output against the f64 CPU reference,
-    /// where the kernel's reference was run at bless time.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub psnr_vs_cpu: Option<String>,
 }
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]

@@ -94,4 +94,8 @@ impl CpuReference for HeightfieldKernel {
         crate::cpu32::heightfield::render(p, width, height, HitSearch::BruteForce)
             .expect("heightfield: parameters not validated by check()")
     }
+    /// The oracle marches with fixed steps; the shader's relax march is the fair baseline.
+    fn shader_algorithm_f32(&self, p: &ParamSet, width: u32, height: u32) -> Option<Image> {
+        crate::cpu32::heightfield::render(p, width, height, HitSearch::RelaxMarch).ok()
+    }
 }

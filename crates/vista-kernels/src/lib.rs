@@ -130,6 +130,12 @@ pub trait CpuReference: Send + Sync {
     fn output_bounds(&self, _p: &ParamSet) -> Option<(f32, f32)> {
         None
     }
+    /// The shader's own algorithm run on the CPU in f32, for a kernel whose
+    /// reference is a different (slower) algorithm: the like-for-like bench
+    /// baseline. `None` when the reference already is that algorithm.
+    fn shader_algorithm_f32(&self, _p: &ParamSet, _width: u32, _height: u32) -> Option<Image> {
+        None
+    }
 }
 
 /// The CPU reference registered for a kernel name, if any.
@@ -274,6 +280,12 @@ impl Kernel {
     /// If no reference is registered (check [`Kernel::has_reference`]).
     pub fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
         self.cpu.unwrap_or_else(|| panic!("kernel {} has no CPU reference", self.name())).reference(p, width, height)
+    }
+
+    /// The shader's algorithm on the CPU in f32 where the reference differs
+    /// from it (see [`CpuReference::shader_algorithm_f32`]).
+    pub fn shader_algorithm_f32(&self, p: &ParamSet, width: u32, height: u32) -> Option<Image> {
+        self.cpu.and_then(|c| c.shader_algorithm_f32(p, width, height))
     }
 
     /// The f32 build of the CPU reference (bench baseline).
