@@ -215,3 +215,81 @@ pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, h
     }
     bytes
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MANIFEST: &str = r#"summary = "nested"
+[[param]]
+name = "pos"
+type = "vec3"
+range = [-10, 10]
+default = [1, 2, 3]
+[[param]]
+name = "fov"
+type = "f32"
+range = [1, 90]
+default = 45
+[[param]]
+name = "mode"
+type = "enum"
+values = ["a", "b", "c"]
+default = "c"
+[[param]]
+name = "flip"
+type = "bool"
+default = true
+[[param]]
+name = "shift"
+type = "i32"
+range = [-5, 5]
+default = -3
+"#;
+
+    fn module(params_struct: &str) -> naga::Module {
+        let src = format!(
+            "{params_struct}\n@group(0) @binding(0) var<uniform> params: Params;\n\
+             @compute @workgroup_size(8, 8) fn main() {{ let w = params.width; }}\n"
+        );
+        naga::front::wgsl::parse_str(&src).unwrap()
+    }
+
+    #[test]
+    fn nested_structs_vec3_enum_bool_and_i32_pack_at_naga_offsets() {
+        let k = Kernel::from_manifest("nested", "nested.toml", MANIFEST).unwrap();
+        let m = module(
+            "struct Camera { pos: vec3<f32>, fov: f32 }\n\
+             struct Params { width: u32, height: u32, camera: Camera, mode: u32, flip: u32, shift: i32 }",
+        );
+        let layout = k.layout(&m).unwrap();
+        let at = |n: &str| layout.fields.iter().find(|f| f.name == n).map(|f| (f.path.clone(), f.offset)).unwrap();
+        // vec3 aligns to 16: camera starts at 16, fov packs into pos's padding.
+        assert_eq!(at("pos"), ("camera.pos".to_string(), 16));
+        assert_eq!(at("fov"), ("camera.fov".to_string(), 28));
+        assert_eq!(at("mode").1, 32);
+        assert!(!layout.uses_table);
+        let p = k.resolve(None, &[]).unwrap();
+        let b = k.uniforms(&layout, &p, 7, 5);
+        let word = |o: usize| u32::from_le_bytes(b[o..o + 4].try_into().unwrap());
+        assert_eq!((word(0), word(4)), (7, 5));
+        assert_eq!([f32::from_bits(word(16)), f32::from_bits(word(20)), f32::from_bits(word(24))], [1.0, 2.0, 3.0]);
+        assert_eq!(f32::from_bits(word(28)), 45.0);
+        assert_eq!((word(32), word(36), word(40) as i32), (2, 1, -3));
+        assert_eq!(b.len() % 16, 0);
+    }
+
+    #[test]
+    fn duplicate_leaf_names_and_unsupported_types_are_refused() {
+        let k = Kernel::from_manifest("nested", "nested.toml", MANIFEST).unwrap();
+        let m = module("struct A { fov: f32 }\nstruct Params { width: u32, height: u32, a: A, fov: f32 }");
+        let e = k.layout(&m).unwrap_err().to_string();
+        assert!(e.contains("Params fields a.fov and fov share the name 'fov'"), "{e}");
+        let m = module("struct Params { width: u32, height: u32, m: mat2x2<f32> }");
+        let e = k.layout(&m).unwrap_err().to_string();
+        assert!(e.contains("Params field m is a matrix"), "{e}");
+        let m = module("struct Params { width: u32, height: f32 }");
+        let e = k.layout(&m).unwrap_err().to_string();
+        assert!(e.contains("Params field height is WGSL f32 but the image size is u32"), "{e}");
+    }
+}
