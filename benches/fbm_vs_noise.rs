@@ -23,7 +23,7 @@ fn noise_crate_fbm(f: &Fbm<Perlin>) -> Vec<f64> {
 }
 
 fn fbm_vs_noise(c: &mut Criterion) {
-    let ctx = common::gpu_for_test("bench").expect("a GPU adapter (bash ci/install-lavapipe.sh)");
+    let ctx = common::gpu_for_bench();
     let k = vista_kernels::find("fbm").unwrap();
     let p = k.resolve(None, &[("basis".into(), "perlin".into()), ("octaves".into(), "8".into())]).unwrap();
     let noise_fbm = Fbm::<Perlin>::new(0).set_octaves(8).set_frequency(1.0).set_lacunarity(2.0).set_persistence(0.5);

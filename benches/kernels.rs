@@ -40,7 +40,7 @@ fn median_ms(v: Vec<Duration>) -> Option<f64> {
 }
 
 fn kernels(c: &mut Criterion) {
-    let ctx = common::gpu_for_test("bench").expect("a GPU adapter (bash ci/install-lavapipe.sh)");
+    let ctx = common::gpu_for_bench();
     let (w, h) = SIZE;
     let threads = rayon::current_num_threads();
     for k in vista_kernels::registry() {

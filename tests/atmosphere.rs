@@ -27,11 +27,7 @@ fn samples(view: u32, light: u32) -> [(&'static str, String); 2] {
 
 /// Same discrete scheme on both sides: only f32 vs f64 (and the GPU's
 /// camera-relative altitude formula vs the CPU's |p| - R_ground) differ.
-#[test]
-fn gpu_matches_cpu_at_the_same_settings() {
-    let Some(ctx) = common::gpu_for_test("atmosphere::gpu_matches_cpu_at_the_same_settings") else {
-        return;
-    };
+fn gpu_matches_cpu_at_the_same_settings(ctx: &vista_golden::Renderer) {
     for preset in ["noon", "afternoon", "sunset", "twilight", "high_altitude"] {
         let p = params(Some(preset), &[]);
         let (cpu, gpu) = (K.reference(&p, 48, 24), gpu(ctx, &p, 48, 24));
@@ -56,11 +52,7 @@ fn gpu_matches_cpu_at_the_same_settings() {
 /// runs at 512 x 128: on 64 x 32 images it is within 96-138 dB (peak = max)
 /// of the CPU at 1024 x 256 for every preset, far beyond the 45 dB asked
 /// here, at a quarter of the cost (1024 x 256 takes ~1.5 s per preset).
-#[test]
-fn gpu_high_quality_matches_converged_cpu() {
-    let Some(ctx) = common::gpu_for_test("atmosphere::gpu_high_quality_matches_converged_cpu") else {
-        return;
-    };
+fn gpu_high_quality_matches_converged_cpu(ctx: &vista_golden::Renderer) {
     let (w, h) = (32, 16);
     // afternoon is noon's geometry at another sun angle; left out for time.
     for preset in ["noon", "sunset", "twilight", "high_altitude"] {
@@ -83,11 +75,7 @@ fn mean_rgb(img: &Image, rows: std::ops::Range<u32>) -> [f64; 3] {
     s.map(|v| v / (img.width * rows.len() as u32) as f64)
 }
 
-#[test]
-fn gpu_sky_invariants() {
-    let Some(ctx) = common::gpu_for_test("atmosphere::gpu_sky_invariants") else {
-        return;
-    };
+fn gpu_sky_invariants(ctx: &vista_golden::Renderer) {
     let (w, h) = (64, 32);
     let render = |preset: &str| gpu(ctx, &params(Some(preset), &[]), w, h);
     let (noon, afternoon, sunset, twilight) =
@@ -155,11 +143,7 @@ fn gpu_sky_invariants() {
 
 /// Finite, non-negative and within `output_bounds` over the whole range of
 /// sun elevations and camera altitudes (and the extreme mie_g), tiny images.
-#[test]
-fn gpu_finite_over_the_parameter_grid() {
-    let Some(ctx) = common::gpu_for_test("atmosphere::gpu_finite_over_the_parameter_grid") else {
-        return;
-    };
+fn gpu_finite_over_the_parameter_grid(ctx: &vista_golden::Renderer) {
     let suns = [-10.0, -6.0, -2.0, -0.01, 0.0, 0.01, 1.0, 5.0, 20.0, 45.0, 75.0, 89.99, 90.0];
     let alts = [0.0, 0.5, 10.0, 1000.0, 8000.0, 30_000.0, 59_990.0, 60_000.0, 60_010.0, 100_000.0];
     for sun in suns {
@@ -201,11 +185,7 @@ fn gpu_finite_over_the_parameter_grid() {
     assert!(gpu(ctx, &p, 8, 4).data.iter().all(|px| px.iter().all(|c| c.is_finite())));
 }
 
-#[test]
-fn exr_round_trip_is_bit_identical() {
-    let Some(ctx) = common::gpu_for_test("atmosphere::exr_round_trip_is_bit_identical") else {
-        return;
-    };
+fn exr_round_trip_is_bit_identical(ctx: &vista_golden::Renderer) {
     let raw = gpu(ctx, &params(Some("sunset"), &[]), 32, 16);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sunset.exr");
@@ -213,4 +193,14 @@ fn exr_round_trip_is_bit_identical() {
     let back = vista_image::load(&path).unwrap();
     assert!(back.bit_identical(&raw), "EXR round trip changed the radiance");
     assert!(raw.data.iter().any(|p| p[0] > 1.0), "the sunset render should hold HDR values above 1");
+}
+
+fn main() {
+    common::run_gpu_tests(&[
+        ("gpu_matches_cpu_at_the_same_settings", gpu_matches_cpu_at_the_same_settings),
+        ("gpu_high_quality_matches_converged_cpu", gpu_high_quality_matches_converged_cpu),
+        ("gpu_sky_invariants", gpu_sky_invariants),
+        ("gpu_finite_over_the_parameter_grid", gpu_finite_over_the_parameter_grid),
+        ("exr_round_trip_is_bit_identical", exr_round_trip_is_bit_identical),
+    ]);
 }

@@ -11,11 +11,7 @@ fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
     common::params(&CloudmapKernel, Some(preset), set)
 }
 
-#[test]
-fn gpu_matches_f64_reference_on_every_preset() {
-    let Some(ctx) = common::gpu_for_test("cloudmap gpu vs cpu") else {
-        return;
-    };
+fn gpu_matches_f64_reference_on_every_preset(ctx: &vista_golden::Renderer) {
     let (w, h) = (128, 96);
     let mut settings: Vec<(String, ParamSet)> =
         CloudmapKernel.presets().iter().map(|p| (p.name.to_string(), params(p.name, &[]))).collect();
@@ -32,11 +28,7 @@ fn gpu_matches_f64_reference_on_every_preset() {
     }
 }
 
-#[test]
-fn gpu_invariants_cover_and_frames() {
-    let Some(ctx) = common::gpu_for_test("cloudmap invariants") else {
-        return;
-    };
+fn gpu_invariants_cover_and_frames(ctx: &vista_golden::Renderer) {
     let render =
         |set: &[(&str, &str)]| vista_golden::render(ctx, &CloudmapKernel, &params("default", set), 64, 64).unwrap().raw;
     for basis in ["value", "perlin"] {
@@ -56,4 +48,11 @@ fn gpu_invariants_cover_and_frames() {
         assert!(d <= bound, "frame {frame}: change {d} > bound {bound}");
         assert!(d > 0.0, "frame {frame}: time does not animate");
     }
+}
+
+fn main() {
+    common::run_gpu_tests(&[
+        ("gpu_matches_f64_reference_on_every_preset", gpu_matches_f64_reference_on_every_preset),
+        ("gpu_invariants_cover_and_frames", gpu_invariants_cover_and_frames),
+    ]);
 }

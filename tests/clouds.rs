@@ -21,11 +21,7 @@ fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
 
 /// PSNR on the raw linear radiance with peak = the reference's max RGB
 /// (vista_image::metrics::compare_hdr).
-#[test]
-fn gpu_matches_f64_reference() {
-    let Some(ctx) = common::gpu_for_test("clouds gpu vs cpu") else {
-        return;
-    };
+fn gpu_matches_f64_reference(ctx: &vista_golden::Renderer) {
     let (w, h) = (48, 48);
     for preset in ["cumulus", "cirrus", "cumulonimbus"] {
         for (integrator, jitter) in [("riemann", "none"), ("analytic", "ign"), ("analytic", "white")] {
@@ -53,11 +49,7 @@ fn gpu_matches_f64_reference() {
 }
 
 /// Coverage 0: exactly the background (bit for bit) and alpha exactly 0.
-#[test]
-fn zero_coverage_is_exactly_the_background() {
-    let Some(ctx) = common::gpu_for_test("clouds zero coverage") else {
-        return;
-    };
+fn zero_coverage_is_exactly_the_background(ctx: &vista_golden::Renderer) {
     let sky = [0.3f32, 0.5, 0.9];
     for preset in ["clear", "cumulus", "cumulonimbus"] {
         let p = params(preset, &[("coverage", "0"), ("sky_zenith", "0.3,0.5,0.9"), ("sky_horizon", "0.3,0.5,0.9")]);
@@ -86,11 +78,7 @@ fn zero_coverage_is_exactly_the_background() {
 }
 
 /// Doubling density_scale never raises T: alpha = 1 - T never falls.
-#[test]
-fn doubling_density_never_raises_transmittance() {
-    let Some(ctx) = common::gpu_for_test("clouds density monotone") else {
-        return;
-    };
+fn doubling_density_never_raises_transmittance(ctx: &vista_golden::Renderer) {
     for (preset, d) in [("cumulus", "40"), ("cirrostratus", "0.25"), ("stratocumulus", "4")] {
         let d2 = (d.parse::<f64>().unwrap() * 2.0).to_string();
         let a = gpu(ctx, &params(preset, &[("density_scale", d)]), 40, 40);
@@ -110,11 +98,7 @@ fn doubling_density_never_raises_transmittance() {
 }
 
 /// With the sun behind the camera the backward lobe keeps clouds lit.
-#[test]
-fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind() {
-    let Some(ctx) = common::gpu_for_test("clouds dual lobe") else {
-        return;
-    };
+fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind(ctx: &vista_golden::Renderer) {
     let sun_behind = [("sun_azimuth_deg", "180"), ("sun_elevation_deg", "30"), ("yaw_deg", "0")];
     let dual = gpu(ctx, &params("cumulus", &[&sun_behind[..], &[("phase_blend", "0.5")]].concat()), 40, 40);
     let single = gpu(ctx, &params("cumulus", &[&sun_behind[..], &[("phase_blend", "0")]].concat()), 40, 40);
@@ -134,11 +118,7 @@ fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind() {
     assert!(ratio > 1.1, "dual-lobe HG only {ratio:.3}x as bright as single-lobe with the sun behind");
 }
 
-#[test]
-fn renders_are_deterministic_and_jitter_follows_its_seed() {
-    let Some(ctx) = common::gpu_for_test("clouds determinism") else {
-        return;
-    };
+fn renders_are_deterministic_and_jitter_follows_its_seed(ctx: &vista_golden::Renderer) {
     let (w, h) = (32, 32);
     let none = params("cumulus", &[]);
     assert!(gpu(ctx, &none, w, h).bit_identical(&gpu(ctx, &none, w, h)), "jitter none: renders differ");
@@ -156,11 +136,7 @@ fn renders_are_deterministic_and_jitter_follows_its_seed() {
 /// the 512 x 32 reference comes from the f64 CPU march (the same march,
 /// 10x faster than lavapipe here). The full-size version is the CPU test
 /// `seed_experiment_analytic_ign_at_half_the_steps_beats_riemann_64x12`.
-#[test]
-fn seed_experiment_on_the_gpu() {
-    let Some(ctx) = common::gpu_for_test("clouds seed experiment") else {
-        return;
-    };
+fn seed_experiment_on_the_gpu(ctx: &vista_golden::Renderer) {
     let (w, h) = (48, 48);
     let mut hq: Vec<(&str, &str)> = CloudsKernel.high_quality().to_vec();
     hq.push(("jitter", "none"));
@@ -179,4 +155,21 @@ fn seed_experiment_on_the_gpu() {
     let cpu_fast = CloudsKernel.reference(&fast_p, w, h);
     let agree = compare_hdr(&cpu_fast, &fast).unwrap().psnr;
     assert!(agree >= 50.0, "GPU vs CPU analytic/ign 32x6: {agree:.1} dB");
+}
+
+fn main() {
+    common::run_gpu_tests(&[
+        ("gpu_matches_f64_reference", gpu_matches_f64_reference),
+        ("zero_coverage_is_exactly_the_background", zero_coverage_is_exactly_the_background),
+        ("doubling_density_never_raises_transmittance", doubling_density_never_raises_transmittance),
+        (
+            "dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind",
+            dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind,
+        ),
+        (
+            "renders_are_deterministic_and_jitter_follows_its_seed",
+            renders_are_deterministic_and_jitter_follows_its_seed,
+        ),
+        ("seed_experiment_on_the_gpu", seed_experiment_on_the_gpu),
+    ]);
 }

@@ -42,11 +42,7 @@ fn agreement(gpu: &Image, reference: &Image) -> (usize, usize) {
     (ok, gpu.data.len())
 }
 
-#[test]
-fn depth_agrees_with_brute_force_reference() {
-    let Some(ctx) = common::gpu_for_test("heightfield depth_agrees_with_brute_force_reference") else {
-        return;
-    };
+fn depth_agrees_with_brute_force_reference(ctx: &vista_golden::Renderer) {
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[("view", "depth")]);
         let g = gpu(ctx, &p);
@@ -67,11 +63,7 @@ fn depth_agrees_with_brute_force_reference() {
     }
 }
 
-#[test]
-fn refined_hits_satisfy_eps_rule() {
-    let Some(ctx) = common::gpu_for_test("heightfield refined_hits_satisfy_eps_rule") else {
-        return;
-    };
+fn refined_hits_satisfy_eps_rule(ctx: &vista_golden::Renderer) {
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[("view", "depth")]);
         let g = gpu(ctx, &p);
@@ -103,11 +95,7 @@ fn refined_hits_satisfy_eps_rule() {
     }
 }
 
-#[test]
-fn raising_max_steps_never_removes_hits() {
-    let Some(ctx) = common::gpu_for_test("heightfield raising_max_steps_never_removes_hits") else {
-        return;
-    };
+fn raising_max_steps_never_removes_hits(ctx: &vista_golden::Renderer) {
     for preset in ["valley", "grazing"] {
         let renders: Vec<Image> = ["64", "128", "256"]
             .iter()
@@ -138,11 +126,7 @@ fn oversteps(gpu: &Image, reference: &Image) -> usize {
 /// (hits land behind the true one or the ray escapes), while 0.5 keeps the
 /// steps short enough to stop in front of nearly every crest at roughly
 /// twice the cost in steps.
-#[test]
-fn relax_one_oversteps_on_grazing_where_half_does_not() {
-    let Some(ctx) = common::gpu_for_test("heightfield relax_one_oversteps_on_grazing_where_half_does_not") else {
-        return;
-    };
+fn relax_one_oversteps_on_grazing_where_half_does_not(ctx: &vista_golden::Renderer) {
     let p = params("grazing", &[("view", "depth")]);
     let reference = HeightfieldKernel.reference(&p, W, H);
     let count = |relax: &str| {
@@ -161,11 +145,7 @@ fn relax_one_oversteps_on_grazing_where_half_does_not() {
     assert!(one >= 4 * half + 20, "relax 1.0 overstepped at only {one} pixels vs {half} at 0.5");
 }
 
-#[test]
-fn analytic_plane_depth_and_ramp_normals() {
-    let Some(ctx) = common::gpu_for_test("heightfield analytic_plane_depth_and_ramp_normals") else {
-        return;
-    };
+fn analytic_plane_depth_and_ramp_normals(ctx: &vista_golden::Renderer) {
     // Flat plane h0 = 0.2: t* = (o.y - h0) / (-d.y) within eps t. Near the
     // horizon D shrinks by (1 - relax |d.y|) per step, so those rays need
     // more than the default 256 steps.
@@ -209,11 +189,7 @@ fn analytic_plane_depth_and_ramp_normals() {
     assert!(n > 1000, "only {n} ramp pixels");
 }
 
-#[test]
-fn sine_terrain_matches_bisection_and_normals_face_up() {
-    let Some(ctx) = common::gpu_for_test("heightfield sine_terrain_matches_bisection_and_normals_face_up") else {
-        return;
-    };
+fn sine_terrain_matches_bisection_and_normals_face_up(ctx: &vista_golden::Renderer) {
     let sets = [("terrain", "sine"), ("amplitude", "0.4"), ("scale", "1.3"), ("camera_pos", "0.2,1.6,0.1")];
     let p = params("valley", &[&sets[..], &[("camera_target", "3,0,6"), ("view", "depth")]].concat());
     let g = gpu(ctx, &p);
@@ -243,11 +219,7 @@ fn sine_terrain_matches_bisection_and_normals_face_up() {
     assert!(hits.iter().all(|px| px[1] > 0.5), "a normal points down");
 }
 
-#[test]
-fn color_and_steps_match_reference() {
-    let Some(ctx) = common::gpu_for_test("heightfield color_and_steps_match_reference") else {
-        return;
-    };
+fn color_and_steps_match_reference(ctx: &vista_golden::Renderer) {
     // Smaller than the other tests: the f64 reference shades every hit
     // (normal, shadow march) on top of the brute-force search.
     let (w, h) = (48, 30);
@@ -278,11 +250,7 @@ fn color_and_steps_match_reference() {
 /// so a ray that grazes a crest can land on its near or far side (measured:
 /// one pixel of 1440 on valley, 13 m apart in depth); at most one pixel per
 /// 1000 may differ by more than 1/255, and the rest must agree at >= 60 dB.
-#[test]
-fn cpu_f32_relax_march_matches_the_gpu() {
-    let Some(ctx) = common::gpu_for_test("heightfield cpu_f32_relax_march_matches_the_gpu") else {
-        return;
-    };
+fn cpu_f32_relax_march_matches_the_gpu(ctx: &vista_golden::Renderer) {
     let (w, h) = (48, 30);
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[]);
@@ -311,4 +279,17 @@ fn cpu_f32_relax_march_matches_the_gpu() {
         assert!(to_march >= 60.0, "{preset}: GPU vs f32 CPU relax march only {to_march:.1} dB");
         assert!(to_march > to_oracle, "{preset}: the march port ({to_march:.1} dB) is not closer than the oracle");
     }
+}
+
+fn main() {
+    common::run_gpu_tests(&[
+        ("depth_agrees_with_brute_force_reference", depth_agrees_with_brute_force_reference),
+        ("refined_hits_satisfy_eps_rule", refined_hits_satisfy_eps_rule),
+        ("raising_max_steps_never_removes_hits", raising_max_steps_never_removes_hits),
+        ("relax_one_oversteps_on_grazing_where_half_does_not", relax_one_oversteps_on_grazing_where_half_does_not),
+        ("analytic_plane_depth_and_ramp_normals", analytic_plane_depth_and_ramp_normals),
+        ("sine_terrain_matches_bisection_and_normals_face_up", sine_terrain_matches_bisection_and_normals_face_up),
+        ("color_and_steps_match_reference", color_and_steps_match_reference),
+        ("cpu_f32_relax_march_matches_the_gpu", cpu_f32_relax_march_matches_the_gpu),
+    ]);
 }

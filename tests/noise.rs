@@ -24,10 +24,7 @@ fn max_field_error(gpu: &Image, cpu: &Image) -> (f32, (u32, u32)) {
 /// (preset, overrides) of one comparison.
 type Setting<'a> = (Option<&'a str>, &'a [(&'a str, &'a str)]);
 
-fn gpu_vs_cpu(kernel_name: &str, cases: &[Setting]) {
-    let Some(ctx) = common::gpu_for_test(kernel_name) else {
-        return;
-    };
+fn gpu_vs_cpu(ctx: &vista_golden::Renderer, kernel_name: &str, cases: &[Setting]) {
     let k = vista_kernels::find(kernel_name).unwrap();
     for (preset, set) in cases {
         let p = params(k, *preset, set);
@@ -42,9 +39,9 @@ fn gpu_vs_cpu(kernel_name: &str, cases: &[Setting]) {
     }
 }
 
-#[test]
-fn fbm_gpu_matches_f64_reference() {
+fn fbm_gpu_matches_f64_reference(ctx: &vista_golden::Renderer) {
     gpu_vs_cpu(
+        ctx,
         "fbm",
         &[
             (Some("default"), &[]),
@@ -62,11 +59,7 @@ fn fbm_gpu_matches_f64_reference() {
 /// the error grows like (gain * lacunarity)^i. This pins the documented
 /// limit: with gain * lacunarity = 1.53 over 16 octaves the error leaves the
 /// 1e-4 band, but stays within the f32 estimate sum_i gain^i eps |p_i| L_N / A.
-#[test]
-fn fbm_f32_error_follows_the_coordinate_precision_estimate() {
-    let Some(ctx) = common::gpu_for_test("fbm precision") else {
-        return;
-    };
+fn fbm_f32_error_follows_the_coordinate_precision_estimate(ctx: &vista_golden::Renderer) {
     let k = vista_kernels::find("fbm").unwrap();
     let p = params(k, None, &[("octaves", "16"), ("gain", "0.9"), ("lacunarity", "1.7"), ("frequency", "9")]);
     let gpu = vista_golden::render(ctx, k, &p, 96, 96).unwrap().raw;
@@ -81,9 +74,9 @@ fn fbm_f32_error_follows_the_coordinate_precision_estimate() {
     assert!((err as f64) < 0.5 * estimate + 1e-4, "error {err} exceeds the f32 coordinate estimate {estimate}");
 }
 
-#[test]
-fn ridged_gpu_matches_f64_reference() {
+fn ridged_gpu_matches_f64_reference(ctx: &vista_golden::Renderer) {
     gpu_vs_cpu(
+        ctx,
         "ridged",
         &[
             (Some("default"), &[]),
@@ -102,11 +95,7 @@ fn lattice_params(k: &Kernel, basis: &str, seed: &str, w: u32) -> ParamSet {
     params(k, None, &[("basis", basis), ("seed", seed), ("octaves", "1"), ("frequency", &f), ("offset", "-0.5,-0.5")])
 }
 
-#[test]
-fn value_noise_is_bit_identical_to_cpu_at_lattice_points() {
-    let Some(ctx) = common::gpu_for_test("value lattice") else {
-        return;
-    };
+fn value_noise_is_bit_identical_to_cpu_at_lattice_points(ctx: &vista_golden::Renderer) {
     let k = vista_kernels::find("fbm").unwrap();
     let w = 64;
     for seed in [0u32, 1, 123_456] {
@@ -124,11 +113,7 @@ fn value_noise_is_bit_identical_to_cpu_at_lattice_points() {
     }
 }
 
-#[test]
-fn perlin_is_zero_at_lattice_points_on_gpu() {
-    let Some(ctx) = common::gpu_for_test("perlin lattice") else {
-        return;
-    };
+fn perlin_is_zero_at_lattice_points_on_gpu(ctx: &vista_golden::Renderer) {
     let k = vista_kernels::find("fbm").unwrap();
     for seed in ["0", "17"] {
         let p = lattice_params(k, "perlin", seed, 32);
@@ -137,11 +122,7 @@ fn perlin_is_zero_at_lattice_points_on_gpu() {
     }
 }
 
-#[test]
-fn seed_changes_the_gpu_image() {
-    let Some(ctx) = common::gpu_for_test("seed changes") else {
-        return;
-    };
+fn seed_changes_the_gpu_image(ctx: &vista_golden::Renderer) {
     for kernel in ["fbm", "ridged"] {
         let k = vista_kernels::find(kernel).unwrap();
         for basis in ["perlin", "value"] {
@@ -154,11 +135,7 @@ fn seed_changes_the_gpu_image() {
     }
 }
 
-#[test]
-fn one_octave_fbm_equals_the_basis_on_gpu() {
-    let Some(ctx) = common::gpu_for_test("octaves=1") else {
-        return;
-    };
+fn one_octave_fbm_equals_the_basis_on_gpu(ctx: &vista_golden::Renderer) {
     let k = vista_kernels::find("fbm").unwrap();
     let p = params(k, None, &[("octaves", "1"), ("seed", "3")]);
     let gpu = vista_golden::render(ctx, k, &p, 48, 48).unwrap().raw;
@@ -171,4 +148,22 @@ fn one_octave_fbm_equals_the_basis_on_gpu() {
             assert!((got - want).abs() < 1e-6, "({x}, {y}): {got} vs basis {want}");
         }
     }
+}
+
+fn main() {
+    common::run_gpu_tests(&[
+        (
+            "fbm_f32_error_follows_the_coordinate_precision_estimate",
+            fbm_f32_error_follows_the_coordinate_precision_estimate,
+        ),
+        (
+            "value_noise_is_bit_identical_to_cpu_at_lattice_points",
+            value_noise_is_bit_identical_to_cpu_at_lattice_points,
+        ),
+        ("perlin_is_zero_at_lattice_points_on_gpu", perlin_is_zero_at_lattice_points_on_gpu),
+        ("seed_changes_the_gpu_image", seed_changes_the_gpu_image),
+        ("one_octave_fbm_equals_the_basis_on_gpu", one_octave_fbm_equals_the_basis_on_gpu),
+        ("fbm_gpu_matches_f64_reference", fbm_gpu_matches_f64_reference),
+        ("ridged_gpu_matches_f64_reference", ridged_gpu_matches_f64_reference),
+    ]);
 }

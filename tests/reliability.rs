@@ -36,11 +36,7 @@ fn nan_case() -> Case {
     }
 }
 
-#[test]
-fn injected_nan_fails_the_case_naming_count_and_first_pixel() {
-    let Some(ctx) = common::gpu_for_test("NaN injection") else {
-        return;
-    };
+fn injected_nan_fails_the_case_naming_count_and_first_pixel(ctx: &vista_golden::Renderer) {
     let dir = tempfile::tempdir().unwrap();
     let store = Store { dir: dir.path().to_path_buf(), kernels: vista_kernels::Registry::builtin().clone() };
     // A golden that would otherwise match: NaN must fail on its own.
@@ -55,11 +51,7 @@ fn injected_nan_fails_the_case_naming_count_and_first_pixel() {
     assert_eq!(o.metrics.map(|m| m.nan), Some(2), "{text}");
 }
 
-#[test]
-fn render_path_reports_nan_from_the_gpu_bit_exactly() {
-    let Some(ctx) = common::gpu_for_test("NaN readback") else {
-        return;
-    };
+fn render_path_reports_nan_from_the_gpu_bit_exactly(ctx: &vista_golden::Renderer) {
     let r = vista_golden::render(ctx, nan_kernel(), &nan_case().params, 16, 8).unwrap();
     assert!(r.raw.get(5, 3)[0].is_nan());
     assert_eq!(r.raw.get(7, 3)[0], f32::INFINITY);
@@ -104,11 +96,7 @@ fn fuzz_cases() -> u32 {
 /// Size small enough that even maximal step counts stay quick on lavapipe.
 const FUZZ_SIZE: (u32, u32) = (8, 8);
 
-#[test]
-fn random_in_range_params_give_finite_output_within_documented_bounds() {
-    let Some(ctx) = common::gpu_for_test("parameter fuzzing") else {
-        return;
-    };
+fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vista_golden::Renderer) {
     let mut total = 0;
     for kernel in vista_kernels::registry() {
         let specs = kernel.params();
@@ -163,4 +151,18 @@ fn random_in_range_params_give_finite_output_within_documented_bounds() {
         total += tried;
     }
     eprintln!("fuzz: {total} renders in total");
+}
+
+fn main() {
+    common::run_gpu_tests(&[
+        (
+            "injected_nan_fails_the_case_naming_count_and_first_pixel",
+            injected_nan_fails_the_case_naming_count_and_first_pixel,
+        ),
+        ("render_path_reports_nan_from_the_gpu_bit_exactly", render_path_reports_nan_from_the_gpu_bit_exactly),
+        (
+            "random_in_range_params_give_finite_output_within_documented_bounds",
+            random_in_range_params_give_finite_output_within_documented_bounds,
+        ),
+    ]);
 }

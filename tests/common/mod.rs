@@ -22,22 +22,47 @@ pub fn project() -> Project {
     Project::at(Path::new(env!("CARGO_MANIFEST_DIR"))).expect("the repository is a vista project")
 }
 
-/// The shared renderer over this checkout's shaders. Without an adapter
-/// this panics with the install hint, unless `VISTA_ALLOW_NO_GPU=1`, in
-/// which case it prints a loud SKIPPED line naming the test and returns
-/// `None`.
-pub fn gpu_for_test(test: &str) -> Option<&'static Renderer<'static>> {
+/// The shared renderer over this checkout's shaders, or why there is none.
+pub fn renderer() -> Result<&'static Renderer<'static>, String> {
     static GPU: OnceLock<Result<Renderer<'static>, String>> = OnceLock::new();
-    let gpu = GPU.get_or_init(|| {
+    GPU.get_or_init(|| {
         let ctx = vista_gpu::Context::shared().map_err(|e| e.to_string())?;
         Renderer::new(ctx, &project()).map_err(|e| e.to_string())
-    });
-    match gpu {
-        Ok(r) => Some(r),
-        Err(e) if allow_no_gpu() => {
-            eprintln!("!!! VISTA_ALLOW_NO_GPU=1: SKIPPED GPU test '{test}': {e}");
-            None
-        }
-        Err(e) => panic!("GPU test '{test}' cannot run: {e}"),
+    })
+    .as_ref()
+    .map_err(Clone::clone)
+}
+
+/// For benches: the renderer, or a panic with the install hint.
+pub fn gpu_for_bench() -> &'static Renderer<'static> {
+    renderer().unwrap_or_else(|e| panic!("benchmarks need a GPU adapter: {e}"))
+}
+
+/// A GPU test: its name and body.
+pub type GpuTest = (&'static str, fn(&Renderer<'static>));
+
+/// Runs a file's GPU tests under libtest-mimic (filters, `--list`,
+/// `--ignored` as cargo test has them). Without an adapter every test fails
+/// with the install hint, unless `VISTA_ALLOW_NO_GPU=1`: then each is
+/// reported *ignored* by the harness (never "ok") and a loud line counts them.
+pub fn run_gpu_tests(tests: &[GpuTest]) -> ! {
+    let args = libtest_mimic::Arguments::from_args();
+    let skip = if args.list { None } else { renderer().err().filter(|_| allow_no_gpu()) };
+    if let Some(e) = &skip {
+        let names: Vec<&str> = tests.iter().map(|t| t.0).collect();
+        eprintln!("\n!!! VISTA_ALLOW_NO_GPU=1 and no adapter: {e}");
+        eprintln!("!!! SKIPPED {} GPU tests (reported ignored): {}\n", tests.len(), names.join(", "));
     }
+    let trials = tests
+        .iter()
+        .map(|&(name, body)| {
+            libtest_mimic::Trial::test(name, move || {
+                let gpu = renderer().map_err(|e| format!("GPU test '{name}' cannot run: {e}"))?;
+                body(gpu);
+                Ok(())
+            })
+            .with_ignored_flag(skip.is_some())
+        })
+        .collect();
+    libtest_mimic::run(&args, trials).exit()
 }

@@ -315,6 +315,9 @@ fn check_output_path(out: &Path) -> Result<(), GoldenError> {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    if dir.exists() && !dir.is_dir() {
+        return Err(bad(format!("output directory {} is not a directory (it is a file)", dir.display())));
+    }
     if !dir.is_dir() {
         return Err(bad(format!("output directory {} does not exist", dir.display())));
     }

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Proves that GPU tests never pass silently without an adapter: with no
+# Vulkan driver visible and VISTA_ALLOW_NO_GPU=1, every GPU suite must report
+# all of its tests ignored and none passed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+suites=(golden atmosphere clouds cloudmap heightfield noise reliability)
+args=()
+for s in "${suites[@]}"; do args+=(--test "$s"); done
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json VISTA_ALLOW_NO_GPU=1 \
+    ${CARGO:-cargo} test -q "${args[@]}" >"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: the suites failed without an adapter"; exit 1; }
+results=$(grep -E '^test result:' "$log")
+n=$(echo "$results" | wc -l)
+if [ "$n" -ne "${#suites[@]}" ]; then
+    cat "$log"; echo "no-gpu-skips: expected ${#suites[@]} suites, saw $n"; exit 1
+fi
+if echo "$results" | grep -vqE ' 0 passed; 0 failed; [1-9][0-9]* ignored'; then
+    echo "$results"; echo "no-gpu-skips: a GPU test passed or failed without an adapter instead of being ignored"; exit 1
+fi
+skipped=$(echo "$results" | awk '{ for (i = 1; i <= NF; i++) if ($(i + 1) ~ /^ignored/) s += $i } END { print s }')
+echo "no-gpu-skips: without an adapter all $skipped GPU tests of ${#suites[@]} suites are reported ignored, none ok"
