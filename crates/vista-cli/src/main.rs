@@ -149,6 +149,16 @@ fn main() -> ExitCode {
     #[cfg(unix)]
     die_quietly_on_closed_pipe();
     let cli = Cli::parse();
+    // Fault injection for the write-path tests (see vista_image::fault).
+    if let Some(text) = std::env::var_os("VISTA_FAULT") {
+        match vista_image::fault::FaultPlan::parse(&text.to_string_lossy()) {
+            Ok(plan) => vista_image::fault::install(plan),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
     if let Some(a) = &cli.adapter {
         // SAFETY: single-threaded at this point; read once by Context::shared.
         unsafe { std::env::set_var("VISTA_ADAPTER", a) };

@@ -473,37 +473,106 @@ fn malformed_cases_toml_names_the_line() {
     assert_rejected(&vista_in(Some(d.path()), &[], &["check", "--case", "zz*"]), 2, &["matches no case", "a, b, c"]);
 }
 
-#[test]
-fn interrupted_bless_leaves_every_golden_old_or_new() {
+/// Writes of one bless of CASES with every case changed: per case the
+/// manifest (accepting both files), the golden, the manifest again.
+const BLESS_WRITES: usize = 9;
+
+/// A blessed project, the bytes of its goldens, and the bytes a complete
+/// bless of the changed cases writes.
+struct BlessFixture {
+    old: Vec<Vec<u8>>,
+    new: Vec<Vec<u8>>,
+}
+
+const IDS: [(&str, &str); 3] = [("fbm", "a"), ("fbm", "b"), ("ridged", "c")];
+
+fn changed_cases() -> String {
+    CASES
+        .replace("size = \"32x32\"", "size = \"32x32\"\nset = { seed = 5 }")
+        .replace("set = { seed = 5 }\nset = { basis = \"value\" }", "set = { basis = \"value\", seed = 5 }")
+}
+
+fn blessed_project() -> tempfile::TempDir {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
-    let ids = [("fbm", "a"), ("fbm", "b"), ("ridged", "c")];
-    let old: Vec<Vec<u8>> = ids.iter().map(|(k, i)| std::fs::read(golden(d.path(), k, i)).unwrap()).collect();
-    // Change every case, then kill bless after its first golden write.
-    std::fs::write(
-        cases_path(d.path()),
-        CASES
-            .replace("size = \"32x32\"", "size = \"32x32\"\nset = { seed = 5 }")
-            .replace("set = { seed = 5 }\nset = { basis = \"value\" }", "set = { basis = \"value\", seed = 5 }"),
-    )
-    .unwrap();
-    let r = vista_in(Some(d.path()), &[("VISTA_FAULT_ABORT_AFTER_WRITES", "1")], &["bless"]);
-    assert_ne!(r.code, 0, "the fault hook must abort the bless");
-    assert!(r.stderr.contains("aborting after 1 golden writes"), "{}", r.stderr);
-    let mut changed = 0;
-    for ((k, i), before) in ids.iter().zip(&old) {
-        let now = std::fs::read(golden(d.path(), k, i)).unwrap();
-        vista_image::read_png16(&golden(d.path(), k, i)).expect("golden must stay a valid PNG");
-        if &now != before {
-            changed += 1;
+    d
+}
+
+fn bless_fixture() -> BlessFixture {
+    let d = blessed_project();
+    let read = |d: &Path| IDS.iter().map(|(k, i)| std::fs::read(golden(d, k, i)).unwrap()).collect::<Vec<_>>();
+    let old = read(d.path());
+    std::fs::write(cases_path(d.path()), changed_cases()).unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    BlessFixture { old, new: read(d.path()) }
+}
+
+fn hash(bytes: &[u8]) -> String {
+    vista_golden::short_hash_bytes(bytes)
+}
+
+/// After a stopped bless: every golden is the old or the new file, the
+/// manifest parses, and each golden is a file its manifest entry describes.
+fn consistent(d: &Path, fx: &BlessFixture) -> Result<(), String> {
+    let store = vista_golden::Store { dir: d.join("golden"), kernels: vista_kernels::Registry::builtin().clone() };
+    let manifest = store.manifest().map_err(|e| format!("manifest: {e}"))?;
+    for (n, (k, i)) in IDS.iter().enumerate() {
+        let bytes = std::fs::read(golden(d, k, i)).map_err(|e| format!("{i}: {e}"))?;
+        if bytes != fx.old[n] && bytes != fx.new[n] {
+            return Err(format!("golden {i} is neither the old nor the new file ({} bytes)", bytes.len()));
+        }
+        let e = manifest.case.get(*i).ok_or_else(|| format!("{i}: no manifest entry"))?;
+        let h = hash(&bytes);
+        if h != e.golden_hash && e.replacing.as_deref() != Some(h.as_str()) {
+            return Err(format!(
+                "golden {i} ({h}) is not described by its entry ({}, {:?})",
+                e.golden_hash, e.replacing
+            ));
         }
     }
-    assert_eq!(changed, 1, "exactly the first golden is new, the rest old");
-    let leftovers: Vec<_> = walk(d.path()).into_iter().filter(|p| p.to_string_lossy().ends_with(".tmp")).collect();
-    assert!(leftovers.is_empty(), "temp files left behind: {leftovers:?}");
-    // A complete bless afterwards converges, and check passes.
-    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
-    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0);
+    Ok(())
+}
+
+/// Stops `vista bless` at every write of a 3-case bless, halfway through a
+/// temp file and between write and rename: every golden and the manifest
+/// stay old or new and consistent with each other, `vista check` names an
+/// unfinished case, and a complete bless converges. The same stops with a
+/// plain in-place writer substituted break consistency, so the check can fail.
+#[test]
+fn interrupted_bless_leaves_every_golden_old_or_new() {
+    let fx = bless_fixture();
+    assert!(fx.old.iter().zip(&fx.new).all(|(a, b)| a != b), "every case must change");
+    let mut plain_broken = 0;
+    for writer in ["", "plain,"] {
+        for stop in ["partial", "before-rename"] {
+            for n in 1..=BLESS_WRITES {
+                let d = blessed_project();
+                std::fs::write(cases_path(d.path()), changed_cases()).unwrap();
+                let fault = format!("{writer}{stop}:{n}");
+                let r = vista_in(Some(d.path()), &[("VISTA_FAULT", &fault)], &["bless"]);
+                assert_ne!(r.code, 0, "{fault}: the fault must stop the bless");
+                assert!(r.stderr.contains("VISTA_FAULT: stopping at"), "{fault}: {}", r.stderr);
+                let verdict = consistent(d.path(), &fx);
+                if writer.is_empty() {
+                    verdict.unwrap_or_else(|e| panic!("{fault}: {e}"));
+                    // check reports an unfinished case instead of passing it silently.
+                    let c = vista_in(Some(d.path()), &[], &["check"]);
+                    let unfinished = c.stdout.contains("interrupted bless was replacing");
+                    assert!(c.code == 1 || !unfinished, "{fault}: {}", c.stdout);
+                    // A complete bless afterwards converges and clears stale temp files.
+                    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0, "{fault}");
+                    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0, "{fault}");
+                    let left: Vec<_> =
+                        walk(d.path()).into_iter().filter(|p| p.to_string_lossy().ends_with(".tmp")).collect();
+                    assert!(left.is_empty(), "{fault}: temp files left after a full bless: {left:?}");
+                } else if verdict.is_err() {
+                    plain_broken += 1;
+                }
+            }
+        }
+    }
+    assert!(plain_broken >= 3, "the plain writer broke consistency only {plain_broken} times: the check cannot fail");
+    assert_rejected(&vista_in(None, &[("VISTA_FAULT", "sometimes")], &["list"]), 2, &["VISTA_FAULT item 'sometimes'"]);
 }
 
 fn walk(dir: &Path) -> Vec<PathBuf> {

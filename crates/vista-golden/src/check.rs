@@ -207,6 +207,26 @@ fn judge(
         ));
         return Ok(());
     }
+    if let (Some(e), Ok(bytes)) = (entry, std::fs::read(&golden_path))
+        && !e.golden_hash.is_empty()
+    {
+        let on_disk = crate::short_hash_bytes(&bytes);
+        if e.replacing.as_deref() == Some(on_disk.as_str()) {
+            out.problems.push(format!(
+                "golden {} is the file an interrupted bless was replacing; finish it with: {}",
+                golden_path.display(),
+                case.bless_command()
+            ));
+        } else if on_disk != e.golden_hash {
+            out.problems.push(format!(
+                "golden {} (hash {on_disk}) is not the file its manifest entry describes ({}): it was changed \
+                 outside vista bless; review it and re-bless: {}",
+                golden_path.display(),
+                e.golden_hash,
+                case.bless_command()
+            ));
+        }
+    }
     let expected = vista_image::read_png16(&golden_path)?;
     out.files.expected = Some(write("expected.png", &expected)?);
     if (expected.width, expected.height) != (actual.width, actual.height) {

@@ -66,7 +66,12 @@ pub fn now_utc() -> String {
 
 /// Short stable hash of a text (params hashes in the manifest).
 pub fn short_hash(text: &str) -> String {
-    blake3::hash(text.as_bytes()).to_hex()[..16].to_string()
+    short_hash_bytes(text.as_bytes())
+}
+
+/// Short stable hash of bytes (golden file hashes in the manifest).
+pub fn short_hash_bytes(bytes: &[u8]) -> String {
+    blake3::hash(bytes).to_hex()[..16].to_string()
 }
 
 /// True when the user set `VISTA_ALLOW_NO_GPU=1`.

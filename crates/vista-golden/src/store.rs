@@ -26,6 +26,14 @@ pub struct ManifestEntry {
     pub raw_hash: String,
     /// PSNR of this golden against the one it replaced ("new" if none).
     pub psnr_vs_previous: String,
+    /// Hash of the golden PNG's bytes: the file this entry describes.
+    #[serde(default)]
+    pub golden_hash: String,
+    /// While a bless replaces this golden: the hash of the file being
+    /// replaced ("none" for a new golden). Written before the golden and
+    /// cleared after it, so the file on disk always matches the entry.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replacing: Option<String>,
 }
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]

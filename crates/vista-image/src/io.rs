@@ -13,12 +13,17 @@ use crate::{Image, ImageError};
 /// Each channel is clamped to `[0, 1]` and quantised as `round(v * 65535)`;
 /// NaN is written as 0. Use [`write_exr`] to keep values unchanged.
 pub fn write_png16(path: &Path, img: &Image) -> Result<(), ImageError> {
+    atomic_write(path, &encode_png16(path, img)?)
+}
+
+/// The 16-bit RGBA PNG bytes [`write_png16`] writes (`path` names errors).
+pub fn encode_png16(path: &Path, img: &Image) -> Result<Vec<u8>, ImageError> {
     let samples: Vec<u16> = img.data.iter().flatten().map(|&v| quantize16(v)).collect();
     let buf = ImageBuffer::<Rgba<u16>, Vec<u16>>::from_raw(img.width, img.height, samples)
         .ok_or_else(|| encode_error(path, "PNG", "pixel buffer does not match image size"))?;
     let mut bytes = Cursor::new(Vec::new());
     DynamicImage::ImageRgba16(buf).write_to(&mut bytes, ImageFormat::Png).map_err(|e| encode_error(path, "PNG", e))?;
-    atomic_write(path, bytes.get_ref())
+    Ok(bytes.into_inner())
 }
 
 /// Reads any PNG (1-16 bit, grey/grey+alpha/RGB/RGBA/palette) as f32 RGBA in
@@ -80,14 +85,45 @@ pub fn load(path: &Path) -> Result<Image, ImageError> {
 /// same directory, fsyncs it and renames it over `path`. On failure the
 /// temporary file is removed and any existing `path` is left untouched.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
+    use crate::fault::{Stop, maybe_stop};
     let io_err = |source| ImageError::Io { path: path.to_path_buf(), source };
+    let n = crate::fault::next_write();
+    let half = bytes.len() / 2;
+    if crate::fault::plan().plain_writer {
+        // The non-atomic writer a test substitutes: truncate, then write in place.
+        let mut f = std::fs::File::create(path).map_err(io_err)?;
+        f.write_all(&bytes[..half]).map_err(io_err)?;
+        f.sync_all().map_err(io_err)?;
+        maybe_stop(n, Stop::Partial, path);
+        f.write_all(&bytes[half..]).map_err(io_err)?;
+        f.sync_all().map_err(io_err)?;
+        maybe_stop(n, Stop::BeforeRename, path);
+        maybe_stop(n, Stop::After, path);
+        return Ok(());
+    }
     let dir = parent_dir(path);
     let mut tmp = create_temp(&dir, path).map_err(io_err)?;
-    tmp.write_all(bytes).map_err(io_err)?;
+    tmp.write_all(&bytes[..half]).map_err(io_err)?;
     tmp.as_file().sync_all().map_err(io_err)?;
+    maybe_stop(n, Stop::Partial, path);
+    tmp.write_all(&bytes[half..]).map_err(io_err)?;
+    tmp.as_file().sync_all().map_err(io_err)?;
+    maybe_stop(n, Stop::BeforeRename, path);
     tmp.persist(path).map_err(|e| io_err(e.error))?;
     sync_dir(&dir);
+    maybe_stop(n, Stop::After, path);
     Ok(())
+}
+
+/// Removes temp files a killed writer left in `dir` (`.<name>.XXXXXX.tmp`).
+pub fn remove_stale_temps(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with('.') && name.ends_with(".tmp") && e.path().is_file() {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
 }
 
 enum Kind {

@@ -24,6 +24,7 @@
 
 mod buffer;
 mod error;
+pub mod fault;
 mod heatmap;
 mod io;
 pub mod metrics;
@@ -33,5 +34,7 @@ mod tonemap;
 pub use buffer::Image;
 pub use error::ImageError;
 pub use heatmap::diff_heatmap;
-pub use io::{atomic_write, load, read_exr, read_png16, save, write_exr, write_png16};
+pub use io::{
+    atomic_write, encode_png16, load, read_exr, read_png16, remove_stale_temps, save, write_exr, write_png16,
+};
 pub use tonemap::{srgb_encode, tonemap};
