@@ -16,7 +16,11 @@ fn main() {
     let store = Store::of_project(&project, "the golden tests").expect("repository root");
     let cases = store.load_cases().unwrap_or_else(|e| panic!("cannot load golden cases: {e}"));
     let manifest = Arc::new(store.manifest().unwrap_or_else(|e| panic!("cannot load manifest: {e}")));
-    let report_dir = project.report_dir().expect("repository root");
+    // One report per implementation (VISTA_BACKEND), so runs do not overwrite each other.
+    let report_dir = match std::env::var("VISTA_BACKEND").ok().filter(|b| !b.is_empty() && b != "lavapipe") {
+        Some(b) => project.root().expect("repository root").join(format!("target/vista-report-{b}")),
+        None => project.report_dir().expect("repository root"),
+    };
     let outcomes = Arc::new(Mutex::new(Vec::new()));
 
     // Listing must work without a device (nextest lists before it runs).

@@ -1018,3 +1018,58 @@ fn the_example_project_works_with_a_copied_binary() {
     // The built-ins are still there, from the embedded sources.
     assert_eq!(run(&["render", "fbm", "--size", "16x16", "-o", "f.png"]).code, 0);
 }
+
+/// Expectations are data in golden/cases.toml: a failure they name passes
+/// the run (reported xfail with the reason), an expected failure that
+/// passes fails the run, and a bad expectation is refused.
+#[test]
+fn expected_failures_are_data_and_an_unexpected_pass_fails() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let xfail =
+        "expect_fail = [{ backend = \"lavapipe\", driver = \"llvmpipe\", reason = \"seed 9 differs on purpose\" }]\n";
+    // b now renders differently (seed 9) and is expected to fail on lavapipe.
+    let cases =
+        CASES.replace("set = { basis = \"value\" }", &format!("set = {{ basis = \"value\", seed = 9 }}\n{xfail}"));
+    std::fs::write(cases_path(d.path()), &cases).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert_eq!(r.code, 0, "{}", r.stdout);
+    assert!(r.stdout.contains("xfail") && r.stdout.contains("seed 9 differs on purpose"), "{}", r.stdout);
+    // a still passes, so an expectation on it fails the run.
+    let cases = cases.replacen("size = \"32x32\"\n", &format!("size = \"32x32\"\n{xfail}"), 1);
+    std::fs::write(cases_path(d.path()), &cases).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "a"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(r.stdout.contains("expected to fail on lavapipe") && r.stdout.contains("but passed"), "{}", r.stdout);
+    let bad = CASES.replacen(
+        "size = \"32x32\"\n",
+        "size = \"32x32\"\nexpect_fail = [{ backend = \"vulkan\", reason = \"x\" }]\n",
+        1,
+    );
+    std::fs::write(cases_path(d.path()), bad).unwrap();
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["check"]),
+        2,
+        &["expect_fail backend 'vulkan'", "lavapipe|swiftshader|browser|gpu"],
+    );
+}
+
+/// `vista check --matrix` renders every case on each implementation and
+/// prints one case x backend table; a backend that is missing is named loudly.
+#[test]
+fn check_matrix_prints_one_row_per_case_and_one_column_per_backend() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let r = vista_in(Some(d.path()), &[], &["check", "--matrix"]);
+    assert!(
+        r.stdout.lines().next().unwrap().split_whitespace().eq(["case", "lavapipe", "swiftshader", "browser"]),
+        "{}",
+        r.stdout
+    );
+    for id in ["a", "b", "c"] {
+        assert!(r.stdout.lines().any(|l| l.starts_with(&format!("{id} ")) && l.contains("identical")), "{}", r.stdout);
+    }
+    assert!(r.stdout.contains("!!! browser: SKIPPED, all 3 cells"), "{}", r.stdout);
+    assert!(report(d.path()).join("matrix.html").exists());
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+}

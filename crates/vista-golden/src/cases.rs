@@ -44,8 +44,32 @@ struct RawCase {
     psnr_other_driver: Option<f64>,
     min_ssim: Option<f64>,
     #[serde(default)]
+    expect_fail: Vec<Expectation>,
+    #[serde(default)]
     doc: String,
 }
+
+/// A case expected to fail on one implementation (SPEC 11), as data:
+/// `expect_fail = [{ backend = "swiftshader", driver = "SwiftShader", reason = "why" }]`.
+/// It matches when the backend is equal and the adapter description
+/// contains `driver` (empty: any). An expected failure that passes fails.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Expectation {
+    pub backend: String,
+    #[serde(default)]
+    pub driver: String,
+    pub reason: String,
+}
+
+impl Expectation {
+    pub fn matches(&self, backend: &str, adapter: &str) -> bool {
+        self.backend == backend && adapter.contains(&self.driver)
+    }
+}
+
+/// The backends an expectation may name.
+pub const EXPECTATION_BACKENDS: &[&str] = &["lavapipe", "swiftshader", "browser", "gpu"];
 
 /// One validated golden case.
 #[derive(Debug, Clone)]
@@ -60,6 +84,8 @@ pub struct Case {
     pub psnr_same_driver: f64,
     pub psnr_other_driver: f64,
     pub min_ssim: Option<f64>,
+    /// Where this case is expected to fail, and why.
+    pub expect_fail: Vec<Expectation>,
     pub doc: String,
 }
 
@@ -113,6 +139,18 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         {
             return Err(bad(format!("min_ssim={s} is out of range; allowed: [-1, 1]")));
         }
+        for x in &raw.expect_fail {
+            if !EXPECTATION_BACKENDS.contains(&x.backend.as_str()) {
+                return Err(bad(format!(
+                    "expect_fail backend '{}' is not valid; expected one of {}",
+                    x.backend,
+                    EXPECTATION_BACKENDS.join("|")
+                )));
+            }
+            if x.reason.trim().is_empty() {
+                return Err(bad("expect_fail needs a reason that names the difference".into()));
+            }
+        }
         out.push(Case {
             id: raw.id,
             kernel,
@@ -124,6 +162,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             psnr_same_driver,
             psnr_other_driver,
             min_ssim: raw.min_ssim,
+            expect_fail: raw.expect_fail,
             doc: raw.doc,
         });
     }

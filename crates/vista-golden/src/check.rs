@@ -18,6 +18,8 @@ pub enum Verdict {
     Missing,
     /// Could not render or read (bad params, GPU error, corrupt golden).
     Error,
+    /// Failed where `expect_fail` in golden/cases.toml says it does.
+    ExpectedFail,
 }
 
 /// Images written for the report (paths relative to the report dir).
@@ -50,8 +52,9 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// Passing for the run: a pass, or a failure that an expectation names.
     pub fn passed(&self) -> bool {
-        self.verdict == Verdict::Pass
+        matches!(self.verdict, Verdict::Pass | Verdict::ExpectedFail)
     }
 
     /// Multi-line explanation for test output and `vista check`.
@@ -122,6 +125,26 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         out.problems.push(e.to_string());
     } else if out.verdict == Verdict::Pass && !out.problems.is_empty() {
         out.verdict = Verdict::Fail;
+    }
+    let adapter = ctx.adapter_description();
+    if let Some(x) = case.expect_fail.iter().find(|x| x.matches(ctx.backend(), &adapter)) {
+        if out.passed() {
+            out.verdict = Verdict::Fail;
+            out.problems.push(format!(
+                "expected to fail on {} (driver '{}': {}) but passed: remove the expectation from golden/cases.toml",
+                x.backend, x.driver, x.reason
+            ));
+        } else {
+            out.notes.push(format!(
+                "expected failure on {} (driver '{}'): {}; it failed with: {}",
+                x.backend,
+                x.driver,
+                x.reason,
+                out.problems.join("; ")
+            ));
+            out.problems.clear();
+            out.verdict = Verdict::ExpectedFail;
+        }
     }
     out
 }

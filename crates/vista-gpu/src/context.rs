@@ -11,40 +11,88 @@ use wgpu::util::DeviceExt;
 use crate::shaders::ShaderSet;
 use crate::{GpuError, INSTALL_HINT};
 
-/// Which adapter to ask for.
+/// Which adapter to ask for. Software adapters are chosen by name, never
+/// by whichever CPU driver the Vulkan loader lists first.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum AdapterChoice {
-    /// A CPU (software) adapter: lavapipe. Reproducible; the default.
-    Software,
+    /// Mesa's lavapipe (device "llvmpipe"). Reproducible; the default.
+    Lavapipe,
+    /// Google's SwiftShader Vulkan ICD (device "SwiftShader ...").
+    SwiftShader,
     /// A hardware adapter (discrete preferred, then integrated, then virtual).
     Hardware,
     /// The first adapter whose name contains this text (case-insensitive).
     Named(String),
 }
 
+/// The backends `--backend` / `VISTA_BACKEND` accept on wgpu (the browser
+/// backend drives Chromium instead and is not an adapter).
+pub const WGPU_BACKENDS: &[&str] = &["lavapipe", "swiftshader", "gpu"];
+
 impl AdapterChoice {
-    /// `WGPU_ADAPTER_NAME` wins, then `VISTA_ADAPTER=gpu|cpu`, else software.
+    /// The adapter of a backend name: lavapipe | swiftshader | gpu.
+    pub fn of_backend(name: &str) -> Result<AdapterChoice, GpuError> {
+        match name {
+            "lavapipe" => Ok(AdapterChoice::Lavapipe),
+            "swiftshader" => Ok(AdapterChoice::SwiftShader),
+            "gpu" => Ok(AdapterChoice::Hardware),
+            other => Err(GpuError::Request(format!(
+                "backend '{other}' is not valid; expected one of {}",
+                WGPU_BACKENDS.join("|")
+            ))),
+        }
+    }
+
+    /// `WGPU_ADAPTER_NAME` wins, then `VISTA_BACKEND`, then
+    /// `VISTA_ADAPTER=gpu|cpu` (cpu = lavapipe), else lavapipe.
     pub fn from_env() -> Result<AdapterChoice, GpuError> {
         if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME")
             && !name.is_empty()
         {
             return Ok(AdapterChoice::Named(name));
         }
+        if let Ok(b) = std::env::var("VISTA_BACKEND")
+            && !b.is_empty()
+        {
+            return AdapterChoice::of_backend(&b).map_err(|e| GpuError::Request(format!("VISTA_BACKEND: {e}")));
+        }
         match std::env::var("VISTA_ADAPTER").as_deref() {
-            Err(_) | Ok("") | Ok("cpu") | Ok("software") | Ok("lavapipe") => Ok(AdapterChoice::Software),
+            Err(_) | Ok("") | Ok("cpu") | Ok("software") | Ok("lavapipe") => Ok(AdapterChoice::Lavapipe),
             Ok("gpu") | Ok("hardware") => Ok(AdapterChoice::Hardware),
             Ok(other) => Err(GpuError::Request(format!("VISTA_ADAPTER={other} is not valid; expected one of cpu|gpu"))),
         }
     }
 
+    /// The backend name reports and manifests use.
+    pub fn backend_name(&self) -> &'static str {
+        match self {
+            AdapterChoice::Lavapipe => "lavapipe",
+            AdapterChoice::SwiftShader => "swiftshader",
+            AdapterChoice::Hardware => "gpu",
+            AdapterChoice::Named(_) => "named",
+        }
+    }
+
     fn describe(&self) -> String {
         match self {
-            AdapterChoice::Software => "software (CPU, lavapipe)".into(),
+            AdapterChoice::Lavapipe => "lavapipe (software, device 'llvmpipe')".into(),
+            AdapterChoice::SwiftShader => "SwiftShader (software)".into(),
             AdapterChoice::Hardware => "hardware GPU".into(),
             AdapterChoice::Named(n) => format!("adapter named like '{n}'"),
         }
     }
+
+    fn hint(&self) -> &'static str {
+        match self {
+            AdapterChoice::SwiftShader => SWIFTSHADER_HINT,
+            _ => INSTALL_HINT,
+        }
+    }
 }
+
+/// Printed when the SwiftShader adapter is missing.
+pub const SWIFTSHADER_HINT: &str = "install Google's SwiftShader Vulkan ICD with `bash ci/install-swiftshader.sh` \
+(it extracts libvk_swiftshader.so from Debian's chromium-common); set VISTA_ALLOW_NO_GPU=1 to skip GPU tests loudly";
 
 /// One compute job over a W x H image.
 #[derive(Debug, Clone)]
@@ -77,6 +125,7 @@ pub struct Context {
     device: wgpu::Device,
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
+    backend: &'static str,
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
@@ -111,7 +160,7 @@ impl Context {
         let adapter = pick(adapters, &choice).ok_or_else(|| GpuError::NoAdapter {
             wanted: choice.describe(),
             seen: if seen.is_empty() { "none".into() } else { seen.join("; ") },
-            hint: INSTALL_HINT,
+            hint: choice.hint(),
         })?;
         let info = adapter.get_info();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
@@ -164,6 +213,7 @@ impl Context {
             device,
             queue,
             info,
+            backend: choice.backend_name(),
             layout,
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
@@ -171,6 +221,11 @@ impl Context {
             submit_lock: Mutex::new(()),
             creation_time: start.elapsed(),
         })
+    }
+
+    /// lavapipe | swiftshader | gpu (or "named" for WGPU_ADAPTER_NAME).
+    pub fn backend(&self) -> &'static str {
+        self.backend
     }
 
     pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
@@ -371,7 +426,8 @@ fn pick(adapters: Vec<wgpu::Adapter>, choice: &AdapterChoice) -> Option<wgpu::Ad
     let rank = |a: &wgpu::Adapter| -> Option<u8> {
         let i = a.get_info();
         match choice {
-            AdapterChoice::Software => (i.device_type == T::Cpu).then_some(0),
+            AdapterChoice::Lavapipe => (i.device_type == T::Cpu && i.name.contains("llvmpipe")).then_some(0),
+            AdapterChoice::SwiftShader => i.name.contains("SwiftShader").then_some(0),
             AdapterChoice::Hardware => match i.device_type {
                 T::DiscreteGpu => Some(0),
                 T::IntegratedGpu => Some(1),

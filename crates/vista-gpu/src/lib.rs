@@ -9,7 +9,7 @@
 mod context;
 mod shaders;
 
-pub use context::{AdapterChoice, Context, Dispatch, RunStats};
+pub use context::{AdapterChoice, Context, Dispatch, RunStats, SWIFTSHADER_HINT, WGPU_BACKENDS};
 pub use shaders::{ShaderSet, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
