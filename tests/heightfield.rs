@@ -26,39 +26,21 @@ fn hit_t(depth: f32, t_max: f64) -> Option<f64> {
     (depth < 1.0).then_some(depth as f64 * t_max)
 }
 
-/// Pixels where GPU and reference agree: both miss, or both hit with depths
-/// within 2% (relative to the reference).
-fn agreement(gpu: &Image, reference: &Image) -> (usize, usize) {
-    let ok = gpu
-        .data
-        .iter()
-        .zip(&reference.data)
-        .filter(|(g, r)| match (g[0] < 1.0, r[0] < 1.0) {
-            (false, false) => true,
-            (true, true) => (g[0] - r[0]).abs() <= 0.02 * r[0],
-            _ => false,
-        })
-        .count();
-    (ok, gpu.data.len())
-}
-
-fn depth_agrees_with_brute_force_reference(ctx: &vista_golden::Renderer) {
+/// The hit-search side of the oracle comparison: no GPU hit lies behind the
+/// reference's (SPEC 3.4; the reference never passes the first point under
+/// the terrain). relax = 0.5 is not below 1/sqrt(1 + L^2) for these noise
+/// terrains, so 0.5% of the pixels may. How closely the depths agree, over
+/// the pixels where either side hits, is tests/agreement.rs's job.
+fn no_hit_lies_behind_the_brute_force_reference(ctx: &vista_golden::Renderer) {
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[("view", "depth")]);
         let g = gpu(ctx, &p);
         let r = HeightfieldKernel.reference(&p, W, H);
-        let (ok, n) = agreement(&g, &r);
+        let n = g.data.len();
         let hits = r.data.iter().filter(|c| c[0] < 1.0).count();
-        let pct = 100.0 * ok as f64 / n as f64;
-        // SPEC 3.4: no hit behind the reference's (which never passes the
-        // first point under the terrain). relax = 0.5 is not below
-        // 1/sqrt(1 + L^2) for these noise terrains, so allow 0.5%.
         let behind = oversteps(&g, &r);
-        eprintln!(
-            "heightfield {preset}: depth agrees at {ok}/{n} pixels ({pct:.2}%), {hits} reference hits, {behind} behind"
-        );
+        eprintln!("heightfield {preset}: {hits} reference hits, {behind} GPU hits behind them");
         assert!(hits > n / 4, "{preset}: only {hits} terrain pixels");
-        assert!(pct >= 97.0, "{preset}: depth agrees with the brute-force reference at only {pct:.2}% of pixels");
         assert!(behind * 200 <= n, "{preset}: {behind} hits lie behind the reference's");
     }
 }
@@ -131,16 +113,11 @@ fn relax_one_oversteps_on_grazing_where_half_does_not(ctx: &vista_golden::Render
     let reference = HeightfieldKernel.reference(&p, W, H);
     let count = |relax: &str| {
         let g = gpu(ctx, &params("grazing", &[("view", "depth"), ("relax", relax)]));
-        (oversteps(&g, &reference), agreement(&g, &reference).0)
+        oversteps(&g, &reference)
     };
-    let (half, half_ok) = count("0.5");
-    let (one, one_ok) = count("1.0");
+    let (half, one) = (count("0.5"), count("1.0"));
     let n = (W * H) as usize;
-    eprintln!(
-        "heightfield grazing: overstepped pixels relax 1.0: {one}, relax 0.5: {half} (of {n}); depth agreement {:.2}% vs {:.2}%",
-        100.0 * one_ok as f64 / n as f64,
-        100.0 * half_ok as f64 / n as f64
-    );
+    eprintln!("heightfield grazing: overstepped pixels relax 1.0: {one}, relax 0.5: {half} (of {n})");
     assert!(half * 200 <= n, "relax 0.5 overstepped at {half} pixels (> 0.5%)");
     assert!(one >= 4 * half + 20, "relax 1.0 overstepped at only {one} pixels vs {half} at 0.5");
 }
@@ -219,18 +196,11 @@ fn sine_terrain_matches_bisection_and_normals_face_up(ctx: &vista_golden::Render
     assert!(hits.iter().all(|px| px[1] > 0.5), "a normal points down");
 }
 
-fn color_and_steps_match_reference(ctx: &vista_golden::Renderer) {
+fn steps_match_reference(ctx: &vista_golden::Renderer) {
     // Smaller than the other tests: the f64 reference shades every hit
     // (normal, shadow march) on top of the brute-force search.
-    let (w, h) = (48, 30);
-    for preset in ["valley", "ridges", "fog"] {
-        let p = params(preset, &[]);
-        let g = vista_golden::render(ctx, &HeightfieldKernel, &p, w, h).expect("render").raw;
-        let r = HeightfieldKernel.reference(&p, w, h);
-        let psnr = vista_image::metrics::psnr(&r, &g);
-        eprintln!("heightfield {preset}: color PSNR GPU vs CPU {psnr:.1} dB");
-        assert!(psnr >= 30.0, "{preset}: color PSNR {psnr:.1} dB");
-    }
+    // Colour against the oracle lives in tests/agreement.rs (shading compared
+    // where both sides hit the same surface, at 65 dB).
     // Steps: the reference counts the f64 relax march; f32 may differ by a
     // step or two at a few pixels.
     let p = params("valley", &[("view", "steps")]);
@@ -283,13 +253,13 @@ fn cpu_f32_relax_march_matches_the_gpu(ctx: &vista_golden::Renderer) {
 
 fn main() {
     common::run_gpu_tests(&[
-        ("depth_agrees_with_brute_force_reference", depth_agrees_with_brute_force_reference),
+        ("no_hit_lies_behind_the_brute_force_reference", no_hit_lies_behind_the_brute_force_reference),
         ("refined_hits_satisfy_eps_rule", refined_hits_satisfy_eps_rule),
         ("raising_max_steps_never_removes_hits", raising_max_steps_never_removes_hits),
         ("relax_one_oversteps_on_grazing_where_half_does_not", relax_one_oversteps_on_grazing_where_half_does_not),
         ("analytic_plane_depth_and_ramp_normals", analytic_plane_depth_and_ramp_normals),
         ("sine_terrain_matches_bisection_and_normals_face_up", sine_terrain_matches_bisection_and_normals_face_up),
-        ("color_and_steps_match_reference", color_and_steps_match_reference),
+        ("steps_match_reference", steps_match_reference),
         ("cpu_f32_relax_march_matches_the_gpu", cpu_f32_relax_march_matches_the_gpu),
     ]);
 }
