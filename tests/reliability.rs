@@ -4,6 +4,8 @@
 
 mod common;
 
+use std::cell::Cell;
+
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 use vista_golden::{Case, CheckOptions, Store};
@@ -75,10 +77,17 @@ fn value_strategy(spec: &ParamSpec) -> BoxedStrategy<String> {
             .prop_map(|v| v.to_string())
             .boxed()
         }
+        // Counts (steps, octaves) spanning decades are also drawn log-uniformly,
+        // so small and large ones are both common and the work budget rejects
+        // a bounded share of draws.
         Kind::Int { min, max } => prop_oneof![
             1 => Just(min),
             1 => Just(max),
-            6 => min..=max,
+            3 => min..=max,
+            3 => (0.0f64..=1.0).prop_map(move |t| {
+                let (lo, hi) = ((min.max(1)) as f64, max as f64);
+                ((lo.ln() + t * (hi.ln() - lo.ln())).exp().round() as i64).clamp(min, max)
+            }),
         ]
         .prop_map(|v| v.to_string())
         .boxed(),
@@ -90,14 +99,21 @@ fn value_strategy(spec: &ParamSpec) -> BoxedStrategy<String> {
     }
 }
 
+/// Accepted draws per kernel (`VISTA_FUZZ_CASES` for a longer run).
 fn fuzz_cases() -> u32 {
-    std::env::var("VISTA_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(16)
+    std::env::var("VISTA_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64)
 }
 
-/// Size small enough that even maximal step counts stay quick on lavapipe.
-const FUZZ_SIZE: (u32, u32) = (8, 8);
+/// Large enough for each kernel's structure to show (octaves, a horizon,
+/// cloud edges).
+const FUZZ_SIZE: (u32, u32) = (32, 32);
+
+/// Draws whose work estimate (inner-loop evaluations for the whole image)
+/// exceeds this are rejected and counted, so one run stays within seconds.
+const FUZZ_WORK: f64 = 5.0e7;
 
 fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vista_golden::Renderer) {
+    let start = std::time::Instant::now();
     let mut total = 0;
     for kernel in vista_kernels::registry() {
         let specs = kernel.params();
@@ -108,19 +124,20 @@ fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vist
             failure_persistence: None,
             ..Config::default()
         };
-        let mut runner = TestRunner::new(config);
-        let tried = std::cell::Cell::new(0u32);
+        let mut runner = TestRunner::new(Config { max_global_rejects: 100_000, ..config });
+        let (tried, invalid, heavy) = (Cell::new(0u32), Cell::new(0u32), Cell::new(0u32));
+        let (w, h) = FUZZ_SIZE;
         let result = runner.run(&strategy, |values| {
             let overrides: Vec<(String, String)> =
                 specs.iter().zip(&values).map(|(s, v)| (s.name.to_string(), v.clone())).collect();
-            // Cross-parameter rules (e.g. a camera looking straight up) may reject a draw.
-            let Ok(p) = kernel.resolve(None, &overrides) else {
-                return Ok(());
-            };
-            let (w, h) = FUZZ_SIZE;
-            if vista_golden::check_request(kernel, &p, w, h).is_err() {
-                return Ok(());
-            }
+            // Cross-parameter rules (e.g. a camera looking straight up) reject a draw.
+            let p = kernel.resolve(None, &overrides);
+            invalid.set(invalid.get() + p.is_err() as u32);
+            prop_assume!(p.is_ok());
+            let p = p.unwrap();
+            let work = kernel.work_per_pixel(&p) * (w * h) as f64;
+            heavy.set(heavy.get() + (work > FUZZ_WORK) as u32);
+            prop_assume!(work <= FUZZ_WORK);
             tried.set(tried.get() + 1);
             let r = vista_golden::render(ctx, kernel, &p, w, h)
                 .map_err(|e| TestCaseError::fail(format!("{}: {e}", kernel.name())))?;
@@ -147,11 +164,17 @@ fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vist
             panic!("{}: {e}", kernel.name());
         }
         let tried = tried.get();
-        eprintln!("fuzz {}: {tried} renders of random in-range params, all finite and in range", kernel.name());
-        assert!(tried > 0, "{}: every random draw was rejected; the fuzzer tested nothing", kernel.name());
+        eprintln!(
+            "fuzz {}: {tried} accepted renders at {w}x{h}, all finite and in range; rejected: {} by \
+             cross-parameter checks, {} over the work budget",
+            kernel.name(),
+            invalid.get(),
+            heavy.get()
+        );
+        assert!(tried >= fuzz_cases(), "{}: only {tried} draws accepted", kernel.name());
         total += tried;
     }
-    eprintln!("fuzz: {total} renders in total");
+    eprintln!("fuzz: {total} renders in {:.1} s", start.elapsed().as_secs_f64());
 }
 
 fn main() {

@@ -347,7 +347,19 @@ pub fn soft_shadow(terrain: &Terrain, p: V3, sun: V3, steps: u32, distance: Real
 
 /// Display encoding of a linear colour: clamp to [0, 1], gamma 1/2.2.
 pub fn encode(c: V3) -> V3 {
-    c.map(|x| x.clamp(0.0, 1.0).powf(1.0 / 2.2))
+    c.map(|x| x.max(0.0).powf(1.0 / 2.2))
+}
+
+/// The largest encoded colour channel the shading can produce: the
+/// brightest albedo under full sun plus full ambient, per channel (fog mixes
+/// toward the dimmer horizon colour). No clamp hides it, so the raw-output
+/// guard checks the shading itself.
+pub fn max_encoded_colour() -> Real {
+    (0..3)
+        .map(|c| [ROCK[c], GRASS[c], SNOW[c]].into_iter().fold(0.0, Real::max) * (SUN_COLOR[c] + AMBIENT[c]))
+        .chain(SKY_HORIZON.into_iter().chain(SKY_ZENITH))
+        .fold(0.0, Real::max)
+        .powf(1.0 / 2.2)
 }
 
 /// Everything one pixel needs, resolved from a parameter set.
