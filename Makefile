@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves bench lavapipe swiftshader build
+.PHONY: demo test golden curves bench mutants lavapipe swiftshader build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -38,6 +38,10 @@ golden: lavapipe build
 # Regenerate the step-count/quality curves in docs/curves.
 curves: lavapipe build
 	bash ci/curves.sh $(VISTA) docs/curves
+
+# Mutation score of every kernel's suite into docs/mutants (not part of make test).
+mutants: lavapipe build
+	bash ci/mutants.sh $(VISTA) docs/mutants
 
 bench: lavapipe
 	$(CARGO) bench -p vista

@@ -7,4 +7,5 @@ pub use vista_golden as golden;
 pub use vista_gpu as gpu;
 pub use vista_image as image;
 pub use vista_kernels as kernels;
+pub use vista_mutate as mutate;
 pub use vista_project as project;

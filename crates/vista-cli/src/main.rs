@@ -12,6 +12,7 @@ use vista_project::Project;
 
 mod bench;
 mod matrix;
+mod mutate;
 mod sweep;
 
 #[derive(Parser)]
@@ -119,6 +120,31 @@ enum Command {
         metric: String,
         #[arg(long)]
         out: PathBuf,
+    },
+    /// Mutation testing: single-token mutants of a kernel's WGSL against its
+    /// golden cases and CPU reference; prints the score and the survivors.
+    Mutate {
+        #[arg(long, conflicts_with = "case")]
+        kernel: Option<String>,
+        #[arg(long = "case", value_name = "GLOB")]
+        case: Option<String>,
+        /// Mutants per kernel, sampled with --seed (default: all).
+        #[arg(long)]
+        sample: Option<usize>,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Worker threads sharing the device.
+        #[arg(long, default_value_t = 1)]
+        jobs: usize,
+        /// A deterministic slice of the mutants, nextest's syntax: k/n or count:k/n.
+        #[arg(long)]
+        partition: Option<String>,
+        /// Write the report as JSON (score, mutants[] with file, line, col, operator, before, after, outcome, killed_by).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Join partition reports (JSON files) into one score and report instead of running.
+        #[arg(long, num_args = 1.., value_name = "JSON")]
+        merge: Vec<PathBuf>,
     },
     /// Median kernel throughput after a warm-up (excludes device creation and compilation).
     Bench {
@@ -321,6 +347,9 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
                 out,
             },
         ),
+        Command::Mutate { kernel, case, sample, seed, jobs, partition, json, merge } => {
+            mutate::mutate(project, mutate::Args { kernel, case, sample, seed, jobs, partition, json, merge })
+        }
         Command::Bench { kernel, preset, set, size, runs, json, cpu } => {
             bench::bench(project, &kernel, preset.as_deref(), &set, &size, runs, json, cpu)
         }

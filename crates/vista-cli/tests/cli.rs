@@ -1073,3 +1073,124 @@ fn check_matrix_prints_one_row_per_case_and_one_column_per_backend() {
     assert!(report(d.path()).join("matrix.html").exists());
     assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
 }
+
+// ---- vista mutate -----------------------------------------------------------
+
+/// Every file under `root` (but target/) with its bytes, to prove a run wrote nothing.
+fn snapshot(root: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut files: Vec<_> = walk(root)
+        .into_iter()
+        .filter(|p| !p.strip_prefix(root).unwrap().starts_with("target"))
+        .map(|p| (p.clone(), std::fs::read(&p).unwrap()))
+        .collect();
+    files.sort();
+    files
+}
+
+/// A project with its own copy of the fbm shaders, for mutants to work on.
+fn mutate_project() -> tempfile::TempDir {
+    let d = golden_dir(&CASES.replace("[[case]]\nid = \"c\"\nkernel = \"ridged\"\nsize = \"32x32\"\n", ""));
+    copy_tree(&repo().join("shaders"), &d.path().join("shaders"));
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    d
+}
+
+fn mutants_json(d: &Path, name: &str, extra: &[&str]) -> serde_json::Value {
+    let out = d.join(name);
+    let mut args = vec!["mutate", "--kernel", "fbm", "--sample", "12", "--seed", "7", "--json", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let r = vista_in(Some(d), &[], &args);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("overall score") && r.stdout.contains("fbm "), "{}", r.stdout);
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    std::fs::remove_file(out).unwrap();
+    v
+}
+
+#[test]
+fn mutate_is_deterministic_shards_like_nextest_and_writes_nothing() {
+    let d = mutate_project();
+    let before = snapshot(d.path());
+    let whole = mutants_json(d.path(), "whole.json", &[]);
+    assert_eq!(snapshot(d.path()), before, "a mutate run changed the project's files");
+    let again = mutants_json(d.path(), "again.json", &["--jobs", "2"]);
+    assert_eq!(whole["mutants"], again["mutants"], "same seed, different result (or --jobs changed it)");
+    let m = whole["mutants"].as_array().unwrap();
+    assert_eq!(m.len(), 12);
+    for field in ["file", "line", "col", "operator", "before", "after", "outcome", "killed_by"] {
+        assert!(m.iter().all(|x| x.get(field).is_some()), "mutants[] lack {field}");
+    }
+    assert!(whole["score"].is_number(), "{whole}");
+    assert!(m.iter().any(|x| x["outcome"] == "killed"), "no mutant killed: {whole}");
+    // Two halves merged equal the whole run.
+    let (a, b) = (d.path().join("a.json"), d.path().join("b.json"));
+    for (part, out) in [("1/2", &a), ("count:2/2", &b)] {
+        let r = vista_in(
+            Some(d.path()),
+            &[],
+            &[
+                "mutate",
+                "--kernel",
+                "fbm",
+                "--sample",
+                "12",
+                "--seed",
+                "7",
+                "--partition",
+                part,
+                "--json",
+                out.to_str().unwrap(),
+            ],
+        );
+        assert_eq!(r.code, 0, "{}", r.stderr);
+    }
+    let merged = d.path().join("merged.json");
+    let r = vista_in(
+        Some(d.path()),
+        &[],
+        &["mutate", "--merge", a.to_str().unwrap(), b.to_str().unwrap(), "--json", merged.to_str().unwrap()],
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let merged: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&merged).unwrap()).unwrap();
+    let key = |v: &serde_json::Value| {
+        let mut m: Vec<String> = v["mutants"].as_array().unwrap().iter().map(|x| x.to_string()).collect();
+        m.sort();
+        m
+    };
+    assert_eq!(key(&merged), key(&whole), "merged halves differ from the whole run");
+    assert_eq!(merged["score"], whole["score"]);
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["mutate", "--merge", a.to_str().unwrap(), a.to_str().unwrap()]),
+        2,
+        &["partition 1/2 given twice"],
+    );
+    // An interrupted run leaves the project byte-identical too.
+    let before = snapshot(d.path());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vista"))
+        .args(["mutate", "--kernel", "fbm"])
+        .current_dir(d.path())
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(700));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert_eq!(snapshot(d.path()), before, "an interrupted mutate run changed the project's files");
+}
+
+#[test]
+fn mutate_bad_input_is_refused() {
+    let d = golden_dir(CASES);
+    for (args, needle) in [
+        (vec!["mutate", "--kernel", "fbm", "--partition", "3/2"], "--partition 3/2 is not valid"),
+        (vec!["mutate", "--kernel", "fbm", "--sample", "0"], "--sample 0"),
+        (vec!["mutate", "--kernel", "fbm", "--jobs", "0"], "--jobs 0 is out of range"),
+        (vec!["mutate", "--kernel", "nope"], "unknown kernel 'nope'"),
+        (vec!["mutate", "--kernel", "clouds"], "kernel clouds has no golden case selected"),
+    ] {
+        assert_rejected(&vista_in(Some(d.path()), &[], &args), 2, &[needle]);
+    }
+    assert_rejected(&vista(&["mutate", "--kernel", "fbm"]), 2, &["vista mutate needs a vista project"]);
+}

@@ -223,6 +223,13 @@ impl Context {
         })
     }
 
+    /// The same context with another GPU watchdog (mutation runs use a short
+    /// one: a mutant can loop for ever).
+    pub fn with_timeout(mut self, timeout: Duration) -> Context {
+        self.timeout = timeout;
+        self
+    }
+
     /// lavapipe | swiftshader | gpu (or "named" for WGPU_ADAPTER_NAME).
     pub fn backend(&self) -> &'static str {
         self.backend

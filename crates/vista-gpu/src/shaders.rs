@@ -135,6 +135,15 @@ impl ShaderSet {
         Ok(h.finalize().to_hex()[..16].to_string())
     }
 
+    /// The kernel file and the lib modules it reaches through `#import`
+    /// (paths relative to `shaders/`): every file whose edit can change it.
+    pub fn import_closure(&self, name: &str) -> Result<Vec<String>, GpuError> {
+        let (source, _) = self.kernel_source(name)?;
+        Ok(std::iter::once(name.to_string())
+            .chain(self.imported_lib(source).into_iter().map(|e| e.0.clone()))
+            .collect())
+    }
+
     /// Library files reachable from `source` through `#import`, in `lib` order.
     fn imported_lib(&self, source: &str) -> Vec<&(String, String)> {
         let path_of = |src: &str| {

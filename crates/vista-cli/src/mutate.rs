@@ -1,0 +1,142 @@
+//! `vista mutate`: glue over vista-mutate (plan, progress bar, summary, JSON).
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use vista_golden::{GoldenError, Store};
+use vista_gpu::{AdapterChoice, Context};
+use vista_mutate::{Options, Report};
+use vista_project::Project;
+
+use crate::bad;
+
+/// A mutant may loop for ever; the watchdog ends it as a timeout.
+const MUTANT_TIMEOUT: Duration = Duration::from_secs(20);
+
+pub struct Args {
+    pub kernel: Option<String>,
+    pub case: Option<String>,
+    pub sample: Option<usize>,
+    pub seed: u64,
+    pub jobs: usize,
+    pub partition: Option<String>,
+    pub json: Option<PathBuf>,
+    pub merge: Vec<PathBuf>,
+}
+
+pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
+    if !a.merge.is_empty() {
+        let mut parts = Vec::new();
+        for path in &a.merge {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| bad(format!("--merge {}: cannot read: {e}", path.display())))?;
+            let r: Report = serde_json::from_str(&text)
+                .map_err(|e| bad(format!("--merge {}: not a vista mutate report: {e}", path.display())))?;
+            parts.push(r);
+        }
+        let report = Report::merge(parts).map_err(|e| bad(format!("--merge: {e}")))?;
+        return finish(&report, a.json.as_ref());
+    }
+    if !(1..=64).contains(&a.jobs) {
+        return Err(bad(format!("--jobs {} is out of range; allowed: [1, 64]", a.jobs)));
+    }
+    if a.sample == Some(0) {
+        return Err(bad("--sample 0 runs nothing; allowed: 1 or more"));
+    }
+    let partition = match &a.partition {
+        Some(p) => vista_mutate::parse_partition(p).map_err(bad)?,
+        None => (1, 1),
+    };
+    let store = Store::of_project(project, "vista mutate")?;
+    let all_cases = store.load_cases()?;
+    let cases = vista_golden::select(&all_cases, a.case.as_deref())?;
+    let kernels: Vec<&'static vista_kernels::Kernel> = match &a.kernel {
+        Some(name) => vec![store.kernels.find(name).map_err(bad)?],
+        None => {
+            let mut ks: Vec<_> = cases.iter().map(|c| c.kernel).collect();
+            ks.sort_by_key(|k| k.name());
+            ks.dedup_by_key(|k| k.name());
+            ks
+        }
+    };
+    if let Some(k) = kernels.iter().find(|k| !cases.iter().any(|c| c.kernel.name() == k.name())) {
+        return Err(bad(format!("kernel {} has no golden case selected; mutants need cases to run against", k.name())));
+    }
+    let files = project.shader_files()?;
+    let shaders = vista_golden::shader_set(project)?;
+    let opts = Options {
+        kernel: a.kernel.clone(),
+        case_glob: a.case.clone(),
+        sample: a.sample,
+        seed: a.seed,
+        jobs: a.jobs,
+        partition,
+    };
+    let planned = vista_mutate::plan(&files, &shaders, &kernels, &opts)?;
+    eprintln!(
+        "vista mutate: {} mutants of {} kernel(s) (seed {}, sample {}, partition {}/{})",
+        planned.len(),
+        kernels.len(),
+        a.seed,
+        a.sample.map_or("all".to_string(), |s| s.to_string()),
+        partition.0,
+        partition.1
+    );
+    let ctx = Context::new(AdapterChoice::from_env()?)?.with_timeout(MUTANT_TIMEOUT);
+    let bar = ProgressBar::new(planned.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} mutants, {elapsed} elapsed, ETA {eta}")
+            .expect("valid template"),
+    );
+    let results =
+        vista_mutate::run(&ctx, project, &store, &cases, &planned, a.jobs, &|done, _| bar.set_position(done as u64))?;
+    bar.finish_and_clear();
+    let report = Report::new(a.seed, a.sample, vec![format!("{}/{}", partition.0, partition.1)], results);
+    finish(&report, a.json.as_ref())
+}
+
+fn pct(s: Option<f64>) -> String {
+    s.map_or("-".into(), |v| format!("{:.1}%", 100.0 * v))
+}
+
+fn finish(report: &Report, json: Option<&PathBuf>) -> Result<i32, GoldenError> {
+    println!(
+        "{:<14} {:>7} {:>8} {:>12} {:>8} {:>10}  score",
+        "kernel", "killed", "survived", "equivalent?", "timeout", "stillborn"
+    );
+    for (k, s) in &report.kernels {
+        println!(
+            "{k:<14} {:>7} {:>8} {:>12} {:>8} {:>10}  {}",
+            s.killed,
+            s.survived,
+            s.equivalent,
+            s.timeout,
+            s.stillborn,
+            pct(s.score)
+        );
+    }
+    println!("overall score {} (killed / (killed + survived))", pct(report.score));
+    let survivors: Vec<_> = report.mutants.iter().filter(|m| m.outcome == "survived").collect();
+    if !survivors.is_empty() {
+        println!("survivors:");
+        for m in survivors {
+            println!(
+                "  {}:{}:{}  {} -> {}  ({} cases run){}",
+                m.mutant.file,
+                m.mutant.line,
+                m.mutant.col,
+                m.mutant.before,
+                if m.mutant.after.is_empty() { "(removed)" } else { &m.mutant.after },
+                m.cases_run,
+                if m.equivalent { "  equivalent?" } else { "" }
+            );
+        }
+    }
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(report).map_err(|e| bad(format!("JSON encode: {e}")))?;
+        vista_image::atomic_write(path, text.as_bytes())?;
+        println!("json: {}", path.display());
+    }
+    Ok(0)
+}

@@ -1,0 +1,381 @@
+//! `vista mutate` (SPEC 12): how much of a kernel's WGSL the suite really
+//! checks. Every single-token mutant ([`mutants`]) of the kernel file and
+//! the lib modules in its import closure is composed in memory (the
+//! project's files are never written, not even to a temporary copy) and run
+//! against the kernel's golden cases at their thresholds and a GPU-vs-CPU
+//! reference check, stopping at the first failure.
+//!
+//! Outcomes: killed (naming what killed it), survived, timeout (the GPU
+//! watchdog fired), stillborn (naga or the pipeline rejects the mutant; not
+//! counted). A survivor bit-identical to the unmutated render on every case
+//! is flagged `equivalent?`. Score = killed / (killed + survived).
+
+#![deny(missing_docs)]
+
+use std::collections::BTreeMap;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rand::seq::SliceRandom;
+use rand_pcg::Pcg32;
+use vista_golden::{Case, GoldenError, Manifest, Renderer, Store};
+use vista_gpu::{Context, GpuError, ShaderSet};
+use vista_image::Image;
+use vista_kernels::{Kernel, Output};
+use vista_project::{Project, SourceFile};
+
+pub mod mutants;
+pub use mutants::{Mutant, mutants};
+
+/// What happened to one mutant.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MutantReport {
+    /// The kernel whose suite ran it.
+    pub kernel: String,
+    /// Where and what.
+    #[serde(flatten)]
+    pub mutant: Mutant,
+    /// killed | survived | timeout | stillborn.
+    pub outcome: String,
+    /// The case id, or `cpu-reference`, that killed it.
+    pub killed_by: Option<String>,
+    /// A survivor whose raw output is bit-identical to the unmutated render
+    /// on every case: truly equivalent, or code no case reaches.
+    #[serde(rename = "equivalent?")]
+    pub equivalent: bool,
+    /// Detectors run before the verdict (cases, then the CPU check).
+    pub cases_run: usize,
+}
+
+/// Counts and score of one kernel (or all).
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Score {
+    /// Mutants killed.
+    pub killed: usize,
+    /// Mutants that survived every detector.
+    pub survived: usize,
+    /// Survivors flagged `equivalent?`.
+    pub equivalent: usize,
+    /// Mutants the watchdog stopped.
+    pub timeout: usize,
+    /// Mutants naga or the pipeline rejected (not counted).
+    pub stillborn: usize,
+    /// killed / (killed + survived); None without any.
+    pub score: Option<f64>,
+}
+
+/// A whole run (or a merge of partitions).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Report {
+    /// The sampling seed.
+    pub seed: u64,
+    /// Mutants per kernel (None: all).
+    pub sample: Option<usize>,
+    /// Partitions this report holds (`1/1` for a whole run).
+    pub partitions: Vec<String>,
+    /// killed / (killed + survived) over every kernel.
+    pub score: Option<f64>,
+    /// Per kernel.
+    pub kernels: BTreeMap<String, Score>,
+    /// Every mutant run, in plan order.
+    pub mutants: Vec<MutantReport>,
+}
+
+impl Report {
+    /// A report from mutant results, scores computed.
+    pub fn new(seed: u64, sample: Option<usize>, partitions: Vec<String>, mutants: Vec<MutantReport>) -> Report {
+        let mut kernels: BTreeMap<String, Score> = BTreeMap::new();
+        let mut all = Score::default();
+        for m in &mutants {
+            for s in [kernels.entry(m.kernel.clone()).or_default(), &mut all] {
+                match m.outcome.as_str() {
+                    "killed" => s.killed += 1,
+                    "survived" => {
+                        s.survived += 1;
+                        s.equivalent += m.equivalent as usize;
+                    }
+                    "timeout" => s.timeout += 1,
+                    _ => s.stillborn += 1,
+                }
+            }
+        }
+        let finish = |s: &mut Score| {
+            let n = s.killed + s.survived;
+            s.score = (n > 0).then(|| s.killed as f64 / n as f64);
+        };
+        kernels.values_mut().for_each(finish);
+        finish(&mut all);
+        Report { seed, sample, partitions, score: all.score, kernels, mutants }
+    }
+
+    /// Joins partition reports of one plan into one report. Refuses reports
+    /// of different seeds or samples, and a partition given twice.
+    pub fn merge(parts: Vec<Report>) -> Result<Report, String> {
+        let first = parts.first().ok_or("nothing to merge")?;
+        let (seed, sample) = (first.seed, first.sample);
+        let mut partitions = Vec::new();
+        let mut mutants = Vec::new();
+        for p in parts {
+            if (p.seed, p.sample) != (seed, sample) {
+                return Err(format!(
+                    "reports of different runs: seed {} sample {:?} vs seed {seed} sample {sample:?}",
+                    p.seed, p.sample
+                ));
+            }
+            for part in &p.partitions {
+                if partitions.contains(part) {
+                    return Err(format!("partition {part} given twice"));
+                }
+            }
+            partitions.extend(p.partitions);
+            mutants.extend(p.mutants);
+        }
+        mutants.sort_by(|a, b| {
+            (&a.kernel, &a.mutant.file, a.mutant.line, a.mutant.col, &a.mutant.operator, &a.mutant.after).cmp(&(
+                &b.kernel,
+                &b.mutant.file,
+                b.mutant.line,
+                b.mutant.col,
+                &b.mutant.operator,
+                &b.mutant.after,
+            ))
+        });
+        partitions.sort();
+        Ok(Report::new(seed, sample, partitions, mutants))
+    }
+}
+
+/// What to run.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Only this kernel.
+    pub kernel: Option<String>,
+    /// Only the cases matching this glob (and their kernels).
+    pub case_glob: Option<String>,
+    /// Mutants per kernel, sampled with `seed` (None: all).
+    pub sample: Option<usize>,
+    /// Sampling seed.
+    pub seed: u64,
+    /// Worker threads sharing the device.
+    pub jobs: usize,
+    /// This run's slice of the plan: (k, n), 1 <= k <= n.
+    pub partition: (usize, usize),
+}
+
+/// Parses nextest's partition syntax: `k/n` or `count:k/n`.
+pub fn parse_partition(text: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("--partition {text} is not valid; expected k/n or count:k/n with 1 <= k <= n");
+    let body = text.strip_prefix("count:").unwrap_or(text);
+    let (k, n) = body.split_once('/').ok_or_else(bad)?;
+    let (k, n): (usize, usize) = (k.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?);
+    if k == 0 || n == 0 || k > n {
+        return Err(bad());
+    }
+    Ok((k, n))
+}
+
+/// One planned mutant.
+#[derive(Debug, Clone)]
+pub struct Planned {
+    /// Whose suite runs it.
+    pub kernel: &'static Kernel,
+    /// The change.
+    pub mutant: Mutant,
+}
+
+/// The deterministic plan: per kernel (sorted by name), every mutant of its
+/// import closure in source order, shuffled by `seed` and cut to `sample`;
+/// then this partition's slice (every n-th from the k-th).
+pub fn plan(
+    files: &[SourceFile],
+    shaders: &ShaderSet,
+    kernels: &[&'static Kernel],
+    opts: &Options,
+) -> Result<Vec<Planned>, GoldenError> {
+    let mut kernels = kernels.to_vec();
+    kernels.sort_by_key(|k| k.name());
+    let mut all = Vec::new();
+    for k in kernels {
+        let mut list = Vec::new();
+        for rel in shaders.import_closure(k.shader())? {
+            let f = files.iter().find(|f| f.rel == rel).expect("the closure names files of the set");
+            list.extend(mutants(&f.rel, &f.text));
+        }
+        let name_hash = k.name().bytes().fold(0u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64));
+        list.shuffle(&mut Pcg32::new(opts.seed ^ name_hash, 0x0a02_bdbf_7bb3_c0a7));
+        if let Some(n) = opts.sample {
+            list.truncate(n);
+        }
+        all.extend(list.into_iter().map(|mutant| Planned { kernel: k, mutant }));
+    }
+    let (k, n) = opts.partition;
+    Ok(all.into_iter().enumerate().filter(|(i, _)| i % n == k - 1).map(|(_, p)| p).collect())
+}
+
+/// The size of the GPU-vs-CPU check: small, the f64 references are slow.
+const CPU_CHECK_SIZE: (u32, u32) = (48, 32);
+
+/// What an unmutated kernel looks like to its detectors.
+struct Baseline<'a> {
+    cases: Vec<(&'a Case, Option<Image>, String, f64)>, // case, golden, raw hash, threshold
+    cpu: Option<(vista_kernels::ParamSet, Image, Agreement, String)>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Agreement {
+    psnr: f64,
+    max_abs: f64,
+}
+
+fn agreement(kernel: &Kernel, gpu: &Image, cpu: &Image) -> Agreement {
+    let peak = match kernel.output() {
+        Output::Display => 1.0,
+        Output::Hdr => cpu.data.iter().flat_map(|p| p[..3].iter()).fold(0.0f64, |m, v| m.max(*v as f64)),
+    };
+    let (mut se, mut max_abs) = (0.0f64, 0.0f64);
+    for (g, c) in gpu.data.iter().zip(&cpu.data) {
+        for k in 0..4 {
+            let d = (g[k] as f64 - c[k] as f64).abs();
+            se += d * d;
+            max_abs = if d.is_nan() { f64::INFINITY } else { max_abs.max(d) };
+        }
+    }
+    let mse = se / (gpu.data.len() * 4) as f64;
+    Agreement { psnr: if mse == 0.0 { f64::INFINITY } else { 10.0 * (peak * peak / mse).log10() }, max_abs }
+}
+
+fn baseline<'a>(
+    gpu: &Renderer,
+    store: &Store,
+    manifest: &Manifest,
+    kernel: &Kernel,
+    cases: &[&'a Case],
+) -> Result<Baseline<'a>, GoldenError> {
+    let adapter = gpu.adapter_description();
+    let mut out = Vec::new();
+    for c in cases.iter().filter(|c| c.kernel.name() == kernel.name()) {
+        let r = vista_golden::render(gpu, kernel, &c.params, c.width, c.height)?;
+        let golden = vista_image::read_png16(&store.golden_path(c)).ok();
+        let same = manifest.case.get(&c.id).is_some_and(|e| e.adapter == adapter);
+        out.push((*c, golden, r.raw.content_hash(), if same { c.psnr_same_driver } else { c.psnr_other_driver }));
+    }
+    let cpu = match (kernel.has_reference(), out.first()) {
+        (true, Some((c, ..))) => {
+            let (w, h) = CPU_CHECK_SIZE;
+            let raw = vista_golden::render(gpu, kernel, &c.params, w, h)?.raw;
+            let reference = kernel.reference(&c.params, w, h);
+            let a = agreement(kernel, &raw, &reference);
+            Some((c.params.clone(), reference, a, raw.content_hash()))
+        }
+        _ => None,
+    };
+    Ok(Baseline { cases: out, cpu })
+}
+
+/// Runs one mutant against the detectors; the first failure kills it.
+fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> MutantReport {
+    let report = |outcome: &str, killed_by: Option<String>, equivalent: bool, cases_run: usize| MutantReport {
+        kernel: kernel.name().to_string(),
+        mutant: m.clone(),
+        outcome: outcome.to_string(),
+        killed_by,
+        equivalent,
+        cases_run,
+    };
+    let failed = |e: &GoldenError| match e {
+        GoldenError::Gpu(GpuError::Timeout { .. }) => "timeout",
+        _ => "stillborn",
+    };
+    let mut identical = true;
+    for (n, (case, golden, raw_hash, threshold)) in base.cases.iter().enumerate() {
+        let r = match vista_golden::render(gpu, kernel, &case.params, case.width, case.height) {
+            Ok(r) => r,
+            Err(e) => return report(failed(&e), None, false, n + 1),
+        };
+        identical &= r.raw.content_hash() == *raw_hash;
+        if r.raw.nonfinite_count() > 0 {
+            return report("killed", Some(format!("{} (NaN/Inf)", case.id)), false, n + 1);
+        }
+        let (lo, hi) = kernel.output_bounds(&case.params);
+        if r.raw.data.iter().any(|p| p[..3].iter().any(|v| *v < lo || *v > hi)) {
+            return report("killed", Some(format!("{} (output range)", case.id)), false, n + 1);
+        }
+        if let Some(g) = golden {
+            let psnr = vista_image::metrics::psnr(g, &vista_golden::quantize16(&r.display));
+            if psnr < *threshold {
+                return report("killed", Some(case.id.clone()), false, n + 1);
+            }
+        }
+    }
+    let mut run = base.cases.len();
+    if let Some((p, reference, before, raw_hash)) = &base.cpu {
+        run += 1;
+        let (w, h) = CPU_CHECK_SIZE;
+        match vista_golden::render(gpu, kernel, p, w, h) {
+            Ok(r) => {
+                identical &= r.raw.content_hash() == *raw_hash;
+                let a = agreement(kernel, &r.raw, reference);
+                // Killed when the mutant at least doubles the error (6 dB)
+                // against the reference, beyond f32 noise.
+                if a.psnr < before.psnr - 6.0 && a.max_abs > 2.0 * before.max_abs + 1e-6 {
+                    return report("killed", Some("cpu-reference".into()), false, run);
+                }
+            }
+            Err(e) => return report(failed(&e), None, false, run),
+        }
+    }
+    report("survived", None, identical, run)
+}
+
+/// Runs the plan on `ctx` with `jobs` workers; `progress(done, total)` is
+/// called after each mutant. The project's files are only read.
+pub fn run(
+    ctx: &Context,
+    project: &Project,
+    store: &Store,
+    cases: &[&Case],
+    planned: &[Planned],
+    jobs: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<MutantReport>, GoldenError> {
+    let files = project.shader_files()?;
+    let label = "mutant";
+    let set = |edit: Option<&Mutant>| {
+        ShaderSet::from_files(
+            label,
+            files.iter().map(|f| {
+                let text = match edit {
+                    Some(m) if m.file == f.rel => m.apply(&f.text),
+                    _ => f.text.clone(),
+                };
+                (f.rel.clone(), text, f.origin.clone())
+            }),
+        )
+    };
+    let manifest = store.manifest()?;
+    let original = Renderer { ctx, shaders: set(None) };
+    let mut baselines = BTreeMap::new();
+    for p in planned {
+        if !baselines.contains_key(p.kernel.name()) {
+            baselines.insert(p.kernel.name(), baseline(&original, store, &manifest, p.kernel, cases)?);
+        }
+    }
+    let results: Mutex<Vec<Option<MutantReport>>> = Mutex::new(vec![None; planned.len()]);
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..jobs.max(1) {
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(p) = planned.get(i) else { break };
+                    let gpu = Renderer { ctx, shaders: set(Some(&p.mutant)) };
+                    let r = judge(&gpu, p.kernel, &baselines[p.kernel.name()], &p.mutant);
+                    results.lock().expect("results")[i] = Some(r);
+                    progress(done.fetch_add(1, Ordering::SeqCst) + 1, planned.len());
+                }
+            });
+        }
+    });
+    Ok(results.into_inner().expect("results").into_iter().map(|r| r.expect("every mutant ran")).collect())
+}

@@ -1,0 +1,50 @@
+//! `vista mutate` against this checkout's fbm suite: a known-bad mutant is
+//! killed (naming the case that killed it), and a change to a component the
+//! shader never reads is a survivor flagged `equivalent?`.
+
+mod common;
+
+use vista_golden::{Renderer, Store};
+use vista_mutate::{Planned, mutants};
+
+fn run_one(gpu: &Renderer, file: &str, line_text: &str, before: &str, after: &str) -> vista_mutate::MutantReport {
+    let project = common::project();
+    let store = Store::of_project(&project, "tests").unwrap();
+    let all = store.load_cases().unwrap();
+    let cases = vista_golden::select(&all, Some("fbm-*")).unwrap();
+    let text = std::fs::read_to_string(project.root().unwrap().join("shaders").join(file)).unwrap();
+    // The last line holding the text (pcg3d mixes twice; its final z is the unread one).
+    let line = text.lines().collect::<Vec<_>>().iter().rposition(|l| l.contains(line_text)).expect("line in the shader")
+        as u32
+        + 1;
+    let mutant = mutants(file, &text)
+        .into_iter()
+        .find(|m| m.line == line && m.before == before && m.after == after)
+        .unwrap_or_else(|| panic!("no mutant {before} -> {after} on {file}:{line}"));
+    let kernel = vista_kernels::find("fbm").unwrap();
+    let planned = [Planned { kernel, mutant }];
+    let mut r = vista_mutate::run(gpu.ctx, &project, &store, &cases, &planned, 1, &|_, _| {}).unwrap();
+    r.pop().unwrap()
+}
+
+fn a_known_bad_mutant_is_killed_by_a_golden_case(gpu: &Renderer) {
+    // The display map 0.5 + 0.5 f / A becomes 0.5 - 0.5 f / A: every image inverts.
+    let r = run_one(gpu, "fbm.wgsl", "let value = 0.5 + 0.5 * f", "+", "-");
+    assert_eq!(r.outcome, "killed", "{r:?}");
+    assert_eq!(r.killed_by.as_deref(), Some("fbm-perlin-default"), "{r:?}");
+    assert_eq!(r.cases_run, 1, "stops at the first failure: {r:?}");
+}
+
+fn a_change_the_shader_never_reads_is_equivalent(gpu: &Renderer) {
+    // pcg3d's z component: value noise reads only .x.
+    let r = run_one(gpu, "lib/hash.wgsl", "v.z += v.x * v.y;", "*", "/");
+    assert_eq!(r.outcome, "survived", "{r:?}");
+    assert!(r.equivalent, "{r:?}");
+}
+
+fn main() {
+    common::run_gpu_tests(&[
+        ("a_known_bad_mutant_is_killed_by_a_golden_case", a_known_bad_mutant_is_killed_by_a_golden_case),
+        ("a_change_the_shader_never_reads_is_equivalent", a_change_the_shader_never_reads_is_equivalent),
+    ]);
+}
