@@ -9,9 +9,9 @@ mod common;
 
 use std::path::Path;
 
-use vista_golden::Renderer;
+use vista_golden::{Renderer, agreement};
 use vista_image::Image;
-use vista_kernels::{Kernel, Output};
+use vista_kernels::Kernel;
 
 /// One compared setting: kernel, preset, overrides, size.
 type Setting = (&'static str, &'static str, &'static [(&'static str, &'static str)], (u32, u32));
@@ -36,33 +36,6 @@ const SETTINGS: &[Setting] = &[
     ("heightfield", "fog", &[], (48, 30)),
     ("heightfield", "mist", &[], (48, 30)),
 ];
-
-/// Agreement of two raw images over R, G, B and alpha.
-#[derive(Debug, Clone, Copy)]
-struct Agreement {
-    /// PSNR with peak 1 (display kernels) or the reference's largest RGB
-    /// value (HDR kernels, SPEC 5's rule).
-    psnr: f64,
-    max_abs: f64,
-}
-
-fn agreement(kernel: &Kernel, gpu: &Image, cpu: &Image) -> Agreement {
-    let peak = match kernel.output() {
-        Output::Display => 1.0,
-        Output::Hdr => cpu.data.iter().flat_map(|p| p[..3].iter()).fold(0.0f64, |m, v| m.max(*v as f64)),
-    };
-    let (mut se, mut max_abs) = (0.0f64, 0.0f64);
-    for (g, c) in gpu.data.iter().zip(&cpu.data) {
-        for k in 0..4 {
-            let d = (g[k] as f64 - c[k] as f64).abs();
-            se += d * d;
-            max_abs = if d.is_nan() { f64::INFINITY } else { max_abs.max(d) };
-        }
-    }
-    let mse = se / (gpu.data.len() * 4) as f64;
-    let psnr = if mse == 0.0 { f64::INFINITY } else { 10.0 * (peak * peak / mse).log10() };
-    Agreement { psnr, max_abs }
-}
 
 /// Bound of a kernel's GPU-vs-CPU agreement on a backend: (min PSNR dB,
 /// max abs), a few dB under the worst measured there (README "GPU vs CPU

@@ -15,18 +15,7 @@ struct Run {
 /// `None`, in an empty directory outside any project (built-ins only).
 fn vista_in(project: Option<&Path>, env: &[(&str, &str)], args: &[&str]) -> Run {
     let outside = tmp();
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_vista"));
-    cmd.args(args).env("XDG_RUNTIME_DIR", "/tmp").env_remove("CI").env_remove("VISTA_ROOT");
-    cmd.current_dir(project.unwrap_or(outside.path()));
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    let Output { status, stdout, stderr } = cmd.output().expect("run vista");
-    Run {
-        code: status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&stderr).into_owned(),
-    }
+    run_in(Path::new(env!("CARGO_BIN_EXE_vista")), project.unwrap_or(outside.path()), env, args)
 }
 
 fn vista(args: &[&str]) -> Run {

@@ -5,6 +5,7 @@
 //! This is the only crate that writes goldens, and it writes every file
 //! atomically (temp file + rename).
 
+pub mod agreement;
 pub mod bless;
 pub mod cases;
 pub mod check;
@@ -12,6 +13,7 @@ pub mod render;
 pub mod report;
 pub mod store;
 
+pub use agreement::{Agreement, agreement};
 pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, load_cases, parse_cases, select};
 pub use check::{CheckOptions, Outcome, Verdict, check_case};

@@ -18,10 +18,10 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rand::seq::SliceRandom;
 use rand_pcg::Pcg32;
-use vista_golden::{Case, GoldenError, Manifest, Renderer, Store};
+use vista_golden::{Agreement, Case, GoldenError, Manifest, Renderer, Store, agreement};
 use vista_gpu::{Context, GpuError, ShaderSet};
 use vista_image::Image;
-use vista_kernels::{Kernel, Output};
+use vista_kernels::Kernel;
 use vista_project::{Project, SourceFile};
 
 pub mod mutants;
@@ -219,29 +219,6 @@ const CPU_CHECK_SIZE: (u32, u32) = (48, 32);
 struct Baseline<'a> {
     cases: Vec<(&'a Case, Option<Image>, String, f64)>, // case, golden, raw hash, threshold
     cpu: Option<(vista_kernels::ParamSet, Image, Agreement, String)>,
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Agreement {
-    psnr: f64,
-    max_abs: f64,
-}
-
-fn agreement(kernel: &Kernel, gpu: &Image, cpu: &Image) -> Agreement {
-    let peak = match kernel.output() {
-        Output::Display => 1.0,
-        Output::Hdr => cpu.data.iter().flat_map(|p| p[..3].iter()).fold(0.0f64, |m, v| m.max(*v as f64)),
-    };
-    let (mut se, mut max_abs) = (0.0f64, 0.0f64);
-    for (g, c) in gpu.data.iter().zip(&cpu.data) {
-        for k in 0..4 {
-            let d = (g[k] as f64 - c[k] as f64).abs();
-            se += d * d;
-            max_abs = if d.is_nan() { f64::INFINITY } else { max_abs.max(d) };
-        }
-    }
-    let mse = se / (gpu.data.len() * 4) as f64;
-    Agreement { psnr: if mse == 0.0 { f64::INFINITY } else { 10.0 * (peak * peak / mse).log10() }, max_abs }
 }
 
 fn baseline<'a>(
