@@ -5,13 +5,16 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves bench mutants lavapipe swiftshader build
+.PHONY: demo test golden curves bench mutants lavapipe swiftshader validation build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
 
 swiftshader: lavapipe
 	bash ci/install-swiftshader.sh
+
+validation: lavapipe
+	bash ci/install-validation.sh
 
 build:
 	$(CARGO) build -p vista-cli
@@ -23,11 +26,13 @@ demo: lavapipe build
 # The whole suite (what .ci/run calls): unit tests, CPU references,
 # invariants, and every golden case on lavapipe; then a closing count, and
 # proof that without an adapter the GPU tests are reported skipped, never ok.
-test: lavapipe swiftshader
+test: lavapipe swiftshader validation
 	mkdir -p target
 	set -o pipefail; $(CARGO) test --workspace 2>&1 | tee target/test.log
 	@echo "---- every golden case again on SwiftShader (other-driver thresholds, expectations from golden/cases.toml)"
 	set -o pipefail; VISTA_BACKEND=swiftshader $(CARGO) test --test golden 2>&1 | tee -a target/test.log
+	@echo "---- every golden case under the Khronos validation layer (VISTA_VALIDATION=1): any message fails the case"
+	set -o pipefail; VISTA_VALIDATION=1 $(CARGO) test --test golden 2>&1 | tee -a target/test.log
 	bash ci/test-summary.sh target/test.log
 	bash ci/no-gpu-skips.sh
 

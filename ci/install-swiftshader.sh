@@ -14,8 +14,15 @@ icd=/usr/share/vulkan/icd.d/vista_swiftshader_icd.json
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 
+summary() {
+    XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp} vulkaninfo --summary 2>/dev/null || true
+}
+
 listed() {
-    XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp} vulkaninfo --summary 2>/dev/null | grep -q 'SwiftShader'
+    # Capture first: grep -q closing the pipe early would fail the pipeline (pipefail).
+    local s
+    s=$(summary)
+    grep -q 'SwiftShader' <<<"$s"
 }
 
 if [ -f "$icd" ] && [ -f "$lib_dir/libvk_swiftshader.so" ]; then
@@ -43,7 +50,8 @@ else
 fi
 
 if listed; then
-    echo "install-swiftshader: Vulkan adapter visible: $(XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp} vulkaninfo --summary 2>/dev/null | grep -m1 'deviceName.*SwiftShader' | sed 's/.*= //')"
+    s=$(summary)
+    echo "install-swiftshader: Vulkan adapter visible: $(grep -m1 'deviceName.*SwiftShader' <<<"$s" | sed 's/.*= //')"
 else
     echo "install-swiftshader: the Vulkan loader does not list SwiftShader; see 'vulkaninfo --summary'" >&2
     exit 1

@@ -177,8 +177,28 @@ fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vist
     eprintln!("fuzz: {total} renders in {:.1} s", start.elapsed().as_secs_f64());
 }
 
+/// VISTA_VALIDATION=1: with the Khronos layer on, a clean kernel renders,
+/// and a validation message arriving during a dispatch fails it, naming the
+/// layer and the message (injected here through the logger wgpu-hal uses).
+fn a_validation_message_fails_the_dispatch(_shared: &vista_golden::Renderer) {
+    if !std::path::Path::new(vista_gpu::VALIDATION_LAYER_JSON).exists() {
+        panic!("the Khronos validation layer is missing: run `bash ci/install-validation.sh`");
+    }
+    let ctx = vista_gpu::Context::with_validation(vista_gpu::AdapterChoice::Lavapipe, true).unwrap();
+    assert!(ctx.validating());
+    let gpu = vista_golden::Renderer::new(&ctx, &common::project()).unwrap();
+    let k = vista_kernels::find("fbm").unwrap();
+    let p = k.resolve(None, &[]).unwrap();
+    vista_golden::render(&gpu, k, &p, 32, 32).expect("a clean kernel passes under the validation layer");
+    log::error!(target: vista_gpu::validation::TARGET, "VALIDATION [VUID-injected (0x1)] injected by the test");
+    let e = vista_golden::render(&gpu, k, &p, 32, 32).unwrap_err().to_string();
+    assert!(e.contains("Khronos validation layer") && e.contains("VUID-injected"), "{e}");
+    vista_golden::render(&gpu, k, &p, 32, 32).expect("messages are per dispatch");
+}
+
 fn main() {
     common::run_gpu_tests(&[
+        ("a_validation_message_fails_the_dispatch", a_validation_message_fails_the_dispatch),
         (
             "injected_nan_fails_the_case_naming_count_and_first_pixel",
             injected_nan_fails_the_case_naming_count_and_first_pixel,

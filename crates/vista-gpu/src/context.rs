@@ -133,7 +133,12 @@ pub struct Context {
     /// Serialises submissions so a timeout is attributed to the right job.
     submit_lock: Mutex<()>,
     pub creation_time: Duration,
+    /// Whether the Khronos validation layer is on.
+    validate: bool,
 }
+
+/// Where Debian's vulkan-validationlayers puts the layer's manifest.
+pub const VALIDATION_LAYER_JSON: &str = "/usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json";
 
 static SHARED: OnceLock<Result<Context, GpuError>> = OnceLock::new();
 
@@ -144,9 +149,26 @@ impl Context {
     }
 
     pub fn new(choice: AdapterChoice) -> Result<Context, GpuError> {
+        let validate = std::env::var("VISTA_VALIDATION").is_ok_and(|v| v == "1" || v.eq_ignore_ascii_case("true"));
+        Context::with_validation(choice, validate)
+    }
+
+    /// A context, with the Khronos validation layer when `validate`; every
+    /// validation message then fails the dispatch it arrives in.
+    pub fn with_validation(choice: AdapterChoice, validate: bool) -> Result<Context, GpuError> {
         let start = Instant::now();
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
+        if validate {
+            crate::validation::install().map_err(GpuError::Request)?;
+            if !std::path::Path::new(VALIDATION_LAYER_JSON).exists() {
+                return Err(GpuError::Request(format!(
+                    "VISTA_VALIDATION=1 needs the Khronos validation layer ({VALIDATION_LAYER_JSON}); install it with \
+                     `bash ci/install-validation.sh` (Debian's vulkan-validationlayers)"
+                )));
+            }
+            desc.flags |= wgpu::InstanceFlags::VALIDATION;
+        }
         let backends = desc.backends;
         let instance = wgpu::Instance::new(desc);
         let adapters = pollster::block_on(instance.enumerate_adapters(backends));
@@ -220,6 +242,7 @@ impl Context {
             timeout: Duration::from_secs_f64(timeout),
             submit_lock: Mutex::new(()),
             creation_time: start.elapsed(),
+            validate,
         })
     }
 
@@ -228,6 +251,11 @@ impl Context {
     pub fn with_timeout(mut self, timeout: Duration) -> Context {
         self.timeout = timeout;
         self
+    }
+
+    /// Whether the Khronos validation layer is on (`VISTA_VALIDATION=1`).
+    pub fn validating(&self) -> bool {
+        self.validate
     }
 
     /// lavapipe | swiftshader | gpu (or "named" for WGPU_ADAPTER_NAME).
@@ -388,6 +416,15 @@ impl Context {
             unpad_rows(&mapped, job.width, job.height, padded_row)
         };
         readback.unmap();
+        if self.validate {
+            let messages = crate::validation::take();
+            if !messages.is_empty() {
+                return Err(GpuError::Validation {
+                    what: format!("{} (Khronos validation layer, {} messages)", job.shader, messages.len()),
+                    message: messages.join(" | "),
+                });
+            }
+        }
         Ok((image, RunStats { gpu_wall, total: start.elapsed() }))
     }
 

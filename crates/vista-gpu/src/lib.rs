@@ -8,8 +8,9 @@
 
 mod context;
 mod shaders;
+pub mod validation;
 
-pub use context::{AdapterChoice, Context, Dispatch, RunStats, SWIFTSHADER_HINT, WGPU_BACKENDS};
+pub use context::{AdapterChoice, Context, Dispatch, RunStats, SWIFTSHADER_HINT, VALIDATION_LAYER_JSON, WGPU_BACKENDS};
 pub use shaders::{ShaderSet, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
