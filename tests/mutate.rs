@@ -42,9 +42,30 @@ fn a_change_the_shader_never_reads_is_equivalent(gpu: &Renderer) {
     assert!(r.equivalent, "{r:?}");
 }
 
+/// The plan mutates only functions fbm's main reaches: fbm2 and the noise,
+/// never ridged2 or ridged_max in the same module.
+fn only_functions_the_kernel_reaches_are_mutated(_gpu: &Renderer) {
+    let project = common::project();
+    let files = project.shader_files().unwrap();
+    let shaders = vista_golden::shader_set(&project).unwrap();
+    let fbm = vista_kernels::find("fbm").unwrap();
+    let opts =
+        vista_mutate::Options { kernel: None, case_glob: None, sample: None, seed: 1, jobs: 1, partition: (1, 1) };
+    let plan = vista_mutate::plan(&files, &shaders, &[fbm], &opts).unwrap();
+    let fractal = files.iter().find(|f| f.rel == "lib/fractal.wgsl").unwrap();
+    let fns = vista_mutate::mutants::functions(&fractal.text);
+    let body = |name: &str| fns.iter().find(|f| f.name == name).unwrap().body;
+    let inside =
+        |m: &vista_mutate::Mutant, (a, b): (usize, usize)| m.file == "lib/fractal.wgsl" && a <= m.start && m.end <= b;
+    assert!(plan.iter().any(|p| inside(&p.mutant, body("fbm2"))), "fbm2 is not mutated");
+    assert!(!plan.iter().any(|p| inside(&p.mutant, body("ridged2")) || inside(&p.mutant, body("ridged_max"))));
+    assert!(plan.iter().any(|p| p.mutant.file == "lib/hash.wgsl"), "pcg3d (value noise) is reached");
+}
+
 fn main() {
     common::run_gpu_tests(&[
         ("a_known_bad_mutant_is_killed_by_a_golden_case", a_known_bad_mutant_is_killed_by_a_golden_case),
         ("a_change_the_shader_never_reads_is_equivalent", a_change_the_shader_never_reads_is_equivalent),
+        ("only_functions_the_kernel_reaches_are_mutated", only_functions_the_kernel_reaches_are_mutated),
     ]);
 }

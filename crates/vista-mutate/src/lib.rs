@@ -185,7 +185,10 @@ pub struct Planned {
 
 /// The deterministic plan: per kernel (sorted by name), every mutant of its
 /// import closure in source order, shuffled by `seed` and cut to `sample`;
-/// then this partition's slice (every n-th from the k-th).
+/// then this partition's slice (every n-th from the k-th). Only functions
+/// the kernel's `main` reaches (by name, through calls, across the closure)
+/// are mutated: a function it never calls cannot change its output, so its
+/// mutants would only be `equivalent?` noise.
 pub fn plan(
     files: &[SourceFile],
     shaders: &ShaderSet,
@@ -196,10 +199,34 @@ pub fn plan(
     kernels.sort_by_key(|k| k.name());
     let mut all = Vec::new();
     for k in kernels {
+        let closure: Vec<&SourceFile> = shaders
+            .import_closure(k.shader())?
+            .iter()
+            .map(|rel| files.iter().find(|f| &f.rel == rel).expect("the closure names files of the set"))
+            .collect();
+        let fns: Vec<(&str, mutants::Function)> = closure
+            .iter()
+            .flat_map(|f| mutants::functions(&f.text).into_iter().map(move |g| (f.rel.as_str(), g)))
+            .collect();
+        let mut reached: Vec<bool> = fns.iter().map(|(rel, g)| *rel == k.shader() && g.name == "main").collect();
+        let mut work: Vec<String> =
+            fns.iter().zip(&reached).filter(|(_, r)| **r).flat_map(|((_, g), _)| g.calls.clone()).collect();
+        while let Some(name) = work.pop() {
+            for (i, (_, g)) in fns.iter().enumerate() {
+                if !reached[i] && g.name == name {
+                    reached[i] = true;
+                    work.extend(g.calls.iter().cloned());
+                }
+            }
+        }
+        let live = |m: &Mutant| {
+            fns.iter()
+                .zip(&reached)
+                .any(|((rel, g), r)| *r && *rel == m.file && g.body.0 <= m.start && m.end <= g.body.1)
+        };
         let mut list = Vec::new();
-        for rel in shaders.import_closure(k.shader())? {
-            let f = files.iter().find(|f| f.rel == rel).expect("the closure names files of the set");
-            list.extend(mutants(&f.rel, &f.text));
+        for f in &closure {
+            list.extend(mutants(&f.rel, &f.text).into_iter().filter(|m| live(m)));
         }
         let name_hash = k.name().bytes().fold(0u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64));
         list.shuffle(&mut Pcg32::new(opts.seed ^ name_hash, 0x0a02_bdbf_7bb3_c0a7));

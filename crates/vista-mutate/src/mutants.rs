@@ -159,6 +159,55 @@ fn bump_int(lit: &str) -> Option<String> {
     (v < i32::MAX as u64).then(|| format!("{}{suffix}", v + 1))
 }
 
+/// One function of a WGSL file: its name, the byte range of its body and
+/// the names it calls.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Function {
+    /// The function's name.
+    pub name: String,
+    /// Byte range of the body, braces included.
+    pub body: (usize, usize),
+    /// Identifiers called in the body (`name(`), builtins included.
+    pub calls: Vec<String>,
+}
+
+/// The functions of `text`, in source order.
+pub fn functions(text: &str) -> Vec<Function> {
+    let toks = lex(text);
+    let s = |t: &Token| &text[t.start..t.end];
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i + 1 < toks.len() {
+        if s(&toks[i]) == "fn" && toks[i + 1].kind == Kind::Ident {
+            let name = s(&toks[i + 1]).to_string();
+            let Some(open) = (i..toks.len()).find(|&k| s(&toks[k]) == "{") else { break };
+            let mut depth = 0;
+            let mut close = open;
+            for (k, t) in toks.iter().enumerate().skip(open) {
+                match s(t) {
+                    "{" => depth += 1,
+                    "}" => {
+                        depth -= 1;
+                        if depth == 0 {
+                            close = k;
+                            break;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            let calls = (open..close)
+                .filter(|&k| toks[k].kind == Kind::Ident && toks.get(k + 1).is_some_and(|n| s(n) == "("))
+                .map(|k| s(&toks[k]).to_string())
+                .collect();
+            out.push(Function { name, body: (toks[open].start, toks[close].end), calls });
+            i = close;
+        }
+        i += 1;
+    }
+    out
+}
+
 /// Every mutant of `text` (the file `file`), in source order.
 pub fn mutants(file: &str, text: &str) -> Vec<Mutant> {
     let toks = lex(text);
