@@ -21,3 +21,13 @@ if echo "$results" | grep -vqE ' 0 passed; 0 failed; [1-9][0-9]* ignored'; then
 fi
 skipped=$(echo "$results" | awk '{ for (i = 1; i <= NF; i++) if ($(i + 1) ~ /^ignored/) s += $i } END { print s }')
 echo "no-gpu-skips: without an adapter all $skipped GPU tests of ${#suites[@]} suites are reported ignored, none ok"
+
+# The CLI suite mixes both: its rendering tests must be ignored, its
+# bad-input tests (which stop before any GPU work) must still pass.
+VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json VISTA_ALLOW_NO_GPU=1 \
+    ${CARGO:-cargo} test -q -p vista-cli --test cli >"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: the CLI suite failed without an adapter"; exit 1; }
+cli=$(grep -E '^test result:' "$log")
+if ! echo "$cli" | grep -qE ' [1-9][0-9]* passed; 0 failed; [1-9][0-9]* ignored'; then
+    echo "$cli"; echo "no-gpu-skips: the CLI suite did not both run its bad-input tests and ignore its rendering ones"; exit 1
+fi
+echo "no-gpu-skips: CLI suite without an adapter: $(echo "$cli" | sed 's/.*ok\. //; s/; 0 measured.*//')"

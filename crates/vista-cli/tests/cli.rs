@@ -41,7 +41,6 @@ fn out_png(dir: &Path) -> String {
     dir.join("x.png").to_string_lossy().into_owned()
 }
 
-#[test]
 fn unknown_kernel_lists_valid_kernels() {
     let d = tmp();
     assert_rejected(
@@ -51,7 +50,6 @@ fn unknown_kernel_lists_valid_kernels() {
     );
 }
 
-#[test]
 fn unknown_preset_lists_valid_presets() {
     let d = tmp();
     assert_rejected(
@@ -61,7 +59,6 @@ fn unknown_preset_lists_valid_presets() {
     );
 }
 
-#[test]
 fn unknown_param_lists_valid_params() {
     let d = tmp();
     assert_rejected(
@@ -71,7 +68,6 @@ fn unknown_param_lists_valid_params() {
     );
 }
 
-#[test]
 fn out_of_range_value_names_value_and_range() {
     let d = tmp();
     assert_rejected(
@@ -86,7 +82,6 @@ fn out_of_range_value_names_value_and_range() {
     );
 }
 
-#[test]
 fn wrong_type_names_value_and_expected_kind() {
     let d = tmp();
     assert_rejected(
@@ -108,7 +103,6 @@ fn wrong_type_names_value_and_expected_kind() {
     assert_rejected(&vista(&["render", "fbm", "--set", "gain", "-o", &out_png(d.path())]), 2, &["NAME=VALUE"]);
 }
 
-#[test]
 fn bad_sizes_are_rejected_before_gpu_work() {
     let d = tmp();
     // VISTA_ADAPTER=nonsense would fail at device creation: these never get there.
@@ -125,14 +119,12 @@ fn bad_sizes_are_rejected_before_gpu_work() {
     }
 }
 
-#[test]
 fn absurd_work_is_refused_with_the_cap() {
     let d = tmp();
     let r = vista_in(None, &[("VISTA_MAX_WORK", "1000")], &["render", "fbm", "-o", &out_png(d.path())]);
     assert_rejected(&r, 2, &["above the cap", "VISTA_MAX_WORK"]);
 }
 
-#[test]
 fn unwritable_output_directory_is_refused() {
     let d = tmp();
     let missing = d.path().join("no/such/dir/x.png");
@@ -163,7 +155,6 @@ fn unwritable_output_directory_is_refused() {
     }
 }
 
-#[test]
 fn compare_reports_json_fields_and_rejects_bad_files() {
     let d = tmp();
     let a = d.path().join("a.png");
@@ -185,7 +176,6 @@ fn compare_reports_json_fields_and_rejects_bad_files() {
     assert_rejected(&vista(&["compare", a.to_str().unwrap(), small.to_str().unwrap()]), 2, &["32", "16"]);
 }
 
-#[test]
 fn render_exr_holds_the_raw_fbm_field() {
     let d = tmp();
     let exr = d.path().join("f.exr");
@@ -199,7 +189,6 @@ fn render_exr_holds_the_raw_fbm_field() {
     assert!(err < 1e-5, "EXR R channel differs from 0.5 + 0.5 f / A by {err}");
 }
 
-#[test]
 fn render_exr_holds_heightfield_depth_over_t_max() {
     let d = tmp();
     let exr = d.path().join("d.exr");
@@ -222,7 +211,6 @@ fn render_exr_holds_heightfield_depth_over_t_max() {
 // ---- sweep ------------------------------------------------------------------
 
 /// A sweep's bad input fails before any render and writes nothing.
-#[test]
 fn sweep_rejects_bad_input_before_rendering() {
     let d = tmp();
     let out = d.path().join("sw");
@@ -268,7 +256,6 @@ fn sweep_rejects_bad_input_before_rendering() {
     assert!(!out.exists(), "a rejected sweep must not create its output directory");
 }
 
-#[test]
 fn sweep_writes_csv_plots_and_names_the_cheapest_setting() {
     let d = tmp();
     let out = d.path().join("sw");
@@ -306,7 +293,6 @@ fn sweep_writes_csv_plots_and_names_the_cheapest_setting() {
     }
 }
 
-#[test]
 fn sweep_grid_has_one_row_per_point() {
     let d = tmp();
     let out = d.path().join("grid");
@@ -375,7 +361,6 @@ fn golden(d: &Path, kernel: &str, id: &str) -> PathBuf {
     d.join("golden").join(kernel).join(format!("{id}.png"))
 }
 
-#[test]
 fn missing_golden_fails_with_the_bless_command_and_is_not_created() {
     let d = golden_dir(CASES);
     let r = vista_in(Some(d.path()), &[], &["check"]);
@@ -385,7 +370,6 @@ fn missing_golden_fails_with_the_bless_command_and_is_not_created() {
     assert!(!golden(d.path(), "fbm", "a").exists(), "check must never create a golden");
 }
 
-#[test]
 fn bless_then_check_passes_and_bless_is_refused_in_ci() {
     let d = golden_dir(CASES);
     let refused = vista_in(Some(d.path()), &[("CI", "true")], &["bless"]);
@@ -403,7 +387,6 @@ fn bless_then_check_passes_and_bless_is_refused_in_ci() {
     assert!(forced.stdout.contains("unchanged"), "{}", forced.stdout);
 }
 
-#[test]
 fn a_changed_render_fails_check_with_metrics_and_images() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -427,7 +410,6 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
     assert!(report(d.path()).join("b/diff.png").exists());
 }
 
-#[test]
 fn corrupt_and_wrong_size_goldens_fail_clearly() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -448,7 +430,6 @@ fn corrupt_and_wrong_size_goldens_fail_clearly() {
     assert!(r.stdout.contains("is 32x32 but the case renders 48x32"), "{}", r.stdout);
 }
 
-#[test]
 fn malformed_cases_toml_names_the_line() {
     let d = golden_dir("[[case]]\nid = \"a\"\nkernel = \"fbm\"\nsize = 32x32\n");
     let r = vista_in(Some(d.path()), &[], &["check"]);
@@ -527,7 +508,6 @@ fn consistent(d: &Path, fx: &BlessFixture) -> Result<(), String> {
 /// stay old or new and consistent with each other, `vista check` names an
 /// unfinished case, and a complete bless converges. The same stops with a
 /// plain in-place writer substituted break consistency, so the check can fail.
-#[test]
 fn interrupted_bless_leaves_every_golden_old_or_new() {
     let fx = bless_fixture();
     assert!(fx.old.iter().zip(&fx.new).all(|(a, b)| a != b), "every case must change");
@@ -573,7 +553,6 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-#[test]
 fn bless_keeps_orphans_unless_pruned() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -586,7 +565,6 @@ fn bless_keeps_orphans_unless_pruned() {
     assert!(golden(d.path(), "fbm", "b").exists(), "prune must keep live goldens");
 }
 
-#[test]
 fn gpu_watchdog_turns_a_long_wait_into_a_clear_error() {
     let d = tmp();
     let r = vista_in(
@@ -597,7 +575,6 @@ fn gpu_watchdog_turns_a_long_wait_into_a_clear_error() {
     assert_rejected(&r, 1, &["GPU wait exceeded", "VISTA_GPU_TIMEOUT_S"]);
 }
 
-#[test]
 fn list_shows_params_ranges_and_presets() {
     let r = vista(&["list"]);
     assert_eq!(r.code, 0);
@@ -608,7 +585,6 @@ fn list_shows_params_ranges_and_presets() {
     assert!(names.stdout.lines().any(|l| l == "fbm default"), "{}", names.stdout);
 }
 
-#[test]
 fn bench_json_reports_throughput() {
     let r = vista(&["bench", "fbm", "--size", "64x64", "--runs", "3", "--json"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -619,7 +595,6 @@ fn bench_json_reports_throughput() {
     assert!(!r.stdout.contains("cpu_f32_ms"), "the CPU side runs only with --cpu");
 }
 
-#[test]
 fn bench_cpu_reports_the_f32_reference_and_ratio() {
     let r = vista(&["bench", "ridged", "--size", "48x32", "--runs", "2", "--json", "--cpu"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -635,7 +610,6 @@ fn bench_cpu_reports_the_f32_reference_and_ratio() {
 /// `vista list | head -1`: a reader that goes away ends vista quietly, as it
 /// does other Unix tools, instead of a "failed printing to stdout" panic.
 #[cfg(unix)]
-#[test]
 fn closed_stdout_pipe_is_not_a_panic() {
     use std::process::Stdio;
     let mut child = Command::new(env!("CARGO_BIN_EXE_vista"))
@@ -676,7 +650,6 @@ fn run_in(bin: &Path, cwd: &Path, env: &[(&str, &str)], args: &[&str]) -> Run {
 /// A copied binary inside a `git clone` whose fbm shader was edited checks
 /// the clone's files: the case fails there, passes in the original, and a
 /// bless in the clone writes the clone's golden, never the original's.
-#[test]
 fn a_copied_binary_checks_the_checkout_it_runs_in() {
     let t = tmp();
     let bin = t.path().join("bin/vista");
@@ -722,7 +695,6 @@ fn a_copied_binary_checks_the_checkout_it_runs_in() {
     assert_eq!(by_env.code, 0, "{}{}", by_env.stdout, by_env.stderr);
 }
 
-#[test]
 fn check_and_bless_without_a_project_name_what_was_looked_for_and_where() {
     let outside = tmp();
     let cwd = outside.path().display().to_string();
@@ -745,7 +717,6 @@ fn check_and_bless_without_a_project_name_what_was_looked_for_and_where() {
     assert_rejected(&r, 2, &["vista.toml: line 1, column 1", "nmae"]);
 }
 
-#[test]
 fn builtin_kernels_render_outside_any_project_from_the_embedded_sources() {
     let outside = tmp();
     let bin = outside.path().join("vista");
@@ -764,7 +735,6 @@ fn builtin_kernels_render_outside_any_project_from_the_embedded_sources() {
 /// No library or binary source finds files through build-time paths
 /// (`CARGO_MANIFEST_DIR`, `env!`, `option_env!`) or the old per-directory
 /// variables; only test code and benches may name the checkout.
-#[test]
 fn no_build_time_paths_in_non_test_code() {
     let mut offenders = Vec::new();
     let mut stack = vec![repo().join("src"), repo().join("crates")];
@@ -839,7 +809,6 @@ fn render_k(manifest: &str, shader: &str) -> Run {
     r
 }
 
-#[test]
 fn a_kernel_described_as_data_renders() {
     let r = render_k(K_MANIFEST, K_SHADER);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -847,13 +816,11 @@ fn a_kernel_described_as_data_renders() {
     assert_eq!(r.code, 0, "{}", r.stderr);
 }
 
-#[test]
 fn params_field_without_a_param_is_refused() {
     let shader = K_SHADER.replace("    gain: f32,\n", "    gain: f32,\n    rot_cos: f32,\n");
     assert_rejected(&render_k(K_MANIFEST, &shader), 2, &["kernel k", "Params field rot_cos (WGSL f32) has no param"]);
 }
 
-#[test]
 fn param_without_a_params_field_is_refused() {
     let manifest =
         format!("{K_MANIFEST}[[param]]\nname = \"unused\"\ntype = \"vec3\"\nrange = [0, 1]\ndefault = [0, 0, 0]\n");
@@ -864,7 +831,6 @@ fn param_without_a_params_field_is_refused() {
     );
 }
 
-#[test]
 fn params_type_mismatch_is_refused() {
     let manifest = K_MANIFEST
         .replace("type = \"f32\"\nrange = [0.0, 1.0]\ndefault = 0.5", "type = \"u32\"\nrange = [0, 1]\ndefault = 0");
@@ -875,7 +841,6 @@ fn params_type_mismatch_is_refused() {
     );
 }
 
-#[test]
 fn unknown_manifest_key_names_file_line_and_key() {
     let manifest = format!("{K_MANIFEST}colour = 3\n");
     assert_rejected(&render_k(&manifest, K_SHADER), 2, &["kernels/k.toml", "unknown field `colour`"]);
@@ -883,7 +848,6 @@ fn unknown_manifest_key_names_file_line_and_key() {
     assert_rejected(&render_k(&manifest, K_SHADER), 2, &["kernels/k.toml: line 7, column 1", "unknown field `dco`"]);
 }
 
-#[test]
 fn bad_range_default_or_enum_value_is_refused() {
     let m = K_MANIFEST.replace("range = [0.0, 1.0]", "range = [1.0, 0.0]");
     assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k: param gain", "range = [1, 0] is not valid"]);
@@ -906,7 +870,6 @@ fn bad_range_default_or_enum_value_is_refused() {
     );
 }
 
-#[test]
 fn preset_naming_an_unknown_param_is_refused() {
     let m = format!("{K_MANIFEST}[preset.dim]\ngian = 0.1\n");
     assert_rejected(
@@ -918,13 +881,11 @@ fn preset_naming_an_unknown_param_is_refused() {
     assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "preset dim: gain=7 is out of range"]);
 }
 
-#[test]
 fn missing_shader_file_is_refused() {
     let m = format!("shader = \"nope.wgsl\"\n{K_MANIFEST}");
     assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "shader nope.wgsl not found", "k.wgsl"]);
 }
 
-#[test]
 fn malformed_manifest_names_file_line_and_column() {
     let m = K_MANIFEST.replace("default = 0.5", "default = 0.5.5");
     assert_rejected(&render_k(&m, K_SHADER), 2, &["kernels/k.toml: line 6, column 14"]);
@@ -952,7 +913,6 @@ fn copy_tree(from: &Path, to: &Path) {
 /// the repository: list, render (PNG and EXR), check against its committed
 /// goldens, bless, sweep, bench, and its params range-checked like the
 /// built-ins'.
-#[test]
 fn the_example_project_works_with_a_copied_binary() {
     let t = tmp();
     let (bin, root) = (t.path().join("vista"), t.path().join("project"));
@@ -1011,7 +971,6 @@ fn the_example_project_works_with_a_copied_binary() {
 /// Expectations are data in golden/cases.toml: a failure they name passes
 /// the run (reported xfail with the reason), an expected failure that
 /// passes fails the run, and a bad expectation is refused.
-#[test]
 fn expected_failures_are_data_and_an_unexpected_pass_fails() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -1045,7 +1004,6 @@ fn expected_failures_are_data_and_an_unexpected_pass_fails() {
 
 /// `vista check --matrix` renders every case on each implementation and
 /// prints one case x backend table; a backend that is missing is named loudly.
-#[test]
 fn check_matrix_prints_one_row_per_case_and_one_column_per_backend() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -1096,7 +1054,6 @@ fn mutants_json(d: &Path, name: &str, extra: &[&str]) -> serde_json::Value {
     v
 }
 
-#[test]
 fn mutate_is_deterministic_shards_like_nextest_and_writes_nothing() {
     let d = mutate_project();
     let before = snapshot(d.path());
@@ -1169,7 +1126,6 @@ fn mutate_is_deterministic_shards_like_nextest_and_writes_nothing() {
     assert_eq!(snapshot(d.path()), before, "an interrupted mutate run changed the project's files");
 }
 
-#[test]
 fn mutate_bad_input_is_refused() {
     let d = golden_dir(CASES);
     for (args, needle) in [
@@ -1182,4 +1138,117 @@ fn mutate_bad_input_is_refused() {
         assert_rejected(&vista_in(Some(d.path()), &[], &args), 2, &[needle]);
     }
     assert_rejected(&vista(&["mutate", "--kernel", "fbm"]), 2, &["vista mutate needs a vista project"]);
+}
+
+/// Whether a test renders (and so needs an adapter) or stops before any GPU work.
+#[derive(Clone, Copy, PartialEq)]
+enum Needs {
+    Gpu,
+    Cpu,
+}
+use Needs::{Cpu, Gpu};
+
+/// The harness: libtest-mimic, so that without an adapter and with
+/// VISTA_ALLOW_NO_GPU=1 the tests that render are reported ignored (never
+/// "ok"), while the bad-input tests, which stop before any GPU work, still run.
+fn main() {
+    let tests: &[(Needs, &str, fn())] = &[
+        (Cpu, "unknown_kernel_lists_valid_kernels", unknown_kernel_lists_valid_kernels),
+        (Cpu, "unknown_preset_lists_valid_presets", unknown_preset_lists_valid_presets),
+        (Cpu, "unknown_param_lists_valid_params", unknown_param_lists_valid_params),
+        (Cpu, "out_of_range_value_names_value_and_range", out_of_range_value_names_value_and_range),
+        (Cpu, "wrong_type_names_value_and_expected_kind", wrong_type_names_value_and_expected_kind),
+        (Cpu, "bad_sizes_are_rejected_before_gpu_work", bad_sizes_are_rejected_before_gpu_work),
+        (Cpu, "absurd_work_is_refused_with_the_cap", absurd_work_is_refused_with_the_cap),
+        (Cpu, "unwritable_output_directory_is_refused", unwritable_output_directory_is_refused),
+        (Gpu, "compare_reports_json_fields_and_rejects_bad_files", compare_reports_json_fields_and_rejects_bad_files),
+        (Gpu, "render_exr_holds_the_raw_fbm_field", render_exr_holds_the_raw_fbm_field),
+        (Gpu, "render_exr_holds_heightfield_depth_over_t_max", render_exr_holds_heightfield_depth_over_t_max),
+        (Cpu, "sweep_rejects_bad_input_before_rendering", sweep_rejects_bad_input_before_rendering),
+        (
+            Gpu,
+            "sweep_writes_csv_plots_and_names_the_cheapest_setting",
+            sweep_writes_csv_plots_and_names_the_cheapest_setting,
+        ),
+        (Gpu, "sweep_grid_has_one_row_per_point", sweep_grid_has_one_row_per_point),
+        (
+            Gpu,
+            "missing_golden_fails_with_the_bless_command_and_is_not_created",
+            missing_golden_fails_with_the_bless_command_and_is_not_created,
+        ),
+        (Gpu, "bless_then_check_passes_and_bless_is_refused_in_ci", bless_then_check_passes_and_bless_is_refused_in_ci),
+        (
+            Gpu,
+            "a_changed_render_fails_check_with_metrics_and_images",
+            a_changed_render_fails_check_with_metrics_and_images,
+        ),
+        (Gpu, "corrupt_and_wrong_size_goldens_fail_clearly", corrupt_and_wrong_size_goldens_fail_clearly),
+        (Cpu, "malformed_cases_toml_names_the_line", malformed_cases_toml_names_the_line),
+        (Gpu, "interrupted_bless_leaves_every_golden_old_or_new", interrupted_bless_leaves_every_golden_old_or_new),
+        (Gpu, "bless_keeps_orphans_unless_pruned", bless_keeps_orphans_unless_pruned),
+        (Gpu, "gpu_watchdog_turns_a_long_wait_into_a_clear_error", gpu_watchdog_turns_a_long_wait_into_a_clear_error),
+        (Cpu, "list_shows_params_ranges_and_presets", list_shows_params_ranges_and_presets),
+        (Gpu, "bench_json_reports_throughput", bench_json_reports_throughput),
+        (Gpu, "bench_cpu_reports_the_f32_reference_and_ratio", bench_cpu_reports_the_f32_reference_and_ratio),
+        #[cfg(unix)]
+        (Cpu, "closed_stdout_pipe_is_not_a_panic", closed_stdout_pipe_is_not_a_panic),
+        (Gpu, "a_copied_binary_checks_the_checkout_it_runs_in", a_copied_binary_checks_the_checkout_it_runs_in),
+        (
+            Cpu,
+            "check_and_bless_without_a_project_name_what_was_looked_for_and_where",
+            check_and_bless_without_a_project_name_what_was_looked_for_and_where,
+        ),
+        (
+            Gpu,
+            "builtin_kernels_render_outside_any_project_from_the_embedded_sources",
+            builtin_kernels_render_outside_any_project_from_the_embedded_sources,
+        ),
+        (Cpu, "no_build_time_paths_in_non_test_code", no_build_time_paths_in_non_test_code),
+        (Gpu, "a_kernel_described_as_data_renders", a_kernel_described_as_data_renders),
+        (Cpu, "params_field_without_a_param_is_refused", params_field_without_a_param_is_refused),
+        (Cpu, "param_without_a_params_field_is_refused", param_without_a_params_field_is_refused),
+        (Cpu, "params_type_mismatch_is_refused", params_type_mismatch_is_refused),
+        (Cpu, "unknown_manifest_key_names_file_line_and_key", unknown_manifest_key_names_file_line_and_key),
+        (Cpu, "bad_range_default_or_enum_value_is_refused", bad_range_default_or_enum_value_is_refused),
+        (Cpu, "preset_naming_an_unknown_param_is_refused", preset_naming_an_unknown_param_is_refused),
+        (Cpu, "missing_shader_file_is_refused", missing_shader_file_is_refused),
+        (Cpu, "malformed_manifest_names_file_line_and_column", malformed_manifest_names_file_line_and_column),
+        (Gpu, "the_example_project_works_with_a_copied_binary", the_example_project_works_with_a_copied_binary),
+        (
+            Gpu,
+            "expected_failures_are_data_and_an_unexpected_pass_fails",
+            expected_failures_are_data_and_an_unexpected_pass_fails,
+        ),
+        (
+            Gpu,
+            "check_matrix_prints_one_row_per_case_and_one_column_per_backend",
+            check_matrix_prints_one_row_per_case_and_one_column_per_backend,
+        ),
+        (
+            Gpu,
+            "mutate_is_deterministic_shards_like_nextest_and_writes_nothing",
+            mutate_is_deterministic_shards_like_nextest_and_writes_nothing,
+        ),
+        (Cpu, "mutate_bad_input_is_refused", mutate_bad_input_is_refused),
+    ];
+    let args = libtest_mimic::Arguments::from_args();
+    let allow = std::env::var("VISTA_ALLOW_NO_GPU").is_ok_and(|v| v == "1" || v.eq_ignore_ascii_case("true"));
+    let missing = if args.list || !allow { None } else { vista_gpu::Context::shared().err() };
+    if let Some(e) = &missing {
+        let n = tests.iter().filter(|t| t.0 == Gpu).count();
+        eprintln!(
+            "\n!!! VISTA_ALLOW_NO_GPU=1 and no adapter: {e}\n!!! SKIPPED {n} CLI tests that render (reported ignored)\n"
+        );
+    }
+    let trials = tests
+        .iter()
+        .map(|&(needs, name, f)| {
+            libtest_mimic::Trial::test(name, move || {
+                f();
+                Ok(())
+            })
+            .with_ignored_flag(needs == Gpu && missing.is_some())
+        })
+        .collect();
+    libtest_mimic::run(&args, trials).exit()
 }
