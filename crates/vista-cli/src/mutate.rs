@@ -36,7 +36,7 @@ pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
             parts.push(r);
         }
         let report = Report::merge(parts).map_err(|e| bad(format!("--merge: {e}")))?;
-        return finish(&report, a.json.as_ref());
+        return finish(project, &report, a.json.as_ref());
     }
     if !(1..=64).contains(&a.jobs) {
         return Err(bad(format!("--jobs {} is out of range; allowed: [1, 64]", a.jobs)));
@@ -93,14 +93,14 @@ pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
         vista_mutate::run(&ctx, project, &store, &cases, &planned, a.jobs, &|done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
     let report = Report::new(a.seed, a.sample, vec![format!("{}/{}", partition.0, partition.1)], results);
-    finish(&report, a.json.as_ref())
+    finish(project, &report, a.json.as_ref())
 }
 
 fn pct(s: Option<f64>) -> String {
     s.map_or("-".into(), |v| format!("{:.1}%", 100.0 * v))
 }
 
-fn finish(report: &Report, json: Option<&PathBuf>) -> Result<i32, GoldenError> {
+fn finish(project: &Project, report: &Report, json: Option<&PathBuf>) -> Result<i32, GoldenError> {
     println!(
         "{:<14} {:>7} {:>8} {:>12} {:>8} {:>10}  score",
         "kernel", "killed", "survived", "equivalent?", "timeout", "stillborn"
@@ -132,6 +132,13 @@ fn finish(report: &Report, json: Option<&PathBuf>) -> Result<i32, GoldenError> {
                 if m.equivalent { "  equivalent?" } else { "" }
             );
         }
+    }
+    if let Some(dir) = project.report_dir() {
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;
+        let path = dir.join("mutants.html");
+        vista_image::atomic_write(&path, report.html().as_bytes())?;
+        println!("report: {}", path.display());
     }
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(report).map_err(|e| bad(format!("JSON encode: {e}")))?;

@@ -1068,6 +1068,8 @@ fn mutate_is_deterministic_shards_like_nextest_and_writes_nothing() {
     }
     assert!(whole["score"].is_number(), "{whole}");
     assert!(m.iter().any(|x| x["outcome"] == "killed"), "no mutant killed: {whole}");
+    let html = std::fs::read_to_string(report(d.path()).join("mutants.html")).unwrap();
+    assert!(html.contains("<h2>Survivors</h2>") && html.contains("fbm"), "the report's mutate section");
     // Two halves merged equal the whole run.
     let (a, b) = (d.path().join("a.json"), d.path().join("b.json"));
     for (part, out) in [("1/2", &a), ("count:2/2", &b)] {

@@ -145,6 +145,61 @@ impl Report {
     }
 }
 
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+impl Report {
+    /// The report's HTML section: score per kernel, then every survivor
+    /// with its place, change and how many detectors ran.
+    pub fn html(&self) -> String {
+        let pct = |s: Option<f64>| s.map_or("-".into(), |v| format!("{:.1}%", 100.0 * v));
+        let mut rows = String::new();
+        for (k, s) in &self.kernels {
+            rows += &format!(
+                "<tr><td>{k}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td><b>{}</b></td></tr>\n",
+                s.killed,
+                s.survived,
+                s.equivalent,
+                s.timeout,
+                s.stillborn,
+                pct(s.score)
+            );
+        }
+        let mut survivors = String::new();
+        for m in self.mutants.iter().filter(|m| m.outcome == "survived") {
+            survivors += &format!(
+                "<tr><td>{}</td><td><code>{}:{}:{}</code></td><td>{}</td><td><code>{}</code> &rarr; <code>{}</code></td>\
+                 <td>{}</td><td>{}</td></tr>\n",
+                esc(&m.kernel),
+                esc(&m.mutant.file),
+                m.mutant.line,
+                m.mutant.col,
+                esc(&m.mutant.operator),
+                esc(&m.mutant.before),
+                esc(if m.mutant.after.is_empty() { "(removed)" } else { &m.mutant.after }),
+                m.cases_run,
+                if m.equivalent { "equivalent?" } else { "" }
+            );
+        }
+        format!(
+            "<!doctype html><meta charset=\"utf-8\"><title>vista mutate</title>\
+             <style>body{{font-family:sans-serif}} td,th{{border:1px solid #ccc;padding:3px 6px}} \
+             table{{border-collapse:collapse;margin-bottom:1em}}</style>\
+             <h1>vista mutate</h1><p>seed {}, sample {}, partitions {}: overall score <b>{}</b> \
+             (killed / (killed + survived)).</p>\
+             <table><tr><th>kernel</th><th>killed</th><th>survived</th><th>equivalent?</th><th>timeout</th>\
+             <th>stillborn</th><th>score</th></tr>\n{rows}</table>\
+             <h2>Survivors</h2><table><tr><th>kernel</th><th>place</th><th>operator</th><th>change</th>\
+             <th>detectors run</th><th></th></tr>\n{survivors}</table>\n",
+            self.seed,
+            self.sample.map_or("all".to_string(), |s| s.to_string()),
+            esc(&self.partitions.join(", ")),
+            pct(self.score)
+        )
+    }
+}
+
 /// What to run.
 #[derive(Debug, Clone)]
 pub struct Options {
