@@ -9,7 +9,10 @@ seed=${SEED:-1}
 sample=${SAMPLE:-60}
 mkdir -p "$out"
 start=$(date +%s)
-"$vista" mutate --sample "$sample" --seed "$seed" --json "$out/mutants.json" | tee "$out/summary.txt"
+# Survivors argued equivalent (one-line reasons) are kept in $out/equivalent.toml.
+args=()
+[ -f "$out/equivalent.toml" ] && args=(--equivalent "$out/equivalent.toml")
+"$vista" mutate --sample "$sample" --seed "$seed" "${args[@]}" --json "$out/mutants.json" | tee "$out/summary.txt"
 secs=$(( $(date +%s) - start ))
 {
     echo "# Mutation score (vista mutate --sample $sample --seed $seed)"
@@ -18,7 +21,9 @@ secs=$(( $(date +%s) - start ))
     echo "change in a kernel's WGSL or the lib modules it imports, run against the"
     echo "kernel's golden cases and its GPU-vs-CPU check (see SPEC 12)."
     echo "\`equivalent?\` survivors are bit-identical to the unmutated render on every"
-    echo "case: truly equivalent, or code no case reaches."
+    echo "case: truly equivalent, or code no case reaches. Survivors argued equivalent,"
+    echo "each with a one-line reason, are listed in \`equivalent.toml\` and excluded"
+    echo "from the score (\`argued\`); every other survivor counts."
     echo
     echo '```'
     cat "$out/summary.txt"

@@ -145,6 +145,10 @@ enum Command {
         /// Join partition reports (JSON files) into one score and report instead of running.
         #[arg(long, num_args = 1.., value_name = "JSON")]
         merge: Vec<PathBuf>,
+        /// Survivors argued equivalent (TOML [[mutant]] kernel, file, line, col, after, why):
+        /// excluded from the score and listed apart.
+        #[arg(long, value_name = "TOML")]
+        equivalent: Option<PathBuf>,
     },
     /// Median kernel throughput after a warm-up (excludes device creation and compilation).
     Bench {
@@ -347,9 +351,10 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
                 out,
             },
         ),
-        Command::Mutate { kernel, case, sample, seed, jobs, partition, json, merge } => {
-            mutate::mutate(project, mutate::Args { kernel, case, sample, seed, jobs, partition, json, merge })
-        }
+        Command::Mutate { kernel, case, sample, seed, jobs, partition, json, merge, equivalent } => mutate::mutate(
+            project,
+            mutate::Args { kernel, case, sample, seed, jobs, partition, json, merge, equivalent },
+        ),
         Command::Bench { kernel, preset, set, size, runs, json, cpu } => {
             bench::bench(project, &kernel, preset.as_deref(), &set, &size, runs, json, cpu)
         }

@@ -23,9 +23,19 @@ pub struct Args {
     pub partition: Option<String>,
     pub json: Option<PathBuf>,
     pub merge: Vec<PathBuf>,
+    pub equivalent: Option<PathBuf>,
+}
+
+/// The argued-equivalent list, if one was given.
+fn argued(path: Option<&PathBuf>) -> Result<Vec<vista_mutate::Argued>, GoldenError> {
+    let Some(path) = path else { return Ok(Vec::new()) };
+    let text =
+        std::fs::read_to_string(path).map_err(|e| bad(format!("--equivalent {}: cannot read: {e}", path.display())))?;
+    vista_mutate::parse_argued(&text).map_err(|e| bad(format!("--equivalent {}: {e}", path.display())))
 }
 
 pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
+    let argued = argued(a.equivalent.as_ref())?;
     if !a.merge.is_empty() {
         let mut parts = Vec::new();
         for path in &a.merge {
@@ -35,7 +45,13 @@ pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
                 .map_err(|e| bad(format!("--merge {}: not a vista mutate report: {e}", path.display())))?;
             parts.push(r);
         }
-        let report = Report::merge(parts).map_err(|e| bad(format!("--merge: {e}")))?;
+        let mut report = Report::merge(parts).map_err(|e| bad(format!("--merge: {e}")))?;
+        if !argued.is_empty() {
+            let mut m = report.mutants.clone();
+            m.iter_mut().filter(|m| m.outcome == "argued").for_each(|m| m.outcome = "survived".into());
+            warn_unused(&vista_mutate::apply_argued(&mut m, &argued));
+            report = Report::new(report.seed, report.sample, report.partitions.clone(), m);
+        }
         return finish(project, &report, a.json.as_ref());
     }
     if !(1..=64).contains(&a.jobs) {
@@ -92,8 +108,24 @@ pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
     let results =
         vista_mutate::run(&ctx, project, &store, &cases, &planned, a.jobs, &|done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
+    let mut results = results;
+    let unused = vista_mutate::apply_argued(&mut results, &argued);
+    // A partition holds only part of the survivors: its unmatched arguments say nothing.
+    if a.partition.is_none() {
+        warn_unused(&unused);
+    }
     let report = Report::new(a.seed, a.sample, vec![format!("{}/{}", partition.0, partition.1)], results);
     finish(project, &report, a.json.as_ref())
+}
+
+/// Arguments that matched no survivor: the code moved, or a case kills it now.
+fn warn_unused(unused: &[vista_mutate::Argued]) {
+    for u in unused {
+        println!(
+            "note: argued equivalent {}:{}:{} -> {} ({}) matches no survivor any more",
+            u.file, u.line, u.col, u.after, u.kernel
+        );
+    }
 }
 
 fn pct(s: Option<f64>) -> String {
@@ -102,21 +134,33 @@ fn pct(s: Option<f64>) -> String {
 
 fn finish(project: &Project, report: &Report, json: Option<&PathBuf>) -> Result<i32, GoldenError> {
     println!(
-        "{:<14} {:>7} {:>8} {:>12} {:>8} {:>10}  score",
-        "kernel", "killed", "survived", "equivalent?", "timeout", "stillborn"
+        "{:<14} {:>7} {:>8} {:>12} {:>7} {:>8} {:>10}  score",
+        "kernel", "killed", "survived", "equivalent?", "argued", "timeout", "stillborn"
     );
     for (k, s) in &report.kernels {
         println!(
-            "{k:<14} {:>7} {:>8} {:>12} {:>8} {:>10}  {}",
+            "{k:<14} {:>7} {:>8} {:>12} {:>7} {:>8} {:>10}  {}",
             s.killed,
             s.survived,
             s.equivalent,
+            s.argued,
             s.timeout,
             s.stillborn,
             pct(s.score)
         );
     }
-    println!("overall score {} (killed / (killed + survived))", pct(report.score));
+    println!("overall score {} (killed / (killed + survived); argued equivalents excluded)", pct(report.score));
+    let argued: Vec<_> = report.mutants.iter().filter(|m| m.outcome == "argued").collect();
+    if !argued.is_empty() {
+        println!("argued equivalent (excluded from the score):");
+        for m in argued {
+            let why = m.argument.as_deref().unwrap_or("");
+            println!(
+                "  {}:{}:{}  {} -> {}  {}: {why}",
+                m.mutant.file, m.mutant.line, m.mutant.col, m.mutant.before, m.mutant.after, m.kernel
+            );
+        }
+    }
     let survivors: Vec<_> = report.mutants.iter().filter(|m| m.outcome == "survived").collect();
     if !survivors.is_empty() {
         println!("survivors:");

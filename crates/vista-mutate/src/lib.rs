@@ -45,6 +45,67 @@ pub struct MutantReport {
     pub equivalent: bool,
     /// Detectors run before the verdict (cases, then the CPU check).
     pub cases_run: usize,
+    /// For `argued` mutants: why no output can differ.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub argument: Option<String>,
+}
+
+/// A survivor argued equivalent in the project's list (`--equivalent
+/// FILE`, TOML `[[mutant]]` tables): excluded from the score, listed apart.
+/// It matches by kernel, file, line, column and replacement, so an edit that
+/// moves the code makes the mutant count as a survivor again.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Argued {
+    /// The kernel whose suite ran it.
+    pub kernel: String,
+    /// Shader file, relative to `shaders/`.
+    pub file: String,
+    /// 1-based line.
+    pub line: u32,
+    /// 1-based column.
+    pub col: u32,
+    /// The replacement text (empty for a dropped statement).
+    pub after: String,
+    /// One line: why no output can differ.
+    pub why: String,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ArguedFile {
+    #[serde(default)]
+    mutant: Vec<Argued>,
+}
+
+/// Parses an `--equivalent` list; errors name line and column.
+pub fn parse_argued(text: &str) -> Result<Vec<Argued>, String> {
+    let f: ArguedFile = toml::from_str(text).map_err(|e| vista_project::one_line_toml_error(text, &e))?;
+    if let Some(a) = f.mutant.iter().find(|a| a.why.trim().is_empty()) {
+        return Err(format!("{}:{}:{}: an argued equivalent needs a why", a.file, a.line, a.col));
+    }
+    Ok(f.mutant)
+}
+
+/// Marks survivors that `argued` names as `argued` (with the argument);
+/// returns the entries that matched no survivor (stale arguments).
+pub fn apply_argued(mutants: &mut [MutantReport], argued: &[Argued]) -> Vec<Argued> {
+    let mut unused = Vec::new();
+    for a in argued {
+        let hit = mutants.iter_mut().find(|m| {
+            m.outcome == "survived"
+                && (m.kernel.as_str(), m.mutant.file.as_str(), m.mutant.line, m.mutant.col, m.mutant.after.as_str())
+                    == (a.kernel.as_str(), a.file.as_str(), a.line, a.col, a.after.as_str())
+        });
+        match hit {
+            Some(m) => {
+                m.outcome = "argued".into();
+                m.argument = Some(a.why.clone());
+            }
+            None => unused.push(a.clone()),
+        }
+    }
+    unused
 }
 
 /// Counts and score of one kernel (or all).
@@ -60,6 +121,9 @@ pub struct Score {
     pub timeout: usize,
     /// Mutants naga or the pipeline rejected (not counted).
     pub stillborn: usize,
+    /// Survivors argued equivalent in the project's list (not counted).
+    #[serde(default)]
+    pub argued: usize,
     /// killed / (killed + survived); None without any.
     pub score: Option<f64>,
 }
@@ -95,6 +159,7 @@ impl Report {
                         s.equivalent += m.equivalent as usize;
                     }
                     "timeout" => s.timeout += 1,
+                    "argued" => s.argued += 1,
                     _ => s.stillborn += 1,
                 }
             }
@@ -340,6 +405,7 @@ fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> Mutant
         killed_by,
         equivalent,
         cases_run,
+        argument: None,
     };
     let failed = |e: &GoldenError| match e {
         GoldenError::Gpu(GpuError::Timeout { .. }) => "timeout",
@@ -437,4 +503,52 @@ pub fn run(
         }
     });
     Ok(results.into_inner().expect("results").into_iter().map(|r| r.expect("every mutant ran")).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn survivor(line: u32) -> MutantReport {
+        MutantReport {
+            kernel: "fbm".into(),
+            mutant: Mutant {
+                file: "fbm.wgsl".into(),
+                line,
+                col: 29,
+                operator: "&& ||".into(),
+                before: "||".into(),
+                after: "&&".into(),
+                start: 0,
+                end: 0,
+            },
+            outcome: "survived".into(),
+            killed_by: None,
+            equivalent: true,
+            cases_run: 3,
+            argument: None,
+        }
+    }
+
+    #[test]
+    fn argued_equivalents_leave_the_score_and_stale_ones_are_reported() {
+        let list = parse_argued(
+            "[[mutant]]\nkernel = \"fbm\"\nfile = \"fbm.wgsl\"\nline = 25\ncol = 29\nafter = \"&&\"\nwhy = \"guard\"\n\
+             [[mutant]]\nkernel = \"fbm\"\nfile = \"fbm.wgsl\"\nline = 99\ncol = 1\nafter = \"&&\"\nwhy = \"moved\"\n",
+        )
+        .unwrap();
+        let mut m = vec![survivor(25), survivor(26)];
+        let stale = apply_argued(&mut m, &list);
+        assert_eq!(stale.len(), 1);
+        assert_eq!(stale[0].line, 99);
+        assert_eq!((m[0].outcome.as_str(), m[0].argument.as_deref()), ("argued", Some("guard")));
+        let r = Report::new(1, None, vec!["1/1".into()], m);
+        let s = &r.kernels["fbm"];
+        assert_eq!((s.survived, s.argued, s.score), (1, 1, Some(0.0)));
+        assert!(
+            parse_argued("[[mutant]]\nkernel = \"fbm\"\nfile = \"f\"\nline = 1\ncol = 1\nafter = \"x\"\nwhy = \" \"\n")
+                .is_err()
+        );
+        assert!(parse_argued("[[mutant]]\nkernal = 1\n").unwrap_err().contains("line 2"));
+    }
 }
