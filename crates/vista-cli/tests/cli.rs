@@ -639,7 +639,19 @@ fn run_in(bin: &Path, cwd: &Path, env: &[(&str, &str)], args: &[&str]) -> Run {
     for (k, v) in env {
         cmd.env(k, v);
     }
-    let Output { status, stdout, stderr } = cmd.output().expect("run vista");
+    // A binary copied moments ago can fail to exec with ETXTBSY while a child
+    // forked by a parallel test still holds the copy's write descriptor; that
+    // child execs its own program within milliseconds, so retry briefly.
+    let mut tries = 0;
+    let Output { status, stdout, stderr } = loop {
+        match cmd.output() {
+            Err(e) if e.kind() == std::io::ErrorKind::ExecutableFileBusy && tries < 100 => {
+                tries += 1;
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            other => break other.expect("run vista"),
+        }
+    };
     Run {
         code: status.code().unwrap_or(-1),
         stdout: String::from_utf8_lossy(&stdout).into_owned(),
