@@ -87,40 +87,7 @@ enum Command {
     /// Sweep a parameter (or a grid of two) against a high-quality reference:
     /// curve.csv, curve.svg, curve.png and a table naming the cheapest setting
     /// reaching --target-psnr.
-    Sweep {
-        kernel: String,
-        #[arg(long)]
-        preset: Option<String>,
-        /// Fixed override NAME=VALUE for every point and the reference (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
-        /// Numeric parameter to sweep.
-        #[arg(long)]
-        param: String,
-        /// Comma-separated values of --param, e.g. 8,16,32,64.
-        #[arg(long)]
-        values: String,
-        /// Second parameter for a 2-D grid (heat map).
-        #[arg(long, requires = "values2")]
-        param2: Option<String>,
-        #[arg(long, requires = "param2")]
-        values2: Option<String>,
-        /// Reference override NAME=VALUE (repeatable); default: the kernel's high-quality settings.
-        #[arg(long = "reference-set", value_name = "NAME=VALUE")]
-        reference_set: Vec<String>,
-        #[arg(long, default_value_t = vista_sweep::DEFAULT_TARGET_PSNR, allow_negative_numbers = true)]
-        target_psnr: f64,
-        #[arg(long, default_value = "128x128")]
-        size: String,
-        /// Timed renders per point (the median is reported).
-        #[arg(long, default_value_t = 3)]
-        runs: u32,
-        /// Compare display values (PSNR peak 1) or linear raw output (PSNR peak = reference max).
-        #[arg(long, default_value = "display", value_name = "display|linear")]
-        metric: String,
-        #[arg(long)]
-        out: PathBuf,
-    },
+    Sweep(sweep::Args),
     /// Mutation testing: single-token mutants of a kernel's WGSL against its
     /// golden cases and CPU reference; prints the score and the survivors.
     Mutate {
@@ -319,38 +286,7 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
             println!("blessed {} cases on {}", summary.rows.len(), ctx.adapter_description());
             Ok(0)
         }
-        Command::Sweep {
-            kernel,
-            preset,
-            set,
-            param,
-            values,
-            param2,
-            values2,
-            reference_set,
-            target_psnr,
-            size,
-            runs,
-            metric,
-            out,
-        } => sweep::sweep(
-            project,
-            sweep::Args {
-                kernel,
-                preset,
-                set,
-                param,
-                values,
-                param2,
-                values2,
-                reference_set,
-                target_psnr,
-                size,
-                runs,
-                metric,
-                out,
-            },
-        ),
+        Command::Sweep(args) => sweep::sweep(project, args),
         Command::Mutate { kernel, case, sample, seed, jobs, partition, json, merge, equivalent } => mutate::mutate(
             project,
             mutate::Args { kernel, case, sample, seed, jobs, partition, json, merge, equivalent },

@@ -11,19 +11,39 @@ use vista_sweep::{Axis, Metric, SweepSpec};
 
 use crate::{bad, parse_sets};
 
+#[derive(clap::Args)]
 pub struct Args {
     pub kernel: String,
+    #[arg(long)]
     pub preset: Option<String>,
+    /// Fixed override NAME=VALUE for every point and the reference (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
+    /// Numeric parameter to sweep.
+    #[arg(long)]
     pub param: String,
+    /// Comma-separated values of --param, e.g. 8,16,32,64.
+    #[arg(long)]
     pub values: String,
+    /// Second parameter for a 2-D grid (heat map).
+    #[arg(long, requires = "values2")]
     pub param2: Option<String>,
+    #[arg(long, requires = "param2")]
     pub values2: Option<String>,
+    /// Reference override NAME=VALUE (repeatable); default: the kernel's high-quality settings.
+    #[arg(long = "reference-set", value_name = "NAME=VALUE")]
     pub reference_set: Vec<String>,
+    #[arg(long, default_value_t = vista_sweep::DEFAULT_TARGET_PSNR, allow_negative_numbers = true)]
     pub target_psnr: f64,
+    #[arg(long, default_value = "128x128")]
     pub size: String,
+    /// Timed renders per point (the median is reported).
+    #[arg(long, default_value_t = 3)]
     pub runs: u32,
+    /// Compare display values (PSNR peak 1) or linear raw output (PSNR peak = reference max).
+    #[arg(long, default_value = "display", value_name = "display|linear")]
     pub metric: String,
+    #[arg(long)]
     pub out: PathBuf,
 }
 
