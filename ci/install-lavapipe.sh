@@ -30,9 +30,10 @@ fi
 icd=$(ls /usr/share/vulkan/icd.d/lvp_icd*.json | head -n 1)
 echo "install-lavapipe: lavapipe ICD at $icd"
 summary=$(XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp} vulkaninfo --summary 2>/dev/null || true)
-if echo "$summary" | grep -q 'PHYSICAL_DEVICE_TYPE_CPU'; then
-    echo "install-lavapipe: Vulkan CPU adapter visible: $(echo "$summary" | grep -m1 -A3 'PHYSICAL_DEVICE_TYPE_CPU' | grep deviceName | sed 's/.*= //')"
+# By name: other CPU drivers (SwiftShader) may be listed first.
+if grep -q 'deviceName *= *llvmpipe' <<<"$summary"; then
+    echo "install-lavapipe: Vulkan adapter visible: $(grep -m1 'deviceName *= *llvmpipe' <<<"$summary" | sed 's/.*= //')"
 else
-    echo "install-lavapipe: the Vulkan loader does not list a CPU adapter (lavapipe); see 'vulkaninfo --summary'" >&2
+    echo "install-lavapipe: the Vulkan loader does not list lavapipe (device 'llvmpipe'); see 'vulkaninfo --summary'" >&2
     exit 1
 fi
