@@ -23,7 +23,8 @@ secs=$(( $(date +%s) - start ))
     echo "\`equivalent?\` survivors are bit-identical to the unmutated render on every"
     echo "case: truly equivalent, or code no case reaches. Survivors argued equivalent,"
     echo "each with a one-line reason, are listed in \`equivalent.toml\` and excluded"
-    echo "from the score (\`argued\`); every other survivor counts."
+    echo "from the score (\`argued\`); every other survivor counts, and"
+    echo "[SURVIVORS.md](SURVIVORS.md) says why each is harmless."
     echo
     echo '```'
     cat "$out/summary.txt"
