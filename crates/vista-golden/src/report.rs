@@ -64,11 +64,17 @@ pub fn write_report(dir: &Path, adapter: &str, outcomes: &[Outcome]) -> Result<P
             d = img(&o.files.diff),
         );
     }
+    // The other pages of the same folder, when a run wrote them.
+    let others: String = [("matrix.html", "case x backend matrix"), ("mutants.html", "mutation score")]
+        .iter()
+        .filter(|(f, _)| dir.join(f).exists())
+        .map(|(f, what)| format!(" <a href=\"{f}\">{what}</a>"))
+        .collect();
     let html = format!(
         "<!doctype html><meta charset=\"utf-8\"><title>vista report</title>\n<style>\
          body{{font-family:sans-serif;margin:1em}} table{{border-collapse:collapse}} td,th{{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:13px}}\
          tr.fail{{background:#fee}} .problem{{color:#b00}} .note{{color:#555}} img{{image-rendering:pixelated}}</style>\n\
-         <h1>vista report</h1><p>{n} cases, {failed} failing. Adapter: {adapter}. Written {date}.</p>\n\
+         <h1>vista report</h1><p>{n} cases, {failed} failing. Adapter: {adapter}. Written {date}.{others}</p>\n\
          <table><tr><th>case</th><th>expected</th><th>actual</th><th>diff</th><th>PSNR</th><th>SSIM</th><th>max abs</th>\
          <th>bad px</th><th>NaN/Inf</th><th>threshold</th><th>details</th></tr>\n{rows}</table>\n",
         n = sorted.len(),
