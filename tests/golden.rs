@@ -22,6 +22,9 @@ fn main() {
         None => project.report_dir().expect("repository root"),
     };
     let outcomes = Arc::new(Mutex::new(Vec::new()));
+    if !args.list {
+        vista_golden::clear_case_folders(&report_dir).unwrap_or_else(|e| panic!("cannot clear the report: {e}"));
+    }
 
     // Listing must work without a device (nextest lists before it runs).
     let gpu = if args.list { None } else { Some(Context::shared()) };

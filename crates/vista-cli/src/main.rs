@@ -346,6 +346,7 @@ fn check(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> 
         Some(d) => d,
         None => project.report_dir().expect("a store implies a root"),
     };
+    vista_golden::clear_case_folders(&report_dir)?;
     let opts = CheckOptions { report_dir, twice: false };
     let mut outcomes = Vec::new();
     for case in picked {
@@ -365,8 +366,13 @@ fn check(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> 
         outcomes.push(o);
     }
     let index = vista_golden::write_report(&opts.report_dir, &ctx.adapter_description(), &outcomes)?;
-    let failed = outcomes.iter().filter(|o| !o.passed()).count();
+    let failing: Vec<&str> = outcomes.iter().filter(|o| !o.passed()).map(|o| o.id.as_str()).collect();
+    let failed = failing.len();
     println!("{} passed, {} failed", outcomes.len() - failed, failed);
+    if let Some(cmd) = vista_golden::bless_all_command(&failing) {
+        println!("failed: {}", failing.join(", "));
+        println!("if every change is intended, after reviewing the report: {cmd}");
+    }
     println!("report: {}", index.display());
     Ok(if failed == 0 { 0 } else { 1 })
 }

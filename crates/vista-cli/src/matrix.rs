@@ -38,6 +38,9 @@ pub fn matrix(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>
     let manifest = store.manifest()?;
     let report_dir = report_dir.unwrap_or_else(|| project.report_dir().expect("a store implies a root"));
     let shaders = vista_golden::shader_set(project)?;
+    for b in BACKENDS {
+        vista_golden::clear_case_folders(&report_dir.join(b))?;
+    }
     let mut columns: Vec<(&str, Column)> = Vec::new();
     for &b in BACKENDS {
         if b == "browser" {

@@ -1154,6 +1154,32 @@ fn mutate_bad_input_is_refused() {
     assert_rejected(&vista(&["mutate", "--kernel", "fbm"]), 2, &["vista mutate needs a vista project"]);
 }
 
+/// A run clears the case folders of earlier runs (only folders vista marked),
+/// and its closing summary lists every failure with one bless command.
+fn check_clears_stale_case_folders_and_closes_with_one_bless_command() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0);
+    let rep = report(d.path());
+    let keep = rep.join("notes");
+    std::fs::create_dir_all(&keep).unwrap();
+    assert!(["a", "b", "c"].iter().all(|id| rep.join(id).is_dir()));
+    assert_eq!(vista_in(Some(d.path()), &[], &["check", "--case", "a"]).code, 0);
+    assert!(rep.join("a").is_dir() && !rep.join("b").exists() && !rep.join("c").exists(), "stale case folders kept");
+    assert!(keep.is_dir(), "a folder vista did not write was removed");
+    std::fs::write(
+        cases_path(d.path()),
+        CASES
+            .replace("size = \"32x32\"", "size = \"32x32\"\nset = { seed = 3 }")
+            .replace("set = { seed = 3 }\nset = { basis = \"value\" }", "set = { basis = \"value\", seed = 3 }"),
+    )
+    .unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(r.code, 1);
+    assert!(r.stdout.contains("failed: a, b, c"), "{}", r.stdout);
+    assert!(r.stdout.contains("vista bless --case '{a,b,c}'"), "{}", r.stdout);
+}
+
 /// Whether a test renders (and so needs an adapter) or stops before any GPU work.
 #[derive(Clone, Copy, PartialEq)]
 enum Needs {
@@ -1244,6 +1270,11 @@ fn main() {
             mutate_is_deterministic_shards_like_nextest_and_writes_nothing,
         ),
         (Cpu, "mutate_bad_input_is_refused", mutate_bad_input_is_refused),
+        (
+            Gpu,
+            "check_clears_stale_case_folders_and_closes_with_one_bless_command",
+            check_clears_stale_case_folders_and_closes_with_one_bless_command,
+        ),
     ];
     let args = libtest_mimic::Arguments::from_args();
     let allow = std::env::var("VISTA_ALLOW_NO_GPU").is_ok_and(|v| v == "1" || v.eq_ignore_ascii_case("true"));

@@ -165,6 +165,12 @@ fn judge(
             path: case_dir.display().to_string(),
             message: format!("cannot create report dir: {e}"),
         })?;
+        // Marks the folder as vista's, so a later run may clear it and nothing else.
+        let marker = case_dir.join(crate::report::CASE_MARKER);
+        if !marker.exists() {
+            std::fs::write(&marker, b"")
+                .map_err(|e| GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
+        }
         vista_image::write_png16(&case_dir.join(name), img)?;
         Ok(format!("{}/{name}", case.id))
     };

@@ -21,7 +21,7 @@ pub use render::{
     Prepared, Rendered, Renderer, check_request, median, median_wall, prepare, quantize16, render, render_median,
     shader_set,
 };
-pub use report::write_report;
+pub use report::{bless_all_command, clear_case_folders, write_report};
 pub use store::{Manifest, ManifestEntry, Store};
 
 use vista_gpu::GpuError;

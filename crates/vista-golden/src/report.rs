@@ -19,6 +19,34 @@ fn img(path: &Option<String>) -> String {
     }
 }
 
+/// The empty file that marks a case folder as written by vista.
+pub const CASE_MARKER: &str = ".vista-case";
+
+/// Clears the case folders an earlier run left in `dir`, so a filtered run's
+/// report shows only its own cases. Only folders holding vista's marker are
+/// removed: a `--report-dir` pointed anywhere else loses nothing.
+pub fn clear_case_folders(dir: &Path) -> Result<(), crate::GoldenError> {
+    let Ok(entries) = std::fs::read_dir(dir) else { return Ok(()) };
+    for e in entries.flatten() {
+        if e.path().is_dir() && e.path().join(CASE_MARKER).is_file() {
+            std::fs::remove_dir_all(e.path()).map_err(|err| crate::GoldenError::Io {
+                path: e.path().display().to_string(),
+                message: err.to_string(),
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// The one bless command for every failing case (globset alternation).
+pub fn bless_all_command(failed: &[&str]) -> Option<String> {
+    match failed {
+        [] => None,
+        [one] => Some(format!("vista bless --case '{one}'")),
+        many => Some(format!("vista bless --case '{{{}}}'", many.join(","))),
+    }
+}
+
 /// Writes the report (atomically) and returns the index path.
 pub fn write_report(dir: &Path, adapter: &str, outcomes: &[Outcome]) -> Result<PathBuf, crate::GoldenError> {
     let mut sorted: Vec<&Outcome> = outcomes.iter().collect();
