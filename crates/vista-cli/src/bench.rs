@@ -33,7 +33,14 @@ pub fn bench(
     // Warm-up: compiles the pipeline and touches every allocation path once.
     // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
     let first = vista_golden::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
-    let median = vista_golden::render_median(ctx, k, &p, w, h, runs)?.1.as_secs_f64();
+    let mut stats = Vec::new();
+    for _ in 0..runs {
+        stats.push(vista_golden::render(ctx, k, &p, w, h)?.stats);
+    }
+    let med = |f: fn(&vista_gpu::RunStats) -> std::time::Duration| {
+        vista_golden::median(stats.iter().map(f).collect()).as_secs_f64()
+    };
+    let (median, kernel_s, readback_s) = (med(|s| s.gpu_wall), med(|s| s.kernel), med(|s| s.readback));
     let mpix = (w as f64 * h as f64) / 1e6 / median;
     // The CPU side: the reference in f32 on every core (rayon), median of
     // up to 3 runs since the slow ones take seconds per image.
@@ -47,6 +54,7 @@ pub fn bench(
         let mut out = serde_json::json!({
             "kernel": kernel, "width": w, "height": h, "runs": runs,
             "median_ms": median * 1e3, "mpix_per_s": mpix,
+            "kernel_ms": kernel_s * 1e3, "readback_ms": readback_s * 1e3,
             "device_creation_ms": ctx.creation_time.as_secs_f64() * 1e3,
             "first_dispatch_ms": first * 1e3,
             "adapter": ctx.adapter_description(), "params": p.canonical(),
@@ -62,6 +70,11 @@ pub fn bench(
             "{kernel} {w}x{h}: median {:.2} ms over {runs} runs, {mpix:.2} Mpix/s on {}",
             median * 1e3,
             ctx.adapter_description()
+        );
+        println!(
+            "  of which the kernel {:.2} ms and the readback (copy, map, unpad) {:.2} ms",
+            kernel_s * 1e3,
+            readback_s * 1e3
         );
         println!(
             "device creation {:.1} ms, first call (compose + pipeline compile + dispatch + readback) {:.1} ms",

@@ -588,7 +588,9 @@ fn list_shows_params_ranges_and_presets() {
 fn bench_json_reports_throughput() {
     let r = vista(&["bench", "fbm", "--size", "64x64", "--runs", "3", "--json"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
-    for field in ["\"mpix_per_s\":", "\"device_creation_ms\":", "\"first_dispatch_ms\":"] {
+    for field in
+        ["\"mpix_per_s\":", "\"device_creation_ms\":", "\"first_dispatch_ms\":", "\"kernel_ms\":", "\"readback_ms\":"]
+    {
         assert!(r.stdout.contains(field), "{field} missing: {}", r.stdout);
     }
     assert_rejected(&vista(&["bench", "fbm", "--runs", "0"]), 2, &["--runs 0", "[1, 1000]"]);

@@ -114,6 +114,10 @@ pub struct Dispatch<'a> {
 pub struct RunStats {
     /// Submit to completion of the compute pass and readback copy.
     pub gpu_wall: Duration,
+    /// Submit to completion of the compute pass alone (the kernel).
+    pub kernel: Duration,
+    /// Texture-to-buffer copy, map and row unpadding (the readback).
+    pub readback: Duration,
     /// Whole call: upload, dispatch, wait, map and unpack.
     pub total: Duration,
 }
@@ -368,13 +372,15 @@ impl Context {
                 wgpu::BindGroupEntry { binding: 2, resource: table.as_entire_binding() },
             ],
         });
-        let mut encoder = d.create_command_encoder(&Default::default());
+        // Two submissions, so the kernel and the readback are timed apart.
+        let mut compute = d.create_command_encoder(&Default::default());
         {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let mut pass = compute.begin_compute_pass(&Default::default());
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.dispatch_workgroups(job.width.div_ceil(WORKGROUP), job.height.div_ceil(WORKGROUP), 1);
         }
+        let mut encoder = d.create_command_encoder(&Default::default());
         encoder.copy_texture_to_buffer(
             texture.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
@@ -392,6 +398,10 @@ impl Context {
         }
         let _serial = self.submit_lock.lock().expect("submit lock");
         let gpu_start = Instant::now();
+        let index = self.queue.submit([compute.finish()]);
+        self.wait(index, job.shader)?;
+        let kernel = gpu_start.elapsed();
+        let copy_start = Instant::now();
         let index = self.queue.submit([encoder.finish()]);
         let (tx, rx) = mpsc::channel();
         readback.slice(..).map_async(wgpu::MapMode::Read, move |r| {
@@ -416,6 +426,7 @@ impl Context {
             unpad_rows(&mapped, job.width, job.height, padded_row)
         };
         readback.unmap();
+        let readback_time = copy_start.elapsed();
         if self.validate {
             let messages = crate::validation::take();
             if !messages.is_empty() {
@@ -425,7 +436,7 @@ impl Context {
                 });
             }
         }
-        Ok((image, RunStats { gpu_wall, total: start.elapsed() }))
+        Ok((image, RunStats { gpu_wall, kernel, readback: readback_time, total: start.elapsed() }))
     }
 
     /// Blocks until `index` completes, or fails after the watchdog timeout.
