@@ -5,8 +5,7 @@
 use std::sync::{Arc, Mutex};
 
 use libtest_mimic::{Arguments, Failed, Trial};
-use vista_golden::{CheckOptions, Renderer, Store, allow_no_gpu};
-use vista_gpu::Context;
+use vista_golden::{CheckOptions, Store, allow_no_gpu};
 
 mod common;
 
@@ -27,11 +26,9 @@ fn main() {
     }
 
     // Listing must work without a device (nextest lists before it runs).
-    let gpu = if args.list { None } else { Some(Context::shared()) };
-    let shaders = vista_golden::shader_set(&project).unwrap_or_else(|e| panic!("cannot load shaders: {e}"));
-    let no_gpu = matches!(&gpu, Some(Err(_)));
-    if no_gpu {
-        let e = gpu.as_ref().and_then(|g| g.as_ref().err()).expect("error");
+    let missing = if args.list { None } else { common::renderer().err() };
+    let no_gpu = missing.is_some();
+    if let Some(e) = &missing {
         if allow_no_gpu() {
             eprintln!("\n!!! VISTA_ALLOW_NO_GPU=1 and no adapter: {e}");
             eprintln!(
@@ -45,12 +42,11 @@ fn main() {
     let trials: Vec<Trial> = cases
         .iter()
         .map(|case| {
-            let (case, store, manifest, outcomes, report_dir, shaders) =
-                (case.clone(), store.clone(), manifest.clone(), outcomes.clone(), report_dir.clone(), shaders.clone());
+            let (case, store, manifest, outcomes, report_dir) =
+                (case.clone(), store.clone(), manifest.clone(), outcomes.clone(), report_dir.clone());
             let name = format!("golden::{}::{}", case.kernel.name(), case.id);
             Trial::test(name, move || {
-                let ctx = Context::shared().map_err(|e| Failed::from(format!("no GPU adapter: {e}")))?;
-                let ctx = &Renderer { ctx, shaders };
+                let ctx = common::renderer().map_err(|e| Failed::from(format!("no GPU adapter: {e}")))?;
                 // The in-process determinism check (two renders, bit-identical)
                 // runs on the bless-time driver; other backends render once.
                 let opts = CheckOptions { report_dir: report_dir.clone(), twice: ctx.backend() == "lavapipe" };
@@ -66,7 +62,7 @@ fn main() {
     let conclusion = libtest_mimic::run(&args, trials);
     let outcomes = outcomes.lock().expect("outcomes");
     if !outcomes.is_empty() {
-        let adapter = Context::shared().map(|c| c.adapter_description()).unwrap_or_default();
+        let adapter = common::renderer().map(|c| c.adapter_description()).unwrap_or_default();
         match vista_golden::write_report(&report_dir, &adapter, &outcomes) {
             Ok(index) => eprintln!("vista report: {}", index.display()),
             Err(e) => eprintln!("could not write the vista report: {e}"),

@@ -148,15 +148,13 @@ fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vist
                     p.canonical()
                 )));
             }
-            let (lo, hi) = kernel.output_bounds(&p);
-            for (i, px) in r.raw.data.iter().enumerate() {
-                if px[..3].iter().any(|v| *v < lo || *v > hi) {
-                    return Err(TestCaseError::fail(format!(
-                        "{}: pixel {i} = {px:?} outside [{lo}, {hi}] with {}",
-                        kernel.name(),
-                        p.canonical()
-                    )));
-                }
+            if let Some((x, y, v)) = vista_golden::first_out_of_range(kernel, &p, &r.raw) {
+                let (lo, hi) = kernel.output_bounds(&p);
+                return Err(TestCaseError::fail(format!(
+                    "{}: pixel ({x}, {y}) = {v} outside [{lo}, {hi}] with {}",
+                    kernel.name(),
+                    p.canonical()
+                )));
             }
             Ok(())
         });

@@ -27,10 +27,6 @@ fn cell(o: &Outcome) -> String {
     }
 }
 
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
-}
-
 pub fn matrix(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> Result<i32, GoldenError> {
     let store = Store::of_project(project, "vista check --matrix")?;
     let cases = store.load_cases()?;
@@ -71,7 +67,7 @@ pub fn matrix(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>
     let mut rows = String::new();
     for (i, case) in picked.iter().enumerate() {
         print!("{:<width$}", case.id);
-        rows += &format!("<tr><td>{}</td>", esc(&case.id));
+        rows += &format!("<tr><td>{}</td>", vista_golden::html_escape(&case.id));
         for (_, col) in &columns {
             let text = match col {
                 Ok((_, outcomes)) => {
@@ -83,7 +79,7 @@ pub fn matrix(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>
                 Err(_) => "n/a".into(),
             };
             let class = if text.contains("FAIL") { "fail" } else { "" };
-            rows += &format!("<td class=\"{class}\">{}</td>", esc(&text));
+            rows += &format!("<td class=\"{class}\">{}</td>", vista_golden::html_escape(&text));
             print!("  {text:<18}");
         }
         rows += "</tr>\n";
@@ -95,12 +91,12 @@ pub fn matrix(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>
         match col {
             Ok((adapter, _)) => {
                 println!("{b}: {adapter}");
-                legend += &format!("<li><b>{b}</b>: {}</li>", esc(adapter));
+                legend += &format!("<li><b>{b}</b>: {}</li>", vista_golden::html_escape(adapter));
             }
             Err(why) => {
                 missing += 1;
                 println!("!!! {b}: SKIPPED, all {} cells: {why}", picked.len());
-                legend += &format!("<li><b>{b}</b>: skipped: {}</li>", esc(why));
+                legend += &format!("<li><b>{b}</b>: skipped: {}</li>", vista_golden::html_escape(why));
             }
         }
     }

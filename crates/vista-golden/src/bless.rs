@@ -83,14 +83,18 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
     for (case, r) in rendered {
         let path = store.golden_path(case);
         let new = quantize16(&r.display);
-        let (status, psnr) = match vista_image::read_png16(&path) {
-            Ok(old) if (old.width, old.height) == (new.width, new.height) => {
+        // Read once: decoded for the PSNR against the new golden, hashed below.
+        let old_bytes = std::fs::read(&path).ok();
+        let old = old_bytes.as_deref().map(|b| vista_image::decode_png16(&path, b));
+        let (status, psnr) = match old {
+            Some(Ok(old)) if (old.width, old.height) == (new.width, new.height) => {
                 let p = metrics::psnr(&old, &new);
                 (if p.is_infinite() { "unchanged" } else { "changed" }, metrics::format_psnr(p))
             }
-            Ok(_) => ("changed", "size changed".to_string()),
-            Err(_) if path.exists() => ("changed", "old golden unreadable".to_string()),
-            Err(_) => ("new", "new".to_string()),
+            Some(Ok(_)) => ("changed", "size changed".to_string()),
+            Some(Err(_)) => ("changed", "old golden unreadable".to_string()),
+            None if path.exists() => ("changed", "old golden unreadable".to_string()),
+            None => ("new", "new".to_string()),
         };
         if let Some(parent) = path.parent() {
             std::fs::create_dir_all(parent)
@@ -98,7 +102,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         }
         let bytes = vista_image::encode_png16(&path, &new)?;
         let new_hash = crate::short_hash_bytes(&bytes);
-        let old_hash = std::fs::read(&path).ok().map(|b| crate::short_hash_bytes(&b));
+        let old_hash = old_bytes.as_deref().map(crate::short_hash_bytes);
         let mut entry = ManifestEntry {
             kernel: case.kernel.name().to_string(),
             size: format!("{}x{}", case.width, case.height),

@@ -236,7 +236,10 @@ fn judge(
         ));
         return Ok(());
     }
-    if let (Some(e), Ok(bytes)) = (entry, std::fs::read(&golden_path))
+    // Read once: hashed against the manifest, then decoded.
+    let bytes = std::fs::read(&golden_path)
+        .map_err(|source| vista_image::ImageError::Io { path: golden_path.clone(), source })?;
+    if let Some(e) = entry
         && !e.golden_hash.is_empty()
     {
         let on_disk = crate::short_hash_bytes(&bytes);
@@ -256,7 +259,7 @@ fn judge(
             ));
         }
     }
-    let expected = vista_image::read_png16(&golden_path)?;
+    let expected = vista_image::decode_png16(&golden_path, &bytes)?;
     out.files.expected = Some(write("expected.png", &expected)?);
     if (expected.width, expected.height) != (actual.width, actual.height) {
         out.problems.push(format!(
@@ -286,6 +289,17 @@ fn judge(
     }
     out.metrics = Some(m);
     Ok(())
+}
+
+/// The first finite raw RGB value outside the kernel's output bounds for
+/// `p`, as (x, y, value): the range guard of check, mutate and the fuzzer.
+pub fn first_out_of_range(
+    kernel: &vista_kernels::Kernel,
+    p: &vista_kernels::ParamSet,
+    img: &Image,
+) -> Option<(u32, u32, f32)> {
+    let (lo, hi) = kernel.output_bounds(p);
+    first_out_of_bounds(img, lo, hi)
 }
 
 fn first_out_of_bounds(img: &Image, lo: f32, hi: f32) -> Option<(u32, u32, f32)> {

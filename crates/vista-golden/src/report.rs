@@ -8,13 +8,14 @@ use vista_image::metrics::format_psnr;
 
 use crate::check::{Outcome, Verdict};
 
-fn esc(s: &str) -> String {
+/// Text escaped for HTML element content and attribute values.
+pub fn html_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
 fn img(path: &Option<String>) -> String {
     match path {
-        Some(p) => format!("<a href=\"{0}\"><img src=\"{0}\" width=\"128\"></a>", esc(p)),
+        Some(p) => format!("<a href=\"{0}\"><img src=\"{0}\" width=\"128\"></a>", html_escape(p)),
         None => "<span class=\"none\">none</span>".into(),
     }
 }
@@ -77,14 +78,14 @@ pub fn write_report(dir: &Path, adapter: &str, outcomes: &[Outcome]) -> Result<P
         let msgs: String = o
             .problems
             .iter()
-            .map(|p| format!("<div class=\"problem\">{}</div>", esc(p)))
-            .chain(o.notes.iter().map(|n| format!("<div class=\"note\">{}</div>", esc(n))))
+            .map(|p| format!("<div class=\"problem\">{}</div>", html_escape(p)))
+            .chain(o.notes.iter().map(|n| format!("<div class=\"note\">{}</div>", html_escape(n))))
             .collect();
         rows += &format!(
             "<tr class=\"{class}\"><td><b>{id}</b><br>{kernel}<br>{verdict:?}<br>{gpu:.1} ms</td><td>{e}</td><td>{a}</td><td>{d}</td>\
              <td>{psnr}</td><td>{ssim}</td><td>{max_abs}</td><td>{bad}</td><td>{nan}</td><td>{threshold}</td><td>{msgs}</td></tr>\n",
-            id = esc(&o.id),
-            kernel = esc(&o.kernel),
+            id = html_escape(&o.id),
+            kernel = html_escape(&o.kernel),
             verdict = o.verdict,
             gpu = o.gpu_ms,
             e = img(&o.files.expected),
@@ -106,7 +107,7 @@ pub fn write_report(dir: &Path, adapter: &str, outcomes: &[Outcome]) -> Result<P
          <table><tr><th>case</th><th>expected</th><th>actual</th><th>diff</th><th>PSNR</th><th>SSIM</th><th>max abs</th>\
          <th>bad px</th><th>NaN/Inf</th><th>threshold</th><th>details</th></tr>\n{rows}</table>\n",
         n = sorted.len(),
-        adapter = esc(adapter),
+        adapter = html_escape(adapter),
         date = crate::now_utc(),
     );
     std::fs::create_dir_all(dir)

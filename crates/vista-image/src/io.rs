@@ -29,9 +29,14 @@ pub fn encode_png16(path: &Path, img: &Image) -> Result<Vec<u8>, ImageError> {
 /// Reads any PNG (1-16 bit, grey/grey+alpha/RGB/RGBA/palette) as f32 RGBA in
 /// `[0, 1]`; missing alpha becomes 1 and grey is replicated to RGB.
 pub fn read_png16(path: &Path) -> Result<Image, ImageError> {
-    let bytes = read_file(path)?;
+    decode_png16(path, &read_file(path)?)
+}
+
+/// [`read_png16`] of bytes already read from `path` (which errors name), for
+/// callers that also hash the file.
+pub fn decode_png16(path: &Path, bytes: &[u8]) -> Result<Image, ImageError> {
     let decoded =
-        image::load_from_memory_with_format(&bytes, ImageFormat::Png).map_err(|e| decode_error(path, "PNG", e))?;
+        image::load_from_memory_with_format(bytes, ImageFormat::Png).map_err(|e| decode_error(path, "PNG", e))?;
     Ok(normalize_png(decoded))
 }
 

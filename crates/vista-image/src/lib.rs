@@ -35,6 +35,7 @@ pub use buffer::Image;
 pub use error::ImageError;
 pub use heatmap::diff_heatmap;
 pub use io::{
-    atomic_write, encode_png16, load, read_exr, read_png16, remove_stale_temps, save, write_exr, write_png16,
+    atomic_write, decode_png16, encode_png16, load, read_exr, read_png16, remove_stale_temps, save, write_exr,
+    write_png16,
 };
 pub use tonemap::{srgb_encode, tonemap};

@@ -210,10 +210,6 @@ impl Report {
     }
 }
 
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
-}
-
 impl Report {
     /// The report's HTML section: score per kernel, then every survivor
     /// with its place, change and how many detectors ran.
@@ -236,13 +232,13 @@ impl Report {
             survivors += &format!(
                 "<tr><td>{}</td><td><code>{}:{}:{}</code></td><td>{}</td><td><code>{}</code> &rarr; <code>{}</code></td>\
                  <td>{}</td><td>{}</td></tr>\n",
-                esc(&m.kernel),
-                esc(&m.mutant.file),
+                vista_golden::html_escape(&m.kernel),
+                vista_golden::html_escape(&m.mutant.file),
                 m.mutant.line,
                 m.mutant.col,
-                esc(&m.mutant.operator),
-                esc(&m.mutant.before),
-                esc(if m.mutant.after.is_empty() { "(removed)" } else { &m.mutant.after }),
+                vista_golden::html_escape(&m.mutant.operator),
+                vista_golden::html_escape(&m.mutant.before),
+                vista_golden::html_escape(if m.mutant.after.is_empty() { "(removed)" } else { &m.mutant.after }),
                 m.cases_run,
                 if m.equivalent { "equivalent?" } else { "" }
             );
@@ -259,7 +255,7 @@ impl Report {
              <th>detectors run</th><th></th></tr>\n{survivors}</table>\n",
             self.seed,
             self.sample.map_or("all".to_string(), |s| s.to_string()),
-            esc(&self.partitions.join(", ")),
+            vista_golden::html_escape(&self.partitions.join(", ")),
             pct(self.score)
         )
     }
@@ -421,8 +417,7 @@ fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> Mutant
         if r.raw.nonfinite_count() > 0 {
             return report("killed", Some(format!("{} (NaN/Inf)", case.id)), false, n + 1);
         }
-        let (lo, hi) = kernel.output_bounds(&case.params);
-        if r.raw.data.iter().any(|p| p[..3].iter().any(|v| *v < lo || *v > hi)) {
+        if vista_golden::first_out_of_range(kernel, &case.params, &r.raw).is_some() {
             return report("killed", Some(format!("{} (output range)", case.id)), false, n + 1);
         }
         if let Some(g) = golden {
