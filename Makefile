@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves bench mutants lavapipe swiftshader validation build
+.PHONY: demo test golden curves bench mutants lavapipe swiftshader validation browser build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -16,6 +16,9 @@ swiftshader: lavapipe
 validation: lavapipe
 	bash ci/install-validation.sh
 
+browser:
+	bash ci/install-browser.sh
+
 build:
 	$(CARGO) build -p vista-cli
 
@@ -24,13 +27,17 @@ demo: lavapipe build
 	bash ci/demo.sh $(VISTA) out
 
 # The whole suite (what .ci/run calls): unit tests, CPU references,
-# invariants, and every golden case on lavapipe; then a closing count, and
-# proof that without an adapter the GPU tests are reported skipped, never ok.
-test: lavapipe swiftshader validation
+# invariants, and every golden case on lavapipe; every golden case again on
+# SwiftShader, in headless Chromium's WebGPU and under the validation layer;
+# then a closing count, and proof that without an adapter the GPU tests are
+# reported skipped, never ok.
+test: lavapipe swiftshader validation browser
 	mkdir -p target
 	set -o pipefail; $(CARGO) test --workspace 2>&1 | tee target/test.log
 	@echo "---- every golden case again on SwiftShader (other-driver thresholds, expectations from golden/cases.toml)"
 	set -o pipefail; VISTA_BACKEND=swiftshader $(CARGO) test --test golden 2>&1 | tee -a target/test.log
+	@echo "---- every golden case again in headless Chromium's WebGPU (naga's WGSL through Tint and Dawn)"
+	set -o pipefail; VISTA_BACKEND=browser $(CARGO) test --test golden 2>&1 | tee -a target/test.log
 	@echo "---- every golden case under the Khronos validation layer (VISTA_VALIDATION=1): any message fails the case"
 	set -o pipefail; VISTA_VALIDATION=1 $(CARGO) test --test golden 2>&1 | tee -a target/test.log
 	bash ci/test-summary.sh target/test.log

@@ -4,13 +4,19 @@
 # all of its tests ignored and none passed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-suites=(golden agreement atmosphere clouds cloudmap heightfield mutate noise reliability)
+suites=(golden agreement atmosphere clouds cloudmap heightfield mutate noise reliability backends)
 args=()
 for s in "${suites[@]}"; do args+=(--test "$s"); done
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
+# No Vulkan driver and no Chromium: every backend is missing.
+export VISTA_CHROMIUM=/nonexistent/chromium
 VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json VISTA_ALLOW_NO_GPU=1 \
     ${CARGO:-cargo} test -q "${args[@]}" >"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: the suites failed without an adapter"; exit 1; }
+# The browser crate's own suite needs only Chromium.
+VISTA_ALLOW_NO_GPU=1 ${CARGO:-cargo} test -q -p vista-browser --test run >>"$log" 2>&1 \
+    || { cat "$log"; echo "no-gpu-skips: the browser suite failed without Chromium"; exit 1; }
+suites+=(vista-browser/run)
 results=$(grep -E '^test result:' "$log")
 n=$(echo "$results" | wc -l)
 if [ "$n" -ne "${#suites[@]}" ]; then

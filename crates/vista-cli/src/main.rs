@@ -21,7 +21,7 @@ struct Cli {
     /// Adapter: cpu (lavapipe, default) or gpu (hardware). Same as VISTA_ADAPTER.
     #[arg(long, global = true)]
     adapter: Option<String>,
-    /// Implementation: lavapipe (default), swiftshader or gpu. Same as VISTA_BACKEND.
+    /// Implementation: lavapipe (default), swiftshader, browser (headless Chromium WebGPU) or gpu. Same as VISTA_BACKEND.
     #[arg(long, global = true, value_name = "NAME")]
     backend: Option<String>,
     /// Project root (a directory holding vista.toml). Default: VISTA_ROOT,

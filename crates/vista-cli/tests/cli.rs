@@ -830,6 +830,37 @@ fn a_kernel_described_as_data_renders() {
     assert_eq!(r.code, 0, "{}", r.stderr);
 }
 
+/// A project's own kernel runs in the browser too (naga writes the composed
+/// module back as one WGSL source for Tint), with lavapipe's pixels.
+fn a_project_kernel_renders_the_same_in_the_browser() {
+    let d = kernel_project(K_MANIFEST, K_SHADER);
+    let png = |b: &str| d.path().join(format!("{b}.png"));
+    for b in ["lavapipe", "browser"] {
+        let out = png(b);
+        let r = vista_in(
+            Some(d.path()),
+            &[],
+            &["--backend", b, "render", "k", "--set", "gain=0.25", "--size", "13x7", "-o", out.to_str().unwrap()],
+        );
+        assert_eq!(r.code, 0, "{b}: {}", r.stderr);
+    }
+    assert_eq!(std::fs::read(png("lavapipe")).unwrap(), std::fs::read(png("browser")).unwrap());
+}
+
+/// Without Chromium the browser backend fails at once with the install
+/// command, on one line, never a panic or a hang.
+fn browser_backend_without_chromium_names_the_install_command() {
+    let out = tmp();
+    let o = out.path().join("x.png");
+    let r = vista_in(
+        None,
+        &[("VISTA_CHROMIUM", "/nonexistent/chromium")],
+        &["--backend", "browser", "render", "fbm", "-o", o.to_str().unwrap()],
+    );
+    assert_rejected(&r, 1, &["VISTA_CHROMIUM=/nonexistent/chromium is not a file", "bash ci/install-browser.sh"]);
+    assert!(!o.exists());
+}
+
 fn params_field_without_a_param_is_refused() {
     let shader = K_SHADER.replace("    gain: f32,\n", "    gain: f32,\n    rot_cos: f32,\n");
     assert_rejected(&render_k(K_MANIFEST, &shader), 2, &["kernel k", "Params field rot_cos (WGSL f32) has no param"]);
@@ -1030,9 +1061,20 @@ fn check_matrix_prints_one_row_per_case_and_one_column_per_backend() {
     for id in ["a", "b", "c"] {
         assert!(r.stdout.lines().any(|l| l.starts_with(&format!("{id} ")) && l.contains("identical")), "{}", r.stdout);
     }
-    assert!(r.stdout.contains("!!! browser: SKIPPED, all 3 cells"), "{}", r.stdout);
+    for b in ["lavapipe", "swiftshader", "browser"] {
+        assert!(r.stdout.lines().any(|l| l.starts_with(&format!("{b}: "))), "{b}: {}", r.stdout);
+    }
+    assert!(r.stdout.contains("matrix: 3 cases x 3 backends, 0 failed, 0 backend(s) skipped"), "{}", r.stdout);
     assert!(report(d.path()).join("matrix.html").exists());
     assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    // A backend that cannot start fails the run, naming its install command.
+    let r = vista_in(Some(d.path()), &[("VISTA_CHROMIUM", "/nonexistent/chromium")], &["check", "--matrix"]);
+    assert!(
+        r.stdout.contains("!!! browser: SKIPPED, all 3 cells") && r.stdout.contains("ci/install-browser.sh"),
+        "{}",
+        r.stdout
+    );
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
 }
 
 // ---- vista mutate -----------------------------------------------------------
@@ -1203,6 +1245,12 @@ fn main() {
         (Cpu, "bad_sizes_are_rejected_before_gpu_work", bad_sizes_are_rejected_before_gpu_work),
         (Cpu, "absurd_work_is_refused_with_the_cap", absurd_work_is_refused_with_the_cap),
         (Cpu, "unwritable_output_directory_is_refused", unwritable_output_directory_is_refused),
+        (
+            Cpu,
+            "browser_backend_without_chromium_names_the_install_command",
+            browser_backend_without_chromium_names_the_install_command,
+        ),
+        (Gpu, "a_project_kernel_renders_the_same_in_the_browser", a_project_kernel_renders_the_same_in_the_browser),
         (Gpu, "compare_reports_json_fields_and_rejects_bad_files", compare_reports_json_fields_and_rejects_bad_files),
         (Gpu, "render_exr_holds_the_raw_fbm_field", render_exr_holds_the_raw_fbm_field),
         (Gpu, "render_exr_holds_heightfield_depth_over_t_max", render_exr_holds_heightfield_depth_over_t_max),

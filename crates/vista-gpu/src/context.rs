@@ -23,11 +23,13 @@ pub enum AdapterChoice {
     Hardware,
     /// The first adapter whose name contains this text (case-insensitive).
     Named(String),
+    /// Headless Chromium's WebGPU: naga writes the composed module back as
+    /// WGSL, Tint compiles it, Dawn runs it on SwiftShader.
+    Browser,
 }
 
-/// The backends `--backend` / `VISTA_BACKEND` accept on wgpu (the browser
-/// backend drives Chromium instead and is not an adapter).
-pub const WGPU_BACKENDS: &[&str] = &["lavapipe", "swiftshader", "gpu"];
+/// The backends `--backend` / `VISTA_BACKEND` accept.
+pub const BACKENDS: &[&str] = &["lavapipe", "swiftshader", "browser", "gpu"];
 
 impl AdapterChoice {
     /// The adapter of a backend name: lavapipe | swiftshader | gpu.
@@ -36,9 +38,10 @@ impl AdapterChoice {
             "lavapipe" => Ok(AdapterChoice::Lavapipe),
             "swiftshader" => Ok(AdapterChoice::SwiftShader),
             "gpu" => Ok(AdapterChoice::Hardware),
+            "browser" => Ok(AdapterChoice::Browser),
             other => Err(GpuError::Request(format!(
                 "backend '{other}' is not valid; expected one of {}",
-                WGPU_BACKENDS.join("|")
+                BACKENDS.join("|")
             ))),
         }
     }
@@ -70,21 +73,24 @@ impl AdapterChoice {
             AdapterChoice::SwiftShader => "swiftshader",
             AdapterChoice::Hardware => "gpu",
             AdapterChoice::Named(_) => "named",
+            AdapterChoice::Browser => "browser",
         }
     }
 
     fn describe(&self) -> String {
         match self {
-            AdapterChoice::Lavapipe => "lavapipe (software, device 'llvmpipe')".into(),
-            AdapterChoice::SwiftShader => "SwiftShader (software)".into(),
-            AdapterChoice::Hardware => "hardware GPU".into(),
-            AdapterChoice::Named(n) => format!("adapter named like '{n}'"),
+            AdapterChoice::Lavapipe => "lavapipe Vulkan adapter (software, device 'llvmpipe')".into(),
+            AdapterChoice::SwiftShader => "SwiftShader Vulkan adapter (software)".into(),
+            AdapterChoice::Hardware => "hardware GPU Vulkan adapter".into(),
+            AdapterChoice::Named(n) => format!("Vulkan adapter named like '{n}'"),
+            AdapterChoice::Browser => "browser backend (headless Chromium with WebGPU)".into(),
         }
     }
 
     fn hint(&self) -> &'static str {
         match self {
             AdapterChoice::SwiftShader => SWIFTSHADER_HINT,
+            AdapterChoice::Browser => vista_browser::INSTALL_HINT,
             _ => INSTALL_HINT,
         }
     }
@@ -124,21 +130,37 @@ pub struct RunStats {
 
 const WORKGROUP: u32 = 8;
 
-/// Headless wgpu state shared by everything in one process.
+/// Headless state shared by everything in one process: a wgpu device, or
+/// the browser.
 pub struct Context {
-    device: wgpu::Device,
-    queue: wgpu::Queue,
+    engine: Engine,
     info: wgpu::AdapterInfo,
     backend: &'static str,
-    layout: wgpu::BindGroupLayout,
-    pipeline_layout: wgpu::PipelineLayout,
-    pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
     timeout: Duration,
     /// Serialises submissions so a timeout is attributed to the right job.
     submit_lock: Mutex<()>,
     pub creation_time: Duration,
     /// Whether the Khronos validation layer is on.
     validate: bool,
+}
+
+enum Engine {
+    Wgpu(WgpuEngine),
+    Browser(Box<BrowserEngine>),
+}
+
+struct WgpuEngine {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
+}
+
+struct BrowserEngine {
+    browser: vista_browser::Browser,
+    /// naga's WGSL of each composed kernel, by source hash.
+    sources: Mutex<HashMap<String, Arc<String>>>,
 }
 
 /// Where Debian's vulkan-validationlayers puts the layer's manifest.
@@ -161,6 +183,22 @@ impl Context {
     /// validation message then fails the dispatch it arrives in.
     pub fn with_validation(choice: AdapterChoice, validate: bool) -> Result<Context, GpuError> {
         let start = Instant::now();
+        let timeout = std::env::var("VISTA_GPU_TIMEOUT_S")
+            .ok()
+            .and_then(|s| s.parse::<f64>().ok())
+            .filter(|s| s.is_finite() && *s >= 0.0)
+            .unwrap_or(120.0);
+        let timeout = Duration::from_secs_f64(timeout);
+        if choice == AdapterChoice::Browser {
+            if validate {
+                return Err(GpuError::Request(
+                    "VISTA_VALIDATION=1 runs the Khronos layer under wgpu; the browser backend has Dawn's own \
+                     validation always on: unset VISTA_VALIDATION or pick another backend"
+                        .into(),
+                ));
+            }
+            return Context::browser(timeout, start);
+        }
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
         if validate {
@@ -185,7 +223,7 @@ impl Context {
             .collect::<Vec<_>>();
         let adapter = pick(adapters, &choice).ok_or_else(|| GpuError::NoAdapter {
             wanted: choice.describe(),
-            seen: if seen.is_empty() { "none".into() } else { seen.join("; ") },
+            seen: if seen.is_empty() { "no adapters".into() } else { seen.join("; ") },
             hint: choice.hint(),
         })?;
         let info = adapter.get_info();
@@ -230,23 +268,47 @@ impl Context {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let timeout = std::env::var("VISTA_GPU_TIMEOUT_S")
-            .ok()
-            .and_then(|s| s.parse::<f64>().ok())
-            .filter(|s| s.is_finite() && *s >= 0.0)
-            .unwrap_or(120.0);
         Ok(Context {
-            device,
-            queue,
+            engine: Engine::Wgpu(WgpuEngine {
+                device,
+                queue,
+                layout,
+                pipeline_layout,
+                pipelines: Mutex::new(HashMap::new()),
+            }),
             info,
             backend: choice.backend_name(),
-            layout,
-            pipeline_layout,
-            pipelines: Mutex::new(HashMap::new()),
-            timeout: Duration::from_secs_f64(timeout),
+            timeout,
             submit_lock: Mutex::new(()),
             creation_time: start.elapsed(),
             validate,
+        })
+    }
+
+    /// Headless Chromium with a WebGPU device on its SwiftShader adapter.
+    fn browser(timeout: Duration, start: Instant) -> Result<Context, GpuError> {
+        let browser = vista_browser::Browser::launch(timeout).map_err(|e| match e {
+            vista_browser::BrowserError::NotInstalled { looked, hint } => GpuError::NoAdapter {
+                wanted: AdapterChoice::Browser.describe(),
+                seen: format!("no Chromium; looked for {looked}"),
+                hint,
+            },
+            other => GpuError::Device { adapter: "headless Chromium".into(), message: other.to_string() },
+        })?;
+        let b = browser.info();
+        // Reports and manifests read the same fields as for a wgpu adapter.
+        let mut info = wgpu::AdapterInfo::new(wgpu::DeviceType::Cpu, wgpu::Backend::BrowserWebGpu);
+        info.name = format!("{} {} (WebGPU in headless Chromium)", b.vendor, b.architecture);
+        info.driver = format!("{} Dawn/Tint", b.product);
+        info.driver_info = b.description.clone();
+        Ok(Context {
+            engine: Engine::Browser(Box::new(BrowserEngine { browser, sources: Mutex::new(HashMap::new()) })),
+            info,
+            backend: AdapterChoice::Browser.backend_name(),
+            timeout,
+            submit_lock: Mutex::new(()),
+            creation_time: start.elapsed(),
+            validate: false,
         })
     }
 
@@ -254,6 +316,9 @@ impl Context {
     /// one: a mutant can loop for ever).
     pub fn with_timeout(mut self, timeout: Duration) -> Context {
         self.timeout = timeout;
+        if let Engine::Browser(b) = &mut self.engine {
+            b.browser.set_timeout(timeout);
+        }
         self
     }
 
@@ -285,26 +350,43 @@ impl Context {
 
     /// Largest width/height a storage texture may have on this device.
     pub fn max_dimension(&self) -> u32 {
-        self.device.limits().max_texture_dimension_2d
+        match &self.engine {
+            Engine::Wgpu(w) => w.device.limits().max_texture_dimension_2d,
+            Engine::Browser(b) => b.browser.info().max_dimension,
+        }
+    }
+
+    /// The composed kernel as one WGSL source, as naga writes it back: what
+    /// the browser backend hands to Tint.
+    pub fn wgsl_source(shaders: &ShaderSet, shader: &str) -> Result<String, GpuError> {
+        let module = shaders.compose(shader)?;
+        let info = crate::shaders::validate(shader, &module)?;
+        naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
+            .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))
     }
 
     /// Compiles (once per source hash) the pipeline of a kernel file. The
     /// cache is keyed by the hash of the file and its imports, so two
     /// projects (or an edited copy) never share a stale pipeline.
-    pub fn pipeline(&self, shaders: &ShaderSet, shader: &str) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+    fn pipeline(
+        &self,
+        w: &WgpuEngine,
+        shaders: &ShaderSet,
+        shader: &str,
+    ) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
         let key = format!("{shader}#{}", shaders.source_hash(shader)?);
-        if let Some(p) = self.pipelines.lock().expect("pipeline cache").get(&key) {
+        if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
         }
         let module = shaders.compose(shader)?;
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let sm = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        let scope = w.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let sm = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(shader),
             source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned((*module).clone())),
         });
-        let pipeline = self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        let pipeline = w.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(shader),
-            layout: Some(&self.pipeline_layout),
+            layout: Some(&w.pipeline_layout),
             module: &sm,
             entry_point: Some("main"),
             compilation_options: Default::default(),
@@ -314,7 +396,7 @@ impl Context {
             return Err(GpuError::Validation { what: shader.to_string(), message: e.to_string() });
         }
         let pipeline = Arc::new(pipeline);
-        self.pipelines.lock().expect("pipeline cache").insert(key, pipeline.clone());
+        w.pipelines.lock().expect("pipeline cache").insert(key, pipeline.clone());
         Ok(pipeline)
     }
 
@@ -327,9 +409,13 @@ impl Context {
                 job.width, job.height
             )));
         }
-        let pipeline = self.pipeline(job.shaders, job.shader)?;
+        let w = match &self.engine {
+            Engine::Wgpu(w) => w,
+            Engine::Browser(b) => return self.run_in_browser(b, job),
+        };
+        let pipeline = self.pipeline(w, job.shaders, job.shader)?;
         let start = Instant::now();
-        let d = &self.device;
+        let d = &w.device;
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
         let uniforms = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
@@ -365,7 +451,7 @@ impl Context {
         let view = texture.create_view(&Default::default());
         let bind_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("io"),
-            layout: &self.layout,
+            layout: &w.layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
@@ -398,16 +484,16 @@ impl Context {
         }
         let _serial = self.submit_lock.lock().expect("submit lock");
         let gpu_start = Instant::now();
-        let index = self.queue.submit([compute.finish()]);
-        self.wait(index, job.shader)?;
+        let index = w.queue.submit([compute.finish()]);
+        self.wait(w, index, job.shader)?;
         let kernel = gpu_start.elapsed();
         let copy_start = Instant::now();
-        let index = self.queue.submit([encoder.finish()]);
+        let index = w.queue.submit([encoder.finish()]);
         let (tx, rx) = mpsc::channel();
         readback.slice(..).map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        self.wait(index, job.shader)?;
+        self.wait(w, index, job.shader)?;
         let gpu_wall = gpu_start.elapsed();
         match rx.recv_timeout(self.timeout) {
             Ok(Ok(())) => {}
@@ -439,9 +525,52 @@ impl Context {
         Ok((image, RunStats { gpu_wall, kernel, readback: readback_time, total: start.elapsed() }))
     }
 
+    /// The same job in headless Chromium: naga's WGSL of the composed
+    /// module, the same uniform bytes and table, the same readback layout.
+    fn run_in_browser(&self, b: &BrowserEngine, job: &Dispatch<'_>) -> Result<(Image, RunStats), GpuError> {
+        let key = format!("{}#{}", job.shader, job.shaders.source_hash(job.shader)?);
+        let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
+        let wgsl = match cached {
+            Some(w) => w,
+            None => {
+                let w = Arc::new(Context::wgsl_source(job.shaders, job.shader)?);
+                b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
+                w
+            }
+        };
+        let _serial = self.submit_lock.lock().expect("submit lock");
+        let out = b
+            .browser
+            .run(&vista_browser::Job {
+                label: job.shader,
+                key: &key,
+                wgsl: &wgsl,
+                uniforms: job.uniforms,
+                table: job.table,
+                width: job.width,
+                height: job.height,
+            })
+            .map_err(|e| match e {
+                vista_browser::BrowserError::Timeout { case, seconds } => GpuError::Timeout { what: case, seconds },
+                vista_browser::BrowserError::Page { case, message } => {
+                    GpuError::Validation { what: format!("{case} (in the browser)"), message }
+                }
+                other => GpuError::Device { adapter: self.info.name.clone(), message: other.to_string() },
+            })?;
+        let image = Image::from_raw(job.width, job.height, out.rgba)
+            .map_err(|e| GpuError::Request(format!("browser readback: {e}")))?;
+        let stats = RunStats {
+            gpu_wall: out.kernel + out.readback,
+            kernel: out.kernel,
+            readback: out.readback,
+            total: out.total,
+        };
+        Ok((image, stats))
+    }
+
     /// Blocks until `index` completes, or fails after the watchdog timeout.
-    fn wait(&self, index: wgpu::SubmissionIndex, what: &str) -> Result<(), GpuError> {
-        self.device
+    fn wait(&self, w: &WgpuEngine, index: wgpu::SubmissionIndex, what: &str) -> Result<(), GpuError> {
+        w.device
             .poll(wgpu::PollType::Wait { submission_index: Some(index), timeout: Some(self.timeout) })
             .map(|_| ())
             .map_err(|e| match e {
@@ -490,6 +619,7 @@ fn pick(adapters: Vec<wgpu::Adapter>, choice: &AdapterChoice) -> Option<wgpu::Ad
                 _ => None,
             },
             AdapterChoice::Named(n) => i.name.to_lowercase().contains(&n.to_lowercase()).then_some(0),
+            AdapterChoice::Browser => None,
         }
     };
     adapters.into_iter().filter_map(|a| rank(&a).map(|r| (r, a))).min_by_key(|(r, _)| *r).map(|(_, a)| a)

@@ -10,7 +10,7 @@ mod context;
 mod shaders;
 pub mod validation;
 
-pub use context::{AdapterChoice, Context, Dispatch, RunStats, SWIFTSHADER_HINT, VALIDATION_LAYER_JSON, WGPU_BACKENDS};
+pub use context::{AdapterChoice, BACKENDS, Context, Dispatch, RunStats, SWIFTSHADER_HINT, VALIDATION_LAYER_JSON};
 pub use shaders::{ShaderSet, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
@@ -19,7 +19,7 @@ pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver w
 
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum GpuError {
-    #[error("no {wanted} Vulkan adapter found (adapters seen: {seen}); {hint}")]
+    #[error("no {wanted} found (seen: {seen}); {hint}")]
     NoAdapter { wanted: String, seen: String, hint: &'static str },
     #[error("device request failed on {adapter}: {message}")]
     Device { adapter: String, message: String },

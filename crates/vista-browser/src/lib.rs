@@ -1,0 +1,397 @@
+//! Runs one WGSL compute kernel in headless Chromium's WebGPU: Tint
+//! compiles it and Dawn runs it on Chromium's SwiftShader adapter. The
+//! browser is driven over the DevTools protocol (the `headless_chrome`
+//! crate); the page side is `runner.js`.
+//!
+//! The I/O contract is the one vista's wgpu path has: binding 0 a uniform
+//! buffer, binding 1 an `rgba32float` write-only storage texture, binding 2
+//! a read-only `array<u32>`; entry point `main`, 8 x 8 workgroups.
+//!
+//! One [`Browser`] holds one Chromium process, reused across runs. Every
+//! protocol call has a watchdog; a run that overruns it, a page error or a
+//! browser that dies is an error naming the run's label, and the process is
+//! dropped (killed) so the next run starts a fresh one.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, mpsc};
+use std::time::{Duration, Instant};
+
+use base64::Engine;
+use base64::engine::general_purpose::STANDARD as B64;
+use headless_chrome::protocol::cdp::types::Event;
+use headless_chrome::{LaunchOptions, Tab};
+use serde::Deserialize;
+
+/// Printed when Chromium is missing.
+pub const INSTALL_HINT: &str = "install Debian's chromium with `bash ci/install-browser.sh` (or point VISTA_CHROMIUM \
+at a Chromium binary); set VISTA_ALLOW_NO_GPU=1 to skip GPU tests loudly";
+
+/// The flags that give headless Chromium a WebGPU adapter on SwiftShader.
+pub const WEBGPU_FLAGS: &[&str] = &["--enable-unsafe-webgpu", "--use-webgpu-adapter=swiftshader"];
+
+const RUNNER: &str = include_str!("runner.js");
+
+/// Output bytes fetched per DevTools message (a multiple of 3 and of 16, so
+/// each chunk is whole base64 quads and whole texels).
+const CHUNK: usize = 3 << 20;
+
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum BrowserError {
+    #[error("no Chromium found ({looked}); {hint}")]
+    NotInstalled { looked: String, hint: &'static str },
+    #[error("Chromium ({path}) did not start: {message}")]
+    Launch { path: String, message: String },
+    #[error("Chromium has no usable WebGPU adapter: {0}")]
+    NoWebGpu(String),
+    #[error("{case}: in the browser: {message}")]
+    Page { case: String, message: String },
+    #[error(
+        "{case}: the browser did not answer within {seconds} s (watchdog; raise VISTA_GPU_TIMEOUT_S); Chromium was killed"
+    )]
+    Timeout { case: String, seconds: f64 },
+    #[error("{case}: Chromium died or closed the DevTools connection: {message}")]
+    Died { case: String, message: String },
+}
+
+/// What the page's WebGPU adapter and the browser say about themselves.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct AdapterInfo {
+    pub vendor: String,
+    pub architecture: String,
+    pub device: String,
+    pub description: String,
+    pub user_agent: String,
+    pub max_dimension: u32,
+    /// "Chrome/156.0.8078.114" from the DevTools version call.
+    #[serde(skip)]
+    pub product: String,
+}
+
+/// One dispatch.
+#[derive(Debug, Clone)]
+pub struct Job<'a> {
+    /// Names the run in errors (vista passes the case or kernel name).
+    pub label: &'a str,
+    /// Pipeline cache key: equal keys must mean equal WGSL.
+    pub key: &'a str,
+    pub wgsl: &'a str,
+    pub uniforms: &'a [u8],
+    pub table: &'a [u32],
+    pub width: u32,
+    pub height: u32,
+}
+
+/// The texture as the kernel wrote it, row-major RGBA, and the page's timings.
+#[derive(Debug, Clone)]
+pub struct Output {
+    pub rgba: Vec<[f32; 4]>,
+    /// Submit to `onSubmittedWorkDone` of the compute pass.
+    pub kernel: Duration,
+    /// Copy, map and unpad in the page (not the DevTools transfer).
+    pub readback: Duration,
+    /// The whole call from Rust, transfer included.
+    pub total: Duration,
+}
+
+struct Session {
+    // Dropping the browser kills Chromium; the tab must go first.
+    tab: Arc<Tab>,
+    /// Set by the DevTools event of a crashed renderer.
+    crashed: Arc<AtomicBool>,
+    _browser: headless_chrome::Browser,
+    _page_dir: tempfile::TempDir,
+}
+
+/// One headless Chromium with a WebGPU device, reused across runs.
+pub struct Browser {
+    path: PathBuf,
+    timeout: Duration,
+    session: Mutex<Option<Session>>,
+    info: AdapterInfo,
+    /// Launch, page load and device creation of the first session.
+    pub launch_time: Duration,
+}
+
+impl Browser {
+    /// Starts Chromium and creates the page's WebGPU device; `timeout` is the
+    /// watchdog on every later call.
+    pub fn launch(timeout: Duration) -> Result<Browser, BrowserError> {
+        let start = Instant::now();
+        let path = find_chromium()?;
+        let (session, info) = Session::start(&path, timeout)?;
+        Ok(Browser { path, timeout, session: Mutex::new(Some(session)), info, launch_time: start.elapsed() })
+    }
+
+    /// Another watchdog for later runs (mutation runs use a short one).
+    pub fn set_timeout(&mut self, timeout: Duration) {
+        self.timeout = timeout;
+    }
+
+    pub fn info(&self) -> &AdapterInfo {
+        &self.info
+    }
+
+    /// The Chromium binary in use.
+    pub fn path(&self) -> &std::path::Path {
+        &self.path
+    }
+
+    /// Runs `job` and reads its texture back. A failure drops the browser,
+    /// so one bad case cannot leave a wedged page for the next.
+    pub fn run(&self, job: &Job<'_>) -> Result<Output, BrowserError> {
+        let start = Instant::now();
+        let mut guard = self.session.lock().unwrap_or_else(|p| p.into_inner());
+        if guard.is_none() {
+            let (session, _) = Session::start(&self.path, self.timeout)?;
+            *guard = Some(session);
+        }
+        let session = guard.as_ref().expect("session just set");
+        let result = self.run_on(session, job, start);
+        if result.is_err() {
+            *guard = None;
+        }
+        result
+    }
+
+    /// Crashes the page's renderer process (chrome://crash), as a broken
+    /// driver would: for tests of the recovery path.
+    #[doc(hidden)]
+    pub fn crash_page_for_test(&self) {
+        let guard = self.session.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(s) = guard.as_ref() {
+            // Navigating to chrome://crash blocks until the crash is seen.
+            let tab = s.tab.clone();
+            std::thread::spawn(move || {
+                let _ = tab.navigate_to("chrome://crash");
+            });
+            // The renderer takes a few seconds to go.
+            let start = Instant::now();
+            while !s.crashed.load(Ordering::SeqCst) && start.elapsed() < Duration::from_secs(30) {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        }
+    }
+
+    fn run_on(&self, s: &Session, job: &Job<'_>, start: Instant) -> Result<Output, BrowserError> {
+        let table: Vec<u8> = job.table.iter().flat_map(|w| w.to_le_bytes()).collect();
+        let args = serde_json::json!({
+            "key": job.key,
+            "wgsl": job.wgsl,
+            "uniforms": B64.encode(job.uniforms),
+            "table": B64.encode(&table),
+            "width": job.width,
+            "height": job.height,
+        });
+        let reply = s.call(job.label, format!("vistaRun({args})"), true, self.timeout)?;
+        #[derive(Deserialize)]
+        struct Ran {
+            kernel_ms: f64,
+            readback_ms: f64,
+            bytes: usize,
+        }
+        let ran: Ran = parse_ok(&reply).map_err(|message| BrowserError::Page { case: job.label.into(), message })?;
+        let expected = job.width as usize * job.height as usize * 16;
+        if ran.bytes != expected {
+            return Err(BrowserError::Page {
+                case: job.label.into(),
+                message: format!("the page read back {} bytes, expected {expected}", ran.bytes),
+            });
+        }
+        let mut bytes = Vec::with_capacity(expected);
+        for offset in (0..expected).step_by(CHUNK) {
+            let chunk = s.call(job.label, format!("vistaChunk({offset}, {CHUNK})"), false, self.timeout)?;
+            let decoded = B64.decode(chunk.as_bytes()).map_err(|e| BrowserError::Page {
+                case: job.label.into(),
+                message: format!("output chunk at byte {offset} is not base64: {e}"),
+            })?;
+            bytes.extend_from_slice(&decoded);
+        }
+        if bytes.len() != expected {
+            return Err(BrowserError::Page {
+                case: job.label.into(),
+                message: format!("received {} output bytes, expected {expected}", bytes.len()),
+            });
+        }
+        let rgba = bytes
+            .chunks_exact(16)
+            .map(|px| std::array::from_fn(|c| f32::from_le_bytes(px[c * 4..c * 4 + 4].try_into().expect("4 bytes"))))
+            .collect();
+        Ok(Output {
+            rgba,
+            kernel: Duration::from_secs_f64(ran.kernel_ms.max(0.0) / 1e3),
+            readback: Duration::from_secs_f64(ran.readback_ms.max(0.0) / 1e3),
+            total: start.elapsed(),
+        })
+    }
+}
+
+impl Session {
+    fn start(path: &std::path::Path, timeout: Duration) -> Result<(Session, AdapterInfo), BrowserError> {
+        let launch_err = |message: String| BrowserError::Launch { path: path.display().to_string(), message };
+        let args: Vec<&std::ffi::OsStr> = WEBGPU_FLAGS.iter().map(std::ffi::OsStr::new).collect();
+        let options = LaunchOptions {
+            path: Some(path.to_path_buf()),
+            headless: true,
+            // Chromium's sandbox needs user namespaces that containers and
+            // root CI runners lack; the page only ever loads vista's runner.
+            sandbox: false,
+            // Without this the crate passes --disable-gpu.
+            enable_gpu: true,
+            args,
+            // The crate's per-call wait and its idle-connection limit.
+            idle_browser_timeout: timeout.max(Duration::from_secs(5)),
+            ..LaunchOptions::default()
+        };
+        let browser = headless_chrome::Browser::new(options).map_err(|e| launch_err(format!("{e:#}")))?;
+        let product = browser.get_version().map(|v| v.product).unwrap_or_default();
+        let tab = browser.new_tab().map_err(|e| launch_err(format!("new tab: {e:#}")))?;
+        tab.set_default_timeout(timeout.max(Duration::from_secs(5)));
+        // WebGPU needs a secure context; a file:// page is one, about:blank
+        // and data: URLs are not.
+        let page_dir = tempfile::Builder::new()
+            .prefix("vista-browser-")
+            .tempdir()
+            .map_err(|e| launch_err(format!("temp dir: {e}")))?;
+        let page = page_dir.path().join("runner.html");
+        std::fs::write(
+            &page,
+            format!("<!doctype html><meta charset=utf-8><title>vista</title><script>\n{RUNNER}\n</script>"),
+        )
+        .map_err(|e| launch_err(format!("writing {}: {e}", page.display())))?;
+        tab.navigate_to(&format!("file://{}", page.display()))
+            .and_then(|t| t.wait_until_navigated())
+            .map_err(|e| launch_err(format!("loading the runner page: {e:#}")))?;
+        let crashed = Arc::new(AtomicBool::new(false));
+        let flag = crashed.clone();
+        tab.call_method(headless_chrome::protocol::cdp::Inspector::Enable(None))
+            .map_err(|e| launch_err(format!("Inspector.enable: {e:#}")))?;
+        tab.add_event_listener(Arc::new(move |event: &Event| {
+            // A crashed renderer reports itself as a detach ("Render
+            // process gone.") more often than as a crash.
+            if matches!(event, Event::InspectorTargetCrashed(_) | Event::InspectorDetached(_)) {
+                flag.store(true, Ordering::SeqCst);
+            }
+        }))
+        .map_err(|e| launch_err(format!("event listener: {e:#}")))?;
+        let session = Session { tab, crashed, _browser: browser, _page_dir: page_dir };
+        let reply =
+            session.call("WebGPU init", "vistaInit()".into(), true, timeout).map_err(|e| launch_err(e.to_string()))?;
+        let mut info: AdapterInfo = parse_ok(&reply).map_err(BrowserError::NoWebGpu)?;
+        info.product = product;
+        Ok((session, info))
+    }
+
+    /// Evaluates `expr` in the page and returns the string it yields. The
+    /// protocol call runs on its own thread so that the watchdog and a
+    /// renderer crash end the wait, whatever the call is doing.
+    fn call(&self, label: &str, expr: String, await_promise: bool, timeout: Duration) -> Result<String, BrowserError> {
+        let (tx, rx) = mpsc::channel();
+        let tab = self.tab.clone();
+        std::thread::spawn(move || {
+            let _ = tx.send(tab.evaluate(&expr, await_promise).map_err(|e| format!("{e:#}")));
+        });
+        let start = Instant::now();
+        loop {
+            match rx.recv_timeout(Duration::from_millis(20)) {
+                Ok(Ok(obj)) => {
+                    return match obj.value {
+                        Some(serde_json::Value::String(s)) => Ok(s),
+                        _ => Err(BrowserError::Page {
+                            case: label.into(),
+                            message: obj.description.unwrap_or_else(|| "the page returned no string".into()),
+                        }),
+                    };
+                }
+                Ok(Err(message)) => return Err(BrowserError::Died { case: label.into(), message }),
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(BrowserError::Died { case: label.into(), message: "the DevTools call ended".into() });
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+            }
+            if self.crashed.load(Ordering::SeqCst) {
+                return Err(BrowserError::Died {
+                    case: label.into(),
+                    message: "the page's renderer process crashed".into(),
+                });
+            }
+            if start.elapsed() >= timeout {
+                return Err(BrowserError::Timeout { case: label.into(), seconds: timeout.as_secs_f64() });
+            }
+        }
+    }
+}
+
+/// The reply of a page function: `{ok: true, ...}` parsed as `T`, or the
+/// page's error message.
+fn parse_ok<T: serde::de::DeserializeOwned>(reply: &str) -> Result<T, String> {
+    let v: serde_json::Value = serde_json::from_str(reply).map_err(|e| format!("unreadable reply ({e}): {reply}"))?;
+    if v.get("ok") != Some(&serde_json::Value::Bool(true)) {
+        let msg = v.get("error").and_then(|e| e.as_str()).unwrap_or(reply);
+        return Err(msg.to_string());
+    }
+    serde_json::from_value(v).map_err(|e| format!("unexpected reply ({e}): {reply}"))
+}
+
+/// `VISTA_CHROMIUM`, else Debian's binary, else the usual names on `PATH`.
+pub fn find_chromium() -> Result<PathBuf, BrowserError> {
+    if let Some(p) = std::env::var_os("VISTA_CHROMIUM").filter(|p| !p.is_empty()) {
+        let p = PathBuf::from(p);
+        return if p.is_file() {
+            Ok(p)
+        } else {
+            Err(BrowserError::NotInstalled {
+                looked: format!("VISTA_CHROMIUM={} is not a file", p.display()),
+                hint: INSTALL_HINT,
+            })
+        };
+    }
+    // The binary itself, not Debian's wrapper script, so that killing the
+    // process we started kills Chromium.
+    let debian = PathBuf::from("/usr/lib/chromium/chromium");
+    if debian.is_file() {
+        return Ok(debian);
+    }
+    const NAMES: &[&str] = &["chromium", "chromium-browser", "google-chrome", "google-chrome-stable"];
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    for dir in std::env::split_paths(&path) {
+        for name in NAMES {
+            let p = dir.join(name);
+            if p.is_file() {
+                return Ok(p);
+            }
+        }
+    }
+    Err(BrowserError::NotInstalled {
+        looked: format!("/usr/lib/chromium/chromium and {} on PATH", NAMES.join(", ")),
+        hint: INSTALL_HINT,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn page_replies_parse_or_name_the_page_error() {
+        #[derive(Deserialize, Debug)]
+        struct R {
+            bytes: usize,
+        }
+        let ok: R = parse_ok(r#"{"ok":true,"bytes":16}"#).unwrap();
+        assert_eq!(ok.bytes, 16);
+        let err = parse_ok::<R>(r#"{"ok":false,"error":"Tint rejected the WGSL: line 3:1: x"}"#).unwrap_err();
+        assert_eq!(err, "Tint rejected the WGSL: line 3:1: x");
+        assert!(parse_ok::<R>("not json").unwrap_err().contains("unreadable reply"));
+    }
+
+    #[test]
+    fn a_missing_vista_chromium_is_a_clear_error() {
+        // SAFETY: this test is the only one in the crate touching the variable.
+        unsafe { std::env::set_var("VISTA_CHROMIUM", "/nonexistent/chromium") };
+        let e = find_chromium().unwrap_err().to_string();
+        unsafe { std::env::remove_var("VISTA_CHROMIUM") };
+        assert!(e.contains("VISTA_CHROMIUM=/nonexistent/chromium is not a file"), "{e}");
+        assert!(e.contains("ci/install-browser.sh"), "{e}");
+    }
+}

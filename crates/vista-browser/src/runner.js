@@ -1,0 +1,162 @@
+// The page side of vista's browser backend. Rust evaluates these functions
+// over the DevTools protocol; each returns a JSON string so that errors come
+// back as data, never as an exception the protocol would flatten.
+"use strict";
+
+const vista = { device: null, layout: null, pipelineLayout: null, pipelines: new Map(), out: null, lost: null };
+
+function fail(e) {
+  return JSON.stringify({ ok: false, error: String((e && e.message) || e) });
+}
+
+function fromBase64(s) {
+  if (Uint8Array.fromBase64) return Uint8Array.fromBase64(s);
+  const bin = atob(s);
+  const u8 = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; i++) u8[i] = bin.charCodeAt(i);
+  return u8;
+}
+
+function toBase64(u8) {
+  if (u8.toBase64) return u8.toBase64();
+  let s = "";
+  for (let i = 0; i < u8.length; i += 0x8000) s += String.fromCharCode.apply(null, u8.subarray(i, i + 0x8000));
+  return btoa(s);
+}
+
+async function vistaInit() {
+  try {
+    if (!navigator.gpu) throw new Error("navigator.gpu is missing: WebGPU is off (Chromium needs --enable-unsafe-webgpu)");
+    const adapter = await navigator.gpu.requestAdapter();
+    if (!adapter) throw new Error("requestAdapter() gave no adapter (--use-webgpu-adapter=swiftshader)");
+    const l = adapter.limits;
+    const device = await adapter.requestDevice({
+      requiredLimits: {
+        maxTextureDimension2D: l.maxTextureDimension2D,
+        maxBufferSize: l.maxBufferSize,
+        maxStorageBufferBindingSize: l.maxStorageBufferBindingSize,
+      },
+    });
+    device.lost.then((info) => {
+      vista.lost = `${info.reason}: ${info.message}`;
+      vista.device = null;
+    });
+    const C = GPUShaderStage.COMPUTE;
+    vista.layout = device.createBindGroupLayout({
+      entries: [
+        { binding: 0, visibility: C, buffer: { type: "uniform" } },
+        { binding: 1, visibility: C, storageTexture: { access: "write-only", format: "rgba32float", viewDimension: "2d" } },
+        { binding: 2, visibility: C, buffer: { type: "read-only-storage" } },
+      ],
+    });
+    vista.pipelineLayout = device.createPipelineLayout({ bindGroupLayouts: [vista.layout] });
+    vista.device = device;
+    vista.pipelines.clear();
+    const i = adapter.info;
+    return JSON.stringify({
+      ok: true,
+      vendor: i.vendor,
+      architecture: i.architecture,
+      device: i.device,
+      description: i.description,
+      user_agent: navigator.userAgent,
+      max_dimension: device.limits.maxTextureDimension2D,
+    });
+  } catch (e) {
+    return fail(e);
+  }
+}
+
+async function pipeline(key, wgsl) {
+  const cached = vista.pipelines.get(key);
+  if (cached) return cached;
+  const d = vista.device;
+  d.pushErrorScope("validation");
+  const module = d.createShaderModule({ code: wgsl, label: key });
+  const info = await module.getCompilationInfo();
+  const errors = info.messages.filter((m) => m.type === "error");
+  if (errors.length) {
+    await d.popErrorScope();
+    const lines = errors.map((m) => `line ${m.lineNum}:${m.linePos}: ${m.message}`);
+    throw new Error(`Tint rejected the WGSL: ${lines.join("; ")}`);
+  }
+  let p;
+  try {
+    p = await d.createComputePipelineAsync({ layout: vista.pipelineLayout, compute: { module, entryPoint: "main" } });
+  } finally {
+    const e = await d.popErrorScope();
+    if (e) throw new Error(`pipeline: ${e.message}`);
+  }
+  vista.pipelines.set(key, p);
+  return p;
+}
+
+// job: { key, wgsl, uniforms (base64), table (base64), width, height }
+async function vistaRun(job) {
+  try {
+    const d = vista.device;
+    if (!d) throw new Error(`the WebGPU device is gone (${vista.lost || "never created"})`);
+    const p = await pipeline(job.key, job.wgsl);
+    const start = performance.now();
+    d.pushErrorScope("out-of-memory");
+    d.pushErrorScope("validation");
+    const bytes = fromBase64(job.uniforms);
+    const uniforms = d.createBuffer({ size: Math.max(16, Math.ceil(bytes.length / 16) * 16), usage: GPUBufferUsage.UNIFORM, mappedAtCreation: true });
+    new Uint8Array(uniforms.getMappedRange()).set(bytes);
+    uniforms.unmap();
+    const words = fromBase64(job.table);
+    const table = d.createBuffer({ size: Math.max(16, Math.ceil(words.length / 4) * 4), usage: GPUBufferUsage.STORAGE, mappedAtCreation: true });
+    new Uint8Array(table.getMappedRange()).set(words);
+    table.unmap();
+    const size = { width: job.width, height: job.height };
+    const texture = d.createTexture({ size, format: "rgba32float", usage: GPUTextureUsage.STORAGE_BINDING | GPUTextureUsage.COPY_SRC });
+    const rowBytes = job.width * 16;
+    const paddedRow = Math.ceil(rowBytes / 256) * 256;
+    const readback = d.createBuffer({ size: paddedRow * job.height, usage: GPUBufferUsage.COPY_DST | GPUBufferUsage.MAP_READ });
+    const group = d.createBindGroup({
+      layout: vista.layout,
+      entries: [
+        { binding: 0, resource: { buffer: uniforms } },
+        { binding: 1, resource: texture.createView() },
+        { binding: 2, resource: { buffer: table } },
+      ],
+    });
+    // Two submissions, so the kernel and the readback are timed apart as on wgpu.
+    const compute = d.createCommandEncoder();
+    const pass = compute.beginComputePass();
+    pass.setPipeline(p);
+    pass.setBindGroup(0, group);
+    pass.dispatchWorkgroups(Math.ceil(job.width / 8), Math.ceil(job.height / 8));
+    pass.end();
+    const copy = d.createCommandEncoder();
+    copy.copyTextureToBuffer({ texture }, { buffer: readback, bytesPerRow: paddedRow, rowsPerImage: job.height }, size);
+    const validation = await d.popErrorScope();
+    const oom = await d.popErrorScope();
+    if (validation) throw new Error(`WebGPU validation: ${validation.message}`);
+    if (oom) throw new Error(`WebGPU out of memory: ${oom.message}`);
+    const gpuStart = performance.now();
+    d.queue.submit([compute.finish()]);
+    await d.queue.onSubmittedWorkDone();
+    const kernelMs = performance.now() - gpuStart;
+    const copyStart = performance.now();
+    d.queue.submit([copy.finish()]);
+    await readback.mapAsync(GPUMapMode.READ);
+    const padded = new Uint8Array(readback.getMappedRange());
+    const out = new Uint8Array(rowBytes * job.height);
+    for (let y = 0; y < job.height; y++) out.set(padded.subarray(y * paddedRow, y * paddedRow + rowBytes), y * rowBytes);
+    readback.unmap();
+    const readbackMs = performance.now() - copyStart;
+    for (const b of [uniforms, table, readback]) b.destroy();
+    texture.destroy();
+    if (!vista.device) throw new Error(`the WebGPU device was lost during the run (${vista.lost})`);
+    vista.out = out;
+    return JSON.stringify({ ok: true, kernel_ms: kernelMs, readback_ms: readbackMs, total_ms: performance.now() - start, bytes: out.length });
+  } catch (e) {
+    return fail(e);
+  }
+}
+
+// A slice of the last output, base64: DevTools messages stay a few MB each.
+function vistaChunk(offset, length) {
+  return toBase64(vista.out.subarray(offset, offset + length));
+}

@@ -1,0 +1,128 @@
+//! Runs small kernels in headless Chromium. Needs Chromium
+//! (`bash ci/install-browser.sh`); with VISTA_ALLOW_NO_GPU=1 and no
+//! Chromium, every test is reported ignored (never ok) and a loud line says so.
+
+use std::time::Duration;
+
+use vista_browser::{Browser, BrowserError, Job};
+
+const GRADIENT: &str = r#"
+struct Params { width: u32, height: u32, scale: f32, pad: f32 }
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(2) var<storage, read> table: array<u32>;
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= params.width || id.y >= params.height) { return; }
+    let t = f32(table[(id.x + id.y) % 4u]);
+    textureStore(out, vec2<i32>(id.xy), vec4<f32>(f32(id.x) * params.scale, f32(id.y), t, 1.0));
+}
+"#;
+
+fn browser() -> Browser {
+    Browser::launch(Duration::from_secs(60)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn main() {
+    let args = libtest_mimic::Arguments::from_args();
+    let missing = vista_browser::find_chromium().err();
+    let skip = missing.filter(|_| std::env::var("VISTA_ALLOW_NO_GPU").as_deref() == Ok("1"));
+    let tests: [(&str, fn()); 3] = [
+        ("a_kernel_runs_and_reads_back_every_texel", a_kernel_runs_and_reads_back_every_texel),
+        ("tint_errors_name_the_case_and_the_next_run_works", tint_errors_name_the_case_and_the_next_run_works),
+        (
+            "a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named",
+            a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named,
+        ),
+    ];
+    if let Some(e) = &skip {
+        eprintln!(
+            "\n!!! VISTA_ALLOW_NO_GPU=1 and no Chromium: {e}\n!!! SKIPPED {} browser tests (reported ignored)\n",
+            tests.len()
+        );
+    }
+    let trials = tests
+        .into_iter()
+        .map(|(name, f)| {
+            libtest_mimic::Trial::test(name, move || {
+                f();
+                Ok(())
+            })
+            .with_ignored_flag(skip.is_some())
+        })
+        .collect();
+    libtest_mimic::run(&args, trials).exit()
+}
+
+/// The error of a run that should have failed (without printing the
+/// output of one that did not).
+fn failure(r: Result<vista_browser::Output, BrowserError>, what: &str) -> BrowserError {
+    match r {
+        Ok(out) => panic!("{what}: {} texels came back", out.rgba.len()),
+        Err(e) => e,
+    }
+}
+
+fn uniforms(w: u32, h: u32, scale: f32) -> Vec<u8> {
+    [w.to_le_bytes(), h.to_le_bytes(), scale.to_le_bytes(), 0f32.to_le_bytes()].concat()
+}
+
+fn a_kernel_runs_and_reads_back_every_texel() {
+    let b = browser();
+    assert!(b.info().architecture.contains("swiftshader"), "{:?}", b.info());
+    let (w, h) = (37u32, 11u32);
+    let table = [10u32, 20, 30, 40];
+    let u = uniforms(w, h, 0.5);
+    let job = Job { label: "gradient", key: "g1", wgsl: GRADIENT, uniforms: &u, table: &table, width: w, height: h };
+    let out = b.run(&job).unwrap();
+    assert_eq!(out.rgba.len(), (w * h) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let px = out.rgba[(y * w + x) as usize];
+            assert_eq!(px, [x as f32 * 0.5, y as f32, table[((x + y) % 4) as usize] as f32, 1.0], "({x}, {y})");
+        }
+    }
+    // The same browser serves a second run with other uniforms.
+    let u = uniforms(w, h, 2.0);
+    let out = b.run(&Job { uniforms: &u, ..job }).unwrap();
+    assert_eq!(out.rgba[(w - 1) as usize][0], (w - 1) as f32 * 2.0);
+}
+
+fn tint_errors_name_the_case_and_the_next_run_works() {
+    let b = browser();
+    let bad = GRADIENT.replace("f32(id.y)", "id.y");
+    let u = uniforms(8, 8, 1.0);
+    let table = [0u32; 4];
+    let job = Job { label: "case-bad", key: "bad", wgsl: &bad, uniforms: &u, table: &table, width: 8, height: 8 };
+    let e = failure(b.run(&job), "Tint accepted a type error").to_string();
+    assert!(e.starts_with("case-bad: in the browser: Tint rejected the WGSL: line"), "{e}");
+    let good = Job { label: "case-good", key: "good", wgsl: GRADIENT, ..job };
+    assert_eq!(b.run(&good).unwrap().rgba.len(), 64);
+}
+
+fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
+    let b = Browser::launch(Duration::from_secs(4)).unwrap();
+    // Never ends: scale is 1, so the loop's exit is never taken.
+    let forever = GRADIENT.replace(
+        "let t = ",
+        "var i = 0.0;\n    loop {\n        i = i + params.scale;\n        textureStore(out, vec2<i32>(id.xy), vec4<f32>(i));\n        if (i < 0.0) { break; }\n    }\n    let t = ",
+    );
+    let u = uniforms(64, 64, 1.0);
+    let table = [0u32; 4];
+    let job =
+        Job { label: "case-hang", key: "hang", wgsl: &forever, uniforms: &u, table: &table, width: 64, height: 64 };
+    let start = std::time::Instant::now();
+    let e = failure(b.run(&job), "the hung kernel returned");
+    let took = start.elapsed();
+    assert!(matches!(e, BrowserError::Timeout { .. } | BrowserError::Page { .. }), "{e}");
+    assert!(e.to_string().starts_with("case-hang: "), "{e}");
+    assert!(took < Duration::from_secs(30), "{took:?}");
+    let good = Job { label: "after-hang", key: "good", wgsl: GRADIENT, ..job };
+    assert_eq!(b.run(&good).unwrap().rgba.len(), 64 * 64);
+
+    b.crash_page_for_test();
+    let e = failure(b.run(&Job { label: "case-crash", ..good.clone() }), "the crashed page returned");
+    assert!(matches!(e, BrowserError::Died { .. }), "{e}");
+    assert!(e.to_string().starts_with("case-crash: "), "{e}");
+    assert_eq!(b.run(&good).unwrap().rgba.len(), 64 * 64, "a fresh browser after the crash");
+}
