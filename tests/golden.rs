@@ -62,8 +62,17 @@ fn main() {
     let conclusion = libtest_mimic::run(&args, trials);
     let outcomes = outcomes.lock().expect("outcomes");
     if !outcomes.is_empty() {
-        let adapter = common::renderer().map(|c| c.adapter_description()).unwrap_or_default();
-        match vista_golden::write_report(&report_dir, &adapter, &outcomes) {
+        let r = common::renderer();
+        let backend = r.as_ref().map(|c| c.backend().to_string()).unwrap_or_default();
+        let run = vista_golden::RunSummary {
+            command: match backend.as_str() {
+                "lavapipe" => "cargo test --test golden".into(),
+                b => format!("VISTA_BACKEND={b} cargo test --test golden"),
+            },
+            adapter: r.map(|c| c.adapter_description()).unwrap_or_default(),
+            backend,
+        };
+        match vista_golden::write_report(&report_dir, &run, &outcomes) {
             Ok(index) => eprintln!("vista report: {}", index.display()),
             Err(e) => eprintln!("could not write the vista report: {e}"),
         }

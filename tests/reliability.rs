@@ -34,6 +34,7 @@ fn nan_case() -> Case {
         psnr_same_driver: 60.0,
         psnr_other_driver: 35.0,
         min_ssim: None,
+        max_flip: None,
         expect_fail: vec![],
         doc: String::new(),
     }

@@ -365,7 +365,12 @@ fn check(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> 
         }
         outcomes.push(o);
     }
-    let index = vista_golden::write_report(&opts.report_dir, &ctx.adapter_description(), &outcomes)?;
+    let run = vista_golden::RunSummary {
+        command: command_line(),
+        backend: ctx.backend().to_string(),
+        adapter: ctx.adapter_description(),
+    };
+    let index = vista_golden::write_report(&opts.report_dir, &run, &outcomes)?;
     let failing: Vec<&str> = outcomes.iter().filter(|o| !o.passed()).map(|o| o.id.as_str()).collect();
     let failed = failing.len();
     println!("{} passed, {} failed", outcomes.len() - failed, failed);
@@ -375,6 +380,19 @@ fn check(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> 
     }
     println!("report: {}", index.display());
     Ok(if failed == 0 { 0 } else { 1 })
+}
+
+/// This process's command line as a user would type it again (`vista` and
+/// its arguments, quoted where the shell would need it), for reports.
+fn command_line() -> String {
+    let quote = |a: String| {
+        if !a.is_empty() && a.chars().all(|c| c.is_ascii_alphanumeric() || "-_=./:,@+".contains(c)) {
+            a
+        } else {
+            format!("'{}'", a.replace('\'', "'\\''"))
+        }
+    };
+    std::iter::once("vista".to_string()).chain(std::env::args().skip(1).map(quote)).collect::<Vec<_>>().join(" ")
 }
 
 /// The project's kernels (its manifests over the built-ins).

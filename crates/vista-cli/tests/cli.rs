@@ -276,10 +276,13 @@ fn sweep_writes_csv_plots_and_names_the_cheapest_setting() {
     assert_eq!(r.code, 0, "{}", r.stderr);
     let csv = std::fs::read_to_string(out.join("curve.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
-    assert_eq!(rows[0], ["octaves", "psnr", "ssim", "max_abs", "bad_pixels", "gpu_ms", "work_per_pixel"]);
+    assert_eq!(rows[0], ["octaves", "psnr", "ssim", "max_abs", "bad_pixels", "gpu_ms", "work_per_pixel", "flip_mean"]);
     assert_eq!(rows.len(), 6, "{csv}");
     // The reference is octaves=16, so that point is bit-identical to it.
     assert_eq!(rows[5][1], "inf", "{csv}");
+    // FLIP beside PSNR: 0 for the identical point, above 0 for the others.
+    assert_eq!(rows[5][7], "0.000000", "{csv}");
+    assert!(rows[1..5].iter().all(|r| r[7].parse::<f64>().unwrap() > 0.0), "{csv}");
     let psnr: Vec<f64> = rows[1..5].iter().map(|r| r[1].parse().unwrap()).collect();
     assert!(psnr.windows(2).all(|w| w[1] > w[0]), "PSNR must grow with octaves: {psnr:?}");
     let expected = rows[1..].iter().find(|r| r[1] == "inf" || r[1].parse::<f64>().unwrap() >= 40.0).unwrap()[0];
@@ -366,7 +369,8 @@ fn missing_golden_fails_with_the_bless_command_and_is_not_created() {
     let r = vista_in(Some(d.path()), &[], &["check"]);
     assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("does not exist") && r.stdout.contains("bless --case 'a'"), "{}", r.stdout);
-    assert!(r.stdout.contains("actual: ") && r.stdout.contains("index.html"), "{}", r.stdout);
+    assert!(r.stdout.contains("index.html#case-a"), "{}", r.stdout);
+    assert!(report(d.path()).join("a/actual.png").exists() && report(d.path()).join("a/actual8.png").exists());
     assert!(!golden(d.path(), "fbm", "a").exists(), "check must never create a golden");
 }
 
@@ -397,17 +401,14 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
     .unwrap();
     let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
     assert_eq!(r.code, 1, "{}", r.stdout);
-    for needle in [
-        "PSNR",
-        "below the threshold 60.0 dB",
-        "expected: ",
-        "actual: ",
-        "diff: ",
-        "parameters changed since the last bless",
-    ] {
+    for needle in
+        ["PSNR", "below the threshold 60.0 dB", "FLIP", "index.html#case-b", "parameters changed since the last bless"]
+    {
         assert!(r.stdout.contains(needle), "missing '{needle}' in: {}", r.stdout);
     }
-    assert!(report(d.path()).join("b/diff.png").exists());
+    for f in ["expected.png", "actual.png", "diff.png", "expected8.png", "actual8.png", "diff8.png", "view.js"] {
+        assert!(report(d.path()).join("b").join(f).exists(), "report file b/{f}");
+    }
 }
 
 fn corrupt_and_wrong_size_goldens_fail_clearly() {
@@ -682,7 +683,7 @@ fn a_copied_binary_checks_the_checkout_it_runs_in() {
     let there = run_in(&bin, &clone.join("golden"), &[], &case);
     assert_eq!(there.code, 1, "the edited clone must fail: {}{}", there.stdout, there.stderr);
     assert!(
-        there.stdout.contains("below the threshold") && there.stdout.contains("shader changed"),
+        there.stdout.contains("below the threshold") && there.stdout.contains("changed shader files: fbm.wgsl\n"),
         "{}",
         there.stdout
     );
@@ -939,6 +940,116 @@ fn malformed_manifest_names_file_line_and_column() {
         K_SHADER,
     );
     assert_rejected(&vista_in(Some(d.path()), &[], &["list"]), 2, &["kernels/k.toml: line 1"]);
+}
+
+// ---- the report in a real browser -------------------------------------------
+
+/// The example project with one case broken by a WGSL edit: `vista check`
+/// prints one line for the passing case and a compact block for the failing
+/// one (naming the changed file), and the report, opened in headless
+/// Chromium from `file://` as a reviewer would, has no console errors,
+/// lists the failure in its summary, and its flip control switches the
+/// image. Screenshots go to target/tmp/report-*.png.
+fn the_report_works_in_a_real_browser() {
+    use headless_chrome::protocol::cdp::types::Event;
+    let t = tmp();
+    let root = t.path().join("project");
+    copy_tree(&repo().join("examples/project"), &root);
+    assert_eq!(vista_in(Some(&root), &[], &["bless"]).code, 0);
+    let shader = root.join("shaders/marble.wgsl");
+    let text = std::fs::read_to_string(&shader).unwrap();
+    // Only the six-stripe default case changes; the calm case (3) does not.
+    let edited = text.replace(
+        "sin(6.283185307 * (params.stripes * uv.x + bend))",
+        "sin(6.283185307 * (params.stripes * uv.x + bend) + select(0.0, 0.05, params.stripes > 4.0))",
+    );
+    assert_ne!(edited, text, "the example shader changed; update this test's edit");
+    std::fs::write(&shader, edited).unwrap();
+    let r = vista_in(Some(&root), &[], &["check"]);
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    let lines: Vec<&str> = r.stdout.lines().collect();
+    assert!(lines.iter().any(|l| l.starts_with("ok ") && l.contains("marble-calm")), "{}", r.stdout);
+    let fail = lines.iter().position(|l| l.starts_with("FAIL") && l.contains("marble-default")).expect("FAIL line");
+    let block: Vec<&str> = lines[fail + 1..].iter().take_while(|l| l.starts_with("  ")).copied().collect();
+    assert!(block.len() <= 6, "a compact block: {block:?}");
+    assert!(block[0].contains("PSNR") && block[0].contains(">= 60.0 dB") && block[0].contains("FLIP"), "{block:?}");
+    assert!(block.iter().any(|l| l.trim() == "changed shader files: marble.wgsl"), "{block:?}");
+    assert!(block.iter().any(|l| l.contains("index.html#case-marble-default")), "{block:?}");
+    assert!(r.stdout.contains("1 passed, 1 failed") && r.stdout.contains("vista bless --case 'marble-default'"));
+
+    let index = root.join("target/vista-report/index.html");
+    let browser = headless_chrome::Browser::new(headless_chrome::LaunchOptions {
+        path: Some(vista_browser::find_chromium().unwrap_or_else(|e| panic!("{e}"))),
+        sandbox: false,
+        window_size: Some((1400, 1000)),
+        ..Default::default()
+    })
+    .expect("launch Chromium");
+    let tab = browser.new_tab().unwrap();
+    let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::<String>::new()));
+    let seen = errors.clone();
+    tab.enable_runtime().unwrap();
+    tab.enable_log().unwrap();
+    tab.add_event_listener(std::sync::Arc::new(move |e: &Event| {
+        let msg = match e {
+            Event::RuntimeExceptionThrown(x) => Some(format!("exception: {:?}", x.params.exception_details.text)),
+            Event::RuntimeConsoleAPICalled(x) if format!("{:?}", x.params.Type).contains("Error") => {
+                Some(format!("console.error: {:?}", x.params.args.first().and_then(|a| a.value.clone())))
+            }
+            Event::LogEntryAdded(x) if format!("{:?}", x.params.entry.level).contains("Error") => {
+                Some(format!("log: {}", x.params.entry.text))
+            }
+            _ => None,
+        };
+        if let Some(m) = msg {
+            seen.lock().unwrap().push(m);
+        }
+    }))
+    .unwrap();
+    tab.navigate_to(&format!("file://{}", index.display())).unwrap().wait_until_navigated().unwrap();
+    let eval = |js: &str| tab.evaluate(js, false).unwrap().value.unwrap_or(serde_json::Value::Null);
+    // The failing case's viewer loads its view.js by itself (it is open).
+    let start = std::time::Instant::now();
+    while eval("!!document.querySelector('#case-marble-default canvas.img')") != serde_json::json!(true) {
+        assert!(start.elapsed().as_secs() < 20, "the failing case's viewer never loaded");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let summary = eval("[...document.querySelectorAll('#summary a')].map(a => a.getAttribute('href')).join(' ')");
+    assert_eq!(summary, serde_json::json!("#case-marble-default"), "the summary lists exactly the failure");
+    assert_eq!(eval("document.querySelector('#case-marble-calm').hidden"), serde_json::json!(true), "failures only");
+    let shots = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let shot = |name: &str| {
+        let png = tab
+            .capture_screenshot(
+                headless_chrome::protocol::cdp::Page::CaptureScreenshotFormatOption::Png,
+                None,
+                None,
+                true,
+            )
+            .unwrap();
+        std::fs::write(shots.join(name), png).unwrap();
+    };
+    shot("report-summary.png");
+    let viewer = "document.querySelector('#case-marble-default .viewer')";
+    let pixels = format!("{viewer}.querySelector('canvas.img').toDataURL()");
+    let before = eval(&pixels);
+    assert_eq!(eval(&format!("{viewer}.dataset.showing")), serde_json::json!("actual"));
+    eval(&format!("{viewer}.scrollIntoView(); {viewer}.querySelector('button.flip').click()"));
+    assert_eq!(eval(&format!("{viewer}.dataset.showing")), serde_json::json!("expected"), "the flip button");
+    assert_ne!(eval(&pixels), before, "flipping to the golden changed the image");
+    shot("report-flipped.png");
+    tab.press_key("f").unwrap();
+    assert_eq!(eval(&format!("{viewer}.dataset.showing")), serde_json::json!("actual"), "the f key");
+    assert_eq!(eval(&pixels), before);
+    // The readout shows both 16-bit values under the cursor.
+    eval(&format!(
+        "const c = {viewer}.querySelector('canvas.img'); const r = c.getBoundingClientRect(); \
+         c.parentElement.dispatchEvent(new MouseEvent('mousemove', {{clientX: r.left + 9, clientY: r.top + 9, bubbles: true}}))"
+    ));
+    let readout = eval(&format!("{viewer}.querySelector('.readout').textContent"));
+    assert!(readout.as_str().unwrap().starts_with("(2, 2)  expected 0."), "{readout}");
+    let errors = errors.lock().unwrap();
+    assert!(errors.is_empty(), "console errors: {errors:?}");
 }
 
 // ---- examples/project: a project outside the built-ins ---------------------
@@ -1251,6 +1362,7 @@ fn main() {
             browser_backend_without_chromium_names_the_install_command,
         ),
         (Gpu, "a_project_kernel_renders_the_same_in_the_browser", a_project_kernel_renders_the_same_in_the_browser),
+        (Gpu, "the_report_works_in_a_real_browser", the_report_works_in_a_real_browser),
         (Gpu, "compare_reports_json_fields_and_rejects_bad_files", compare_reports_json_fields_and_rejects_bad_files),
         (Gpu, "render_exr_holds_the_raw_fbm_field", render_exr_holds_the_raw_fbm_field),
         (Gpu, "render_exr_holds_heightfield_depth_over_t_max", render_exr_holds_heightfield_depth_over_t_max),

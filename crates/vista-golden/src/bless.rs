@@ -108,7 +108,9 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             size: format!("{}x{}", case.width, case.height),
             params_hash: params_hash(case),
             shader_hash: ctx.shader_hash(case.kernel.shader())?,
+            shader_files: ctx.shader_file_hashes(case.kernel.shader())?,
             adapter: adapter.clone(),
+            backend: ctx.backend().to_string(),
             date: now_utc(),
             raw_hash: r.raw.content_hash(),
             psnr_vs_previous: psnr.clone(),
@@ -123,8 +125,16 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             && let Some(previous) = manifest.case.get(&case.id).filter(|e| same_render(e))
         {
             // Nothing changed: keep the entry's date and PSNR-vs-previous (the
-            // provenance of the last real change), only completing its hash.
-            entry = ManifestEntry { golden_hash: new_hash.clone(), replacing: None, ..previous.clone() };
+            // provenance of the last real change), only completing its hashes
+            // (per-file shader hashes too: equal shader_hash, equal files).
+            let (shader_files, backend) = (entry.shader_files.clone(), entry.backend.clone());
+            entry = ManifestEntry {
+                golden_hash: new_hash.clone(),
+                replacing: None,
+                shader_files,
+                backend,
+                ..previous.clone()
+            };
         } else if old_hash.as_deref() != Some(new_hash.as_str()) {
             // Two-phase per case: the manifest first accepts both files, then
             // the golden is replaced, then the manifest names only the new one.

@@ -10,6 +10,7 @@
 //! psnr_same_driver = 60.0        # optional thresholds (dB)
 //! psnr_other_driver = 35.0
 //! min_ssim = 0.99                # optional
+//! max_flip = 0.01                # optional: mean LDR-FLIP error, in [0, 1]
 //! ```
 
 use std::collections::BTreeMap;
@@ -43,6 +44,7 @@ struct RawCase {
     psnr_same_driver: Option<f64>,
     psnr_other_driver: Option<f64>,
     min_ssim: Option<f64>,
+    max_flip: Option<f64>,
     #[serde(default)]
     expect_fail: Vec<Expectation>,
     #[serde(default)]
@@ -84,6 +86,8 @@ pub struct Case {
     pub psnr_same_driver: f64,
     pub psnr_other_driver: f64,
     pub min_ssim: Option<f64>,
+    /// Largest mean LDR-FLIP error allowed (display values), if any.
+    pub max_flip: Option<f64>,
     /// Where this case is expected to fail, and why.
     pub expect_fail: Vec<Expectation>,
     pub doc: String,
@@ -95,9 +99,10 @@ impl Case {
         format!("{}/{}.png", self.kernel.name(), self.id)
     }
 
-    /// The `vista bless` command that (re)writes this case's golden.
+    /// The `vista bless` command that (re)writes this case's golden: the
+    /// same form as the one-for-all-failures command, valid in any project.
     pub fn bless_command(&self) -> String {
-        format!("make golden CASE='{}'  (or: cargo run -p vista-cli -- bless --case '{}')", self.id, self.id)
+        crate::bless_all_command(&[self.id.as_str()]).expect("one case")
     }
 }
 
@@ -139,6 +144,11 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         {
             return Err(bad(format!("min_ssim={s} is out of range; allowed: [-1, 1]")));
         }
+        if let Some(f) = raw.max_flip
+            && !(0.0..=1.0).contains(&f)
+        {
+            return Err(bad(format!("max_flip={f} is out of range; allowed: [0, 1] (mean FLIP error)")));
+        }
         for x in &raw.expect_fail {
             if !EXPECTATION_BACKENDS.contains(&x.backend.as_str()) {
                 return Err(bad(format!(
@@ -162,6 +172,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             psnr_same_driver,
             psnr_other_driver,
             min_ssim: raw.min_ssim,
+            max_flip: raw.max_flip,
             expect_fail: raw.expect_fail,
             doc: raw.doc,
         });

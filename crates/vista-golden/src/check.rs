@@ -22,12 +22,28 @@ pub enum Verdict {
     ExpectedFail,
 }
 
-/// Images written for the report (paths relative to the report dir).
+/// Images written for the report (paths relative to the report dir): the
+/// 16-bit files, their 8-bit display copies, and the viewer's data.
 #[derive(Debug, Clone, Default)]
 pub struct ReportFiles {
     pub expected: Option<String>,
     pub actual: Option<String>,
+    /// Heat map on the fixed log scale (`vista_image::log_position`).
     pub diff: Option<String>,
+    pub expected8: Option<String>,
+    pub actual8: Option<String>,
+    pub diff8: Option<String>,
+    /// `view.js`: both images' 16-bit values for the viewer's readout.
+    pub view: Option<String>,
+}
+
+/// The run's side of the provenance, beside the golden's manifest entry.
+#[derive(Debug, Clone, Default)]
+pub struct RunInfo {
+    pub backend: String,
+    pub adapter: String,
+    pub params_hash: String,
+    pub shader_hash: String,
 }
 
 /// What happened to one case. `#[must_use]`: callers decide pass/fail.
@@ -43,13 +59,28 @@ pub struct Outcome {
     pub psnr_threshold: f64,
     pub same_driver: bool,
     pub min_ssim: Option<f64>,
+    pub max_flip: Option<f64>,
     /// One line per problem or note (shader changed since bless, ...).
     pub problems: Vec<String>,
     pub notes: Vec<String>,
     pub files: ReportFiles,
     pub gpu_ms: f64,
     pub bless_command: String,
+    pub width: u32,
+    pub height: u32,
+    /// The golden's manifest entry at check time, and this run's side.
+    pub golden: Option<crate::ManifestEntry>,
+    pub run: RunInfo,
+    /// WGSL files (relative to `shaders/`) whose hash differs from the one
+    /// recorded at bless time, or that were added to or dropped from the
+    /// kernel's imports.
+    pub changed_files: Vec<String>,
+    /// The first NaN/Inf or out-of-range raw pixel, and what it holds.
+    pub first_bad: Option<(u32, u32, String)>,
 }
+
+/// A pixel is "bad" when a display channel differs by more than this.
+pub const BAD_PIXEL_LIMIT: &str = "1/255";
 
 impl Outcome {
     /// Passing for the run: a pass, or a failure that an expectation names.
@@ -57,37 +88,48 @@ impl Outcome {
         matches!(self.verdict, Verdict::Pass | Verdict::ExpectedFail)
     }
 
-    /// Multi-line explanation for test output and `vista check`.
+    /// Share of the image's pixels that are bad, in percent.
+    pub fn bad_percent(&self) -> Option<f64> {
+        let n = self.width as f64 * self.height as f64;
+        self.metrics.map(|m| if n > 0.0 { 100.0 * m.bad_pixels as f64 / n } else { 0.0 })
+    }
+
+    /// The compact block `vista check` and the golden tests print under a
+    /// case's status line: metrics against thresholds on one line, the
+    /// changed shader files, each problem and note, where to look, and
+    /// (for a failure) the bless command.
     pub fn explain(&self, report_dir: &std::path::Path) -> String {
-        let mut s = format!("case {} ({}): {:?}\n", self.id, self.kernel, self.verdict);
-        if let Some(m) = &self.metrics {
-            s += &format!(
-                "  PSNR {} (threshold >= {:.1} dB, {} driver), SSIM {:.5}{}, max-abs {:.3e}, bad pixels {}, NaN/Inf {}\n",
-                metrics::format_psnr(m.psnr),
-                self.psnr_threshold,
-                if self.same_driver { "same" } else { "other" },
-                m.ssim,
-                self.min_ssim.map(|t| format!(" (threshold >= {t})")).unwrap_or_default(),
-                m.max_abs,
-                m.bad_pixels,
-                m.nan
-            );
+        let mut s = String::new();
+        match &self.metrics {
+            Some(m) => {
+                s += &format!(
+                    "  PSNR {} (>= {:.1} dB, {} driver) | SSIM {:.5}{} | FLIP {} | max-abs {:.3e} | bad pixels {} \
+                     ({:.3}%, > {BAD_PIXEL_LIMIT}) | NaN/Inf {}\n",
+                    metrics::format_psnr(m.psnr),
+                    self.psnr_threshold,
+                    if self.same_driver { "same" } else { "other" },
+                    m.ssim,
+                    self.min_ssim.map(|t| format!(" (>= {t})")).unwrap_or_default(),
+                    m.flip_mean.map(|f| format!("{f:.5}")).unwrap_or_else(|| "-".into()),
+                    m.max_abs,
+                    m.bad_pixels,
+                    self.bad_percent().unwrap_or(0.0),
+                    m.nan
+                );
+            }
+            None => s += &format!("  {:?}: no comparison\n", self.verdict),
+        }
+        if !self.changed_files.is_empty() {
+            s += &format!("  changed shader files: {}\n", self.changed_files.join(", "));
         }
         for p in &self.problems {
             s += &format!("  FAIL: {p}\n");
         }
-        for n in &self.notes {
+        for n in self.notes.iter().filter(|n| !n.starts_with("shader changed") || self.changed_files.is_empty()) {
             s += &format!("  note: {n}\n");
         }
-        for (what, f) in
-            [("expected", &self.files.expected), ("actual", &self.files.actual), ("diff", &self.files.diff)]
-        {
-            if let Some(f) = f {
-                s += &format!("  {what}: {}\n", report_dir.join(f).display());
-            }
-        }
         if !self.passed() {
-            s += &format!("  report: {}\n", report_dir.join("index.html").display());
+            s += &format!("  report: {}#case-{}\n", report_dir.join("index.html").display(), self.id);
             s += &format!("  if this change is intended, bless it: {}\n", self.bless_command);
         }
         s
@@ -114,11 +156,23 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         psnr_threshold: case.psnr_same_driver,
         same_driver: true,
         min_ssim: case.min_ssim,
+        max_flip: case.max_flip,
         problems: Vec::new(),
         notes: Vec::new(),
         files: ReportFiles::default(),
         gpu_ms: 0.0,
         bless_command: case.bless_command(),
+        width: case.width,
+        height: case.height,
+        golden: manifest.case.get(&case.id).cloned(),
+        run: RunInfo {
+            backend: ctx.backend().to_string(),
+            adapter: ctx.adapter_description(),
+            params_hash: params_hash(case),
+            shader_hash: ctx.shader_hash(case.kernel.shader()).unwrap_or_else(|e| format!("unavailable: {e}")),
+        },
+        changed_files: Vec::new(),
+        first_bad: None,
     };
     if let Err(e) = judge(ctx, store, manifest, case, opts, &mut out) {
         out.verdict = Verdict::Error;
@@ -160,6 +214,10 @@ fn judge(
     let r = render(ctx, case.kernel, &case.params, case.width, case.height)?;
     out.gpu_ms = r.stats.gpu_wall.as_secs_f64() * 1e3;
     let case_dir = opts.report_dir.join(&case.id);
+    let write8 = |name: &str, img: &Image| -> Result<String, GoldenError> {
+        vista_image::write_png8(&case_dir.join(name), img)?;
+        Ok(format!("{}/{name}", case.id))
+    };
     let write = |name: &str, img: &Image| -> Result<String, GoldenError> {
         std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
             path: case_dir.display().to_string(),
@@ -176,9 +234,11 @@ fn judge(
     };
     let actual = quantize16(&r.display);
     out.files.actual = Some(write("actual.png", &actual)?);
+    out.files.actual8 = Some(write8("actual8.png", &actual)?);
 
     // Invariants that need no golden: finite, within the documented range.
     if let Some((x, y)) = r.raw.first_nonfinite() {
+        out.first_bad = Some((x, y, format!("NaN/Inf {:?}", r.raw.get(x, y))));
         out.problems.push(format!(
             "{} pixels contain NaN/Inf; first at ({x}, {y}) = {:?}",
             r.raw.nonfinite_count(),
@@ -187,6 +247,7 @@ fn judge(
     }
     let (lo, hi) = case.kernel.output_bounds(&case.params);
     if let Some((x, y, v)) = first_out_of_bounds(&r.raw, lo, hi) {
+        out.first_bad.get_or_insert((x, y, format!("{v} outside [{lo}, {hi}]")));
         out.problems.push(format!("raw output {v} at ({x}, {y}) is outside the kernel's range [{lo}, {hi}]"));
     }
     if opts.twice {
@@ -207,10 +268,19 @@ fn judge(
                 out.notes.push(format!("golden blessed on '{}', running on '{adapter}'", e.adapter));
             }
             if e.shader_hash != shader_hash {
-                out.notes.push(format!(
-                    "shader changed since the last bless (manifest {}, now {shader_hash})",
-                    e.shader_hash
-                ));
+                if !e.shader_files.is_empty() {
+                    let now = ctx.shader_file_hashes(case.kernel.shader())?;
+                    out.changed_files = changed_files(&e.shader_files, &now);
+                }
+                out.notes.push(if e.shader_files.is_empty() {
+                    format!(
+                        "shader changed since the last bless (manifest {}, now {shader_hash}); the manifest \
+                         predates per-file hashes, so the files are not named",
+                        e.shader_hash
+                    )
+                } else {
+                    format!("shader changed since the last bless: {}", out.changed_files.join(", "))
+                });
             }
             if e.params_hash != params_hash(case) {
                 out.notes.push("case parameters changed since the last bless".into());
@@ -261,6 +331,7 @@ fn judge(
     }
     let expected = vista_image::decode_png16(&golden_path, &bytes)?;
     out.files.expected = Some(write("expected.png", &expected)?);
+    out.files.expected8 = Some(write8("expected8.png", &expected)?);
     if (expected.width, expected.height) != (actual.width, actual.height) {
         out.problems.push(format!(
             "golden {} is {}x{} but the case renders {}x{}; re-bless if the size change is intended",
@@ -274,7 +345,13 @@ fn judge(
     }
     let mut m = metrics::compare(&expected, &actual)?;
     m.nan = r.raw.nonfinite_count();
-    out.files.diff = Some(write("diff.png", &vista_image::diff_heatmap(&expected, &actual, None))?);
+    let heat = vista_image::diff_heatmap_log(&expected, &actual);
+    out.files.diff = Some(write("diff.png", &heat)?);
+    out.files.diff8 = Some(write8("diff8.png", &heat)?);
+    let view = crate::report::view_js(&case.id, &expected, &actual, out.first_bad.as_ref().map(|b| (b.0, b.1)));
+    let view_path = case_dir.join("view.js");
+    vista_image::atomic_write(&view_path, view.as_bytes())?;
+    out.files.view = Some(format!("{}/view.js", case.id));
     if m.psnr < out.psnr_threshold {
         out.problems.push(format!(
             "PSNR {} is below the threshold {:.1} dB",
@@ -287,8 +364,28 @@ fn judge(
     {
         out.problems.push(format!("SSIM {:.5} is below the threshold {t}", m.ssim));
     }
+    if let (Some(t), Some(f)) = (case.max_flip, m.flip_mean)
+        && f > t
+    {
+        out.problems.push(format!("FLIP mean {f:.5} is above the threshold {t}"));
+    }
     out.metrics = Some(m);
     Ok(())
+}
+
+/// Files whose hash differs between bless time and now, or that only one
+/// side has, by path.
+fn changed_files(
+    then: &std::collections::BTreeMap<String, String>,
+    now: &std::collections::BTreeMap<String, String>,
+) -> Vec<String> {
+    let mut changed: Vec<String> = now
+        .iter()
+        .filter(|(f, h)| then.get(*f) != Some(h))
+        .map(|(f, _)| if then.contains_key(f) { f.clone() } else { format!("{f} (new import)") })
+        .collect();
+    changed.extend(then.keys().filter(|f| !now.contains_key(*f)).map(|f| format!("{f} (no longer imported)")));
+    changed
 }
 
 /// The first finite raw RGB value outside the kernel's output bounds for

@@ -16,12 +16,12 @@ pub mod store;
 pub use agreement::{Agreement, agreement};
 pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, load_cases, parse_cases, select};
-pub use check::{CheckOptions, Outcome, Verdict, check_case, first_out_of_range};
+pub use check::{BAD_PIXEL_LIMIT, CheckOptions, Outcome, RunInfo, Verdict, check_case, first_out_of_range};
 pub use render::{
     Prepared, Rendered, Renderer, check_request, median, median_wall, prepare, quantize16, render, render_median,
     shader_set,
 };
-pub use report::{bless_all_command, clear_case_folders, html_escape, write_report};
+pub use report::{RunSummary, bless_all_command, clear_case_folders, html_escape, view_js, write_report};
 pub use store::{Manifest, ManifestEntry, Store};
 
 use vista_gpu::GpuError;

@@ -68,6 +68,11 @@ impl<'a> Renderer<'a> {
     pub fn shader_hash(&self, shader: &str) -> Result<String, GoldenError> {
         Ok(self.shaders.source_hash(shader)?)
     }
+
+    /// Hash of each file of the kernel's import closure, by path.
+    pub fn shader_file_hashes(&self, shader: &str) -> Result<std::collections::BTreeMap<String, String>, GoldenError> {
+        Ok(self.shaders.file_hashes(shader)?.into_iter().collect())
+    }
 }
 
 /// The project's WGSL as one [`ShaderSet`].

@@ -1,23 +1,29 @@
-//! `target/vista-report/index.html`: one row per case with expected, actual
-//! and diff thumbnails, metrics and thresholds, failures first.
-//! Self-contained: images live beside it and are linked relatively.
+//! `target/vista-report/index.html`, a review page: the summary first
+//! (failures worst-first, counts, backend and adapter, the command that was
+//! run, one bless command for every failure), then one section per case:
+//! metrics against thresholds, provenance (the golden's manifest entry beside
+//! this run, the WGSL files that changed), and a viewer (flip, slider, synced
+//! zoom, a readout of both 16-bit values under the cursor, a heat map with a
+//! stated scale). Works offline from a copied folder: every file is linked
+//! by a relative path, and the viewer's pixel data comes in each case's
+//! `view.js` (a script, because pages opened from `file://` may not read
+//! image pixels or fetch files).
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use base64::Engine;
+use vista_image::Image;
 use vista_image::metrics::format_psnr;
 
-use crate::check::{Outcome, Verdict};
+use crate::check::{BAD_PIXEL_LIMIT, Outcome, Verdict};
+
+const STYLE: &str = include_str!("report.css");
+const SCRIPT: &str = include_str!("report.js");
 
 /// Text escaped for HTML element content and attribute values.
 pub fn html_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
-fn img(path: &Option<String>) -> String {
-    match path {
-        Some(p) => format!("<a href=\"{0}\"><img src=\"{0}\" width=\"128\"></a>", html_escape(p)),
-        None => "<span class=\"none\">none</span>".into(),
-    }
 }
 
 /// The empty file that marks a case folder as written by vista.
@@ -48,67 +54,298 @@ pub fn bless_all_command(failed: &[&str]) -> Option<String> {
     }
 }
 
-/// Writes the report (atomically) and returns the index path.
-pub fn write_report(dir: &Path, adapter: &str, outcomes: &[Outcome]) -> Result<PathBuf, crate::GoldenError> {
-    let mut sorted: Vec<&Outcome> = outcomes.iter().collect();
-    sorted.sort_by_key(|o| (o.passed(), o.id.clone()));
-    let failed = sorted.iter().filter(|o| !o.passed()).count();
-    let mut rows = String::new();
-    for o in &sorted {
-        let class = match o.verdict {
-            Verdict::Pass => "pass",
-            _ => "fail",
-        };
-        let (psnr, ssim, max_abs, bad, nan) = match &o.metrics {
-            Some(m) => (
-                format_psnr(m.psnr),
-                format!("{:.5}", m.ssim),
-                format!("{:.2e}", m.max_abs),
-                m.bad_pixels.to_string(),
-                m.nan.to_string(),
-            ),
-            None => ("-".into(), "-".into(), "-".into(), "-".into(), "-".into()),
-        };
-        let threshold = format!(
-            "PSNR &ge; {:.1} dB ({} driver){}",
-            o.psnr_threshold,
-            if o.same_driver { "same" } else { "other" },
-            o.min_ssim.map(|t| format!("<br>SSIM &ge; {t}")).unwrap_or_default()
-        );
-        let msgs: String = o
-            .problems
+/// What a report says about the run that made it.
+#[derive(Debug, Clone, Default)]
+pub struct RunSummary {
+    /// The command line, as a user would type it again.
+    pub command: String,
+    pub backend: String,
+    pub adapter: String,
+}
+
+/// The viewer's data for one case: both images' 16-bit display values
+/// (RGB, little-endian u16, base64) and the first bad pixel.
+pub fn view_js(id: &str, expected: &Image, actual: &Image, first_bad: Option<(u32, u32)>) -> String {
+    let u16s = |img: &Image| {
+        let bytes: Vec<u8> = img
+            .data
             .iter()
-            .map(|p| format!("<div class=\"problem\">{}</div>", html_escape(p)))
-            .chain(o.notes.iter().map(|n| format!("<div class=\"note\">{}</div>", html_escape(n))))
+            .flat_map(|p| {
+                p[..3].iter().map(|v| if v.is_nan() { 0u16 } else { (v.clamp(0.0, 1.0) * 65535.0).round() as u16 })
+            })
+            .flat_map(u16::to_le_bytes)
             .collect();
-        rows += &format!(
-            "<tr class=\"{class}\"><td><b>{id}</b><br>{kernel}<br>{verdict:?}<br>{gpu:.1} ms</td><td>{e}</td><td>{a}</td><td>{d}</td>\
-             <td>{psnr}</td><td>{ssim}</td><td>{max_abs}</td><td>{bad}</td><td>{nan}</td><td>{threshold}</td><td>{msgs}</td></tr>\n",
-            id = html_escape(&o.id),
-            kernel = html_escape(&o.kernel),
-            verdict = o.verdict,
-            gpu = o.gpu_ms,
-            e = img(&o.files.expected),
-            a = img(&o.files.actual),
-            d = img(&o.files.diff),
+        base64::engine::general_purpose::STANDARD.encode(bytes)
+    };
+    let data = serde_json::json!({
+        "id": id,
+        "w": expected.width,
+        "h": expected.height,
+        "expected": u16s(expected),
+        "actual": u16s(actual),
+        "first_bad": first_bad.map(|(x, y)| [x, y]),
+    });
+    format!("vistaCase({data});\n")
+}
+
+fn verdict_word(o: &Outcome) -> &'static str {
+    match o.verdict {
+        Verdict::Pass => "pass",
+        Verdict::ExpectedFail => "expected failure",
+        Verdict::Fail => "FAIL",
+        Verdict::Missing => "MISSING",
+        Verdict::Error => "ERROR",
+    }
+}
+
+/// Worst first: errors and missing goldens, then failures by PSNR.
+fn severity(o: &Outcome) -> (u8, i64) {
+    let rank = match o.verdict {
+        Verdict::Error => 0,
+        Verdict::Missing => 1,
+        Verdict::Fail => 2,
+        Verdict::ExpectedFail => 3,
+        Verdict::Pass => 4,
+    };
+    let psnr =
+        o.metrics.map(|m| if m.psnr.is_finite() { (m.psnr * 1000.0) as i64 } else { i64::MAX }).unwrap_or(i64::MIN);
+    (rank, psnr)
+}
+
+fn anchor(id: &str) -> String {
+    format!("case-{}", html_escape(id))
+}
+
+fn thumb(path: &Option<String>, full: &Option<String>, alt: &str) -> String {
+    match (path, full) {
+        (Some(p), Some(f)) => format!(
+            "<a href=\"{f}\" title=\"16-bit file\"><img class=\"thumb\" src=\"{p}\" alt=\"{alt}\" loading=\"lazy\"></a>",
+            f = html_escape(f),
+            p = html_escape(p)
+        ),
+        _ => format!("<span class=\"none\">no {alt}</span>"),
+    }
+}
+
+/// The golden's manifest entry beside this run, mismatches marked.
+fn provenance(o: &Outcome) -> String {
+    let mut t = String::from("<table class=\"prov\"><tr><th></th><th>golden (manifest)</th><th>this run</th></tr>");
+    let golden = o.golden.as_ref();
+    fn split(a: &str, i: usize) -> String {
+        a.split(" | ").nth(i).unwrap_or("").to_string()
+    }
+    let g = |f: fn(&crate::ManifestEntry) -> String| golden.map(f).unwrap_or_else(|| "no manifest entry".into());
+    let rows: [(&str, String, String); 7] = [
+        (
+            "backend",
+            g(|e| if e.backend.is_empty() { "not recorded".into() } else { e.backend.clone() }),
+            o.run.backend.clone(),
+        ),
+        ("adapter", g(|e| split(&e.adapter, 0)), split(&o.run.adapter, 0)),
+        ("driver", g(|e| split(&e.adapter, 1)), split(&o.run.adapter, 1)),
+        (
+            "API | device",
+            g(|e| format!("{} | {}", split(&e.adapter, 2), split(&e.adapter, 3))),
+            format!("{} | {}", split(&o.run.adapter, 2), split(&o.run.adapter, 3)),
+        ),
+        ("date", g(|e| e.date.clone()), crate::now_utc()),
+        ("params hash", g(|e| e.params_hash.clone()), o.run.params_hash.clone()),
+        ("shader hash", g(|e| e.shader_hash.clone()), o.run.shader_hash.clone()),
+    ];
+    for (name, then, now) in rows {
+        let differs = name != "date" && golden.is_some() && then != now && then != "not recorded";
+        let _ = write!(
+            t,
+            "<tr class=\"{}\"><th>{name}</th><td>{}</td><td>{}</td></tr>",
+            if differs { "differs" } else { "" },
+            html_escape(&then),
+            html_escape(&now)
         );
     }
+    t += "</table>";
+    if !o.changed_files.is_empty() {
+        let _ = write!(
+            t,
+            "<p class=\"problem\">WGSL changed since the bless: {}</p>",
+            o.changed_files.iter().map(|f| format!("<code>{}</code>", html_escape(f))).collect::<Vec<_>>().join(", ")
+        );
+    }
+    t
+}
+
+fn metric_cells(o: &Outcome) -> (String, String) {
+    match &o.metrics {
+        Some(m) => {
+            let psnr_bad = m.psnr < o.psnr_threshold;
+            let ssim_bad = o.min_ssim.is_some_and(|t| m.ssim < t);
+            let flip_bad = m.flip_mean.zip(o.max_flip).is_some_and(|(f, t)| f > t);
+            let cls = |bad: bool| if bad { " class=\"bad\"" } else { "" };
+            let table = format!(
+                "<table class=\"metrics\"><tr><th>PSNR</th><td{}>{}</td><td>&ge; {:.1} dB ({} driver)</td></tr>\
+                 <tr><th>SSIM</th><td{}>{:.5}</td><td>{}</td></tr>\
+                 <tr><th>FLIP mean</th><td{}>{}</td><td>{}</td></tr>\
+                 <tr><th>max abs</th><td>{:.3e}</td><td></td></tr>\
+                 <tr><th>bad pixels</th><td>{} ({:.3}%)</td><td>a channel differs by &gt; {BAD_PIXEL_LIMIT}</td></tr>\
+                 <tr><th>NaN/Inf</th><td{}>{}</td><td>none allowed</td></tr></table>",
+                cls(psnr_bad),
+                format_psnr(m.psnr),
+                o.psnr_threshold,
+                if o.same_driver { "same" } else { "other" },
+                cls(ssim_bad),
+                m.ssim,
+                o.min_ssim.map(|t| format!("&ge; {t}")).unwrap_or_else(|| "no threshold".into()),
+                cls(flip_bad),
+                m.flip_mean.map(|f| format!("{f:.5}")).unwrap_or_else(|| "-".into()),
+                o.max_flip.map(|t| format!("&le; {t}")).unwrap_or_else(|| "no threshold".into()),
+                m.max_abs,
+                m.bad_pixels,
+                o.bad_percent().unwrap_or(0.0),
+                cls(m.nan > 0),
+                m.nan,
+            );
+            (format_psnr(m.psnr), table)
+        }
+        None => ("-".into(), "<p>no comparison</p>".into()),
+    }
+}
+
+fn case_section(o: &Outcome) -> String {
+    let (psnr, metrics) = metric_cells(o);
+    let failing = !o.passed();
+    let msgs: String = o
+        .problems
+        .iter()
+        .map(|p| format!("<div class=\"problem\">{}</div>", html_escape(p)))
+        .chain(o.notes.iter().map(|n| format!("<div class=\"note\">{}</div>", html_escape(n))))
+        .collect();
+    let first_bad = o
+        .first_bad
+        .as_ref()
+        .map(|(x, y, what)| {
+            format!(
+                "<p class=\"problem\">first bad pixel, marked in the viewer: ({x}, {y}) = {}</p>",
+                html_escape(what)
+            )
+        })
+        .unwrap_or_default();
+    let viewer = match &o.files.view {
+        Some(v) => format!(
+            "<div class=\"viewer\" data-case=\"{}\" data-src=\"{}\"><p class=\"loading\">viewer loads when opened</p></div>",
+            html_escape(&o.id),
+            html_escape(v)
+        ),
+        None => String::new(),
+    };
+    format!(
+        "<details class=\"case {cls}\" id=\"{anchor}\" data-failing=\"{failing}\"{open}>\
+         <summary><span class=\"verdict\">{verdict}</span> <b>{id}</b> <span class=\"kernel\">{kernel}</span> \
+         <span class=\"psnr\">PSNR {psnr}</span> <span class=\"ms\">{gpu:.1} ms</span> \
+         <span class=\"thumbs\">{e}{a}{d}</span></summary>\
+         <div class=\"body\"><div class=\"cols\"><div>{metrics}{first_bad}{msgs}\
+         <p>bless this case: <code class=\"cmd\">{bless}</code></p></div><div>{prov}</div></div>{viewer}</div></details>\n",
+        cls = if failing { "fail" } else { "pass" },
+        anchor = anchor(&o.id),
+        open = if failing { " open" } else { "" },
+        verdict = verdict_word(o),
+        id = html_escape(&o.id),
+        kernel = html_escape(&o.kernel),
+        gpu = o.gpu_ms,
+        e = thumb(&o.files.expected8, &o.files.expected, "expected"),
+        a = thumb(&o.files.actual8, &o.files.actual, "actual"),
+        d = thumb(&o.files.diff8, &o.files.diff, "heat map"),
+        bless = html_escape(&o.bless_command),
+        prov = provenance(o),
+    )
+}
+
+/// Writes the report (atomically) and returns the index path.
+pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result<PathBuf, crate::GoldenError> {
+    let mut sorted: Vec<&Outcome> = outcomes.iter().collect();
+    sorted.sort_by_key(|o| (severity(o), o.id.clone()));
+    let failing: Vec<&Outcome> = sorted.iter().copied().filter(|o| !o.passed()).collect();
+    let xfail = sorted.iter().filter(|o| o.verdict == Verdict::ExpectedFail).count();
+    let passed = sorted.len() - failing.len() - xfail;
+    let mut summary = String::new();
+    if failing.is_empty() {
+        summary += "<p class=\"allpass\">Every case passed.</p>";
+    } else {
+        summary += "<table class=\"failures\"><tr><th>case</th><th>verdict</th><th>PSNR</th><th>threshold</th>\
+                    <th>bad pixels</th><th>FLIP</th><th>changed WGSL</th><th>first problem</th></tr>";
+        for o in &failing {
+            let _ = write!(
+                summary,
+                "<tr><td><a href=\"#{}\">{}</a></td><td>{}</td><td>{}</td><td>&ge; {:.1} dB</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                anchor(&o.id),
+                html_escape(&o.id),
+                verdict_word(o),
+                o.metrics.map(|m| format_psnr(m.psnr)).unwrap_or_else(|| "-".into()),
+                o.psnr_threshold,
+                o.metrics
+                    .map(|m| format!("{} ({:.3}%)", m.bad_pixels, o.bad_percent().unwrap_or(0.0)))
+                    .unwrap_or_else(|| "-".into()),
+                o.metrics.and_then(|m| m.flip_mean).map(|f| format!("{f:.5}")).unwrap_or_else(|| "-".into()),
+                html_escape(&o.changed_files.join(", ")),
+                html_escape(o.problems.first().map(String::as_str).unwrap_or("")),
+            );
+        }
+        summary += "</table>";
+        let ids: Vec<&str> = failing.iter().map(|o| o.id.as_str()).collect();
+        if let Some(cmd) = bless_all_command(&ids) {
+            let _ = write!(
+                summary,
+                "<p>If every change is intended, bless all {} after review: <code class=\"cmd\">{}</code></p>",
+                ids.len(),
+                html_escape(&cmd)
+            );
+        }
+    }
+    let expectations: String = sorted
+        .iter()
+        .filter(|o| o.verdict == Verdict::ExpectedFail)
+        .map(|o| {
+            format!(
+                "<li><a href=\"#{}\">{}</a>: {}</li>",
+                anchor(&o.id),
+                html_escape(&o.id),
+                html_escape(&o.notes.join("; "))
+            )
+        })
+        .collect();
+    let expectations = if expectations.is_empty() {
+        String::new()
+    } else {
+        format!("<p>Expected failures (golden/cases.toml):</p><ul>{expectations}</ul>")
+    };
     // The other pages of the same folder, when a run wrote them.
     let others: String = [("matrix.html", "case x backend matrix"), ("mutants.html", "mutation score")]
         .iter()
         .filter(|(f, _)| dir.join(f).exists())
         .map(|(f, what)| format!(" <a href=\"{f}\">{what}</a>"))
         .collect();
+    let stops = serde_json::to_string(&vista_image::HEATMAP_STOPS).expect("stops serialise");
+    let sections: String = sorted.iter().map(|o| case_section(o)).collect();
     let html = format!(
-        "<!doctype html><meta charset=\"utf-8\"><title>vista report</title>\n<style>\
-         body{{font-family:sans-serif;margin:1em}} table{{border-collapse:collapse}} td,th{{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:13px}}\
-         tr.fail{{background:#fee}} .problem{{color:#b00}} .note{{color:#555}} img{{image-rendering:pixelated}}</style>\n\
-         <h1>vista report</h1><p>{n} cases, {failed} failing. Adapter: {adapter}. Written {date}.{others}</p>\n\
-         <table><tr><th>case</th><th>expected</th><th>actual</th><th>diff</th><th>PSNR</th><th>SSIM</th><th>max abs</th>\
-         <th>bad px</th><th>NaN/Inf</th><th>threshold</th><th>details</th></tr>\n{rows}</table>\n",
+        "<!doctype html><html lang=\"en\"><meta charset=\"utf-8\"><title>vista report: {nfail} failing of {n}</title>\n\
+         <style>{STYLE}</style>\n\
+         <header><h1>vista report</h1>\
+         <p class=\"counts\"><b>{n}</b> cases: <b class=\"{fcls}\">{nfail} failing</b>, {passed} passed, {xfail} expected failures.</p>\
+         <p>Backend <b>{backend}</b>, adapter <code>{adapter}</code>. Command: <code class=\"cmd\">{command}</code>. Written {date}.{others}</p>\
+         </header>\n<section id=\"summary\"><h2>Failures, worst first</h2>{summary}{expectations}</section>\n\
+         <section id=\"controls\"><label><input type=\"checkbox\" id=\"failures-only\"{checked}> failures only</label> \
+         <label>heat map scale <select id=\"heat-scale\"><option value=\"log\">log, fixed: 1/65535 .. 1 (same in every case)</option>\
+         <option value=\"max\">linear, 0 .. this case's max</option><option value=\"fixed\">linear, 0 .. the value on the right</option></select></label> \
+         <input id=\"heat-max\" type=\"number\" value=\"0.0039216\" step=\"any\" min=\"0\" title=\"difference drawn white (linear, fixed)\"> \
+         <span class=\"help\">In a viewer: <kbd>f</kbd> flips expected/actual, the wheel or +/- zooms (all views together), drag pans.</span></section>\n\
+         <section id=\"cases\"><h2>Cases</h2>\n{sections}</section>\n\
+         <script>const HEAT_STOPS = {stops};\n{SCRIPT}</script>\n</html>\n",
         n = sorted.len(),
-        adapter = html_escape(adapter),
+        nfail = failing.len(),
+        fcls = if failing.is_empty() { "ok" } else { "bad" },
+        backend = html_escape(&run.backend),
+        adapter = html_escape(&run.adapter),
+        command = html_escape(&run.command),
         date = crate::now_utc(),
+        checked = if failing.is_empty() { "" } else { " checked" },
     );
     std::fs::create_dir_all(dir)
         .map_err(|e| crate::GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;

@@ -18,8 +18,15 @@ pub struct ManifestEntry {
     /// Hash of the kernel's WGSL file and the lib modules it reaches
     /// through `#import` (see `ShaderSet::source_hash`).
     pub shader_hash: String,
+    /// Hash of each WGSL file the kernel reaches (path relative to
+    /// `shaders/`), so that a check names the files that changed.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub shader_files: BTreeMap<String, String>,
     /// Adapter name | driver | backend | device type.
     pub adapter: String,
+    /// lavapipe | swiftshader | browser | gpu ("" in entries that predate it).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub backend: String,
     pub date: String,
     /// Hash of the raw f32 output bits: a later render on the same adapter
     /// and shader must reproduce it exactly (determinism across processes).

@@ -135,6 +135,16 @@ impl ShaderSet {
         Ok(h.finalize().to_hex()[..16].to_string())
     }
 
+    /// Each file of [`ShaderSet::import_closure`] with the hash of its text:
+    /// recorded at bless time so that a check can name the files that changed.
+    pub fn file_hashes(&self, name: &str) -> Result<Vec<(String, String)>, GpuError> {
+        let (source, _) = self.kernel_source(name)?;
+        let hash = |text: &str| blake3::hash(text.as_bytes()).to_hex()[..16].to_string();
+        Ok(std::iter::once((name.to_string(), hash(source)))
+            .chain(self.imported_lib(source).into_iter().map(|(path, text)| (path.clone(), hash(text))))
+            .collect())
+    }
+
     /// The kernel file and the lib modules it reaches through `#import`
     /// (paths relative to `shaders/`): every file whose edit can change it.
     pub fn import_closure(&self, name: &str) -> Result<Vec<String>, GpuError> {

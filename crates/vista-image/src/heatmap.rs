@@ -11,8 +11,9 @@ const INVALID: [f32; 4] = [0.0, 1.0, 0.0, 1.0];
 const MIN_SCALE: f32 = 1.0 / 255.0;
 
 /// Colormap stops: black → blue → magenta → yellow → white (monotonic in
-/// brightness, readable without a legend).
-const STOPS: [[f32; 3]; 5] = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1.0, 0.0], [1.0, 1.0, 1.0]];
+/// brightness). The report's viewer draws its heat maps and legend with the
+/// same stops.
+pub const STOPS: [[f32; 3]; 5] = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1.0, 0.0], [1.0, 1.0, 1.0]];
 
 /// Visualises where and how much `actual` differs from `reference`.
 ///
@@ -33,6 +34,30 @@ pub fn diff_heatmap(reference: &Image, actual: &Image, scale: Option<f32>) -> Im
         .iter()
         .map(|d| match d {
             Some(d) => colormap(d / scale),
+            None => INVALID,
+        })
+        .collect();
+    Image { width: reference.width, height: reference.height, data }
+}
+
+/// The difference that maps to black on the log scale: half a 16-bit step,
+/// so one step (1/65535) is already visible.
+pub const LOG_FLOOR: f32 = 0.5 / 65535.0;
+
+/// Position of a difference on the fixed log scale shared by every case:
+/// 0 for no difference, then log10(d / LOG_FLOOR) / log10(1 / LOG_FLOOR),
+/// so one 16-bit step is 0.06, 1/255 is 0.53 and 1 is 1.
+pub fn log_position(d: f32) -> f32 {
+    if d <= 0.0 { 0.0 } else { ((d / LOG_FLOOR).log10() / (1.0 / LOG_FLOOR).log10()).clamp(0.0, 1.0) }
+}
+
+/// [`diff_heatmap`] on the fixed log scale of [`log_position`]: the same
+/// colour means the same difference in every case of a report.
+pub fn diff_heatmap_log(reference: &Image, actual: &Image) -> Image {
+    let data = pixel_diffs(reference, actual)
+        .iter()
+        .map(|d| match d {
+            Some(d) => colormap(log_position(*d)),
             None => INVALID,
         })
         .collect();
@@ -95,6 +120,19 @@ mod tests {
         assert_eq!(colormap(0.75), [1.0, 1.0, 0.0, 1.0]);
         assert_eq!(colormap(1.0), [1.0, 1.0, 1.0, 1.0]);
         assert_eq!(colormap(7.0), [1.0, 1.0, 1.0, 1.0]);
+    }
+
+    #[test]
+    fn log_scale_positions() {
+        assert_eq!(log_position(0.0), 0.0);
+        assert!((log_position(1.0 / 65535.0) - 0.0588).abs() < 1e-3, "{}", log_position(1.0 / 65535.0));
+        assert!((log_position(1.0 / 255.0) - 0.5298).abs() < 1e-3, "{}", log_position(1.0 / 255.0));
+        assert_eq!(log_position(1.0), 1.0);
+        let a = Image::from_fn(2, 1, |_, _| [0.5, 0.5, 0.5, 1.0]);
+        let b = Image::from_fn(2, 1, |x, _| [0.5 + x as f32 / 255.0, 0.5, 0.5, 1.0]);
+        let h = diff_heatmap_log(&a, &b);
+        assert_eq!(h.get(0, 0), [0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(h.get(1, 0), colormap(log_position(1.0 / 255.0)));
     }
 
     #[test]

@@ -26,6 +26,22 @@ pub fn encode_png16(path: &Path, img: &Image) -> Result<Vec<u8>, ImageError> {
     Ok(bytes.into_inner())
 }
 
+/// Writes `img` as an 8-bit RGBA PNG (clamped to `[0, 1]`, NaN as 0): the
+/// light display copy reports load, beside the 16-bit file.
+pub fn write_png8(path: &Path, img: &Image) -> Result<(), ImageError> {
+    let samples: Vec<u8> = img
+        .data
+        .iter()
+        .flatten()
+        .map(|&v| if v.is_nan() { 0 } else { (v.clamp(0.0, 1.0) * 255.0).round() as u8 })
+        .collect();
+    let buf = ImageBuffer::<Rgba<u8>, Vec<u8>>::from_raw(img.width, img.height, samples)
+        .ok_or_else(|| encode_error(path, "PNG", "pixel buffer does not match image size"))?;
+    let mut bytes = Cursor::new(Vec::new());
+    DynamicImage::ImageRgba8(buf).write_to(&mut bytes, ImageFormat::Png).map_err(|e| encode_error(path, "PNG", e))?;
+    atomic_write(path, &bytes.into_inner())
+}
+
 /// Reads any PNG (1-16 bit, grey/grey+alpha/RGB/RGBA/palette) as f32 RGBA in
 /// `[0, 1]`; missing alpha becomes 1 and grey is replicated to RGB.
 pub fn read_png16(path: &Path) -> Result<Image, ImageError> {

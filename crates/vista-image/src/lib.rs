@@ -33,9 +33,9 @@ mod tonemap;
 
 pub use buffer::Image;
 pub use error::ImageError;
-pub use heatmap::diff_heatmap;
+pub use heatmap::{LOG_FLOOR, STOPS as HEATMAP_STOPS, diff_heatmap, diff_heatmap_log, log_position};
 pub use io::{
     atomic_write, decode_png16, encode_png16, load, read_exr, read_png16, remove_stale_temps, save, write_exr,
-    write_png16,
+    write_png8, write_png16,
 };
 pub use tonemap::{srgb_encode, tonemap};

@@ -45,12 +45,44 @@ pub struct Metrics {
     pub nan: u64,
     #[serde(with = "float_repr")]
     pub mse: f64,
+    /// Mean LDR-FLIP error in [0, 1] (NVIDIA's FLIP at
+    /// [`FLIP_PIXELS_PER_DEGREE`] on the display values as 8-bit sRGB);
+    /// `None` for HDR comparisons.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flip_mean: Option<f64>,
+}
+
+/// FLIP's viewing condition: a 0.7 m distance from a 24" 4K monitor.
+pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
+
+/// Mean LDR-FLIP error of `actual` against `reference` (display values in
+/// [0, 1], sRGB-encoded, alpha ignored; NaN counts as 0): 0 for identical
+/// images, 1 at most.
+///
+/// # Panics
+/// If the images differ in size.
+pub fn flip_mean(reference: &Image, actual: &Image) -> f64 {
+    assert_same_size(reference, actual);
+    let rgb8 = |img: &Image| -> Vec<u8> {
+        img.data
+            .iter()
+            .flat_map(|p| p[..3].iter().map(|v| if v.is_nan() { 0 } else { (v.clamp(0.0, 1.0) * 255.0).round() as u8 }))
+            .collect()
+    };
+    let (w, h) = reference.dimensions();
+    if w == 0 || h == 0 {
+        return 0.0;
+    }
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, &rgb8(reference));
+    let a = nv_flip::FlipImageRgb8::with_data(w, h, &rgb8(actual));
+    let errors = nv_flip::flip(r, a, FLIP_PIXELS_PER_DEGREE);
+    f64::from(nv_flip::FlipPool::from_image(&errors).mean())
 }
 
 /// All metrics with a PSNR peak of 1 (LDR data in `[0, 1]`).
 pub fn compare(reference: &Image, actual: &Image) -> Result<Metrics, ImageError> {
     check_same_size(reference, actual)?;
-    Ok(all_metrics(reference, actual, 1.0))
+    Ok(Metrics { flip_mean: Some(flip_mean(reference, actual)), ..all_metrics(reference, actual, 1.0) })
 }
 
 /// All metrics for HDR data: PSNR uses peak = [`hdr_peak`] of the reference.
@@ -151,6 +183,7 @@ fn all_metrics(reference: &Image, actual: &Image, peak: f64) -> Metrics {
         bad_pixels: bad_pixels(reference, actual),
         nan: actual.nonfinite_count(),
         mse,
+        flip_mean: None,
     }
 }
 

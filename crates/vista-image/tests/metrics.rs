@@ -178,7 +178,7 @@ fn format_psnr_rounds_to_two_decimals() {
 
 #[test]
 fn metrics_json_round_trip_keeps_infinity() {
-    let m = Metrics { psnr: f64::INFINITY, ssim: 1.0, max_abs: 0.0, bad_pixels: 0, nan: 0, mse: 0.0 };
+    let m = Metrics { psnr: f64::INFINITY, ssim: 1.0, max_abs: 0.0, bad_pixels: 0, nan: 0, mse: 0.0, flip_mean: None };
     let json = serde_json::to_string(&m).unwrap();
     assert!(json.contains(r#""psnr":"inf""#), "{json}");
     let back: Metrics = serde_json::from_str(&json).unwrap();

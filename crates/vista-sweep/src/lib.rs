@@ -238,23 +238,25 @@ impl Sweep {
         }
     }
 
-    /// `value[,value2],psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel`.
+    /// `value[,value2],psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel,flip_mean`
+    /// (flip_mean empty for linear-value sweeps).
     pub fn csv(&self) -> String {
         let mut s = String::new();
         let y_col = self.spec.y.as_ref().map(|a| format!(",{}", a.name)).unwrap_or_default();
-        let _ = writeln!(s, "{}{y_col},psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel", self.spec.x.name);
+        let _ = writeln!(s, "{}{y_col},psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel,flip_mean", self.spec.x.name);
         for p in &self.points {
             let y = p.y.as_ref().map(|v| format!(",{v}")).unwrap_or_default();
             let _ = writeln!(
                 s,
-                "{}{y},{},{:.6},{:.6e},{},{:.3},{}",
+                "{}{y},{},{:.6},{:.6e},{},{:.3},{},{}",
                 p.x,
                 fmt_psnr(p.metrics.psnr),
                 p.metrics.ssim,
                 p.metrics.max_abs,
                 p.metrics.bad_pixels,
                 p.gpu_ms,
-                p.work
+                p.work,
+                p.metrics.flip_mean.map(|f| format!("{f:.6}")).unwrap_or_default()
             );
         }
         s
@@ -278,15 +280,20 @@ impl Sweep {
             if sp.reference.is_empty() { "same settings".to_string() } else { pairs(&sp.reference) },
             self.reference_ms
         );
-        let _ = writeln!(s, "{:<32} {:>9} {:>8} {:>11} {:>10}", "setting", "PSNR dB", "SSIM", "max abs", "gpu ms");
+        let _ = writeln!(
+            s,
+            "{:<32} {:>9} {:>8} {:>9} {:>11} {:>10}",
+            "setting", "PSNR dB", "SSIM", "FLIP", "max abs", "gpu ms"
+        );
         for p in &self.points {
             let mark = if p.metrics.psnr >= self.spec.target_psnr { "" } else { "  (below target)" };
             let _ = writeln!(
                 s,
-                "{:<32} {:>9} {:>8.4} {:>11.3e} {:>10.2}{mark}",
+                "{:<32} {:>9} {:>8.4} {:>9} {:>11.3e} {:>10.2}{mark}",
                 self.setting(p),
                 fmt_psnr(p.metrics.psnr),
                 p.metrics.ssim,
+                p.metrics.flip_mean.map(|f| format!("{f:.5}")).unwrap_or_else(|| "-".into()),
                 p.metrics.max_abs,
                 p.gpu_ms
             );

@@ -4,7 +4,7 @@ use vista_image::metrics::Metrics;
 use vista_sweep::{Axis, Metric, Point, Sweep, SweepSpec};
 
 fn point(x: &str, y: Option<&str>, psnr: f64, gpu_ms: f64, work: f64) -> Point {
-    let metrics = Metrics { psnr, ssim: 0.99, max_abs: 0.01, bad_pixels: 3, nan: 0, mse: 1e-4 };
+    let metrics = Metrics { psnr, ssim: 0.99, max_abs: 0.01, bad_pixels: 3, nan: 0, mse: 1e-4, flip_mean: Some(0.002) };
     Point { x: x.into(), y: y.map(Into::into), metrics, gpu_ms, work }
 }
 
@@ -61,7 +61,7 @@ fn csv_has_one_row_per_point_and_writes_inf() {
     );
     let csv = s.csv();
     let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(lines[0], "steps,light_steps,psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel");
+    assert_eq!(lines[0], "steps,light_steps,psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel,flip_mean");
     assert_eq!(lines[1], "16,2,30.50,0.990000,1.000000e-2,3,1.250,48");
     assert!(lines[2].starts_with("512,2,inf,"), "{}", lines[2]);
     assert_eq!(lines.len(), 3);
