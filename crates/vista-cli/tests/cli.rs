@@ -411,6 +411,29 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
     }
 }
 
+/// `max_flip` in golden/cases.toml fails a case whose mean FLIP is above it,
+/// even when PSNR passes; an out-of-range value is bad input.
+fn max_flip_fails_a_case_above_it() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let changed = |extra: &str| {
+        CASES.replace("set = { basis = \"value\" }", &format!("set = {{ basis = \"value\", seed = 9 }}\n{extra}"))
+    };
+    std::fs::write(cases_path(d.path()), changed("psnr_same_driver = 0.0\nmax_flip = 0.001")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(
+        r.stdout.contains("is above the threshold 0.001") && !r.stdout.contains("below the threshold"),
+        "{}",
+        r.stdout
+    );
+    std::fs::write(cases_path(d.path()), changed("psnr_same_driver = 0.0\nmax_flip = 1.0")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert_eq!(r.code, 0, "{}", r.stdout);
+    std::fs::write(cases_path(d.path()), changed("max_flip = 2.0")).unwrap();
+    assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["max_flip=2", "[0, 1]"]);
+}
+
 fn corrupt_and_wrong_size_goldens_fail_clearly() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -1363,6 +1386,7 @@ fn main() {
         ),
         (Gpu, "a_project_kernel_renders_the_same_in_the_browser", a_project_kernel_renders_the_same_in_the_browser),
         (Gpu, "the_report_works_in_a_real_browser", the_report_works_in_a_real_browser),
+        (Gpu, "max_flip_fails_a_case_above_it", max_flip_fails_a_case_above_it),
         (Gpu, "compare_reports_json_fields_and_rejects_bad_files", compare_reports_json_fields_and_rejects_bad_files),
         (Gpu, "render_exr_holds_the_raw_fbm_field", render_exr_holds_the_raw_fbm_field),
         (Gpu, "render_exr_holds_heightfield_depth_over_t_max", render_exr_holds_heightfield_depth_over_t_max),

@@ -62,7 +62,7 @@ fn csv_has_one_row_per_point_and_writes_inf() {
     let csv = s.csv();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "steps,light_steps,psnr,ssim,max_abs,bad_pixels,gpu_ms,work_per_pixel,flip_mean");
-    assert_eq!(lines[1], "16,2,30.50,0.990000,1.000000e-2,3,1.250,48");
+    assert_eq!(lines[1], "16,2,30.50,0.990000,1.000000e-2,3,1.250,48,0.002000");
     assert!(lines[2].starts_with("512,2,inf,"), "{}", lines[2]);
     assert_eq!(lines.len(), 3);
 }
