@@ -1,7 +1,7 @@
 //! Runs one WGSL compute kernel in headless Chromium's WebGPU: Tint
 //! compiles it and Dawn runs it on Chromium's SwiftShader adapter. The
-//! browser is driven over the DevTools protocol (the `headless_chrome`
-//! crate); the page side is `runner.js`.
+//! browser is driven over the DevTools protocol through
+//! `--remote-debugging-pipe` ([`cdp`]); the page side is `runner.js`.
 //!
 //! The I/O contract is the one vista's wgpu path has: binding 0 a uniform
 //! buffer, binding 1 an `rgba32float` write-only storage texture, binding 2
@@ -12,16 +12,17 @@
 //! browser that dies is an error naming the run's label, and the process is
 //! dropped (killed) so the next run starts a fresh one.
 
+pub mod cdp;
+
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, mpsc};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use base64::Engine;
 use base64::engine::general_purpose::STANDARD as B64;
-use headless_chrome::protocol::cdp::types::Event;
-use headless_chrome::{LaunchOptions, Tab};
 use serde::Deserialize;
+
+use crate::cdp::{CallError, Chromium};
 
 /// Printed when Chromium is missing.
 pub const INSTALL_HINT: &str = "install Debian's chromium with `bash ci/install-browser.sh` (or point VISTA_CHROMIUM \
@@ -63,7 +64,7 @@ pub struct AdapterInfo {
     pub description: String,
     pub user_agent: String,
     pub max_dimension: u32,
-    /// "Chrome/156.0.8078.114" from the DevTools version call.
+    /// "Chrome/156.0.8078.114" from `Browser.getVersion`.
     #[serde(skip)]
     pub product: String,
 }
@@ -95,11 +96,7 @@ pub struct Output {
 }
 
 struct Session {
-    // Dropping the browser kills Chromium; the tab must go first.
-    tab: Arc<Tab>,
-    /// Set by the DevTools event of a crashed renderer.
-    crashed: Arc<AtomicBool>,
-    _browser: headless_chrome::Browser,
+    chromium: Chromium,
     _page_dir: tempfile::TempDir,
 }
 
@@ -155,19 +152,15 @@ impl Browser {
     }
 
     /// Crashes the page's renderer process (chrome://crash), as a broken
-    /// driver would: for tests of the recovery path.
+    /// driver would, and waits until Chromium reports it: for tests of the
+    /// recovery path.
     #[doc(hidden)]
     pub fn crash_page_for_test(&self) {
         let guard = self.session.lock().unwrap_or_else(|p| p.into_inner());
         if let Some(s) = guard.as_ref() {
-            // Navigating to chrome://crash blocks until the crash is seen.
-            let tab = s.tab.clone();
-            std::thread::spawn(move || {
-                let _ = tab.navigate_to("chrome://crash");
-            });
-            // The renderer takes a few seconds to go.
+            s.chromium.crash_page();
             let start = Instant::now();
-            while !s.crashed.load(Ordering::SeqCst) && start.elapsed() < Duration::from_secs(30) {
+            while s.chromium.gone().is_none() && start.elapsed() < Duration::from_secs(30) {
                 std::thread::sleep(Duration::from_millis(20));
             }
         }
@@ -183,7 +176,7 @@ impl Browser {
             "width": job.width,
             "height": job.height,
         });
-        let reply = s.call(job.label, format!("vistaRun({args})"), true, self.timeout)?;
+        let reply = s.call(job.label, &format!("vistaRun({args})"), self.timeout)?;
         #[derive(Deserialize)]
         struct Ran {
             kernel_ms: f64,
@@ -200,7 +193,7 @@ impl Browser {
         }
         let mut bytes = Vec::with_capacity(expected);
         for offset in (0..expected).step_by(CHUNK) {
-            let chunk = s.call(job.label, format!("vistaChunk({offset}, {CHUNK})"), false, self.timeout)?;
+            let chunk = s.call(job.label, &format!("vistaChunk({offset}, {CHUNK})"), self.timeout)?;
             let decoded = B64.decode(chunk.as_bytes()).map_err(|e| BrowserError::Page {
                 case: job.label.into(),
                 message: format!("output chunk at byte {offset} is not base64: {e}"),
@@ -229,24 +222,9 @@ impl Browser {
 impl Session {
     fn start(path: &std::path::Path, timeout: Duration) -> Result<(Session, AdapterInfo), BrowserError> {
         let launch_err = |message: String| BrowserError::Launch { path: path.display().to_string(), message };
-        let args: Vec<&std::ffi::OsStr> = WEBGPU_FLAGS.iter().map(std::ffi::OsStr::new).collect();
-        let options = LaunchOptions {
-            path: Some(path.to_path_buf()),
-            headless: true,
-            // Chromium's sandbox needs user namespaces that containers and
-            // root CI runners lack; the page only ever loads vista's runner.
-            sandbox: false,
-            // Without this the crate passes --disable-gpu.
-            enable_gpu: true,
-            args,
-            // The crate's per-call wait and its idle-connection limit.
-            idle_browser_timeout: timeout.max(Duration::from_secs(5)),
-            ..LaunchOptions::default()
-        };
-        let browser = headless_chrome::Browser::new(options).map_err(|e| launch_err(format!("{e:#}")))?;
-        let product = browser.get_version().map(|v| v.product).unwrap_or_default();
-        let tab = browser.new_tab().map_err(|e| launch_err(format!("new tab: {e:#}")))?;
-        tab.set_default_timeout(timeout.max(Duration::from_secs(5)));
+        let timeout = timeout.max(Duration::from_secs(5));
+        let chromium = Chromium::launch(path, WEBGPU_FLAGS, timeout).map_err(launch_err)?;
+        let product = chromium.version(timeout).unwrap_or_default();
         // WebGPU needs a secure context; a file:// page is one, about:blank
         // and data: URLs are not.
         let page_dir = tempfile::Builder::new()
@@ -259,65 +237,27 @@ impl Session {
             format!("<!doctype html><meta charset=utf-8><title>vista</title><script>\n{RUNNER}\n</script>"),
         )
         .map_err(|e| launch_err(format!("writing {}: {e}", page.display())))?;
-        tab.navigate_to(&format!("file://{}", page.display()))
-            .and_then(|t| t.wait_until_navigated())
-            .map_err(|e| launch_err(format!("loading the runner page: {e:#}")))?;
-        let crashed = Arc::new(AtomicBool::new(false));
-        let flag = crashed.clone();
-        tab.call_method(headless_chrome::protocol::cdp::Inspector::Enable(None))
-            .map_err(|e| launch_err(format!("Inspector.enable: {e:#}")))?;
-        tab.add_event_listener(Arc::new(move |event: &Event| {
-            // A crashed renderer reports itself as a detach ("Render
-            // process gone.") more often than as a crash.
-            if matches!(event, Event::InspectorTargetCrashed(_) | Event::InspectorDetached(_)) {
-                flag.store(true, Ordering::SeqCst);
-            }
-        }))
-        .map_err(|e| launch_err(format!("event listener: {e:#}")))?;
-        let session = Session { tab, crashed, _browser: browser, _page_dir: page_dir };
-        let reply =
-            session.call("WebGPU init", "vistaInit()".into(), true, timeout).map_err(|e| launch_err(e.to_string()))?;
+        chromium
+            .navigate(&format!("file://{}", page.display()), timeout)
+            .map_err(|e| launch_err(format!("loading the runner page: {e}")))?;
+        let session = Session { chromium, _page_dir: page_dir };
+        let reply = session.call("WebGPU init", "vistaInit()", timeout).map_err(|e| launch_err(e.to_string()))?;
         let mut info: AdapterInfo = parse_ok(&reply).map_err(BrowserError::NoWebGpu)?;
         info.product = product;
         Ok((session, info))
     }
 
-    /// Evaluates `expr` in the page and returns the string it yields. The
-    /// protocol call runs on its own thread so that the watchdog and a
-    /// renderer crash end the wait, whatever the call is doing.
-    fn call(&self, label: &str, expr: String, await_promise: bool, timeout: Duration) -> Result<String, BrowserError> {
-        let (tx, rx) = mpsc::channel();
-        let tab = self.tab.clone();
-        std::thread::spawn(move || {
-            let _ = tx.send(tab.evaluate(&expr, await_promise).map_err(|e| format!("{e:#}")));
-        });
-        let start = Instant::now();
-        loop {
-            match rx.recv_timeout(Duration::from_millis(20)) {
-                Ok(Ok(obj)) => {
-                    return match obj.value {
-                        Some(serde_json::Value::String(s)) => Ok(s),
-                        _ => Err(BrowserError::Page {
-                            case: label.into(),
-                            message: obj.description.unwrap_or_else(|| "the page returned no string".into()),
-                        }),
-                    };
-                }
-                Ok(Err(message)) => return Err(BrowserError::Died { case: label.into(), message }),
-                Err(mpsc::RecvTimeoutError::Disconnected) => {
-                    return Err(BrowserError::Died { case: label.into(), message: "the DevTools call ended".into() });
-                }
-                Err(mpsc::RecvTimeoutError::Timeout) => {}
+    /// Evaluates `expr` in the page and returns the string it yields; the
+    /// watchdog and a renderer crash end the wait, whatever the page does.
+    fn call(&self, label: &str, expr: &str, timeout: Duration) -> Result<String, BrowserError> {
+        match self.chromium.evaluate(expr, timeout) {
+            Ok(serde_json::Value::String(s)) => Ok(s),
+            Ok(other) => Err(BrowserError::Page { case: label.into(), message: format!("the page returned {other}") }),
+            Err(CallError::Protocol(message)) => Err(BrowserError::Page { case: label.into(), message }),
+            Err(CallError::Timeout) => {
+                Err(BrowserError::Timeout { case: label.into(), seconds: timeout.as_secs_f64() })
             }
-            if self.crashed.load(Ordering::SeqCst) {
-                return Err(BrowserError::Died {
-                    case: label.into(),
-                    message: "the page's renderer process crashed".into(),
-                });
-            }
-            if start.elapsed() >= timeout {
-                return Err(BrowserError::Timeout { case: label.into(), seconds: timeout.as_secs_f64() });
-            }
+            Err(CallError::Gone(message)) => Err(BrowserError::Died { case: label.into(), message }),
         }
     }
 }

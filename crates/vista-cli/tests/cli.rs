@@ -974,7 +974,6 @@ fn malformed_manifest_names_file_line_and_column() {
 /// lists the failure in its summary, and its flip control switches the
 /// image. Screenshots go to target/tmp/report-*.png.
 fn the_report_works_in_a_real_browser() {
-    use headless_chrome::protocol::cdp::types::Event;
     let t = tmp();
     let root = t.path().join("project");
     copy_tree(&repo().join("examples/project"), &root);
@@ -1001,36 +1000,12 @@ fn the_report_works_in_a_real_browser() {
     assert!(r.stdout.contains("1 passed, 1 failed") && r.stdout.contains("vista bless --case 'marble-default'"));
 
     let index = root.join("target/vista-report/index.html");
-    let browser = headless_chrome::Browser::new(headless_chrome::LaunchOptions {
-        path: Some(vista_browser::find_chromium().unwrap_or_else(|e| panic!("{e}"))),
-        sandbox: false,
-        window_size: Some((1400, 1000)),
-        ..Default::default()
-    })
-    .expect("launch Chromium");
-    let tab = browser.new_tab().unwrap();
-    let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::<String>::new()));
-    let seen = errors.clone();
-    tab.enable_runtime().unwrap();
-    tab.enable_log().unwrap();
-    tab.add_event_listener(std::sync::Arc::new(move |e: &Event| {
-        let msg = match e {
-            Event::RuntimeExceptionThrown(x) => Some(format!("exception: {:?}", x.params.exception_details.text)),
-            Event::RuntimeConsoleAPICalled(x) if format!("{:?}", x.params.Type).contains("Error") => {
-                Some(format!("console.error: {:?}", x.params.args.first().and_then(|a| a.value.clone())))
-            }
-            Event::LogEntryAdded(x) if format!("{:?}", x.params.entry.level).contains("Error") => {
-                Some(format!("log: {}", x.params.entry.text))
-            }
-            _ => None,
-        };
-        if let Some(m) = msg {
-            seen.lock().unwrap().push(m);
-        }
-    }))
-    .unwrap();
-    tab.navigate_to(&format!("file://{}", index.display())).unwrap().wait_until_navigated().unwrap();
-    let eval = |js: &str| tab.evaluate(js, false).unwrap().value.unwrap_or(serde_json::Value::Null);
+    let wait = std::time::Duration::from_secs(30);
+    let path = vista_browser::find_chromium().unwrap_or_else(|e| panic!("{e}"));
+    let page =
+        vista_browser::cdp::Chromium::launch(&path, &["--window-size=1400,1000"], wait).expect("launch Chromium");
+    page.navigate(&format!("file://{}", index.display()), wait).unwrap();
+    let eval = |js: &str| page.evaluate(js, wait).unwrap_or_else(|e| panic!("{js}: {e}"));
     // The failing case's viewer loads its view.js by itself (it is open).
     let start = std::time::Instant::now();
     while eval("!!document.querySelector('#case-marble-default canvas.img')") != serde_json::json!(true) {
@@ -1041,17 +1016,7 @@ fn the_report_works_in_a_real_browser() {
     assert_eq!(summary, serde_json::json!("#case-marble-default"), "the summary lists exactly the failure");
     assert_eq!(eval("document.querySelector('#case-marble-calm').hidden"), serde_json::json!(true), "failures only");
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR"));
-    let shot = |name: &str| {
-        let png = tab
-            .capture_screenshot(
-                headless_chrome::protocol::cdp::Page::CaptureScreenshotFormatOption::Png,
-                None,
-                None,
-                true,
-            )
-            .unwrap();
-        std::fs::write(shots.join(name), png).unwrap();
-    };
+    let shot = |name: &str| std::fs::write(shots.join(name), page.screenshot(wait).unwrap()).unwrap();
     shot("report-summary.png");
     let viewer = "document.querySelector('#case-marble-default .viewer')";
     let pixels = format!("{viewer}.querySelector('canvas.img').toDataURL()");
@@ -1061,7 +1026,7 @@ fn the_report_works_in_a_real_browser() {
     assert_eq!(eval(&format!("{viewer}.dataset.showing")), serde_json::json!("expected"), "the flip button");
     assert_ne!(eval(&pixels), before, "flipping to the golden changed the image");
     shot("report-flipped.png");
-    tab.press_key("f").unwrap();
+    page.press("f", wait).unwrap();
     assert_eq!(eval(&format!("{viewer}.dataset.showing")), serde_json::json!("actual"), "the f key");
     assert_eq!(eval(&pixels), before);
     // The readout shows both 16-bit values under the cursor.
@@ -1071,7 +1036,7 @@ fn the_report_works_in_a_real_browser() {
     ));
     let readout = eval(&format!("{viewer}.querySelector('.readout').textContent"));
     assert!(readout.as_str().unwrap().starts_with("(2, 2)  expected 0."), "{readout}");
-    let errors = errors.lock().unwrap();
+    let errors = page.errors();
     assert!(errors.is_empty(), "console errors: {errors:?}");
 }
 
