@@ -1036,6 +1036,22 @@ fn the_report_works_in_a_real_browser() {
     ));
     let readout = eval(&format!("{viewer}.querySelector('.readout').textContent"));
     assert!(readout.as_str().unwrap().starts_with("(2, 2)  expected 0."), "{readout}");
+    // The slider shows the golden left of the cut and the render right of it.
+    eval(&format!("{viewer}.querySelector('button.slide').click()"));
+    let label = eval(&format!("{viewer}.querySelector('.img-label').textContent"));
+    assert!(label.as_str().unwrap().starts_with("slider: expected left, actual right of x = 64"), "{label}");
+    let sliding = eval(&pixels);
+    assert!(sliding != before, "the slider shows part of the golden");
+    // The heat map's legend follows the scale control: log ticks by default,
+    // this case's max when switched.
+    let ticks = format!("{viewer}.querySelector('.ticks').textContent");
+    assert_eq!(eval(&ticks), serde_json::json!("1/655351/40961/2551/161"));
+    eval("const s = document.getElementById('heat-scale'); s.value = 'max'; s.dispatchEvent(new Event('change'))");
+    let linear = eval(&ticks);
+    assert!(
+        linear.as_str().unwrap().starts_with('0') && linear != serde_json::json!("1/655351/40961/2551/161"),
+        "{linear}"
+    );
     let errors = page.errors();
     assert!(errors.is_empty(), "console errors: {errors:?}");
 }
