@@ -68,9 +68,7 @@ fn backends_agree(contexts: &[Context]) -> Result<(), String> {
             let max_abs = metrics::max_abs(&outs[a].0, &outs[b].0);
             let psnr = metrics::psnr(&outs[a].1, &outs[b].1);
             let w = worst.entry((case.kernel.name(), p)).or_insert(Worst { psnr: f64::INFINITY, ..Default::default() });
-            if max_abs >= w.max_abs {
-                w.max_abs = max_abs;
-            }
+            w.max_abs = w.max_abs.max(max_abs);
             if psnr < w.psnr || w.case.is_empty() {
                 w.psnr = psnr;
                 w.case = case.id.clone();

@@ -10,7 +10,7 @@ use std::os::fd::AsRawFd;
 use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, mpsc};
 use std::time::{Duration, Instant};
 
@@ -47,7 +47,6 @@ struct Shared {
     loads: AtomicU64,
     /// Console errors, uncaught exceptions and error log entries, in order.
     errors: Mutex<Vec<String>>,
-    closed: AtomicBool,
 }
 
 /// One Chromium process with one page.
@@ -288,7 +287,6 @@ fn spawn_reader(from_browser: std::io::PipeReader, waiters: Waiters, shared: Arc
             }
             event(&msg, &shared);
         }
-        shared.closed.store(true, Ordering::SeqCst);
         shared.gone.lock().expect("gone").get_or_insert_with(|| "Chromium closed the DevTools pipe".into());
         // Dropping the senders wakes every waiting call.
         waiters.lock().expect("waiters").clear();

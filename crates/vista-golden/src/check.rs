@@ -125,7 +125,7 @@ impl Outcome {
         for p in &self.problems {
             s += &format!("  FAIL: {p}\n");
         }
-        for n in self.notes.iter().filter(|n| !n.starts_with("shader changed") || self.changed_files.is_empty()) {
+        for n in &self.notes {
             s += &format!("  note: {n}\n");
         }
         if !self.passed() {
@@ -268,19 +268,18 @@ fn judge(
                 out.notes.push(format!("golden blessed on '{}', running on '{adapter}'", e.adapter));
             }
             if e.shader_hash != shader_hash {
-                if !e.shader_files.is_empty() {
-                    let now = ctx.shader_file_hashes(case.kernel.shader())?;
-                    out.changed_files = changed_files(&e.shader_files, &now);
-                }
-                out.notes.push(if e.shader_files.is_empty() {
-                    format!(
+                // Named files are reported from `changed_files` (terminal
+                // block, report); only an old manifest needs the note.
+                if e.shader_files.is_empty() {
+                    out.notes.push(format!(
                         "shader changed since the last bless (manifest {}, now {shader_hash}); the manifest \
                          predates per-file hashes, so the files are not named",
                         e.shader_hash
-                    )
+                    ));
                 } else {
-                    format!("shader changed since the last bless: {}", out.changed_files.join(", "))
-                });
+                    let now = ctx.shader_file_hashes(case.kernel.shader())?;
+                    out.changed_files = changed_files(&e.shader_files, &now);
+                }
             }
             if e.params_hash != params_hash(case) {
                 out.notes.push("case parameters changed since the last bless".into());

@@ -1,8 +1,8 @@
 // vista report viewer. Pixel data comes from each case's view.js (a script:
 // a page opened from file:// may neither fetch files nor read image pixels).
+// HEAT_STOPS and LOG_FLOOR come before this script, from vista_image.
 "use strict";
 
-const LOG_FLOOR = 0.5 / 65535; // vista_image::LOG_FLOOR
 const onlyFailures = document.getElementById("failures-only");
 const heatScale = document.getElementById("heat-scale");
 const heatMax = document.getElementById("heat-max");

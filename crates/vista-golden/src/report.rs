@@ -70,9 +70,7 @@ pub fn view_js(id: &str, expected: &Image, actual: &Image, first_bad: Option<(u3
         let bytes: Vec<u8> = img
             .data
             .iter()
-            .flat_map(|p| {
-                p[..3].iter().map(|v| if v.is_nan() { 0u16 } else { (v.clamp(0.0, 1.0) * 65535.0).round() as u16 })
-            })
+            .flat_map(|p| p[..3].iter().map(|&v| vista_image::quantize16(v)))
             .flat_map(u16::to_le_bytes)
             .collect();
         base64::engine::general_purpose::STANDARD.encode(bytes)
@@ -337,7 +335,7 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
          <input id=\"heat-max\" type=\"number\" value=\"0.0039216\" step=\"any\" min=\"0\" title=\"difference drawn white (linear, fixed)\"> \
          <span class=\"help\">In a viewer: <kbd>f</kbd> flips expected/actual, the wheel or +/- zooms (all views together), drag pans.</span></section>\n\
          <section id=\"cases\"><h2>Cases</h2>\n{sections}</section>\n\
-         <script>const HEAT_STOPS = {stops};\n{SCRIPT}</script>\n</html>\n",
+         <script>const HEAT_STOPS = {stops};\nconst LOG_FLOOR = {floor:e};\n{SCRIPT}</script>\n</html>\n",
         n = sorted.len(),
         nfail = failing.len(),
         fcls = if failing.is_empty() { "ok" } else { "bad" },
@@ -346,6 +344,7 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
         command = html_escape(&run.command),
         date = crate::now_utc(),
         checked = if failing.is_empty() { "" } else { " checked" },
+        floor = vista_image::LOG_FLOOR,
     );
     std::fs::create_dir_all(dir)
         .map_err(|e| crate::GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;

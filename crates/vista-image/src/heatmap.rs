@@ -30,13 +30,12 @@ pub fn diff_heatmap(reference: &Image, actual: &Image, scale: Option<f32>) -> Im
         Some(s) if s.is_finite() && s > 0.0 => s,
         _ => default_scale(&diffs),
     };
-    let data = diffs
-        .iter()
-        .map(|d| match d {
-            Some(d) => colormap(d / scale),
-            None => INVALID,
-        })
-        .collect();
+    paint(reference, &diffs, |d| d / scale)
+}
+
+/// Colours each difference at `position(d)` on the colormap; invalid pixels green.
+fn paint(reference: &Image, diffs: &[Option<f32>], position: impl Fn(f32) -> f32) -> Image {
+    let data = diffs.iter().map(|d| d.map_or(INVALID, |d| colormap(position(d)))).collect();
     Image { width: reference.width, height: reference.height, data }
 }
 
@@ -54,14 +53,7 @@ pub fn log_position(d: f32) -> f32 {
 /// [`diff_heatmap`] on the fixed log scale of [`log_position`]: the same
 /// colour means the same difference in every case of a report.
 pub fn diff_heatmap_log(reference: &Image, actual: &Image) -> Image {
-    let data = pixel_diffs(reference, actual)
-        .iter()
-        .map(|d| match d {
-            Some(d) => colormap(log_position(*d)),
-            None => INVALID,
-        })
-        .collect();
-    Image { width: reference.width, height: reference.height, data }
+    paint(reference, &pixel_diffs(reference, actual), log_position)
 }
 
 /// Per reference pixel: `Some(max RGB |diff|)`, or `None` when non-finite or

@@ -29,12 +29,7 @@ pub fn encode_png16(path: &Path, img: &Image) -> Result<Vec<u8>, ImageError> {
 /// Writes `img` as an 8-bit RGBA PNG (clamped to `[0, 1]`, NaN as 0): the
 /// light display copy reports load, beside the 16-bit file.
 pub fn write_png8(path: &Path, img: &Image) -> Result<(), ImageError> {
-    let samples: Vec<u8> = img
-        .data
-        .iter()
-        .flatten()
-        .map(|&v| if v.is_nan() { 0 } else { (v.clamp(0.0, 1.0) * 255.0).round() as u8 })
-        .collect();
+    let samples: Vec<u8> = img.data.iter().flatten().map(|&v| quantize8(v)).collect();
     let buf = ImageBuffer::<Rgba<u8>, Vec<u8>>::from_raw(img.width, img.height, samples)
         .ok_or_else(|| encode_error(path, "PNG", "pixel buffer does not match image size"))?;
     let mut bytes = Cursor::new(Vec::new());
@@ -161,8 +156,17 @@ fn kind_of(path: &Path) -> Result<Kind, ImageError> {
     }
 }
 
-/// `round(clamp(v) * 65535)` computed in f64 so every u16 level round-trips.
-fn quantize16(v: f32) -> u16 {
+/// `round(clamp(v) * 255)`, NaN as 0: an 8-bit display sample.
+pub fn quantize8(v: f32) -> u8 {
+    if v.is_nan() {
+        return 0;
+    }
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// `round(clamp(v) * 65535)` computed in f64 so every u16 level round-trips,
+/// NaN as 0: what a 16-bit PNG stores.
+pub fn quantize16(v: f32) -> u16 {
     if v.is_nan() {
         return 0;
     }

@@ -64,10 +64,7 @@ pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
 pub fn flip_mean(reference: &Image, actual: &Image) -> f64 {
     assert_same_size(reference, actual);
     let rgb8 = |img: &Image| -> Vec<u8> {
-        img.data
-            .iter()
-            .flat_map(|p| p[..3].iter().map(|v| if v.is_nan() { 0 } else { (v.clamp(0.0, 1.0) * 255.0).round() as u8 }))
-            .collect()
+        img.data.iter().flat_map(|p| p[..3].iter().map(|&v| crate::quantize8(v))).collect()
     };
     let (w, h) = reference.dimensions();
     if w == 0 || h == 0 {
