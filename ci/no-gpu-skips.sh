@@ -4,7 +4,7 @@
 # all of its tests ignored and none passed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-suites=(golden agreement atmosphere clouds cloudmap heightfield mutate noise reliability backends)
+suites=(golden agreement atmosphere clouds cloudmap heightfield landscape mutate noise reliability backends)
 args=()
 for s in "${suites[@]}"; do args+=(--test "$s"); done
 log=$(mktemp)

@@ -50,6 +50,13 @@ enum Command {
         set: Vec<String>,
         #[arg(long, default_value = "256x256")]
         size: String,
+        /// Write only this rectangle of the rendered image: X,Y,W,H in pixels
+        /// (the kernel still renders the whole --size frame).
+        #[arg(long, value_name = "X,Y,W,H")]
+        crop: Option<String>,
+        /// Repeat every written pixel N x N times (nearest neighbour, 1-16).
+        #[arg(long, value_name = "N", default_value_t = 1)]
+        zoom: u32,
         #[arg(short, long)]
         out: PathBuf,
     },
@@ -62,6 +69,10 @@ enum Command {
         /// PSNR peak = max of A (for HDR/EXR data) instead of 1.
         #[arg(long)]
         hdr: bool,
+        /// Box-blur both images with this radius first (0-64): what remains is
+        /// structured error such as banding, not pixel noise.
+        #[arg(long, value_name = "R", default_value_t = 0)]
+        blur: u32,
     },
     /// Render golden cases and compare them with their goldens.
     Check {
@@ -224,17 +235,28 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
             }
             Ok(0)
         }
-        Command::Render { kernel, preset, set, size, out } => {
+        Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             let k = registry(project)?.find(&kernel).map_err(bad)?;
             let p = k.resolve(preset.as_deref(), &parse_sets(&set)?).map_err(bad)?;
             let (w, h) = vista_kernels::parse_size(&size).map_err(bad)?;
+            let rect = crop.as_deref().map(|c| parse_crop(c, w, h)).transpose()?;
+            if !(1..=16).contains(&zoom) {
+                return Err(bad(format!("--zoom {zoom} is out of range; allowed: 1 to 16")));
+            }
             check_output_path(&out)?;
             let shaders = vista_golden::shader_set(project)?;
             vista_golden::prepare(&shaders, k, &p, w, h)?;
             let ctx = &Renderer { ctx: Context::shared()?, shaders };
             let r = vista_golden::render(ctx, k, &p, w, h)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-            vista_image::save(&out, if is_exr { &r.raw } else { &r.display })?;
+            let mut img = if is_exr { r.raw.clone() } else { r.display.clone() };
+            if let Some((x, y, cw, ch)) = rect {
+                img = img.crop(x, y, cw, ch).expect("the crop was checked against the size");
+            }
+            if zoom > 1 {
+                img = img.zoom(zoom);
+            }
+            vista_image::save(&out, &img)?;
             eprintln!(
                 "rendered {kernel} {w}x{h} on {} in {:.1} ms -> {}",
                 ctx.adapter_description(),
@@ -247,9 +269,14 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
             }
             Ok(0)
         }
-        Command::Compare { a, b, json, hdr } => {
-            let ia = vista_image::load(&a)?;
-            let ib = vista_image::load(&b)?;
+        Command::Compare { a, b, json, hdr, blur } => {
+            if blur > 64 {
+                return Err(bad(format!("--blur {blur} is out of range; allowed: 0 to 64")));
+            }
+            let (mut ia, mut ib) = (vista_image::load(&a)?, vista_image::load(&b)?);
+            if blur > 0 {
+                (ia, ib) = (ia.box_blur(blur), ib.box_blur(blur));
+            }
             let m = if hdr { metrics::compare_hdr(&ia, &ib)? } else { metrics::compare(&ia, &ib)? };
             if json {
                 let v = serde_json::json!({
@@ -299,6 +326,20 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
 
 /// Refuses an output path whose directory does not exist or is not writable,
 /// before any GPU work.
+/// `X,Y,W,H` inside a `width` x `height` frame.
+fn parse_crop(text: &str, width: u32, height: u32) -> Result<(u32, u32, u32, u32), GoldenError> {
+    let allowed = format!("X,Y,W,H in pixels with W, H >= 1, X + W <= {width} and Y + H <= {height} (the --size frame)");
+    let v: Vec<u32> = text.split(',').map(|s| s.trim().parse::<u32>()).collect::<Result<_, _>>().map_err(|_| {
+        bad(format!("--crop {text} is not valid; expected {allowed}"))
+    })?;
+    match v[..] {
+        [x, y, w, h] if w >= 1 && h >= 1 && x as u64 + w as u64 <= width as u64 && y as u64 + h as u64 <= height as u64 => {
+            Ok((x, y, w, h))
+        }
+        _ => Err(bad(format!("--crop {text} does not fit; expected {allowed}"))),
+    }
+}
+
 fn check_output_path(out: &Path) -> Result<(), GoldenError> {
     let ext_ok = out
         .extension()

@@ -119,6 +119,39 @@ fn bad_sizes_are_rejected_before_gpu_work() {
     }
 }
 
+fn bad_crops_are_rejected_before_gpu_work() {
+    let d = tmp();
+    let env = [("VISTA_ADAPTER", "nonsense")];
+    for (crop, zoom, needle) in [
+        ("40,0,30,10", "1", "--crop 40,0,30,10 does not fit"),
+        ("0,0,0,10", "1", "W, H >= 1"),
+        ("1,2,3", "1", "X + W <= 64"),
+        ("a,b,c,d", "1", "--crop a,b,c,d is not valid"),
+        ("0,0,8,8", "17", "--zoom 17 is out of range"),
+    ] {
+        let args = ["render", "fbm", "--size", "64x32", "--crop", crop, "--zoom", zoom, "-o", &out_png(d.path())];
+        assert_rejected(&vista_in(None, &env, &args), 2, &[needle]);
+    }
+}
+
+/// A crop is exactly that rectangle of the whole frame, zoomed pixel by pixel.
+fn a_crop_is_the_rectangle_of_the_frame() {
+    let d = tmp();
+    let (full, part) = (d.path().join("full.png"), d.path().join("part.png"));
+    let r = vista(&["render", "fbm", "--size", "64x32", "-o", full.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let args = ["render", "fbm", "--size", "64x32", "--crop", "10,4,20,8", "--zoom", "3", "-o", part.to_str().unwrap()];
+    let r = vista(&args);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let (f, c) = (vista_image::load(&full).unwrap(), vista_image::load(&part).unwrap());
+    assert_eq!(c.dimensions(), (60, 24));
+    for y in 0..24 {
+        for x in 0..60 {
+            assert_eq!(c.get(x, y), f.get(10 + x / 3, 4 + y / 3), "crop pixel ({x}, {y})");
+        }
+    }
+}
+
 fn absurd_work_is_refused_with_the_cap() {
     let d = tmp();
     let r = vista_in(None, &[("VISTA_MAX_WORK", "1000")], &["render", "fbm", "-o", &out_png(d.path())]);
@@ -168,6 +201,14 @@ fn compare_reports_json_fields_and_rejects_bad_files() {
     for field in ["\"psnr\":", "\"ssim\":", "\"max_abs\":", "\"bad_pixels\":", "\"nan\":"] {
         assert!(diff.stdout.contains(field), "missing {field}: {}", diff.stdout);
     }
+    // Blurring both removes the pixel-scale part of the difference.
+    let psnr = |out: &str| -> f64 {
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        v["psnr"].as_f64().unwrap()
+    };
+    let blurred = vista(&["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--json", "--blur", "2"]);
+    assert!(psnr(&blurred.stdout) > psnr(&diff.stdout) + 1.0, "{} vs {}", blurred.stdout, diff.stdout);
+    assert_rejected(&vista(&["compare", a.to_str().unwrap(), a.to_str().unwrap(), "--blur", "65"]), 2, &["--blur 65"]);
     let corrupt = d.path().join("corrupt.png");
     std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnot really").unwrap();
     assert_rejected(&vista(&["compare", a.to_str().unwrap(), corrupt.to_str().unwrap()]), 2, &["corrupt.png"]);
@@ -1358,6 +1399,8 @@ fn main() {
         (Cpu, "out_of_range_value_names_value_and_range", out_of_range_value_names_value_and_range),
         (Cpu, "wrong_type_names_value_and_expected_kind", wrong_type_names_value_and_expected_kind),
         (Cpu, "bad_sizes_are_rejected_before_gpu_work", bad_sizes_are_rejected_before_gpu_work),
+        (Cpu, "bad_crops_are_rejected_before_gpu_work", bad_crops_are_rejected_before_gpu_work),
+        (Gpu, "a_crop_is_the_rectangle_of_the_frame", a_crop_is_the_rectangle_of_the_frame),
         (Cpu, "absurd_work_is_refused_with_the_cap", absurd_work_is_refused_with_the_cap),
         (Cpu, "unwritable_output_directory_is_refused", unwritable_output_directory_is_refused),
         (

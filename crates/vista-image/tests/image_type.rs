@@ -100,3 +100,31 @@ fn bit_identical_is_nan_safe_and_bitwise() {
     assert!(!zero.bit_identical(&neg_zero));
     assert!(!Image::new(2, 3).bit_identical(&Image::new(3, 2)));
 }
+
+#[test]
+fn crop_takes_the_rectangle_and_refuses_what_does_not_fit() {
+    let img = Image::from_fn(8, 4, |x, y| [x as f32, y as f32, 0.0, 1.0]);
+    let c = img.crop(2, 1, 3, 2).unwrap();
+    assert_eq!(c.dimensions(), (3, 2));
+    assert_eq!(c.get(0, 0), img.get(2, 1));
+    assert_eq!(c.get(2, 1), img.get(4, 2));
+    assert!(img.crop(6, 0, 3, 1).is_none() && img.crop(0, 0, 0, 1).is_none() && img.crop(u32::MAX, 0, 2, 1).is_none());
+    let z = c.zoom(2);
+    assert_eq!(z.dimensions(), (6, 4));
+    assert_eq!(z.get(5, 3), c.get(2, 1));
+}
+
+/// Pixel noise (a checkerboard) blurs away; a step (a band edge) stays.
+#[test]
+fn box_blur_removes_pixel_noise_and_keeps_steps() {
+    let noise = Image::from_fn(16, 16, |x, y| [((x + y) % 2) as f32; 4]);
+    let b = noise.box_blur(1);
+    let inner = b.get(8, 8)[0];
+    assert!((inner - 4.0 / 9.0).abs() < 1e-6 || (inner - 5.0 / 9.0).abs() < 1e-6, "{inner}");
+    let step = Image::from_fn(16, 16, |x, _| [if x < 8 { 0.0 } else { 1.0 }; 4]);
+    let s = step.box_blur(1);
+    assert_eq!((s.get(2, 5)[0], s.get(13, 5)[0]), (0.0, 1.0));
+    assert!((s.get(7, 5)[0] - 1.0 / 3.0).abs() < 1e-6);
+    // Edge windows are clipped, not zero-padded.
+    assert_eq!(s.get(15, 0)[0], 1.0);
+}

@@ -97,7 +97,8 @@ impl CpuReference for HeightfieldKernel {
     /// Depth, steps and normal views are in [0, 1]; colour is bounded by the
     /// brightest albedo under full sun and ambient (about 0.9964, unclamped).
     fn output_bounds(&self, p: &ParamSet) -> Option<(f32, f32)> {
-        let hi = if p.choice("view") == "color" { max_encoded_colour() as f32 * 1.0001 } else { 1.0 };
+        let hi =
+            if p.choice("view") == "color" { max_encoded_colour(p.vec3("sun_color")) as f32 * 1.0001 } else { 1.0 };
         Some((0.0, hi))
     }
     /// The oracle marches with fixed steps; the shader's relax march is the fair baseline.

@@ -35,6 +35,8 @@ macro_rules! cpu_references {
         pub mod geometry;
         #[path = "cpu/heightfield.rs"]
         pub mod heightfield;
+        #[path = "cpu/landscape.rs"]
+        pub mod landscape;
         #[path = "cpu/noise.rs"]
         pub mod noise;
         #[path = "cpu/phase.rs"]
@@ -66,6 +68,7 @@ pub mod cloudmap;
 pub mod clouds;
 pub mod fbm;
 pub mod heightfield;
+pub mod landscape;
 pub mod layout;
 pub mod manifest;
 pub mod noise;
@@ -147,6 +150,7 @@ pub fn cpu_reference(name: &str) -> Option<&'static dyn CpuReference> {
         "clouds" => &clouds::CloudsKernel,
         "heightfield" => &heightfield::HeightfieldKernel,
         "cloudmap" => &cloudmap::CloudmapKernel,
+        "landscape" => &landscape::LandscapeKernel,
         _ => return None,
     })
 }

@@ -14,6 +14,7 @@ fn sky(sun_deg: f64, alt: f64, view: u32, light: u32) -> Sky {
         mie_g: 0.8,
         view_samples: view,
         light_samples: light,
+        density_scale: [1.0, 1.0],
     }
 }
 

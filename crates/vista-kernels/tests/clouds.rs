@@ -326,3 +326,50 @@ fn density_evaluations_follow_steps_times_one_plus_light_steps() {
         assert!(full * 10 >= n * 9, "{steps}x{light}: only {full} of {n} rays spent steps * (1 + light_steps)");
     }
 }
+
+/// Camera inside the layer (the flythrough preset): every ray's march starts
+/// at the camera, not at the slab's boundary behind it, and its
+/// transmittance is exp(-integral of sigma_t from the camera), which a fine
+/// independent quadrature over [0, t1] confirms; the same integral taken
+/// from the slab boundary behind the camera does not match.
+#[test]
+fn with_the_camera_inside_the_layer_the_march_starts_at_the_camera() {
+    let c = Clouds::from_params(&params("flythrough", &[("steps", "1024"), ("max_distance_km", "6")]));
+    let o = c.view.pos;
+    assert!(o[1] > c.base && o[1] < c.top, "the flythrough camera must be inside the slab");
+    let (mut checked, mut distinct) = (0, 0);
+    for (x, y, o, d) in rays(&c, 8) {
+        let (t0, t1) = c.slab_segment(o, d).expect("inside the slab every ray has a segment");
+        assert_eq!(t0, 0.0, "pixel ({x}, {y}): the segment starts at {t0}, not at the camera");
+        let r = c.march(o, d, 0.5, false);
+        if r.transmittance <= T_CUTOFF {
+            continue;
+        }
+        // Midpoint rule at 16x the march's resolution, from the camera.
+        let tau = |from: f64, to: f64| {
+            let n = 16 * 1024;
+            let dt = (to - from) / n as f64;
+            (0..n).map(|i| c.density([0, 1, 2].map(|k| o[k] + d[k] * (from + (i as f64 + 0.5) * dt)))).sum::<f64>() * dt
+        };
+        let from_camera = tau(0.0, t1);
+        let t = r.transmittance;
+        assert!(
+            (t - (-from_camera).exp()).abs() <= 2e-3,
+            "pixel ({x}, {y}): T = {t}, exp(-tau from the camera) = {}",
+            (-from_camera).exp()
+        );
+        // The part of the line behind the camera, inside the slab.
+        let back =
+            if d[1].abs() < 1e-6 { c.max_distance } else { ((if d[1] > 0.0 { c.base } else { c.top }) - o[1]) / d[1] };
+        let behind = tau(back.min(0.0).max(-c.max_distance), 0.0);
+        if behind > 0.05 {
+            distinct += 1;
+            assert!(
+                (t - (-(from_camera + behind)).exp()).abs() > 1e-3,
+                "pixel ({x}, {y}): the part behind the camera counted"
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked >= 20 && distinct >= 5, "only {checked} rays checked, {distinct} with cloud behind the camera");
+}

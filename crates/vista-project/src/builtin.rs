@@ -17,12 +17,16 @@ pub const SHADERS: &[(&str, &str)] = embed!("shaders":
     "lib/fractal.wgsl",
     "lib/phase.wgsl",
     "lib/geometry.wgsl",
+    "lib/terrain.wgsl",
+    "lib/sky.wgsl",
+    "lib/cloud_slab.wgsl",
     "fbm.wgsl",
     "ridged.wgsl",
     "atmosphere.wgsl",
     "heightfield.wgsl",
     "clouds.wgsl",
     "cloudmap.wgsl",
+    "landscape.wgsl",
 );
 
 /// `kernels/` manifests: `(path relative to kernels/, text)`.
@@ -33,4 +37,5 @@ pub const KERNELS: &[(&str, &str)] = embed!("kernels":
     "clouds.toml",
     "heightfield.toml",
     "cloudmap.toml",
+    "landscape.toml",
 );

@@ -135,6 +135,9 @@ pub struct Sky {
     pub mie_g: Real,
     pub view_samples: u32,
     pub light_samples: u32,
+    /// Multipliers of the (Rayleigh, Mie) densities: (1, 1) for SPEC 3.5's
+    /// air (the atmosphere kernel), (0, 0) for none.
+    pub density_scale: [Real; 2],
 }
 
 impl Sky {
@@ -146,7 +149,14 @@ impl Sky {
             mie_g: real(p, "mie_g"),
             view_samples: p.u32("view_samples"),
             light_samples: p.u32("light_samples"),
+            density_scale: [1.0, 1.0],
         }
+    }
+
+    /// Densities (rho_R, rho_M) of this sky at altitude h.
+    pub fn densities(&self, h: Real) -> [Real; 2] {
+        let [r, m] = densities(h);
+        [r * self.density_scale[0], m * self.density_scale[1]]
     }
 
     pub fn camera(&self) -> Vec3 {
@@ -160,7 +170,8 @@ impl Sky {
             return [0.0; 3];
         }
         let exit = ray_sphere(p, self.sun, R_TOP).map_or(0.0, |(_, t1)| t1.max(0.0));
-        transmittance(p, self.sun, exit, self.light_samples)
+        let [r, m] = column(p, self.sun, exit, self.light_samples);
+        optical_depth_of([r * self.density_scale[0], m * self.density_scale[1]]).map(|t| (-t).exp())
     }
 
     /// The view segment [t_start, t_end] inside the atmosphere, None when the
@@ -183,9 +194,16 @@ impl Sky {
 
     /// Radiance (RGB) arriving at the camera along the unit direction `dir`.
     pub fn radiance(&self, dir: Vec3) -> [Real; 3] {
-        let Some((t0, t1)) = self.view_segment(dir) else {
-            return [0.0; 3];
-        };
+        match self.view_segment(dir) {
+            Some((t0, t1)) => self.segment(dir, t0, t1).0,
+            None => [0.0; 3],
+        }
+    }
+
+    /// (in-scattered radiance, transmittance) per channel of the part
+    /// [t0, t1] (m) of the view ray along `dir`: the midpoint rule with
+    /// `view_samples` steps, each step's light dimmed back to t0.
+    pub fn segment(&self, dir: Vec3, t0: Real, t1: Real) -> ([Real; 3], [Real; 3]) {
         let c = self.camera();
         let mu = dir.dot(self.sun);
         let (pr, pm) = (rayleigh(mu), hg(mu, self.mie_g));
@@ -195,7 +213,7 @@ impl Sky {
         let mut sum = [0.0; 3];
         for i in 0..n {
             let p = c + (t0 + (i as Real + 0.5) * dt) * dir;
-            let rho = densities(altitude(p));
+            let rho = self.densities(altitude(p));
             let to_mid =
                 optical_depth_of([before[0] + 0.5 * dt * rho[0], before[1] + 0.5 * dt * rho[1]]);
             let sun = self.sun_transmittance(p);
@@ -206,7 +224,7 @@ impl Sky {
             before[0] += dt * rho[0];
             before[1] += dt * rho[1];
         }
-        sum.map(|s| self.sun_intensity * s * dt)
+        (sum.map(|s| self.sun_intensity * s * dt), optical_depth_of(before).map(|t| (-t).exp()))
     }
 }
 

@@ -287,10 +287,17 @@ impl Clouds {
     /// Marches the ray o + t d with first-sample offset `xi` (in steps).
     /// With `trace`, records the transmittance after every step.
     pub fn march(&self, o: V3, d: V3, xi: Real, trace: bool) -> RayResult {
+        match self.slab_segment(o, d) {
+            Some((t0, t1)) => self.march_segment(o, d, t0, t1, xi, self.sun, trace),
+            None => RayResult { radiance: [0.0; 3], transmittance: 1.0, trace: Vec::new(), density_evals: 0 },
+        }
+    }
+
+    /// Marches [t0, t1] of the ray o + t d in `steps` equal steps, the first
+    /// sample `xi` steps in, lit by `sun` (radiance from sun_dir).
+    #[allow(clippy::too_many_arguments)]
+    pub fn march_segment(&self, o: V3, d: V3, t0: Real, t1: Real, xi: Real, sun: V3, trace: bool) -> RayResult {
         let mut out = RayResult { radiance: [0.0; 3], transmittance: 1.0, trace: Vec::new(), density_evals: 0 };
-        let Some((t0, t1)) = self.slab_segment(o, d) else {
-            return out;
-        };
         let dt = (t1 - t0) / self.steps as Real;
         let phase = self.phase(dot(d, self.sun_dir));
         let ext = 1.0 + self.absorption;
@@ -310,8 +317,8 @@ impl Clouds {
                     Integrator::Riemann => dt,
                     Integrator::Analytic => dt * analytic_weight(x),
                 };
-                for c in 0..3 {
-                    let l_in = self.sun[c] * phase * sun_vis + self.ambient[c] * amb;
+                for (c, sun_c) in sun.iter().enumerate() {
+                    let l_in = sun_c * phase * sun_vis + self.ambient[c] * amb;
                     out.radiance[c] += t_view * sigma_s * l_in * w;
                 }
                 t_view *= (-x).exp();

@@ -17,8 +17,8 @@ pub const REFINE_TOL: Real = 0.01;
 /// Extinction times visibility: ln(1 / 0.02), Koschmieder's 2% contrast.
 pub const KOSCHMIEDER: Real = 3.912;
 
-// Linear-light colours of the shading model (shared with shaders/heightfield.wgsl).
-pub const SUN_COLOR: [Real; 3] = [1.0, 0.92, 0.78];
+// Linear-light colours of the shading model (shared with shaders/heightfield.wgsl
+// and shaders/lib/terrain.wgsl); the sun's colour is the `sun_color` param.
 pub const AMBIENT: [Real; 3] = [0.16, 0.22, 0.32];
 pub const SKY_HORIZON: [Real; 3] = [0.60, 0.70, 0.82];
 pub const SKY_ZENITH: [Real; 3] = [0.18, 0.34, 0.66];
@@ -354,12 +354,58 @@ pub fn encode(c: V3) -> V3 {
 /// brightest albedo under full sun plus full ambient, per channel (fog mixes
 /// toward the dimmer horizon colour). No clamp hides it, so the raw-output
 /// guard checks the shading itself.
-pub fn max_encoded_colour() -> Real {
+pub fn max_encoded_colour(sun_color: V3) -> Real {
     (0..3)
-        .map(|c| [ROCK[c], GRASS[c], SNOW[c]].into_iter().fold(0.0, Real::max) * (SUN_COLOR[c] + AMBIENT[c]))
+        .map(|c| [ROCK[c], GRASS[c], SNOW[c]].into_iter().fold(0.0, Real::max) * (sun_color[c] + AMBIENT[c]))
         .chain(SKY_HORIZON.into_iter().chain(SKY_ZENITH))
         .fold(0.0, Real::max)
         .powf(1.0 / 2.2)
+}
+
+/// The soft shadow's fixed samples (see [`soft_shadow`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ShadowSettings {
+    pub steps: u32,
+    pub distance: Real,
+    pub softness: Real,
+}
+
+/// What lights a terrain point: the direction toward the sun, the sun's
+/// colour arriving there, the sky's ambient colour (x (0.5 + 0.5 n.y)).
+#[derive(Debug, Clone, Copy)]
+pub struct SurfaceLight {
+    pub sun_dir: V3,
+    pub sun: V3,
+    pub ambient: V3,
+}
+
+/// Radiance leaving the terrain hit at distance t along o + t d, before any
+/// fog or aerial perspective: albedo (rock, grass where flat, snow above the
+/// snow line) x (sun x Lambert x soft shadow + ambient x (0.5 + 0.5 n.y)).
+#[allow(clippy::too_many_arguments)]
+pub fn surface_radiance(
+    terrain: &Terrain,
+    eps: Real,
+    shadow: &ShadowSettings,
+    snow_line: Real,
+    o: V3,
+    d: V3,
+    t: Real,
+    light: &SurfaceLight,
+) -> V3 {
+    let hit = add(o, scale(d, t));
+    let (x, z) = (hit[0], hit[2]);
+    let h = terrain.height(x, z);
+    let n = terrain.normal(x, z, Terrain::normal_step(x, z, eps, t));
+    let p = [x, h, z];
+    let flat = smoothstep(0.75, 0.92, n[1]);
+    let snow = smoothstep(snow_line, snow_line + SNOW_FADE, h) * smoothstep(0.55, 0.75, n[1]);
+    let albedo = mix3(mix3(ROCK, GRASS, flat), SNOW, snow);
+    let lambert = dot(n, light.sun_dir).max(0.0);
+    let shadow =
+        if lambert > 0.0 { soft_shadow(terrain, p, light.sun_dir, shadow.steps, shadow.distance, shadow.softness) } else { 0.0 };
+    let sky_light = 0.5 + 0.5 * n[1];
+    std::array::from_fn(|i| albedo[i] * (light.sun[i] * lambert * shadow + light.ambient[i] * sky_light))
 }
 
 /// Everything one pixel needs, resolved from a parameter set.
@@ -375,6 +421,7 @@ pub struct Scene {
     pub shadow_softness: Real,
     pub sigma: Real,
     pub snow_line: Real,
+    pub sun_color: V3,
 }
 
 impl Scene {
@@ -391,6 +438,7 @@ impl Scene {
             shadow_softness: real(p, "shadow_softness"),
             sigma: fog_extinction(real(p, "visibility_km")),
             snow_line: real(p, "snow_line"),
+            sun_color: real3(p, "sun_color"),
         })
     }
 
@@ -402,23 +450,13 @@ impl Scene {
 
     /// Linear colour of a terrain hit at distance t along d.
     pub fn shade(&self, d: V3, t: Real) -> V3 {
-        let hit = add(self.camera.pos, scale(d, t));
-        let (x, z) = (hit[0], hit[2]);
-        let h = self.terrain.height(x, z);
-        let n = self.normal_at(d, t);
-        let p = [x, h, z];
-        let flat = smoothstep(0.75, 0.92, n[1]);
-        let snow = smoothstep(self.snow_line, self.snow_line + SNOW_FADE, h) * smoothstep(0.55, 0.75, n[1]);
-        let albedo = mix3(mix3(ROCK, GRASS, flat), SNOW, snow);
-        let lambert = dot(n, self.sun).max(0.0);
-        let shadow = if lambert > 0.0 {
-            soft_shadow(&self.terrain, p, self.sun, self.shadow_steps, self.shadow_distance, self.shadow_softness)
-        } else {
-            0.0
+        let shadow = ShadowSettings {
+            steps: self.shadow_steps,
+            distance: self.shadow_distance,
+            softness: self.shadow_softness,
         };
-        let sky_light = 0.5 + 0.5 * n[1];
-        let light: V3 = std::array::from_fn(|i| SUN_COLOR[i] * lambert * shadow + AMBIENT[i] * sky_light);
-        let lit = std::array::from_fn(|i| albedo[i] * light[i]);
+        let light = SurfaceLight { sun_dir: self.sun, sun: self.sun_color, ambient: AMBIENT };
+        let lit = surface_radiance(&self.terrain, self.march.eps, &shadow, self.snow_line, self.camera.pos, d, t, &light);
         apply_fog(lit, t, self.sigma)
     }
 
