@@ -324,22 +324,27 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
     }
 }
 
-/// Refuses an output path whose directory does not exist or is not writable,
-/// before any GPU work.
 /// `X,Y,W,H` inside a `width` x `height` frame.
 fn parse_crop(text: &str, width: u32, height: u32) -> Result<(u32, u32, u32, u32), GoldenError> {
-    let allowed = format!("X,Y,W,H in pixels with W, H >= 1, X + W <= {width} and Y + H <= {height} (the --size frame)");
-    let v: Vec<u32> = text.split(',').map(|s| s.trim().parse::<u32>()).collect::<Result<_, _>>().map_err(|_| {
-        bad(format!("--crop {text} is not valid; expected {allowed}"))
-    })?;
+    let allowed =
+        format!("X,Y,W,H in pixels with W, H >= 1, X + W <= {width} and Y + H <= {height} (the --size frame)");
+    let v: Vec<u32> = text
+        .split(',')
+        .map(|s| s.trim().parse::<u32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad(format!("--crop {text} is not valid; expected {allowed}")))?;
     match v[..] {
-        [x, y, w, h] if w >= 1 && h >= 1 && x as u64 + w as u64 <= width as u64 && y as u64 + h as u64 <= height as u64 => {
+        [x, y, w, h]
+            if w >= 1 && h >= 1 && x as u64 + w as u64 <= width as u64 && y as u64 + h as u64 <= height as u64 =>
+        {
             Ok((x, y, w, h))
         }
         _ => Err(bad(format!("--crop {text} does not fit; expected {allowed}"))),
     }
 }
 
+/// Refuses an output path whose directory does not exist or is not writable,
+/// before any GPU work.
 fn check_output_path(out: &Path) -> Result<(), GoldenError> {
     let ext_ok = out
         .extension()
