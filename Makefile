@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves bench mutants lavapipe swiftshader validation browser build
+.PHONY: demo test golden curves seed-study bench mutants lavapipe swiftshader validation browser build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -50,6 +50,12 @@ golden: lavapipe build
 # Regenerate the step-count/quality curves in docs/curves.
 curves: lavapipe build
 	bash ci/curves.sh $(VISTA) docs/curves
+
+# The seed's clouds quality study on the whole landscape frame into
+# docs/seed-study (480x270 on lavapipe; SIZE=1920x1080 on a hardware GPU with
+# VISTA_STUDY_ARGS="--backend gpu" and VISTA_MAX_WORK raised). Not part of make test.
+seed-study: lavapipe build
+	bash ci/seed-study.sh $(VISTA) docs/seed-study $(or $(SIZE),480x270)
 
 # Mutation score of every kernel's suite into docs/mutants (not part of make test).
 mutants: lavapipe build

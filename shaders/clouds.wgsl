@@ -25,6 +25,9 @@ struct Params {
     cloud_base_km: f32,
     cloud_top_km: f32,
     coverage: f32,
+    coverage_oktas: i32,
+    okta_coverage_low: vec4<f32>,
+    okta_coverage_high: vec4<f32>,
     density_scale: f32,
     absorption: f32,
     profile_bottom: f32,
@@ -55,8 +58,24 @@ struct Params {
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
 
+// `coverage`, or with coverage_oktas = n >= 0 the preset's calibrated
+// coverage for n oktas (a table lookup; the CPU reads the same table).
+fn coverage() -> f32 {
+    let n = params.coverage_oktas;
+    if n < 0 {
+        return params.coverage;
+    }
+    if n == 0 {
+        return 0.0;
+    }
+    if n <= 4 {
+        return params.okta_coverage_low[n - 1];
+    }
+    return params.okta_coverage_high[n - 5];
+}
+
 fn slab() -> CloudSlab {
-    return cloud_slab(CloudParams(params.cloud_base_km, params.cloud_top_km, params.coverage, params.density_scale,
+    return cloud_slab(CloudParams(params.cloud_base_km, params.cloud_top_km, coverage(), params.density_scale,
         params.absorption, params.profile, params.profile_bottom, params.profile_top, params.noise_scale,
         params.noise_stretch, params.wind_offset, params.octaves, params.lacunarity, params.gain, params.seed,
         params.max_distance_km, params.steps, params.light_steps, params.light_spread, params.integrator, params.g1,

@@ -126,8 +126,24 @@ fn seed_experiment_on_the_gpu(ctx: &vista_golden::Renderer) {
     assert!(agree >= 50.0, "GPU vs CPU analytic/ign 32x6: {agree:.1} dB");
 }
 
+/// On the GPU coverage_oktas = n is exactly the preset's table entry for n
+/// (the WGSL looks it up; CPU tests check what the table means).
+fn coverage_oktas_reads_the_presets_table_on_the_gpu(ctx: &vista_golden::Renderer) {
+    for (preset, n) in [("cumulus", 0), ("cumulus", 3), ("stratocumulus", 6), ("cirrus", 8)] {
+        let p = params(preset, &[("coverage_oktas", &n.to_string())]);
+        let table = [p.vector("okta_coverage_low"), p.vector("okta_coverage_high")].concat();
+        let coverage = if n == 0 { 0.0 } else { table[n - 1] };
+        let by_oktas = gpu(ctx, &p, 48, 48);
+        let direct = gpu(ctx, &params(preset, &[("coverage", &format!("{coverage}"))]), 48, 48);
+        assert!(by_oktas.data == direct.data, "{preset} {n} oktas differs from coverage = {coverage}");
+        let cloudy = by_oktas.data.iter().filter(|px| px[3] > 0.01).count();
+        assert_eq!(cloudy == 0, n == 0, "{preset} {n} oktas: {cloudy} cloudy pixels");
+    }
+}
+
 fn main() {
     common::run_gpu_tests(&[
+        ("coverage_oktas_reads_the_presets_table_on_the_gpu", coverage_oktas_reads_the_presets_table_on_the_gpu),
         ("zero_coverage_is_exactly_the_background", zero_coverage_is_exactly_the_background),
         ("doubling_density_never_raises_transmittance", doubling_density_never_raises_transmittance),
         (

@@ -140,10 +140,14 @@ fn cloud_density(s: CloudSlab, p: vec3<f32>) -> f32 {
     return s.c.density_scale * profile * shape;
 }
 
-// Optical depth toward the sun (unit sun_dir) up to the slab top: midpoint
-// rule on steps growing geometrically (first = light_first of the path,
-// ratio light_growth).
-fn sun_optical_depth(s: CloudSlab, p: vec3<f32>, sun_dir: vec3<f32>) -> f32 {
+// Optical depth toward the sun (unit sun_dir, above the horizon) through
+// the slab from p: midpoint rule on steps growing geometrically (first =
+// light_first of the path, ratio light_growth) from where the sun ray is
+// first inside the slab (p itself for a point in the slab; the base for a
+// point below it, so a cloud shadow on the ground spends no step in the
+// empty air under the layer) up to its top, cut at max_distance from there.
+fn sun_optical_depth(s: CloudSlab, p_from: vec3<f32>, sun_dir: vec3<f32>) -> f32 {
+    let p = p_from + sun_dir * max(0.0, (s.c.base_km - p_from.y) / sun_dir.y);
     let len = clamp((s.c.top_km - p.y) / sun_dir.y, 0.0, s.c.max_distance_km);
     let ext = 1.0 + s.c.absorption;
     var dt = len * s.light_first;

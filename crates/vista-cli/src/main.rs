@@ -73,6 +73,9 @@ enum Command {
         /// structured error such as banding, not pixel noise.
         #[arg(long, value_name = "R", default_value_t = 0)]
         blur: u32,
+        /// Compare only this rectangle of both images: X,Y,W,H in pixels.
+        #[arg(long, value_name = "X,Y,W,H")]
+        crop: Option<String>,
     },
     /// Render golden cases and compare them with their goldens.
     Check {
@@ -269,11 +272,16 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
             }
             Ok(0)
         }
-        Command::Compare { a, b, json, hdr, blur } => {
+        Command::Compare { a, b, json, hdr, blur, crop } => {
             if blur > 64 {
                 return Err(bad(format!("--blur {blur} is out of range; allowed: 0 to 64")));
             }
             let (mut ia, mut ib) = (vista_image::load(&a)?, vista_image::load(&b)?);
+            if let Some(c) = crop {
+                let (x, y, w, h) = parse_crop(&c, ia.width.min(ib.width), ia.height.min(ib.height))?;
+                let cut = |i: &vista_image::Image| i.crop(x, y, w, h).expect("the crop was checked against both sizes");
+                (ia, ib) = (cut(&ia), cut(&ib));
+            }
             if blur > 0 {
                 (ia, ib) = (ia.box_blur(blur), ib.box_blur(blur));
             }
@@ -326,8 +334,7 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
 
 /// `X,Y,W,H` inside a `width` x `height` frame.
 fn parse_crop(text: &str, width: u32, height: u32) -> Result<(u32, u32, u32, u32), GoldenError> {
-    let allowed =
-        format!("X,Y,W,H in pixels with W, H >= 1, X + W <= {width} and Y + H <= {height} (the --size frame)");
+    let allowed = format!("X,Y,W,H in pixels with W, H >= 1, X + W <= {width} and Y + H <= {height} (the image)");
     let v: Vec<u32> = text
         .split(',')
         .map(|s| s.trim().parse::<u32>())

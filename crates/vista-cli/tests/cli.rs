@@ -209,6 +209,12 @@ fn compare_reports_json_fields_and_rejects_bad_files() {
     let blurred = vista(&["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--json", "--blur", "2"]);
     assert!(psnr(&blurred.stdout) > psnr(&diff.stdout) + 1.0, "{} vs {}", blurred.stdout, diff.stdout);
     assert_rejected(&vista(&["compare", a.to_str().unwrap(), a.to_str().unwrap(), "--blur", "65"]), 2, &["--blur 65"]);
+    // A crop compares that rectangle only: a's left half against itself is identical.
+    let half = vista(&["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--json", "--crop", "0,0,16,32"]);
+    assert_eq!(half.code, 0, "{}", half.stderr);
+    assert_ne!(psnr(&half.stdout), psnr(&diff.stdout));
+    let args = ["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--crop", "20,0,16,32"];
+    assert_rejected(&vista(&args), 2, &["--crop 20,0,16,32 does not fit", "X + W <= 32"]);
     let corrupt = d.path().join("corrupt.png");
     std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnot really").unwrap();
     assert_rejected(&vista(&["compare", a.to_str().unwrap(), corrupt.to_str().unwrap()]), 2, &["corrupt.png"]);

@@ -373,3 +373,92 @@ fn with_the_camera_inside_the_layer_the_march_starts_at_the_camera() {
     }
     assert!(checked >= 20 && distinct >= 5, "only {checked} rays checked, {distinct} with cloud behind the camera");
 }
+
+/// Seeds the okta calibration averages over, and the others the test below
+/// checks: 16 and 12, doubled for altostratus, whose 7 x 13 km cells make a
+/// single sky one of only a few draws (single seeds scatter from 0.30 to 0.62
+/// at 4 oktas), so its means need twice the seeds to settle within 1/16.
+fn okta_seeds(preset: &str, held_out: bool) -> std::ops::Range<u32> {
+    let k = if preset == "altostratus" { 2 } else { 1 };
+    if held_out { 16 * k..16 * k + 12 * k } else { 0..16 * k }
+}
+/// Sky directions per side of the okta grid (32 x 32 = 1024 rays).
+const SKY_GRID: u32 = 32;
+
+fn sky_cover_at(preset: &str, set: &[(&str, &str)], seed: u32) -> f64 {
+    let mut s = set.to_vec();
+    let seed = seed.to_string();
+    s.push(("seed", &seed));
+    Clouds::from_params(&params(preset, &s)).sky_cover(SKY_GRID)
+}
+
+/// Regenerates each preset's okta table (paste into kernels/clouds.toml):
+/// for n = 1..8 the coverage at which the sky cover, averaged over the
+/// calibration seeds (okta_seeds), is n / 8 (8: 31/32, inside the 1/16
+/// band), by bisection. `cargo test -p vista-kernels --test clouds
+/// calibrate_oktas --release -- --ignored --nocapture` (VISTA_CALIBRATE=genus
+/// for one).
+#[test]
+#[ignore]
+fn calibrate_oktas() {
+    let only = std::env::var("VISTA_CALIBRATE").ok();
+    for preset in GENERA.iter().filter(|g| only.as_deref().is_none_or(|o| o == **g)) {
+        let seeds = okta_seeds(preset, false);
+        let mean = |c: f64| {
+            let c = format!("{c:.5}");
+            seeds.clone().map(|s| sky_cover_at(preset, &[("coverage", &c)], s)).sum::<f64>() / seeds.len() as f64
+        };
+        let mut table = Vec::new();
+        for n in 1..=8 {
+            let target = if n == 8 { 31.0 / 32.0 } else { n as f64 / 8.0 };
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            for _ in 0..18 {
+                let mid = 0.5 * (lo + hi);
+                if mean(mid) < target { lo = mid } else { hi = mid }
+            }
+            table.push(hi);
+        }
+        let f = |v: &[f64]| v.iter().map(|c| format!("{c:.4}")).collect::<Vec<_>>().join(", ");
+        println!(
+            "[preset.{preset}]\nokta_coverage_low = [{}]\nokta_coverage_high = [{}]",
+            f(&table[..4]),
+            f(&table[4..])
+        );
+    }
+}
+
+/// Where the 1/16 cannot hold, and why (measured; README "Cloud amount in
+/// oktas"): (genus, oktas, allowed distance of the held-out mean from n / 8).
+/// Cirrostratus is a veil of 0.25/km whose vertical optical depth is about
+/// 0.09: even at full coverage its thinnest directions stay under tau = 0.1,
+/// so it tops out at 0.86 of the sky (7 oktas), which 8 then gives.
+const OKTA_LIMITS: [(&str, i32, f64); 1] = [("cirrostratus", 8, 0.15)];
+
+/// coverage_oktas = n gives n / 8 of the sky directions (those that reach
+/// the layer) an optical depth above 0.1, within 1/16, for every genus and
+/// every n (but OKTA_LIMITS), averaged over seeds the calibration never
+/// saw (okta_seeds). One seed's sky is one draw of the noise field, and a layer
+/// with large cells shows only a few of them, so single seeds scatter more;
+/// the worst single seed is printed.
+#[test]
+fn coverage_oktas_gives_that_fraction_of_the_sky_within_a_sixteenth() {
+    let mut failures = Vec::new();
+    for preset in GENERA {
+        let (mut row, mut worst_seed) = (format!("{preset:14}"), 0.0f64);
+        for n in 0..=8 {
+            let n_text = n.to_string();
+            let fr: Vec<f64> =
+                okta_seeds(preset, true).map(|s| sky_cover_at(preset, &[("coverage_oktas", &n_text)], s)).collect();
+            let mean = fr.iter().sum::<f64>() / fr.len() as f64;
+            let target = n as f64 / 8.0;
+            worst_seed = fr.iter().map(|f| (f - target).abs()).fold(worst_seed, f64::max);
+            row += &format!(" {n}:{mean:.3}");
+            let limit = OKTA_LIMITS.iter().find(|l| l.0 == *preset && l.1 == n).map_or(1.0 / 16.0, |l| l.2);
+            if (mean - target).abs() > limit {
+                failures.push(format!("{preset} {n} oktas: mean sky cover {mean:.3} over seeds {fr:.3?}"));
+            }
+        }
+        eprintln!("{row} | worst single seed off by {worst_seed:.3}");
+    }
+    assert!(failures.is_empty(), "okta calibration misses its bound:\n{}", failures.join("\n"));
+}

@@ -18,6 +18,25 @@ pub const T_CUTOFF: Real = 1e-4;
 pub const TAU_SUN_CUTOFF: Real = 16.0;
 
 
+/// A sky direction counts as cloudy when its optical depth exceeds this
+/// (transmittance below 0.905: visibly cloud, SPEC's oktas calibration).
+pub const OKTA_TAU: Real = 0.1;
+/// Midpoint samples per sky direction in [`Clouds::sky_cover`].
+pub const OKTA_SAMPLES: u32 = 96;
+
+/// The coverage a parameter set asks for: `coverage` itself, or with
+/// `coverage_oktas` = n >= 0 the preset's calibrated coverage for n oktas
+/// (0 for none; `okta_coverage_low` holds 1-4, `okta_coverage_high` 5-8).
+/// The WGSL looks the same table up.
+pub fn coverage_of(p: &ParamSet) -> Real {
+    match p.int("coverage_oktas") {
+        n if n < 0 => real(p, "coverage"),
+        0 => 0.0,
+        n @ 1..=4 => p.vector("okta_coverage_low")[n as usize - 1] as Real,
+        n => p.vector("okta_coverage_high")[n as usize - 5] as Real,
+    }
+}
+
 /// remap(x, a, b, c, d) = c + (x - a)(d - c)/(b - a); with b == a (no
 /// interval) it is the step c below and d above a. Clouds only use it with
 /// a = 1 - coverage, b = 1, so coverage 0 gives c = 0 for every G <= 1.
@@ -140,7 +159,7 @@ impl Clouds {
         Clouds {
             base: real(p, "cloud_base_km"),
             top: real(p, "cloud_top_km"),
-            coverage: real(p, "coverage"),
+            coverage: coverage_of(p),
             density_scale: real(p, "density_scale"),
             absorption: real(p, "absorption"),
             profile: match p.choice("profile") {
@@ -243,7 +262,8 @@ impl Clouds {
 
     /// Optical depth from p toward the sun to the slab's top (midpoint rule
     /// on `light_steps` geometrically growing steps, cut at max_distance
-    /// and at TAU_SUN_CUTOFF).
+    /// and at TAU_SUN_CUTOFF). A point below the slab (the ground, for a
+    /// cloud shadow) starts where its sun ray enters the slab.
     pub fn sun_optical_depth(&self, p: V3) -> Real {
         self.sun_march(p).0
     }
@@ -251,6 +271,8 @@ impl Clouds {
     /// (optical depth toward the sun, density evaluations spent).
     fn sun_march(&self, p: V3) -> (Real, u32) {
         let s = self.sun_dir;
+        // From where the sun ray enters the slab (p itself inside it).
+        let p = add(p, scale(s, ((self.base - p[1]) / s[1]).max(0.0)));
         let len = ((self.top - p[1]) / s[1]).clamp(0.0, self.max_distance);
         let (first, growth) = self.light_step_layout();
         let mut dt = len * first;
@@ -335,6 +357,43 @@ impl Clouds {
         }
         out.transmittance = t_view;
         out
+    }
+
+    /// Optical depth (extinction) of the ray o + t d through the slab, by the
+    /// midpoint rule with `samples` steps over its slab segment.
+    pub fn optical_depth(&self, o: V3, d: V3, samples: u32) -> Real {
+        let Some((t0, t1)) = self.slab_segment(o, d) else { return 0.0 };
+        let dt = (t1 - t0) / samples as Real;
+        let ext = 1.0 + self.absorption;
+        (0..samples).map(|k| self.density(add(o, scale(d, t0 + (k as Real + 0.5) * dt)))).sum::<Real>() * ext * dt
+    }
+
+    /// Cloud amount as an observer at the camera counts it: the fraction of
+    /// sky directions whose optical depth exceeds [`OKTA_TAU`]. The sky is
+    /// the upper hemisphere in `n` x `n` cells of equal solid angle (azimuth
+    /// uniform, sin(elevation) uniform, one ray through each cell's centre),
+    /// less the directions that do not reach the layer within
+    /// max_distance_km (near the horizon under a high layer): no cloud can
+    /// show there in this render, whatever the coverage.
+    pub fn sky_cover(&self, n: u32) -> Real {
+        let o = self.view.pos;
+        let (mut sky, mut cloudy) = (0u32, 0u32);
+        for i in 0..n {
+            let sin_e = (i as Real + 0.5) / n as Real;
+            let cos_e = (1.0 - sin_e * sin_e).sqrt();
+            for j in 0..n {
+                let az = 2.0 * super::consts::PI * (j as Real + 0.5) / n as Real;
+                let d = [cos_e * az.sin(), sin_e, cos_e * az.cos()];
+                if self.slab_segment(o, d).is_none() {
+                    continue;
+                }
+                sky += 1;
+                if self.optical_depth(o, d, OKTA_SAMPLES) > OKTA_TAU {
+                    cloudy += 1;
+                }
+            }
+        }
+        if sky == 0 { 0.0 } else { cloudy as Real / sky as Real }
     }
 
     /// Final pixel value: (L + T * background, 1 - T).
