@@ -7,8 +7,6 @@
 
 mod common;
 
-use std::path::Path;
-
 use vista_golden::{Agreement, Renderer, agreement};
 use vista_image::Image;
 use vista_kernels::Kernel;
@@ -239,32 +237,10 @@ const FAULTS: &[Fault] = &[
     ),
 ];
 
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap().flatten() {
-        let (src, dst) = (e.path(), to.join(e.file_name()));
-        if src.is_dir() { copy_tree(&src, &dst) } else { std::fs::copy(&src, &dst).map(|_| ()).unwrap() }
-    }
-}
-
-/// A renderer over a temporary project whose shaders are this checkout's
-/// with `file`'s `from` replaced by `to` (the checkout is never written).
-fn with_edit(gpu: &Renderer<'static>, file: &str, from: &str, to: &str) -> (tempfile::TempDir, Renderer<'static>) {
-    let t = tempfile::tempdir().unwrap();
-    std::fs::write(t.path().join("vista.toml"), "").unwrap();
-    copy_tree(&common::project().root().unwrap().join("shaders"), &t.path().join("shaders"));
-    let path = t.path().join("shaders").join(file);
-    let text = std::fs::read_to_string(&path).unwrap();
-    assert_eq!(text.matches(from).count(), 1, "{file}: '{from}' must occur exactly once (shader changed?)");
-    std::fs::write(&path, text.replace(from, to)).unwrap();
-    let project = vista_project::Project::at(t.path()).unwrap();
-    (t, Renderer::new(gpu.ctx, &project).unwrap())
-}
-
 fn a_five_percent_constant_change_fails_an_agreement_bound(gpu: &Renderer<'static>) {
     let mut survived = Vec::new();
     for (kernel, file, from, to) in FAULTS {
-        let (_dir, edited) = with_edit(gpu, file, from, to);
+        let (_dir, edited) = common::with_edit(gpu, file, from, to);
         let v = violations(&edited, kernel);
         eprintln!("fault {kernel} {file}: '{from}' -> '{to}': {} settings out of bounds {v:?}", v.len());
         if v.is_empty() {
@@ -314,7 +290,7 @@ fn heightfield_depth_agrees_over_pixels_where_either_side_hits(gpu: &Renderer) {
 
 fn dropping_the_hit_refinement_fails_the_depth_agreement(gpu: &Renderer<'static>) {
     let refined = "return Hit(true, refine(s, m.eps, o, d, prev, vec2(t, dh)), k);";
-    let (_dir, edited) = with_edit(gpu, "lib/terrain.wgsl", refined, "return Hit(true, t, k);");
+    let (_dir, edited) = common::with_edit(gpu, "lib/terrain.wgsl", refined, "return Hit(true, t, k);");
     for (preset, min_pct) in DEPTH_AGREEMENT_PCT {
         let (ok, n) = depth_agreement(&edited, preset);
         let pct = 100.0 * ok as f64 / n as f64;

@@ -150,8 +150,37 @@ fn one_octave_fbm_equals_the_basis_on_gpu(ctx: &vista_golden::Renderer) {
     }
 }
 
+/// Perlin skips the upper face of its cell on an integer z plane (weight
+/// exactly 0): every 2D perlin kernel must render bit-identical raw output
+/// with and without that shortcut.
+fn the_integer_z_shortcut_is_bit_identical_to_the_full_formula(gpu: &vista_golden::Renderer<'static>) {
+    let (_dir, full) = common::with_edit(gpu, "lib/noise.wgsl", "if f.z == 0.0 {", "if false {");
+    for (name, preset, size) in [
+        ("fbm", "default", (128, 96)),
+        ("fbm", "rough", (128, 96)),
+        ("ridged", "default", (128, 96)),
+        ("heightfield", "ridges", (64, 40)),
+        ("landscape", "seed", (64, 36)),
+        ("clouds", "cumulus", (48, 48)),
+    ] {
+        let k = vista_kernels::find(name).unwrap();
+        let p = common::params(k, Some(preset), &[]);
+        let (w, h) = size;
+        let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
+        let b = vista_golden::render(&full, k, &p, w, h).unwrap().raw;
+        assert!(
+            a.data.iter().flatten().zip(b.data.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits()),
+            "{name} {preset}: the integer-z shortcut changes the output"
+        );
+    }
+}
+
 fn main() {
     common::run_gpu_tests(&[
+        (
+            "the_integer_z_shortcut_is_bit_identical_to_the_full_formula",
+            the_integer_z_shortcut_is_bit_identical_to_the_full_formula,
+        ),
         (
             "fbm_f32_error_follows_the_coordinate_precision_estimate",
             fbm_f32_error_follows_the_coordinate_precision_estimate,

@@ -40,9 +40,17 @@ fn perlin(p: vec3<f32>) -> f32 {
     let bb = perm[b + 1u] + i.z;
     let x0 = mix(perlin_grad(perm[aa], f), perlin_grad(perm[ba], f - vec3(1.0, 0.0, 0.0)), w.x);
     let x1 = mix(perlin_grad(perm[ab], f - vec3(0.0, 1.0, 0.0)), perlin_grad(perm[bb], f - vec3(1.0, 1.0, 0.0)), w.x);
+    let lower = mix(x0, x1, w.y);
+    // On an integer z plane (the 2D kernels' z_slice 0: fbm, ridged, the
+    // terrains) w.z = 0, so the upper face weighs exactly 0 and
+    // mix(lower, upper, 0) = lower: its four corners are skipped, with the
+    // same result (tests/noise.rs checks the bits against the full formula).
+    if f.z == 0.0 {
+        return lower;
+    }
     let x2 = mix(perlin_grad(perm[aa + 1u], f - vec3(0.0, 0.0, 1.0)), perlin_grad(perm[ba + 1u], f - vec3(1.0, 0.0, 1.0)), w.x);
     let x3 = mix(perlin_grad(perm[ab + 1u], f - vec3(0.0, 1.0, 1.0)), perlin_grad(perm[bb + 1u], f - vec3(1.0, 1.0, 1.0)), w.x);
-    return mix(mix(x0, x1, w.y), mix(x2, x3, w.y), w.z);
+    return mix(lower, mix(x2, x3, w.y), w.z);
 }
 
 // Lattice value in [-1, 1): pcg3d of the signed cell, seed folded into z by a Weyl step.

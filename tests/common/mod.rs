@@ -66,3 +66,26 @@ pub fn run_gpu_tests(tests: &[GpuTest]) -> ! {
         .collect();
     libtest_mimic::run(&args, trials).exit()
 }
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let (src, dst) = (e.path(), to.join(e.file_name()));
+        if src.is_dir() { copy_tree(&src, &dst) } else { std::fs::copy(&src, &dst).map(|_| ()).unwrap() }
+    }
+}
+
+/// A renderer over a temporary copy of this checkout's shaders with one
+/// edit (`from`, which must occur exactly once, replaced by `to`): the
+/// checkout itself is never written. Keep the TempDir alive while rendering.
+pub fn with_edit(gpu: &Renderer<'static>, file: &str, from: &str, to: &str) -> (tempfile::TempDir, Renderer<'static>) {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(t.path().join("vista.toml"), "").unwrap();
+    copy_tree(&project().root().unwrap().join("shaders"), &t.path().join("shaders"));
+    let path = t.path().join("shaders").join(file);
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(text.matches(from).count(), 1, "{file}: '{from}' must occur exactly once (shader changed?)");
+    std::fs::write(&path, text.replace(from, to)).unwrap();
+    let project = vista_project::Project::at(t.path()).unwrap();
+    (t, Renderer::new(gpu.ctx, &project).unwrap())
+}
