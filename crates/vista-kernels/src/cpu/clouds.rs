@@ -376,23 +376,29 @@ impl Clouds {
     /// max_distance_km (near the horizon under a high layer): no cloud can
     /// show there in this render, whatever the coverage.
     pub fn sky_cover(&self, n: u32) -> Real {
+        use rayon::prelude::*;
         let o = self.view.pos;
-        let (mut sky, mut cloudy) = (0u32, 0u32);
-        for i in 0..n {
-            let sin_e = (i as Real + 0.5) / n as Real;
-            let cos_e = (1.0 - sin_e * sin_e).sqrt();
-            for j in 0..n {
-                let az = 2.0 * super::consts::PI * (j as Real + 0.5) / n as Real;
-                let d = [cos_e * az.sin(), sin_e, cos_e * az.cos()];
-                if self.slab_segment(o, d).is_none() {
-                    continue;
+        // (directions reaching the layer, cloudy ones) per elevation row, on all cores.
+        let (sky, cloudy) = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let sin_e = (i as Real + 0.5) / n as Real;
+                let cos_e = (1.0 - sin_e * sin_e).sqrt();
+                let (mut sky, mut cloudy) = (0u32, 0u32);
+                for j in 0..n {
+                    let az = 2.0 * super::consts::PI * (j as Real + 0.5) / n as Real;
+                    let d = [cos_e * az.sin(), sin_e, cos_e * az.cos()];
+                    if self.slab_segment(o, d).is_none() {
+                        continue;
+                    }
+                    sky += 1;
+                    if self.optical_depth(o, d, OKTA_SAMPLES) > OKTA_TAU {
+                        cloudy += 1;
+                    }
                 }
-                sky += 1;
-                if self.optical_depth(o, d, OKTA_SAMPLES) > OKTA_TAU {
-                    cloudy += 1;
-                }
-            }
-        }
+                (sky, cloudy)
+            })
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         if sky == 0 { 0.0 } else { cloudy as Real / sky as Real }
     }
 
