@@ -3,11 +3,10 @@
 // hit at p.y - h < eps * t, refined by interpolation; Lambert sun, soft
 // shadow, sky ambient, fog with extinction sigma = 3.912 / visibility.
 // Params are packed by name from kernels/heightfield.toml; the camera basis,
-// sun direction, octave rotation, terrain normaliser and fog extinction are
-// derived here, never on the host.
-#import vista::fractal::{FbmSettings, RidgedSettings, fbm_amplitude, ridged_max}
+// sun direction and fog extinction are derived here, the octave rotation and
+// terrain normaliser in lib/terrain.wgsl: in WGSL, never on the host.
 #import vista::geometry::{direction, pinhole_look_at, pinhole_ray}
-#import vista::terrain::{Light, March, Shadow, TERRAIN_FBM, TERRAIN_RIDGED, Terrain, march, normal_at, surface_radiance}
+#import vista::terrain::{Light, March, Shadow, Terrain, TerrainParams, march, normal_at, surface_radiance, terrain_of}
 
 struct Params {
     width: u32,
@@ -58,19 +57,9 @@ const SKY_ZENITH = vec3(0.18, 0.34, 0.66);
 const KOSCHMIEDER: f32 = 3.912;
 
 fn terrain() -> Terrain {
-    let theta = radians(params.octave_rotation_deg);
-    let fbm = FbmSettings(params.basis, params.seed, params.octaves, params.lacunarity, params.gain,
-                          cos(theta), sin(theta));
-    let ridged = RidgedSettings(params.basis, params.seed, params.octaves, params.lacunarity, params.ridge_h,
-                                params.ridge_offset, params.ridge_gain);
-    // T's normaliser: 1 / A (fbm) or 1 / max (ridged).
-    var inv_norm = 1.0;
-    if params.terrain == TERRAIN_FBM {
-        inv_norm = 1.0 / fbm_amplitude(params.octaves, params.gain);
-    } else if params.terrain == TERRAIN_RIDGED {
-        inv_norm = 1.0 / ridged_max(ridged);
-    }
-    return Terrain(params.terrain, fbm, ridged, params.amplitude, params.scale, params.plane_slope, inv_norm);
+    return terrain_of(TerrainParams(params.terrain, params.basis, params.seed, params.octaves, params.lacunarity,
+        params.gain, params.octave_rotation_deg, params.ridge_h, params.ridge_offset, params.ridge_gain,
+        params.amplitude, params.scale, params.plane_slope));
 }
 
 fn sky(d: vec3<f32>) -> vec3<f32> {

@@ -22,10 +22,9 @@
 // sky light. The cloud's sun is E_sun T_sun at the middle of its segment. Without a cloud segment (or
 // with coverage or density 0) the ray is one atmosphere segment.
 #import vista::cloud_slab::{CloudParams, CloudSlab, cloud_march, cloud_slab, jitter_offset, slab_segment, sun_optical_depth}
-#import vista::fractal::{FbmSettings, RidgedSettings, fbm_amplitude, ridged_max}
 #import vista::geometry::{direction, latlong_direction, pinhole_looking, pinhole_ray}
 #import vista::sky::{Atmosphere, sky_segment, sun_transmittance_along, view_segment}
-#import vista::terrain::{Light, March, Shadow, TERRAIN_FBM, TERRAIN_RIDGED, Terrain, march, surface_point, surface_radiance}
+#import vista::terrain::{Light, March, Shadow, Terrain, TerrainParams, march, surface_point, surface_radiance, terrain_of}
 
 // Packed by name from kernels/landscape.toml (exposure is the host's tone map).
 struct Params {
@@ -105,18 +104,9 @@ const KM: f32 = 1000.0;
 const PI: f32 = 3.141592653589793;
 
 fn terrain() -> Terrain {
-    let theta = radians(params.octave_rotation_deg);
-    let fbm = FbmSettings(params.basis, params.seed, params.octaves, params.lacunarity, params.gain,
-                          cos(theta), sin(theta));
-    let ridged = RidgedSettings(params.basis, params.seed, params.octaves, params.lacunarity, params.ridge_h,
-                                params.ridge_offset, params.ridge_gain);
-    var inv_norm = 1.0;
-    if params.terrain == TERRAIN_FBM {
-        inv_norm = 1.0 / fbm_amplitude(params.octaves, params.gain);
-    } else if params.terrain == TERRAIN_RIDGED {
-        inv_norm = 1.0 / ridged_max(ridged);
-    }
-    return Terrain(params.terrain, fbm, ridged, params.amplitude, params.scale, params.plane_slope, inv_norm);
+    return terrain_of(TerrainParams(params.terrain, params.basis, params.seed, params.octaves, params.lacunarity,
+        params.gain, params.octave_rotation_deg, params.ridge_h, params.ridge_offset, params.ridge_gain,
+        params.amplitude, params.scale, params.plane_slope));
 }
 
 fn slab() -> CloudSlab {

@@ -5,7 +5,7 @@
 // such as the normaliser, computed by the caller's WGSL).
 #define_import_path vista::terrain
 
-#import vista::fractal::{FbmSettings, RidgedSettings, fbm2, ridged2}
+#import vista::fractal::{FbmSettings, RidgedSettings, fbm2, fbm_amplitude, ridged2, ridged_max}
 
 const TERRAIN_FBM: u32 = 0u;
 const TERRAIN_RIDGED: u32 = 1u;
@@ -28,6 +28,39 @@ struct Terrain {
     plane_slope: vec2<f32>,
     // T's normaliser: 1 / A (fbm) or 1 / ridged max (ridged); 1 otherwise.
     inv_norm: f32,
+}
+
+// The terrain params as a kernel's manifest names them (heightfield, landscape).
+struct TerrainParams {
+    kind: u32,
+    basis: u32,
+    seed: u32,
+    octaves: u32,
+    lacunarity: f32,
+    gain: f32,
+    octave_rotation_deg: f32,
+    ridge_h: f32,
+    ridge_offset: f32,
+    ridge_gain: f32,
+    amplitude: f32,
+    scale: f32,
+    plane_slope: vec2<f32>,
+}
+
+// The terrain of those params, with what is derived from them (the octave
+// rotation's cos/sin; T's normaliser: 1 / A for fbm, 1 / max for ridged)
+// computed here, once per invocation.
+fn terrain_of(p: TerrainParams) -> Terrain {
+    let theta = radians(p.octave_rotation_deg);
+    let fbm = FbmSettings(p.basis, p.seed, p.octaves, p.lacunarity, p.gain, cos(theta), sin(theta));
+    let ridged = RidgedSettings(p.basis, p.seed, p.octaves, p.lacunarity, p.ridge_h, p.ridge_offset, p.ridge_gain);
+    var inv_norm = 1.0;
+    if p.kind == TERRAIN_FBM {
+        inv_norm = 1.0 / fbm_amplitude(p.octaves, p.gain);
+    } else if p.kind == TERRAIN_RIDGED {
+        inv_norm = 1.0 / ridged_max(ridged);
+    }
+    return Terrain(p.kind, fbm, ridged, p.amplitude, p.scale, p.plane_slope, inv_norm);
 }
 
 // The relax march (SPEC 3.4).
