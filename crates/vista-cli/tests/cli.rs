@@ -582,35 +582,51 @@ fn consistent(d: &Path, fx: &BlessFixture) -> Result<(), String> {
 fn interrupted_bless_leaves_every_golden_old_or_new() {
     let fx = bless_fixture();
     assert!(fx.old.iter().zip(&fx.new).all(|(a, b)| a != b), "every case must change");
-    let mut plain_broken = 0;
-    for writer in ["", "plain,"] {
-        for stop in ["partial", "before-rename"] {
-            for n in 1..=BLESS_WRITES {
-                let d = blessed_project();
-                std::fs::write(cases_path(d.path()), changed_cases()).unwrap();
-                let fault = format!("{writer}{stop}:{n}");
-                let r = vista_in(Some(d.path()), &[("VISTA_FAULT", &fault)], &["bless"]);
-                assert_ne!(r.code, 0, "{fault}: the fault must stop the bless");
-                assert!(r.stderr.contains("VISTA_FAULT: stopping at"), "{fault}: {}", r.stderr);
-                let verdict = consistent(d.path(), &fx);
-                if writer.is_empty() {
-                    verdict.unwrap_or_else(|e| panic!("{fault}: {e}"));
-                    // check reports an unfinished case instead of passing it silently.
-                    let c = vista_in(Some(d.path()), &[], &["check"]);
-                    let unfinished = c.stdout.contains("interrupted bless was replacing");
-                    assert!(c.code == 1 || !unfinished, "{fault}: {}", c.stdout);
-                    // A complete bless afterwards converges and clears stale temp files.
-                    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0, "{fault}");
-                    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0, "{fault}");
-                    let left: Vec<_> =
-                        walk(d.path()).into_iter().filter(|p| p.to_string_lossy().ends_with(".tmp")).collect();
-                    assert!(left.is_empty(), "{fault}: temp files left after a full bless: {left:?}");
-                } else if verdict.is_err() {
-                    plain_broken += 1;
+    // Every fault point starts from a copy of one blessed project (a bless
+    // is deterministic), and the points run on a few threads: each is a
+    // handful of vista processes that mostly wait on the device.
+    let template = blessed_project();
+    let points: Vec<(&str, &str, usize)> = ["", "plain,"]
+        .into_iter()
+        .flat_map(|w| {
+            ["partial", "before-rename"].into_iter().flat_map(move |s| (1..=BLESS_WRITES).map(move |n| (w, s, n)))
+        })
+        .collect();
+    let broken = std::sync::atomic::AtomicUsize::new(0);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    std::thread::scope(|scope| {
+        for _ in 0..4 {
+            scope.spawn(|| {
+                while let Some(&(writer, stop, n)) = points.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+                {
+                    let d = tmp();
+                    copy_tree(template.path(), d.path());
+                    std::fs::write(cases_path(d.path()), changed_cases()).unwrap();
+                    let fault = format!("{writer}{stop}:{n}");
+                    let r = vista_in(Some(d.path()), &[("VISTA_FAULT", &fault)], &["bless"]);
+                    assert_ne!(r.code, 0, "{fault}: the fault must stop the bless");
+                    assert!(r.stderr.contains("VISTA_FAULT: stopping at"), "{fault}: {}", r.stderr);
+                    let verdict = consistent(d.path(), &fx);
+                    if writer.is_empty() {
+                        verdict.unwrap_or_else(|e| panic!("{fault}: {e}"));
+                        // check reports an unfinished case instead of passing it silently.
+                        let c = vista_in(Some(d.path()), &[], &["check"]);
+                        let unfinished = c.stdout.contains("interrupted bless was replacing");
+                        assert!(c.code == 1 || !unfinished, "{fault}: {}", c.stdout);
+                        // A complete bless afterwards converges and clears stale temp files.
+                        assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0, "{fault}");
+                        assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0, "{fault}");
+                        let left: Vec<_> =
+                            walk(d.path()).into_iter().filter(|p| p.to_string_lossy().ends_with(".tmp")).collect();
+                        assert!(left.is_empty(), "{fault}: temp files left after a full bless: {left:?}");
+                    } else if verdict.is_err() {
+                        broken.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    }
                 }
-            }
+            });
         }
-    }
+    });
+    let plain_broken = broken.into_inner();
     assert!(plain_broken >= 3, "the plain writer broke consistency only {plain_broken} times: the check cannot fail");
     assert_rejected(&vista_in(None, &[("VISTA_FAULT", "sometimes")], &["list"]), 2, &["VISTA_FAULT item 'sometimes'"]);
 }
