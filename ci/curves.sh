@@ -57,6 +57,20 @@ sweep clouds-riemann-none-linear clouds --preset cumulus --set integrator=rieman
     --param steps --values 8,16,32,64,128,256 --param2 light_steps --values2 2,4,6,12,24 --size 96x96
 sweep clouds-analytic-ign-linear clouds --preset cumulus --set integrator=analytic --set jitter=ign --metric linear \
     --param steps --values 8,16,32,64,128,256 --param2 light_steps --values2 2,4,6,12,24 --size 96x96
+# Issue 19's cheaper sampling, at the light-step count where the primary
+# march is the bottleneck (4): primary steps growing geometrically from the
+# camera (step_spread, 1 = the uniform steps above), at both sizes the
+# target names; and golden-ratio offsets per step (the grid of
+# clouds-analytic-ign, whose steps share one offset).
+sweep clouds-analytic-ign-step_spread clouds --preset cumulus --set integrator=analytic --set jitter=ign \
+    --set light_steps=4 --param steps --values 32,40,44,48,52,56,64 --param2 step_spread --values2 1,1.5,2,4,8 --size 96x96
+sweep clouds-analytic-ign-step_spread-128x96 clouds --preset cumulus --set integrator=analytic --set jitter=ign \
+    --set light_steps=4 --param steps --values 32,40,44,48,52,56,64 --param2 step_spread --values2 1,1.5,2,4,8 --size 128x96
+sweep clouds-analytic-ign-golden clouds --preset cumulus --set integrator=analytic --set jitter=ign --set jitter_steps=golden \
+    --param steps --values 8,16,32,64,128,256 --param2 light_steps --values2 2,4,6,12,24 --size 96x96
+# The baseline they must match, at 128x96 as well (96x96 is clouds-riemann-none).
+sweep clouds-riemann-none-128x96 clouds --preset cumulus --set integrator=riemann --set jitter=none \
+    --param steps --values 32,64,128 --param2 light_steps --values2 6,12,24 --size 128x96
 # Atmosphere: view x light samples at two sun elevations (reference 512 x 128).
 sweep atmosphere-afternoon atmosphere --preset afternoon \
     --param view_samples --values 4,8,16,32,64,128 --param2 light_samples --values2 2,4,8,16,32 --size 128x64

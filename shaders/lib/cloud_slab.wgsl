@@ -14,6 +14,9 @@
 const INTEGRATOR_ANALYTIC: u32 = 1u;
 const JITTER_WHITE: u32 = 1u;
 const JITTER_IGN: u32 = 2u;
+const JITTER_STEPS_GOLDEN: u32 = 1u;
+// 1 / golden ratio: offsets fract(xi + k / phi) stay evenly spread along the ray.
+const INV_PHI: f32 = 0.6180339887498949;
 const PROFILE_CUMULIFORM: u32 = 1u;
 const PROFILE_ANVIL: u32 = 2u;
 // Same cutoffs as the reference (T_CUTOFF, TAU_SUN_CUTOFF).
@@ -43,6 +46,8 @@ struct CloudParams {
     steps: u32,
     light_steps: u32,
     light_spread: f32,
+    step_spread: f32,
+    jitter_steps: u32,
     integrator: u32,
     forward_g: f32,
     backward_g: f32,
@@ -60,6 +65,8 @@ struct CloudSlab {
     frequency: vec3<f32>, // noise_scale * noise_stretch
     light_first: f32, // first light step, fraction of the path
     light_growth: f32, // ratio of consecutive light steps
+    step_log_growth: f32, // log of the ratio of consecutive primary steps
+    step_total: f32, // r^n - 1 for that ratio r: step k ends at (r^(k+1) - 1) / (r^n - 1)
 }
 
 // e^x - 1 without the cancellation of exp(x) - 1 near 0.
@@ -83,7 +90,12 @@ fn light_step_layout(n: u32, spread: f32) -> vec2<f32> {
 fn cloud_slab(c: CloudParams) -> CloudSlab {
     let a = fbm_amplitude(c.octaves, c.gain);
     let light = light_step_layout(c.light_steps, c.light_spread);
-    return CloudSlab(c, a, 1.0 / a, c.noise_scale * c.noise_stretch, light.x, light.y);
+    // Primary steps: the same geometric layout, but each step's ends come
+    // from r^k in closed form: a running product over hundreds of steps
+    // drifts by ~1e-5 in f32 (measured 93 dB against the f64 reference).
+    let log_r = log(c.step_spread) / f32(max(c.steps, 2u) - 1u);
+    return CloudSlab(c, a, 1.0 / a, c.noise_scale * c.noise_stretch, light.x, light.y, log_r,
+        expm1(f32(c.steps) * log_r));
 }
 
 fn height01(s: CloudSlab, y: f32) -> f32 {
@@ -205,19 +217,35 @@ fn slab_segment(s: CloudSlab, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     return vec2(t0, t1);
 }
 
-// Marches [t0, t1] of the ray o + t d (unit d) in `steps` equal steps, the
-// first sample xi steps in; `sun` is the sun's radiance arriving at the slab
-// from sun_dir. Returns (L_cloud, T): the radiance the cloud sends along the
-// ray and its transmittance (0 after the cutoff).
+// Marches [t0, t1] of the ray o + t d (unit d) in `steps` steps, equal or
+// (step_spread > 1) growing geometrically from the camera, each sample xi of
+// its step in (jitter_steps golden: fract(xi + k / phi) for step k); `sun` is
+// the sun's radiance arriving at the slab from sun_dir. Returns (L_cloud, T):
+// the radiance the cloud sends along the ray and its transmittance (0 after
+// the cutoff).
 fn cloud_march(s: CloudSlab, o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, xi: f32, sun_dir: vec3<f32>,
                sun: vec3<f32>) -> vec4<f32> {
     var radiance = vec3(0.0);
     var transmittance = 1.0;
     let phase = dual_hg_phase(dot(d, sun_dir), s.c.forward_g, s.c.backward_g, s.c.phase_blend);
     let ext = 1.0 + s.c.absorption;
-    let dt = (t1 - t0) / f32(s.c.steps);
+    let uniform = s.c.step_spread == 1.0;
+    let dt_uniform = (t1 - t0) / f32(s.c.steps);
+    var dt = dt_uniform;
+    var end_frac = 0.0; // where step k - 1 ended, fraction of the segment
     for (var k = 0u; k < s.c.steps; k++) {
-        let p = o + d * (t0 + (f32(k) + xi) * dt);
+        var xk = xi;
+        if s.c.jitter_steps == JITTER_STEPS_GOLDEN {
+            xk = fract(xi + f32(k) * INV_PHI);
+        }
+        var t = t0 + (f32(k) + xk) * dt_uniform;
+        if !uniform {
+            let start_frac = end_frac;
+            end_frac = expm1(f32(k + 1u) * s.step_log_growth) / s.step_total;
+            dt = (t1 - t0) * (end_frac - start_frac);
+            t = t0 + (t1 - t0) * start_frac + xk * dt;
+        }
+        let p = o + d * t;
         let sigma_s = cloud_density(s, p);
         if sigma_s > 0.0 {
             let tau_sun = sun_optical_depth(s, p, sun_dir);

@@ -7,7 +7,12 @@
 //! that meets the slab is marched in `steps` equal steps of length dt over
 //! its part inside the slab (cut at `max_distance_km`), sample k at
 //! t0 + (k + xi) dt with xi = 0.5 (midpoint rule) or a per-pixel jitter
-//! hash. At every sample that holds cloud a `light_steps` midpoint march
+//! hash. Two options move the samples (issue 19): `step_spread` > 1 makes
+//! the steps grow geometrically from t0 (step k spans the fractions
+//! (r^k - 1) / (r^n - 1) to (r^(k+1) - 1) / (r^n - 1) of the segment,
+//! r = step_spread^(1 / (n - 1)), each sample xi of its step in), and
+//! `jitter_steps = golden` offsets step k by fract(xi + k / phi) instead of
+//! xi. At every sample that holds cloud a `light_steps` midpoint march
 //! toward the sun, up to the slab top, gives tau_sun; its steps grow
 //! geometrically (last / first = `light_spread`, 1 = uniform), see
 //! [`light_step_layout`]. Azimuths (yaw, sun) run from +z toward +x.
@@ -51,6 +56,14 @@ pub enum Jitter {
     None,
     White,
     Ign,
+}
+
+/// Where in its step each primary sample sits: the same offset xi for every
+/// step, or fract(xi + k / phi) for step k (golden-ratio offsets).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JitterSteps {
+    Shared,
+    Golden,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -294,6 +294,25 @@ fn light_step_spacings_converge_to_the_same_image() {
     }
 }
 
+/// Issue 19's primary-step options change where the samples sit, not what
+/// they integrate: geometric steps (step_spread) and golden-ratio offsets
+/// per step (jitter_steps) converge to the uniform march's image.
+#[test]
+fn primary_step_layouts_converge_to_the_same_image() {
+    let uniform = CloudsKernel.reference(&hq("cumulus", &[]), 16, 16);
+    let peak = vista_image::metrics::hdr_peak(&uniform);
+    for set in [&[("step_spread", "4")][..], &[("jitter", "ign"), ("jitter_steps", "golden")][..]] {
+        let other = CloudsKernel.reference(&hq("cumulus", set), 16, 16);
+        let p = vista_image::metrics::psnr_with_peak(&uniform, &other, peak);
+        eprintln!("{set:?} vs uniform steps at 512 steps: {p:.1} dB");
+        assert!(p > 50.0, "{set:?} vs uniform steps at 512 steps: {p:.1} dB");
+    }
+    // At 32 steps each layout differs from the uniform march: the options do something.
+    let coarse = CloudsKernel.reference(&hq("cumulus", &[("steps", "32")]), 16, 16);
+    let spread = CloudsKernel.reference(&hq("cumulus", &[("steps", "32"), ("step_spread", "4")]), 16, 16);
+    assert!(vista_image::metrics::max_abs(&coarse, &spread) > 1e-3, "step_spread 4 left the image unchanged");
+}
+
 /// SPEC 9: cost grows about as steps * (1 + light_steps). Every ray spends
 /// at most that many density evaluations (work_per_pixel / octaves), and a
 /// thin overcast layer, where no cutoff fires, spends exactly that.
@@ -461,4 +480,29 @@ fn coverage_oktas_gives_that_fraction_of_the_sky_within_a_sixteenth() {
         eprintln!("{row} | worst single seed off by {worst_seed:.3}");
     }
     assert!(failures.is_empty(), "okta calibration misses its bound:\n{}", failures.join("\n"));
+}
+
+/// sky_cover stops each optical-depth sum once it passes the threshold; the
+/// early answer must be the full sum's for every direction, cloudy or clear.
+#[test]
+fn the_early_optical_depth_test_agrees_with_the_full_sum() {
+    let mut compared = [0usize; 2];
+    for preset in ["cumulus", "stratus", "altostratus", "cirrostratus"] {
+        let c = Clouds::from_params(&params(preset, &[]));
+        for i in 0..12 {
+            let sin_e = (i as f64 + 0.5) / 12.0;
+            let cos_e = (1.0 - sin_e * sin_e).sqrt();
+            for j in 0..24 {
+                let az = std::f64::consts::TAU * (j as f64 + 0.5) / 24.0;
+                let d = [cos_e * az.sin(), sin_e, cos_e * az.cos()];
+                let full = c.optical_depth(c.view.pos, d, 96);
+                for tau in [0.0, 0.1, 1.0, 5.0] {
+                    let early = c.optical_depth_exceeds(c.view.pos, d, 96, tau);
+                    assert_eq!(early, full > tau, "{preset} dir {d:?}: optical depth {full} against {tau}");
+                    compared[early as usize] += 1;
+                }
+            }
+        }
+    }
+    assert!(compared[0] > 100 && compared[1] > 100, "both answers must occur: {compared:?}");
 }

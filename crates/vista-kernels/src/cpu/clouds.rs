@@ -6,7 +6,7 @@ use super::noise::{Fbm, Noise};
 use super::phase::dual_hg;
 use super::{Real, pixel_uv, real, real3, render_cpu};
 use crate::ParamSet;
-use crate::clouds::{Integrator, Jitter, Profile};
+use crate::clouds::{Integrator, Jitter, JitterSteps, Profile};
 use crate::noise::{Basis, pcg3d};
 use vista_image::Image;
 
@@ -17,10 +17,11 @@ pub const T_CUTOFF: Real = 1e-4;
 /// (T_sun < 1.1e-7: no visible contribution left).
 pub const TAU_SUN_CUTOFF: Real = 16.0;
 
-
 /// A sky direction counts as cloudy when its optical depth exceeds this
 /// (transmittance below 0.905: visibly cloud, SPEC's oktas calibration).
 pub const OKTA_TAU: Real = 0.1;
+/// 1 / golden ratio, (sqrt 5 - 1) / 2: the golden-ratio step offsets.
+const INV_PHI: f64 = 0.618_033_988_749_894_9;
 /// Midpoint samples per sky direction in [`Clouds::sky_cover`].
 pub const OKTA_SAMPLES: u32 = 96;
 
@@ -143,6 +144,9 @@ pub struct Clouds {
     pub light_steps: u32,
     /// Last light step / first light step (1 = uniform).
     pub light_spread: Real,
+    /// Last primary step / first (1 = uniform).
+    pub step_spread: Real,
+    pub jitter_steps: JitterSteps,
     pub integrator: Integrator,
     pub jitter: Jitter,
     pub jitter_seed: u32,
@@ -189,6 +193,8 @@ impl Clouds {
             steps: p.u32("steps"),
             light_steps: p.u32("light_steps"),
             light_spread: real(p, "light_spread"),
+            step_spread: real(p, "step_spread"),
+            jitter_steps: if p.choice("jitter_steps") == "golden" { JitterSteps::Golden } else { JitterSteps::Shared },
             integrator: if p.choice("integrator") == "analytic" { Integrator::Analytic } else { Integrator::Riemann },
             jitter: match p.choice("jitter") {
                 "white" => Jitter::White,
@@ -315,17 +321,35 @@ impl Clouds {
         }
     }
 
-    /// Marches [t0, t1] of the ray o + t d in `steps` equal steps, the first
-    /// sample `xi` steps in, lit by `sun` (radiance from sun_dir).
+    /// Marches [t0, t1] of the ray o + t d in `steps` steps, lit by `sun`
+    /// (radiance from sun_dir). The steps are equal, or with step_spread > 1
+    /// grow geometrically from t0 so the last is step_spread times the
+    /// first; each sample sits `xi` of its step in, or with jitter_steps
+    /// golden fract(xi + k / phi) in step k.
     #[allow(clippy::too_many_arguments)]
     pub fn march_segment(&self, o: V3, d: V3, t0: Real, t1: Real, xi: Real, sun: V3, trace: bool) -> RayResult {
         let mut out = RayResult { radiance: [0.0; 3], transmittance: 1.0, trace: Vec::new(), density_evals: 0 };
-        let dt = (t1 - t0) / self.steps as Real;
+        // Geometric steps: step k spans fractions (r^k - 1) / (r^n - 1) to
+        // (r^(k+1) - 1) / (r^n - 1) of the segment, r = spread^(1 / (n - 1)).
+        let log_r = self.step_spread.ln() / (self.steps.max(2) - 1) as Real;
+        let end_of = |k: u32| (k as Real * log_r).exp_m1() / (self.steps as Real * log_r).exp_m1();
         let phase = self.phase(dot(d, self.sun_dir));
         let ext = 1.0 + self.absorption;
         let mut t_view = 1.0;
         for k in 0..self.steps {
-            let p = add(o, scale(d, t0 + (k as Real + xi) * dt));
+            let xk = match self.jitter_steps {
+                JitterSteps::Shared => xi,
+                JitterSteps::Golden => (xi + k as Real * INV_PHI as Real).fract(),
+            };
+            // Uniform steps at t0 + (k + xk) dt, without a running sum's rounding.
+            let (t, dt) = if self.step_spread == 1.0 {
+                let dt = (t1 - t0) / self.steps as Real;
+                (t0 + (k as Real + xk) * dt, dt)
+            } else {
+                let (a, b) = (end_of(k), end_of(k + 1));
+                (t0 + (t1 - t0) * (a + xk * (b - a)), (t1 - t0) * (b - a))
+            };
+            let p = add(o, scale(d, t));
             let sigma_s = self.density(p);
             out.density_evals += 1;
             if sigma_s > 0.0 {
@@ -368,6 +392,25 @@ impl Clouds {
         (0..samples).map(|k| self.density(add(o, scale(d, t0 + (k as Real + 0.5) * dt)))).sum::<Real>() * ext * dt
     }
 
+    /// Whether [`Self::optical_depth`] exceeds `tau`, stopping at the first
+    /// sample that settles it. The terms are >= 0 and are added in the same
+    /// order, and rounding is monotone, so a partial sum over `tau` implies
+    /// the full one is: the answer is the full sum's, at a fraction of the
+    /// work under cloud.
+    pub fn optical_depth_exceeds(&self, o: V3, d: V3, samples: u32, tau: Real) -> bool {
+        let Some((t0, t1)) = self.slab_segment(o, d) else { return 0.0 > tau };
+        let dt = (t1 - t0) / samples as Real;
+        let ext = 1.0 + self.absorption;
+        let mut sum = 0.0;
+        for k in 0..samples {
+            sum += self.density(add(o, scale(d, t0 + (k as Real + 0.5) * dt)));
+            if sum * ext * dt > tau {
+                return true;
+            }
+        }
+        false
+    }
+
     /// Cloud amount as an observer at the camera counts it: the fraction of
     /// sky directions whose optical depth exceeds [`OKTA_TAU`]. The sky is
     /// the upper hemisphere in `n` x `n` cells of equal solid angle (azimuth
@@ -392,7 +435,7 @@ impl Clouds {
                         continue;
                     }
                     sky += 1;
-                    if self.optical_depth(o, d, OKTA_SAMPLES) > OKTA_TAU {
+                    if self.optical_depth_exceeds(o, d, OKTA_SAMPLES, OKTA_TAU) {
                         cloudy += 1;
                     }
                 }

@@ -14,7 +14,7 @@ use super::heightfield::{
 use super::noise::{Fbm, Noise};
 use super::{Real, Vec3, pixel_uv, real, real3, render_cpu};
 use crate::ParamSet;
-use crate::clouds::{Integrator, Jitter, Profile};
+use crate::clouds::{Integrator, Jitter, JitterSteps, Profile};
 use crate::heightfield::{BRUTE_STEPS, HitSearch};
 use crate::noise::Basis;
 use vista_image::Image;
@@ -103,6 +103,8 @@ impl Landscape {
             steps: p.u32("cloud_steps"),
             light_steps: p.u32("cloud_light_steps"),
             light_spread: real(p, "light_spread"),
+            step_spread: 1.0,
+            jitter_steps: JitterSteps::Shared,
             integrator: if p.choice("cloud_integrator") == "analytic" {
                 Integrator::Analytic
             } else {
