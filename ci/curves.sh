@@ -59,13 +59,21 @@ sweep clouds-analytic-ign-linear clouds --preset cumulus --set integrator=analyt
     --param steps --values 8,16,32,64,128,256 --param2 light_steps --values2 2,4,6,12,24 --size 96x96
 # Issue 19's cheaper sampling, at the light-step count where the primary
 # march is the bottleneck (4): primary steps growing geometrically from the
-# camera (step_spread, 1 = the uniform steps above), at both sizes the
+# slab entry (step_spread, 1 = the uniform steps above), at both sizes the
 # target names; and golden-ratio offsets per step (the grid of
 # clouds-analytic-ign, whose steps share one offset).
 sweep clouds-analytic-ign-step_spread clouds --preset cumulus --set integrator=analytic --set jitter=ign \
     --set light_steps=4 --param steps --values 32,40,44,48,52,56,64 --param2 step_spread --values2 1,1.5,2,4,8 --size 96x96
 sweep clouds-analytic-ign-step_spread-128x96 clouds --preset cumulus --set integrator=analytic --set jitter=ign \
     --set light_steps=4 --param steps --values 32,40,44,48,52,56,64 --param2 step_spread --values2 1,1.5,2,4,8 --size 128x96
+# Steps per ray from step_km (at most 128): work is then counted ray by ray
+# (mean of steps x (1 + light_steps) x octaves over the image).
+sweep clouds-analytic-ign-step_km clouds --preset cumulus --set integrator=analytic --set jitter=ign \
+    --set light_steps=4 --set steps=128 --param step_km --values 0.08,0.1,0.12,0.14,0.16,0.2 \
+    --param2 step_spread --values2 1,1.5,2 --size 96x96
+sweep clouds-analytic-ign-step_km-128x96 clouds --preset cumulus --set integrator=analytic --set jitter=ign \
+    --set light_steps=4 --set steps=128 --param step_km --values 0.08,0.1,0.12,0.14,0.16,0.2 \
+    --param2 step_spread --values2 1,1.5,2 --size 128x96
 sweep clouds-analytic-ign-golden clouds --preset cumulus --set integrator=analytic --set jitter=ign --set jitter_steps=golden \
     --param steps --values 8,16,32,64,128,256 --param2 light_steps --values2 2,4,6,12,24 --size 96x96
 # The baseline they must match, at 128x96 as well (96x96 is clouds-riemann-none).

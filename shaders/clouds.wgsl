@@ -55,6 +55,7 @@ struct Params {
     light_spread: f32,
     step_spread: f32,
     jitter_steps: u32,
+    step_km: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -80,7 +81,7 @@ fn slab() -> CloudSlab {
     return cloud_slab(CloudParams(params.cloud_base_km, params.cloud_top_km, coverage(), params.density_scale,
         params.absorption, params.profile, params.profile_bottom, params.profile_top, params.noise_scale,
         params.noise_stretch, params.wind_offset, params.octaves, params.lacunarity, params.gain, params.seed,
-        params.max_distance_km, params.steps, params.light_steps, params.light_spread, params.step_spread, params.jitter_steps, params.integrator, params.g1,
+        params.max_distance_km, params.steps, params.light_steps, params.light_spread, params.step_spread, params.step_km, params.jitter_steps, params.integrator, params.g1,
         params.g2, params.phase_blend, params.powder, params.ambient, params.ambient_bottom));
 }
 

@@ -109,14 +109,14 @@ fn terrain() -> Terrain {
         params.amplitude, params.scale, params.plane_slope));
 }
 
-// Uniform primary steps with one offset per ray (step_spread 1, jitter_steps
-// shared: the clouds kernel's defaults).
+// Uniform primary steps, `cloud_steps` on every ray, one offset per ray
+// (step_spread 1, step_km 0, jitter_steps shared: the clouds kernel's defaults).
 fn slab() -> CloudSlab {
     return cloud_slab(CloudParams(params.cloud_base_km, params.cloud_top_km, params.coverage, params.density_scale,
         params.absorption, params.profile, params.profile_bottom, params.profile_top, params.noise_scale,
         params.noise_stretch, params.wind_offset, params.cloud_octaves, params.cloud_lacunarity, params.cloud_gain,
         params.seed, params.cloud_max_distance_km, params.cloud_steps, params.cloud_light_steps, params.light_spread,
-        1.0, 0u, params.cloud_integrator, params.cloud_g1, params.cloud_g2, params.cloud_phase_blend, params.powder,
+        1.0, 0.0, 0u, params.cloud_integrator, params.cloud_g1, params.cloud_g2, params.cloud_phase_blend, params.powder,
         params.cloud_ambient, params.ambient_bottom));
 }
 

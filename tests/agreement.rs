@@ -31,7 +31,13 @@ const SETTINGS: &[Setting] = &[
     (
         "clouds",
         "cumulus",
-        &[("integrator", "analytic"), ("jitter", "ign"), ("step_spread", "2"), ("jitter_steps", "golden")],
+        &[
+            ("integrator", "analytic"),
+            ("jitter", "ign"),
+            ("step_spread", "2"),
+            ("jitter_steps", "golden"),
+            ("step_km", "0.1"),
+        ],
         (48, 48),
     ),
     ("clouds", "cirrus", &[], (48, 48)),
@@ -241,14 +247,16 @@ const FAULTS: &[Fault] = &[
     ("atmosphere", "lib/sky.wgsl", "const BETA_M: f32 = 3.996e-6;", "const BETA_M: f32 = 4.1958e-6;"),
     ("clouds", "lib/cloud_slab.wgsl", "return plateau * (1.0 - 0.5 * h);", "return plateau * (1.0 - 0.525 * h);"),
     ("clouds", "lib/phase.wgsl", "(4.0 * PI * denom * sqrt(denom))", "(4.2 * PI * denom * sqrt(denom))"),
-    // Issue 19's sampling options: geometric primary steps, golden-ratio offsets.
+    // Issue 19's sampling options: geometric primary steps, golden-ratio
+    // offsets, steps per ray from step_km.
     (
         "clouds",
         "lib/cloud_slab.wgsl",
-        "end_frac = expm1(f32(k + 1u) * s.step_log_growth)",
-        "end_frac = expm1(f32(k + 1u) * 1.05 * s.step_log_growth)",
+        "end_frac = expm1(f32(k + 1u) * log_r)",
+        "end_frac = expm1(f32(k + 1u) * 1.05 * log_r)",
     ),
     ("clouds", "lib/cloud_slab.wgsl", "xk = fract(xi + f32(k) * INV_PHI);", "xk = fract(xi + f32(k) * 0.6);"),
+    ("clouds", "lib/cloud_slab.wgsl", "clamp(ceil((t1 - t0) / s.c.step_km)", "clamp(floor((t1 - t0) / s.c.step_km)"),
     (
         "clouds",
         "lib/cloud_slab.wgsl",

@@ -12,7 +12,8 @@
 //! (r^k - 1) / (r^n - 1) to (r^(k+1) - 1) / (r^n - 1) of the segment,
 //! r = step_spread^(1 / (n - 1)), each sample xi of its step in), and
 //! `jitter_steps = golden` offsets step k by fract(xi + k / phi) instead of
-//! xi. At every sample that holds cloud a `light_steps` midpoint march
+//! xi; a third, `step_km` > 0, gives each ray ceil(segment / step_km) steps
+//! (at most `steps`) instead of `steps`. At every sample that holds cloud a `light_steps` midpoint march
 //! toward the sun, up to the slab top, gives tau_sun; its steps grow
 //! geometrically (last / first = `light_spread`, 1 = uniform), see
 //! [`light_step_layout`]. Azimuths (yaw, sun) run from +z toward +x.
@@ -78,6 +79,21 @@ pub enum Profile {
 pub struct CloudsKernel;
 crate::builtin_handle!(CloudsKernel, "clouds");
 
+/// The longest primary step any ray can take (km). A ray of n steps spans at
+/// most max_distance, and with step_km > 0 and n < steps at most n step_km;
+/// its last step is the longest, a fraction first * growth^(n - 1) of it.
+fn longest_step(c: &Clouds) -> f64 {
+    let n_all = if c.step_km > 0.0 { 1..=c.steps } else { c.steps..=c.steps };
+    n_all
+        .map(|n| {
+            let span =
+                if c.step_km > 0.0 && n < c.steps { c.max_distance.min(n as f64 * c.step_km) } else { c.max_distance };
+            let (first, growth) = light_step_layout(n, c.step_spread);
+            span * first * growth.powi(n as i32 - 1)
+        })
+        .fold(0.0, f64::max)
+}
+
 impl CpuReference for CloudsKernel {
     fn check(&self, p: &ParamSet) -> Result<(), ParamError> {
         let (base, top) = (p.f64("cloud_base_km"), p.f64("cloud_top_km"));
@@ -92,11 +108,14 @@ impl CpuReference for CloudsKernel {
     fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image {
         crate::cpu32::clouds::render(p, width, height)
     }
+    fn mean_work_per_pixel(&self, p: &ParamSet, width: u32, height: u32) -> Option<f64> {
+        Some(Clouds::from_params(p).mean_work(width, height))
+    }
     fn output_bounds(&self, p: &ParamSet) -> Option<(f32, f32)> {
         // Analytic: L <= max Lin. Riemann: sum T_k x_k <= X / (1 - e^-X) <=
         // 1 + X with X the largest optical depth of one step.
         let c = Clouds::from_params(p);
-        let x_max = c.density_scale * (1.0 + c.absorption) * c.max_distance / c.steps as f64;
+        let x_max = c.density_scale * (1.0 + c.absorption) * longest_step(&c);
         let bg = c.sky_zenith.iter().chain(&c.sky_horizon).cloned().fold(0.0, f64::max);
         let hi = c.max_l_in() * (1.0 + x_max) + bg;
         Some((0.0, (hi * 1.001 + 1e-6) as f32))

@@ -139,6 +139,12 @@ pub trait CpuReference: Send + Sync {
     fn shader_algorithm_f32(&self, _p: &ParamSet, _width: u32, _height: u32) -> Option<Image> {
         None
     }
+    /// The work estimate averaged over an image's rays, for a kernel whose
+    /// per-ray cost varies with the ray (clouds' step_km); `None` when the
+    /// manifest's per-pixel estimate holds for every pixel.
+    fn mean_work_per_pixel(&self, _p: &ParamSet, _width: u32, _height: u32) -> Option<f64> {
+        None
+    }
 }
 
 /// The CPU reference registered for a kernel name, if any.
@@ -234,6 +240,12 @@ impl Kernel {
     /// entries; 1 without any), used to refuse absurd dispatches.
     pub fn work_per_pixel(&self, p: &ParamSet) -> f64 {
         self.manifest.work.iter().map(|f| f.constant + f.params.iter().map(|n| p.f64(n)).sum::<f64>()).product()
+    }
+
+    /// [`Self::work_per_pixel`] averaged over a `width` x `height` image's
+    /// rays where the CPU reference knows it per ray, else the estimate.
+    pub fn mean_work_per_pixel(&self, p: &ParamSet, width: u32, height: u32) -> f64 {
+        self.cpu.and_then(|c| c.mean_work_per_pixel(p, width, height)).unwrap_or_else(|| self.work_per_pixel(p))
     }
 
     /// Inclusive bounds every RGB value of the raw output must respect.

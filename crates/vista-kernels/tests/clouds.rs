@@ -506,3 +506,33 @@ fn the_early_optical_depth_test_agrees_with_the_full_sum() {
     }
     assert!(compared[0] > 100 && compared[1] > 100, "both answers must occur: {compared:?}");
 }
+
+/// step_km: a ray takes ceil(segment / step_km) steps, at most `steps`, and
+/// spends at most that many times (1 + light_steps) density evaluations;
+/// mean_work (what sweeps report as work) is that count averaged over the
+/// image, and for cumulus at 0.14 km it is well under the fixed count.
+#[test]
+fn step_km_gives_each_ray_the_steps_its_segment_needs() {
+    let c = Clouds::from_params(&params("cumulus", &[("steps", "128"), ("light_steps", "4"), ("step_km", "0.14")]));
+    let (mut sum, mut n, mut capped, mut short) = (0.0, 0, 0, 0);
+    for (x, y, o, d) in rays(&c, 4) {
+        let (t0, t1) = c.slab_segment(o, d).expect("cumulus: every ray meets the slab");
+        let steps = c.primary_steps(t0, t1);
+        let expected = ((t1 - t0) / 0.14).ceil().min(128.0) as u32;
+        assert_eq!(steps, expected, "({x},{y}): {steps} steps over {:.3} km", t1 - t0);
+        let r = c.march(o, d, 0.5, false);
+        assert!(r.density_evals <= steps * 5, "({x},{y}): {} evaluations > {steps} x 5", r.density_evals);
+        capped += (steps == 128) as u32;
+        short += (steps < 32) as u32;
+        sum += steps as f64;
+        n += 1;
+    }
+    assert!(short > 0 && capped == 0, "{short} rays under 32 steps, {capped} at the cap of 128");
+    // Over every pixel of the 64 x 64 image, not the sampled rays above.
+    let mean = c.mean_work(64, 64) / (5.0 * c.fbm.octaves as f64);
+    assert!((mean - sum / n as f64).abs() < 2.0, "mean steps {mean:.2} vs {:.2} on the sampled rays", sum / n as f64);
+    assert!(mean < 40.0, "cumulus at 0.14 km: {mean:.1} steps per ray on average");
+    // Off (the default): every ray takes `steps`.
+    let fixed = Clouds::from_params(&params("cumulus", &[("steps", "48"), ("light_steps", "4")]));
+    assert_eq!(fixed.mean_work(64, 64), 48.0 * 5.0 * fixed.fbm.octaves as f64);
+}

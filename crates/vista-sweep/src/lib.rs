@@ -88,7 +88,8 @@ pub struct Point {
     pub y: Option<String>,
     pub metrics: Metrics,
     pub gpu_ms: f64,
-    /// `work_per_pixel` of the point's settings.
+    /// Work per pixel of the point's settings: the manifest's estimate,
+    /// averaged over the image's rays where it varies per ray.
     pub work: f64,
 }
 
@@ -206,7 +207,7 @@ pub fn run(
             Metric::Display => metrics::compare(&reference.display, &r.display)?,
             Metric::Linear => metrics::compare_hdr(&reference.raw, &r.raw)?,
         };
-        out.push(Point { x: xv.clone(), y: yv.clone(), metrics: m, gpu_ms, work: k.work_per_pixel(p) });
+        out.push(Point { x: xv.clone(), y: yv.clone(), metrics: m, gpu_ms, work: k.mean_work_per_pixel(p, w, h) });
     }
     progress(total, total, "done");
     Ok(Sweep {

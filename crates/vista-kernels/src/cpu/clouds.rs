@@ -146,6 +146,8 @@ pub struct Clouds {
     pub light_spread: Real,
     /// Last primary step / first (1 = uniform).
     pub step_spread: Real,
+    /// Primary step length (km); 0 = always `steps` steps.
+    pub step_km: Real,
     pub jitter_steps: JitterSteps,
     pub integrator: Integrator,
     pub jitter: Jitter,
@@ -194,6 +196,7 @@ impl Clouds {
             light_steps: p.u32("light_steps"),
             light_spread: real(p, "light_spread"),
             step_spread: real(p, "step_spread"),
+            step_km: real(p, "step_km"),
             jitter_steps: if p.choice("jitter_steps") == "golden" { JitterSteps::Golden } else { JitterSteps::Shared },
             integrator: if p.choice("integrator") == "analytic" { Integrator::Analytic } else { Integrator::Riemann },
             jitter: match p.choice("jitter") {
@@ -321,8 +324,34 @@ impl Clouds {
         }
     }
 
+    /// Primary steps over a segment [t0, t1]: `steps`, or with step_km > 0
+    /// ceil((t1 - t0) / step_km) clamped to 1..=steps.
+    pub fn primary_steps(&self, t0: Real, t1: Real) -> u32 {
+        if self.step_km > 0.0 {
+            ((t1 - t0) / self.step_km).ceil().clamp(1.0, self.steps as Real) as u32
+        } else {
+            self.steps
+        }
+    }
+
+    /// The mean over the image's pixels of steps x (1 + light_steps) x
+    /// octaves per ray (0 for a ray that misses the slab): the manifest's
+    /// work estimate evaluated ray by ray, which step_km makes vary.
+    pub fn mean_work(&self, width: u32, height: u32) -> Real {
+        let mut sum = 0.0;
+        for y in 0..height {
+            for x in 0..width {
+                let (o, d) = self.ray(x, y, width, height);
+                if let Some((t0, t1)) = self.slab_segment(o, d) {
+                    sum += self.primary_steps(t0, t1) as Real;
+                }
+            }
+        }
+        sum * (1 + self.light_steps) as Real * self.fbm.octaves as Real / (width * height) as Real
+    }
+
     /// Marches [t0, t1] of the ray o + t d in `steps` steps, lit by `sun`
-    /// (radiance from sun_dir). The steps are equal, or with step_spread > 1
+    /// (radiance from sun_dir; step_km > 0: [`Self::primary_steps`] steps). The steps are equal, or with step_spread > 1
     /// grow geometrically from t0 so the last is step_spread times the
     /// first; each sample sits `xi` of its step in, or with jitter_steps
     /// golden fract(xi + k / phi) in step k.
@@ -331,19 +360,20 @@ impl Clouds {
         let mut out = RayResult { radiance: [0.0; 3], transmittance: 1.0, trace: Vec::new(), density_evals: 0 };
         // Geometric steps: step k spans fractions (r^k - 1) / (r^n - 1) to
         // (r^(k+1) - 1) / (r^n - 1) of the segment, r = spread^(1 / (n - 1)).
-        let log_r = self.step_spread.ln() / (self.steps.max(2) - 1) as Real;
-        let end_of = |k: u32| (k as Real * log_r).exp_m1() / (self.steps as Real * log_r).exp_m1();
+        let n = self.primary_steps(t0, t1);
+        let log_r = self.step_spread.ln() / (n.max(2) - 1) as Real;
+        let end_of = |k: u32| (k as Real * log_r).exp_m1() / (n as Real * log_r).exp_m1();
         let phase = self.phase(dot(d, self.sun_dir));
         let ext = 1.0 + self.absorption;
         let mut t_view = 1.0;
-        for k in 0..self.steps {
+        for k in 0..n {
             let xk = match self.jitter_steps {
                 JitterSteps::Shared => xi,
                 JitterSteps::Golden => (xi + k as Real * INV_PHI as Real).fract(),
             };
             // Uniform steps at t0 + (k + xk) dt, without a running sum's rounding.
             let (t, dt) = if self.step_spread == 1.0 {
-                let dt = (t1 - t0) / self.steps as Real;
+                let dt = (t1 - t0) / n as Real;
                 (t0 + (k as Real + xk) * dt, dt)
             } else {
                 let (a, b) = (end_of(k), end_of(k + 1));

@@ -104,6 +104,7 @@ impl Landscape {
             light_steps: p.u32("cloud_light_steps"),
             light_spread: real(p, "light_spread"),
             step_spread: 1.0,
+            step_km: 0.0,
             jitter_steps: JitterSteps::Shared,
             integrator: if p.choice("cloud_integrator") == "analytic" {
                 Integrator::Analytic
