@@ -26,14 +26,15 @@ build:
 demo: lavapipe build
 	bash ci/demo.sh $(VISTA) out
 
-# The whole suite (what .ci/run calls): unit tests, CPU references,
-# invariants, and every golden case on lavapipe; every golden case again on
+# The whole suite (what .ci/run calls): `cargo test --workspace`, two test
+# binaries at a time (ci/test-parallel.sh; JOBS=1 for one at a time): unit
+# tests, CPU references, invariants, and every golden case on lavapipe; every golden case again on
 # SwiftShader, in headless Chromium's WebGPU and under the validation layer;
 # then a closing count, and proof that without an adapter the GPU tests are
 # reported skipped, never ok.
 test: lavapipe swiftshader validation browser
 	mkdir -p target
-	set -o pipefail; $(CARGO) test --workspace 2>&1 | tee target/test.log
+	set -o pipefail; CARGO=$(CARGO) bash ci/test-parallel.sh 2>&1 | tee target/test.log
 	@echo "---- every golden case again on SwiftShader (other-driver thresholds, expectations from golden/cases.toml)"
 	set -o pipefail; VISTA_BACKEND=swiftshader $(CARGO) test --test golden 2>&1 | tee -a target/test.log
 	@echo "---- every golden case again in headless Chromium's WebGPU (naga's WGSL through Tint and Dawn)"

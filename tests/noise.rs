@@ -175,8 +175,47 @@ fn the_integer_z_shortcut_is_bit_identical_to_the_full_formula(gpu: &vista_golde
     }
 }
 
+/// fbm and ridged read one hash per corner from the table's plane when
+/// z_slice is an integer (manifest hash_plane, VISTA_HASH_PLANE): bit-identical
+/// raw output to the permutation chain, at planes that wrap (255, 256, -3),
+/// for several seeds; and the comparison can fail (a wrong corner shows).
+fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::Renderer<'static>) {
+    let (_dir, chain) = common::with_edit(gpu, "lib/noise.wgsl", "#ifdef VISTA_HASH_PLANE", "#ifdef VISTA_CHAIN_ONLY");
+    let (_dir2, broken) =
+        common::with_edit(gpu, "lib/noise.wgsl", "let y1 = (i.y + 1u) & 255u;", "let y1 = (i.y + 2u) & 255u;");
+    let same = |a: &vista_image::Image, b: &vista_image::Image| {
+        a.data.iter().flatten().zip(b.data.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits())
+    };
+    for (name, preset, set) in [
+        ("fbm", "default", &[][..]),
+        ("fbm", "rough", &[("z_slice", "-3")][..]),
+        ("fbm", "rotated", &[("seed", "7"), ("z_slice", "255")][..]),
+        ("fbm", "default", &[("z_slice", "256"), ("seed", "12")][..]),
+        ("ridged", "default", &[][..]),
+        ("ridged", "sharp", &[("z_slice", "41")][..]),
+    ] {
+        let k = vista_kernels::find(name).unwrap();
+        let p = common::params(k, Some(preset), set);
+        assert!(k.shader_for(&p).ends_with("?VISTA_HASH_PLANE"), "{name} {preset} {set:?}: not on a hash plane");
+        let a = vista_golden::render(gpu, k, &p, 96, 64).unwrap().raw;
+        let b = vista_golden::render(&chain, k, &p, 96, 64).unwrap().raw;
+        assert!(same(&a, &b), "{name} {preset} {set:?}: the hash plane changes the output");
+        let c = vista_golden::render(&broken, k, &p, 96, 64).unwrap().raw;
+        assert!(!same(&a, &c), "{name} {preset} {set:?}: a wrong corner on the plane went unseen");
+    }
+    // Off the integer planes, and for kernels without hash_plane, the chain.
+    let fbm = vista_kernels::find("fbm").unwrap();
+    assert!(!fbm.shader_for(&common::params(fbm, None, &[("z_slice", "0.5")])).contains('?'));
+    let clouds = vista_kernels::find("clouds").unwrap();
+    assert!(!clouds.shader_for(&common::params(clouds, None, &[])).contains('?'));
+}
+
 fn main() {
     common::run_gpu_tests(&[
+        (
+            "the_hash_plane_is_bit_identical_to_the_permutation_chain",
+            the_hash_plane_is_bit_identical_to_the_permutation_chain,
+        ),
         (
             "the_integer_z_shortcut_is_bit_identical_to_the_full_formula",
             the_integer_z_shortcut_is_bit_identical_to_the_full_formula,

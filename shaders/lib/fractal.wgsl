@@ -2,7 +2,7 @@
 // (The clouds kernel sums its 3D fBm itself, to stop early; see clouds.wgsl.)
 #define_import_path vista::fractal
 
-#import vista::noise::{basis_noise, PERLIN_MAX_ABS}
+#import vista::noise::{slice_noise, PERLIN_MAX_ABS}
 
 struct FbmSettings {
     basis: u32,
@@ -32,7 +32,7 @@ fn fbm2(s: FbmSettings, p0: vec2<f32>, z: f32) -> f32 {
     var amplitude = 1.0;
     var sum = 0.0;
     for (var i = 0u; i < s.octaves; i++) {
-        sum += amplitude * basis_noise(s.basis, s.seed, vec3(p, z));
+        sum += amplitude * slice_noise(s.basis, s.seed, vec3(p, z));
         amplitude *= s.gain;
         p = s.lacunarity * (rot * p);
     }
@@ -65,13 +65,13 @@ fn ridged_max(s: RidgedSettings) -> f32 {
 // signal (clamped feedback) and by lacunarity^(-i H).
 fn ridged2(s: RidgedSettings, p0: vec2<f32>, z: f32) -> f32 {
     var p = p0;
-    var signal = s.offset - abs(basis_noise(s.basis, s.seed, vec3(p, z)));
+    var signal = s.offset - abs(slice_noise(s.basis, s.seed, vec3(p, z)));
     signal *= signal;
     var result = signal;
     for (var i = 1u; i < s.octaves; i++) {
         p *= s.lacunarity;
         let weight = clamp(signal * s.gain, 0.0, 1.0);
-        let ridge = s.offset - abs(basis_noise(s.basis, s.seed, vec3(p, z)));
+        let ridge = s.offset - abs(slice_noise(s.basis, s.seed, vec3(p, z)));
         signal = ridge * ridge * weight;
         result += signal * pow(s.lacunarity, -f32(i) * s.h);
     }

@@ -5,7 +5,16 @@
 
 // 512-entry permutation (Perlin's table for seed 0, a PCG32 shuffle otherwise),
 // built on the CPU so the WGSL and the reference share one definition of it.
+// After it the host puts a plane flag and, for a kernel that samples one
+// integer plane z (its manifest's hash_plane param: fbm's and ridged's
+// z_slice), that plane's corner hashes: perm[PLANE_FLAG] = 1, perm[PLANE_Z] =
+// z & 255, then at PLANE_HASHES + 256 x + y the hash perm[perm[perm[x] + y] +
+// z] of lattice corner (x, y, z). One load per corner replaces the chain of
+// three, with the same values (tests/noise.rs checks the bits).
 @group(0) @binding(2) var<storage, read> perm: array<u32>;
+const PLANE_FLAG: u32 = 512u;
+const PLANE_Z: u32 = 513u;
+const PLANE_HASHES: u32 = 514u;
 
 const BASIS_PERLIN: u32 = 0u;
 const BASIS_VALUE: u32 = 1u;
@@ -24,6 +33,23 @@ fn perlin_grad(hash: u32, p: vec3<f32>) -> f32 {
     let u = select(p.y, p.x, h < 8u);
     let v = select(select(p.z, p.x, h == 12u || h == 14u), p.y, h < 4u);
     return select(-u, u, (h & 1u) == 0u) + select(-v, v, (h & 2u) == 0u);
+}
+
+// perlin(p) for p.z on the table's hash plane: the lower face of the cell
+// only (w.z = 0 there), each corner's hash one load; the same arithmetic in
+// the same order as perlin, so the same bits.
+fn perlin_on_plane(p: vec3<f32>) -> f32 {
+    let cell = floor(p);
+    let i = vec3<u32>(vec3<i32>(cell) & vec3<i32>(255));
+    let f = p - cell;
+    let w = quintic(f);
+    // x + 1 and y + 1 wrap as the doubled table does (perm[k + 256] = perm[k]).
+    let row0 = PLANE_HASHES + (i.x << 8u);
+    let row1 = PLANE_HASHES + (((i.x + 1u) & 255u) << 8u);
+    let y1 = (i.y + 1u) & 255u;
+    let x0 = mix(perlin_grad(perm[row0 + i.y], f), perlin_grad(perm[row1 + i.y], f - vec3(1.0, 0.0, 0.0)), w.x);
+    let x1 = mix(perlin_grad(perm[row0 + y1], f - vec3(0.0, 1.0, 0.0)), perlin_grad(perm[row1 + y1], f - vec3(1.0, 1.0, 0.0)), w.x);
+    return mix(x0, x1, w.y);
 }
 
 fn perlin(p: vec3<f32>) -> f32 {
@@ -71,6 +97,23 @@ fn value_noise(p: vec3<f32>, seed: u32) -> f32 {
 }
 
 // The basis N selected at run time.
+// fbm2 and ridged2 sample their noise through here. A kernel whose manifest
+// names a hash_plane param gets, on an integer plane, that plane's corner
+// hashes in the table and VISTA_HASH_PLANE at composition, so Perlin reads
+// one hash per corner. Composed rather than branched on: llvmpipe runs both
+// sides of a branch its lanes could disagree on, masked, so a run-time test
+// kept the chain's full cost (measured: no gain).
+fn slice_noise(basis: u32, seed: u32, p: vec3<f32>) -> f32 {
+#ifdef VISTA_HASH_PLANE
+    if basis == BASIS_VALUE {
+        return value_noise(p, seed);
+    }
+    return perlin_on_plane(p);
+#else
+    return basis_noise(basis, seed, p);
+#endif
+}
+
 fn basis_noise(basis: u32, seed: u32, p: vec3<f32>) -> f32 {
     if basis == BASIS_VALUE {
         return value_noise(p, seed);

@@ -1002,6 +1002,11 @@ fn bad_range_default_or_enum_value_is_refused() {
     );
 }
 
+fn hash_plane_must_name_an_f32_param() {
+    let m = K_MANIFEST.replacen("summary", "hash_plane = \"gian\"\nsummary", 1);
+    assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "hash_plane = \"gian\" must name an f32 param"]);
+}
+
 fn preset_naming_an_unknown_param_is_refused() {
     let m = format!("{K_MANIFEST}[preset.dim]\ngian = 0.1\n");
     assert_rejected(
@@ -1483,6 +1488,7 @@ fn main() {
         (Cpu, "unknown_manifest_key_names_file_line_and_key", unknown_manifest_key_names_file_line_and_key),
         (Cpu, "bad_range_default_or_enum_value_is_refused", bad_range_default_or_enum_value_is_refused),
         (Cpu, "preset_naming_an_unknown_param_is_refused", preset_naming_an_unknown_param_is_refused),
+        (Cpu, "hash_plane_must_name_an_f32_param", hash_plane_must_name_an_f32_param),
         (Cpu, "missing_shader_file_is_refused", missing_shader_file_is_refused),
         (Cpu, "malformed_manifest_names_file_line_and_column", malformed_manifest_names_file_line_and_column),
         (Gpu, "the_example_project_works_with_a_copied_binary", the_example_project_works_with_a_copied_binary),

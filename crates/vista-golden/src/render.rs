@@ -104,7 +104,7 @@ pub fn prepare(
     height: u32,
 ) -> Result<Prepared, GoldenError> {
     check_request(kernel, p, width, height)?;
-    let module = shaders.compose(kernel.shader()).map_err(|e| match e {
+    let module = shaders.compose(&kernel.shader_for(p)).map_err(|e| match e {
         // A missing or broken shader file is the user's to fix.
         vista_gpu::GpuError::Shader(m) => GoldenError::BadInput(format!("kernel {}: {m}", kernel.name())),
         other => GoldenError::Gpu(other),
@@ -116,8 +116,8 @@ pub fn prepare(
 /// Renders `kernel` with `p` at `width` x `height` on the GPU.
 pub fn render(gpu: &Renderer, kernel: &Kernel, p: &ParamSet, width: u32, height: u32) -> Result<Rendered, GoldenError> {
     let Prepared { uniforms, table } = prepare(&gpu.shaders, kernel, p, width, height)?;
-    let job =
-        Dispatch { shaders: &gpu.shaders, shader: kernel.shader(), uniforms: &uniforms, table: &table, width, height };
+    let shader = kernel.shader_for(p);
+    let job = Dispatch { shaders: &gpu.shaders, shader: &shader, uniforms: &uniforms, table: &table, width, height };
     let (raw, stats) = gpu.ctx.run(&job)?;
     let display = kernel.display(&raw, p);
     Ok(Rendered { raw, display, stats })

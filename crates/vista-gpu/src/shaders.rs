@@ -57,7 +57,10 @@ impl ShaderSet {
         self.kernels.keys().cloned().collect()
     }
 
+    /// `name` is a kernel file, optionally followed by `?DEF&DEF...`: naga_oil
+    /// shader defs (boolean) to compose it with, e.g. `fbm.wgsl?VISTA_HASH_PLANE`.
     fn kernel_source(&self, name: &str) -> Result<&(String, String), GpuError> {
+        let name = name.split_once('?').map_or(name, |(file, _)| file);
         self.kernels.get(name).ok_or_else(|| {
             GpuError::Shader(format!(
                 "shader {name} not found in {} (kernel files: {})",
@@ -113,13 +116,18 @@ impl ShaderSet {
         let (source, origin) = self.kernel_source(name)?;
         let mut composer = self.composer()?;
         let module = composer
-            .make_naga_module(NagaModuleDescriptor { source, file_path: origin, ..Default::default() })
+            .make_naga_module(NagaModuleDescriptor {
+                source,
+                file_path: origin,
+                shader_defs: shader_defs(name),
+                ..Default::default()
+            })
             .map_err(|e| GpuError::Shader(describe(&composer, &self.label, &e)))?;
         validate(name, &module)?;
         Ok(module)
     }
 
-    /// Hash of the kernel file and of the library modules it imports,
+    /// Hash of the kernel file (with its shader defs, if any) and of the library modules it imports,
     /// directly or through other modules: any WGSL edit that can change this
     /// kernel's output changes it, and edits to unrelated modules do not
     /// (so they do not mark every golden's provenance stale).
@@ -201,4 +209,13 @@ pub fn validate(name: &str, module: &naga::Module) -> Result<naga::valid::Module
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
         .validate(module)
         .map_err(|e| GpuError::Shader(format!("{name}: naga validation failed: {}", e.emit_to_string(""))))
+}
+
+/// The shader defs after `?` in a kernel name (`fbm.wgsl?A&B`), all `true`.
+fn shader_defs(name: &str) -> HashMap<String, naga_oil::compose::ShaderDefValue> {
+    let defs = name.split_once('?').map_or("", |(_, d)| d);
+    defs.split('&')
+        .filter(|d| !d.is_empty())
+        .map(|d| (d.to_string(), naga_oil::compose::ShaderDefValue::Bool(true)))
+        .collect()
 }

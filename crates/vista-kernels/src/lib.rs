@@ -275,7 +275,32 @@ impl Kernel {
             Some(Value::Int(s)) => *s as u32,
             _ => 0,
         };
-        noise::permutation(seed)
+        let mut table = noise::permutation(seed);
+        match self.hash_plane(p) {
+            Some(z) => table.extend(noise::plane_hashes(&table, z)),
+            None => table.extend([0, 0]),
+        }
+        table
+    }
+
+    /// The integer plane z of the manifest's `hash_plane` param, when it is
+    /// one: the table then carries that plane's corner hashes and the
+    /// shader is composed with VISTA_HASH_PLANE (lib/noise.wgsl).
+    pub fn hash_plane(&self, p: &ParamSet) -> Option<i64> {
+        let name = self.manifest.hash_plane?;
+        match p.value(name) {
+            Some(Value::Float(z)) if z.fract() == 0.0 => Some(*z as i64),
+            _ => None,
+        }
+    }
+
+    /// The kernel file to compose for `p`: [`Self::shader`], with
+    /// `?VISTA_HASH_PLANE` (a naga_oil shader def) on a hash plane.
+    pub fn shader_for(&self, p: &ParamSet) -> String {
+        match self.hash_plane(p) {
+            Some(_) => format!("{}?VISTA_HASH_PLANE", self.shader()),
+            None => self.shader().to_string(),
+        }
     }
 
     /// Reflects and checks the uniform layout of this kernel's composed module.

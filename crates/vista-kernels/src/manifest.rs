@@ -10,6 +10,8 @@
 //! display_alpha = "keep"           # keep | opaque (PNG alpha = 1; the RGB is already composited)
 //! work = ["octaves"]               # product of entries, each `name` or a sum `a + b + 3`
 //! output_range = [0.0, 1.0]        # NaN/range guard of the raw RGB (default: display [0, 1], hdr [0, inf))
+//! hash_plane = "z_slice"           # optional: every fbm2/ridged2 call samples z = this f32 param
+//!                                  # (an integer value gets Perlin's corner hashes for that plane)
 //! [[param]]
 //! name = "octaves"
 //! type = "u32"                     # u32 | i32 | f32 | bool | vec2 | vec3 | vec4 | enum
@@ -40,6 +42,7 @@ struct RawManifest {
     #[serde(default)]
     work: Vec<String>,
     output_range: Option<[f64; 2]>,
+    hash_plane: Option<String>,
     #[serde(default, rename = "param")]
     params: Vec<RawParam>,
     #[serde(default)]
@@ -86,6 +89,8 @@ pub struct Manifest {
     pub opaque_display: bool,
     pub work: Vec<WorkFactor>,
     pub output_range: Option<(f64, f64)>,
+    /// The f32 param every fbm2/ridged2 call of the shader takes as its z.
+    pub hash_plane: Option<&'static str>,
     pub params: &'static [ParamSpec],
     pub presets: &'static [Preset],
     pub sweep_reference: &'static [(&'static str, &'static str)],
@@ -279,6 +284,13 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     if output == Output::Hdr && !params.iter().any(|p| p.name == "exposure" && matches!(p.kind, Kind::Float { .. })) {
         return Err(kfail("output = \"hdr\" needs an f32 param named exposure (the PNG tone map)".into()));
     }
+    let hash_plane = match raw.hash_plane.as_deref() {
+        None => None,
+        Some(n) => match params.iter().find(|p| p.name == n) {
+            Some(p) if matches!(p.kind, Kind::Float { .. }) => Some(p.name),
+            _ => return Err(kfail(format!("hash_plane = \"{n}\" must name an f32 param"))),
+        },
+    };
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
         name: leak(name),
@@ -288,6 +300,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         opaque_display,
         work,
         output_range: raw.output_range.map(|[a, b]| (a, b)),
+        hash_plane,
         params,
         presets: Box::leak(presets.into_boxed_slice()),
         sweep_reference,

@@ -41,6 +41,21 @@ pub fn permutation(seed: u32) -> Vec<u32> {
     base
 }
 
+/// The flag, plane and corner hashes the WGSL Perlin reads after the
+/// 512-entry permutation `perm` for the integer plane z: [1, z & 255, then
+/// perm[perm[perm[x] + y] + z] at 256 x + y for x, y in 0..256].
+pub fn plane_hashes(perm: &[u32], z: i64) -> Vec<u32> {
+    let z = (z & 255) as usize;
+    let mut out = Vec::with_capacity(2 + 256 * 256);
+    out.extend([1, z as u32]);
+    for x in 0..256 {
+        for y in 0..256 {
+            out.push(perm[perm[perm[x] as usize + y] as usize + z]);
+        }
+    }
+    out
+}
+
 /// pcg3d (Jarzynski & Olano 2020): a 3D -> 3D integer hash, wrapping u32 math.
 pub fn pcg3d(v: [u32; 3]) -> [u32; 3] {
     let mut v = v.map(|c| c.wrapping_mul(1_664_525).wrapping_add(1_013_904_223));
