@@ -35,28 +35,44 @@ fn perlin_grad(hash: u32, p: vec3<f32>) -> f32 {
     return select(-u, u, (h & 1u) == 0u) + select(-v, v, (h & 2u) == 0u);
 }
 
-// perlin(p) for p.z on the table's hash plane: the lower face of the cell
-// only (w.z = 0 there), each corner's hash one load; the same arithmetic in
-// the same order as perlin, so the same bits.
-fn perlin_on_plane(p: vec3<f32>) -> f32 {
+// The cell of p: its lattice corner wrapped to 0..255, the offset inside
+// it and the quintic weights of that offset.
+struct PerlinCell {
+    i: vec3<u32>,
+    f: vec3<f32>,
+    w: vec3<f32>,
+}
+
+fn perlin_cell(p: vec3<f32>) -> PerlinCell {
     let cell = floor(p);
-    let i = vec3<u32>(vec3<i32>(cell) & vec3<i32>(255));
     let f = p - cell;
-    let w = quintic(f);
+    return PerlinCell(vec3<u32>(vec3<i32>(cell) & vec3<i32>(255)), f, quintic(f));
+}
+
+// One z face of a cell: the gradients of its corners (hashes h00, h10, h01,
+// h11 at x, y offsets 0/1 from f) blended by w.x, then w.y.
+fn perlin_face(h00: u32, h10: u32, h01: u32, h11: u32, f: vec3<f32>, w: vec3<f32>) -> f32 {
+    let x0 = mix(perlin_grad(h00, f), perlin_grad(h10, f - vec3(1.0, 0.0, 0.0)), w.x);
+    let x1 = mix(perlin_grad(h01, f - vec3(0.0, 1.0, 0.0)), perlin_grad(h11, f - vec3(1.0, 1.0, 0.0)), w.x);
+    return mix(x0, x1, w.y);
+}
+
+// perlin(p) for p.z on the table's hash plane: the lower face only (w.z = 0
+// there), each corner's hash one load; the same face as perlin's, so the
+// same bits.
+fn perlin_on_plane(p: vec3<f32>) -> f32 {
+    let c = perlin_cell(p);
+    let i = c.i;
     // x + 1 and y + 1 wrap as the doubled table does (perm[k + 256] = perm[k]).
     let row0 = PLANE_HASHES + (i.x << 8u);
     let row1 = PLANE_HASHES + (((i.x + 1u) & 255u) << 8u);
     let y1 = (i.y + 1u) & 255u;
-    let x0 = mix(perlin_grad(perm[row0 + i.y], f), perlin_grad(perm[row1 + i.y], f - vec3(1.0, 0.0, 0.0)), w.x);
-    let x1 = mix(perlin_grad(perm[row0 + y1], f - vec3(0.0, 1.0, 0.0)), perlin_grad(perm[row1 + y1], f - vec3(1.0, 1.0, 0.0)), w.x);
-    return mix(x0, x1, w.y);
+    return perlin_face(perm[row0 + i.y], perm[row1 + i.y], perm[row0 + y1], perm[row1 + y1], c.f, c.w);
 }
 
 fn perlin(p: vec3<f32>) -> f32 {
-    let cell = floor(p);
-    let i = vec3<u32>(vec3<i32>(cell) & vec3<i32>(255));
-    let f = p - cell;
-    let w = quintic(f);
+    let c = perlin_cell(p);
+    let i = c.i;
     // Corner hashes through the doubled permutation table.
     let a = perm[i.x] + i.y;
     let b = perm[i.x + 1u] + i.y;
@@ -64,19 +80,18 @@ fn perlin(p: vec3<f32>) -> f32 {
     let ab = perm[a + 1u] + i.z;
     let ba = perm[b] + i.z;
     let bb = perm[b + 1u] + i.z;
-    let x0 = mix(perlin_grad(perm[aa], f), perlin_grad(perm[ba], f - vec3(1.0, 0.0, 0.0)), w.x);
-    let x1 = mix(perlin_grad(perm[ab], f - vec3(0.0, 1.0, 0.0)), perlin_grad(perm[bb], f - vec3(1.0, 1.0, 0.0)), w.x);
-    let lower = mix(x0, x1, w.y);
+    let lower = perlin_face(perm[aa], perm[ba], perm[ab], perm[bb], c.f, c.w);
     // On an integer z plane (the 2D kernels' z_slice 0: fbm, ridged, the
     // terrains) w.z = 0, so the upper face weighs exactly 0 and
     // mix(lower, upper, 0) = lower: its four corners are skipped, with the
     // same result (tests/noise.rs checks the bits against the full formula).
+    let f = c.f;
     if f.z == 0.0 {
         return lower;
     }
-    let x2 = mix(perlin_grad(perm[aa + 1u], f - vec3(0.0, 0.0, 1.0)), perlin_grad(perm[ba + 1u], f - vec3(1.0, 0.0, 1.0)), w.x);
-    let x3 = mix(perlin_grad(perm[ab + 1u], f - vec3(0.0, 1.0, 1.0)), perlin_grad(perm[bb + 1u], f - vec3(1.0, 1.0, 1.0)), w.x);
-    return mix(lower, mix(x2, x3, w.y), w.z);
+    // f - (0, 0, 1) - (1, 0, 0) is f - (1, 0, 1) exactly: the same offsets.
+    let upper = perlin_face(perm[aa + 1u], perm[ba + 1u], perm[ab + 1u], perm[bb + 1u], f - vec3(0.0, 0.0, 1.0), c.w);
+    return mix(lower, upper, c.w.z);
 }
 
 // Lattice value in [-1, 1): pcg3d of the signed cell, seed folded into z by a Weyl step.
