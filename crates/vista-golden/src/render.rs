@@ -86,9 +86,11 @@ pub fn shader_set(project: &vista_project::Project) -> Result<ShaderSet, GoldenE
 }
 
 /// What a dispatch needs besides the device: the uniform bytes packed from
-/// naga's reflection of the composed module, and the binding-2 table.
+/// naga's reflection of the composed module, and the binding-2 table, and the kernel file as composed for them.
 #[derive(Debug, Clone)]
 pub struct Prepared {
+    /// The kernel file as composed for these params (`Kernel::shader_for`).
+    pub shader: String,
     pub uniforms: Vec<u8>,
     pub table: Vec<u32>,
 }
@@ -104,19 +106,19 @@ pub fn prepare(
     height: u32,
 ) -> Result<Prepared, GoldenError> {
     check_request(kernel, p, width, height)?;
-    let module = shaders.compose(&kernel.shader_for(p)).map_err(|e| match e {
+    let shader = kernel.shader_for(p);
+    let module = shaders.compose(&shader).map_err(|e| match e {
         // A missing or broken shader file is the user's to fix.
         vista_gpu::GpuError::Shader(m) => GoldenError::BadInput(format!("kernel {}: {m}", kernel.name())),
         other => GoldenError::Gpu(other),
     })?;
     let layout = kernel.layout(&module).map_err(|e| GoldenError::BadInput(e.to_string()))?;
-    Ok(Prepared { uniforms: kernel.uniforms(&layout, p, width, height), table: kernel.table(&layout, p) })
+    Ok(Prepared { shader, uniforms: kernel.uniforms(&layout, p, width, height), table: kernel.table(&layout, p) })
 }
 
 /// Renders `kernel` with `p` at `width` x `height` on the GPU.
 pub fn render(gpu: &Renderer, kernel: &Kernel, p: &ParamSet, width: u32, height: u32) -> Result<Rendered, GoldenError> {
-    let Prepared { uniforms, table } = prepare(&gpu.shaders, kernel, p, width, height)?;
-    let shader = kernel.shader_for(p);
+    let Prepared { shader, uniforms, table } = prepare(&gpu.shaders, kernel, p, width, height)?;
     let job = Dispatch { shaders: &gpu.shaders, shader: &shader, uniforms: &uniforms, table: &table, width, height };
     let (raw, stats) = gpu.ctx.run(&job)?;
     let display = kernel.display(&raw, p);

@@ -81,15 +81,14 @@ crate::builtin_handle!(CloudsKernel, "clouds");
 
 /// The longest primary step any ray can take (km). A ray of n steps spans at
 /// most max_distance, and with step_km > 0 and n < steps at most n step_km;
-/// its last step is the longest, a fraction first * growth^(n - 1) of it.
+/// its last step is the longest, the part of it past the first n - 1.
 fn longest_step(c: &Clouds) -> f64 {
     let n_all = if c.step_km > 0.0 { 1..=c.steps } else { c.steps..=c.steps };
     n_all
         .map(|n| {
             let span =
                 if c.step_km > 0.0 && n < c.steps { c.max_distance.min(n as f64 * c.step_km) } else { c.max_distance };
-            let (first, growth) = light_step_layout(n, c.step_spread);
-            span * first * growth.powi(n as i32 - 1)
+            span * (1.0 - StepLayout::new(n, c.step_spread).end(n - 1))
         })
         .fold(0.0, f64::max)
 }

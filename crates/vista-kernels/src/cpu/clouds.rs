@@ -96,6 +96,28 @@ pub fn light_step_layout(n: u32, spread: Real) -> (Real, Real) {
     ((log_r).exp_m1() / (n as Real * log_r).exp_m1(), log_r.exp())
 }
 
+/// Where the primary steps of a ray end, as fractions of its segment: the
+/// first k of n steps growing geometrically (last / first = spread) end at
+/// (r^k - 1) / (r^n - 1), r = spread^(1 / (n - 1)); k / n when uniform.
+#[derive(Debug, Clone, Copy)]
+pub struct StepLayout {
+    n: u32,
+    log_r: Real,
+    total: Real,
+}
+
+impl StepLayout {
+    pub fn new(n: u32, spread: Real) -> StepLayout {
+        let log_r = spread.ln() / (n.max(2) - 1) as Real;
+        StepLayout { n, log_r, total: (n as Real * log_r).exp_m1() }
+    }
+
+    /// Fraction of the segment covered by the first `k` steps.
+    pub fn end(&self, k: u32) -> Real {
+        if self.log_r == 0.0 { k as Real / self.n as Real } else { (k as Real * self.log_r).exp_m1() / self.total }
+    }
+}
+
 /// One marched ray.
 #[derive(Debug, Clone)]
 pub struct RayResult {
@@ -358,11 +380,9 @@ impl Clouds {
     #[allow(clippy::too_many_arguments)]
     pub fn march_segment(&self, o: V3, d: V3, t0: Real, t1: Real, xi: Real, sun: V3, trace: bool) -> RayResult {
         let mut out = RayResult { radiance: [0.0; 3], transmittance: 1.0, trace: Vec::new(), density_evals: 0 };
-        // Geometric steps: step k spans fractions (r^k - 1) / (r^n - 1) to
-        // (r^(k+1) - 1) / (r^n - 1) of the segment, r = spread^(1 / (n - 1)).
         let n = self.primary_steps(t0, t1);
-        let log_r = self.step_spread.ln() / (n.max(2) - 1) as Real;
-        let end_of = |k: u32| (k as Real * log_r).exp_m1() / (n as Real * log_r).exp_m1();
+        let layout = StepLayout::new(n, self.step_spread);
+        let dt_uniform = (t1 - t0) / n as Real;
         let phase = self.phase(dot(d, self.sun_dir));
         let ext = 1.0 + self.absorption;
         let mut t_view = 1.0;
@@ -371,12 +391,12 @@ impl Clouds {
                 JitterSteps::Shared => xi,
                 JitterSteps::Golden => (xi + k as Real * INV_PHI as Real).fract(),
             };
-            // Uniform steps at t0 + (k + xk) dt, without a running sum's rounding.
+            // Uniform steps at t0 + (k + xk) dt, as before the layout existed
+            // (the same rounding, which the f32 build's precision test sees).
             let (t, dt) = if self.step_spread == 1.0 {
-                let dt = (t1 - t0) / n as Real;
-                (t0 + (k as Real + xk) * dt, dt)
+                (t0 + (k as Real + xk) * dt_uniform, dt_uniform)
             } else {
-                let (a, b) = (end_of(k), end_of(k + 1));
+                let (a, b) = (layout.end(k), layout.end(k + 1));
                 (t0 + (t1 - t0) * (a + xk * (b - a)), (t1 - t0) * (b - a))
             };
             let p = add(o, scale(d, t));
@@ -416,10 +436,17 @@ impl Clouds {
     /// Optical depth (extinction) of the ray o + t d through the slab, by the
     /// midpoint rule with `samples` steps over its slab segment.
     pub fn optical_depth(&self, o: V3, d: V3, samples: u32) -> Real {
-        let Some((t0, t1)) = self.slab_segment(o, d) else { return 0.0 };
+        let Some((ext, dt, densities)) = self.depth_samples(o, d, samples) else { return 0.0 };
+        densities.sum::<Real>() * ext * dt
+    }
+
+    /// (1 + absorption, dt, the densities at the `samples` midpoints of the
+    /// ray's slab segment in order); `None` off the slab.
+    fn depth_samples(&self, o: V3, d: V3, samples: u32) -> Option<(Real, Real, impl Iterator<Item = Real> + '_)> {
+        let (t0, t1) = self.slab_segment(o, d)?;
         let dt = (t1 - t0) / samples as Real;
-        let ext = 1.0 + self.absorption;
-        (0..samples).map(|k| self.density(add(o, scale(d, t0 + (k as Real + 0.5) * dt)))).sum::<Real>() * ext * dt
+        let densities = (0..samples).map(move |k| self.density(add(o, scale(d, t0 + (k as Real + 0.5) * dt))));
+        Some((1.0 + self.absorption, dt, densities))
     }
 
     /// Whether [`Self::optical_depth`] exceeds `tau`, stopping at the first
@@ -428,17 +455,12 @@ impl Clouds {
     /// the full one is: the answer is the full sum's, at a fraction of the
     /// work under cloud.
     pub fn optical_depth_exceeds(&self, o: V3, d: V3, samples: u32, tau: Real) -> bool {
-        let Some((t0, t1)) = self.slab_segment(o, d) else { return 0.0 > tau };
-        let dt = (t1 - t0) / samples as Real;
-        let ext = 1.0 + self.absorption;
+        let Some((ext, dt, mut densities)) = self.depth_samples(o, d, samples) else { return 0.0 > tau };
         let mut sum = 0.0;
-        for k in 0..samples {
-            sum += self.density(add(o, scale(d, t0 + (k as Real + 0.5) * dt)));
-            if sum * ext * dt > tau {
-                return true;
-            }
-        }
-        false
+        densities.any(|x| {
+            sum += x;
+            sum * ext * dt > tau
+        })
     }
 
     /// Cloud amount as an observer at the camera counts it: the fraction of
