@@ -168,24 +168,27 @@ fn the_integer_z_shortcut_is_bit_identical_to_the_full_formula(gpu: &vista_golde
         let (w, h) = size;
         let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
         let b = vista_golden::render(&full, k, &p, w, h).unwrap().raw;
-        assert!(
-            a.data.iter().flatten().zip(b.data.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits()),
-            "{name} {preset}: the integer-z shortcut changes the output"
-        );
+        assert!(bit_identical(&a, &b), "{name} {preset}: the integer-z shortcut changes the output");
     }
 }
 
-/// fbm and ridged read one hash per corner from the table's plane when
+/// Every raw value has the same bits in `a` and `b`.
+fn bit_identical(a: &Image, b: &Image) -> bool {
+    a.data.iter().flatten().zip(b.data.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+/// fbm and ridged read one packed word per cell from the table's plane when
 /// z_slice is an integer (manifest hash_plane, VISTA_HASH_PLANE): bit-identical
 /// raw output to the permutation chain, at planes that wrap (255, 256, -3),
-/// for several seeds; and the comparison can fail (a wrong corner shows).
+/// for several seeds; and the comparison can fail (two swapped corners show).
 fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::Renderer<'static>) {
     let (_dir, chain) = common::with_edit(gpu, "lib/noise.wgsl", "#ifdef VISTA_HASH_PLANE", "#ifdef VISTA_CHAIN_ONLY");
-    let (_dir2, broken) =
-        common::with_edit(gpu, "lib/noise.wgsl", "let y1 = (i.y + 1u) & 255u;", "let y1 = (i.y + 2u) & 255u;");
-    let same = |a: &vista_image::Image, b: &vista_image::Image| {
-        a.data.iter().flatten().zip(b.data.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits())
-    };
+    let (_dir2, broken) = common::with_edit(
+        gpu,
+        "lib/noise.wgsl",
+        "perlin_face(q, q >> 8u, q >> 16u, q >> 24u,",
+        "perlin_face(q, q >> 16u, q >> 8u, q >> 24u,",
+    );
     for (name, preset, set) in [
         ("fbm", "default", &[][..]),
         ("fbm", "rough", &[("z_slice", "-3")][..]),
@@ -196,18 +199,49 @@ fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::
     ] {
         let k = vista_kernels::find(name).unwrap();
         let p = common::params(k, Some(preset), set);
-        assert!(k.shader_for(&p).ends_with("?VISTA_HASH_PLANE"), "{name} {preset} {set:?}: not on a hash plane");
+        assert!(k.shader_for(&p).contains("VISTA_HASH_PLANE"), "{name} {preset} {set:?}: not on a hash plane");
         let a = vista_golden::render(gpu, k, &p, 96, 64).unwrap().raw;
         let b = vista_golden::render(&chain, k, &p, 96, 64).unwrap().raw;
-        assert!(same(&a, &b), "{name} {preset} {set:?}: the hash plane changes the output");
+        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: the hash plane changes the output");
         let c = vista_golden::render(&broken, k, &p, 96, 64).unwrap().raw;
-        assert!(!same(&a, &c), "{name} {preset} {set:?}: a wrong corner on the plane went unseen");
+        assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: swapped corners on the plane went unseen");
     }
     // Off the integer planes, and for kernels without hash_plane, the chain.
     let fbm = vista_kernels::find("fbm").unwrap();
-    assert!(!fbm.shader_for(&common::params(fbm, None, &[("z_slice", "0.5")])).contains('?'));
+    assert!(!fbm.shader_for(&common::params(fbm, None, &[("z_slice", "0.5")])).contains("VISTA_HASH_PLANE"));
     let clouds = vista_kernels::find("clouds").unwrap();
     assert!(!clouds.shader_for(&common::params(clouds, None, &[])).contains('?'));
+}
+
+/// fbm and ridged list `basis` under `specialize`: the basis is a shader def
+/// (BASIS_IS_PERLIN, BASIS_IS_VALUE) and slice_noise compiles only that
+/// basis. Bit-identical raw output to the run-time branch on `basis`, for
+/// both bases, on and off the hash plane; and the comparison can fail (the
+/// wrong basis composed in shows).
+fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
+    let defs = "#ifdef BASIS_IS_VALUE\n    return value_noise(p, seed);\n#else ifdef BASIS_IS_PERLIN\n    return slice_perlin(p);\n#else\n";
+    let (_dir, branch) = common::with_edit(gpu, "lib/noise.wgsl", defs, "#ifndef VISTA_NEVER_DEFINED\n");
+    let swapped = defs.replacen("return value_noise(p, seed);", "return slice_perlin(p);", 1);
+    let (_dir2, broken) = common::with_edit(gpu, "lib/noise.wgsl", defs, &swapped);
+    for (name, preset, set, def) in [
+        ("fbm", "default", &[][..], "BASIS_IS_PERLIN"),
+        ("fbm", "value", &[][..], "BASIS_IS_VALUE"),
+        ("fbm", "value", &[("z_slice", "0.25"), ("seed", "9")][..], "BASIS_IS_VALUE"),
+        ("fbm", "rotated", &[("z_slice", "0.5")][..], "BASIS_IS_PERLIN"),
+        ("ridged", "default", &[][..], "BASIS_IS_PERLIN"),
+        ("ridged", "default", &[("basis", "value"), ("z_slice", "3")][..], "BASIS_IS_VALUE"),
+    ] {
+        let k = vista_kernels::find(name).unwrap();
+        let p = common::params(k, Some(preset), set);
+        assert!(k.shader_for(&p).contains(def), "{name} {preset} {set:?}: {} lacks {def}", k.shader_for(&p));
+        let a = vista_golden::render(gpu, k, &p, 96, 64).unwrap().raw;
+        let b = vista_golden::render(&branch, k, &p, 96, 64).unwrap().raw;
+        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: specializing the basis changes the output");
+        if def == "BASIS_IS_VALUE" {
+            let c = vista_golden::render(&broken, k, &p, 96, 64).unwrap().raw;
+            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: the wrong basis composed in went unseen");
+        }
+    }
 }
 
 fn main() {
@@ -215,6 +249,10 @@ fn main() {
         (
             "the_hash_plane_is_bit_identical_to_the_permutation_chain",
             the_hash_plane_is_bit_identical_to_the_permutation_chain,
+        ),
+        (
+            "the_specialized_basis_is_bit_identical_to_the_run_time_branch",
+            the_specialized_basis_is_bit_identical_to_the_run_time_branch,
         ),
         (
             "the_integer_z_shortcut_is_bit_identical_to_the_full_formula",

@@ -7,10 +7,12 @@
 // built on the CPU so the WGSL and the reference share one definition of it.
 // After it the host puts a plane flag and, for a kernel that samples one
 // integer plane z (its manifest's hash_plane param: fbm's and ridged's
-// z_slice), that plane's corner hashes: perm[PLANE_FLAG] = 1, perm[PLANE_Z] =
-// z & 255, then at PLANE_HASHES + 256 x + y the hash perm[perm[perm[x] + y] +
-// z] of lattice corner (x, y, z). One load per corner replaces the chain of
-// three, with the same values (tests/noise.rs checks the bits).
+// z_slice), that plane's corner hashes, packed four to a word: perm[PLANE_FLAG]
+// = 1, perm[PLANE_Z] = z & 255, then at PLANE_HASHES + 256 x + y the hashes
+// perm[perm[perm[x] + y] + z] of the cell's corners (x, y), (x + 1, y),
+// (x, y + 1), (x + 1, y + 1) in bytes 0 to 3 (x + 1 and y + 1 wrapped to
+// 0..255, as the doubled table wraps). One load per cell replaces the chains
+// of three per corner, with the same values (tests/noise.rs checks the bits).
 @group(0) @binding(2) var<storage, read> perm: array<u32>;
 const PLANE_FLAG: u32 = 512u;
 const PLANE_Z: u32 = 513u;
@@ -58,16 +60,16 @@ fn perlin_face(h00: u32, h10: u32, h01: u32, h11: u32, f: vec3<f32>, w: vec3<f32
 }
 
 // perlin(p) for p.z on the table's hash plane: the lower face only (w.z = 0
-// there), each corner's hash one load; the same face as perlin's, so the
-// same bits.
+// there), its four corner hashes one load; the same face as perlin's, so the
+// same bits. On the plane perlin_cell's z offset p.z - floor(p.z) is +0
+// exactly, so the cell is found in 2D with f.z = 0 (w.z is not read by the
+// face). perlin_grad reads the low 4 bits of each shifted byte.
 fn perlin_on_plane(p: vec3<f32>) -> f32 {
-    let c = perlin_cell(p);
-    let i = c.i;
-    // x + 1 and y + 1 wrap as the doubled table does (perm[k + 256] = perm[k]).
-    let row0 = PLANE_HASHES + (i.x << 8u);
-    let row1 = PLANE_HASHES + (((i.x + 1u) & 255u) << 8u);
-    let y1 = (i.y + 1u) & 255u;
-    return perlin_face(perm[row0 + i.y], perm[row1 + i.y], perm[row0 + y1], perm[row1 + y1], c.f, c.w);
+    let cell = floor(p.xy);
+    let f = vec3(p.xy - cell, 0.0);
+    let i = vec2<u32>(vec2<i32>(cell) & vec2<i32>(255));
+    let q = perm[PLANE_HASHES + (i.x << 8u) + i.y];
+    return perlin_face(q, q >> 8u, q >> 16u, q >> 24u, f, quintic(f));
 }
 
 fn perlin(p: vec3<f32>) -> f32 {
@@ -111,21 +113,36 @@ fn value_noise(p: vec3<f32>, seed: u32) -> f32 {
     return mix(mix(x0, x1, w.y), mix(x2, x3, w.y), w.z);
 }
 
-// The basis N selected at run time.
-// fbm2 and ridged2 sample their noise through here. A kernel whose manifest
-// names a hash_plane param gets, on an integer plane, that plane's corner
-// hashes in the table and VISTA_HASH_PLANE at composition, so Perlin reads
-// one hash per corner. Composed rather than branched on: llvmpipe runs both
-// sides of a branch its lanes could disagree on, masked, so a run-time test
-// kept the chain's full cost (measured: no gain).
+// The basis N of fbm2 and ridged2, and how it is chosen. Composed rather
+// than branched on where the kernel allows it: llvmpipe runs both sides of a
+// branch its lanes could disagree on, masked, so run-time tests keep their
+// full cost there (measured in the README).
+// - BASIS_IS_PERLIN / BASIS_IS_VALUE: the kernel's manifest lists `basis` under
+//   `specialize`, so its value is a shader def and the other basis is not
+//   compiled in; without either def, the run-time branch on `basis`.
+// - VISTA_HASH_PLANE: the manifest names a hash_plane param and its value is
+//   an integer, so the table carries that plane's corner hashes and Perlin
+//   reads one word per cell.
+// Either way the same functions compute the same values (tests/noise.rs
+// checks the bits of every combination against the run-time branch).
 fn slice_noise(basis: u32, seed: u32, p: vec3<f32>) -> f32 {
-#ifdef VISTA_HASH_PLANE
+#ifdef BASIS_IS_VALUE
+    return value_noise(p, seed);
+#else ifdef BASIS_IS_PERLIN
+    return slice_perlin(p);
+#else
     if basis == BASIS_VALUE {
         return value_noise(p, seed);
     }
+    return slice_perlin(p);
+#endif
+}
+
+fn slice_perlin(p: vec3<f32>) -> f32 {
+#ifdef VISTA_HASH_PLANE
     return perlin_on_plane(p);
 #else
-    return basis_noise(basis, seed, p);
+    return perlin(p);
 #endif
 }
 

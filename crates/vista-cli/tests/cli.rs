@@ -1007,6 +1007,42 @@ fn hash_plane_must_name_an_f32_param() {
     assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "hash_plane = \"gian\" must name an f32 param"]);
 }
 
+fn specialize_must_name_an_enum_param_once() {
+    let m = K_MANIFEST.replacen("summary", "specialize = [\"gain\"]\nsummary", 1);
+    assert_rejected(
+        &render_k(&m, K_SHADER),
+        2,
+        &["kernel k", "specialize = [\"gain\"]: \"gain\" must name an enum param"],
+    );
+    let m = format!("{K_MANIFEST}{MODE_PARAM}").replacen("summary", "specialize = [\"mode\", \"mode\"]\nsummary", 1);
+    assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "specialize lists \"mode\" twice"]);
+}
+
+const MODE_PARAM: &str =
+    "[[param]]\nname = \"mode\"\ntype = \"enum\"\nvalues = [\"dark\", \"light-grey\"]\ndefault = \"dark\"\n";
+
+/// A project kernel's `specialize` enum reaches its WGSL as a shader def
+/// (MODE_IS_DARK, MODE_IS_LIGHT_GREY): each value composes its own branch.
+fn a_specialized_enum_is_a_shader_def() {
+    let m = format!("{K_MANIFEST}{MODE_PARAM}").replacen("summary", "specialize = [\"mode\"]\nsummary", 1);
+    let shader = K_SHADER.replace("    gain: f32,\n", "    gain: f32,\n    mode: u32,\n").replace(
+        "    textureStore(output, id.xy, vec4(vec3(params.gain), 1.0));",
+        "#ifdef MODE_IS_LIGHT_GREY\n    let v = 0.75;\n#else ifdef MODE_IS_DARK\n    let v = 0.125;\n#else\n    let v = 0.5;\n#endif\n    textureStore(output, id.xy, vec4(vec3(v), 1.0));",
+    );
+    let d = kernel_project(&m, &shader);
+    for (mode, want) in [("dark", 0.125), ("light-grey", 0.75)] {
+        let out = d.path().join(format!("{mode}.exr"));
+        let r = vista_in(
+            Some(d.path()),
+            &[],
+            &["render", "k", "--set", &format!("mode={mode}"), "--size", "8x8", "-o", out.to_str().unwrap()],
+        );
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let img = vista_image::read_exr(&out).unwrap();
+        assert_eq!(img.get(3, 5)[0], want, "mode={mode}");
+    }
+}
+
 fn preset_naming_an_unknown_param_is_refused() {
     let m = format!("{K_MANIFEST}[preset.dim]\ngian = 0.1\n");
     assert_rejected(
@@ -1489,6 +1525,8 @@ fn main() {
         (Cpu, "bad_range_default_or_enum_value_is_refused", bad_range_default_or_enum_value_is_refused),
         (Cpu, "preset_naming_an_unknown_param_is_refused", preset_naming_an_unknown_param_is_refused),
         (Cpu, "hash_plane_must_name_an_f32_param", hash_plane_must_name_an_f32_param),
+        (Cpu, "specialize_must_name_an_enum_param_once", specialize_must_name_an_enum_param_once),
+        (Gpu, "a_specialized_enum_is_a_shader_def", a_specialized_enum_is_a_shader_def),
         (Cpu, "missing_shader_file_is_refused", missing_shader_file_is_refused),
         (Cpu, "malformed_manifest_names_file_line_and_column", malformed_manifest_names_file_line_and_column),
         (Gpu, "the_example_project_works_with_a_copied_binary", the_example_project_works_with_a_copied_binary),

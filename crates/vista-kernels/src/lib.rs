@@ -161,6 +161,32 @@ pub fn cpu_reference(name: &str) -> Option<&'static dyn CpuReference> {
     })
 }
 
+/// Raw output to display values (SPEC 3) for one param set: the HDR tone
+/// map with its exposure, and whether alpha is forced to 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DisplayMap {
+    exposure: Option<f32>,
+    opaque: bool,
+}
+
+impl DisplayMap {
+    /// The display values of `raw`, or None where they are `raw` itself (a
+    /// display kernel that keeps its alpha), so callers need not copy it.
+    pub fn apply(&self, raw: &Image) -> Option<Image> {
+        let mut out = match self.exposure {
+            Some(e) => vista_image::tonemap(raw, e),
+            None if self.opaque => raw.clone(),
+            None => return None,
+        };
+        if self.opaque {
+            for px in &mut out.data {
+                px[3] = 1.0;
+            }
+        }
+        Some(out)
+    }
+}
+
 /// One kernel: its manifest, where it came from, and its CPU reference if
 /// one is registered under its name. Kernels live for the whole process.
 #[derive(Clone)]
@@ -224,16 +250,15 @@ impl Kernel {
 
     /// Raw output to display values in [0, 1].
     pub fn display(&self, raw: &Image, p: &ParamSet) -> Image {
-        let mut out = match self.output() {
-            Output::Display => raw.clone(),
-            Output::Hdr => vista_image::tonemap(raw, p.f32("exposure")),
-        };
-        if self.manifest.opaque_display {
-            for px in &mut out.data {
-                px[3] = 1.0;
-            }
+        self.display_map(p).apply(raw).unwrap_or_else(|| raw.clone())
+    }
+
+    /// How this kernel's display values follow from its raw output for `p`.
+    pub fn display_map(&self, p: &ParamSet) -> DisplayMap {
+        DisplayMap {
+            exposure: (self.output() == Output::Hdr).then(|| p.f32("exposure")),
+            opaque: self.manifest.opaque_display,
         }
-        out
     }
 
     /// The manifest's work estimate per pixel (product of its `work`
@@ -294,12 +319,25 @@ impl Kernel {
         }
     }
 
-    /// The kernel file to compose for `p`: [`Self::shader`], with
-    /// `?VISTA_HASH_PLANE` (a naga_oil shader def) on a hash plane.
+    /// The kernel file to compose for `p`: [`Self::shader`], followed by
+    /// the naga_oil shader defs `p` selects after `?`, joined by `&`:
+    /// `VISTA_HASH_PLANE` on a hash plane, then `NAME_IS_VALUE` (upper case)
+    /// for each param the manifest lists under `specialize`, e.g.
+    /// `fbm.wgsl?VISTA_HASH_PLANE&BASIS_IS_PERLIN`. Each distinct name is
+    /// composed, cached and compiled as its own pipeline.
     pub fn shader_for(&self, p: &ParamSet) -> String {
-        match self.hash_plane(p) {
-            Some(_) => format!("{}?VISTA_HASH_PLANE", self.shader()),
-            None => self.shader().to_string(),
+        let mut defs: Vec<String> = Vec::new();
+        if self.hash_plane(p).is_some() {
+            defs.push("VISTA_HASH_PLANE".into());
+        }
+        for name in &self.manifest.specialize {
+            if let Some(Value::Enum(v)) = p.value(name) {
+                defs.push(format!("{name}_is_{v}").to_uppercase().replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
+            }
+        }
+        match defs.is_empty() {
+            true => self.shader().to_string(),
+            false => format!("{}?{}", self.shader(), defs.join("&")),
         }
     }
 

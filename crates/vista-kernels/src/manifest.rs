@@ -12,6 +12,8 @@
 //! output_range = [0.0, 1.0]        # NaN/range guard of the raw RGB (default: display [0, 1], hdr [0, inf))
 //! hash_plane = "z_slice"           # optional: every fbm2/ridged2 call samples z = this f32 param
 //!                                  # (an integer value gets Perlin's corner hashes for that plane)
+//! specialize = ["basis"]           # optional: enum params fixed when the shader is composed
+//!                                  # (naga_oil def BASIS_IS_PERLIN etc.; one pipeline per value)
 //! [[param]]
 //! name = "octaves"
 //! type = "u32"                     # u32 | i32 | f32 | bool | vec2 | vec3 | vec4 | enum
@@ -43,6 +45,8 @@ struct RawManifest {
     work: Vec<String>,
     output_range: Option<[f64; 2]>,
     hash_plane: Option<String>,
+    #[serde(default)]
+    specialize: Vec<String>,
     #[serde(default, rename = "param")]
     params: Vec<RawParam>,
     #[serde(default)]
@@ -91,6 +95,10 @@ pub struct Manifest {
     pub output_range: Option<(f64, f64)>,
     /// The f32 param every fbm2/ridged2 call of the shader takes as its z.
     pub hash_plane: Option<&'static str>,
+    /// Enum params whose value is a shader def (`NAME_IS_VALUE`, upper case)
+    /// rather than only a uniform, so the shader can drop the other cases
+    /// at composition.
+    pub specialize: Vec<&'static str>,
     pub params: &'static [ParamSpec],
     pub presets: &'static [Preset],
     pub sweep_reference: &'static [(&'static str, &'static str)],
@@ -291,6 +299,16 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             _ => return Err(kfail(format!("hash_plane = \"{n}\" must name an f32 param"))),
         },
     };
+    let mut specialize: Vec<&'static str> = Vec::new();
+    for n in &raw.specialize {
+        match params.iter().find(|p| &p.name == n) {
+            Some(p) if matches!(p.kind, Kind::Enum(_)) && !specialize.contains(&p.name) => specialize.push(p.name),
+            Some(p) if matches!(p.kind, Kind::Enum(_)) => {
+                return Err(kfail(format!("specialize lists \"{n}\" twice")));
+            }
+            _ => return Err(kfail(format!("specialize = [\"{n}\"]: \"{n}\" must name an enum param"))),
+        }
+    }
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
         name: leak(name),
@@ -301,6 +319,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         work,
         output_range: raw.output_range.map(|[a, b]| (a, b)),
         hash_plane,
+        specialize,
         params,
         presets: Box::leak(presets.into_boxed_slice()),
         sweep_reference,

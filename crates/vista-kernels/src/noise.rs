@@ -42,15 +42,20 @@ pub fn permutation(seed: u32) -> Vec<u32> {
 }
 
 /// The flag, plane and corner hashes the WGSL Perlin reads after the
-/// 512-entry permutation `perm` for the integer plane z: [1, z & 255, then
-/// perm[perm[perm[x] + y] + z] at 256 x + y for x, y in 0..256].
+/// 512-entry permutation `perm` for the integer plane z: [1, z & 255, then at
+/// 256 x + y the corner hashes h(x, y), h(x + 1, y), h(x, y + 1), h(x + 1,
+/// y + 1) of that cell in bytes 0 to 3, for x, y in 0..256], where h(x, y) =
+/// perm[perm[perm[x] + y] + z] and x + 1, y + 1 wrap to 0..255 (as the doubled
+/// table does). Each hash is a permutation entry, below 256, so four fit in
+/// a word and one load fetches the cell.
 pub fn plane_hashes(perm: &[u32], z: i64) -> Vec<u32> {
     let z = (z & 255) as usize;
+    let h = |x: usize, y: usize| perm[perm[perm[x & 255] as usize + (y & 255)] as usize + z];
     let mut out = Vec::with_capacity(2 + 256 * 256);
     out.extend([1, z as u32]);
     for x in 0..256 {
         for y in 0..256 {
-            out.push(perm[perm[perm[x] as usize + y] as usize + z]);
+            out.push(h(x, y) | h(x + 1, y) << 8 | h(x, y + 1) << 16 | h(x + 1, y + 1) << 24);
         }
     }
     out
@@ -110,6 +115,24 @@ mod tests {
         let p = permutation(0);
         let v = perlin(&p, 3.14, 42.0, 7.0);
         assert!((v - 0.136_919_958_784_000_12).abs() < 1e-15, "perlin(3.14, 42, 7) = {v}");
+    }
+
+    #[test]
+    fn plane_words_hold_the_four_corner_hashes_of_their_cell() {
+        for (seed, z) in [(0, 0), (7, 255), (12, -3)] {
+            let perm = permutation(seed);
+            let plane = plane_hashes(&perm, z);
+            let zw = (z & 255) as usize;
+            assert_eq!(plane[..2], [1, zw as u32]);
+            let chain = |x: usize, y: usize| perm[perm[perm[x % 256] as usize + y % 256] as usize + zw];
+            // Interior cells and the wrapping edges x = 255, y = 255.
+            for (x, y) in [(0, 0), (17, 200), (255, 3), (9, 255), (255, 255)] {
+                let word = plane[2 + 256 * x + y];
+                let bytes = [word & 255, word >> 8 & 255, word >> 16 & 255, word >> 24];
+                let want = [chain(x, y), chain(x + 1, y), chain(x, y + 1), chain(x + 1, y + 1)];
+                assert_eq!(bytes, want, "seed {seed} z {z} cell ({x}, {y})");
+            }
+        }
     }
 
     #[test]
