@@ -60,7 +60,10 @@ fn backends_agree(contexts: &[Context]) -> Result<(), String> {
             .iter()
             .map(|r| {
                 render(r, case.kernel, &case.params, case.width, case.height)
-                    .map(|o| (o.raw, vista_golden::quantize16(&o.display)))
+                    .map(|o| {
+                        let display = vista_golden::quantize16(o.display());
+                        (o.raw, display)
+                    })
                     .map_err(|e| format!("{} on {}: {e}", case.id, r.backend()))
             })
             .collect::<Result<_, _>>()?;

@@ -63,6 +63,33 @@ fn render_path_reports_nan_from_the_gpu_bit_exactly(ctx: &vista_golden::Renderer
     assert_eq!(r.raw.nonfinite_count(), 2);
 }
 
+/// Test-only kernel backed by `shaders/test/partial.wgsl`: writes the
+/// columns x < cut only.
+fn partial_kernel() -> &'static Kernel {
+    static PARTIAL: std::sync::OnceLock<Kernel> = std::sync::OnceLock::new();
+    PARTIAL.get_or_init(|| {
+        let manifest = "summary = \"writes 1 to the columns x < cut\"\nshader = \"test/partial.wgsl\"\n\
+                        [[param]]\nname = \"cut\"\ntype = \"u32\"\nrange = [0, 64]\ndefault = 16\n";
+        Kernel::from_manifest("test-partial", "tests/reliability.rs", manifest).expect("valid manifest")
+    })
+}
+
+/// Runs of one size share an output texture (vista-gpu's scratch): a pixel
+/// the kernel does not write must still read 0, as in a fresh texture, and
+/// never the value an earlier run wrote there.
+fn an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it(ctx: &vista_golden::Renderer) {
+    let k = partial_kernel();
+    let full = vista_golden::render(ctx, k, &k.resolve(None, &[]).unwrap(), 16, 8).unwrap();
+    assert_eq!(full.raw.get(12, 5), [1.0; 4]);
+    for _ in 0..2 {
+        let part = vista_golden::render(ctx, k, &k.resolve(None, &[("cut".into(), "4".into())]).unwrap(), 16, 8);
+        let part = part.unwrap().raw;
+        assert_eq!(part.get(3, 5), [1.0; 4]);
+        assert_eq!(part.get(4, 0), [0.0; 4], "an earlier run's value leaked into an unwritten pixel");
+        assert_eq!(part.get(15, 7), [0.0; 4], "an earlier run's value leaked into an unwritten pixel");
+    }
+}
+
 // ---- parameter fuzzing -----------------------------------------------------
 
 /// A strategy producing text for one parameter, anywhere in its range.
@@ -203,6 +230,10 @@ fn main() {
             injected_nan_fails_the_case_naming_count_and_first_pixel,
         ),
         ("render_path_reports_nan_from_the_gpu_bit_exactly", render_path_reports_nan_from_the_gpu_bit_exactly),
+        (
+            "an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it",
+            an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it,
+        ),
         (
             "random_in_range_params_give_finite_output_within_documented_bounds",
             random_in_range_params_give_finite_output_within_documented_bounds,

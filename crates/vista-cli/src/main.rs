@@ -252,7 +252,7 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
             let ctx = &Renderer { ctx: Context::shared()?, shaders };
             let r = vista_golden::render(ctx, k, &p, w, h)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-            let mut img = if is_exr { r.raw.clone() } else { r.display.clone() };
+            let mut img = if is_exr { r.raw.clone() } else { r.display().clone() };
             if let Some((x, y, cw, ch)) = rect {
                 img = img.crop(x, y, cw, ch).expect("the crop was checked against the size");
             }

@@ -82,7 +82,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
     let mut rows = Vec::new();
     for (case, r) in rendered {
         let path = store.golden_path(case);
-        let new = quantize16(&r.display);
+        let new = quantize16(r.display());
         // Read once: decoded for the PSNR against the new golden, hashed below.
         let old_bytes = std::fs::read(&path).ok();
         let old = old_bytes.as_deref().map(|b| vista_image::decode_png16(&path, b));

@@ -232,7 +232,7 @@ fn judge(
         vista_image::write_png16(&case_dir.join(name), img)?;
         Ok(format!("{}/{name}", case.id))
     };
-    let actual = quantize16(&r.display);
+    let actual = quantize16(r.display());
     out.files.actual = Some(write("actual.png", &actual)?);
     out.files.actual8 = Some(write8("actual8.png", &actual)?);
 

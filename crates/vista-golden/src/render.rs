@@ -1,10 +1,11 @@
 //! case -> kernel -> GPU run -> image: the one path every render takes.
 
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use vista_gpu::{Context, Dispatch, RunStats, ShaderSet};
 use vista_image::Image;
-use vista_kernels::{Kernel, ParamSet};
+use vista_kernels::{DisplayMap, Kernel, ParamSet};
 
 use crate::GoldenError;
 
@@ -17,12 +18,24 @@ fn max_work() -> f64 {
     std::env::var("VISTA_MAX_WORK").ok().and_then(|s| s.parse().ok()).unwrap_or(DEFAULT_MAX_WORK)
 }
 
-/// A rendered kernel: raw output (what the shader wrote) and display values.
+/// A rendered kernel: raw output (what the shader wrote) and, on demand,
+/// display values.
 #[derive(Debug, Clone)]
 pub struct Rendered {
     pub raw: Image,
-    pub display: Image,
     pub stats: RunStats,
+    to_display: DisplayMap,
+    /// Display values, made on first use unless they are `raw` itself: a
+    /// benchmark or a raw-only caller never pays for a second image.
+    display: OnceLock<Option<Image>>,
+}
+
+impl Rendered {
+    /// Display values in [0, 1] (what PNG goldens hold): `raw` itself for a
+    /// display kernel, else the kernel's tone map / opaque alpha of it.
+    pub fn display(&self) -> &Image {
+        self.display.get_or_init(|| self.to_display.apply(&self.raw)).as_ref().unwrap_or(&self.raw)
+    }
 }
 
 /// Checks size and work bounds before any GPU work.
@@ -121,8 +134,7 @@ pub fn render(gpu: &Renderer, kernel: &Kernel, p: &ParamSet, width: u32, height:
     let Prepared { shader, uniforms, table } = prepare(&gpu.shaders, kernel, p, width, height)?;
     let job = Dispatch { shaders: &gpu.shaders, shader: &shader, uniforms: &uniforms, table: &table, width, height };
     let (raw, stats) = gpu.ctx.run(&job)?;
-    let display = kernel.display(&raw, p);
-    Ok(Rendered { raw, display, stats })
+    Ok(Rendered { raw, stats, to_display: kernel.display_map(p), display: OnceLock::new() })
 }
 
 /// Renders `runs` (at least 1) times; returns the first render and the

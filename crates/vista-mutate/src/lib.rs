@@ -421,7 +421,7 @@ fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> Mutant
             return report("killed", Some(format!("{} (output range)", case.id)), false, n + 1);
         }
         if let Some(g) = golden {
-            let psnr = vista_image::metrics::psnr(g, &vista_golden::quantize16(&r.display));
+            let psnr = vista_image::metrics::psnr(g, &vista_golden::quantize16(r.display()));
             if psnr < *threshold {
                 return report("killed", Some(case.id.clone()), false, n + 1);
             }

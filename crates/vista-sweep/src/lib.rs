@@ -204,7 +204,7 @@ pub fn run(
         let (r, time) = vista_golden::render_median(ctx, k, p, w, h, spec.runs)?;
         let gpu_ms = time.as_secs_f64() * 1e3;
         let m = match spec.metric {
-            Metric::Display => metrics::compare(&reference.display, &r.display)?,
+            Metric::Display => metrics::compare(reference.display(), r.display())?,
             Metric::Linear => metrics::compare_hdr(&reference.raw, &r.raw)?,
         };
         out.push(Point { x: xv.clone(), y: yv.clone(), metrics: m, gpu_ms, work: k.mean_work_per_pixel(p, w, h) });
