@@ -180,7 +180,8 @@ fn bit_identical(a: &Image, b: &Image) -> bool {
 /// fbm and ridged read one packed word per cell from the table's plane when
 /// z_slice is an integer (manifest hash_plane, VISTA_HASH_PLANE): bit-identical
 /// raw output to the permutation chain, at planes that wrap (255, 256, -3),
-/// for several seeds; and the comparison can fail (two swapped corners show).
+/// for several seeds, and on the terrains' fixed plane z = 0; and the
+/// comparison can fail (two swapped corners show).
 fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::Renderer<'static>) {
     let (_dir, chain) = common::with_edit(gpu, "lib/noise.wgsl", "#ifdef VISTA_HASH_PLANE", "#ifdef VISTA_CHAIN_ONLY");
     let (_dir2, broken) = common::with_edit(
@@ -196,14 +197,19 @@ fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::
         ("fbm", "default", &[("z_slice", "256"), ("seed", "12")][..]),
         ("ridged", "default", &[][..]),
         ("ridged", "sharp", &[("z_slice", "41")][..]),
+        // The terrains' fixed plane z = 0 (hash_plane = 0).
+        ("heightfield", "ridges", &[("seed", "3")][..]),
+        ("heightfield", "valley", &[][..]),
+        ("landscape", "seed", &[][..]),
     ] {
         let k = vista_kernels::find(name).unwrap();
         let p = common::params(k, Some(preset), set);
         assert!(k.shader_for(&p).contains("VISTA_HASH_PLANE"), "{name} {preset} {set:?}: not on a hash plane");
-        let a = vista_golden::render(gpu, k, &p, 96, 64).unwrap().raw;
-        let b = vista_golden::render(&chain, k, &p, 96, 64).unwrap().raw;
+        let (w, h) = if name == "fbm" || name == "ridged" { (96, 64) } else { (48, 32) };
+        let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
+        let b = vista_golden::render(&chain, k, &p, w, h).unwrap().raw;
         assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: the hash plane changes the output");
-        let c = vista_golden::render(&broken, k, &p, 96, 64).unwrap().raw;
+        let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
         assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: swapped corners on the plane went unseen");
     }
     // Off the integer planes, and for kernels without hash_plane, the chain.
@@ -213,35 +219,80 @@ fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::
     assert!(!clouds.shader_for(&common::params(clouds, None, &[])).contains('?'));
 }
 
-/// fbm and ridged list `basis` under `specialize`: the basis is a shader def
-/// (BASIS_IS_PERLIN, BASIS_IS_VALUE) and slice_noise compiles only that
-/// basis. Bit-identical raw output to the run-time branch on `basis`, for
-/// both bases, on and off the hash plane; and the comparison can fail (the
-/// wrong basis composed in shows).
-fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
-    let defs = "#ifdef BASIS_IS_VALUE\n    return value_noise(p, seed);\n#else ifdef BASIS_IS_PERLIN\n    return slice_perlin(p);\n#else\n";
-    let (_dir, branch) = common::with_edit(gpu, "lib/noise.wgsl", defs, "#ifndef VISTA_NEVER_DEFINED\n");
-    let swapped = defs.replacen("return value_noise(p, seed);", "return slice_perlin(p);", 1);
-    let (_dir2, broken) = common::with_edit(gpu, "lib/noise.wgsl", defs, &swapped);
-    for (name, preset, set, def) in [
-        ("fbm", "default", &[][..], "BASIS_IS_PERLIN"),
-        ("fbm", "value", &[][..], "BASIS_IS_VALUE"),
-        ("fbm", "value", &[("z_slice", "0.25"), ("seed", "9")][..], "BASIS_IS_VALUE"),
-        ("fbm", "rotated", &[("z_slice", "0.5")][..], "BASIS_IS_PERLIN"),
-        ("ridged", "default", &[][..], "BASIS_IS_PERLIN"),
-        ("ridged", "default", &[("basis", "value"), ("z_slice", "3")][..], "BASIS_IS_VALUE"),
-    ] {
+/// A kernel render's shader defs (`specialize`) give bit-identical raw
+/// output to the run-time branches they replace: `defs` is the `#ifdef`
+/// chain in `file`, replaced by its run-time `#else` arm for the
+/// comparison, and by `wrong` to show the comparison can fail. Each case is
+/// (kernel, preset, overrides, the def it must be composed with, whether
+/// `wrong` changes it).
+fn specialization_is_bit_identical(
+    gpu: &vista_golden::Renderer<'static>,
+    file: &str,
+    defs: &str,
+    wrong: &str,
+    cases: &[(&str, &str, &[(&str, &str)], &str, bool)],
+) {
+    let (_dir, branch) = common::with_edit(gpu, file, defs, "#ifndef VISTA_NEVER_DEFINED\n");
+    let (_dir2, broken) = common::with_edit(gpu, file, defs, wrong);
+    for &(name, preset, set, def, shows) in cases {
         let k = vista_kernels::find(name).unwrap();
         let p = common::params(k, Some(preset), set);
         assert!(k.shader_for(&p).contains(def), "{name} {preset} {set:?}: {} lacks {def}", k.shader_for(&p));
-        let a = vista_golden::render(gpu, k, &p, 96, 64).unwrap().raw;
-        let b = vista_golden::render(&branch, k, &p, 96, 64).unwrap().raw;
-        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: specializing the basis changes the output");
-        if def == "BASIS_IS_VALUE" {
-            let c = vista_golden::render(&broken, k, &p, 96, 64).unwrap().raw;
-            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: the wrong basis composed in went unseen");
+        let (w, h) = if name == "fbm" || name == "ridged" { (96, 64) } else { (48, 32) };
+        let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
+        let b = vista_golden::render(&branch, k, &p, w, h).unwrap().raw;
+        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: composing {def} in changes the output");
+        if shows {
+            let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
+            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: the wrong {def} branch went unseen");
         }
     }
+}
+
+/// fbm, ridged and the terrains list `basis` under `specialize`: the basis
+/// is a shader def (BASIS_IS_PERLIN, BASIS_IS_VALUE) and slice_noise
+/// compiles only that basis; on and off the hash plane.
+fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
+    let defs = "#ifdef BASIS_IS_VALUE\n    return value_noise(p, seed);\n#else ifdef BASIS_IS_PERLIN\n    return slice_perlin(p);\n#else\n";
+    let wrong = defs.replacen("return value_noise(p, seed);", "return slice_perlin(p);", 1);
+    let value = &[("basis", "value")][..];
+    specialization_is_bit_identical(
+        gpu,
+        "lib/noise.wgsl",
+        defs,
+        &wrong,
+        &[
+            ("fbm", "default", &[], "BASIS_IS_PERLIN", false),
+            ("fbm", "value", &[], "BASIS_IS_VALUE", true),
+            ("fbm", "value", &[("z_slice", "0.25"), ("seed", "9")], "BASIS_IS_VALUE", true),
+            ("fbm", "rotated", &[("z_slice", "0.5")], "BASIS_IS_PERLIN", false),
+            ("ridged", "default", &[], "BASIS_IS_PERLIN", false),
+            ("ridged", "default", &[("basis", "value"), ("z_slice", "3")], "BASIS_IS_VALUE", true),
+            ("heightfield", "valley", value, "BASIS_IS_VALUE", true),
+            ("landscape", "seed", value, "BASIS_IS_VALUE", true),
+        ],
+    );
+}
+
+/// The terrains list `terrain` under `specialize`: is_kind (lib/terrain.wgsl)
+/// is a constant and only that kind's height function is compiled in.
+fn the_specialized_terrain_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
+    let defs = "#ifdef TERRAIN_IS_FBM\n    return k == TERRAIN_FBM;\n#else ifdef TERRAIN_IS_RIDGED\n    return k == TERRAIN_RIDGED;\n#else ifdef TERRAIN_IS_PLANE\n    return k == TERRAIN_PLANE;\n#else ifdef TERRAIN_IS_SINE\n    return k == TERRAIN_SINE;\n#else\n";
+    let wrong = defs.replacen("return k == TERRAIN_FBM;", "return k == TERRAIN_RIDGED;", 1);
+    specialization_is_bit_identical(
+        gpu,
+        "lib/terrain.wgsl",
+        defs,
+        &wrong,
+        &[
+            ("heightfield", "valley", &[], "TERRAIN_IS_FBM", true),
+            ("heightfield", "ridges", &[], "TERRAIN_IS_RIDGED", false),
+            ("heightfield", "default", &[("terrain", "plane")], "TERRAIN_IS_PLANE", false),
+            ("heightfield", "default", &[("terrain", "sine")], "TERRAIN_IS_SINE", false),
+            ("landscape", "seed", &[], "TERRAIN_IS_RIDGED", false),
+            ("landscape", "seed", &[("terrain", "fbm")], "TERRAIN_IS_FBM", true),
+        ],
+    );
 }
 
 fn main() {
@@ -253,6 +304,10 @@ fn main() {
         (
             "the_specialized_basis_is_bit_identical_to_the_run_time_branch",
             the_specialized_basis_is_bit_identical_to_the_run_time_branch,
+        ),
+        (
+            "the_specialized_terrain_is_bit_identical_to_the_run_time_branch",
+            the_specialized_terrain_is_bit_identical_to_the_run_time_branch,
         ),
         (
             "the_integer_z_shortcut_is_bit_identical_to_the_full_formula",

@@ -10,6 +10,7 @@
 const TERRAIN_FBM: u32 = 0u;
 const TERRAIN_RIDGED: u32 = 1u;
 const TERRAIN_PLANE: u32 = 2u;
+const TERRAIN_SINE: u32 = 3u;
 const REFINE_ITERS: u32 = 16u;
 const REFINE_TOL: f32 = 0.01;
 
@@ -55,12 +56,31 @@ fn terrain_of(p: TerrainParams) -> Terrain {
     let fbm = FbmSettings(p.basis, p.seed, p.octaves, p.lacunarity, p.gain, cos(theta), sin(theta));
     let ridged = RidgedSettings(p.basis, p.seed, p.octaves, p.lacunarity, p.ridge_h, p.ridge_offset, p.ridge_gain);
     var inv_norm = 1.0;
-    if p.kind == TERRAIN_FBM {
+    if is_kind(p.kind, TERRAIN_FBM) {
         inv_norm = 1.0 / fbm_amplitude(p.octaves, p.gain);
-    } else if p.kind == TERRAIN_RIDGED {
+    } else if is_kind(p.kind, TERRAIN_RIDGED) {
         inv_norm = 1.0 / ridged_max(ridged);
     }
     return Terrain(p.kind, fbm, ridged, p.amplitude, p.scale, p.plane_slope, inv_norm);
+}
+
+// Whether the terrain kind (the `terrain` param) is k. A kernel whose
+// manifest lists `terrain` under `specialize` is composed with
+// TERRAIN_IS_<KIND>: the answer is then a constant and the other kinds'
+// height functions are not compiled in (llvmpipe would run every one of
+// them, masked, at each height sample). Without the def, the run-time test.
+fn is_kind(kind: u32, k: u32) -> bool {
+#ifdef TERRAIN_IS_FBM
+    return k == TERRAIN_FBM;
+#else ifdef TERRAIN_IS_RIDGED
+    return k == TERRAIN_RIDGED;
+#else ifdef TERRAIN_IS_PLANE
+    return k == TERRAIN_PLANE;
+#else ifdef TERRAIN_IS_SINE
+    return k == TERRAIN_SINE;
+#else
+    return kind == k;
+#endif
 }
 
 // The relax march (SPEC 3.4).
@@ -73,13 +93,13 @@ struct March {
 
 fn terrain_height(s: Terrain, xz: vec2<f32>) -> f32 {
     let q = xz * s.scale;
-    if s.kind == TERRAIN_FBM {
+    if is_kind(s.kind, TERRAIN_FBM) {
         return s.amplitude * fbm2(s.fbm, q, 0.0) * s.inv_norm;
     }
-    if s.kind == TERRAIN_RIDGED {
+    if is_kind(s.kind, TERRAIN_RIDGED) {
         return s.amplitude * ridged2(s.ridged, q, 0.0) * s.inv_norm;
     }
-    if s.kind == TERRAIN_PLANE {
+    if is_kind(s.kind, TERRAIN_PLANE) {
         return s.amplitude + dot(s.plane_slope, xz);
     }
     return s.amplitude * sin(q.x) * cos(q.y);

@@ -1004,7 +1004,17 @@ fn bad_range_default_or_enum_value_is_refused() {
 
 fn hash_plane_must_name_an_f32_param() {
     let m = K_MANIFEST.replacen("summary", "hash_plane = \"gian\"\nsummary", 1);
-    assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "hash_plane = \"gian\" must name an f32 param"]);
+    assert_rejected(
+        &render_k(&m, K_SHADER),
+        2,
+        &["kernel k", "hash_plane = \"gian\" must name an f32 param or be an integer z"],
+    );
+    let m = K_MANIFEST.replacen("summary", "hash_plane = 0.5\nsummary", 1);
+    assert_rejected(
+        &render_k(&m, K_SHADER),
+        2,
+        &["kernel k", "hash_plane = 0.5 must name an f32 param or be an integer z"],
+    );
 }
 
 fn specialize_must_name_an_enum_param_once() {

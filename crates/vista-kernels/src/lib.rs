@@ -81,6 +81,7 @@ use std::sync::OnceLock;
 pub use cpu64::geometry;
 pub use cpu64::{pixel_uv, render_cpu};
 pub use layout::UniformLayout;
+pub use manifest::HashPlane;
 pub use params::{Kind, ParamSet, ParamSpec, ParamType, Preset, Value};
 use vista_image::Image;
 
@@ -308,14 +309,17 @@ impl Kernel {
         table
     }
 
-    /// The integer plane z of the manifest's `hash_plane` param, when it is
-    /// one: the table then carries that plane's corner hashes and the
-    /// shader is composed with VISTA_HASH_PLANE (lib/noise.wgsl).
+    /// The integer plane z of the manifest's `hash_plane` (its fixed z, or
+    /// its param's value when that is an integer): the table then carries
+    /// that plane's corner hashes and the shader is composed with
+    /// VISTA_HASH_PLANE (lib/noise.wgsl).
     pub fn hash_plane(&self, p: &ParamSet) -> Option<i64> {
-        let name = self.manifest.hash_plane?;
-        match p.value(name) {
-            Some(Value::Float(z)) if z.fract() == 0.0 => Some(*z as i64),
-            _ => None,
+        match self.manifest.hash_plane? {
+            HashPlane::Fixed(z) => Some(z),
+            HashPlane::Param(name) => match p.value(name) {
+                Some(Value::Float(z)) if z.fract() == 0.0 => Some(*z as i64),
+                _ => None,
+            },
         }
     }
 

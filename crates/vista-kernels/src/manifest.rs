@@ -11,7 +11,8 @@
 //! work = ["octaves"]               # product of entries, each `name` or a sum `a + b + 3`
 //! output_range = [0.0, 1.0]        # NaN/range guard of the raw RGB (default: display [0, 1], hdr [0, inf))
 //! hash_plane = "z_slice"           # optional: every fbm2/ridged2 call samples z = this f32 param
-//!                                  # (an integer value gets Perlin's corner hashes for that plane)
+//!                                  # (an integer value gets Perlin's corner hashes for that plane),
+//!                                  # or an integer: every such call samples that fixed z
 //! specialize = ["basis"]           # optional: enum params fixed when the shader is composed
 //!                                  # (naga_oil def BASIS_IS_PERLIN etc.; one pipeline per value)
 //! [[param]]
@@ -44,7 +45,7 @@ struct RawManifest {
     #[serde(default)]
     work: Vec<String>,
     output_range: Option<[f64; 2]>,
-    hash_plane: Option<String>,
+    hash_plane: Option<toml::Value>,
     #[serde(default)]
     specialize: Vec<String>,
     #[serde(default, rename = "param")]
@@ -82,6 +83,15 @@ pub struct WorkFactor {
     pub constant: f64,
 }
 
+/// Where a kernel's fbm2/ridged2 calls sample z (manifest `hash_plane`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HashPlane {
+    /// At this f32 param's value: a hash plane when it is an integer.
+    Param(&'static str),
+    /// Always at this integer z (the terrains' height field, z = 0).
+    Fixed(i64),
+}
+
 /// A parsed, validated manifest. Strings are leaked: a process loads each
 /// project's manifests once and keeps its kernels for its whole life.
 #[derive(Debug, Clone)]
@@ -93,8 +103,8 @@ pub struct Manifest {
     pub opaque_display: bool,
     pub work: Vec<WorkFactor>,
     pub output_range: Option<(f64, f64)>,
-    /// The f32 param every fbm2/ridged2 call of the shader takes as its z.
-    pub hash_plane: Option<&'static str>,
+    /// The z every fbm2/ridged2 call of the shader takes.
+    pub hash_plane: Option<HashPlane>,
     /// Enum params whose value is a shader def (`NAME_IS_VALUE`, upper case)
     /// rather than only a uniform, so the shader can drop the other cases
     /// at composition.
@@ -292,11 +302,12 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     if output == Output::Hdr && !params.iter().any(|p| p.name == "exposure" && matches!(p.kind, Kind::Float { .. })) {
         return Err(kfail("output = \"hdr\" needs an f32 param named exposure (the PNG tone map)".into()));
     }
-    let hash_plane = match raw.hash_plane.as_deref() {
+    let hash_plane = match &raw.hash_plane {
         None => None,
-        Some(n) => match params.iter().find(|p| p.name == n) {
-            Some(p) if matches!(p.kind, Kind::Float { .. }) => Some(p.name),
-            _ => return Err(kfail(format!("hash_plane = \"{n}\" must name an f32 param"))),
+        Some(toml::Value::Integer(z)) => Some(HashPlane::Fixed(*z)),
+        Some(v) => match params.iter().find(|p| v.as_str() == Some(p.name)) {
+            Some(p) if matches!(p.kind, Kind::Float { .. }) => Some(HashPlane::Param(p.name)),
+            _ => return Err(kfail(format!("hash_plane = {v} must name an f32 param or be an integer z"))),
         },
     };
     let mut specialize: Vec<&'static str> = Vec::new();
