@@ -157,9 +157,9 @@ struct WgpuEngine {
     pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
     /// The last run's output texture and readback buffer, which the next run
     /// of the same size takes instead of allocating its own: fresh ones cost
-    /// a page fault per 4 KiB as they are first written (at 1024 x 1024
-    /// about 10 ms of a 45 ms fbm render here). A concurrent run finds it
-    /// empty and allocates. The texture is reused only where the device can
+    /// a page fault per 4 KiB as they are first written (filling a fresh
+    /// 16 MiB image, 1024 x 1024, took 10-12 ms here). A concurrent run
+    /// finds it empty and allocates. The texture is reused only where the device can
     /// clear it (CLEAR_TEXTURE): every run starts from zeros, as a new one
     /// does, so a pixel a kernel leaves unwritten never shows an earlier
     /// run's value.
