@@ -219,18 +219,20 @@ fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::
     assert!(!clouds.shader_for(&common::params(clouds, None, &[])).contains('?'));
 }
 
+/// (kernel, preset, overrides, the def it must be composed with, whether the
+/// wrong branch changes it).
+type SpecializedCase<'a> = (&'a str, &'a str, &'a [(&'a str, &'a str)], &'a str, bool);
+
 /// A kernel render's shader defs (`specialize`) give bit-identical raw
 /// output to the run-time branches they replace: `defs` is the `#ifdef`
 /// chain in `file`, replaced by its run-time `#else` arm for the
-/// comparison, and by `wrong` to show the comparison can fail. Each case is
-/// (kernel, preset, overrides, the def it must be composed with, whether
-/// `wrong` changes it).
+/// comparison, and by `wrong` to show the comparison can fail.
 fn specialization_is_bit_identical(
     gpu: &vista_golden::Renderer<'static>,
     file: &str,
     defs: &str,
     wrong: &str,
-    cases: &[(&str, &str, &[(&str, &str)], &str, bool)],
+    cases: &[SpecializedCase],
 ) {
     let (_dir, branch) = common::with_edit(gpu, file, defs, "#ifndef VISTA_NEVER_DEFINED\n");
     let (_dir2, broken) = common::with_edit(gpu, file, defs, wrong);

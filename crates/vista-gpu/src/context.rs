@@ -145,7 +145,7 @@ pub struct Context {
 }
 
 enum Engine {
-    Wgpu(WgpuEngine),
+    Wgpu(Box<WgpuEngine>),
     Browser(Box<BrowserEngine>),
 }
 
@@ -287,7 +287,7 @@ impl Context {
             immediate_size: 0,
         });
         Ok(Context {
-            engine: Engine::Wgpu(WgpuEngine {
+            engine: Engine::Wgpu(Box::new(WgpuEngine {
                 device,
                 queue,
                 layout,
@@ -295,7 +295,7 @@ impl Context {
                 pipelines: Mutex::new(HashMap::new()),
                 scratch: Mutex::new(None),
                 can_clear,
-            }),
+            })),
             info,
             backend: choice.backend_name(),
             timeout,

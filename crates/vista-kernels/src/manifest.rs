@@ -312,7 +312,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     };
     let mut specialize: Vec<&'static str> = Vec::new();
     for n in &raw.specialize {
-        match params.iter().find(|p| &p.name == n) {
+        match params.iter().find(|p| p.name == n) {
             Some(p) if matches!(p.kind, Kind::Enum(_)) && !specialize.contains(&p.name) => specialize.push(p.name),
             Some(p) if matches!(p.kind, Kind::Enum(_)) => {
                 return Err(kfail(format!("specialize lists \"{n}\" twice")));
