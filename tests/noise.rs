@@ -209,8 +209,12 @@ fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::
         let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
         let b = vista_golden::render(&chain, k, &p, w, h).unwrap().raw;
         assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: the hash plane changes the output");
-        let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
-        assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: swapped corners on the plane went unseen");
+        // The plane code is the same for every kernel: shown on the cheap ones
+        // (each edited shader is a fresh llvmpipe compile, seconds for a terrain).
+        if name == "fbm" || name == "ridged" {
+            let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
+            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: swapped corners on the plane went unseen");
+        }
     }
     // Off the integer planes, and for kernels without hash_plane, the chain.
     let fbm = vista_kernels::find("fbm").unwrap();
@@ -253,7 +257,9 @@ fn specialization_is_bit_identical(
 
 /// fbm, ridged and the terrains list `basis` under `specialize`: the basis
 /// is a shader def (BASIS_IS_PERLIN, BASIS_IS_VALUE) and slice_noise
-/// compiles only that basis; on and off the hash plane.
+/// compiles only that basis; on and off the hash plane. (landscape composes
+/// the same lib/terrain.wgsl height as heightfield; its raw hashes are the
+/// golden tests'.)
 fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
     let defs = "#ifdef BASIS_IS_VALUE\n    return value_noise(p, seed);\n#else ifdef BASIS_IS_PERLIN\n    return slice_perlin(p);\n#else\n";
     let wrong = defs.replacen("return value_noise(p, seed);", "return slice_perlin(p);", 1);
@@ -271,7 +277,6 @@ fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_gol
             ("ridged", "default", &[], "BASIS_IS_PERLIN", false),
             ("ridged", "default", &[("basis", "value"), ("z_slice", "3")], "BASIS_IS_VALUE", true),
             ("heightfield", "valley", value, "BASIS_IS_VALUE", true),
-            ("landscape", "seed", value, "BASIS_IS_VALUE", true),
         ],
     );
 }
@@ -292,7 +297,6 @@ fn the_specialized_terrain_is_bit_identical_to_the_run_time_branch(gpu: &vista_g
             ("heightfield", "default", &[("terrain", "plane")], "TERRAIN_IS_PLANE", false),
             ("heightfield", "default", &[("terrain", "sine")], "TERRAIN_IS_SINE", false),
             ("landscape", "seed", &[], "TERRAIN_IS_RIDGED", false),
-            ("landscape", "seed", &[("terrain", "fbm")], "TERRAIN_IS_FBM", true),
         ],
     );
 }
