@@ -223,6 +223,43 @@ fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::
     assert!(!clouds.shader_for(&common::params(clouds, None, &[])).contains('?'));
 }
 
+/// 3D Perlin reads its cell's chain values from the packed words after the
+/// permutation (lib/noise.wgsl perlin_hashes): bit-identical raw output to
+/// Perlin's own chain of three loads per corner (VISTA_PERLIN_CHAIN), off
+/// the integer planes (both faces) and on them, for several seeds; and the
+/// comparison can fail (two swapped corners show).
+fn the_packed_chain_is_bit_identical_to_perlins_chain(gpu: &vista_golden::Renderer<'static>) {
+    let (_dir, chain) =
+        common::with_edit(gpu, "lib/noise.wgsl", "#ifdef VISTA_PERLIN_CHAIN", "#ifndef VISTA_NEVER_DEFINED");
+    let (_dir2, broken) = common::with_edit(
+        gpu,
+        "lib/noise.wgsl",
+        "perm[PERLIN_PAIRS + k.y], perm[PERLIN_PAIRS + k.z]",
+        "perm[PERLIN_PAIRS + k.z], perm[PERLIN_PAIRS + k.y]",
+    );
+    for (name, preset, set, shows) in [
+        ("fbm", "default", &[("z_slice", "0.5")][..], true),
+        ("fbm", "rotated", &[("z_slice", "-3.25"), ("seed", "7")][..], false),
+        ("ridged", "default", &[("z_slice", "254.75"), ("seed", "12")][..], false),
+        ("cloudmap", "perlin", &[("time", "0.3")][..], false),
+        ("clouds", "cumulus", &[][..], true),
+        ("clouds", "cirrus", &[("seed", "5")][..], false),
+        // Its terrain is on the plane z = 0; its cloud slab's 3D fBm is not.
+        ("landscape", "seed", &[][..], false),
+    ] {
+        let k = vista_kernels::find(name).unwrap();
+        let p = common::params(k, Some(preset), set);
+        let (w, h) = if name == "fbm" || name == "ridged" || name == "cloudmap" { (96, 64) } else { (48, 32) };
+        let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
+        let b = vista_golden::render(&chain, k, &p, w, h).unwrap().raw;
+        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: the packed chain changes the output");
+        if shows {
+            let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
+            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: swapped corners in the packed chain went unseen");
+        }
+    }
+}
+
 /// (kernel, preset, overrides, the def it must be composed with, whether the
 /// wrong branch changes it).
 type SpecializedCase<'a> = (&'a str, &'a str, &'a [(&'a str, &'a str)], &'a str, bool);
@@ -307,6 +344,7 @@ fn main() {
             "the_hash_plane_is_bit_identical_to_the_permutation_chain",
             the_hash_plane_is_bit_identical_to_the_permutation_chain,
         ),
+        ("the_packed_chain_is_bit_identical_to_perlins_chain", the_packed_chain_is_bit_identical_to_perlins_chain),
         (
             "the_specialized_basis_is_bit_identical_to_the_run_time_branch",
             the_specialized_basis_is_bit_identical_to_the_run_time_branch,

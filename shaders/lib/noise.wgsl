@@ -5,18 +5,26 @@
 
 // 512-entry permutation (Perlin's table for seed 0, a PCG32 shuffle otherwise),
 // built on the CPU so the WGSL and the reference share one definition of it.
-// After it the host puts a plane flag and, for a kernel that samples one
-// integer plane z (its manifest's hash_plane param: fbm's and ridged's
-// z_slice), that plane's corner hashes, packed four to a word: perm[PLANE_FLAG]
-// = 1, perm[PLANE_Z] = z & 255, then at PLANE_HASHES + 256 x + y the hashes
-// perm[perm[perm[x] + y] + z] of the cell's corners (x, y), (x + 1, y),
-// (x, y + 1), (x + 1, y + 1) in bytes 0 to 3 (x + 1 and y + 1 wrapped to
-// 0..255, as the doubled table wraps). One load per cell replaces the chains
-// of three per corner, with the same values (tests/noise.rs checks the bits).
+// After it the host puts the same chain's values packed for fewer loads (each
+// hash is a permutation entry, below 256, so four fit in a word), all with
+// wraps as the doubled table wraps:
+// - at PERLIN_PAIRS + k, k < 511: perm[k] | perm[k + 1] << 8, a corner's hash
+//   and the one above it (z + 1);
+// - at PERLIN_CELLS + 256 x + y: perm[a], perm[a + 1], perm[b], perm[b + 1] in
+//   bytes 0 to 3, with a = perm[x] + y, b = perm[x + 1] + y (the chain's
+//   second level for cell (x, y));
+// - perm[PLANE_FLAG] = 1 and perm[PLANE_Z] = z & 255 and, for a kernel that
+//   samples one integer plane z (its manifest's hash_plane), at PLANE_HASHES
+//   + 256 x + y the hashes perm[perm[perm[x] + y] + z] of the cell's corners
+//   (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1) in bytes 0 to 3.
+// So a 3D cell takes 5 loads instead of the chain's 14, and a cell on the
+// plane 1, with the same values (tests/noise.rs checks the bits).
 @group(0) @binding(2) var<storage, read> perm: array<u32>;
-const PLANE_FLAG: u32 = 512u;
-const PLANE_Z: u32 = 513u;
-const PLANE_HASHES: u32 = 514u;
+const PERLIN_PAIRS: u32 = 512u;
+const PERLIN_CELLS: u32 = 1024u;
+const PLANE_FLAG: u32 = 66560u;
+const PLANE_Z: u32 = 66561u;
+const PLANE_HASHES: u32 = 66562u;
 
 const BASIS_PERLIN: u32 = 0u;
 const BASIS_VALUE: u32 = 1u;
@@ -72,17 +80,29 @@ fn perlin_on_plane(p: vec3<f32>) -> f32 {
     return perlin_face(q, q >> 8u, q >> 16u, q >> 24u, f, quintic(f));
 }
 
-fn perlin(p: vec3<f32>) -> f32 {
-    let c = perlin_cell(p);
-    let i = c.i;
-    // Corner hashes through the doubled permutation table.
+// The hashes of cell i's lower corners (x, y), (x + 1, y), (x, y + 1),
+// (x + 1, y + 1) at z in byte 0 of each component and of the corners above
+// them (z + 1) in byte 1.
+fn perlin_hashes(i: vec3<u32>) -> vec4<u32> {
+#ifdef VISTA_PERLIN_CHAIN
+    // Perlin's own chain through the doubled table, three loads per corner:
+    // the reference the packed tables are checked against (tests/noise.rs).
     let a = perm[i.x] + i.y;
     let b = perm[i.x + 1u] + i.y;
-    let aa = perm[a] + i.z;
-    let ab = perm[a + 1u] + i.z;
-    let ba = perm[b] + i.z;
-    let bb = perm[b + 1u] + i.z;
-    let lower = perlin_face(perm[aa], perm[ba], perm[ab], perm[bb], c.f, c.w);
+    let k = vec4(perm[a], perm[b], perm[a + 1u], perm[b + 1u]) + i.z;
+    return vec4(perm[k.x] | perm[k.x + 1u] << 8u, perm[k.y] | perm[k.y + 1u] << 8u,
+                perm[k.z] | perm[k.z + 1u] << 8u, perm[k.w] | perm[k.w + 1u] << 8u);
+#else
+    let q = perm[PERLIN_CELLS + (i.x << 8u) + i.y];
+    let k = (vec4(q, q >> 16u, q >> 8u, q >> 24u) & vec4(255u)) + i.z;
+    return vec4(perm[PERLIN_PAIRS + k.x], perm[PERLIN_PAIRS + k.y], perm[PERLIN_PAIRS + k.z], perm[PERLIN_PAIRS + k.w]);
+#endif
+}
+
+fn perlin(p: vec3<f32>) -> f32 {
+    let c = perlin_cell(p);
+    let h = perlin_hashes(c.i);
+    let lower = perlin_face(h.x, h.y, h.z, h.w, c.f, c.w);
     // On an integer z plane (the 2D kernels' z_slice 0: fbm, ridged, the
     // terrains) w.z = 0, so the upper face weighs exactly 0 and
     // mix(lower, upper, 0) = lower: its four corners are skipped, with the
@@ -92,7 +112,7 @@ fn perlin(p: vec3<f32>) -> f32 {
         return lower;
     }
     // f - (0, 0, 1) - (1, 0, 0) is f - (1, 0, 1) exactly: the same offsets.
-    let upper = perlin_face(perm[aa + 1u], perm[ba + 1u], perm[ab + 1u], perm[bb + 1u], f - vec3(0.0, 0.0, 1.0), c.w);
+    let upper = perlin_face(h.x >> 8u, h.y >> 8u, h.z >> 8u, h.w >> 8u, f - vec3(0.0, 0.0, 1.0), c.w);
     return mix(lower, upper, c.w.z);
 }
 

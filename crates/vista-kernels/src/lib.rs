@@ -291,8 +291,11 @@ impl Kernel {
         self.manifest.sweep_reference
     }
 
-    /// Read-only u32 table for binding 2: Perlin's permutation for the
-    /// kernel's `seed` param (seed 0 without one), if the module declares it.
+    /// Read-only u32 table for binding 2, if the module declares it:
+    /// Perlin's permutation for the kernel's `seed` param (seed 0 without
+    /// one), its chain values packed ([`noise::chain_words`]), then the plane
+    /// flag and z and, on a hash plane, its corner hashes
+    /// ([`noise::plane_hashes`]); lib/noise.wgsl reads them.
     pub fn table(&self, layout: &UniformLayout, p: &ParamSet) -> Vec<u32> {
         if !layout.uses_table {
             return vec![0; 4];
@@ -302,8 +305,9 @@ impl Kernel {
             _ => 0,
         };
         let mut table = noise::permutation(seed);
+        table.extend(noise::chain_words(&table));
         match self.hash_plane(p) {
-            Some(z) => table.extend(noise::plane_hashes(&table, z)),
+            Some(z) => table.extend(noise::plane_hashes(&table[..512], z)),
             None => table.extend([0, 0]),
         }
         table

@@ -41,6 +41,24 @@ pub fn permutation(seed: u32) -> Vec<u32> {
     base
 }
 
+/// The packed chain values the WGSL Perlin reads after the 512-entry
+/// permutation `perm` (lib/noise.wgsl): 512 pair words, perm[k] | perm[k + 1]
+/// << 8 (k = 511 wraps to perm[0]), then 256 x 256 cell words at 256 x + y,
+/// perm[a] | perm[a + 1] << 8 | perm[b] << 16 | perm[b + 1] << 24 with a =
+/// perm[x] + y, b = perm[x + 1] + y. Every entry is below 256, so four fit.
+pub fn chain_words(perm: &[u32]) -> Vec<u32> {
+    let p = |k: usize| perm[k % 512];
+    let mut out = Vec::with_capacity(512 + 256 * 256);
+    out.extend((0..512).map(|k| p(k) | p(k + 1) << 8));
+    for x in 0..256 {
+        for y in 0..256 {
+            let (a, b) = (p(x) as usize + y, p(x + 1) as usize + y);
+            out.push(p(a) | p(a + 1) << 8 | p(b) << 16 | p(b + 1) << 24);
+        }
+    }
+    out
+}
+
 /// The flag, plane and corner hashes the WGSL Perlin reads after the
 /// 512-entry permutation `perm` for the integer plane z: [1, z & 255, then at
 /// 256 x + y the corner hashes h(x, y), h(x + 1, y), h(x, y + 1), h(x + 1,
@@ -115,6 +133,25 @@ mod tests {
         let p = permutation(0);
         let v = perlin(&p, 3.14, 42.0, 7.0);
         assert!((v - 0.136_919_958_784_000_12).abs() < 1e-15, "perlin(3.14, 42, 7) = {v}");
+    }
+
+    #[test]
+    fn chain_words_hold_the_chain_values_of_their_cell() {
+        for seed in [0, 7] {
+            let perm = permutation(seed);
+            let words = chain_words(&perm);
+            assert_eq!(words.len(), 512 + 65536);
+            let bytes = |w: u32| [w & 255, w >> 8 & 255, w >> 16 & 255, w >> 24];
+            for k in [0, 200, 510] {
+                assert_eq!(bytes(words[k])[..2], [perm[k], perm[k + 1]], "seed {seed} pair {k}");
+            }
+            for (x, y) in [(0, 0), (17, 200), (255, 3), (9, 255), (255, 255)] {
+                let a = perm[x] as usize + y;
+                let b = perm[x + 1] as usize + y;
+                let want = [perm[a], perm[a + 1], perm[b], perm[b + 1]];
+                assert_eq!(bytes(words[512 + 256 * x + y]), want, "seed {seed} cell ({x}, {y})");
+            }
+        }
     }
 
     #[test]
