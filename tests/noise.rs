@@ -177,48 +177,68 @@ fn bit_identical(a: &Image, b: &Image) -> bool {
     a.data.iter().flatten().zip(b.data.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
-/// fbm and ridged read one packed word per cell from the table's plane when
-/// z_slice is an integer (manifest hash_plane, VISTA_HASH_PLANE): bit-identical
-/// raw output to the permutation chain, at planes that wrap (255, 256, -3),
-/// for several seeds, and on the terrains' fixed plane z = 0; and the
-/// comparison can fail (two swapped corners show).
-fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::Renderer<'static>) {
-    let (_dir, chain) = common::with_edit(gpu, "lib/noise.wgsl", "#ifdef VISTA_HASH_PLANE", "#ifdef VISTA_CHAIN_ONLY");
-    let (_dir2, broken) = common::with_edit(
-        gpu,
-        "lib/noise.wgsl",
-        "perlin_face(q, q >> 8u, q >> 16u, q >> 24u,",
-        "perlin_face(q, q >> 16u, q >> 8u, q >> 24u,",
-    );
-    for (name, preset, set) in [
-        ("fbm", "default", &[][..]),
-        ("fbm", "rough", &[("z_slice", "-3")][..]),
-        ("fbm", "rotated", &[("seed", "7"), ("z_slice", "255")][..]),
-        ("fbm", "default", &[("z_slice", "256"), ("seed", "12")][..]),
-        ("ridged", "default", &[][..]),
-        ("ridged", "sharp", &[("z_slice", "41")][..]),
-        // The terrains' fixed plane z = 0 (hash_plane = 0).
-        ("heightfield", "ridges", &[("seed", "3")][..]),
-        ("heightfield", "valley", &[][..]),
-        ("landscape", "seed", &[][..]),
-    ] {
+/// One comparison: (kernel, preset, overrides, a shader def its composed
+/// name must hold ("" for none), whether the wrong edit must change it).
+type Equivalence<'a> = (&'a str, &'a str, &'a [(&'a str, &'a str)], &'a str, bool);
+
+/// Renders each case with this checkout's shaders, with `reference` (an
+/// edit of `file` that swaps the fast path for what it replaces) and with
+/// `wrong` (an edit that breaks the fast path): raw output must be
+/// bit-identical to the reference's, and differ from the wrong one where the
+/// case says so, so the comparison can fail. Each edited shader is a fresh
+/// llvmpipe compile (seconds for a terrain), so the wrong edit is shown on
+/// the cheap kernels where its code is shared.
+fn bit_identical_to_reference(
+    gpu: &vista_golden::Renderer<'static>,
+    file: &str,
+    reference: (&str, &str),
+    wrong: (&str, &str),
+    cases: &[Equivalence],
+) {
+    let (_dir, reference) = common::with_edit(gpu, file, reference.0, reference.1);
+    let (_dir2, broken) = common::with_edit(gpu, file, wrong.0, wrong.1);
+    for &(name, preset, set, def, shows) in cases {
         let k = vista_kernels::find(name).unwrap();
         let p = common::params(k, Some(preset), set);
-        assert!(k.shader_for(&p).contains("VISTA_HASH_PLANE"), "{name} {preset} {set:?}: not on a hash plane");
-        let (w, h) = if name == "fbm" || name == "ridged" { (96, 64) } else { (48, 32) };
+        assert!(k.shader_for(&p).contains(def), "{name} {preset} {set:?}: {} lacks {def}", k.shader_for(&p));
+        let (w, h) = if matches!(name, "fbm" | "ridged" | "cloudmap") { (96, 64) } else { (48, 32) };
         let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
-        let b = vista_golden::render(&chain, k, &p, w, h).unwrap().raw;
-        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: the hash plane changes the output");
-        // The plane code is the same for every kernel: shown on the cheap ones
-        // (each edited shader is a fresh llvmpipe compile, seconds for a terrain).
-        if name == "fbm" || name == "ridged" {
+        let b = vista_golden::render(&reference, k, &p, w, h).unwrap().raw;
+        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: the fast path changes the output");
+        if shows {
             let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
-            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: swapped corners on the plane went unseen");
+            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: the broken fast path went unseen");
         }
     }
-    // Off the integer planes, and for kernels without hash_plane, the chain.
+}
+
+/// fbm and ridged read one packed word per cell from the table's plane when
+/// z_slice is an integer (manifest hash_plane, VISTA_HASH_PLANE), and the
+/// terrains on their fixed plane z = 0: bit-identical raw output to 3D
+/// Perlin, at planes that wrap (255, 256, -3), for several seeds; swapped
+/// corners show.
+fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::Renderer<'static>) {
+    let plane = "VISTA_HASH_PLANE";
+    bit_identical_to_reference(
+        gpu,
+        "lib/noise.wgsl",
+        ("#ifdef VISTA_HASH_PLANE", "#ifdef VISTA_CHAIN_ONLY"),
+        ("perlin_face(q, q >> 8u, q >> 16u, q >> 24u,", "perlin_face(q, q >> 16u, q >> 8u, q >> 24u,"),
+        &[
+            ("fbm", "default", &[], plane, true),
+            ("fbm", "rough", &[("z_slice", "-3")], plane, true),
+            ("fbm", "rotated", &[("seed", "7"), ("z_slice", "255")], plane, true),
+            ("fbm", "default", &[("z_slice", "256"), ("seed", "12")], plane, true),
+            ("ridged", "default", &[], plane, true),
+            ("ridged", "sharp", &[("z_slice", "41")], plane, true),
+            ("heightfield", "ridges", &[("seed", "3")], plane, false),
+            ("heightfield", "valley", &[], plane, false),
+            ("landscape", "seed", &[], plane, false),
+        ],
+    );
+    // Off the integer planes, and for kernels without hash_plane, 3D Perlin.
     let fbm = vista_kernels::find("fbm").unwrap();
-    assert!(!fbm.shader_for(&common::params(fbm, None, &[("z_slice", "0.5")])).contains("VISTA_HASH_PLANE"));
+    assert!(!fbm.shader_for(&common::params(fbm, None, &[("z_slice", "0.5")])).contains(plane));
     let clouds = vista_kernels::find("clouds").unwrap();
     assert!(!clouds.shader_for(&common::params(clouds, None, &[])).contains('?'));
 }
@@ -226,86 +246,46 @@ fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::
 /// 3D Perlin reads its cell's chain values from the packed words after the
 /// permutation (lib/noise.wgsl perlin_hashes): bit-identical raw output to
 /// Perlin's own chain of three loads per corner (VISTA_PERLIN_CHAIN), off
-/// the integer planes (both faces) and on them, for several seeds; and the
-/// comparison can fail (two swapped corners show).
+/// the integer planes (both faces), for several seeds; swapped corners show.
 fn the_packed_chain_is_bit_identical_to_perlins_chain(gpu: &vista_golden::Renderer<'static>) {
-    let (_dir, chain) =
-        common::with_edit(gpu, "lib/noise.wgsl", "#ifdef VISTA_PERLIN_CHAIN", "#ifndef VISTA_NEVER_DEFINED");
-    let (_dir2, broken) = common::with_edit(
+    bit_identical_to_reference(
         gpu,
         "lib/noise.wgsl",
-        "perm[PERLIN_PAIRS + k.y], perm[PERLIN_PAIRS + k.z]",
-        "perm[PERLIN_PAIRS + k.z], perm[PERLIN_PAIRS + k.y]",
+        ("#ifdef VISTA_PERLIN_CHAIN", "#ifndef VISTA_NEVER_DEFINED"),
+        ("perm[PERLIN_PAIRS + k.y], perm[PERLIN_PAIRS + k.z]", "perm[PERLIN_PAIRS + k.z], perm[PERLIN_PAIRS + k.y]"),
+        &[
+            ("fbm", "default", &[("z_slice", "0.5")], "", true),
+            ("fbm", "rotated", &[("z_slice", "-3.25"), ("seed", "7")], "", false),
+            ("ridged", "default", &[("z_slice", "254.75"), ("seed", "12")], "", false),
+            ("cloudmap", "perlin", &[("time", "0.3")], "", false),
+            ("clouds", "cumulus", &[], "", true),
+            ("clouds", "cirrus", &[("seed", "5")], "", false),
+            // Its terrain is on the plane z = 0; its cloud slab's 3D fBm is not.
+            ("landscape", "seed", &[], "", false),
+        ],
     );
-    for (name, preset, set, shows) in [
-        ("fbm", "default", &[("z_slice", "0.5")][..], true),
-        ("fbm", "rotated", &[("z_slice", "-3.25"), ("seed", "7")][..], false),
-        ("ridged", "default", &[("z_slice", "254.75"), ("seed", "12")][..], false),
-        ("cloudmap", "perlin", &[("time", "0.3")][..], false),
-        ("clouds", "cumulus", &[][..], true),
-        ("clouds", "cirrus", &[("seed", "5")][..], false),
-        // Its terrain is on the plane z = 0; its cloud slab's 3D fBm is not.
-        ("landscape", "seed", &[][..], false),
-    ] {
-        let k = vista_kernels::find(name).unwrap();
-        let p = common::params(k, Some(preset), set);
-        let (w, h) = if name == "fbm" || name == "ridged" || name == "cloudmap" { (96, 64) } else { (48, 32) };
-        let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
-        let b = vista_golden::render(&chain, k, &p, w, h).unwrap().raw;
-        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: the packed chain changes the output");
-        if shows {
-            let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
-            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: swapped corners in the packed chain went unseen");
-        }
-    }
 }
 
-/// (kernel, preset, overrides, the def it must be composed with, whether the
-/// wrong branch changes it).
-type SpecializedCase<'a> = (&'a str, &'a str, &'a [(&'a str, &'a str)], &'a str, bool);
-
-/// A kernel render's shader defs (`specialize`) give bit-identical raw
-/// output to the run-time branches they replace: `defs` is the `#ifdef`
-/// chain in `file`, replaced by its run-time `#else` arm for the
-/// comparison, and by `wrong` to show the comparison can fail.
-fn specialization_is_bit_identical(
-    gpu: &vista_golden::Renderer<'static>,
-    file: &str,
-    defs: &str,
-    wrong: &str,
-    cases: &[SpecializedCase],
-) {
-    let (_dir, branch) = common::with_edit(gpu, file, defs, "#ifndef VISTA_NEVER_DEFINED\n");
-    let (_dir2, broken) = common::with_edit(gpu, file, defs, wrong);
-    for &(name, preset, set, def, shows) in cases {
-        let k = vista_kernels::find(name).unwrap();
-        let p = common::params(k, Some(preset), set);
-        assert!(k.shader_for(&p).contains(def), "{name} {preset} {set:?}: {} lacks {def}", k.shader_for(&p));
-        let (w, h) = if name == "fbm" || name == "ridged" { (96, 64) } else { (48, 32) };
-        let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
-        let b = vista_golden::render(&branch, k, &p, w, h).unwrap().raw;
-        assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: composing {def} in changes the output");
-        if shows {
-            let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
-            assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: the wrong {def} branch went unseen");
-        }
-    }
-}
+/// The run-time `#else` arm of an `#ifdef` chain of shader defs, for the
+/// specialization tests: the chain (`defs`, ending in `#else`) is replaced
+/// by a test that is always true.
+const RUN_TIME_ARM: &str = "#ifndef VISTA_NEVER_DEFINED\n";
 
 /// fbm, ridged and the terrains list `basis` under `specialize`: the basis
 /// is a shader def (BASIS_IS_PERLIN, BASIS_IS_VALUE) and slice_noise
-/// compiles only that basis; on and off the hash plane. (landscape composes
-/// the same lib/terrain.wgsl height as heightfield; its raw hashes are the
-/// golden tests'.)
+/// compiles only that basis; bit-identical to the run-time branch on
+/// `basis`, on and off the hash plane; the wrong basis composed in shows.
+/// (landscape composes the same lib/terrain.wgsl height as heightfield; its
+/// raw hashes are the golden tests'.)
 fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
     let defs = "#ifdef BASIS_IS_VALUE\n    return value_noise(p, seed);\n#else ifdef BASIS_IS_PERLIN\n    return slice_perlin(p);\n#else\n";
     let wrong = defs.replacen("return value_noise(p, seed);", "return slice_perlin(p);", 1);
     let value = &[("basis", "value")][..];
-    specialization_is_bit_identical(
+    bit_identical_to_reference(
         gpu,
         "lib/noise.wgsl",
-        defs,
-        &wrong,
+        (defs, RUN_TIME_ARM),
+        (defs, &wrong),
         &[
             ("fbm", "default", &[], "BASIS_IS_PERLIN", false),
             ("fbm", "value", &[], "BASIS_IS_VALUE", true),
@@ -319,15 +299,16 @@ fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_gol
 }
 
 /// The terrains list `terrain` under `specialize`: is_kind (lib/terrain.wgsl)
-/// is a constant and only that kind's height function is compiled in.
+/// is a constant and only that kind's height function is compiled in;
+/// bit-identical to the run-time test of the kind; the wrong kind shows.
 fn the_specialized_terrain_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
     let defs = "#ifdef TERRAIN_IS_FBM\n    return k == TERRAIN_FBM;\n#else ifdef TERRAIN_IS_RIDGED\n    return k == TERRAIN_RIDGED;\n#else ifdef TERRAIN_IS_PLANE\n    return k == TERRAIN_PLANE;\n#else ifdef TERRAIN_IS_SINE\n    return k == TERRAIN_SINE;\n#else\n";
     let wrong = defs.replacen("return k == TERRAIN_FBM;", "return k == TERRAIN_RIDGED;", 1);
-    specialization_is_bit_identical(
+    bit_identical_to_reference(
         gpu,
         "lib/terrain.wgsl",
-        defs,
-        &wrong,
+        (defs, RUN_TIME_ARM),
+        (defs, &wrong),
         &[
             ("heightfield", "valley", &[], "TERRAIN_IS_FBM", true),
             ("heightfield", "ridges", &[], "TERRAIN_IS_RIDGED", false),
