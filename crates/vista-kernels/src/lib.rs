@@ -305,11 +305,13 @@ impl Kernel {
             _ => 0,
         };
         let mut table = noise::permutation(seed);
-        table.extend(noise::chain_words(&table));
-        match self.hash_plane(p) {
-            Some(z) => table.extend(noise::plane_hashes(&table[..512], z)),
-            None => table.extend([0, 0]),
-        }
+        let chain = noise::chain_words(&table);
+        let plane = match self.hash_plane(p) {
+            Some(z) => noise::plane_hashes(&table, &chain[512..], z),
+            None => vec![0, 0],
+        };
+        table.extend(chain);
+        table.extend(plane);
         table
     }
 

@@ -60,22 +60,19 @@ pub fn chain_words(perm: &[u32]) -> Vec<u32> {
 }
 
 /// The flag, plane and corner hashes the WGSL Perlin reads after the
-/// 512-entry permutation `perm` for the integer plane z: [1, z & 255, then at
-/// 256 x + y the corner hashes h(x, y), h(x + 1, y), h(x, y + 1), h(x + 1,
+/// permutation and its chain words for the integer plane z: [1, z & 255, then
+/// at 256 x + y the corner hashes h(x, y), h(x + 1, y), h(x, y + 1), h(x + 1,
 /// y + 1) of that cell in bytes 0 to 3, for x, y in 0..256], where h(x, y) =
 /// perm[perm[perm[x] + y] + z] and x + 1, y + 1 wrap to 0..255 (as the doubled
-/// table does). Each hash is a permutation entry, below 256, so four fit in
-/// a word and one load fetches the cell.
-pub fn plane_hashes(perm: &[u32], z: i64) -> Vec<u32> {
+/// table does). They are the last step of the chain from the cell words of
+/// [`chain_words`] (`cells`, after its 512 pair words): a cell's four hashes
+/// are perm[c + z] of its bytes perm[a], perm[b], perm[a + 1], perm[b + 1].
+pub fn plane_hashes(perm: &[u32], cells: &[u32], z: i64) -> Vec<u32> {
     let z = (z & 255) as usize;
-    let h = |x: usize, y: usize| perm[perm[perm[x & 255] as usize + (y & 255)] as usize + z];
-    let mut out = Vec::with_capacity(2 + 256 * 256);
+    let h = |word: u32, byte: u32| perm[(word >> (8 * byte) & 255) as usize + z];
+    let mut out = Vec::with_capacity(2 + cells.len());
     out.extend([1, z as u32]);
-    for x in 0..256 {
-        for y in 0..256 {
-            out.push(h(x, y) | h(x + 1, y) << 8 | h(x, y + 1) << 16 | h(x + 1, y + 1) << 24);
-        }
-    }
+    out.extend(cells.iter().map(|&w| h(w, 0) | h(w, 2) << 8 | h(w, 1) << 16 | h(w, 3) << 24));
     out
 }
 
@@ -158,7 +155,7 @@ mod tests {
     fn plane_words_hold_the_four_corner_hashes_of_their_cell() {
         for (seed, z) in [(0, 0), (7, 255), (12, -3)] {
             let perm = permutation(seed);
-            let plane = plane_hashes(&perm, z);
+            let plane = plane_hashes(&perm, &chain_words(&perm)[512..], z);
             let zw = (z & 255) as usize;
             assert_eq!(plane[..2], [1, zw as u32]);
             let chain = |x: usize, y: usize| perm[perm[perm[x % 256] as usize + y % 256] as usize + zw];
