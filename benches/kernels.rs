@@ -36,7 +36,7 @@ fn timed(b: &mut Bencher, seen: &mut Vec<Duration>, mut f: impl FnMut()) {
 
 /// Median in ms; None when a filter skipped the benchmark.
 fn median_ms(v: Vec<Duration>) -> Option<f64> {
-    (!v.is_empty()).then(|| vista_golden::median(v).as_secs_f64() * 1e3)
+    (!v.is_empty()).then(|| vista_render::median(v).as_secs_f64() * 1e3)
 }
 
 fn kernels(c: &mut Criterion) {
@@ -49,10 +49,10 @@ fn kernels(c: &mut Criterion) {
         let mut g = c.benchmark_group(k.name());
         g.sample_size(10).warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(3));
         let (mut gpu, mut f32_ref, mut f64_ref, mut march) = (vec![], vec![], vec![], vec![]);
-        vista_golden::render(ctx, k, &p, w, h).expect("warm-up render");
+        vista_render::render(ctx, k, &p, w, h).expect("warm-up render");
         g.bench_function("gpu 256x256", |b| {
             timed(b, &mut gpu, || {
-                vista_golden::render(ctx, k, &p, w, h).expect("render");
+                vista_render::render(ctx, k, &p, w, h).expect("render");
             })
         });
         g.bench_function(format!("cpu f32 reference 256x256 ({threads} threads)"), |b| {

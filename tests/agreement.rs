@@ -7,9 +7,10 @@
 
 mod common;
 
-use vista_golden::{Agreement, Renderer, agreement};
+use vista_golden::{Agreement, agreement};
 use vista_image::Image;
 use vista_kernels::Kernel;
+use vista_render::Renderer;
 
 /// One compared setting: kernel, preset, overrides, size.
 type Setting = (&'static str, &'static str, &'static [(&'static str, &'static str)], (u32, u32));
@@ -112,7 +113,7 @@ fn render_pair(gpu: &Renderer, s: &Setting) -> (&'static Kernel, Image, Image) {
     let (name, preset, set, (w, h)) = *s;
     let k = vista_kernels::find(name).unwrap();
     let p = common::params(k, Some(preset), set);
-    let mut g = vista_golden::render(gpu, k, &p, w, h).unwrap_or_else(|e| panic!("{name} {preset}: {e}")).raw;
+    let mut g = vista_render::render(gpu, k, &p, w, h).unwrap_or_else(|e| panic!("{name} {preset}: {e}")).raw;
     if name == "landscape" {
         let c = with_gpu_hits(gpu, k, s, &p);
         return (k, g, c);
@@ -141,7 +142,7 @@ fn with_gpu_hits(gpu: &Renderer, k: &Kernel, s: &Setting, p: &vista_kernels::Par
     let mut depth_set: Vec<(&str, &str)> = set.iter().copied().filter(|(n, _)| *n != "view").collect();
     depth_set.push(("view", "depth"));
     let dp = common::params(k, Some(preset), &depth_set);
-    let gd = vista_golden::render(gpu, k, &dp, w, h).unwrap().raw;
+    let gd = vista_render::render(gpu, k, &dp, w, h).unwrap().raw;
     let cd = reference(k, &dp, w, h);
     let same = gd
         .data
@@ -176,7 +177,7 @@ fn masked_by_hits(gpu: &Renderer, k: &Kernel, s: &Setting, g: &mut Image, c: &mu
     let mut depth_set: Vec<(&str, &str)> = set.iter().copied().filter(|(n, _)| *n != "view").collect();
     depth_set.push(("view", "depth"));
     let p = common::params(k, Some(preset), &depth_set);
-    let gd = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
+    let gd = vista_render::render(gpu, k, &p, w, h).unwrap().raw;
     let cd = reference(k, &p, w, h);
     let mut differ = 0;
     for i in 0..g.data.len() {
@@ -318,7 +319,7 @@ fn depth_agreement(gpu: &Renderer, preset: &str) -> (usize, usize) {
     let k = vista_kernels::find("heightfield").unwrap();
     let p = common::params(k, Some(preset), &[("view", "depth")]);
     let (w, h) = (64, 40);
-    let g = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
+    let g = vista_render::render(gpu, k, &p, w, h).unwrap().raw;
     let r = reference(k, &p, w, h);
     let either: Vec<(f32, f32)> =
         g.data.iter().zip(&r.data).map(|(a, b)| (a[0], b[0])).filter(|(a, b)| *a < 1.0 || *b < 1.0).collect();

@@ -17,8 +17,8 @@ fn params(preset: Option<&str>, set: &[(&str, String)]) -> ParamSet {
     K.resolve(preset, &o).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
-    vista_golden::render(ctx, &K, p, w, h).unwrap_or_else(|e| panic!("render failed: {e}")).raw
+fn gpu(ctx: &vista_render::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
+    vista_render::render(ctx, &K, p, w, h).unwrap_or_else(|e| panic!("render failed: {e}")).raw
 }
 
 fn samples(view: u32, light: u32) -> [(&'static str, String); 2] {
@@ -27,7 +27,7 @@ fn samples(view: u32, light: u32) -> [(&'static str, String); 2] {
 
 /// Same discrete scheme on both sides: only f32 vs f64 (and the GPU's
 /// camera-relative altitude formula vs the CPU's |p| - R_ground) differ.
-fn gpu_matches_cpu_at_the_same_settings(ctx: &vista_golden::Renderer) {
+fn gpu_matches_cpu_at_the_same_settings(ctx: &vista_render::Renderer) {
     for preset in ["noon", "afternoon", "sunset", "twilight", "high_altitude"] {
         let p = params(Some(preset), &[]);
         let (cpu, gpu) = (K.reference(&p, 48, 24), gpu(ctx, &p, 48, 24));
@@ -52,7 +52,7 @@ fn gpu_matches_cpu_at_the_same_settings(ctx: &vista_golden::Renderer) {
 /// runs at 512 x 128: on 64 x 32 images it is within 96-138 dB (peak = max)
 /// of the CPU at 1024 x 256 for every preset, far beyond the 45 dB asked
 /// here, at a quarter of the cost (1024 x 256 takes ~1.5 s per preset).
-fn gpu_high_quality_matches_converged_cpu(ctx: &vista_golden::Renderer) {
+fn gpu_high_quality_matches_converged_cpu(ctx: &vista_render::Renderer) {
     let (w, h) = (32, 16);
     // afternoon is noon's geometry at another sun angle; left out for time.
     for preset in ["noon", "sunset", "twilight", "high_altitude"] {
@@ -75,7 +75,7 @@ fn mean_rgb(img: &Image, rows: std::ops::Range<u32>) -> [f64; 3] {
     s.map(|v| v / (img.width * rows.len() as u32) as f64)
 }
 
-fn gpu_sky_invariants(ctx: &vista_golden::Renderer) {
+fn gpu_sky_invariants(ctx: &vista_render::Renderer) {
     let (w, h) = (64, 32);
     let render = |preset: &str| gpu(ctx, &params(Some(preset), &[]), w, h);
     let (noon, afternoon, sunset, twilight) =
@@ -143,7 +143,7 @@ fn gpu_sky_invariants(ctx: &vista_golden::Renderer) {
 
 /// Finite, non-negative and within `output_bounds` over the whole range of
 /// sun elevations and camera altitudes (and the extreme mie_g), tiny images.
-fn gpu_finite_over_the_parameter_grid(ctx: &vista_golden::Renderer) {
+fn gpu_finite_over_the_parameter_grid(ctx: &vista_render::Renderer) {
     let suns = [-10.0, -6.0, -2.0, -0.01, 0.0, 0.01, 1.0, 5.0, 20.0, 45.0, 75.0, 89.99, 90.0];
     let alts = [0.0, 0.5, 10.0, 1000.0, 8000.0, 30_000.0, 59_990.0, 60_000.0, 60_010.0, 100_000.0];
     for sun in suns {
@@ -185,7 +185,7 @@ fn gpu_finite_over_the_parameter_grid(ctx: &vista_golden::Renderer) {
     assert!(gpu(ctx, &p, 8, 4).data.iter().all(|px| px.iter().all(|c| c.is_finite())));
 }
 
-fn exr_round_trip_is_bit_identical(ctx: &vista_golden::Renderer) {
+fn exr_round_trip_is_bit_identical(ctx: &vista_render::Renderer) {
     let raw = gpu(ctx, &params(Some("sunset"), &[]), 32, 16);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sunset.exr");

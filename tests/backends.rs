@@ -7,10 +7,12 @@
 //! By default the first case of each kernel runs; `VISTA_BACKENDS_CASES=glob`
 //! picks others (`'*'` for all, as the README's table was made).
 
+use common::allow_no_gpu;
 use libtest_mimic::{Arguments, Trial};
-use vista_golden::{Case, Renderer, allow_no_gpu, render};
+use vista_golden::Case;
 use vista_gpu::{AdapterChoice, Context};
 use vista_image::{Image, metrics};
+use vista_render::{Renderer, render};
 
 mod common;
 
@@ -22,7 +24,13 @@ const SAME_DEVICE_PSNR: f64 = 100.0;
 fn contexts() -> Result<Vec<Context>, String> {
     BACKENDS
         .iter()
-        .map(|b| Context::new(AdapterChoice::of_backend(b).expect("known backend")).map_err(|e| format!("{b}: {e}")))
+        .map(|b| {
+            let config = vista_gpu::GpuConfig {
+                adapter: AdapterChoice::of_backend(b).expect("known backend"),
+                ..common::config().gpu.clone()
+            };
+            Context::new(&config).map_err(|e| format!("{b}: {e}"))
+        })
         .collect()
 }
 
@@ -50,8 +58,11 @@ fn backends_agree(contexts: &[Context]) -> Result<(), String> {
     let project = common::project();
     let store = vista_golden::Store::of_project(&project, "the backend test").map_err(|e| e.to_string())?;
     let cases = picked(&store.load_cases().map_err(|e| e.to_string())?);
-    let shaders = vista_golden::shader_set(&project).map_err(|e| e.to_string())?;
-    let renderers: Vec<Renderer> = contexts.iter().map(|ctx| Renderer { ctx, shaders: shaders.clone() }).collect();
+    let shaders = vista_render::shader_set(&project).map_err(|e| e.to_string())?;
+    let renderers: Vec<Renderer> = contexts
+        .iter()
+        .map(|ctx| Renderer { ctx, shaders: shaders.clone(), limits: common::config().limits })
+        .collect();
     let pairs = [(0usize, 1usize), (0, 2), (1, 2)];
     let mut worst: std::collections::BTreeMap<(&str, usize), Worst> = Default::default();
     let mut failures = Vec::new();
@@ -61,7 +72,7 @@ fn backends_agree(contexts: &[Context]) -> Result<(), String> {
             .map(|r| {
                 render(r, case.kernel, &case.params, case.width, case.height)
                     .map(|o| {
-                        let display = vista_golden::quantize16(o.display());
+                        let display = vista_render::quantize16(o.display());
                         (o.raw, display)
                     })
                     .map_err(|e| format!("{} on {}: {e}", case.id, r.backend()))

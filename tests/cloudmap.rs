@@ -11,7 +11,7 @@ fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
     common::params(&CloudmapKernel, Some(preset), set)
 }
 
-fn gpu_matches_f64_reference_on_every_preset(ctx: &vista_golden::Renderer) {
+fn gpu_matches_f64_reference_on_every_preset(ctx: &vista_render::Renderer) {
     let (w, h) = (128, 96);
     let mut settings: Vec<(String, ParamSet)> =
         CloudmapKernel.presets().iter().map(|p| (p.name.to_string(), params(p.name, &[]))).collect();
@@ -20,7 +20,7 @@ fn gpu_matches_f64_reference_on_every_preset(ctx: &vista_golden::Renderer) {
         params("default", &[("seed", "9"), ("sharpness", "0.9"), ("time", "7.3")]),
     ));
     for (name, p) in settings {
-        let gpu = vista_golden::render(ctx, &CloudmapKernel, &p, w, h).unwrap().raw;
+        let gpu = vista_render::render(ctx, &CloudmapKernel, &p, w, h).unwrap().raw;
         let cpu = CloudmapKernel.reference(&p, w, h);
         let err = vista_image::metrics::max_abs(&gpu, &cpu);
         eprintln!("cloudmap {name}: max |gpu - cpu| over RGBA = {err:.2e}");
@@ -28,9 +28,9 @@ fn gpu_matches_f64_reference_on_every_preset(ctx: &vista_golden::Renderer) {
     }
 }
 
-fn gpu_invariants_cover_and_frames(ctx: &vista_golden::Renderer) {
+fn gpu_invariants_cover_and_frames(ctx: &vista_render::Renderer) {
     let render =
-        |set: &[(&str, &str)]| vista_golden::render(ctx, &CloudmapKernel, &params("default", set), 64, 64).unwrap().raw;
+        |set: &[(&str, &str)]| vista_render::render(ctx, &CloudmapKernel, &params("default", set), 64, 64).unwrap().raw;
     for basis in ["value", "perlin"] {
         let clear = render(&[("basis", basis), ("cover", "1")]);
         assert!(clear.data.iter().all(|p| p[..3] == [0.0; 3]), "{basis}: cover 1 is not exactly clear");

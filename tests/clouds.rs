@@ -3,22 +3,22 @@
 
 mod common;
 
-use vista_golden::render;
 use vista_image::Image;
 use vista_image::metrics::{compare_hdr, hdr_peak, psnr_with_peak};
 use vista_kernels::ParamSet;
 use vista_kernels::clouds::CloudsKernel;
+use vista_render::render;
 
 fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
     common::params(&CloudsKernel, Some(preset), set)
 }
 
-fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
+fn gpu(ctx: &vista_render::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
     render(ctx, &CloudsKernel, p, w, h).expect("render").raw
 }
 
 /// Coverage 0: exactly the background (bit for bit) and alpha exactly 0.
-fn zero_coverage_is_exactly_the_background(ctx: &vista_golden::Renderer) {
+fn zero_coverage_is_exactly_the_background(ctx: &vista_render::Renderer) {
     let sky = [0.3f32, 0.5, 0.9];
     for preset in ["clear", "cumulus", "cumulonimbus"] {
         let p = params(preset, &[("coverage", "0"), ("sky_zenith", "0.3,0.5,0.9"), ("sky_horizon", "0.3,0.5,0.9")]);
@@ -47,7 +47,7 @@ fn zero_coverage_is_exactly_the_background(ctx: &vista_golden::Renderer) {
 }
 
 /// Doubling density_scale never raises T: alpha = 1 - T never falls.
-fn doubling_density_never_raises_transmittance(ctx: &vista_golden::Renderer) {
+fn doubling_density_never_raises_transmittance(ctx: &vista_render::Renderer) {
     for (preset, d) in [("cumulus", "40"), ("cirrostratus", "0.25"), ("stratocumulus", "4")] {
         let d2 = (d.parse::<f64>().unwrap() * 2.0).to_string();
         let a = gpu(ctx, &params(preset, &[("density_scale", d)]), 40, 40);
@@ -67,7 +67,7 @@ fn doubling_density_never_raises_transmittance(ctx: &vista_golden::Renderer) {
 }
 
 /// With the sun behind the camera the backward lobe keeps clouds lit.
-fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind(ctx: &vista_golden::Renderer) {
+fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind(ctx: &vista_render::Renderer) {
     let sun_behind = [("sun_azimuth_deg", "180"), ("sun_elevation_deg", "30"), ("yaw_deg", "0")];
     let dual = gpu(ctx, &params("cumulus", &[&sun_behind[..], &[("phase_blend", "0.5")]].concat()), 40, 40);
     let single = gpu(ctx, &params("cumulus", &[&sun_behind[..], &[("phase_blend", "0")]].concat()), 40, 40);
@@ -87,7 +87,7 @@ fn dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind(ctx: &vista_gol
     assert!(ratio > 1.1, "dual-lobe HG only {ratio:.3}x as bright as single-lobe with the sun behind");
 }
 
-fn renders_are_deterministic_and_jitter_follows_its_seed(ctx: &vista_golden::Renderer) {
+fn renders_are_deterministic_and_jitter_follows_its_seed(ctx: &vista_render::Renderer) {
     let (w, h) = (32, 32);
     let none = params("cumulus", &[]);
     assert!(gpu(ctx, &none, w, h).bit_identical(&gpu(ctx, &none, w, h)), "jitter none: renders differ");
@@ -105,7 +105,7 @@ fn renders_are_deterministic_and_jitter_follows_its_seed(ctx: &vista_golden::Ren
 /// the 512 x 32 reference comes from the f64 CPU march (the same march,
 /// 10x faster than lavapipe here). The full-size version is the CPU test
 /// `seed_experiment_analytic_ign_at_half_the_steps_beats_riemann_64x12`.
-fn seed_experiment_on_the_gpu(ctx: &vista_golden::Renderer) {
+fn seed_experiment_on_the_gpu(ctx: &vista_render::Renderer) {
     let (w, h) = (48, 48);
     let mut hq: Vec<(&str, &str)> = CloudsKernel.high_quality().to_vec();
     hq.push(("jitter", "none"));
@@ -128,7 +128,7 @@ fn seed_experiment_on_the_gpu(ctx: &vista_golden::Renderer) {
 
 /// On the GPU coverage_oktas = n is exactly the preset's table entry for n
 /// (the WGSL looks it up; CPU tests check what the table means).
-fn coverage_oktas_reads_the_presets_table_on_the_gpu(ctx: &vista_golden::Renderer) {
+fn coverage_oktas_reads_the_presets_table_on_the_gpu(ctx: &vista_render::Renderer) {
     for (preset, n) in [("cumulus", 0), ("cumulus", 3), ("stratocumulus", 6), ("cirrus", 8)] {
         let p = params(preset, &[("coverage_oktas", &n.to_string())]);
         let table = [p.vector("okta_coverage_low"), p.vector("okta_coverage_high")].concat();

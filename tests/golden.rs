@@ -4,8 +4,9 @@
 
 use std::sync::{Arc, Mutex};
 
+use common::allow_no_gpu;
 use libtest_mimic::{Arguments, Failed, Trial};
-use vista_golden::{CheckOptions, Store, allow_no_gpu};
+use vista_golden::{CheckOptions, Store};
 
 mod common;
 

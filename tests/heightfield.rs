@@ -17,8 +17,8 @@ fn params(preset: &str, sets: &[(&str, &str)]) -> ParamSet {
     common::params(&HeightfieldKernel, Some(preset), sets)
 }
 
-fn gpu(ctx: &vista_golden::Renderer, p: &ParamSet) -> Image {
-    vista_golden::render(ctx, &HeightfieldKernel, p, W, H).expect("render").raw
+fn gpu(ctx: &vista_render::Renderer, p: &ParamSet) -> Image {
+    vista_render::render(ctx, &HeightfieldKernel, p, W, H).expect("render").raw
 }
 
 /// Hit distance of a depth pixel (None for sky, depth 1).
@@ -31,7 +31,7 @@ fn hit_t(depth: f32, t_max: f64) -> Option<f64> {
 /// the terrain). relax = 0.5 is not below 1/sqrt(1 + L^2) for these noise
 /// terrains, so 0.5% of the pixels may. How closely the depths agree, over
 /// the pixels where either side hits, is tests/agreement.rs's job.
-fn no_hit_lies_behind_the_brute_force_reference(ctx: &vista_golden::Renderer) {
+fn no_hit_lies_behind_the_brute_force_reference(ctx: &vista_render::Renderer) {
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[("view", "depth")]);
         let g = gpu(ctx, &p);
@@ -45,7 +45,7 @@ fn no_hit_lies_behind_the_brute_force_reference(ctx: &vista_golden::Renderer) {
     }
 }
 
-fn refined_hits_satisfy_eps_rule(ctx: &vista_golden::Renderer) {
+fn refined_hits_satisfy_eps_rule(ctx: &vista_render::Renderer) {
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[("view", "depth")]);
         let g = gpu(ctx, &p);
@@ -77,7 +77,7 @@ fn refined_hits_satisfy_eps_rule(ctx: &vista_golden::Renderer) {
     }
 }
 
-fn raising_max_steps_never_removes_hits(ctx: &vista_golden::Renderer) {
+fn raising_max_steps_never_removes_hits(ctx: &vista_render::Renderer) {
     for preset in ["valley", "grazing"] {
         let renders: Vec<Image> = ["64", "128", "256"]
             .iter()
@@ -108,7 +108,7 @@ fn oversteps(gpu: &Image, reference: &Image) -> usize {
 /// (hits land behind the true one or the ray escapes), while 0.5 keeps the
 /// steps short enough to stop in front of nearly every crest at roughly
 /// twice the cost in steps.
-fn relax_one_oversteps_on_grazing_where_half_does_not(ctx: &vista_golden::Renderer) {
+fn relax_one_oversteps_on_grazing_where_half_does_not(ctx: &vista_render::Renderer) {
     let p = params("grazing", &[("view", "depth")]);
     let reference = HeightfieldKernel.reference(&p, W, H);
     let count = |relax: &str| {
@@ -122,7 +122,7 @@ fn relax_one_oversteps_on_grazing_where_half_does_not(ctx: &vista_golden::Render
     assert!(one >= 4 * half + 20, "relax 1.0 overstepped at only {one} pixels vs {half} at 0.5");
 }
 
-fn analytic_plane_depth_and_ramp_normals(ctx: &vista_golden::Renderer) {
+fn analytic_plane_depth_and_ramp_normals(ctx: &vista_render::Renderer) {
     // Flat plane h0 = 0.2: t* = (o.y - h0) / (-d.y) within eps t. Near the
     // horizon D shrinks by (1 - relax |d.y|) per step, so those rays need
     // more than the default 256 steps.
@@ -166,7 +166,7 @@ fn analytic_plane_depth_and_ramp_normals(ctx: &vista_golden::Renderer) {
     assert!(n > 1000, "only {n} ramp pixels");
 }
 
-fn sine_terrain_matches_bisection_and_normals_face_up(ctx: &vista_golden::Renderer) {
+fn sine_terrain_matches_bisection_and_normals_face_up(ctx: &vista_render::Renderer) {
     let sets = [("terrain", "sine"), ("amplitude", "0.4"), ("scale", "1.3"), ("camera_pos", "0.2,1.6,0.1")];
     let p = params("valley", &[&sets[..], &[("camera_target", "3,0,6"), ("view", "depth")]].concat());
     let g = gpu(ctx, &p);
@@ -196,7 +196,7 @@ fn sine_terrain_matches_bisection_and_normals_face_up(ctx: &vista_golden::Render
     assert!(hits.iter().all(|px| px[1] > 0.5), "a normal points down");
 }
 
-fn steps_match_reference(ctx: &vista_golden::Renderer) {
+fn steps_match_reference(ctx: &vista_render::Renderer) {
     // Smaller than the other tests: the f64 reference shades every hit
     // (normal, shadow march) on top of the brute-force search.
     // Colour against the oracle lives in tests/agreement.rs (shading compared
@@ -220,11 +220,11 @@ fn steps_match_reference(ctx: &vista_golden::Renderer) {
 /// so a ray that grazes a crest can land on its near or far side (measured:
 /// one pixel of 1440 on valley, 13 m apart in depth); at most one pixel per
 /// 1000 may differ by more than 1/255, and the rest must agree at >= 60 dB.
-fn cpu_f32_relax_march_matches_the_gpu(ctx: &vista_golden::Renderer) {
+fn cpu_f32_relax_march_matches_the_gpu(ctx: &vista_render::Renderer) {
     let (w, h) = (48, 30);
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[]);
-        let g = vista_golden::render(ctx, &HeightfieldKernel, &p, w, h).expect("render").raw;
+        let g = vista_render::render(ctx, &HeightfieldKernel, &p, w, h).expect("render").raw;
         let march = vista_kernels::cpu32::heightfield::render(&p, w, h, HitSearch::RelaxMarch).expect("valid");
         let oracle = HeightfieldKernel.reference(&p, w, h);
         let differs = |a: &[f32; 4], b: &[f32; 4]| (0..3).any(|c| (a[c] - b[c]).abs() > 1.0 / 255.0);

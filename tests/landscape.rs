@@ -7,12 +7,12 @@
 
 mod common;
 
-use vista_golden::{Renderer, render};
 use vista_image::Image;
 use vista_kernels::atmosphere::AtmosphereKernel;
 use vista_kernels::heightfield::HeightfieldKernel;
 use vista_kernels::landscape::LandscapeKernel;
 use vista_kernels::{Kernel, ParamSet};
+use vista_render::{Renderer, render};
 
 fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
     common::params(&LandscapeKernel, Some(preset), set)

@@ -4,8 +4,9 @@
 
 mod common;
 
-use vista_golden::{Renderer, Store};
+use vista_golden::Store;
 use vista_mutate::{Planned, mutants};
+use vista_render::Renderer;
 
 fn run_one(gpu: &Renderer, file: &str, line_text: &str, before: &str, after: &str) -> vista_mutate::MutantReport {
     let project = common::project();
@@ -47,7 +48,7 @@ fn a_change_the_shader_never_reads_is_equivalent(gpu: &Renderer) {
 fn only_functions_the_kernel_reaches_are_mutated(_gpu: &Renderer) {
     let project = common::project();
     let files = project.shader_files().unwrap();
-    let shaders = vista_golden::shader_set(&project).unwrap();
+    let shaders = vista_render::shader_set(&project).unwrap();
     let fbm = vista_kernels::find("fbm").unwrap();
     let opts =
         vista_mutate::Options { kernel: None, case_glob: None, sample: None, seed: 1, jobs: 1, partition: (1, 1) };

@@ -24,12 +24,12 @@ fn max_field_error(gpu: &Image, cpu: &Image) -> (f32, (u32, u32)) {
 /// (preset, overrides) of one comparison.
 type Setting<'a> = (Option<&'a str>, &'a [(&'a str, &'a str)]);
 
-fn gpu_vs_cpu(ctx: &vista_golden::Renderer, kernel_name: &str, cases: &[Setting]) {
+fn gpu_vs_cpu(ctx: &vista_render::Renderer, kernel_name: &str, cases: &[Setting]) {
     let k = vista_kernels::find(kernel_name).unwrap();
     for (preset, set) in cases {
         let p = params(k, *preset, set);
         let (w, h) = (128, 96);
-        let gpu = vista_golden::render(ctx, k, &p, w, h).unwrap().raw;
+        let gpu = vista_render::render(ctx, k, &p, w, h).unwrap().raw;
         let cpu = k.reference(&p, w, h);
         let (err, at) = max_field_error(&gpu, &cpu);
         let psnr = vista_image::metrics::psnr(&cpu, &gpu);
@@ -39,7 +39,7 @@ fn gpu_vs_cpu(ctx: &vista_golden::Renderer, kernel_name: &str, cases: &[Setting]
     }
 }
 
-fn fbm_gpu_matches_f64_reference(ctx: &vista_golden::Renderer) {
+fn fbm_gpu_matches_f64_reference(ctx: &vista_render::Renderer) {
     gpu_vs_cpu(
         ctx,
         "fbm",
@@ -59,10 +59,10 @@ fn fbm_gpu_matches_f64_reference(ctx: &vista_golden::Renderer) {
 /// the error grows like (gain * lacunarity)^i. This pins the documented
 /// limit: with gain * lacunarity = 1.53 over 16 octaves the error leaves the
 /// 1e-4 band, but stays within the f32 estimate sum_i gain^i eps |p_i| L_N / A.
-fn fbm_f32_error_follows_the_coordinate_precision_estimate(ctx: &vista_golden::Renderer) {
+fn fbm_f32_error_follows_the_coordinate_precision_estimate(ctx: &vista_render::Renderer) {
     let k = vista_kernels::find("fbm").unwrap();
     let p = params(k, None, &[("octaves", "16"), ("gain", "0.9"), ("lacunarity", "1.7"), ("frequency", "9")]);
-    let gpu = vista_golden::render(ctx, k, &p, 96, 96).unwrap().raw;
+    let gpu = vista_render::render(ctx, k, &p, 96, 96).unwrap().raw;
     let cpu = k.reference(&p, 96, 96);
     let (err, _) = max_field_error(&gpu, &cpu);
     let a: f64 = (0..16).map(|i| 0.9f64.powi(i)).sum();
@@ -74,7 +74,7 @@ fn fbm_f32_error_follows_the_coordinate_precision_estimate(ctx: &vista_golden::R
     assert!((err as f64) < 0.5 * estimate + 1e-4, "error {err} exceeds the f32 coordinate estimate {estimate}");
 }
 
-fn ridged_gpu_matches_f64_reference(ctx: &vista_golden::Renderer) {
+fn ridged_gpu_matches_f64_reference(ctx: &vista_render::Renderer) {
     gpu_vs_cpu(
         ctx,
         "ridged",
@@ -95,12 +95,12 @@ fn lattice_params(k: &Kernel, basis: &str, seed: &str, w: u32) -> ParamSet {
     params(k, None, &[("basis", basis), ("seed", seed), ("octaves", "1"), ("frequency", &f), ("offset", "-0.5,-0.5")])
 }
 
-fn value_noise_is_bit_identical_to_cpu_at_lattice_points(ctx: &vista_golden::Renderer) {
+fn value_noise_is_bit_identical_to_cpu_at_lattice_points(ctx: &vista_render::Renderer) {
     let k = vista_kernels::find("fbm").unwrap();
     let w = 64;
     for seed in [0u32, 1, 123_456] {
         let p = lattice_params(k, "value", &seed.to_string(), w);
-        let gpu = vista_golden::render(ctx, k, &p, w, w).unwrap().raw;
+        let gpu = vista_render::render(ctx, k, &p, w, w).unwrap().raw;
         for y in 0..w {
             for x in 0..w {
                 // R = 0.5 + 0.5 * N: 0.5 * N is exact in f32, so one rounding.
@@ -113,32 +113,32 @@ fn value_noise_is_bit_identical_to_cpu_at_lattice_points(ctx: &vista_golden::Ren
     }
 }
 
-fn perlin_is_zero_at_lattice_points_on_gpu(ctx: &vista_golden::Renderer) {
+fn perlin_is_zero_at_lattice_points_on_gpu(ctx: &vista_render::Renderer) {
     let k = vista_kernels::find("fbm").unwrap();
     for seed in ["0", "17"] {
         let p = lattice_params(k, "perlin", seed, 32);
-        let gpu = vista_golden::render(ctx, k, &p, 32, 32).unwrap().raw;
+        let gpu = vista_render::render(ctx, k, &p, 32, 32).unwrap().raw;
         assert!(gpu.data.iter().all(|px| px[0] == 0.5), "seed {seed}: perlin is not 0 on the lattice");
     }
 }
 
-fn seed_changes_the_gpu_image(ctx: &vista_golden::Renderer) {
+fn seed_changes_the_gpu_image(ctx: &vista_render::Renderer) {
     for kernel in ["fbm", "ridged"] {
         let k = vista_kernels::find(kernel).unwrap();
         for basis in ["perlin", "value"] {
-            let a = vista_golden::render(ctx, k, &params(k, None, &[("basis", basis)]), 64, 64).unwrap().raw;
+            let a = vista_render::render(ctx, k, &params(k, None, &[("basis", basis)]), 64, 64).unwrap().raw;
             let b =
-                vista_golden::render(ctx, k, &params(k, None, &[("basis", basis), ("seed", "1")]), 64, 64).unwrap().raw;
+                vista_render::render(ctx, k, &params(k, None, &[("basis", basis), ("seed", "1")]), 64, 64).unwrap().raw;
             let psnr = vista_image::metrics::psnr(&a, &b);
             assert!(psnr < 30.0, "{kernel}/{basis}: seed 0 and 1 give nearly the same image (PSNR {psnr})");
         }
     }
 }
 
-fn one_octave_fbm_equals_the_basis_on_gpu(ctx: &vista_golden::Renderer) {
+fn one_octave_fbm_equals_the_basis_on_gpu(ctx: &vista_render::Renderer) {
     let k = vista_kernels::find("fbm").unwrap();
     let p = params(k, None, &[("octaves", "1"), ("seed", "3")]);
-    let gpu = vista_golden::render(ctx, k, &p, 48, 48).unwrap().raw;
+    let gpu = vista_render::render(ctx, k, &p, 48, 48).unwrap().raw;
     let n = noise::Noise::new(noise::Basis::Perlin, 3);
     for y in 0..48 {
         for x in 0..48 {
@@ -153,7 +153,7 @@ fn one_octave_fbm_equals_the_basis_on_gpu(ctx: &vista_golden::Renderer) {
 /// Perlin skips the upper face of its cell on an integer z plane (weight
 /// exactly 0): every 2D perlin kernel must render bit-identical raw output
 /// with and without that shortcut.
-fn the_integer_z_shortcut_is_bit_identical_to_the_full_formula(gpu: &vista_golden::Renderer<'static>) {
+fn the_integer_z_shortcut_is_bit_identical_to_the_full_formula(gpu: &vista_render::Renderer<'static>) {
     let (_dir, full) = common::with_edit(gpu, "lib/noise.wgsl", "if f.z == 0.0 {", "if false {");
     for (name, preset, size) in [
         ("fbm", "default", (128, 96)),
@@ -166,8 +166,8 @@ fn the_integer_z_shortcut_is_bit_identical_to_the_full_formula(gpu: &vista_golde
         let k = vista_kernels::find(name).unwrap();
         let p = common::params(k, Some(preset), &[]);
         let (w, h) = size;
-        let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
-        let b = vista_golden::render(&full, k, &p, w, h).unwrap().raw;
+        let a = vista_render::render(gpu, k, &p, w, h).unwrap().raw;
+        let b = vista_render::render(&full, k, &p, w, h).unwrap().raw;
         assert!(bit_identical(&a, &b), "{name} {preset}: the integer-z shortcut changes the output");
     }
 }
@@ -189,7 +189,7 @@ type Equivalence<'a> = (&'a str, &'a str, &'a [(&'a str, &'a str)], &'a str, boo
 /// llvmpipe compile (seconds for a terrain), so the wrong edit is shown on
 /// the cheap kernels where its code is shared.
 fn bit_identical_to_reference(
-    gpu: &vista_golden::Renderer<'static>,
+    gpu: &vista_render::Renderer<'static>,
     file: &str,
     reference: (&str, &str),
     wrong: (&str, &str),
@@ -202,11 +202,11 @@ fn bit_identical_to_reference(
         let p = common::params(k, Some(preset), set);
         assert!(k.shader_for(&p).contains(def), "{name} {preset} {set:?}: {} lacks {def}", k.shader_for(&p));
         let (w, h) = if matches!(name, "fbm" | "ridged" | "cloudmap") { (96, 64) } else { (48, 32) };
-        let a = vista_golden::render(gpu, k, &p, w, h).unwrap().raw;
-        let b = vista_golden::render(&reference, k, &p, w, h).unwrap().raw;
+        let a = vista_render::render(gpu, k, &p, w, h).unwrap().raw;
+        let b = vista_render::render(&reference, k, &p, w, h).unwrap().raw;
         assert!(bit_identical(&a, &b), "{name} {preset} {set:?}: the fast path changes the output");
         if shows {
-            let c = vista_golden::render(&broken, k, &p, w, h).unwrap().raw;
+            let c = vista_render::render(&broken, k, &p, w, h).unwrap().raw;
             assert!(!bit_identical(&a, &c), "{name} {preset} {set:?}: the broken fast path went unseen");
         }
     }
@@ -217,7 +217,7 @@ fn bit_identical_to_reference(
 /// terrains on their fixed plane z = 0: bit-identical raw output to 3D
 /// Perlin, at planes that wrap (255, 256, -3), for several seeds; swapped
 /// corners show.
-fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::Renderer<'static>) {
+fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_render::Renderer<'static>) {
     let plane = "VISTA_HASH_PLANE";
     bit_identical_to_reference(
         gpu,
@@ -247,7 +247,7 @@ fn the_hash_plane_is_bit_identical_to_the_permutation_chain(gpu: &vista_golden::
 /// permutation (lib/noise.wgsl perlin_hashes): bit-identical raw output to
 /// Perlin's own chain of three loads per corner (VISTA_PERLIN_CHAIN), off
 /// the integer planes (both faces), for several seeds; swapped corners show.
-fn the_packed_chain_is_bit_identical_to_perlins_chain(gpu: &vista_golden::Renderer<'static>) {
+fn the_packed_chain_is_bit_identical_to_perlins_chain(gpu: &vista_render::Renderer<'static>) {
     bit_identical_to_reference(
         gpu,
         "lib/noise.wgsl",
@@ -277,7 +277,7 @@ const RUN_TIME_ARM: &str = "#ifndef VISTA_NEVER_DEFINED\n";
 /// `basis`, on and off the hash plane; the wrong basis composed in shows.
 /// (landscape composes the same lib/terrain.wgsl height as heightfield; its
 /// raw hashes are the golden tests'.)
-fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
+fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_render::Renderer<'static>) {
     let defs = "#ifdef BASIS_IS_VALUE\n    return value_noise(p, seed);\n#else ifdef BASIS_IS_PERLIN\n    return slice_perlin(p);\n#else\n";
     let wrong = defs.replacen("return value_noise(p, seed);", "return slice_perlin(p);", 1);
     let value = &[("basis", "value")][..];
@@ -301,7 +301,7 @@ fn the_specialized_basis_is_bit_identical_to_the_run_time_branch(gpu: &vista_gol
 /// The terrains list `terrain` under `specialize`: is_kind (lib/terrain.wgsl)
 /// is a constant and only that kind's height function is compiled in;
 /// bit-identical to the run-time test of the kind; the wrong kind shows.
-fn the_specialized_terrain_is_bit_identical_to_the_run_time_branch(gpu: &vista_golden::Renderer<'static>) {
+fn the_specialized_terrain_is_bit_identical_to_the_run_time_branch(gpu: &vista_render::Renderer<'static>) {
     let defs = "#ifdef TERRAIN_IS_FBM\n    return k == TERRAIN_FBM;\n#else ifdef TERRAIN_IS_RIDGED\n    return k == TERRAIN_RIDGED;\n#else ifdef TERRAIN_IS_PLANE\n    return k == TERRAIN_PLANE;\n#else ifdef TERRAIN_IS_SINE\n    return k == TERRAIN_SINE;\n#else\n";
     let wrong = defs.replacen("return k == TERRAIN_FBM;", "return k == TERRAIN_RIDGED;", 1);
     bit_identical_to_reference(

@@ -40,7 +40,7 @@ fn nan_case() -> Case {
     }
 }
 
-fn injected_nan_fails_the_case_naming_count_and_first_pixel(ctx: &vista_golden::Renderer) {
+fn injected_nan_fails_the_case_naming_count_and_first_pixel(ctx: &vista_render::Renderer) {
     let dir = tempfile::tempdir().unwrap();
     let store = Store { dir: dir.path().to_path_buf(), kernels: vista_kernels::Registry::builtin().clone() };
     // A golden that would otherwise match: NaN must fail on its own.
@@ -55,8 +55,8 @@ fn injected_nan_fails_the_case_naming_count_and_first_pixel(ctx: &vista_golden::
     assert_eq!(o.metrics.map(|m| m.nan), Some(2), "{text}");
 }
 
-fn render_path_reports_nan_from_the_gpu_bit_exactly(ctx: &vista_golden::Renderer) {
-    let r = vista_golden::render(ctx, nan_kernel(), &nan_case().params, 16, 8).unwrap();
+fn render_path_reports_nan_from_the_gpu_bit_exactly(ctx: &vista_render::Renderer) {
+    let r = vista_render::render(ctx, nan_kernel(), &nan_case().params, 16, 8).unwrap();
     assert!(r.raw.get(5, 3)[0].is_nan());
     assert_eq!(r.raw.get(7, 3)[0], f32::INFINITY);
     assert_eq!(r.raw.first_nonfinite(), Some((5, 3)));
@@ -77,12 +77,12 @@ fn partial_kernel() -> &'static Kernel {
 /// Runs of one size share an output texture (vista-gpu's scratch): a pixel
 /// the kernel does not write must still read 0, as in a fresh texture, and
 /// never the value an earlier run wrote there.
-fn an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it(ctx: &vista_golden::Renderer) {
+fn an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it(ctx: &vista_render::Renderer) {
     let k = partial_kernel();
-    let full = vista_golden::render(ctx, k, &k.resolve(None, &[]).unwrap(), 16, 8).unwrap();
+    let full = vista_render::render(ctx, k, &k.resolve(None, &[]).unwrap(), 16, 8).unwrap();
     assert_eq!(full.raw.get(12, 5), [1.0; 4]);
     for _ in 0..2 {
-        let part = vista_golden::render(ctx, k, &k.resolve(None, &[("cut".into(), "4".into())]).unwrap(), 16, 8);
+        let part = vista_render::render(ctx, k, &k.resolve(None, &[("cut".into(), "4".into())]).unwrap(), 16, 8);
         let part = part.unwrap().raw;
         assert_eq!(part.get(3, 5), [1.0; 4]);
         assert_eq!(part.get(4, 0), [0.0; 4], "an earlier run's value leaked into an unwritten pixel");
@@ -140,7 +140,7 @@ const FUZZ_SIZE: (u32, u32) = (32, 32);
 /// exceeds this are rejected and counted, so one run stays within seconds.
 const FUZZ_WORK: f64 = 5.0e7;
 
-fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vista_golden::Renderer) {
+fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vista_render::Renderer) {
     let start = std::time::Instant::now();
     let mut total = 0;
     for kernel in vista_kernels::registry() {
@@ -167,7 +167,7 @@ fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vist
             heavy.set(heavy.get() + (work > FUZZ_WORK) as u32);
             prop_assume!(work <= FUZZ_WORK);
             tried.set(tried.get() + 1);
-            let r = vista_golden::render(ctx, kernel, &p, w, h)
+            let r = vista_render::render(ctx, kernel, &p, w, h)
                 .map_err(|e| TestCaseError::fail(format!("{}: {e}", kernel.name())))?;
             if let Some((x, y)) = r.raw.first_nonfinite() {
                 return Err(TestCaseError::fail(format!(
@@ -206,20 +206,21 @@ fn random_in_range_params_give_finite_output_within_documented_bounds(ctx: &vist
 /// VISTA_VALIDATION=1: with the Khronos layer on, a clean kernel renders,
 /// and a validation message arriving during a dispatch fails it, naming the
 /// layer and the message (injected here through the logger wgpu-hal uses).
-fn a_validation_message_fails_the_dispatch(_shared: &vista_golden::Renderer) {
+fn a_validation_message_fails_the_dispatch(_shared: &vista_render::Renderer) {
     if !std::path::Path::new(vista_gpu::VALIDATION_LAYER_JSON).exists() {
         panic!("the Khronos validation layer is missing: run `bash ci/install-validation.sh`");
     }
-    let ctx = vista_gpu::Context::with_validation(vista_gpu::AdapterChoice::Lavapipe, true).unwrap();
+    let config = vista_gpu::GpuConfig { validate: true, ..vista_gpu::GpuConfig::default() };
+    let ctx = vista_gpu::Context::new(&config).unwrap();
     assert!(ctx.validating());
-    let gpu = vista_golden::Renderer::new(&ctx, &common::project()).unwrap();
+    let gpu = vista_render::Renderer::new(&ctx, &common::project(), Default::default()).unwrap();
     let k = vista_kernels::find("fbm").unwrap();
     let p = k.resolve(None, &[]).unwrap();
-    vista_golden::render(&gpu, k, &p, 32, 32).expect("a clean kernel passes under the validation layer");
+    vista_render::render(&gpu, k, &p, 32, 32).expect("a clean kernel passes under the validation layer");
     log::error!(target: vista_gpu::validation::TARGET, "VALIDATION [VUID-injected (0x1)] injected by the test");
-    let e = vista_golden::render(&gpu, k, &p, 32, 32).unwrap_err().to_string();
+    let e = vista_render::render(&gpu, k, &p, 32, 32).unwrap_err().to_string();
     assert!(e.contains("Khronos validation layer") && e.contains("VUID-injected"), "{e}");
-    vista_golden::render(&gpu, k, &p, 32, 32).expect("messages are per dispatch");
+    vista_render::render(&gpu, k, &p, 32, 32).expect("messages are per dispatch");
 }
 
 fn main() {

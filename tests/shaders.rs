@@ -7,7 +7,7 @@ use vista_kernels::{Kind, Value};
 mod common;
 
 fn repo_shaders() -> ShaderSet {
-    vista_golden::shader_set(&common::project()).unwrap()
+    vista_render::shader_set(&common::project()).unwrap()
 }
 
 /// A set over the `.wgsl` files of a directory tree (paths relative to it).

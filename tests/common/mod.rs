@@ -6,9 +6,9 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use vista_golden::{Renderer, allow_no_gpu};
 use vista_kernels::{Kernel, ParamSet};
 use vista_project::Project;
+use vista_render::Renderer;
 
 /// `kernel`'s params from a preset and `name=value` overrides; panics with
 /// the error on bad test input.
@@ -22,12 +22,24 @@ pub fn project() -> Project {
     Project::at(Path::new(env!("CARGO_MANIFEST_DIR"))).expect("the repository is a vista project")
 }
 
+/// This process's configuration, read once from the environment (the test
+/// harness is an edge, like the binary).
+pub fn config() -> &'static vista::Config {
+    static CONFIG: OnceLock<vista::Config> = OnceLock::new();
+    CONFIG.get_or_init(|| vista::Config::from_env(&vista::Flags::default()).unwrap_or_else(|e| panic!("{e}")))
+}
+
+/// True when the user set `VISTA_ALLOW_NO_GPU=1`.
+pub fn allow_no_gpu() -> bool {
+    config().allow_no_gpu
+}
+
 /// The shared renderer over this checkout's shaders, or why there is none.
 pub fn renderer() -> Result<&'static Renderer<'static>, String> {
     static GPU: OnceLock<Result<Renderer<'static>, String>> = OnceLock::new();
     GPU.get_or_init(|| {
-        let ctx = vista_gpu::Context::shared().map_err(|e| e.to_string())?;
-        Renderer::new(ctx, &project()).map_err(|e| e.to_string())
+        let ctx = vista_gpu::Context::shared(&config().gpu).map_err(|e| e.to_string())?;
+        Renderer::new(ctx, &project(), config().limits).map_err(|e| e.to_string())
     })
     .as_ref()
     .map_err(Clone::clone)
@@ -87,5 +99,5 @@ pub fn with_edit(gpu: &Renderer<'static>, file: &str, from: &str, to: &str) -> (
     assert_eq!(text.matches(from).count(), 1, "{file}: '{from}' must occur exactly once (shader changed?)");
     std::fs::write(&path, text.replace(from, to)).unwrap();
     let project = vista_project::Project::at(t.path()).unwrap();
-    (t, Renderer::new(gpu.ctx, &project).unwrap())
+    (t, Renderer::new(gpu.ctx, &project, gpu.limits).unwrap())
 }

@@ -113,9 +113,9 @@ pub struct Browser {
 impl Browser {
     /// Starts Chromium and creates the page's WebGPU device; `timeout` is the
     /// watchdog on every later call.
-    pub fn launch(timeout: Duration) -> Result<Browser, BrowserError> {
+    pub fn launch(timeout: Duration, config: &BrowserConfig) -> Result<Browser, BrowserError> {
         let start = Instant::now();
-        let path = find_chromium()?;
+        let path = find_chromium(config)?;
         let (session, info) = Session::start(&path, timeout)?;
         Ok(Browser { path, timeout, session: Mutex::new(Some(session)), info, launch_time: start.elapsed() })
     }
@@ -273,12 +273,32 @@ fn parse_ok<T: serde::de::DeserializeOwned>(reply: &str) -> Result<T, String> {
     serde_json::from_value(v).map_err(|e| format!("unexpected reply ({e}): {reply}"))
 }
 
-/// `VISTA_CHROMIUM`, else Debian's binary, else the usual names on `PATH`.
-pub fn find_chromium() -> Result<PathBuf, BrowserError> {
-    if let Some(p) = std::env::var_os("VISTA_CHROMIUM").filter(|p| !p.is_empty()) {
-        let p = PathBuf::from(p);
+/// Where to look for Chromium, as read once at the edge (the binary or the
+/// test harness): this crate reads no environment.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct BrowserConfig {
+    /// `VISTA_CHROMIUM`: this binary and no other.
+    pub chromium: Option<PathBuf>,
+    /// The directories of `PATH`, searched after Debian's binary.
+    pub search_path: Vec<PathBuf>,
+}
+
+impl BrowserConfig {
+    /// From settings looked up by name (the edge passes `std::env::var_os`):
+    /// `VISTA_CHROMIUM` and `PATH`.
+    pub fn from_lookup(get: &dyn Fn(&str) -> Option<std::ffi::OsString>) -> BrowserConfig {
+        BrowserConfig {
+            chromium: get("VISTA_CHROMIUM").filter(|p| !p.is_empty()).map(PathBuf::from),
+            search_path: get("PATH").map(|p| std::env::split_paths(&p).collect()).unwrap_or_default(),
+        }
+    }
+}
+
+/// The configured binary, else Debian's, else the usual names on the search path.
+pub fn find_chromium(config: &BrowserConfig) -> Result<PathBuf, BrowserError> {
+    if let Some(p) = config.chromium.as_ref().filter(|p| !p.as_os_str().is_empty()) {
         return if p.is_file() {
-            Ok(p)
+            Ok(p.clone())
         } else {
             Err(BrowserError::NotInstalled {
                 looked: format!("VISTA_CHROMIUM={} is not a file", p.display()),
@@ -293,8 +313,7 @@ pub fn find_chromium() -> Result<PathBuf, BrowserError> {
         return Ok(debian);
     }
     const NAMES: &[&str] = &["chromium", "chromium-browser", "google-chrome", "google-chrome-stable"];
-    let path = std::env::var_os("PATH").unwrap_or_default();
-    for dir in std::env::split_paths(&path) {
+    for dir in &config.search_path {
         for name in NAMES {
             let p = dir.join(name);
             if p.is_file() {
@@ -327,10 +346,8 @@ mod tests {
 
     #[test]
     fn a_missing_vista_chromium_is_a_clear_error() {
-        // SAFETY: this test is the only one in the crate touching the variable.
-        unsafe { std::env::set_var("VISTA_CHROMIUM", "/nonexistent/chromium") };
-        let e = find_chromium().unwrap_err().to_string();
-        unsafe { std::env::remove_var("VISTA_CHROMIUM") };
+        let config = BrowserConfig { chromium: Some("/nonexistent/chromium".into()), search_path: Vec::new() };
+        let e = find_chromium(&config).unwrap_err().to_string();
         assert!(e.contains("VISTA_CHROMIUM=/nonexistent/chromium is not a file"), "{e}");
         assert!(e.contains("ci/install-browser.sh"), "{e}");
     }

@@ -19,13 +19,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
+fn config() -> vista_browser::BrowserConfig {
+    vista_browser::BrowserConfig::from_lookup(&|k| std::env::var_os(k))
+}
+
 fn browser() -> Browser {
-    Browser::launch(Duration::from_secs(60)).unwrap_or_else(|e| panic!("{e}"))
+    Browser::launch(Duration::from_secs(60), &config()).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn main() {
     let args = libtest_mimic::Arguments::from_args();
-    let missing = vista_browser::find_chromium().err();
+    let missing = vista_browser::find_chromium(&config()).err();
     let skip = missing.filter(|_| std::env::var("VISTA_ALLOW_NO_GPU").as_deref() == Ok("1"));
     let tests: [(&str, fn()); 3] = [
         ("a_kernel_runs_and_reads_back_every_texel", a_kernel_runs_and_reads_back_every_texel),
@@ -101,7 +105,7 @@ fn tint_errors_name_the_case_and_the_next_run_works() {
 }
 
 fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
-    let b = Browser::launch(Duration::from_secs(4)).unwrap();
+    let b = Browser::launch(Duration::from_secs(4), &config()).unwrap();
     // Never ends: scale is 1, so the loop's exit is never taken.
     let forever = GRADIENT.replace(
         "let t = ",

@@ -1,15 +1,17 @@
 //! `vista bench`: median kernel throughput after a warm-up run, optionally
 //! beside the f32 CPU reference on all cores.
 
-use vista_golden::{GoldenError, Renderer};
+use vista_golden::GoldenError;
 use vista_gpu::Context;
 use vista_project::Project;
+use vista_render::Renderer;
 
 use crate::{bad, parse_sets};
 
 #[allow(clippy::too_many_arguments)]
 pub fn bench(
     project: &Project,
+    config: &vista::Config,
     kernel: &str,
     preset: Option<&str>,
     set: &[String],
@@ -24,28 +26,28 @@ pub fn bench(
     let k = crate::registry(project)?.find(kernel).map_err(bad)?;
     let p = k.resolve(preset, &parse_sets(set)?).map_err(bad)?;
     let (w, h) = vista_kernels::parse_size(size).map_err(bad)?;
-    let shaders = vista_golden::shader_set(project)?;
-    vista_golden::prepare(&shaders, k, &p, w, h)?;
+    let shaders = vista_render::shader_set(project)?;
+    vista_render::plan(&shaders, k, &p, w, h, &config.limits)?;
     if cpu && !k.has_reference() {
         return Err(bad(format!("--cpu: kernel {kernel} has no CPU reference (only built-in kernels have one)")));
     }
-    let ctx = &Renderer { ctx: Context::shared()?, shaders };
+    let ctx = &Renderer { ctx: Context::shared(&config.gpu)?, shaders, limits: config.limits };
     // Warm-up: compiles the pipeline and touches every allocation path once.
     // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
-    let first = vista_golden::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
+    let first = vista_render::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
     let mut stats = Vec::new();
     for _ in 0..runs {
-        stats.push(vista_golden::render(ctx, k, &p, w, h)?.stats);
+        stats.push(vista_render::render(ctx, k, &p, w, h)?.stats);
     }
     let med = |f: fn(&vista_gpu::RunStats) -> std::time::Duration| {
-        vista_golden::median(stats.iter().map(f).collect()).as_secs_f64()
+        vista_render::median(stats.iter().map(f).collect()).as_secs_f64()
     };
     let (median, kernel_s, readback_s) = (med(|s| s.gpu_wall), med(|s| s.kernel), med(|s| s.readback));
     let mpix = (w as f64 * h as f64) / 1e6 / median;
     // The CPU side: the reference in f32 on every core (rayon), median of
     // up to 3 runs since the slow ones take seconds per image.
     let cpu_ms = cpu.then(|| {
-        let t = vista_golden::median_wall(runs.min(3), || {
+        let t = vista_render::median_wall(runs.min(3), || {
             k.reference_f32(&p, w, h);
         });
         t.as_secs_f64() * 1e3

@@ -5,10 +5,12 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use vista_golden::{BlessOptions, CheckOptions, GoldenError, Renderer, Store};
+use vista::Config;
+use vista_golden::{BlessOptions, CheckOptions, GoldenError, Store};
 use vista_gpu::Context;
 use vista_image::metrics;
 use vista_project::Project;
+use vista_render::Renderer;
 
 mod bench;
 mod matrix;
@@ -167,9 +169,18 @@ fn main() -> ExitCode {
     #[cfg(unix)]
     die_quietly_on_closed_pipe();
     let cli = Cli::parse();
+    // The one configuration: flags first, then the environment, read here once.
+    let flags = vista::Flags { backend: cli.backend.clone(), adapter: cli.adapter.clone() };
+    let config = match vista::Config::from_env(&flags) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(e.exit_code() as u8);
+        }
+    };
     // Fault injection for the write-path tests (see vista_image::fault).
-    if let Some(text) = std::env::var_os("VISTA_FAULT") {
-        match vista_image::fault::FaultPlan::parse(&text.to_string_lossy()) {
+    if let Some(text) = &config.fault {
+        match vista_image::fault::FaultPlan::parse(text) {
             Ok(plan) => vista_image::fault::install(plan),
             Err(e) => {
                 eprintln!("error: {e}");
@@ -177,21 +188,9 @@ fn main() -> ExitCode {
             }
         }
     }
-    if let Some(a) = &cli.adapter {
-        // SAFETY: single-threaded at this point; read once by Context::shared.
-        unsafe { std::env::set_var("VISTA_ADAPTER", a) };
-    }
-    if let Some(b) = &cli.backend {
-        if let Err(e) = vista_gpu::AdapterChoice::of_backend(b) {
-            eprintln!("error: --backend {b}: {e}");
-            return ExitCode::from(2);
-        }
-        // SAFETY: as above.
-        unsafe { std::env::set_var("VISTA_BACKEND", b) };
-    }
     let project = match std::env::current_dir()
         .map_err(|e| GoldenError::BadInput(format!("cannot read the current directory: {e}")))
-        .and_then(|cwd| Ok(Project::discover(cli.root.as_deref(), std::env::var_os("VISTA_ROOT"), &cwd)?))
+        .and_then(|cwd| Ok(Project::discover(cli.root.as_deref(), config.root.clone(), &cwd)?))
     {
         Ok(p) => p,
         Err(e) => {
@@ -199,7 +198,7 @@ fn main() -> ExitCode {
             return ExitCode::from(e.exit_code() as u8);
         }
     };
-    match run(&project, cli.command) {
+    match run(&project, &config, cli.command) {
         Ok(code) => ExitCode::from(code as u8),
         Err(e) => {
             eprintln!("error: {e}");
@@ -223,7 +222,7 @@ fn bad(e: impl std::fmt::Display) -> GoldenError {
     GoldenError::BadInput(e.to_string())
 }
 
-fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
+fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenError> {
     match cmd {
         Command::List { names } => {
             let kernels = registry(project)?;
@@ -247,10 +246,10 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
                 return Err(bad(format!("--zoom {zoom} is out of range; allowed: 1 to 16")));
             }
             check_output_path(&out)?;
-            let shaders = vista_golden::shader_set(project)?;
-            vista_golden::prepare(&shaders, k, &p, w, h)?;
-            let ctx = &Renderer { ctx: Context::shared()?, shaders };
-            let r = vista_golden::render(ctx, k, &p, w, h)?;
+            let shaders = vista_render::shader_set(project)?;
+            let plan = vista_render::plan(&shaders, k, &p, w, h, &config.limits)?;
+            let ctx = &Renderer { ctx: Context::shared(&config.gpu)?, shaders, limits: config.limits };
+            let r = vista_render::run(ctx, &plan)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
             let mut img = if is_exr { r.raw.clone() } else { r.display().clone() };
             if let Some((x, y, cw, ch)) = rect {
@@ -301,12 +300,15 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
             }
             Ok(0)
         }
-        Command::Check { case, report_dir, matrix: true } => matrix::matrix(project, case.as_deref(), report_dir),
-        Command::Check { case, report_dir, matrix: false } => check(project, case.as_deref(), report_dir),
+        Command::Check { case, report_dir, matrix: true } => {
+            matrix::matrix(project, config, case.as_deref(), report_dir)
+        }
+        Command::Check { case, report_dir, matrix: false } => check(project, config, case.as_deref(), report_dir),
         Command::Bless { case, force, prune } => {
             let store = Store::of_project(project, "vista bless")?;
-            let ctx = &Renderer::new(Context::shared()?, project)?;
-            let summary = vista_golden::bless(ctx, &store, &BlessOptions { glob: case, force, prune })?;
+            let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
+            let opts = BlessOptions { glob: case, force, prune, in_ci: config.in_ci };
+            let summary = vista_golden::bless(ctx, &store, &opts)?;
             println!("{:<40} {:<10} PSNR new vs old", "case", "status");
             for r in &summary.rows {
                 println!("{:<40} {:<10} {}", r.id, r.status, r.psnr_vs_previous);
@@ -321,13 +323,14 @@ fn run(project: &Project, cmd: Command) -> Result<i32, GoldenError> {
             println!("blessed {} cases on {}", summary.rows.len(), ctx.adapter_description());
             Ok(0)
         }
-        Command::Sweep(args) => sweep::sweep(project, args),
+        Command::Sweep(args) => sweep::sweep(project, config, args),
         Command::Mutate { kernel, case, sample, seed, jobs, partition, json, merge, equivalent } => mutate::mutate(
             project,
+            config,
             mutate::Args { kernel, case, sample, seed, jobs, partition, json, merge, equivalent },
         ),
         Command::Bench { kernel, preset, set, size, runs, json, cpu } => {
-            bench::bench(project, &kernel, preset.as_deref(), &set, &size, runs, json, cpu)
+            bench::bench(project, config, &kernel, preset.as_deref(), &set, &size, runs, json, cpu)
         }
     }
 }
@@ -389,12 +392,17 @@ fn probe_writable(dir: &Path) -> Result<(), GoldenError> {
     Ok(())
 }
 
-fn check(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> Result<i32, GoldenError> {
+fn check(
+    project: &Project,
+    config: &Config,
+    glob: Option<&str>,
+    report_dir: Option<PathBuf>,
+) -> Result<i32, GoldenError> {
     let store = Store::of_project(project, "vista check")?;
     let cases = store.load_cases()?;
     let picked = vista_golden::select(&cases, glob)?;
     let manifest = store.manifest()?;
-    let ctx = &Renderer::new(Context::shared()?, project)?;
+    let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
     let report_dir = match report_dir {
         Some(d) => d,
         None => project.report_dir().expect("a store implies a root"),

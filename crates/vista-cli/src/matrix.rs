@@ -4,10 +4,11 @@
 
 use std::path::PathBuf;
 
-use vista_golden::{CheckOptions, GoldenError, Outcome, Renderer, Store, Verdict};
+use vista_golden::{CheckOptions, GoldenError, Outcome, Store, Verdict};
 use vista_gpu::{AdapterChoice, Context};
 use vista_image::metrics;
 use vista_project::Project;
+use vista_render::Renderer;
 
 /// The implementations of the matrix, in column order.
 const BACKENDS: &[&str] = &["lavapipe", "swiftshader", "browser"];
@@ -24,26 +25,32 @@ fn cell(o: &Outcome) -> String {
     }
 }
 
-pub fn matrix(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>) -> Result<i32, GoldenError> {
+pub fn matrix(
+    project: &Project,
+    config: &vista::Config,
+    glob: Option<&str>,
+    report_dir: Option<PathBuf>,
+) -> Result<i32, GoldenError> {
     let store = Store::of_project(project, "vista check --matrix")?;
     let cases = store.load_cases()?;
     let picked = vista_golden::select(&cases, glob)?;
     let manifest = store.manifest()?;
     let report_dir = report_dir.unwrap_or_else(|| project.report_dir().expect("a store implies a root"));
-    let shaders = vista_golden::shader_set(project)?;
+    let shaders = vista_render::shader_set(project)?;
     for b in BACKENDS {
         vista_golden::clear_case_folders(&report_dir.join(b))?;
     }
     let mut columns: Vec<(&str, Column)> = Vec::new();
     for &b in BACKENDS {
-        let ctx = match Context::new(AdapterChoice::of_backend(b)?) {
+        let gpu_config = vista_gpu::GpuConfig { adapter: AdapterChoice::of_backend(b)?, ..config.gpu.clone() };
+        let ctx = match Context::new(&gpu_config) {
             Ok(c) => c,
             Err(e) => {
                 columns.push((b, Err(e.to_string())));
                 continue;
             }
         };
-        let gpu = Renderer { ctx: &ctx, shaders: shaders.clone() };
+        let gpu = Renderer { ctx: &ctx, shaders: shaders.clone(), limits: config.limits };
         let opts = CheckOptions { report_dir: report_dir.join(b), twice: false };
         let outcomes: Vec<Outcome> =
             picked.iter().map(|c| vista_golden::check_case(&gpu, &store, &manifest, c, &opts)).collect();
@@ -110,7 +117,7 @@ pub fn matrix(project: &Project, glob: Option<&str>, report_dir: Option<PathBuf>
     println!("matrix: {} cases x {ran} backends, {failed} failed, {missing} backend(s) skipped", picked.len());
     println!("report: {}", path.display());
     // A column that could not run is a failure unless skips are allowed.
-    let skipped_ok = missing == 0 || vista_golden::allow_no_gpu();
+    let skipped_ok = missing == 0 || config.allow_no_gpu;
     if missing > 0 && skipped_ok {
         println!("!!! VISTA_ALLOW_NO_GPU=1: the {missing} skipped backend(s) do not fail the run");
     }

@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use vista_golden::{GoldenError, Store};
-use vista_gpu::{AdapterChoice, Context};
+use vista_gpu::Context;
 use vista_mutate::{Options, Report};
 use vista_project::Project;
 
@@ -34,7 +34,7 @@ fn argued(path: Option<&PathBuf>) -> Result<Vec<vista_mutate::Argued>, GoldenErr
     vista_mutate::parse_argued(&text).map_err(|e| bad(format!("--equivalent {}: {e}", path.display())))
 }
 
-pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
+pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32, GoldenError> {
     let argued = argued(a.equivalent.as_ref())?;
     if !a.merge.is_empty() {
         let mut parts = Vec::new();
@@ -80,7 +80,7 @@ pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
         return Err(bad(format!("kernel {} has no golden case selected; mutants need cases to run against", k.name())));
     }
     let files = project.shader_files()?;
-    let shaders = vista_golden::shader_set(project)?;
+    let shaders = vista_render::shader_set(project)?;
     let opts = Options {
         kernel: a.kernel.clone(),
         case_glob: a.case.clone(),
@@ -99,7 +99,7 @@ pub fn mutate(project: &Project, a: Args) -> Result<i32, GoldenError> {
         partition.0,
         partition.1
     );
-    let ctx = Context::new(AdapterChoice::from_env()?)?.with_timeout(MUTANT_TIMEOUT);
+    let ctx = Context::new(&config.gpu)?.with_timeout(MUTANT_TIMEOUT);
     let bar = ProgressBar::new(planned.len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} mutants, {elapsed} elapsed, ETA {eta}")

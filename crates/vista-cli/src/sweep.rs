@@ -4,9 +4,10 @@
 use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use vista_golden::{GoldenError, Renderer};
+use vista_golden::GoldenError;
 use vista_gpu::Context;
 use vista_project::Project;
+use vista_render::Renderer;
 use vista_sweep::{Axis, Metric, SweepSpec};
 
 use crate::{bad, parse_sets};
@@ -47,7 +48,7 @@ pub struct Args {
     pub out: PathBuf,
 }
 
-pub fn sweep(project: &Project, a: Args) -> Result<i32, GoldenError> {
+pub fn sweep(project: &Project, config: &vista::Config, a: Args) -> Result<i32, GoldenError> {
     let kernel = crate::registry(project)?.find(&a.kernel).map_err(bad)?;
     let (width, height) = vista_kernels::parse_size(&a.size).map_err(bad)?;
     let y = match (a.param2, a.values2) {
@@ -73,9 +74,9 @@ pub fn sweep(project: &Project, a: Args) -> Result<i32, GoldenError> {
         metric: Metric::parse(&a.metric)?,
     };
     // Every value is checked before the device is touched.
-    spec.resolve()?;
+    spec.resolve(&config.limits)?;
     crate::check_output_dir(&a.out)?;
-    let ctx = &Renderer::new(Context::shared()?, project)?;
+    let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{bar:30}] {pos}/{len} {msg} ({elapsed})")
@@ -90,7 +91,7 @@ pub fn sweep(project: &Project, a: Args) -> Result<i32, GoldenError> {
     bar.finish_and_clear();
     let sweep = result?;
     print!("{}", sweep.table());
-    let (written, plot_problem) = sweep.write(&a.out)?;
+    let (written, plot_problem) = sweep.write(&a.out, config.font.as_deref())?;
     for p in &written {
         println!("wrote {}", p.display());
     }

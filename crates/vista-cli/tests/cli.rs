@@ -105,8 +105,8 @@ fn wrong_type_names_value_and_expected_kind() {
 
 fn bad_sizes_are_rejected_before_gpu_work() {
     let d = tmp();
-    // VISTA_ADAPTER=nonsense would fail at device creation: these never get there.
-    let env = [("VISTA_ADAPTER", "nonsense")];
+    // An adapter no machine has fails at device creation: these never get there.
+    let env = [("WGPU_ADAPTER_NAME", "no-such-adapter")];
     for (size, needle) in [
         ("0x16", "width=0"),
         ("16x0", "height=0"),
@@ -121,7 +121,7 @@ fn bad_sizes_are_rejected_before_gpu_work() {
 
 fn bad_crops_are_rejected_before_gpu_work() {
     let d = tmp();
-    let env = [("VISTA_ADAPTER", "nonsense")];
+    let env = [("WGPU_ADAPTER_NAME", "no-such-adapter")];
     for (crop, zoom, needle) in [
         ("40,0,30,10", "1", "--crop 40,0,30,10 does not fit"),
         ("0,0,0,10", "1", "W, H >= 1"),
@@ -334,7 +334,7 @@ fn sweep_writes_csv_plots_and_names_the_cheapest_setting() {
     assert!(psnr.windows(2).all(|w| w[1] > w[0]), "PSNR must grow with octaves: {psnr:?}");
     let expected = rows[1..].iter().find(|r| r[1] == "inf" || r[1].parse::<f64>().unwrap() >= 40.0).unwrap()[0];
     assert!(r.stdout.contains(&format!("cheapest reaching 40.0 dB: octaves={expected} ")), "{}", r.stdout);
-    if vista_sweep::find_font().is_some() {
+    if vista_sweep::find_font(std::env::var_os("VISTA_FONT").map(std::path::PathBuf::from).as_deref()).is_some() {
         let png = vista_image::load(&out.join("curve.png")).unwrap();
         assert_eq!((png.width, png.height), (900, 560));
         assert!(std::fs::read_to_string(out.join("curve.svg")).unwrap().contains("<svg"));
@@ -1115,7 +1115,8 @@ fn the_report_works_in_a_real_browser() {
 
     let index = root.join("target/vista-report/index.html");
     let wait = std::time::Duration::from_secs(30);
-    let path = vista_browser::find_chromium().unwrap_or_else(|e| panic!("{e}"));
+    let path = vista_browser::find_chromium(&vista_browser::BrowserConfig::from_lookup(&|k| std::env::var_os(k)))
+        .unwrap_or_else(|e| panic!("{e}"));
     let page =
         vista_browser::cdp::Chromium::launch(&path, &["--window-size=1400,1000"], wait).expect("launch Chromium");
     page.navigate(&format!("file://{}", index.display()), wait).unwrap();
@@ -1564,7 +1565,14 @@ fn main() {
     ];
     let args = libtest_mimic::Arguments::from_args();
     let allow = std::env::var("VISTA_ALLOW_NO_GPU").is_ok_and(|v| v == "1" || v.eq_ignore_ascii_case("true"));
-    let missing = if args.list || !allow { None } else { vista_gpu::Context::shared().err() };
+    let missing = if args.list || !allow {
+        None
+    } else {
+        vista::Config::from_env(&vista::Flags::default())
+            .map_err(|e| e.to_string())
+            .and_then(|c| vista_gpu::Context::new(&c.gpu).map(|_| ()).map_err(|e| e.to_string()))
+            .err()
+    };
     if let Some(e) = &missing {
         let n = tests.iter().filter(|t| t.0 == Gpu).count();
         eprintln!(

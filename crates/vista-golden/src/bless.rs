@@ -9,9 +9,9 @@ use std::path::PathBuf;
 
 use vista_image::metrics;
 
-use crate::render::{Rendered, Renderer, quantize16, render};
 use crate::store::{ManifestEntry, Store, params_hash};
 use crate::{GoldenError, now_utc, select};
+use vista_render::{Rendered, Renderer, quantize16, render};
 
 #[derive(Debug, Clone, Default)]
 pub struct BlessOptions {
@@ -19,6 +19,8 @@ pub struct BlessOptions {
     pub glob: Option<String>,
     /// Bless even when `CI=true`.
     pub force: bool,
+    /// Running in CI (`CI=true`, read at the edge): bless is refused unless forced.
+    pub in_ci: bool,
     /// Delete golden PNGs that no case refers to (otherwise only listed).
     pub prune: bool,
 }
@@ -42,12 +44,8 @@ pub struct BlessSummary {
     pub pruned: bool,
 }
 
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| v.eq_ignore_ascii_case("true") || v == "1")
-}
-
 pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<BlessSummary, GoldenError> {
-    if in_ci() && !opts.force {
+    if opts.in_ci && !opts.force {
         return Err(GoldenError::Refused(
             "CI=true: refusing to bless goldens in CI (a failing golden must be reviewed, not overwritten); \
              bless locally, or pass --force"

@@ -5,9 +5,9 @@ use std::path::PathBuf;
 use vista_image::Image;
 use vista_image::metrics::{self, Metrics};
 
-use crate::render::{Renderer, quantize16, render};
 use crate::store::{Manifest, Store, params_hash};
 use crate::{Case, GoldenError};
+use vista_render::{Renderer, quantize16, render};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {

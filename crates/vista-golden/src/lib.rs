@@ -1,7 +1,8 @@
 //! vista's golden cases: the case file, the golden store and its manifest,
-//! render-and-compare with per-case thresholds, bless, and the HTML report.
+//! compare-with-thresholds, bless, and the HTML report.
 //!
-//! Not for: kernel math (`vista-kernels`) or device handling (`vista-gpu`).
+//! Not for: kernel math (`vista-kernels`), device handling (`vista-gpu`) or
+//! rendering (`vista-render`, the one render path, which this crate calls).
 //! This is the only crate that writes goldens, and it writes every file
 //! atomically (temp file + rename).
 
@@ -9,7 +10,6 @@ pub mod agreement;
 pub mod bless;
 pub mod cases;
 pub mod check;
-pub mod render;
 pub mod report;
 pub mod store;
 
@@ -17,10 +17,6 @@ pub use agreement::{Agreement, agreement};
 pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, load_cases, parse_cases, select};
 pub use check::{BAD_PIXEL_LIMIT, CheckOptions, Outcome, RunInfo, Verdict, check_case, first_out_of_range};
-pub use render::{
-    Prepared, Rendered, Renderer, check_request, median, median_wall, prepare, quantize16, render, render_median,
-    shader_set,
-};
 pub use report::{RunSummary, bless_all_command, clear_case_folders, html_escape, view_js, write_report};
 pub use store::{Manifest, ManifestEntry, Store};
 
@@ -37,6 +33,8 @@ pub enum GoldenError {
     Refused(String),
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    #[error(transparent)]
+    Render(#[from] vista_render::RenderError),
     #[error(transparent)]
     Project(#[from] vista_project::ProjectError),
     #[error(transparent)]
@@ -56,6 +54,7 @@ impl GoldenError {
             GoldenError::Image(_) => 2,
             GoldenError::Io { .. } => 2,
             GoldenError::Project(_) => 2,
+            GoldenError::Render(e) => e.exit_code(),
             _ => 1,
         }
     }
@@ -74,9 +73,4 @@ pub fn short_hash(text: &str) -> String {
 /// Short stable hash of bytes (golden file hashes in the manifest).
 pub fn short_hash_bytes(bytes: &[u8]) -> String {
     blake3::hash(bytes).to_hex()[..16].to_string()
-}
-
-/// True when the user set `VISTA_ALLOW_NO_GPU=1`.
-pub fn allow_no_gpu() -> bool {
-    std::env::var("VISTA_ALLOW_NO_GPU").is_ok_and(|v| v == "1" || v.eq_ignore_ascii_case("true"))
 }

@@ -31,6 +31,87 @@ pub enum AdapterChoice {
 /// The backends `--backend` / `VISTA_BACKEND` accept.
 pub const BACKENDS: &[&str] = &["lavapipe", "swiftshader", "browser", "gpu"];
 
+/// The raw adapter settings, as the edge (the binary, a test harness) read
+/// them from its flags and the environment, once.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct AdapterSettings {
+    pub backend_flag: Option<String>,
+    pub adapter_flag: Option<String>,
+    pub wgpu_adapter_name: Option<String>,
+    pub backend_env: Option<String>,
+    pub adapter_env: Option<String>,
+}
+
+/// Everything the GPU context needs to know from outside. Built once at the
+/// edge and passed in: this crate reads no environment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GpuConfig {
+    pub adapter: AdapterChoice,
+    /// The Khronos validation layer (`VISTA_VALIDATION=1`): every message fails the run.
+    pub validate: bool,
+    /// The watchdog on every GPU wait (`VISTA_GPU_TIMEOUT_S`, default 120 s).
+    pub timeout: Duration,
+    /// wgpu's instance backends (`WGPU_BACKEND`, a comma list); Vulkan when `None`.
+    pub wgpu_backends: Option<String>,
+    /// Where the browser backend finds Chromium.
+    pub browser: vista_browser::BrowserConfig,
+}
+
+/// The GPU watchdog's default.
+pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(120);
+
+impl Default for GpuConfig {
+    fn default() -> GpuConfig {
+        GpuConfig {
+            adapter: AdapterChoice::Lavapipe,
+            validate: false,
+            timeout: DEFAULT_TIMEOUT,
+            wgpu_backends: None,
+            browser: vista_browser::BrowserConfig::default(),
+        }
+    }
+}
+
+impl GpuConfig {
+    /// The configuration of these adapter settings, with the other settings
+    /// looked up by name (the edge passes `std::env::var_os`):
+    /// `VISTA_VALIDATION`, `VISTA_GPU_TIMEOUT_S`, `WGPU_BACKEND`, and the
+    /// browser's `VISTA_CHROMIUM` and `PATH`. A value that does not parse is
+    /// bad input, named.
+    pub fn from_lookup(
+        adapter: &AdapterSettings,
+        get: &dyn Fn(&str) -> Option<std::ffi::OsString>,
+    ) -> Result<GpuConfig, GpuError> {
+        let text = |k: &str| get(k).map(|v| v.to_string_lossy().into_owned()).filter(|v| !v.is_empty());
+        let validate = match text("VISTA_VALIDATION").as_deref() {
+            None | Some("0") => false,
+            Some(v) if v.eq_ignore_ascii_case("false") => false,
+            Some(v) if v == "1" || v.eq_ignore_ascii_case("true") => true,
+            Some(v) => {
+                return Err(GpuError::Request(format!("VISTA_VALIDATION={v} is not valid; expected 1|0|true|false")));
+            }
+        };
+        let timeout = match text("VISTA_GPU_TIMEOUT_S") {
+            None => DEFAULT_TIMEOUT,
+            Some(v) => match v.parse::<f64>() {
+                Ok(s) if s.is_finite() && s >= 0.0 => Duration::from_secs_f64(s),
+                _ => {
+                    return Err(GpuError::Request(format!(
+                        "VISTA_GPU_TIMEOUT_S={v} is not valid; expected a number of seconds >= 0"
+                    )));
+                }
+            },
+        };
+        Ok(GpuConfig {
+            adapter: AdapterChoice::from_settings(adapter)?,
+            validate,
+            timeout,
+            wgpu_backends: text("WGPU_BACKEND"),
+            browser: vista_browser::BrowserConfig::from_lookup(get),
+        })
+    }
+}
+
 impl AdapterChoice {
     /// The adapter of a backend name: lavapipe | swiftshader | gpu.
     pub fn of_backend(name: &str) -> Result<AdapterChoice, GpuError> {
@@ -46,23 +127,35 @@ impl AdapterChoice {
         }
     }
 
-    /// `WGPU_ADAPTER_NAME` wins, then `VISTA_BACKEND`, then
-    /// `VISTA_ADAPTER=gpu|cpu` (cpu = lavapipe), else lavapipe.
-    pub fn from_env() -> Result<AdapterChoice, GpuError> {
-        if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME")
-            && !name.is_empty()
-        {
+    /// The adapter named by settings as the edge read them, first given
+    /// first: `--backend`, `--adapter` (cpu = lavapipe), `WGPU_ADAPTER_NAME`,
+    /// `VISTA_BACKEND`, `VISTA_ADAPTER`; else lavapipe.
+    pub fn from_settings(s: &AdapterSettings) -> Result<AdapterChoice, GpuError> {
+        let given = |v: &Option<String>| v.clone().filter(|v| !v.is_empty());
+        if let Some(b) = given(&s.backend_flag) {
+            return AdapterChoice::of_backend(&b).map_err(|e| GpuError::Request(format!("--backend {b}: {e}")));
+        }
+        if let Some(a) = given(&s.adapter_flag) {
+            return AdapterChoice::of_adapter(&a).map_err(|e| GpuError::Request(format!("--adapter {a}: {e}")));
+        }
+        if let Some(name) = given(&s.wgpu_adapter_name) {
             return Ok(AdapterChoice::Named(name));
         }
-        if let Ok(b) = std::env::var("VISTA_BACKEND")
-            && !b.is_empty()
-        {
+        if let Some(b) = given(&s.backend_env) {
             return AdapterChoice::of_backend(&b).map_err(|e| GpuError::Request(format!("VISTA_BACKEND: {e}")));
         }
-        match std::env::var("VISTA_ADAPTER").as_deref() {
-            Err(_) | Ok("") | Ok("cpu") | Ok("software") | Ok("lavapipe") => Ok(AdapterChoice::Lavapipe),
-            Ok("gpu") | Ok("hardware") => Ok(AdapterChoice::Hardware),
-            Ok(other) => Err(GpuError::Request(format!("VISTA_ADAPTER={other} is not valid; expected one of cpu|gpu"))),
+        match given(&s.adapter_env) {
+            None => Ok(AdapterChoice::Lavapipe),
+            Some(a) => AdapterChoice::of_adapter(&a).map_err(|e| GpuError::Request(format!("VISTA_ADAPTER={a}: {e}"))),
+        }
+    }
+
+    /// The adapter of `--adapter` / `VISTA_ADAPTER`: cpu (lavapipe) or gpu.
+    pub fn of_adapter(name: &str) -> Result<AdapterChoice, GpuError> {
+        match name {
+            "cpu" | "software" | "lavapipe" => Ok(AdapterChoice::Lavapipe),
+            "gpu" | "hardware" => Ok(AdapterChoice::Hardware),
+            other => Err(GpuError::Request(format!("adapter '{other}' is not valid; expected one of cpu|gpu"))),
         }
     }
 
@@ -183,30 +276,29 @@ struct BrowserEngine {
 /// Where Debian's vulkan-validationlayers puts the layer's manifest.
 pub const VALIDATION_LAYER_JSON: &str = "/usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json";
 
-static SHARED: OnceLock<Result<Context, GpuError>> = OnceLock::new();
+static SHARED: OnceLock<(GpuConfig, Result<Context, GpuError>)> = OnceLock::new();
 
 impl Context {
-    /// The process-wide context, created on first use from the environment.
-    pub fn shared() -> Result<&'static Context, GpuError> {
-        SHARED.get_or_init(|| Context::new(AdapterChoice::from_env()?)).as_ref().map_err(Clone::clone)
+    /// The process-wide context, created on first use from `config`. Every
+    /// later call must pass the same configuration: one process, one device.
+    pub fn shared(config: &GpuConfig) -> Result<&'static Context, GpuError> {
+        let (made_with, ctx) = SHARED.get_or_init(|| (config.clone(), Context::new(config)));
+        if made_with != config {
+            return Err(GpuError::Request(format!(
+                "this process's shared context was made for {:?}, not {:?}; one process has one context",
+                made_with.adapter, config.adapter
+            )));
+        }
+        ctx.as_ref().map_err(Clone::clone)
     }
 
-    pub fn new(choice: AdapterChoice) -> Result<Context, GpuError> {
-        let validate = std::env::var("VISTA_VALIDATION").is_ok_and(|v| v == "1" || v.eq_ignore_ascii_case("true"));
-        Context::with_validation(choice, validate)
-    }
-
-    /// A context, with the Khronos validation layer when `validate`; every
-    /// validation message then fails the dispatch it arrives in.
-    pub fn with_validation(choice: AdapterChoice, validate: bool) -> Result<Context, GpuError> {
+    /// A context as `config` says, with the Khronos validation layer when
+    /// `config.validate`; every validation message then fails the dispatch
+    /// it arrives in.
+    pub fn new(config: &GpuConfig) -> Result<Context, GpuError> {
         let start = Instant::now();
-        let timeout = std::env::var("VISTA_GPU_TIMEOUT_S")
-            .ok()
-            .and_then(|s| s.parse::<f64>().ok())
-            .filter(|s| s.is_finite() && *s >= 0.0)
-            .unwrap_or(120.0);
-        let timeout = Duration::from_secs_f64(timeout);
-        if choice == AdapterChoice::Browser {
+        let (choice, validate, timeout) = (&config.adapter, config.validate, config.timeout);
+        if *choice == AdapterChoice::Browser {
             if validate {
                 return Err(GpuError::Request(
                     "VISTA_VALIDATION=1 runs the Khronos layer under wgpu; the browser backend has Dawn's own \
@@ -214,10 +306,20 @@ impl Context {
                         .into(),
                 ));
             }
-            return Context::browser(timeout, start);
+            return Context::browser(timeout, &config.browser, start);
         }
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
+        desc.backends = match config.wgpu_backends.as_deref() {
+            None => wgpu::Backends::VULKAN,
+            Some(list) => match wgpu::Backends::from_comma_list(list) {
+                b if b.is_empty() => {
+                    return Err(GpuError::Request(format!(
+                        "WGPU_BACKEND={list} names no backend; expected a comma list such as vulkan"
+                    )));
+                }
+                b => b,
+            },
+        };
         if validate {
             crate::validation::install().map_err(GpuError::Request)?;
             if !std::path::Path::new(VALIDATION_LAYER_JSON).exists() {
@@ -238,7 +340,7 @@ impl Context {
                 format!("{} [{:?}, {:?}]", i.name, i.device_type, i.backend)
             })
             .collect::<Vec<_>>();
-        let adapter = pick(adapters, &choice).ok_or_else(|| GpuError::NoAdapter {
+        let adapter = pick(adapters, choice).ok_or_else(|| GpuError::NoAdapter {
             wanted: choice.describe(),
             seen: if seen.is_empty() { "no adapters".into() } else { seen.join("; ") },
             hint: choice.hint(),
@@ -306,8 +408,8 @@ impl Context {
     }
 
     /// Headless Chromium with a WebGPU device on its SwiftShader adapter.
-    fn browser(timeout: Duration, start: Instant) -> Result<Context, GpuError> {
-        let browser = vista_browser::Browser::launch(timeout).map_err(|e| match e {
+    fn browser(timeout: Duration, config: &vista_browser::BrowserConfig, start: Instant) -> Result<Context, GpuError> {
+        let browser = vista_browser::Browser::launch(timeout, config).map_err(|e| match e {
             vista_browser::BrowserError::NotInstalled { looked, hint } => GpuError::NoAdapter {
                 wanted: AdapterChoice::Browser.describe(),
                 seen: format!("no Chromium; looked for {looked}"),

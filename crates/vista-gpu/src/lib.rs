@@ -10,7 +10,10 @@ mod context;
 mod shaders;
 pub mod validation;
 
-pub use context::{AdapterChoice, BACKENDS, Context, Dispatch, RunStats, SWIFTSHADER_HINT, VALIDATION_LAYER_JSON};
+pub use context::{
+    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dispatch, GpuConfig, RunStats,
+    SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
+};
 pub use shaders::{ShaderSet, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.

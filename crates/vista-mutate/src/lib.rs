@@ -18,11 +18,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rand::seq::SliceRandom;
 use rand_pcg::Pcg32;
-use vista_golden::{Agreement, Case, GoldenError, Manifest, Renderer, Store, agreement};
+use vista_golden::{Agreement, Case, GoldenError, Manifest, Store, agreement};
 use vista_gpu::{Context, GpuError, ShaderSet};
 use vista_image::Image;
 use vista_kernels::Kernel;
 use vista_project::{Project, SourceFile};
+use vista_render::Renderer;
 
 pub mod mutants;
 pub use mutants::{Mutant, mutants};
@@ -374,7 +375,7 @@ fn baseline<'a>(
     let adapter = gpu.adapter_description();
     let mut out = Vec::new();
     for c in cases.iter().filter(|c| c.kernel.name() == kernel.name()) {
-        let r = vista_golden::render(gpu, kernel, &c.params, c.width, c.height)?;
+        let r = vista_render::render(gpu, kernel, &c.params, c.width, c.height)?;
         let golden = vista_image::read_png16(&store.golden_path(c)).ok();
         let same = manifest.case.get(&c.id).is_some_and(|e| e.adapter == adapter);
         out.push((*c, golden, r.raw.content_hash(), if same { c.psnr_same_driver } else { c.psnr_other_driver }));
@@ -382,7 +383,7 @@ fn baseline<'a>(
     let cpu = match (kernel.has_reference(), out.first()) {
         (true, Some((c, ..))) => {
             let (w, h) = CPU_CHECK_SIZE;
-            let raw = vista_golden::render(gpu, kernel, &c.params, w, h)?.raw;
+            let raw = vista_render::render(gpu, kernel, &c.params, w, h)?.raw;
             let reference = kernel.reference(&c.params, w, h);
             let a = agreement(kernel, &raw, &reference);
             Some((c.params.clone(), reference, a, raw.content_hash()))
@@ -403,13 +404,13 @@ fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> Mutant
         cases_run,
         argument: None,
     };
-    let failed = |e: &GoldenError| match e {
-        GoldenError::Gpu(GpuError::Timeout { .. }) => "timeout",
+    let failed = |e: &vista_render::RenderError| match e {
+        vista_render::RenderError::Gpu(GpuError::Timeout { .. }) => "timeout",
         _ => "stillborn",
     };
     let mut identical = true;
     for (n, (case, golden, raw_hash, threshold)) in base.cases.iter().enumerate() {
-        let r = match vista_golden::render(gpu, kernel, &case.params, case.width, case.height) {
+        let r = match vista_render::render(gpu, kernel, &case.params, case.width, case.height) {
             Ok(r) => r,
             Err(e) => return report(failed(&e), None, false, n + 1),
         };
@@ -421,7 +422,7 @@ fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> Mutant
             return report("killed", Some(format!("{} (output range)", case.id)), false, n + 1);
         }
         if let Some(g) = golden {
-            let psnr = vista_image::metrics::psnr(g, &vista_golden::quantize16(r.display()));
+            let psnr = vista_image::metrics::psnr(g, &vista_render::quantize16(r.display()));
             if psnr < *threshold {
                 return report("killed", Some(case.id.clone()), false, n + 1);
             }
@@ -431,7 +432,7 @@ fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> Mutant
     if let Some((p, reference, before, raw_hash)) = &base.cpu {
         run += 1;
         let (w, h) = CPU_CHECK_SIZE;
-        match vista_golden::render(gpu, kernel, p, w, h) {
+        match vista_render::render(gpu, kernel, p, w, h) {
             Ok(r) => {
                 identical &= r.raw.content_hash() == *raw_hash;
                 let a = agreement(kernel, &r.raw, reference);
@@ -473,7 +474,7 @@ pub fn run(
         )
     };
     let manifest = store.manifest()?;
-    let original = Renderer { ctx, shaders: set(None) };
+    let original = Renderer { ctx, shaders: set(None), limits: Default::default() };
     let mut baselines = BTreeMap::new();
     for p in planned {
         if !baselines.contains_key(p.kernel.name()) {
@@ -489,7 +490,7 @@ pub fn run(
                 loop {
                     let i = next.fetch_add(1, Ordering::SeqCst);
                     let Some(p) = planned.get(i) else { break };
-                    let gpu = Renderer { ctx, shaders: set(Some(&p.mutant)) };
+                    let gpu = Renderer { ctx, shaders: set(Some(&p.mutant)), limits: Default::default() };
                     let r = judge(&gpu, p.kernel, &baselines[p.kernel.name()], &p.mutant);
                     results.lock().expect("results")[i] = Some(r);
                     progress(done.fetch_add(1, Ordering::SeqCst) + 1, planned.len());

@@ -11,16 +11,16 @@
 //! measured GPU time breaks ties (e.g. `relax`, which changes no count).
 //!
 //! Not for: drawing progress bars (the caller gets a callback) or golden
-//! checks (`vista-golden`).
+//! checks (`vista-golden`). Renders through `vista-render`, as everything does.
 
 mod plot;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use vista_golden::GoldenError;
 use vista_image::metrics::{self, Metrics};
 use vista_kernels::{Kernel, Kind, ParamSet};
+use vista_render::RenderError;
 
 pub use plot::{PlotError, find_font, write_plots};
 
@@ -37,7 +37,7 @@ pub enum Metric {
 }
 
 impl Metric {
-    pub fn parse(text: &str) -> Result<Metric, GoldenError> {
+    pub fn parse(text: &str) -> Result<Metric, RenderError> {
         match text {
             "display" => Ok(Metric::Display),
             "linear" => Ok(Metric::Linear),
@@ -103,13 +103,13 @@ pub struct Sweep {
     pub points: Vec<Point>,
 }
 
-fn bad(e: impl std::fmt::Display) -> GoldenError {
-    GoldenError::BadInput(e.to_string())
+fn bad(e: impl std::fmt::Display) -> RenderError {
+    RenderError::BadInput(e.to_string())
 }
 
 /// Splits `a,b,c` into values; `a:b` style ranges are not accepted so a CSV
 /// row always shows exactly what was typed.
-pub fn parse_values(flag: &str, text: &str) -> Result<Vec<String>, GoldenError> {
+pub fn parse_values(flag: &str, text: &str) -> Result<Vec<String>, RenderError> {
     let values: Vec<String> = text.split(',').map(|v| v.trim().to_string()).collect();
     if values.iter().any(String::is_empty) {
         return Err(bad(format!("{flag} '{text}' has an empty value; give a comma-separated list like 8,16,32")));
@@ -124,7 +124,7 @@ impl SweepSpec {
     /// Every point's parameter set and the reference's, validated before
     /// any GPU work: unknown names and out-of-range values fail here, and so
     /// does a sweep whose total work is past the per-dispatch cap.
-    pub fn resolve(&self) -> Result<(ParamSet, Vec<SweepPoint>), GoldenError> {
+    pub fn resolve(&self, limits: &vista_render::RenderLimits) -> Result<(ParamSet, Vec<SweepPoint>), RenderError> {
         let k = self.kernel;
         for axis in std::iter::once(&self.x).chain(&self.y) {
             let spec = k.params().iter().find(|s| s.name == axis.name).ok_or_else(|| {
@@ -155,7 +155,7 @@ impl SweepSpec {
         }
         let preset = self.preset.as_deref();
         let reference = k.resolve(preset, &[self.base.clone(), self.reference.clone()].concat()).map_err(bad)?;
-        vista_golden::check_request(k, &reference, self.width, self.height)?;
+        vista_render::check_request(k, &reference, self.width, self.height, limits)?;
         let ys: Vec<Option<&String>> = match &self.y {
             Some(y) => y.values.iter().map(Some).collect(),
             None => vec![None],
@@ -169,7 +169,7 @@ impl SweepSpec {
                     set.push((axis.name.clone(), v.clone()));
                 }
                 let p = k.resolve(preset, &set).map_err(bad)?;
-                vista_golden::check_request(k, &p, self.width, self.height)?;
+                vista_render::check_request(k, &p, self.width, self.height, limits)?;
                 points.push((xv.clone(), yv.cloned(), p));
             }
         }
@@ -179,20 +179,20 @@ impl SweepSpec {
 
 /// Runs the sweep. `progress(done, total, label)` is called before each render group.
 pub fn run(
-    ctx: &vista_golden::Renderer,
+    ctx: &vista_render::Renderer,
     spec: &SweepSpec,
     mut progress: impl FnMut(usize, usize, &str),
-) -> Result<Sweep, GoldenError> {
-    let (reference_params, points) = spec.resolve()?;
+) -> Result<Sweep, RenderError> {
+    let (reference_params, points) = spec.resolve(&ctx.limits)?;
     let (k, w, h) = (spec.kernel, spec.width, spec.height);
     let total = points.len() + 1;
     progress(0, total, "reference");
     // Warm-up: pipeline compilation is not part of any timing.
-    vista_golden::render(ctx, k, &points[0].2, 8, 8)?;
-    let (reference, reference_time) = vista_golden::render_median(ctx, k, &reference_params, w, h, spec.runs)?;
+    vista_render::render(ctx, k, &points[0].2, 8, 8)?;
+    let (reference, reference_time) = vista_render::render_median(ctx, k, &reference_params, w, h, spec.runs)?;
     let reference_ms = reference_time.as_secs_f64() * 1e3;
     if let Some((x, y)) = reference.raw.first_nonfinite() {
-        return Err(GoldenError::BadInput(format!("the reference render has NaN/Inf, first at ({x}, {y})")));
+        return Err(RenderError::BadInput(format!("the reference render has NaN/Inf, first at ({x}, {y})")));
     }
     let mut out = Vec::with_capacity(points.len());
     for (i, (xv, yv, p)) in points.iter().enumerate() {
@@ -201,7 +201,7 @@ pub fn run(
             None => format!("{}={xv}", spec.x.name),
         };
         progress(i + 1, total, &label);
-        let (r, time) = vista_golden::render_median(ctx, k, p, w, h, spec.runs)?;
+        let (r, time) = vista_render::render_median(ctx, k, p, w, h, spec.runs)?;
         let gpu_ms = time.as_secs_f64() * 1e3;
         let m = match spec.metric {
             Metric::Display => metrics::compare(reference.display(), r.display())?,
@@ -320,16 +320,17 @@ impl Sweep {
     /// Writes `curve.csv`, `summary.txt`, and (when a font is found)
     /// `curve.svg` and `curve.png` into `dir`, atomically each. Returns the
     /// written paths and, when the plots could not be drawn, why.
-    pub fn write(&self, dir: &Path) -> Result<(Vec<PathBuf>, Option<String>), GoldenError> {
+    /// `font` is the configured font file (`VISTA_FONT`), else a system one.
+    pub fn write(&self, dir: &Path, font: Option<&Path>) -> Result<(Vec<PathBuf>, Option<String>), RenderError> {
         std::fs::create_dir_all(dir)
-            .map_err(|e| GoldenError::Io { path: dir.display().to_string(), message: format!("cannot create: {e}") })?;
+            .map_err(|e| RenderError::Io { path: dir.display().to_string(), message: format!("cannot create: {e}") })?;
         let mut written = Vec::new();
         for (name, text) in [("curve.csv", self.csv()), ("summary.txt", self.table())] {
             let path = dir.join(name);
             vista_image::atomic_write(&path, text.as_bytes())?;
             written.push(path);
         }
-        match write_plots(self, dir) {
+        match write_plots(self, dir, font) {
             Ok(paths) => {
                 written.extend(paths);
                 Ok((written, None))

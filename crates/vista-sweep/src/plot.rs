@@ -38,19 +38,20 @@ const FONT_PATHS: &[&str] = &[
     "C:\\Windows\\Fonts\\arial.ttf",
 ];
 
-/// The font file plots use: `$VISTA_FONT`, else the first common system path that exists.
-pub fn find_font() -> Option<PathBuf> {
-    if let Some(p) = std::env::var_os("VISTA_FONT") {
-        return Some(PathBuf::from(p));
+/// The font file plots use: the configured one (`VISTA_FONT`, read at the
+/// edge), else the first common system path that exists.
+pub fn find_font(configured: Option<&Path>) -> Option<PathBuf> {
+    if let Some(p) = configured {
+        return Some(p.to_path_buf());
     }
     FONT_PATHS.iter().map(PathBuf::from).find(|p| p.is_file())
 }
 
 /// Registers the font as "sans-serif" once per process.
-fn ensure_font() -> Result<(), PlotError> {
+fn ensure_font(configured: Option<&Path>) -> Result<(), PlotError> {
     static DONE: OnceLock<Result<(), String>> = OnceLock::new();
     DONE.get_or_init(|| {
-        let path = find_font().ok_or_else(|| {
+        let path = find_font(configured).ok_or_else(|| {
             "no TrueType font found for plot text; install one (`apt-get install fonts-dejavu-core`, \
              which ci/curves.sh does) or set VISTA_FONT=/path/to/font.ttf"
                 .to_string()
@@ -74,8 +75,8 @@ fn psnr_of(p: &crate::Point) -> f64 {
 }
 
 /// Draws both files and writes each atomically. Returns their paths.
-pub fn write_plots(sweep: &Sweep, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    ensure_font()?;
+pub fn write_plots(sweep: &Sweep, dir: &Path, font: Option<&Path>) -> Result<Vec<PathBuf>, PlotError> {
+    ensure_font(font)?;
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();

@@ -1,0 +1,293 @@
+//! vista's one render path: kernel + params + a project's shaders -> a
+//! [`Plan`] (every check that needs no device happens while making it) ->
+//! run on the context's engine (wgpu on lavapipe, SwiftShader or a GPU; or
+//! headless Chromium) -> the outputs ([`Rendered`]).
+//!
+//! check, bless, sweep, bench, mutate and the test harnesses all render
+//! through this crate; nothing else dispatches a kernel.
+//!
+//! Not for: judging outputs (`vista-golden`), writing files (nothing here
+//! writes), or knowing any kernel's meaning (`vista-kernels`).
+#![deny(missing_docs)]
+
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use vista_gpu::{Context, Dispatch, RunStats, ShaderSet};
+use vista_image::Image;
+use vista_kernels::{DisplayMap, Kernel, ParamSet};
+
+/// Why a render could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// The request is the user's to fix (size, work cap, a shader that does
+    /// not compose, a `Params` struct that does not fit the manifest).
+    #[error("{0}")]
+    BadInput(String),
+    /// The device failed, or refused the request.
+    #[error(transparent)]
+    Gpu(#[from] vista_gpu::GpuError),
+    /// The project's files could not be read.
+    #[error(transparent)]
+    Project(#[from] vista_project::ProjectError),
+    /// An image could not be read, written or compared.
+    #[error(transparent)]
+    Image(#[from] vista_image::ImageError),
+    /// A file or directory could not be used.
+    #[error("{path}: {message}")]
+    Io {
+        /// The path.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl RenderError {
+    /// Process exit code: 2 for bad input, 1 for failures while running.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            RenderError::BadInput(_) | RenderError::Project(_) | RenderError::Image(_) | RenderError::Io { .. } => 2,
+            RenderError::Gpu(vista_gpu::GpuError::Request(_)) => 2,
+            RenderError::Gpu(_) => 1,
+        }
+    }
+}
+
+/// Default cap on `work_per_pixel * pixels`. Lavapipe on 2 cores evaluates
+/// roughly 1e8-1e9 noise samples per second, so this keeps any accepted
+/// dispatch under about a minute there instead of stalling the device.
+pub const DEFAULT_MAX_WORK: f64 = 4.0e10;
+
+/// Bounds every render is held to before GPU work, set at the edge
+/// (`VISTA_MAX_WORK`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderLimits {
+    /// Cap on `work_per_pixel * pixels`.
+    pub max_work: f64,
+}
+
+impl Default for RenderLimits {
+    fn default() -> RenderLimits {
+        RenderLimits { max_work: DEFAULT_MAX_WORK }
+    }
+}
+
+/// A rendered kernel: raw output (what the shader wrote) and, on demand,
+/// display values.
+#[derive(Debug, Clone)]
+pub struct Rendered {
+    /// What the shader wrote, unchanged.
+    pub raw: Image,
+    /// Timing of the run.
+    pub stats: RunStats,
+    to_display: DisplayMap,
+    /// Display values, made on first use unless they are `raw` itself: a
+    /// benchmark or a raw-only caller never pays for a second image.
+    display: OnceLock<Option<Image>>,
+}
+
+impl Rendered {
+    /// Display values in [0, 1] (what PNG goldens hold): `raw` itself for a
+    /// display kernel, else the kernel's tone map / opaque alpha of it.
+    pub fn display(&self) -> &Image {
+        self.display.get_or_init(|| self.to_display.apply(&self.raw)).as_ref().unwrap_or(&self.raw)
+    }
+}
+
+/// Checks size and work bounds before any GPU work.
+pub fn check_request(
+    kernel: &Kernel,
+    p: &ParamSet,
+    width: u32,
+    height: u32,
+    limits: &RenderLimits,
+) -> Result<(), RenderError> {
+    vista_kernels::check_size(width, height).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let work = kernel.work_per_pixel(p) * width as f64 * height as f64;
+    let cap = limits.max_work;
+    if work > cap {
+        return Err(RenderError::BadInput(format!(
+            "{}: this request needs about {work:.2e} inner-loop evaluations ({}x{} pixels x {:.0} per pixel), \
+             above the cap of {cap:.2e}; lower the size or the step/octave counts (or raise VISTA_MAX_WORK)",
+            kernel.name(),
+            width,
+            height,
+            kernel.work_per_pixel(p)
+        )));
+    }
+    Ok(())
+}
+
+/// The GPU context and the WGSL of one project: everything a render needs
+/// besides the kernel and its params. Derefs to the [`Context`].
+pub struct Renderer<'a> {
+    /// The process's device (or browser).
+    pub ctx: &'a Context,
+    /// The project's WGSL over the built-ins.
+    pub shaders: ShaderSet,
+    /// Bounds every render is held to.
+    pub limits: RenderLimits,
+}
+
+impl std::ops::Deref for Renderer<'_> {
+    type Target = Context;
+    fn deref(&self) -> &Context {
+        self.ctx
+    }
+}
+
+impl<'a> Renderer<'a> {
+    /// A renderer over the project's shaders (its `shaders/` layered over the
+    /// built-ins).
+    pub fn new(
+        ctx: &'a Context,
+        project: &vista_project::Project,
+        limits: RenderLimits,
+    ) -> Result<Renderer<'a>, RenderError> {
+        Ok(Renderer { ctx, shaders: shader_set(project)?, limits })
+    }
+
+    /// Provenance hash of a kernel file and its imports.
+    pub fn shader_hash(&self, shader: &str) -> Result<String, RenderError> {
+        Ok(self.shaders.source_hash(shader)?)
+    }
+
+    /// Hash of each file of the kernel's import closure, by path.
+    pub fn shader_file_hashes(&self, shader: &str) -> Result<std::collections::BTreeMap<String, String>, RenderError> {
+        Ok(self.shaders.file_hashes(shader)?.into_iter().collect())
+    }
+}
+
+/// The project's WGSL as one [`ShaderSet`].
+pub fn shader_set(project: &vista_project::Project) -> Result<ShaderSet, RenderError> {
+    let label = match project.root() {
+        Some(r) => format!("project {}", r.display()),
+        None => "built-in shaders".to_string(),
+    };
+    let files = project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin));
+    Ok(ShaderSet::from_files(&label, files))
+}
+
+/// One render as every engine runs it: the kernel file as composed for
+/// these params, the uniform bytes packed from naga's reflection of the
+/// composed module, the binding-2 table, the size, and how raw output maps
+/// to display values. Made by [`plan`], where every check that needs no
+/// device happens; run by [`run`].
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The kernel's name, for errors.
+    pub kernel: String,
+    /// The kernel file as composed for these params (`Kernel::shader_for`).
+    pub shader: String,
+    /// Binding 0's bytes.
+    pub uniforms: Vec<u8>,
+    /// Binding 2's words (Perlin's permutation and its packed chains).
+    pub table: Vec<u32>,
+    /// Output width in pixels.
+    pub width: u32,
+    /// Output height in pixels.
+    pub height: u32,
+    /// Raw output to display values.
+    pub display: DisplayMap,
+}
+
+/// The plan of `kernel` with `p` at `width` x `height`, after every check
+/// that needs no device: size and work bounds, composition of the kernel's
+/// WGSL, and its `Params` struct against the manifest (a field with no
+/// param, a param with no field, a type mismatch are bad input).
+pub fn plan(
+    shaders: &ShaderSet,
+    kernel: &Kernel,
+    p: &ParamSet,
+    width: u32,
+    height: u32,
+    limits: &RenderLimits,
+) -> Result<Plan, RenderError> {
+    check_request(kernel, p, width, height, limits)?;
+    let shader = kernel.shader_for(p);
+    let module = shaders.compose(&shader).map_err(|e| match e {
+        // A missing or broken shader file is the user's to fix.
+        vista_gpu::GpuError::Shader(m) => RenderError::BadInput(format!("kernel {}: {m}", kernel.name())),
+        other => RenderError::Gpu(other),
+    })?;
+    let layout = kernel.layout(&module).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    Ok(Plan {
+        kernel: kernel.name().to_string(),
+        uniforms: kernel.uniforms(&layout, p, width, height),
+        table: kernel.table(&layout, p),
+        shader,
+        width,
+        height,
+        display: kernel.display_map(p),
+    })
+}
+
+/// Runs a plan on the renderer's engine.
+pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
+    let job = Dispatch {
+        shaders: &gpu.shaders,
+        shader: &plan.shader,
+        uniforms: &plan.uniforms,
+        table: &plan.table,
+        width: plan.width,
+        height: plan.height,
+    };
+    let (raw, stats) = gpu.ctx.run(&job)?;
+    Ok(Rendered { raw, stats, to_display: plan.display, display: OnceLock::new() })
+}
+
+/// Renders `kernel` with `p` at `width` x `height`: [`plan`], then [`run`].
+pub fn render(gpu: &Renderer, kernel: &Kernel, p: &ParamSet, width: u32, height: u32) -> Result<Rendered, RenderError> {
+    run(gpu, &plan(&gpu.shaders, kernel, p, width, height, &gpu.limits)?)
+}
+
+/// Renders `runs` (at least 1) times; returns the first render and the
+/// median GPU wall time, for benchmarks and sweeps.
+pub fn render_median(
+    gpu: &Renderer,
+    kernel: &Kernel,
+    p: &ParamSet,
+    width: u32,
+    height: u32,
+    runs: u32,
+) -> Result<(Rendered, Duration), RenderError> {
+    let first = render(gpu, kernel, p, width, height)?;
+    let mut times = vec![first.stats.gpu_wall];
+    for _ in 1..runs {
+        times.push(render(gpu, kernel, p, width, height)?.stats.gpu_wall);
+    }
+    Ok((first, median(times)))
+}
+
+/// The middle time (the upper one for an even count) of a non-empty list.
+///
+/// # Panics
+/// If `times` is empty.
+pub fn median(mut times: Vec<Duration>) -> Duration {
+    times.sort();
+    times[times.len() / 2]
+}
+
+/// Median wall-clock time of `runs` calls of `f` (at least one): the
+/// CPU-side twin of [`render_median`], for baselines timed beside it.
+pub fn median_wall(runs: u32, mut f: impl FnMut()) -> Duration {
+    median(
+        (0..runs.max(1))
+            .map(|_| {
+                let start = Instant::now();
+                f();
+                start.elapsed()
+            })
+            .collect(),
+    )
+}
+
+/// Display values as a 16-bit PNG stores them, so a fresh render compares
+/// with a golden exactly as it would after being blessed.
+pub fn quantize16(img: &Image) -> Image {
+    let q = |v: f32| {
+        if v.is_nan() { 0.0 } else { (v.clamp(0.0, 1.0) * 65535.0).round() / 65535.0 }
+    };
+    Image::from_raw(img.width, img.height, img.data.iter().map(|p| p.map(q)).collect()).expect("same size")
+}

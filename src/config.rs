@@ -1,0 +1,208 @@
+//! The one configuration of a vista process, built at the edge (the `vista`
+//! binary, a test harness) from its flags and the environment, read once,
+//! and passed down in parts: the GPU context's, the render limits, the bless
+//! policy, the plot font, the browser path. No library crate reads the
+//! environment; a test below greps them to keep it so.
+
+use std::ffi::OsString;
+use std::path::PathBuf;
+
+use vista_golden::GoldenError;
+use vista_gpu::{AdapterSettings, GpuConfig};
+use vista_render::RenderLimits;
+
+/// Everything vista's libraries are told from outside.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Config {
+    /// Adapter, validation layer, watchdog, wgpu backends, Chromium.
+    pub gpu: GpuConfig,
+    /// `VISTA_MAX_WORK`: the cap on a render's work estimate.
+    pub limits: RenderLimits,
+    /// `CI` set (to anything but 0 or false): bless is refused without `--force`.
+    pub in_ci: bool,
+    /// `VISTA_ALLOW_NO_GPU=1`: without an adapter, GPU tests are reported
+    /// skipped (loudly) instead of failing.
+    pub allow_no_gpu: bool,
+    /// `VISTA_FONT`: the font file for plot text.
+    pub font: Option<PathBuf>,
+    /// `VISTA_ROOT`: the project root, after `--root`.
+    pub root: Option<OsString>,
+    /// `VISTA_FAULT`: fault-injection plan for the write-path tests.
+    pub fault: Option<String>,
+}
+
+/// The command-line flags that override the environment.
+#[derive(Debug, Clone, Default)]
+pub struct Flags {
+    /// `--backend NAME`.
+    pub backend: Option<String>,
+    /// `--adapter cpu|gpu`.
+    pub adapter: Option<String>,
+}
+
+fn truthy(name: &str, v: Option<String>) -> Result<bool, GoldenError> {
+    match v.as_deref() {
+        None | Some("") | Some("0") => Ok(false),
+        Some(v) if v.eq_ignore_ascii_case("false") => Ok(false),
+        Some(v) if v == "1" || v.eq_ignore_ascii_case("true") => Ok(true),
+        Some(v) => Err(GoldenError::BadInput(format!("{name}={v} is not valid; expected 1|0|true|false"))),
+    }
+}
+
+impl Config {
+    /// The configuration of `flags` over settings looked up by name: flags
+    /// first, then the variables. A value that does not parse is bad input
+    /// naming the variable and what is allowed.
+    pub fn from_lookup(flags: &Flags, get: &dyn Fn(&str) -> Option<OsString>) -> Result<Config, GoldenError> {
+        let text = |k: &str| get(k).map(|v| v.to_string_lossy().into_owned());
+        let adapter = AdapterSettings {
+            backend_flag: flags.backend.clone(),
+            adapter_flag: flags.adapter.clone(),
+            wgpu_adapter_name: text("WGPU_ADAPTER_NAME"),
+            backend_env: text("VISTA_BACKEND"),
+            adapter_env: text("VISTA_ADAPTER"),
+        };
+        let max_work = match text("VISTA_MAX_WORK").filter(|v| !v.is_empty()) {
+            None => vista_render::DEFAULT_MAX_WORK,
+            Some(v) => v.parse::<f64>().ok().filter(|w| w.is_finite() && *w > 0.0).ok_or_else(|| {
+                GoldenError::BadInput(format!(
+                    "VISTA_MAX_WORK={v} is not valid; expected a positive number such as 4e10"
+                ))
+            })?,
+        };
+        Ok(Config {
+            gpu: GpuConfig::from_lookup(&adapter, get)?,
+            limits: RenderLimits { max_work },
+            // CI systems spell it true, 1 or their own name (CI=woodpecker).
+            in_ci: text("CI").is_some_and(|v| !matches!(v.to_ascii_lowercase().as_str(), "" | "0" | "false")),
+            allow_no_gpu: truthy("VISTA_ALLOW_NO_GPU", text("VISTA_ALLOW_NO_GPU"))?,
+            font: get("VISTA_FONT").filter(|v| !v.is_empty()).map(PathBuf::from),
+            root: get("VISTA_ROOT").filter(|v| !v.is_empty()),
+            fault: text("VISTA_FAULT"),
+        })
+    }
+
+    /// The configuration of `flags` over this process's environment.
+    pub fn from_env(flags: &Flags) -> Result<Config, GoldenError> {
+        Config::from_lookup(flags, &|k| std::env::var_os(k))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashMap;
+
+    fn config(flags: &Flags, vars: &[(&str, &str)]) -> Result<Config, GoldenError> {
+        let vars: HashMap<String, OsString> = vars.iter().map(|(k, v)| (k.to_string(), OsString::from(v))).collect();
+        Config::from_lookup(flags, &|k| vars.get(k).cloned())
+    }
+
+    #[test]
+    fn flags_come_before_the_environment() {
+        use vista_gpu::AdapterChoice as A;
+        let env = [("VISTA_BACKEND", "swiftshader"), ("VISTA_ADAPTER", "gpu")];
+        assert_eq!(config(&Flags::default(), &env).unwrap().gpu.adapter, A::SwiftShader);
+        let flag = Flags { backend: Some("browser".into()), adapter: None };
+        assert_eq!(config(&flag, &env).unwrap().gpu.adapter, A::Browser);
+        let flag = Flags { backend: None, adapter: Some("cpu".into()) };
+        assert_eq!(config(&flag, &env).unwrap().gpu.adapter, A::Lavapipe);
+        assert_eq!(config(&Flags::default(), &[("VISTA_ADAPTER", "gpu")]).unwrap().gpu.adapter, A::Hardware);
+        assert_eq!(config(&Flags::default(), &[]).unwrap().gpu.adapter, A::Lavapipe);
+        let named = config(&Flags::default(), &[("WGPU_ADAPTER_NAME", "llvm"), ("VISTA_BACKEND", "gpu")]).unwrap();
+        assert_eq!(named.gpu.adapter, A::Named("llvm".into()));
+    }
+
+    #[test]
+    fn every_setting_is_read_from_the_lookup() {
+        let c = config(
+            &Flags::default(),
+            &[
+                ("VISTA_MAX_WORK", "1e6"),
+                ("CI", "true"),
+                ("VISTA_ALLOW_NO_GPU", "1"),
+                ("VISTA_FONT", "/f.ttf"),
+                ("VISTA_VALIDATION", "1"),
+                ("VISTA_GPU_TIMEOUT_S", "7.5"),
+                ("VISTA_CHROMIUM", "/c"),
+                ("VISTA_ROOT", "/r"),
+                ("VISTA_FAULT", "x"),
+            ],
+        )
+        .unwrap();
+        assert_eq!(c.limits.max_work, 1e6);
+        assert!(c.in_ci && c.allow_no_gpu && c.gpu.validate);
+        assert_eq!(c.font.as_deref(), Some(std::path::Path::new("/f.ttf")));
+        assert_eq!(c.gpu.timeout, std::time::Duration::from_secs_f64(7.5));
+        assert_eq!(c.gpu.browser.chromium.as_deref(), Some(std::path::Path::new("/c")));
+        assert_eq!(c.root.as_deref(), Some(std::ffi::OsStr::new("/r")));
+        assert_eq!(c.fault.as_deref(), Some("x"));
+        let d = config(&Flags::default(), &[]).unwrap();
+        assert_eq!(d.limits.max_work, vista_render::DEFAULT_MAX_WORK);
+        assert!(!d.in_ci && !d.allow_no_gpu && !d.gpu.validate);
+        for (ci, is) in [("woodpecker", true), ("1", true), ("0", false), ("false", false)] {
+            assert_eq!(config(&Flags::default(), &[("CI", ci)]).unwrap().in_ci, is, "CI={ci}");
+        }
+    }
+
+    #[test]
+    fn a_bad_value_names_the_variable_and_what_is_allowed() {
+        for (var, value, allowed) in [
+            ("VISTA_MAX_WORK", "lots", "positive number"),
+            ("VISTA_BACKEND", "metal", "lavapipe|swiftshader|browser|gpu"),
+            ("VISTA_ADAPTER", "fast", "cpu|gpu"),
+            ("VISTA_GPU_TIMEOUT_S", "-1", "seconds"),
+            ("VISTA_VALIDATION", "yes", "1|0|true|false"),
+            ("VISTA_ALLOW_NO_GPU", "maybe", "1|0|true|false"),
+        ] {
+            let e = config(&Flags::default(), &[(var, value)]).unwrap_err().to_string();
+            assert!(e.contains(var) && e.contains(value) && e.contains(allowed), "{var}: {e}");
+            assert_eq!(config(&Flags::default(), &[(var, value)]).unwrap_err().exit_code(), 2, "{var}");
+        }
+    }
+
+    /// The non-test sources of every library crate (all of `crates/` but the
+    /// binary) read no environment variable, and nothing anywhere sets one.
+    #[test]
+    fn no_library_crate_reads_the_environment() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut offenders = Vec::new();
+        let mut files = Vec::new();
+        let mut dirs = vec![root.join("crates"), root.join("src")];
+        while let Some(d) = dirs.pop() {
+            for e in std::fs::read_dir(&d).unwrap().flatten() {
+                let p = e.path();
+                let name = p.file_name().unwrap().to_string_lossy().into_owned();
+                if p.is_dir() {
+                    // Integration tests and benches are edges of their own.
+                    if !matches!(name.as_str(), "tests" | "benches" | "target") {
+                        dirs.push(p);
+                    }
+                } else if name.ends_with(".rs") {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() > 40, "found only {} sources under crates/ and src/", files.len());
+        let binary = root.join("crates/vista-cli");
+        for f in files {
+            let text = std::fs::read_to_string(&f).unwrap();
+            // Unit tests sit in a trailing `#[cfg(test)]` module.
+            let code = text.split("#[cfg(test)]").next().unwrap();
+            let rel = f.strip_prefix(root).unwrap().display().to_string();
+            for (n, line) in code.lines().enumerate() {
+                let line = line.trim_start();
+                if line.starts_with("//") {
+                    continue;
+                }
+                let reads = ["env::var(", "env::var_os(", "env::vars(", "env::vars_os(", "Backends::from_env("];
+                let writes = ["set_var(", "remove_var("];
+                let at_edge = f.starts_with(&binary) || rel == "src/config.rs";
+                if writes.iter().any(|w| line.contains(w)) || (!at_edge && reads.iter().any(|r| line.contains(r))) {
+                    offenders.push(format!("{rel}:{}: {line}", n + 1));
+                }
+            }
+        }
+        assert!(offenders.is_empty(), "environment read or written outside the edge:\n{}", offenders.join("\n"));
+    }
+}
