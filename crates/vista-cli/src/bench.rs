@@ -52,44 +52,67 @@ pub fn bench(
         });
         t.as_secs_f64() * 1e3
     });
+    let result = BenchResult {
+        kernel: kernel.to_string(),
+        width: w,
+        height: h,
+        runs,
+        median_ms: median * 1e3,
+        mpix_per_s: mpix,
+        kernel_ms: kernel_s * 1e3,
+        readback_ms: readback_s * 1e3,
+        device_creation_ms: ctx.creation_time.as_secs_f64() * 1e3,
+        first_dispatch_ms: first * 1e3,
+        adapter: ctx.adapter_description(),
+        params: p.canonical(),
+        cpu_f32_ms: cpu_ms,
+        cpu_threads: cpu_ms.map(|_| rayon::current_num_threads()),
+        cpu_over_gpu: cpu_ms.map(|ms| ms / (median * 1e3)),
+    };
     if json {
-        let mut out = serde_json::json!({
-            "kernel": kernel, "width": w, "height": h, "runs": runs,
-            "median_ms": median * 1e3, "mpix_per_s": mpix,
-            "kernel_ms": kernel_s * 1e3, "readback_ms": readback_s * 1e3,
-            "device_creation_ms": ctx.creation_time.as_secs_f64() * 1e3,
-            "first_dispatch_ms": first * 1e3,
-            "adapter": ctx.adapter_description(), "params": p.canonical(),
-        });
-        if let Some(ms) = cpu_ms {
-            out["cpu_f32_ms"] = ms.into();
-            out["cpu_threads"] = rayon::current_num_threads().into();
-            out["cpu_over_gpu"] = (ms / (median * 1e3)).into();
-        }
-        println!("{out}");
+        println!("{}", serde_json::to_string(&result).map_err(|e| bad(format!("JSON encode: {e}")))?);
     } else {
+        let r = &result;
         println!(
-            "{kernel} {w}x{h}: median {:.2} ms over {runs} runs, {mpix:.2} Mpix/s on {}",
-            median * 1e3,
-            ctx.adapter_description()
+            "{} {}x{}: median {:.2} ms over {} runs, {:.2} Mpix/s on {}",
+            r.kernel, r.width, r.height, r.median_ms, r.runs, r.mpix_per_s, r.adapter
         );
         println!(
             "  of which the kernel {:.2} ms and the readback (copy, map, unpad) {:.2} ms",
-            kernel_s * 1e3,
-            readback_s * 1e3
+            r.kernel_ms, r.readback_ms
         );
         println!(
             "device creation {:.1} ms, first call (compose + pipeline compile + dispatch + readback) {:.1} ms",
-            ctx.creation_time.as_secs_f64() * 1e3,
-            first * 1e3
+            r.device_creation_ms, r.first_dispatch_ms
         );
-        if let Some(ms) = cpu_ms {
-            println!(
-                "f32 CPU reference on {} threads: {ms:.2} ms = {:.2}x the GPU time",
-                rayon::current_num_threads(),
-                ms / (median * 1e3)
-            );
+        if let (Some(ms), Some(threads), Some(ratio)) = (r.cpu_f32_ms, r.cpu_threads, r.cpu_over_gpu) {
+            println!("f32 CPU reference on {threads} threads: {ms:.2} ms = {ratio:.2}x the GPU time");
         }
     }
     Ok(0)
+}
+
+/// What `vista bench` measured: printed as text, or serialised whole by `--json`.
+#[derive(Debug, serde::Serialize)]
+struct BenchResult {
+    kernel: String,
+    width: u32,
+    height: u32,
+    runs: u32,
+    /// Median GPU wall (dispatch to mapped readback).
+    median_ms: f64,
+    mpix_per_s: f64,
+    kernel_ms: f64,
+    readback_ms: f64,
+    device_creation_ms: f64,
+    /// Whole first call: composition, pipeline compilation, dispatch, readback.
+    first_dispatch_ms: f64,
+    adapter: String,
+    params: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cpu_f32_ms: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cpu_threads: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cpu_over_gpu: Option<f64>,
 }

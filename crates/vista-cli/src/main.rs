@@ -286,14 +286,15 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             }
             let m = if hdr { metrics::compare_hdr(&ia, &ib)? } else { metrics::compare(&ia, &ib)? };
             if json {
-                let v = serde_json::json!({
-                    "psnr": if m.psnr.is_finite() { serde_json::json!(m.psnr) } else { serde_json::json!("inf") },
-                    "ssim": m.ssim, "max_abs": m.max_abs, "bad_pixels": m.bad_pixels, "nan": m.nan, "mse": m.mse,
-                });
-                println!("{v}");
+                // Serialised from the one metrics type, so no metric is left out.
+                println!("{}", serde_json::to_string(&m).map_err(|e| bad(format!("JSON encode: {e}")))?);
             } else {
                 println!("PSNR       {}", metrics::format_psnr(m.psnr));
                 println!("SSIM       {:.6}", m.ssim);
+                match m.flip_mean {
+                    Some(f) => println!("FLIP       {f:.6} (mean LDR-FLIP)"),
+                    None => println!("FLIP       - (not defined for --hdr)"),
+                }
                 println!("max abs    {:.6e}", m.max_abs);
                 println!("bad pixels {} (> 1/255)", m.bad_pixels);
                 println!("NaN/Inf    {}", m.nan);

@@ -198,9 +198,13 @@ fn compare_reports_json_fields_and_rejects_bad_files() {
     assert_eq!(same.code, 0, "{}", same.stderr);
     assert!(same.stdout.contains("\"psnr\":\"inf\""), "{}", same.stdout);
     let diff = vista(&["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--json"]);
-    for field in ["\"psnr\":", "\"ssim\":", "\"max_abs\":", "\"bad_pixels\":", "\"nan\":"] {
-        assert!(diff.stdout.contains(field), "missing {field}: {}", diff.stdout);
+    // Serialised from the metrics type: every metric, FLIP included.
+    let v: serde_json::Value = serde_json::from_str(diff.stdout.trim()).unwrap();
+    for field in ["psnr", "ssim", "max_abs", "bad_pixels", "nan", "mse", "flip_mean"] {
+        assert!(v.get(field).is_some(), "missing {field}: {}", diff.stdout);
     }
+    assert!(v["flip_mean"].as_f64().is_some_and(|f| f > 0.0 && f < 1.0), "{}", diff.stdout);
+    assert!(vista(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]).stdout.contains("FLIP"));
     // Blurring both removes the pixel-scale part of the difference.
     let psnr = |out: &str| -> f64 {
         let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
@@ -334,6 +338,13 @@ fn sweep_writes_csv_plots_and_names_the_cheapest_setting() {
     assert!(psnr.windows(2).all(|w| w[1] > w[0]), "PSNR must grow with octaves: {psnr:?}");
     let expected = rows[1..].iter().find(|r| r[1] == "inf" || r[1].parse::<f64>().unwrap() >= 40.0).unwrap()[0];
     assert!(r.stdout.contains(&format!("cheapest reaching 40.0 dB: octaves={expected} ")), "{}", r.stdout);
+    // curve.json is the result serialised: every point with all its metrics.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("curve.json")).unwrap()).unwrap();
+    assert_eq!(json["spec"]["kernel"], "fbm");
+    assert_eq!(json["points"].as_array().unwrap().len(), 5);
+    assert_eq!(json["points"][4]["metrics"]["psnr"], "inf");
+    assert!(json["points"][0]["metrics"]["flip_mean"].as_f64().unwrap() > 0.0, "{json}");
     if vista_sweep::find_font(std::env::var_os("VISTA_FONT").map(std::path::PathBuf::from).as_deref()).is_some() {
         let png = vista_image::load(&out.join("curve.png")).unwrap();
         assert_eq!((png.width, png.height), (900, 560));
@@ -908,6 +919,30 @@ fn render_k(manifest: &str, shader: &str) -> Run {
     let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", out.to_str().unwrap()]);
     assert!(!out.exists() || r.code == 0, "a refused render wrote its output");
     r
+}
+
+/// A display kernel whose raw output reaches 1.0025 in one pixel: check
+/// fails it for its range, and bless refuses it with the same words,
+/// exit 1, writing nothing (it used to bless it without a word).
+fn bless_refuses_what_check_would_fail() {
+    let shader = K_SHADER.replace(
+        "textureStore(output, id.xy, vec4(vec3(params.gain), 1.0));",
+        "var v = params.gain;\n    if id.x == 5u && id.y == 3u { v = 1.0025; }\n    textureStore(output, id.xy, vec4(vec3(v), 1.0));",
+    );
+    let d = kernel_project(K_MANIFEST, &shader);
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    std::fs::write(cases_path(d.path()), "[[case]]\nid = \"hot\"\nkernel = \"k\"\nsize = \"8x8\"\n").unwrap();
+    let problem = "raw output 1.0025 at (5, 3) is outside the kernel's range [0, 1]";
+    let b = vista_in(Some(d.path()), &[], &["bless"]);
+    assert_rejected(&b, 1, &[problem, "refusing to bless", "case hot"]);
+    assert!(!d.path().join("golden/k").exists() && !d.path().join("golden/manifest.toml").exists(), "bless wrote");
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains(problem), "{}", c.stdout);
+    // The same kernel inside its range blesses.
+    let fixed = d.path().join("shaders/k.wgsl");
+    std::fs::write(&fixed, std::fs::read_to_string(&fixed).unwrap().replace("1.0025", "0.25")).unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
 }
 
 fn a_kernel_described_as_data_renders() {
@@ -1501,6 +1536,7 @@ fn main() {
             missing_golden_fails_with_the_bless_command_and_is_not_created,
         ),
         (Gpu, "bless_then_check_passes_and_bless_is_refused_in_ci", bless_then_check_passes_and_bless_is_refused_in_ci),
+        (Gpu, "bless_refuses_what_check_would_fail", bless_refuses_what_check_would_fail),
         (
             Gpu,
             "a_changed_render_fails_check_with_metrics_and_images",

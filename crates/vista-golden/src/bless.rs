@@ -60,11 +60,15 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
     let mut rendered: Vec<(&crate::Case, Rendered)> = Vec::new();
     for case in &picked {
         let r = render(ctx, case.kernel, &case.params, case.width, case.height)?;
-        if let Some((x, y)) = r.raw.first_nonfinite() {
-            return Err(GoldenError::BadInput(format!(
-                "case {}: output has {} NaN/Inf pixels (first at ({x}, {y})); refusing to bless it",
+        // The checks of `vista check` that need no golden, with the same
+        // words: a golden is never blessed from output check would fail.
+        let again = render(ctx, case.kernel, &case.params, case.width, case.height)?;
+        let (problems, _) = crate::guards(case, &r.raw, Some(again.raw.bit_identical(&r.raw)));
+        if !problems.is_empty() {
+            return Err(GoldenError::Rejected(format!(
+                "case {}: {}; refusing to bless it (vista check would fail it); nothing was written",
                 case.id,
-                r.raw.nonfinite_count()
+                problems.join("; ")
             )));
         }
         rendered.push((case, r));

@@ -102,7 +102,7 @@ impl Case {
     /// The `vista bless` command that (re)writes this case's golden: the
     /// same form as the one-for-all-failures command, valid in any project.
     pub fn bless_command(&self) -> String {
-        crate::bless_all_command(&[self.id.as_str()]).expect("one case")
+        bless_all_command(&[self.id.as_str()]).expect("one case")
     }
 }
 
@@ -178,6 +178,15 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         });
     }
     Ok(out)
+}
+
+/// The one bless command for every failing case (globset alternation).
+pub fn bless_all_command(failed: &[&str]) -> Option<String> {
+    match failed {
+        [] => None,
+        [one] => Some(format!("vista bless --case '{one}'")),
+        many => Some(format!("vista bless --case '{{{}}}'", many.join(","))),
+    }
 }
 
 pub use vista_project::one_line_toml_error;

@@ -1,13 +1,17 @@
-//! Render one case and judge it against its golden.
+//! The verdict: one pure function from what a check observed of a case
+//! (its render, its golden as read, this run's provenance) and what the
+//! case and manifest say, to an [`Outcome`]. No rendering, no file I/O:
+//! `vista check`, the golden tests, `vista bless` (through [`guards`]) and
+//! `vista mutate` all judge with it.
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::Path;
 
 use vista_image::Image;
 use vista_image::metrics::{self, Metrics};
 
-use crate::store::{Manifest, Store, params_hash};
-use crate::{Case, GoldenError};
-use vista_render::{Renderer, quantize16, render};
+use crate::Case;
+use crate::store::ManifestEntry;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
@@ -136,18 +140,62 @@ impl Outcome {
     }
 }
 
-/// Options for checking.
-#[derive(Debug, Clone)]
-pub struct CheckOptions {
-    /// Where expected/actual/diff images go (`target/vista-report`).
-    pub report_dir: PathBuf,
-    /// Render twice in this process and require bit-identical output.
-    pub twice: bool,
+/// The golden as the caller read it.
+#[derive(Debug, Clone, Copy)]
+pub enum GoldenRead<'a> {
+    /// No file at `path`.
+    Missing { path: &'a Path },
+    /// The file, the short hash of its bytes and its decoded values, or
+    /// why they could not be decoded.
+    Present { path: &'a Path, hash: &'a str, image: Result<&'a Image, &'a str> },
 }
 
-/// Renders `case`, compares it with its golden and manifest entry, writes
-/// report images, and returns the outcome (errors become `Verdict::Error`).
-pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Case, opts: &CheckOptions) -> Outcome {
+/// What a check observed of one case, gathered by the caller.
+#[derive(Debug, Clone, Copy)]
+pub struct Observed<'a> {
+    /// What the shader wrote.
+    pub raw: &'a Image,
+    /// Display values as a 16-bit PNG holds them (`vista_render::quantize16`).
+    pub actual: &'a Image,
+    /// Whether a second render in this process was bit-identical; `None`
+    /// when the case was rendered once.
+    pub repeat_identical: Option<bool>,
+    /// Hash of each WGSL file the kernel reaches now, by path.
+    pub shader_files: &'a BTreeMap<String, String>,
+    pub golden: GoldenRead<'a>,
+}
+
+/// The checks that need no golden, and so also gate `vista bless`: finite
+/// output, within the kernel's documented range, deterministic in one
+/// process. Returns each problem (the text check prints) and the first bad
+/// raw pixel.
+pub fn guards(case: &Case, raw: &Image, repeat_identical: Option<bool>) -> (Vec<String>, Option<(u32, u32, String)>) {
+    let (mut problems, mut first_bad) = (Vec::new(), None);
+    if let Some((x, y)) = raw.first_nonfinite() {
+        first_bad = Some((x, y, format!("NaN/Inf {:?}", raw.get(x, y))));
+        problems.push(format!(
+            "{} pixels contain NaN/Inf; first at ({x}, {y}) = {:?}",
+            raw.nonfinite_count(),
+            raw.get(x, y)
+        ));
+    }
+    let (lo, hi) = case.kernel.output_bounds(&case.params);
+    if let Some((x, y, v)) = first_out_of_bounds(raw, lo, hi) {
+        first_bad.get_or_insert((x, y, format!("{v} outside [{lo}, {hi}]")));
+        problems.push(format!("raw output {v} at ({x}, {y}) is outside the kernel's range [{lo}, {hi}]"));
+    }
+    if repeat_identical == Some(false) {
+        problems.push("two renders in one process are not bit-identical (non-deterministic kernel)".into());
+    }
+    (problems, first_bad)
+}
+
+/// The verdict on one case: `observed` is what the run saw, or why it saw
+/// nothing (a render or read error). Applies the guards, the provenance
+/// checks against the manifest entry, the golden comparison at the case's
+/// thresholds, and last the case's expectations. Pure: the caller fills in
+/// `files` and `gpu_ms`.
+pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed: Result<Observed, String>) -> Outcome {
     let mut out = Outcome {
         id: case.id.clone(),
         kernel: case.kernel.name().to_string(),
@@ -164,24 +212,24 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         bless_command: case.bless_command(),
         width: case.width,
         height: case.height,
-        golden: manifest.case.get(&case.id).cloned(),
-        run: RunInfo {
-            backend: ctx.backend().to_string(),
-            adapter: ctx.adapter_description(),
-            params_hash: params_hash(case),
-            shader_hash: ctx.shader_hash(case.kernel.shader()).unwrap_or_else(|e| format!("unavailable: {e}")),
-        },
+        golden: entry.cloned(),
+        run,
         changed_files: Vec::new(),
         first_bad: None,
     };
-    if let Err(e) = judge(ctx, store, manifest, case, opts, &mut out) {
-        out.verdict = Verdict::Error;
-        out.problems.push(e.to_string());
-    } else if out.verdict == Verdict::Pass && !out.problems.is_empty() {
-        out.verdict = Verdict::Fail;
+    match observed {
+        Err(e) => {
+            out.verdict = Verdict::Error;
+            out.problems.push(e);
+        }
+        Ok(obs) => {
+            compare(case, entry, &obs, &mut out);
+            if out.verdict == Verdict::Pass && !out.problems.is_empty() {
+                out.verdict = Verdict::Fail;
+            }
+        }
     }
-    let adapter = ctx.adapter_description();
-    if let Some(x) = case.expect_fail.iter().find(|x| x.matches(ctx.backend(), &adapter)) {
+    if let Some(x) = case.expect_fail.iter().find(|x| x.matches(&out.run.backend, &out.run.adapter)) {
         if out.passed() {
             out.verdict = Verdict::Fail;
             out.problems.push(format!(
@@ -203,154 +251,104 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     out
 }
 
-fn judge(
-    ctx: &Renderer,
-    store: &Store,
-    manifest: &Manifest,
-    case: &Case,
-    opts: &CheckOptions,
-    out: &mut Outcome,
-) -> Result<(), GoldenError> {
-    let r = render(ctx, case.kernel, &case.params, case.width, case.height)?;
-    out.gpu_ms = r.stats.gpu_wall.as_secs_f64() * 1e3;
-    let case_dir = opts.report_dir.join(&case.id);
-    let write8 = |name: &str, img: &Image| -> Result<String, GoldenError> {
-        vista_image::write_png8(&case_dir.join(name), img)?;
-        Ok(format!("{}/{name}", case.id))
-    };
-    let write = |name: &str, img: &Image| -> Result<String, GoldenError> {
-        std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
-            path: case_dir.display().to_string(),
-            message: format!("cannot create report dir: {e}"),
-        })?;
-        // Marks the folder as vista's, so a later run may clear it and nothing else.
-        let marker = case_dir.join(crate::report::CASE_MARKER);
-        if !marker.exists() {
-            std::fs::write(&marker, b"")
-                .map_err(|e| GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
-        }
-        vista_image::write_png16(&case_dir.join(name), img)?;
-        Ok(format!("{}/{name}", case.id))
-    };
-    let actual = quantize16(r.display());
-    out.files.actual = Some(write("actual.png", &actual)?);
-    out.files.actual8 = Some(write8("actual8.png", &actual)?);
-
-    // Invariants that need no golden: finite, within the documented range.
-    if let Some((x, y)) = r.raw.first_nonfinite() {
-        out.first_bad = Some((x, y, format!("NaN/Inf {:?}", r.raw.get(x, y))));
-        out.problems.push(format!(
-            "{} pixels contain NaN/Inf; first at ({x}, {y}) = {:?}",
-            r.raw.nonfinite_count(),
-            r.raw.get(x, y)
-        ));
-    }
-    let (lo, hi) = case.kernel.output_bounds(&case.params);
-    if let Some((x, y, v)) = first_out_of_bounds(&r.raw, lo, hi) {
-        out.first_bad.get_or_insert((x, y, format!("{v} outside [{lo}, {hi}]")));
-        out.problems.push(format!("raw output {v} at ({x}, {y}) is outside the kernel's range [{lo}, {hi}]"));
-    }
-    if opts.twice {
-        let again = render(ctx, case.kernel, &case.params, case.width, case.height)?;
-        if !again.raw.bit_identical(&r.raw) {
-            out.problems.push("two renders in one process are not bit-identical (non-deterministic kernel)".into());
-        }
-    }
-
-    let entry = manifest.case.get(&case.id);
-    let adapter = ctx.adapter_description();
-    let shader_hash = ctx.shader_hash(case.kernel.shader())?;
+fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut Outcome) {
+    let (problems, first_bad) = guards(case, obs.raw, obs.repeat_identical);
+    out.problems.extend(problems);
+    out.first_bad = first_bad;
+    let run = out.run.clone();
     match entry {
         Some(e) => {
-            out.same_driver = e.adapter == adapter;
+            out.same_driver = e.adapter == run.adapter;
             if !out.same_driver {
                 out.psnr_threshold = case.psnr_other_driver;
-                out.notes.push(format!("golden blessed on '{}', running on '{adapter}'", e.adapter));
+                out.notes.push(format!("golden blessed on '{}', running on '{}'", e.adapter, run.adapter));
             }
-            if e.shader_hash != shader_hash {
+            if e.shader_hash != run.shader_hash {
                 // Named files are reported from `changed_files` (terminal
                 // block, report); only an old manifest needs the note.
                 if e.shader_files.is_empty() {
                     out.notes.push(format!(
-                        "shader changed since the last bless (manifest {}, now {shader_hash}); the manifest \
-                         predates per-file hashes, so the files are not named",
-                        e.shader_hash
+                        "shader changed since the last bless (manifest {}, now {}); the manifest predates per-file \
+                         hashes, so the files are not named",
+                        e.shader_hash, run.shader_hash
                     ));
                 } else {
-                    let now = ctx.shader_file_hashes(case.kernel.shader())?;
-                    out.changed_files = changed_files(&e.shader_files, &now);
+                    out.changed_files = changed_files(&e.shader_files, obs.shader_files);
                 }
             }
-            if e.params_hash != params_hash(case) {
+            if e.params_hash != run.params_hash {
                 out.notes.push("case parameters changed since the last bless".into());
-            } else if out.same_driver && e.shader_hash == shader_hash && e.raw_hash != r.raw.content_hash() {
+            } else if out.same_driver && e.shader_hash == run.shader_hash && e.raw_hash != obs.raw.content_hash() {
                 out.problems.push(format!(
                     "not bit-identical with the bless-time render on the same adapter, shader and params \
                      (raw hash {} vs manifest {})",
-                    r.raw.content_hash(),
+                    obs.raw.content_hash(),
                     e.raw_hash
                 ));
             }
         }
         None => out.notes.push("no manifest entry for this case".into()),
     }
-
-    let golden_path = store.golden_path(case);
-    if !golden_path.exists() {
-        out.verdict = Verdict::Missing;
-        out.problems.push(format!(
-            "golden {} does not exist; render and review it, then create it with: {}",
-            golden_path.display(),
-            case.bless_command()
-        ));
-        return Ok(());
-    }
-    // Read once: hashed against the manifest, then decoded.
-    let bytes = std::fs::read(&golden_path)
-        .map_err(|source| vista_image::ImageError::Io { path: golden_path.clone(), source })?;
+    let (path, hash, expected) = match obs.golden {
+        GoldenRead::Missing { path } => {
+            out.verdict = Verdict::Missing;
+            out.problems.push(format!(
+                "golden {} does not exist; render and review it, then create it with: {}",
+                path.display(),
+                case.bless_command()
+            ));
+            return;
+        }
+        GoldenRead::Present { path, hash, image } => (path, hash, image),
+    };
     if let Some(e) = entry
         && !e.golden_hash.is_empty()
     {
-        let on_disk = crate::short_hash_bytes(&bytes);
-        if e.replacing.as_deref() == Some(on_disk.as_str()) {
+        if e.replacing.as_deref() == Some(hash) {
             out.problems.push(format!(
                 "golden {} is the file an interrupted bless was replacing; finish it with: {}",
-                golden_path.display(),
+                path.display(),
                 case.bless_command()
             ));
-        } else if on_disk != e.golden_hash {
+        } else if hash != e.golden_hash {
             out.problems.push(format!(
-                "golden {} (hash {on_disk}) is not the file its manifest entry describes ({}): it was changed \
+                "golden {} (hash {hash}) is not the file its manifest entry describes ({}): it was changed \
                  outside vista bless; review it and re-bless: {}",
-                golden_path.display(),
+                path.display(),
                 e.golden_hash,
                 case.bless_command()
             ));
         }
     }
-    let expected = vista_image::decode_png16(&golden_path, &bytes)?;
-    out.files.expected = Some(write("expected.png", &expected)?);
-    out.files.expected8 = Some(write8("expected8.png", &expected)?);
+    let expected = match expected {
+        Ok(image) => image,
+        Err(e) => {
+            out.verdict = Verdict::Error;
+            out.problems.push(e.to_string());
+            return;
+        }
+    };
+    let actual = obs.actual;
     if (expected.width, expected.height) != (actual.width, actual.height) {
         out.problems.push(format!(
             "golden {} is {}x{} but the case renders {}x{}; re-bless if the size change is intended",
-            golden_path.display(),
+            path.display(),
             expected.width,
             expected.height,
             actual.width,
             actual.height
         ));
-        return Ok(());
+        return;
     }
-    let mut m = metrics::compare(&expected, &actual)?;
-    m.nan = r.raw.nonfinite_count();
-    let heat = vista_image::diff_heatmap_log(&expected, &actual);
-    out.files.diff = Some(write("diff.png", &heat)?);
-    out.files.diff8 = Some(write8("diff8.png", &heat)?);
-    let view = crate::report::view_js(&case.id, &expected, &actual, out.first_bad.as_ref().map(|b| (b.0, b.1)));
-    let view_path = case_dir.join("view.js");
-    vista_image::atomic_write(&view_path, view.as_bytes())?;
-    out.files.view = Some(format!("{}/view.js", case.id));
+    let mut m = match metrics::compare(expected, actual) {
+        Ok(m) => m,
+        Err(e) => {
+            out.verdict = Verdict::Error;
+            out.problems.push(e.to_string());
+            return;
+        }
+    };
+    m.nan = obs.raw.nonfinite_count();
     if m.psnr < out.psnr_threshold {
         out.problems.push(format!(
             "PSNR {} is below the threshold {:.1} dB",
@@ -369,15 +367,11 @@ fn judge(
         out.problems.push(format!("FLIP mean {f:.5} is above the threshold {t}"));
     }
     out.metrics = Some(m);
-    Ok(())
 }
 
 /// Files whose hash differs between bless time and now, or that only one
 /// side has, by path.
-fn changed_files(
-    then: &std::collections::BTreeMap<String, String>,
-    now: &std::collections::BTreeMap<String, String>,
-) -> Vec<String> {
+fn changed_files(then: &BTreeMap<String, String>, now: &BTreeMap<String, String>) -> Vec<String> {
     let mut changed: Vec<String> = now
         .iter()
         .filter(|(f, h)| then.get(*f) != Some(h))

@@ -11,13 +11,15 @@ pub mod bless;
 pub mod cases;
 pub mod check;
 pub mod report;
+pub mod run;
 pub mod store;
 
 pub use agreement::{Agreement, agreement};
 pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
-pub use cases::{Case, load_cases, parse_cases, select};
-pub use check::{BAD_PIXEL_LIMIT, CheckOptions, Outcome, RunInfo, Verdict, check_case, first_out_of_range};
-pub use report::{RunSummary, bless_all_command, clear_case_folders, html_escape, view_js, write_report};
+pub use cases::{Case, bless_all_command, load_cases, parse_cases, select};
+pub use check::{BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, first_out_of_range, guards, judge};
+pub use report::{RunSummary, clear_case_folders, html_escape, view_js, write_report};
+pub use run::{CheckOptions, check_case};
 pub use store::{Manifest, ManifestEntry, Store};
 
 use vista_gpu::GpuError;
@@ -31,6 +33,9 @@ pub enum GoldenError {
     BadInput(String),
     #[error("{0}")]
     Refused(String),
+    /// A render that a check would fail (exit 1, like the failed check).
+    #[error("{0}")]
+    Rejected(String),
     #[error(transparent)]
     Gpu(#[from] GpuError),
     #[error(transparent)]

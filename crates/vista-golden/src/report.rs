@@ -16,6 +16,7 @@ use base64::Engine;
 use vista_image::Image;
 use vista_image::metrics::format_psnr;
 
+use crate::bless_all_command;
 use crate::check::{BAD_PIXEL_LIMIT, Outcome, Verdict};
 
 const STYLE: &str = include_str!("report.css");
@@ -45,13 +46,53 @@ pub fn clear_case_folders(dir: &Path) -> Result<(), crate::GoldenError> {
     Ok(())
 }
 
-/// The one bless command for every failing case (globset alternation).
-pub fn bless_all_command(failed: &[&str]) -> Option<String> {
-    match failed {
-        [] => None,
-        [one] => Some(format!("vista bless --case '{one}'")),
-        many => Some(format!("vista bless --case '{{{}}}'", many.join(","))),
+/// Writes one case's report images into `<dir>/<id>/` and records their
+/// relative paths in `out.files`: the actual display values (16-bit and an
+/// 8-bit copy), the golden's when there is one, and where both have the
+/// same size the diff heat map (fixed log scale) and the viewer's data.
+pub fn write_case_files(
+    dir: &Path,
+    out: &mut Outcome,
+    actual: &Image,
+    expected: Option<&Image>,
+) -> Result<(), crate::GoldenError> {
+    let id = out.id.clone();
+    let case_dir = dir.join(&id);
+    std::fs::create_dir_all(&case_dir).map_err(|e| crate::GoldenError::Io {
+        path: case_dir.display().to_string(),
+        message: format!("cannot create report dir: {e}"),
+    })?;
+    // Marks the folder as vista's, so a later run may clear it and nothing else.
+    let marker = case_dir.join(CASE_MARKER);
+    if !marker.exists() {
+        std::fs::write(&marker, b"")
+            .map_err(|e| crate::GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
     }
+    let write = |name: &str, img: &Image, bits16: bool| -> Result<Option<String>, crate::GoldenError> {
+        if bits16 {
+            vista_image::write_png16(&case_dir.join(name), img)?;
+        } else {
+            vista_image::write_png8(&case_dir.join(name), img)?;
+        }
+        Ok(Some(format!("{id}/{name}")))
+    };
+    out.files.actual = write("actual.png", actual, true)?;
+    out.files.actual8 = write("actual8.png", actual, false)?;
+    let Some(expected) = expected else {
+        return Ok(());
+    };
+    out.files.expected = write("expected.png", expected, true)?;
+    out.files.expected8 = write("expected8.png", expected, false)?;
+    if (expected.width, expected.height) != (actual.width, actual.height) {
+        return Ok(());
+    }
+    let heat = vista_image::diff_heatmap_log(expected, actual);
+    out.files.diff = write("diff.png", &heat, true)?;
+    out.files.diff8 = write("diff8.png", &heat, false)?;
+    let view = view_js(&id, expected, actual, out.first_bad.as_ref().map(|b| (b.0, b.1)));
+    vista_image::atomic_write(&case_dir.join("view.js"), view.as_bytes())?;
+    out.files.view = Some(format!("{id}/view.js"));
+    Ok(())
 }
 
 /// What a report says about the run that made it.

@@ -28,7 +28,8 @@ pub use plot::{PlotError, find_font, write_plots};
 pub const DEFAULT_TARGET_PSNR: f64 = 40.0;
 
 /// What the images are compared on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Metric {
     /// Display values (tone-mapped for HDR kernels), PSNR peak 1.
     Display,
@@ -53,18 +54,23 @@ impl Metric {
 }
 
 /// One swept parameter and its values, as typed by the user.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct Axis {
     pub name: String,
     pub values: Vec<String>,
+}
+
+fn kernel_name<S: serde::Serializer>(k: &&'static Kernel, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(k.name())
 }
 
 /// A point to render: x value, y value (2-D sweeps), resolved parameters.
 pub type SweepPoint = (String, Option<String>, ParamSet);
 
 /// What to sweep.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct SweepSpec {
+    #[serde(serialize_with = "kernel_name")]
     pub kernel: &'static Kernel,
     pub preset: Option<String>,
     /// Fixed overrides applied to every point and to the reference.
@@ -82,7 +88,7 @@ pub struct SweepSpec {
 }
 
 /// One measured point.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct Point {
     pub x: String,
     pub y: Option<String>,
@@ -93,8 +99,8 @@ pub struct Point {
     pub work: f64,
 }
 
-/// A finished sweep.
-#[derive(Debug, Clone)]
+/// A finished sweep: `curve.json` is this, serialised.
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct Sweep {
     pub spec: SweepSpec,
     pub adapter: String,
@@ -317,7 +323,7 @@ impl Sweep {
         s
     }
 
-    /// Writes `curve.csv`, `summary.txt`, and (when a font is found)
+    /// Writes `curve.csv`, `summary.txt`, `curve.json` (the whole result), and (when a font is found)
     /// `curve.svg` and `curve.png` into `dir`, atomically each. Returns the
     /// written paths and, when the plots could not be drawn, why.
     /// `font` is the configured font file (`VISTA_FONT`), else a system one.
@@ -325,7 +331,8 @@ impl Sweep {
         std::fs::create_dir_all(dir)
             .map_err(|e| RenderError::Io { path: dir.display().to_string(), message: format!("cannot create: {e}") })?;
         let mut written = Vec::new();
-        for (name, text) in [("curve.csv", self.csv()), ("summary.txt", self.table())] {
+        let json = serde_json::to_string_pretty(self).map_err(|e| bad(format!("JSON encode: {e}")))?;
+        for (name, text) in [("curve.csv", self.csv()), ("summary.txt", self.table()), ("curve.json", json)] {
             let path = dir.join(name);
             vista_image::atomic_write(&path, text.as_bytes())?;
             written.push(path);
