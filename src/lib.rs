@@ -13,3 +13,4 @@ pub use vista_kernels as kernels;
 pub use vista_mutate as mutate;
 pub use vista_project as project;
 pub use vista_render as render;
+pub use vista_report as report;

@@ -23,7 +23,7 @@ fn main() {
     };
     let outcomes = Arc::new(Mutex::new(Vec::new()));
     if !args.list {
-        vista_golden::clear_case_folders(&report_dir).unwrap_or_else(|e| panic!("cannot clear the report: {e}"));
+        vista_report::clear_case_folders(&report_dir).unwrap_or_else(|e| panic!("cannot clear the report: {e}"));
     }
 
     // Listing must work without a device (nextest lists before it runs).
@@ -50,8 +50,11 @@ fn main() {
                 let ctx = common::renderer().map_err(|e| Failed::from(format!("no GPU adapter: {e}")))?;
                 // The in-process determinism check (two renders, bit-identical)
                 // runs on the bless-time driver; other backends render once.
-                let opts = CheckOptions { report_dir: report_dir.clone(), twice: ctx.backend() == "lavapipe" };
-                let o = vista_golden::check_case(ctx, &store, &manifest, &case, &opts);
+                let opts = CheckOptions { twice: ctx.backend() == "lavapipe" };
+                let o = vista_report::file_case(
+                    &report_dir,
+                    vista_golden::check_case(ctx, &store, &manifest, &case, &opts),
+                );
                 let result = if o.passed() { Ok(()) } else { Err(Failed::from(o.explain(&report_dir))) };
                 outcomes.lock().expect("outcomes").push(o);
                 result
@@ -65,7 +68,7 @@ fn main() {
     if !outcomes.is_empty() {
         let r = common::renderer();
         let backend = r.as_ref().map(|c| c.backend().to_string()).unwrap_or_default();
-        let run = vista_golden::RunSummary {
+        let run = vista_report::RunSummary {
             command: match backend.as_str() {
                 "lavapipe" => "cargo test --test golden".into(),
                 b => format!("VISTA_BACKEND={b} cargo test --test golden"),
@@ -73,7 +76,7 @@ fn main() {
             adapter: r.map(|c| c.adapter_description()).unwrap_or_default(),
             backend,
         };
-        match vista_golden::write_report(&report_dir, &run, &outcomes) {
+        match vista_report::write_report(&report_dir, &run, &outcomes) {
             Ok(index) => eprintln!("vista report: {}", index.display()),
             Err(e) => eprintln!("could not write the vista report: {e}"),
         }

@@ -24,7 +24,7 @@ fn run_one(gpu: &Renderer, file: &str, line_text: &str, before: &str, after: &st
         .unwrap_or_else(|| panic!("no mutant {before} -> {after} on {file}:{line}"));
     let kernel = vista_kernels::find("fbm").unwrap();
     let planned = [Planned { kernel, mutant }];
-    let mut r = vista_mutate::run(gpu.ctx, &project, &store, &cases, &planned, 1, &|_, _| {}).unwrap();
+    let mut r = vista_mutate::run(gpu.ctx, &project, &store, &cases, &planned, 1, gpu.limits, &|_, _| {}).unwrap();
     r.pop().unwrap()
 }
 
@@ -33,6 +33,8 @@ fn a_known_bad_mutant_is_killed_by_a_golden_case(gpu: &Renderer) {
     let r = run_one(gpu, "fbm.wgsl", "let value = 0.5 + 0.5 * f", "+", "-");
     assert_eq!(r.outcome, "killed", "{r:?}");
     assert_eq!(r.killed_by.as_deref(), Some("fbm-perlin-default"), "{r:?}");
+    // Judged by check's own verdict, whose words it carries.
+    assert!(r.reason.as_deref().is_some_and(|w| w.contains("is below the threshold 60.0 dB")), "{r:?}");
     assert_eq!(r.cases_run, 1, "stops at the first failure: {r:?}");
 }
 

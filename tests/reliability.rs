@@ -47,10 +47,12 @@ fn injected_nan_fails_the_case_naming_count_and_first_pixel(ctx: &vista_render::
     let golden = store.golden_path(&nan_case());
     std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
     vista_image::write_png16(&golden, &Image::from_fn(16, 8, |_, _| [0.5, 0.5, 0.5, 1.0])).unwrap();
-    let opts = CheckOptions { report_dir: dir.path().join("report"), twice: false };
-    let o = vista_golden::check_case(ctx, &store, &Default::default(), &nan_case(), &opts);
+    let report_dir = dir.path().join("report");
+    let checked =
+        vista_golden::check_case(ctx, &store, &Default::default(), &nan_case(), &CheckOptions { twice: false });
+    let o = vista_report::file_case(&report_dir, checked);
     assert!(!o.passed(), "a NaN render passed: {o:?}");
-    let text = o.explain(&opts.report_dir);
+    let text = o.explain(&report_dir);
     assert!(text.contains("2 pixels contain NaN/Inf; first at (5, 3)"), "{text}");
     assert_eq!(o.metrics.map(|m| m.nan), Some(2), "{text}");
 }

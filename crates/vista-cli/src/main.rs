@@ -408,11 +408,11 @@ fn check(
         Some(d) => d,
         None => project.report_dir().expect("a store implies a root"),
     };
-    vista_golden::clear_case_folders(&report_dir)?;
-    let opts = CheckOptions { report_dir, twice: false };
+    vista_report::clear_case_folders(&report_dir)?;
+    let opts = CheckOptions { twice: false };
     let mut outcomes = Vec::new();
     for case in picked {
-        let o = vista_golden::check_case(ctx, &store, &manifest, case, &opts);
+        let o = vista_report::file_case(&report_dir, vista_golden::check_case(ctx, &store, &manifest, case, &opts));
         let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
         let label = match o.verdict {
             vista_golden::Verdict::Pass => "ok",
@@ -421,18 +421,18 @@ fn check(
         };
         println!("{label:<6} {:<40} PSNR {:<12} {:>8.1} ms", o.id, psnr, o.gpu_ms);
         if !o.passed() {
-            print!("{}", o.explain(&opts.report_dir));
+            print!("{}", o.explain(&report_dir));
         } else if o.verdict == vista_golden::Verdict::ExpectedFail {
             o.notes.iter().for_each(|n| println!("  note: {n}"));
         }
         outcomes.push(o);
     }
-    let run = vista_golden::RunSummary {
+    let run = vista_report::RunSummary {
         command: command_line(),
         backend: ctx.backend().to_string(),
         adapter: ctx.adapter_description(),
     };
-    let index = vista_golden::write_report(&opts.report_dir, &run, &outcomes)?;
+    let index = vista_report::write_report(&report_dir, &run, &outcomes)?;
     let failing: Vec<&str> = outcomes.iter().filter(|o| !o.passed()).map(|o| o.id.as_str()).collect();
     let failed = failing.len();
     println!("{} passed, {} failed", outcomes.len() - failed, failed);

@@ -105,8 +105,9 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
         ProgressStyle::with_template("{bar:40} {pos}/{len} mutants, {elapsed} elapsed, ETA {eta}")
             .expect("valid template"),
     );
-    let results =
-        vista_mutate::run(&ctx, project, &store, &cases, &planned, a.jobs, &|done, _| bar.set_position(done as u64))?;
+    let results = vista_mutate::run(&ctx, project, &store, &cases, &planned, a.jobs, config.limits, &|done, _| {
+        bar.set_position(done as u64)
+    })?;
     bar.finish_and_clear();
     let mut results = results;
     let unused = vista_mutate::apply_argued(&mut results, &argued);
@@ -178,10 +179,7 @@ fn finish(project: &Project, report: &Report, json: Option<&PathBuf>) -> Result<
         }
     }
     if let Some(dir) = project.report_dir() {
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;
-        let path = dir.join("mutants.html");
-        vista_image::atomic_write(&path, report.html().as_bytes())?;
+        let path = vista_report::write_page(&dir, "mutants.html", &vista_report::mutation_page(report))?;
         println!("report: {}", path.display());
     }
     if let Some(path) = json {

@@ -103,6 +103,21 @@ fn wrong_type_names_value_and_expected_kind() {
     assert_rejected(&vista(&["render", "fbm", "--set", "gain", "-o", &out_png(d.path())]), 2, &["NAME=VALUE"]);
 }
 
+/// The environment is read once, at start, and a value that does not parse
+/// is refused by name before anything runs (it used to fall back silently).
+fn bad_environment_values_are_named() {
+    for (var, value, allowed) in [
+        ("VISTA_MAX_WORK", "lots", "expected a positive number"),
+        ("VISTA_BACKEND", "metal", "lavapipe|swiftshader|browser|gpu"),
+        ("VISTA_GPU_TIMEOUT_S", "soon", "number of seconds"),
+        ("VISTA_VALIDATION", "yes", "1|0|true|false"),
+    ] {
+        let r = vista_in(None, &[(var, value)], &["list", "--names"]);
+        assert_rejected(&r, 2, &[&format!("{var}={value}"), allowed]);
+    }
+    assert_rejected(&vista(&["--backend", "metal", "list"]), 2, &["--backend metal", "lavapipe|swiftshader"]);
+}
+
 fn bad_sizes_are_rejected_before_gpu_work() {
     let d = tmp();
     // An adapter no machine has fails at device creation: these never get there.
@@ -1461,6 +1476,15 @@ fn mutate_bad_input_is_refused() {
         assert_rejected(&vista_in(Some(d.path()), &[], &args), 2, &[needle]);
     }
     assert_rejected(&vista(&["mutate", "--kernel", "fbm"]), 2, &["vista mutate needs a vista project"]);
+    // A case without a readable golden is an error, not a skipped detector.
+    let (a, b) = (golden(d.path(), "fbm", "a"), golden(d.path(), "fbm", "b"));
+    assert!(!a.exists());
+    let r = vista_in(Some(d.path()), &[], &["mutate", "--kernel", "fbm", "--sample", "1"]);
+    assert_rejected(&r, 2, &["case a: golden", "cannot be read", "vista bless --case 'a'"]);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    std::fs::write(&b, b"\x89PNG\r\n\x1a\nnot really").unwrap();
+    let r = vista_in(Some(d.path()), &[], &["mutate", "--kernel", "fbm", "--sample", "1"]);
+    assert_rejected(&r, 2, &["b.png"]);
 }
 
 /// A run clears the case folders of earlier runs (only folders vista marked),
@@ -1507,6 +1531,7 @@ fn main() {
         (Cpu, "unknown_param_lists_valid_params", unknown_param_lists_valid_params),
         (Cpu, "out_of_range_value_names_value_and_range", out_of_range_value_names_value_and_range),
         (Cpu, "wrong_type_names_value_and_expected_kind", wrong_type_names_value_and_expected_kind),
+        (Cpu, "bad_environment_values_are_named", bad_environment_values_are_named),
         (Cpu, "bad_sizes_are_rejected_before_gpu_work", bad_sizes_are_rejected_before_gpu_work),
         (Cpu, "bad_crops_are_rejected_before_gpu_work", bad_crops_are_rejected_before_gpu_work),
         (Gpu, "a_crop_is_the_rectangle_of_the_frame", a_crop_is_the_rectangle_of_the_frame),
@@ -1592,7 +1617,7 @@ fn main() {
             "mutate_is_deterministic_shards_like_nextest_and_writes_nothing",
             mutate_is_deterministic_shards_like_nextest_and_writes_nothing,
         ),
-        (Cpu, "mutate_bad_input_is_refused", mutate_bad_input_is_refused),
+        (Gpu, "mutate_bad_input_is_refused", mutate_bad_input_is_refused),
         (
             Gpu,
             "check_clears_stale_case_folders_and_closes_with_one_bless_command",

@@ -1,5 +1,6 @@
 //! vista's golden cases: the case file, the golden store and its manifest,
-//! compare-with-thresholds, bless, and the HTML report.
+//! the verdict (`check::judge`, pure), and bless. Reports are written from
+//! its outcomes by `vista-report`.
 //!
 //! Not for: kernel math (`vista-kernels`), device handling (`vista-gpu`) or
 //! rendering (`vista-render`, the one render path, which this crate calls).
@@ -10,7 +11,6 @@ pub mod agreement;
 pub mod bless;
 pub mod cases;
 pub mod check;
-pub mod report;
 pub mod run;
 pub mod store;
 
@@ -18,8 +18,7 @@ pub use agreement::{Agreement, agreement};
 pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, bless_all_command, load_cases, parse_cases, select};
 pub use check::{BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, first_out_of_range, guards, judge};
-pub use report::{RunSummary, clear_case_folders, html_escape, view_js, write_report};
-pub use run::{CheckOptions, check_case};
+pub use run::{CheckOptions, Checked, check_case};
 pub use store::{Manifest, ManifestEntry, Store};
 
 use vista_gpu::GpuError;

@@ -1,29 +1,35 @@
 //! One case through the pipeline: render it (`vista-render`), read its
-//! golden, judge it (`check::judge`, pure), and write its report images
-//! (`report`). The only module that calls all three, so neither the
-//! verdict nor the report imports the other's work.
-
-use std::path::PathBuf;
+//! golden, judge it (`check::judge`, pure). The images come back with the
+//! outcome, for the caller to hand to `vista-report`.
 
 use vista_image::Image;
 use vista_render::{Renderer, quantize16, render};
 
 use crate::Case;
-use crate::check::{GoldenRead, Observed, Outcome, RunInfo, Verdict, judge};
+use crate::check::{GoldenRead, Observed, Outcome, RunInfo, judge};
 use crate::store::{Manifest, Store, params_hash};
 
 /// Options for checking.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct CheckOptions {
-    /// Where expected/actual/diff images go (`target/vista-report`).
-    pub report_dir: PathBuf,
     /// Render twice in this process and require bit-identical output.
     pub twice: bool,
 }
 
-/// Renders `case`, judges it against its golden and manifest entry, writes
-/// its report images, and returns the outcome (errors become `Verdict::Error`).
-pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Case, opts: &CheckOptions) -> Outcome {
+/// One judged case and the images the report shows of it.
+#[must_use]
+#[derive(Debug, Clone)]
+pub struct Checked {
+    pub outcome: Outcome,
+    /// The render's display values as a 16-bit PNG holds them (none when it failed).
+    pub actual: Option<Image>,
+    /// The golden's values, when it could be read.
+    pub expected: Option<Image>,
+}
+
+/// Renders `case` and judges it against its golden and manifest entry
+/// (errors become `Verdict::Error`).
+pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Case, opts: &CheckOptions) -> Checked {
     let shader = case.kernel.shader();
     let run = RunInfo {
         backend: ctx.backend().to_string(),
@@ -35,7 +41,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     let rendered = render(ctx, case.kernel, &case.params, case.width, case.height).map_err(|e| e.to_string());
     let r = match rendered {
         Ok(r) => r,
-        Err(e) => return judge(case, entry, run, Err(e)),
+        Err(e) => return Checked { outcome: judge(case, entry, run, Err(e)), actual: None, expected: None },
     };
     let actual = quantize16(r.display());
     let gathered = (|| -> Result<_, String> {
@@ -82,13 +88,9 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         }
     };
     out.gpu_ms = r.stats.gpu_wall.as_secs_f64() * 1e3;
-    let expected: Option<&Image> = match &gathered {
+    let expected = match gathered {
         Ok((_, _, _, Some((_, Ok(image))))) => Some(image),
         _ => None,
     };
-    if let Err(e) = crate::report::write_case_files(&opts.report_dir, &mut out, &actual, expected) {
-        out.verdict = Verdict::Error;
-        out.problems.push(e.to_string());
-    }
-    out
+    Checked { outcome: out, actual: Some(actual), expected }
 }

@@ -142,7 +142,7 @@ impl AdapterChoice {
             return Ok(AdapterChoice::Named(name));
         }
         if let Some(b) = given(&s.backend_env) {
-            return AdapterChoice::of_backend(&b).map_err(|e| GpuError::Request(format!("VISTA_BACKEND: {e}")));
+            return AdapterChoice::of_backend(&b).map_err(|e| GpuError::Request(format!("VISTA_BACKEND={b}: {e}")));
         }
         match given(&s.adapter_env) {
             None => Ok(AdapterChoice::Lavapipe),

@@ -2,8 +2,10 @@
 //! checks. Every single-token mutant ([`mutants`]) of the kernel file and
 //! the lib modules in its import closure is composed in memory (the
 //! project's files are never written, not even to a temporary copy) and run
-//! against the kernel's golden cases at their thresholds and a GPU-vs-CPU
-//! reference check, stopping at the first failure.
+//! against the kernel's golden cases, judged by `vista_golden::judge` (the
+//! verdict `vista check` gives: every metric, threshold and guard), and the
+//! kernel's GPU-vs-CPU agreement settings at the bounds the agreement tests
+//! use (`vista_golden::agreement`), stopping at the first failure.
 //!
 //! Outcomes: killed (naming what killed it), survived, timeout (the GPU
 //! watchdog fired), stillborn (naga or the pipeline rejects the mutant; not
@@ -18,7 +20,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rand::seq::SliceRandom;
 use rand_pcg::Pcg32;
-use vista_golden::{Agreement, Case, GoldenError, Manifest, Store, agreement};
+use vista_golden::agreement::{self, Setting, SettingError};
+use vista_golden::{Case, GoldenError, GoldenRead, Manifest, Observed, Store};
 use vista_gpu::{Context, GpuError, ShaderSet};
 use vista_image::Image;
 use vista_kernels::Kernel;
@@ -40,6 +43,10 @@ pub struct MutantReport {
     pub outcome: String,
     /// The case id, or `cpu-reference`, that killed it.
     pub killed_by: Option<String>,
+    /// What the killer saw: the first problem of the case's verdict, or the
+    /// agreement setting and its figures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
     /// A survivor whose raw output is bit-identical to the unmutated render
     /// on every case: truly equivalent, or code no case reaches.
     #[serde(rename = "equivalent?")]
@@ -211,56 +218,7 @@ impl Report {
     }
 }
 
-impl Report {
-    /// The report's HTML section: score per kernel, then every survivor
-    /// with its place, change and how many detectors ran.
-    pub fn html(&self) -> String {
-        let pct = |s: Option<f64>| s.map_or("-".into(), |v| format!("{:.1}%", 100.0 * v));
-        let mut rows = String::new();
-        for (k, s) in &self.kernels {
-            rows += &format!(
-                "<tr><td>{k}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td><b>{}</b></td></tr>\n",
-                s.killed,
-                s.survived,
-                s.equivalent,
-                s.timeout,
-                s.stillborn,
-                pct(s.score)
-            );
-        }
-        let mut survivors = String::new();
-        for m in self.mutants.iter().filter(|m| m.outcome == "survived") {
-            survivors += &format!(
-                "<tr><td>{}</td><td><code>{}:{}:{}</code></td><td>{}</td><td><code>{}</code> &rarr; <code>{}</code></td>\
-                 <td>{}</td><td>{}</td></tr>\n",
-                vista_golden::html_escape(&m.kernel),
-                vista_golden::html_escape(&m.mutant.file),
-                m.mutant.line,
-                m.mutant.col,
-                vista_golden::html_escape(&m.mutant.operator),
-                vista_golden::html_escape(&m.mutant.before),
-                vista_golden::html_escape(if m.mutant.after.is_empty() { "(removed)" } else { &m.mutant.after }),
-                m.cases_run,
-                if m.equivalent { "equivalent?" } else { "" }
-            );
-        }
-        format!(
-            "<!doctype html><meta charset=\"utf-8\"><title>vista mutate</title>\
-             <style>body{{font-family:sans-serif}} td,th{{border:1px solid #ccc;padding:3px 6px}} \
-             table{{border-collapse:collapse;margin-bottom:1em}}</style>\
-             <h1>vista mutate</h1><p>seed {}, sample {}, partitions {}: overall score <b>{}</b> \
-             (killed / (killed + survived)).</p>\
-             <table><tr><th>kernel</th><th>killed</th><th>survived</th><th>equivalent?</th><th>timeout</th>\
-             <th>stillborn</th><th>score</th></tr>\n{rows}</table>\
-             <h2>Survivors</h2><table><tr><th>kernel</th><th>place</th><th>operator</th><th>change</th>\
-             <th>detectors run</th><th></th></tr>\n{survivors}</table>\n",
-            self.seed,
-            self.sample.map_or("all".to_string(), |s| s.to_string()),
-            vista_golden::html_escape(&self.partitions.join(", ")),
-            pct(self.score)
-        )
-    }
-}
+impl Report {}
 
 /// What to run.
 #[derive(Debug, Clone)]
@@ -356,15 +314,27 @@ pub fn plan(
     Ok(all.into_iter().enumerate().filter(|(i, _)| i % n == k - 1).map(|(_, p)| p).collect())
 }
 
-/// The size of the GPU-vs-CPU check: small, the f64 references are slow.
-const CPU_CHECK_SIZE: (u32, u32) = (48, 32);
-
-/// What an unmutated kernel looks like to its detectors.
-struct Baseline<'a> {
-    cases: Vec<(&'a Case, Option<Image>, String, f64)>, // case, golden, raw hash, threshold
-    cpu: Option<(vista_kernels::ParamSet, Image, Agreement, String)>,
+/// One golden case as the unmutated kernel renders it: the case, its
+/// golden (hash and image) and the unmutated raw output's hash.
+struct CaseBaseline<'a> {
+    case: &'a Case,
+    golden_hash: String,
+    golden: Image,
+    raw_hash: String,
 }
 
+/// What an unmutated kernel looks like to its detectors: its golden cases
+/// and, for a built-in kernel with a CPU reference, its agreement settings
+/// (the unmutated GPU render's hash of each).
+struct Baseline<'a> {
+    cases: Vec<CaseBaseline<'a>>,
+    settings: Vec<(&'static Setting, String)>,
+}
+
+/// The unmutated kernel through the same detectors a mutant meets. Every
+/// case must have a readable golden and pass, and every agreement setting
+/// hold its bound: otherwise the suite itself fails and no mutant's
+/// verdict would mean anything, so that is an error, not a skip.
 fn baseline<'a>(
     gpu: &Renderer,
     store: &Store,
@@ -372,77 +342,128 @@ fn baseline<'a>(
     kernel: &Kernel,
     cases: &[&'a Case],
 ) -> Result<Baseline<'a>, GoldenError> {
-    let adapter = gpu.adapter_description();
     let mut out = Vec::new();
     for c in cases.iter().filter(|c| c.kernel.name() == kernel.name()) {
+        let path = store.golden_path(c);
+        let bytes = std::fs::read(&path).map_err(|e| {
+            GoldenError::BadInput(format!(
+                "case {}: golden {} cannot be read ({e}); mutation testing judges every case like vista check, \
+                 so bless it first: {}",
+                c.id,
+                path.display(),
+                c.bless_command()
+            ))
+        })?;
+        let golden = vista_image::decode_png16(&path, &bytes)?;
         let r = vista_render::render(gpu, kernel, &c.params, c.width, c.height)?;
-        let golden = vista_image::read_png16(&store.golden_path(c)).ok();
-        let same = manifest.case.get(&c.id).is_some_and(|e| e.adapter == adapter);
-        out.push((*c, golden, r.raw.content_hash(), if same { c.psnr_same_driver } else { c.psnr_other_driver }));
-    }
-    let cpu = match (kernel.has_reference(), out.first()) {
-        (true, Some((c, ..))) => {
-            let (w, h) = CPU_CHECK_SIZE;
-            let raw = vista_render::render(gpu, kernel, &c.params, w, h)?.raw;
-            let reference = kernel.reference(&c.params, w, h);
-            let a = agreement(kernel, &raw, &reference);
-            Some((c.params.clone(), reference, a, raw.content_hash()))
+        let b = CaseBaseline {
+            case: c,
+            golden_hash: vista_golden::short_hash_bytes(&bytes),
+            golden,
+            raw_hash: r.raw.content_hash(),
+        };
+        let o = judge_case(gpu, manifest, &b, &r.raw, &vista_render::quantize16(r.display()));
+        if !o.passed() {
+            return Err(GoldenError::BadInput(format!(
+                "case {} fails before any mutation ({}); fix or bless it before mutating",
+                c.id,
+                o.problems.join("; ")
+            )));
         }
-        _ => None,
+        out.push(b);
+    }
+    let mut settings = Vec::new();
+    if kernel.has_reference() {
+        for s in agreement::settings().iter().filter(|s| s.kernel == kernel.name()) {
+            let j = agreement::judge_setting(gpu, s).map_err(|e| GoldenError::BadInput(e.to_string()))?;
+            if let Some(broken) = j.broken {
+                return Err(GoldenError::BadInput(format!(
+                    "the unmutated kernel breaks its GPU-vs-CPU bound on {}: {broken}",
+                    gpu.backend()
+                )));
+            }
+            settings.push((s, j.gpu_hash));
+        }
+    }
+    Ok(Baseline { cases: out, settings })
+}
+
+/// A case's verdict as `vista check` gives it: the same function, every
+/// metric and threshold, bit-identity where the shader and driver are the
+/// manifest's.
+fn judge_case(
+    gpu: &Renderer,
+    manifest: &Manifest,
+    b: &CaseBaseline,
+    raw: &Image,
+    actual: &Image,
+) -> vista_golden::Outcome {
+    let shader = b.case.kernel.shader();
+    let run = vista_golden::RunInfo {
+        backend: gpu.backend().to_string(),
+        adapter: gpu.adapter_description(),
+        params_hash: vista_golden::store::params_hash(b.case),
+        shader_hash: gpu.shader_hash(shader).unwrap_or_default(),
     };
-    Ok(Baseline { cases: out, cpu })
+    let files = gpu.shader_file_hashes(shader).unwrap_or_default();
+    let path = std::path::PathBuf::from(b.case.golden_rel_path());
+    let observed = Observed {
+        raw,
+        actual,
+        repeat_identical: None,
+        shader_files: &files,
+        golden: GoldenRead::Present { path: &path, hash: &b.golden_hash, image: Ok(&b.golden) },
+    };
+    vista_golden::judge(b.case, manifest.case.get(&b.case.id), run, Ok(observed))
 }
 
 /// Runs one mutant against the detectors; the first failure kills it.
-fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> MutantReport {
-    let report = |outcome: &str, killed_by: Option<String>, equivalent: bool, cases_run: usize| MutantReport {
-        kernel: kernel.name().to_string(),
-        mutant: m.clone(),
-        outcome: outcome.to_string(),
-        killed_by,
-        equivalent,
-        cases_run,
-        argument: None,
+fn judge(gpu: &Renderer, manifest: &Manifest, kernel: &Kernel, base: &Baseline, m: &Mutant) -> MutantReport {
+    let report = |outcome: &str, killed_by: Option<(String, String)>, equivalent: bool, cases_run: usize| {
+        let (killed_by, reason) = killed_by.unzip();
+        MutantReport {
+            kernel: kernel.name().to_string(),
+            mutant: m.clone(),
+            outcome: outcome.to_string(),
+            killed_by,
+            reason,
+            equivalent,
+            cases_run,
+            argument: None,
+        }
     };
     let failed = |e: &vista_render::RenderError| match e {
         vista_render::RenderError::Gpu(GpuError::Timeout { .. }) => "timeout",
         _ => "stillborn",
     };
     let mut identical = true;
-    for (n, (case, golden, raw_hash, threshold)) in base.cases.iter().enumerate() {
-        let r = match vista_render::render(gpu, kernel, &case.params, case.width, case.height) {
+    for (n, b) in base.cases.iter().enumerate() {
+        let c = b.case;
+        let r = match vista_render::render(gpu, kernel, &c.params, c.width, c.height) {
             Ok(r) => r,
             Err(e) => return report(failed(&e), None, false, n + 1),
         };
-        identical &= r.raw.content_hash() == *raw_hash;
-        if r.raw.nonfinite_count() > 0 {
-            return report("killed", Some(format!("{} (NaN/Inf)", case.id)), false, n + 1);
-        }
-        if vista_golden::first_out_of_range(kernel, &case.params, &r.raw).is_some() {
-            return report("killed", Some(format!("{} (output range)", case.id)), false, n + 1);
-        }
-        if let Some(g) = golden {
-            let psnr = vista_image::metrics::psnr(g, &vista_render::quantize16(r.display()));
-            if psnr < *threshold {
-                return report("killed", Some(case.id.clone()), false, n + 1);
-            }
+        identical &= r.raw.content_hash() == b.raw_hash;
+        let o = judge_case(gpu, manifest, b, &r.raw, &vista_render::quantize16(r.display()));
+        if !o.passed() {
+            let why = o.problems.first().cloned().unwrap_or_default();
+            return report("killed", Some((c.id.clone(), why)), false, n + 1);
         }
     }
     let mut run = base.cases.len();
-    if let Some((p, reference, before, raw_hash)) = &base.cpu {
+    for (s, hash) in &base.settings {
         run += 1;
-        let (w, h) = CPU_CHECK_SIZE;
-        match vista_render::render(gpu, kernel, p, w, h) {
-            Ok(r) => {
-                identical &= r.raw.content_hash() == *raw_hash;
-                let a = agreement(kernel, &r.raw, reference);
-                // Killed when the mutant at least doubles the error (6 dB)
-                // against the reference, beyond f32 noise.
-                if a.psnr < before.psnr - 6.0 && a.max_abs > 2.0 * before.max_abs + 1e-6 {
-                    return report("killed", Some("cpu-reference".into()), false, run);
+        match agreement::judge_setting(gpu, s) {
+            Ok(j) => {
+                identical &= j.gpu_hash == *hash;
+                if let Some(broken) = j.broken {
+                    return report("killed", Some(("cpu-reference".into(), broken)), false, run);
                 }
             }
-            Err(e) => return report(failed(&e), None, false, run),
+            Err(SettingError::Render { source, .. }) => return report(failed(&source), None, false, run),
+            Err(SettingError::Unjudgeable(why)) => {
+                return report("killed", Some(("cpu-reference".into(), why)), false, run);
+            }
         }
     }
     report("survived", None, identical, run)
@@ -450,6 +471,7 @@ fn judge(gpu: &Renderer, kernel: &Kernel, base: &Baseline, m: &Mutant) -> Mutant
 
 /// Runs the plan on `ctx` with `jobs` workers; `progress(done, total)` is
 /// called after each mutant. The project's files are only read.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     ctx: &Context,
     project: &Project,
@@ -457,6 +479,7 @@ pub fn run(
     cases: &[&Case],
     planned: &[Planned],
     jobs: usize,
+    limits: vista_render::RenderLimits,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<MutantReport>, GoldenError> {
     let files = project.shader_files()?;
@@ -474,7 +497,7 @@ pub fn run(
         )
     };
     let manifest = store.manifest()?;
-    let original = Renderer { ctx, shaders: set(None), limits: Default::default() };
+    let original = Renderer { ctx, shaders: set(None), limits };
     let mut baselines = BTreeMap::new();
     for p in planned {
         if !baselines.contains_key(p.kernel.name()) {
@@ -490,8 +513,8 @@ pub fn run(
                 loop {
                     let i = next.fetch_add(1, Ordering::SeqCst);
                     let Some(p) = planned.get(i) else { break };
-                    let gpu = Renderer { ctx, shaders: set(Some(&p.mutant)), limits: Default::default() };
-                    let r = judge(&gpu, p.kernel, &baselines[p.kernel.name()], &p.mutant);
+                    let gpu = Renderer { ctx, shaders: set(Some(&p.mutant)), limits };
+                    let r = judge(&gpu, &manifest, p.kernel, &baselines[p.kernel.name()], &p.mutant);
                     results.lock().expect("results")[i] = Some(r);
                     progress(done.fetch_add(1, Ordering::SeqCst) + 1, planned.len());
                 }
@@ -520,6 +543,7 @@ mod tests {
             },
             outcome: "survived".into(),
             killed_by: None,
+            reason: None,
             equivalent: true,
             cases_run: 3,
             argument: None,

@@ -16,16 +16,11 @@ use base64::Engine;
 use vista_image::Image;
 use vista_image::metrics::format_psnr;
 
-use crate::bless_all_command;
-use crate::check::{BAD_PIXEL_LIMIT, Outcome, Verdict};
+use vista_golden::{BAD_PIXEL_LIMIT, GoldenError, Outcome, Verdict, bless_all_command};
 
-const STYLE: &str = include_str!("report.css");
+use crate::{html_escape, page};
+
 const SCRIPT: &str = include_str!("report.js");
-
-/// Text escaped for HTML element content and attribute values.
-pub fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
 
 /// The empty file that marks a case folder as written by vista.
 pub const CASE_MARKER: &str = ".vista-case";
@@ -33,17 +28,28 @@ pub const CASE_MARKER: &str = ".vista-case";
 /// Clears the case folders an earlier run left in `dir`, so a filtered run's
 /// report shows only its own cases. Only folders holding vista's marker are
 /// removed: a `--report-dir` pointed anywhere else loses nothing.
-pub fn clear_case_folders(dir: &Path) -> Result<(), crate::GoldenError> {
+pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
     let Ok(entries) = std::fs::read_dir(dir) else { return Ok(()) };
     for e in entries.flatten() {
         if e.path().is_dir() && e.path().join(CASE_MARKER).is_file() {
-            std::fs::remove_dir_all(e.path()).map_err(|err| crate::GoldenError::Io {
-                path: e.path().display().to_string(),
-                message: err.to_string(),
-            })?;
+            std::fs::remove_dir_all(e.path())
+                .map_err(|err| GoldenError::Io { path: e.path().display().to_string(), message: err.to_string() })?;
         }
     }
     Ok(())
+}
+
+/// A checked case with its images written into `dir`: the outcome with
+/// `files` filled in (a failure to write them makes the case an error).
+pub fn file_case(dir: &Path, checked: vista_golden::Checked) -> Outcome {
+    let vista_golden::Checked { mut outcome, actual, expected } = checked;
+    if let Some(actual) = &actual
+        && let Err(e) = write_case_files(dir, &mut outcome, actual, expected.as_ref())
+    {
+        outcome.verdict = Verdict::Error;
+        outcome.problems.push(e.to_string());
+    }
+    outcome
 }
 
 /// Writes one case's report images into `<dir>/<id>/` and records their
@@ -55,10 +61,10 @@ pub fn write_case_files(
     out: &mut Outcome,
     actual: &Image,
     expected: Option<&Image>,
-) -> Result<(), crate::GoldenError> {
+) -> Result<(), GoldenError> {
     let id = out.id.clone();
     let case_dir = dir.join(&id);
-    std::fs::create_dir_all(&case_dir).map_err(|e| crate::GoldenError::Io {
+    std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
         path: case_dir.display().to_string(),
         message: format!("cannot create report dir: {e}"),
     })?;
@@ -66,9 +72,9 @@ pub fn write_case_files(
     let marker = case_dir.join(CASE_MARKER);
     if !marker.exists() {
         std::fs::write(&marker, b"")
-            .map_err(|e| crate::GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
+            .map_err(|e| GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
     }
-    let write = |name: &str, img: &Image, bits16: bool| -> Result<Option<String>, crate::GoldenError> {
+    let write = |name: &str, img: &Image, bits16: bool| -> Result<Option<String>, GoldenError> {
         if bits16 {
             vista_image::write_png16(&case_dir.join(name), img)?;
         } else {
@@ -100,7 +106,9 @@ pub fn write_case_files(
 pub struct RunSummary {
     /// The command line, as a user would type it again.
     pub command: String,
+    /// lavapipe | swiftshader | browser | gpu.
     pub backend: String,
+    /// The adapter's description (name | driver | backend | type).
     pub adapter: String,
 }
 
@@ -173,7 +181,7 @@ fn provenance(o: &Outcome) -> String {
     fn split(a: &str, i: usize) -> String {
         a.split(" | ").nth(i).unwrap_or("").to_string()
     }
-    let g = |f: fn(&crate::ManifestEntry) -> String| golden.map(f).unwrap_or_else(|| "no manifest entry".into());
+    let g = |f: fn(&vista_golden::ManifestEntry) -> String| golden.map(f).unwrap_or_else(|| "no manifest entry".into());
     let rows: [(&str, String, String); 7] = [
         (
             "backend",
@@ -187,7 +195,7 @@ fn provenance(o: &Outcome) -> String {
             g(|e| format!("{} | {}", split(&e.adapter, 2), split(&e.adapter, 3))),
             format!("{} | {}", split(&o.run.adapter, 2), split(&o.run.adapter, 3)),
         ),
-        ("date", g(|e| e.date.clone()), crate::now_utc()),
+        ("date", g(|e| e.date.clone()), vista_golden::now_utc()),
         ("params hash", g(|e| e.params_hash.clone()), o.run.params_hash.clone()),
         ("shader hash", g(|e| e.shader_hash.clone()), o.run.shader_hash.clone()),
     ];
@@ -298,7 +306,7 @@ fn case_section(o: &Outcome) -> String {
 }
 
 /// Writes the report (atomically) and returns the index path.
-pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result<PathBuf, crate::GoldenError> {
+pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result<PathBuf, GoldenError> {
     let mut sorted: Vec<&Outcome> = outcomes.iter().collect();
     sorted.sort_by_key(|o| (severity(o), o.id.clone()));
     let failing: Vec<&Outcome> = sorted.iter().copied().filter(|o| !o.passed()).collect();
@@ -363,10 +371,8 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
         .collect();
     let stops = serde_json::to_string(&vista_image::HEATMAP_STOPS).expect("stops serialise");
     let sections: String = sorted.iter().map(|o| case_section(o)).collect();
-    let html = format!(
-        "<!doctype html><html lang=\"en\"><meta charset=\"utf-8\"><title>vista report: {nfail} failing of {n}</title>\n\
-         <style>{STYLE}</style>\n\
-         <header><h1>vista report</h1>\
+    let body = format!(
+        "<header><h1>vista report</h1>\
          <p class=\"counts\"><b>{n}</b> cases: <b class=\"{fcls}\">{nfail} failing</b>, {passed} passed, {xfail} expected failures.</p>\
          <p>Backend <b>{backend}</b>, adapter <code>{adapter}</code>. Command: <code class=\"cmd\">{command}</code>. Written {date}.{others}</p>\
          </header>\n<section id=\"summary\"><h2>Failures, worst first</h2>{summary}{expectations}</section>\n\
@@ -375,20 +381,20 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
          <option value=\"max\">linear, 0 .. this case's max</option><option value=\"fixed\">linear, 0 .. the value on the right</option></select></label> \
          <input id=\"heat-max\" type=\"number\" value=\"0.0039216\" step=\"any\" min=\"0\" title=\"difference drawn white (linear, fixed)\"> \
          <span class=\"help\">In a viewer: <kbd>f</kbd> flips expected/actual, the wheel or +/- zooms (all views together), drag pans.</span></section>\n\
-         <section id=\"cases\"><h2>Cases</h2>\n{sections}</section>\n\
-         <script>const HEAT_STOPS = {stops};\nconst LOG_FLOOR = {floor:e};\n{SCRIPT}</script>\n</html>\n",
+         <section id=\"cases\"><h2>Cases</h2>\n{sections}</section>",
         n = sorted.len(),
         nfail = failing.len(),
         fcls = if failing.is_empty() { "ok" } else { "bad" },
         backend = html_escape(&run.backend),
         adapter = html_escape(&run.adapter),
         command = html_escape(&run.command),
-        date = crate::now_utc(),
+        date = vista_golden::now_utc(),
         checked = if failing.is_empty() { "" } else { " checked" },
-        floor = vista_image::LOG_FLOOR,
     );
+    let script = format!("const HEAT_STOPS = {stops};\nconst LOG_FLOOR = {:e};\n{SCRIPT}", vista_image::LOG_FLOOR);
+    let html = page(&format!("vista report: {} failing of {}", failing.len(), sorted.len()), &body, Some(&script));
     std::fs::create_dir_all(dir)
-        .map_err(|e| crate::GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;
+        .map_err(|e| GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;
     let index = dir.join("index.html");
     vista_image::atomic_write(&index, html.as_bytes())?;
     Ok(index)
