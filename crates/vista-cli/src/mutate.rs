@@ -150,7 +150,10 @@ fn finish(project: &Project, report: &Report, json: Option<&PathBuf>) -> Result<
             pct(s.score)
         );
     }
-    println!("overall score {} (killed / (killed + survived); argued equivalents excluded)", pct(report.score));
+    println!(
+        "overall score {} (killed / (killed + survived); equivalent? and argued survivors listed, not scored)",
+        pct(report.score)
+    );
     let argued: Vec<_> = report.mutants.iter().filter(|m| m.outcome == "argued").collect();
     if !argued.is_empty() {
         println!("argued equivalent (excluded from the score):");

@@ -10,7 +10,9 @@
 //! Outcomes: killed (naming what killed it), survived, timeout (the GPU
 //! watchdog fired), stillborn (naga or the pipeline rejects the mutant; not
 //! counted). A survivor bit-identical to the unmutated render on every case
-//! is flagged `equivalent?`. Score = killed / (killed + survived).
+//! is flagged `equivalent?` and left out of the score (SPEC 12): it is
+//! truly equivalent or in code no case reaches, which the list says apart.
+//! Score = killed / (killed + survived - equivalent?).
 
 #![deny(missing_docs)]
 
@@ -132,7 +134,7 @@ pub struct Score {
     /// Survivors argued equivalent in the project's list (not counted).
     #[serde(default)]
     pub argued: usize,
-    /// killed / (killed + survived); None without any.
+    /// killed / (killed + survived - equivalent?); None without any.
     pub score: Option<f64>,
 }
 
@@ -145,7 +147,7 @@ pub struct Report {
     pub sample: Option<usize>,
     /// Partitions this report holds (`1/1` for a whole run).
     pub partitions: Vec<String>,
-    /// killed / (killed + survived) over every kernel.
+    /// killed / (killed + survived - equivalent?) over every kernel.
     pub score: Option<f64>,
     /// Per kernel.
     pub kernels: BTreeMap<String, Score>,
@@ -173,7 +175,8 @@ impl Report {
             }
         }
         let finish = |s: &mut Score| {
-            let n = s.killed + s.survived;
+            // `equivalent?` survivors are listed, not scored (SPEC 12).
+            let n = s.killed + s.survived - s.equivalent;
             s.score = (n > 0).then(|| s.killed as f64 / n as f64);
         };
         kernels.values_mut().for_each(finish);
@@ -557,14 +560,20 @@ mod tests {
              [[mutant]]\nkernel = \"fbm\"\nfile = \"fbm.wgsl\"\nline = 99\ncol = 1\nafter = \"&&\"\nwhy = \"moved\"\n",
         )
         .unwrap();
-        let mut m = vec![survivor(25), survivor(26)];
+        let mut m = vec![survivor(25), survivor(26), survivor(27)];
+        m[1].equivalent = false;
         let stale = apply_argued(&mut m, &list);
         assert_eq!(stale.len(), 1);
         assert_eq!(stale[0].line, 99);
         assert_eq!((m[0].outcome.as_str(), m[0].argument.as_deref()), ("argued", Some("guard")));
         let r = Report::new(1, None, vec!["1/1".into()], m);
         let s = &r.kernels["fbm"];
-        assert_eq!((s.survived, s.argued, s.score), (1, 1, Some(0.0)));
+        // One survivor counts, the `equivalent?` one is listed but not scored.
+        assert_eq!((s.survived, s.equivalent, s.argued, s.score), (2, 1, 1, Some(0.0)));
+        let mut killed = survivor(28);
+        (killed.outcome, killed.equivalent) = ("killed".into(), false);
+        let r = Report::new(1, None, vec!["1/1".into()], vec![killed, survivor(29)]);
+        assert_eq!(r.score, Some(1.0));
         assert!(
             parse_argued("[[mutant]]\nkernel = \"fbm\"\nfile = \"f\"\nline = 1\ncol = 1\nafter = \"x\"\nwhy = \" \"\n")
                 .is_err()
