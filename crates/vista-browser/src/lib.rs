@@ -5,7 +5,8 @@
 //!
 //! The I/O contract is the one vista's wgpu path has: binding 0 a uniform
 //! buffer, binding 1 an `rgba32float` write-only storage texture, binding 2
-//! a read-only `array<u32>`; entry point `main`, 8 x 8 workgroups.
+//! a read-only `array<u32>`; the entry point and the workgroup count the
+//! job names; the output filled with the job's sentinel before the kernel.
 //!
 //! One [`Browser`] holds one Chromium process, reused across runs. Every
 //! protocol call has a watchdog; a run that overruns it, a page error or a
@@ -77,6 +78,12 @@ pub struct Job<'a> {
     /// Pipeline cache key: equal keys must mean equal WGSL.
     pub key: &'a str,
     pub wgsl: &'a str,
+    /// The compute entry point.
+    pub entry: &'a str,
+    /// Workgroups dispatched along x, y and z.
+    pub workgroups: [u32; 3],
+    /// The bits every channel of the output holds before the kernel runs.
+    pub sentinel: u32,
     pub uniforms: &'a [u8],
     pub table: &'a [u32],
     pub width: u32,
@@ -171,6 +178,9 @@ impl Browser {
         let args = serde_json::json!({
             "key": job.key,
             "wgsl": job.wgsl,
+            "entry": job.entry,
+            "workgroups": job.workgroups,
+            "sentinel": job.sentinel,
             "uniforms": B64.encode(job.uniforms),
             "table": B64.encode(&table),
             "width": job.width,

@@ -67,7 +67,8 @@ async function vistaInit() {
   }
 }
 
-async function pipeline(key, wgsl) {
+async function pipeline(key, wgsl, entry) {
+  key = `${key}@${entry}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
   const d = vista.device;
@@ -82,7 +83,7 @@ async function pipeline(key, wgsl) {
   }
   let p;
   try {
-    p = await d.createComputePipelineAsync({ layout: vista.pipelineLayout, compute: { module, entryPoint: "main" } });
+    p = await d.createComputePipelineAsync({ layout: vista.pipelineLayout, compute: { module, entryPoint: entry } });
   } finally {
     const e = await d.popErrorScope();
     if (e) throw new Error(`pipeline: ${e.message}`);
@@ -91,12 +92,12 @@ async function pipeline(key, wgsl) {
   return p;
 }
 
-// job: { key, wgsl, uniforms (base64), table (base64), width, height }
+// job: { key, wgsl, entry, workgroups [x, y, z], sentinel (u32 bits), uniforms (base64), table (base64), width, height }
 async function vistaRun(job) {
   try {
     const d = vista.device;
     if (!d) throw new Error(`the WebGPU device is gone (${vista.lost || "never created"})`);
-    const p = await pipeline(job.key, job.wgsl);
+    const p = await pipeline(job.key, job.wgsl, job.entry);
     const start = performance.now();
     d.pushErrorScope("out-of-memory");
     d.pushErrorScope("validation");
@@ -109,7 +110,9 @@ async function vistaRun(job) {
     new Uint8Array(table.getMappedRange()).set(words);
     table.unmap();
     const size = { width: job.width, height: job.height };
-    const texture = d.createTexture({ size, format: "rgba32float", usage: GPUTextureUsage.STORAGE_BINDING | GPUTextureUsage.COPY_SRC });
+    const texture = d.createTexture({ size, format: "rgba32float", usage: GPUTextureUsage.STORAGE_BINDING | GPUTextureUsage.COPY_SRC | GPUTextureUsage.COPY_DST });
+    // Every texel starts as the sentinel, so Rust can count those never written.
+    d.queue.writeTexture({ texture }, new Uint32Array(job.width * job.height * 4).fill(job.sentinel), { bytesPerRow: job.width * 16, rowsPerImage: job.height }, size);
     const rowBytes = job.width * 16;
     const paddedRow = Math.ceil(rowBytes / 256) * 256;
     const readback = d.createBuffer({ size: paddedRow * job.height, usage: GPUBufferUsage.COPY_DST | GPUBufferUsage.MAP_READ });
@@ -126,7 +129,7 @@ async function vistaRun(job) {
     const pass = compute.beginComputePass();
     pass.setPipeline(p);
     pass.setBindGroup(0, group);
-    pass.dispatchWorkgroups(Math.ceil(job.width / 8), Math.ceil(job.height / 8));
+    pass.dispatchWorkgroups(job.workgroups[0], job.workgroups[1], job.workgroups[2]);
     pass.end();
     const copy = d.createCommandEncoder();
     copy.copyTextureToBuffer({ texture }, { buffer: readback, bytesPerRow: paddedRow, rowsPerImage: job.height }, size);
@@ -134,6 +137,7 @@ async function vistaRun(job) {
     const oom = await d.popErrorScope();
     if (validation) throw new Error(`WebGPU validation: ${validation.message}`);
     if (oom) throw new Error(`WebGPU out of memory: ${oom.message}`);
+    await d.queue.onSubmittedWorkDone();
     const gpuStart = performance.now();
     d.queue.submit([compute.finish()]);
     await d.queue.onSubmittedWorkDone();

@@ -77,7 +77,18 @@ fn a_kernel_runs_and_reads_back_every_texel() {
     let (w, h) = (37u32, 11u32);
     let table = [10u32, 20, 30, 40];
     let u = uniforms(w, h, 0.5);
-    let job = Job { label: "gradient", key: "g1", wgsl: GRADIENT, uniforms: &u, table: &table, width: w, height: h };
+    let job = Job {
+        label: "gradient",
+        key: "g1",
+        wgsl: GRADIENT,
+        entry: "main",
+        workgroups: [w.div_ceil(8), h.div_ceil(8), 1],
+        sentinel: 0x7FC0_DEAD,
+        uniforms: &u,
+        table: &table,
+        width: w,
+        height: h,
+    };
     let out = b.run(&job).unwrap();
     assert_eq!(out.rgba.len(), (w * h) as usize);
     for y in 0..h {
@@ -97,7 +108,18 @@ fn tint_errors_name_the_case_and_the_next_run_works() {
     let bad = GRADIENT.replace("f32(id.y)", "id.y");
     let u = uniforms(8, 8, 1.0);
     let table = [0u32; 4];
-    let job = Job { label: "case-bad", key: "bad", wgsl: &bad, uniforms: &u, table: &table, width: 8, height: 8 };
+    let job = Job {
+        label: "case-bad",
+        key: "bad",
+        wgsl: &bad,
+        entry: "main",
+        workgroups: [1, 1, 1],
+        sentinel: 0x7FC0_DEAD,
+        uniforms: &u,
+        table: &table,
+        width: 8,
+        height: 8,
+    };
     let e = failure(b.run(&job), "Tint accepted a type error").to_string();
     assert!(e.starts_with("case-bad: in the browser: Tint rejected the WGSL: line"), "{e}");
     let good = Job { label: "case-good", key: "good", wgsl: GRADIENT, ..job };
@@ -113,8 +135,18 @@ fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
     );
     let u = uniforms(64, 64, 1.0);
     let table = [0u32; 4];
-    let job =
-        Job { label: "case-hang", key: "hang", wgsl: &forever, uniforms: &u, table: &table, width: 64, height: 64 };
+    let job = Job {
+        label: "case-hang",
+        key: "hang",
+        wgsl: &forever,
+        entry: "main",
+        workgroups: [8, 8, 1],
+        sentinel: 0x7FC0_DEAD,
+        uniforms: &u,
+        table: &table,
+        width: 64,
+        height: 64,
+    };
     let start = std::time::Instant::now();
     let e = failure(b.run(&job), "the hung kernel returned");
     let took = start.elapsed();

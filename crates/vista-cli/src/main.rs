@@ -269,6 +269,10 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
                 eprintln!("error: output has {} NaN/Inf pixels, first at ({x}, {y})", r.raw.nonfinite_count());
                 return Ok(1);
             }
+            if r.unwritten > 0 && !k.partial() {
+                eprintln!("error: kernel {kernel}: {}", vista_golden::unwritten_problem(r.unwritten, &r.raw));
+                return Ok(1);
+            }
             Ok(0)
         }
         Command::Compare { a, b, json, hdr, blur, crop } => {

@@ -960,6 +960,123 @@ fn bless_refuses_what_check_would_fail() {
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
 }
 
+/// A gradient kernel written the way real kernels are: its own entry name
+/// and workgroup size, a bounds check on the size.
+fn gradient_shader(entry: &str, workgroup: &str, bound: &str) -> String {
+    format!(
+        r#"struct Params {{
+    width: u32,
+    height: u32,
+    gain: f32,
+}}
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
+@compute @workgroup_size({workgroup})
+fn {entry}(@builtin(global_invocation_id) id: vec3<u32>) {{
+    if id.x >= params.width || id.y >= {bound} {{
+        return;
+    }}
+    let u = (f32(id.x) + 0.5) / f32(params.width);
+    let v = (f32(id.y) + 0.5) / f32(params.height);
+    textureStore(output, id.xy, vec4(u, v, params.gain * u * v, 1.0));
+}}
+"#
+    )
+}
+
+fn render_exr(d: &Path, size: &str, name: &str) -> (Run, PathBuf) {
+    let out = d.join(format!("{name}.exr"));
+    (vista_in(Some(d), &[], &["render", "k", "--size", size, "-o", out.to_str().unwrap()]), out)
+}
+
+/// Reflection decides the dispatch: the same kernel at other workgroup sizes
+/// writes the same image, every texel (37 x 23: no size divides it).
+fn workgroup_size_comes_from_reflection_not_8x8() {
+    let reference = {
+        let d = kernel_project(K_MANIFEST, &gradient_shader("main", "8, 8", "params.height"));
+        let (r, out) = render_exr(d.path(), "37x23", "ref");
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        vista_image::load(&out).unwrap()
+    };
+    assert!(reference.data.iter().all(|p| p[3] == 1.0), "the 8 x 8 render left texels unwritten");
+    for wg in ["1", "16, 16", "256, 1", "8, 8, 4", "3, 5"] {
+        let d = kernel_project(K_MANIFEST, &gradient_shader("main", wg, "params.height"));
+        let (r, out) = render_exr(d.path(), "37x23", "wg");
+        assert_eq!(r.code, 0, "@workgroup_size({wg}): {}", r.stderr);
+        assert!(vista_image::load(&out).unwrap().bit_identical(&reference), "@workgroup_size({wg}) differs");
+    }
+    // The other two implementations dispatch from the same plan, and count
+    // unwritten texels the same way (WGSL allows inexact division: 1e-6).
+    for backend in ["swiftshader", "browser"] {
+        for wg in ["1", "256, 1", "8, 8, 4"] {
+            let d = kernel_project(K_MANIFEST, &gradient_shader("main", wg, "params.height"));
+            let out = d.path().join("b.exr");
+            let args = ["render", "k", "--size", "37x23", "--backend", backend, "-o", out.to_str().unwrap()];
+            let r = vista_in(Some(d.path()), &[], &args);
+            assert_eq!(r.code, 0, "{backend} @workgroup_size({wg}): {}", r.stderr);
+            let m = vista_image::metrics::compare_hdr(&reference, &vista_image::load(&out).unwrap()).unwrap();
+            assert!(m.max_abs <= 1e-6, "{backend} @workgroup_size({wg}): max abs {}", m.max_abs);
+        }
+        let d = kernel_project(K_MANIFEST, &gradient_shader("main", "8, 8", "params.height - 1u"));
+        let out = d.path().join("cut.exr");
+        let args = ["render", "k", "--size", "37x23", "--backend", backend, "-o", out.to_str().unwrap()];
+        assert_rejected(&vista_in(Some(d.path()), &[], &args), 1, &["37 of 851 texels never written"]);
+    }
+}
+
+/// The manifest names the entry point; an unknown one lists the shader's.
+fn the_manifest_names_the_entry_point() {
+    let manifest = format!("{K_MANIFEST}[[pass]]\nentry = \"height\"\n");
+    let d = kernel_project(&manifest, &gradient_shader("height", "16, 4", "params.height"));
+    let (r, _) = render_exr(d.path(), "20x20", "h");
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let d = kernel_project(K_MANIFEST, &gradient_shader("height", "16, 4", "params.height"));
+    let (r, out) = render_exr(d.path(), "20x20", "h");
+    assert_rejected(&r, 2, &["k.wgsl has no compute entry point 'main'", "its compute entry points: height"]);
+    assert!(!out.exists());
+}
+
+/// A kernel that leaves texels unwritten fails render, bless and check with
+/// "N of M texels never written", unless its output says partial = true.
+fn unwritten_texels_fail_unless_the_output_is_partial() {
+    // A bounds check off by one row: the last of 23 rows is never written.
+    let shader = gradient_shader("main", "8, 8", "params.height - 1u");
+    let d = kernel_project(K_MANIFEST, &shader);
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    std::fs::write(cases_path(d.path()), "[[case]]\nid = \"g\"\nkernel = \"k\"\nsize = \"37x23\"\n").unwrap();
+    let never = "37 of 851 texels never written";
+    let (r, _) = render_exr(d.path(), "37x23", "cut");
+    assert_rejected(&r, 1, &[never, "partial = true"]);
+    assert_rejected(&vista_in(Some(d.path()), &[], &["bless"]), 1, &[never, "refusing to bless"]);
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert!(c.code == 1 && c.stdout.contains(never), "{}", c.stdout);
+    // partial = true: the same kernel renders, blesses and checks; the row reads 0.
+    let partial = format!("{K_MANIFEST}[[output]]\npartial = true\n");
+    std::fs::write(d.path().join("kernels/k.toml"), &partial).unwrap();
+    let (r, out) = render_exr(d.path(), "37x23", "partial");
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let img = vista_image::load(&out).unwrap();
+    assert_eq!((img.get(5, 22), img.get(5, 21)[3]), ([0.0; 4], 1.0));
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 0, "{}", c.stdout);
+    // A fixed dispatch too small for the output: [[pass]] workgroups.
+    let fixed = format!("{K_MANIFEST}[[pass]]\nworkgroups = [1, 1, 1]\n");
+    let d = kernel_project(&fixed, &gradient_shader("main", "8, 8", "params.height"));
+    let (r, _) = render_exr(d.path(), "64x64", "fixed");
+    assert_rejected(&r, 1, &["4032 of 4096 texels never written"]);
+    let covered = format!("{K_MANIFEST}[[pass]]\nworkgroups = [\"ceil_div(width, 8)\", \"ceil_div(height, 8)\", 1]\n");
+    let d = kernel_project(&covered, &gradient_shader("main", "8, 8", "params.height"));
+    assert_eq!(render_exr(d.path(), "64x60", "covered").0.code, 0);
+    let bad = format!("{K_MANIFEST}[[pass]]\nworkgroups = [\"ceil_div(width, gain)\", 1, 1]\n");
+    let d = kernel_project(&bad, &gradient_shader("main", "8, 8", "params.height"));
+    assert_rejected(
+        &render_exr(d.path(), "8x8", "bad").0,
+        2,
+        &["workgroups entry", "param gain takes [0, 1]", "not an integer"],
+    );
+}
+
 fn a_kernel_described_as_data_renders() {
     let r = render_k(K_MANIFEST, K_SHADER);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -1562,6 +1679,9 @@ fn main() {
         ),
         (Gpu, "bless_then_check_passes_and_bless_is_refused_in_ci", bless_then_check_passes_and_bless_is_refused_in_ci),
         (Gpu, "bless_refuses_what_check_would_fail", bless_refuses_what_check_would_fail),
+        (Gpu, "workgroup_size_comes_from_reflection_not_8x8", workgroup_size_comes_from_reflection_not_8x8),
+        (Gpu, "the_manifest_names_the_entry_point", the_manifest_names_the_entry_point),
+        (Gpu, "unwritten_texels_fail_unless_the_output_is_partial", unwritten_texels_fail_unless_the_output_is_partial),
         (
             Gpu,
             "a_changed_render_fails_check_with_metrics_and_images",

@@ -155,6 +155,8 @@ pub enum GoldenRead<'a> {
 pub struct Observed<'a> {
     /// What the shader wrote.
     pub raw: &'a Image,
+    /// Texels of the output the kernel never wrote.
+    pub unwritten: u64,
     /// Display values as a 16-bit PNG holds them (`vista_render::quantize16`).
     pub actual: &'a Image,
     /// Whether a second render in this process was bit-identical; `None`
@@ -165,12 +167,20 @@ pub struct Observed<'a> {
     pub golden: GoldenRead<'a>,
 }
 
-/// The checks that need no golden, and so also gate `vista bless`: finite
-/// output, within the kernel's documented range, deterministic in one
-/// process. Returns each problem (the text check prints) and the first bad
-/// raw pixel.
-pub fn guards(case: &Case, raw: &Image, repeat_identical: Option<bool>) -> (Vec<String>, Option<(u32, u32, String)>) {
+/// The checks that need no golden, and so also gate `vista bless`: every
+/// texel written (unless the kernel's output is `partial`), finite output,
+/// within the kernel's documented range, deterministic in one process.
+/// Returns each problem (the text check prints) and the first bad raw pixel.
+pub fn guards(
+    case: &Case,
+    raw: &Image,
+    unwritten: u64,
+    repeat_identical: Option<bool>,
+) -> (Vec<String>, Option<(u32, u32, String)>) {
     let (mut problems, mut first_bad) = (Vec::new(), None);
+    if unwritten > 0 && !case.kernel.partial() {
+        problems.push(unwritten_problem(unwritten, raw));
+    }
     if let Some((x, y)) = raw.first_nonfinite() {
         first_bad = Some((x, y, format!("NaN/Inf {:?}", raw.get(x, y))));
         problems.push(format!(
@@ -188,6 +198,16 @@ pub fn guards(case: &Case, raw: &Image, repeat_identical: Option<bool>) -> (Vec<
         problems.push("two renders in one process are not bit-identical (non-deterministic kernel)".into());
     }
     (problems, first_bad)
+}
+
+/// "N of M texels never written": a workgroup size, dispatch or bounds check
+/// that does not cover the output. Shared by check, bless and render.
+pub fn unwritten_problem(unwritten: u64, raw: &Image) -> String {
+    format!(
+        "{unwritten} of {} texels never written (the dispatch or a bounds check does not cover the output); \
+         if that is intended, add [[output]] partial = true to the kernel's manifest",
+        raw.width as u64 * raw.height as u64
+    )
 }
 
 /// The verdict on one case: `observed` is what the run saw, or why it saw
@@ -252,7 +272,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
 }
 
 fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut Outcome) {
-    let (problems, first_bad) = guards(case, obs.raw, obs.repeat_identical);
+    let (problems, first_bad) = guards(case, obs.raw, obs.unwritten, obs.repeat_identical);
     out.problems.extend(problems);
     out.first_bad = first_bad;
     let run = out.run.clone();

@@ -17,7 +17,10 @@ pub mod store;
 pub use agreement::{Agreement, agreement};
 pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, bless_all_command, load_cases, parse_cases, select};
-pub use check::{BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, first_out_of_range, guards, judge};
+pub use check::{
+    BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, first_out_of_range, guards, judge,
+    unwritten_problem,
+};
 pub use run::{CheckOptions, Checked, check_case};
 pub use store::{Manifest, ManifestEntry, Store};
 

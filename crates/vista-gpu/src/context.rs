@@ -198,8 +198,13 @@ pub const SWIFTSHADER_HINT: &str = "install Google's SwiftShader Vulkan ICD with
 pub struct Dispatch<'a> {
     /// The project's WGSL sources.
     pub shaders: &'a ShaderSet,
-    /// Kernel WGSL file relative to `shaders/`; entry point `main`.
+    /// Kernel WGSL file relative to `shaders/`.
     pub shader: &'a str,
+    /// The compute entry point.
+    pub entry: &'a str,
+    /// Workgroups dispatched along x, y and z (the plan derives them from
+    /// the entry point's reflected workgroup size; nothing here assumes 8 x 8).
+    pub workgroups: [u32; 3],
     /// Uniform block for binding 0 (padded to 16 bytes by the caller).
     pub uniforms: &'a [u8],
     /// Read-only u32 table for binding 2.
@@ -221,7 +226,22 @@ pub struct RunStats {
     pub total: Duration,
 }
 
-const WORKGROUP: u32 = 8;
+/// What the output texture holds before the kernel runs: a NaN with a
+/// payload no arithmetic produces (operations give the canonical NaN), in
+/// all four channels. A texel still holding it after the run was never
+/// written; it is read back as 0, as from a fresh texture.
+pub const UNWRITTEN: u32 = 0x7FC0_DEAD;
+
+/// A run's output: the image, its timing, and how many texels the kernel
+/// never wrote.
+#[derive(Debug, Clone)]
+pub struct Readback {
+    /// What the kernel wrote (unwritten texels read 0).
+    pub image: Image,
+    pub stats: RunStats,
+    /// Texels still holding [`UNWRITTEN`] after the run.
+    pub unwritten: u64,
+}
 
 /// Headless state shared by everything in one process: a wgpu device, or
 /// the browser.
@@ -248,23 +268,24 @@ struct WgpuEngine {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
-    /// The last run's output texture and readback buffer, which the next run
-    /// of the same size takes instead of allocating its own: fresh ones cost
-    /// a page fault per 4 KiB as they are first written (filling a fresh
-    /// 16 MiB image, 1024 x 1024, took 10-12 ms here). A concurrent run
-    /// finds it empty and allocates. The texture is reused only where the device can
-    /// clear it (CLEAR_TEXTURE): every run starts from zeros, as a new one
-    /// does, so a pixel a kernel leaves unwritten never shows an earlier
-    /// run's value.
+    /// The last run's output texture, readback and sentinel buffers, which
+    /// the next run of the same size takes instead of allocating its own:
+    /// fresh ones cost a page fault per 4 KiB as they are first written
+    /// (filling a fresh 16 MiB image, 1024 x 1024, took 10-12 ms here). A
+    /// concurrent run finds it empty and allocates. Every run first copies
+    /// the sentinel over the texture, so a texel a kernel leaves unwritten
+    /// is counted, and never shows an earlier run's value.
     scratch: Mutex<Option<Scratch>>,
-    can_clear: bool,
 }
 
 struct Scratch {
     width: u32,
     height: u32,
-    texture: Option<wgpu::Texture>,
+    texture: wgpu::Texture,
     readback: wgpu::Buffer,
+    /// The output's size of [`UNWRITTEN`] texels, copied over the texture
+    /// before every run.
+    sentinel: wgpu::Buffer,
 }
 
 struct BrowserEngine {
@@ -346,10 +367,9 @@ impl Context {
             hint: choice.hint(),
         })?;
         let info = adapter.get_info();
-        let can_clear = adapter.features().contains(wgpu::Features::CLEAR_TEXTURE);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("vista"),
-            required_features: if can_clear { wgpu::Features::CLEAR_TEXTURE } else { wgpu::Features::empty() },
+            required_features: wgpu::Features::empty(),
             required_limits: adapter.limits(),
             ..Default::default()
         }))
@@ -396,7 +416,6 @@ impl Context {
                 pipeline_layout,
                 pipelines: Mutex::new(HashMap::new()),
                 scratch: Mutex::new(None),
-                can_clear,
             })),
             info,
             backend: choice.backend_name(),
@@ -495,8 +514,9 @@ impl Context {
         w: &WgpuEngine,
         shaders: &ShaderSet,
         shader: &str,
+        entry: &str,
     ) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
-        let key = format!("{shader}#{}", shaders.source_hash(shader)?);
+        let key = format!("{shader}#{}@{entry}", shaders.source_hash(shader)?);
         if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
         }
@@ -510,7 +530,7 @@ impl Context {
             label: Some(shader),
             layout: Some(&w.pipeline_layout),
             module: &sm,
-            entry_point: Some("main"),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
             cache: None,
         });
@@ -522,8 +542,9 @@ impl Context {
         Ok(pipeline)
     }
 
-    /// Runs one dispatch and reads the output texture back.
-    pub fn run(&self, job: &Dispatch<'_>) -> Result<(Image, RunStats), GpuError> {
+    /// Runs one dispatch and reads the output texture back, counting the
+    /// texels the kernel never wrote.
+    pub fn run(&self, job: &Dispatch<'_>) -> Result<Readback, GpuError> {
         let max = self.max_dimension();
         if job.width == 0 || job.height == 0 || job.width > max || job.height > max {
             return Err(GpuError::Request(format!(
@@ -535,7 +556,7 @@ impl Context {
             Engine::Wgpu(w) => w,
             Engine::Browser(b) => return self.run_in_browser(b, job),
         };
-        let pipeline = self.pipeline(w, job.shaders, job.shader)?;
+        let pipeline = self.pipeline(w, job.shaders, job.shader, job.entry)?;
         let start = Instant::now();
         let d = &w.device;
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -555,31 +576,36 @@ impl Context {
         let row_bytes = job.width * 16;
         let padded_row = row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let kept = w.scratch.lock().expect("scratch").take().filter(|s| (s.width, s.height) == (job.width, job.height));
-        let (kept_texture, kept_readback) = match kept {
-            Some(s) => (s.texture, Some(s.readback)),
-            None => (None, None),
+        let Scratch { texture, readback, sentinel, .. } = match kept {
+            Some(s) => s,
+            None => Scratch {
+                width: job.width,
+                height: job.height,
+                texture: d.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("output"),
+                    size: extent,
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba32Float,
+                    usage: wgpu::TextureUsages::STORAGE_BINDING
+                        | wgpu::TextureUsages::COPY_SRC
+                        | wgpu::TextureUsages::COPY_DST,
+                    view_formats: &[],
+                }),
+                readback: d.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("readback"),
+                    size: padded_row as u64 * job.height as u64,
+                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                    mapped_at_creation: false,
+                }),
+                sentinel: d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("unwritten sentinel"),
+                    contents: &UNWRITTEN.to_le_bytes().repeat((padded_row / 4 * job.height) as usize),
+                    usage: wgpu::BufferUsages::COPY_SRC,
+                }),
+            },
         };
-        let reused_texture = kept_texture.is_some();
-        let texture = kept_texture.unwrap_or_else(|| {
-            d.create_texture(&wgpu::TextureDescriptor {
-                label: Some("output"),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        });
-        let readback = kept_readback.unwrap_or_else(|| {
-            d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("readback"),
-                size: padded_row as u64 * job.height as u64,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            })
-        });
         let view = texture.create_view(&Default::default());
         let bind_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("io"),
@@ -590,34 +616,39 @@ impl Context {
                 wgpu::BindGroupEntry { binding: 2, resource: table.as_entire_binding() },
             ],
         });
-        // Two submissions, so the kernel and the readback are timed apart.
+        // Three submissions: the sentinel fill (untimed), then the kernel and
+        // the readback, timed apart.
+        let layout = wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(padded_row),
+            rows_per_image: Some(job.height),
+        };
+        let mut fill = d.create_command_encoder(&Default::default());
+        fill.copy_buffer_to_texture(
+            wgpu::TexelCopyBufferInfo { buffer: &sentinel, layout },
+            texture.as_image_copy(),
+            extent,
+        );
         let mut compute = d.create_command_encoder(&Default::default());
-        if reused_texture {
-            compute.clear_texture(&texture, &wgpu::ImageSubresourceRange::default());
-        }
         {
             let mut pass = compute.begin_compute_pass(&Default::default());
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
-            pass.dispatch_workgroups(job.width.div_ceil(WORKGROUP), job.height.div_ceil(WORKGROUP), 1);
+            let [x, y, z] = job.workgroups;
+            pass.dispatch_workgroups(x, y, z);
         }
         let mut encoder = d.create_command_encoder(&Default::default());
         encoder.copy_texture_to_buffer(
             texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded_row),
-                    rows_per_image: Some(job.height),
-                },
-            },
+            wgpu::TexelCopyBufferInfo { buffer: &readback, layout },
             extent,
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Validation { what: job.shader.to_string(), message: e.to_string() });
         }
         let _serial = self.submit_lock.lock().expect("submit lock");
+        let index = w.queue.submit([fill.finish()]);
+        self.wait(w, index, job.shader)?;
         let gpu_start = Instant::now();
         let index = w.queue.submit([compute.finish()]);
         self.wait(w, index, job.shader)?;
@@ -639,7 +670,7 @@ impl Context {
                 return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs_f64() });
             }
         }
-        let image = {
+        let (image, unwritten) = {
             let mapped = readback
                 .slice(..)
                 .get_mapped_range()
@@ -648,8 +679,8 @@ impl Context {
         };
         readback.unmap();
         let readback_time = copy_start.elapsed();
-        let texture = w.can_clear.then_some(texture);
-        *w.scratch.lock().expect("scratch") = Some(Scratch { width: job.width, height: job.height, texture, readback });
+        *w.scratch.lock().expect("scratch") =
+            Some(Scratch { width: job.width, height: job.height, texture, readback, sentinel });
         if self.validate {
             let messages = crate::validation::take();
             if !messages.is_empty() {
@@ -659,12 +690,13 @@ impl Context {
                 });
             }
         }
-        Ok((image, RunStats { gpu_wall, kernel, readback: readback_time, total: start.elapsed() }))
+        let stats = RunStats { gpu_wall, kernel, readback: readback_time, total: start.elapsed() };
+        Ok(Readback { image, stats, unwritten })
     }
 
     /// The same job in headless Chromium: naga's WGSL of the composed
     /// module, the same uniform bytes and table, the same readback layout.
-    fn run_in_browser(&self, b: &BrowserEngine, job: &Dispatch<'_>) -> Result<(Image, RunStats), GpuError> {
+    fn run_in_browser(&self, b: &BrowserEngine, job: &Dispatch<'_>) -> Result<Readback, GpuError> {
         let key = format!("{}#{}", job.shader, job.shaders.source_hash(job.shader)?);
         let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
         let wgsl = match cached {
@@ -682,6 +714,9 @@ impl Context {
                 label: job.shader,
                 key: &key,
                 wgsl: &wgsl,
+                entry: job.entry,
+                workgroups: job.workgroups,
+                sentinel: UNWRITTEN,
                 uniforms: job.uniforms,
                 table: job.table,
                 width: job.width,
@@ -694,7 +729,9 @@ impl Context {
                 }
                 other => GpuError::Device { adapter: self.info.name.clone(), message: other.to_string() },
             })?;
-        let image = Image::from_raw(job.width, job.height, out.rgba)
+        let mut rgba = out.rgba;
+        let unwritten = take_unwritten(&mut rgba);
+        let image = Image::from_raw(job.width, job.height, rgba)
             .map_err(|e| GpuError::Request(format!("browser readback: {e}")))?;
         let stats = RunStats {
             gpu_wall: out.kernel + out.readback,
@@ -702,7 +739,7 @@ impl Context {
             readback: out.readback,
             total: out.total,
         };
-        Ok((image, stats))
+        Ok(Readback { image, stats, unwritten })
     }
 
     /// Blocks until `index` completes, or fails after the watchdog timeout.
@@ -727,9 +764,20 @@ fn words_to_bytes(words: &[u32]) -> Vec<u8> {
     words.iter().flat_map(|w| w.to_le_bytes()).collect()
 }
 
+/// Counts the texels whose four channels all hold [`UNWRITTEN`] and sets
+/// them to 0, as a fresh texture reads.
+fn take_unwritten(texels: &mut [[f32; 4]]) -> u64 {
+    let mut n = 0;
+    for px in texels.iter_mut().filter(|px| px.iter().all(|c| c.to_bits() == UNWRITTEN)) {
+        *px = [0.0; 4];
+        n += 1;
+    }
+    n
+}
+
 /// Copies `height` rows of `width` RGBA f32 texels out of a buffer whose rows
-/// are `padded_row` bytes apart.
-pub(crate) fn unpad_rows(bytes: &[u8], width: u32, height: u32, padded_row: u32) -> Image {
+/// are `padded_row` bytes apart; texels never written read 0 and are counted.
+pub(crate) fn unpad_rows(bytes: &[u8], width: u32, height: u32, padded_row: u32) -> (Image, u64) {
     let (w, row, padded) = (width as usize, width as usize * 16, padded_row as usize);
     // Written in place (no per-pixel push), so even the tests' opt-level 1
     // build turns it into straight copies.
@@ -742,7 +790,8 @@ pub(crate) fn unpad_rows(bytes: &[u8], width: u32, height: u32, padded_row: u32)
             }
         }
     }
-    Image::from_raw(width, height, data).expect("unpadded rows fill the image")
+    let unwritten = take_unwritten(&mut data);
+    (Image::from_raw(width, height, data).expect("unpadded rows fill the image"), unwritten)
 }
 
 /// Picks the adapter matching `choice` from those enumerated.
@@ -784,8 +833,17 @@ mod tests {
                 }
             }
         }
-        let img = unpad_rows(&bytes, w, h, padded);
+        // Texel (1, 1) still holds the sentinel in all four channels.
+        for c in 0..4 {
+            let at = (padded + 16 + c * 4) as usize;
+            bytes[at..at + 4].copy_from_slice(&UNWRITTEN.to_le_bytes());
+        }
+        // Texel (0, 1) holds it in one channel only: written.
+        bytes[padded as usize..][..4].copy_from_slice(&UNWRITTEN.to_le_bytes());
+        let (img, unwritten) = unpad_rows(&bytes, w, h, padded);
         assert_eq!(img.get(2, 1), [120.0, 121.0, 122.0, 123.0]);
         assert_eq!(img.get(0, 0), [0.0, 1.0, 2.0, 3.0]);
+        assert_eq!((unwritten, img.get(1, 1)), (1, [0.0; 4]));
+        assert_eq!(img.get(0, 1)[0].to_bits(), UNWRITTEN);
     }
 }

@@ -4,15 +4,16 @@
 //! [`Image`](vista_image::Image).
 //!
 //! Not for: knowing about specific kernels. A dispatch is a shader file name,
-//! a uniform block, a u32 table and a size; meaning lives in `vista-kernels`.
+//! an entry point, a workgroup count, a uniform block, a u32 table and a
+//! size; meaning lives in `vista-kernels`, the plan in `vista-render`.
 
 mod context;
 mod shaders;
 pub mod validation;
 
 pub use context::{
-    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dispatch, GpuConfig, RunStats,
-    SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
+    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dispatch, GpuConfig, Readback, RunStats,
+    SWIFTSHADER_HINT, UNWRITTEN, VALIDATION_LAYER_JSON,
 };
 pub use shaders::{ShaderSet, validate};
 

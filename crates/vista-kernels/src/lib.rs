@@ -66,6 +66,7 @@ pub mod cpu64;
 pub mod atmosphere;
 pub mod cloudmap;
 pub mod clouds;
+pub mod expr;
 pub mod fbm;
 pub mod heightfield;
 pub mod landscape;
@@ -228,9 +229,36 @@ impl Kernel {
     pub fn presets(&self) -> &'static [Preset] {
         self.manifest.presets
     }
-    /// WGSL file under `shaders/` holding the `main` compute entry point.
+    /// WGSL file under `shaders/` holding the compute entry point.
     pub fn shader(&self) -> &'static str {
         self.manifest.shader
+    }
+    /// The compute entry point (`[[pass]] entry`, default `main`).
+    pub fn entry(&self) -> &'static str {
+        self.manifest.entry
+    }
+    /// Whether texels the kernel leaves unwritten are allowed (`[[output]] partial`).
+    pub fn partial(&self) -> bool {
+        self.manifest.partial
+    }
+    /// The manifest's explicit workgroup count for these params and size
+    /// (`[[pass]] workgroups`), or `None`: cover the output with the
+    /// shader's own workgroup size. Each count must be in [1, 65535].
+    pub fn workgroups(&self, p: &ParamSet, width: u32, height: u32) -> Result<Option<[u32; 3]>, ParamError> {
+        let Some(exprs) = &self.manifest.workgroups else { return Ok(None) };
+        let mut out = [0u32; 3];
+        for (i, e) in exprs.iter().enumerate() {
+            let fail = |message: String| ParamError::Manifest {
+                file: self.origin.to_string(),
+                message: format!("kernel {}: [[pass]] workgroups[{i}] {message}", self.name()),
+            };
+            let v = e.eval(p, width, height).map_err(&fail)?;
+            out[i] = u32::try_from(v)
+                .ok()
+                .filter(|v| (1..=65535).contains(v))
+                .ok_or_else(|| fail(format!("is {v} for these params; allowed: [1, 65535]")))?;
+        }
+        Ok(Some(out))
     }
     pub fn output(&self) -> Output {
         self.manifest.output

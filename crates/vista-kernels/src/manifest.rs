@@ -39,8 +39,10 @@ use crate::{Output, ParamError};
 struct RawManifest {
     summary: String,
     shader: Option<String>,
-    #[serde(default = "default_output")]
-    output: String,
+    /// `output = "display" | "hdr"` (SPEC 10), or `[[output]]` tables (SPEC 14).
+    output: Option<toml::Value>,
+    #[serde(default, rename = "pass")]
+    passes: Vec<RawPass>,
     display_alpha: Option<String>,
     #[serde(default)]
     work: Vec<String>,
@@ -57,8 +59,22 @@ struct RawManifest {
     preset: toml::Table,
 }
 
-fn default_output() -> String {
-    "display".into()
+/// A `[[pass]]` table: so far one pass, its entry point and workgroup count.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPass {
+    entry: Option<String>,
+    workgroups: Option<Vec<toml::Value>>,
+}
+
+/// An `[[output]]` table: so far the kernel's one storage-texture output.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    resource: Option<String>,
+    view: Option<String>,
+    #[serde(default)]
+    partial: bool,
 }
 
 #[derive(Debug, Deserialize)]
@@ -101,6 +117,13 @@ pub struct Manifest {
     pub shader: &'static str,
     pub output: Output,
     pub opaque_display: bool,
+    /// The compute entry point (`[[pass]] entry`, default `main`).
+    pub entry: &'static str,
+    /// An explicit workgroup count (`[[pass]] workgroups`), else the plan
+    /// covers the output with the reflected workgroup size.
+    pub workgroups: Option<[crate::expr::Expr; 3]>,
+    /// Texels the kernel leaves unwritten are allowed (`[[output]] partial`).
+    pub partial: bool,
     pub work: Vec<WorkFactor>,
     pub output_range: Option<(f64, f64)>,
     /// The z every fbm2/ridged2 call of the shader takes.
@@ -141,10 +164,34 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let raw: RawManifest = toml::from_str(text).map_err(|e| fail(vista_project::one_line_toml_error(text, &e)))?;
     let kfail = |message: String| fail(format!("kernel {name}: {message}"));
 
-    let output = match raw.output.as_str() {
-        "display" => Output::Display,
-        "hdr" => Output::Hdr,
-        other => return Err(kfail(format!("output = \"{other}\" is not valid; expected display|hdr"))),
+    let view = |v: &str| match v {
+        "display" => Ok(Output::Display),
+        "hdr" => Ok(Output::Hdr),
+        other => Err(kfail(format!("output view \"{other}\" is not valid; expected display|hdr"))),
+    };
+    let (output, partial) = match &raw.output {
+        None => (Output::Display, false),
+        Some(toml::Value::String(s)) => (view(s)?, false),
+        Some(toml::Value::Array(tables)) => {
+            if tables.len() != 1 {
+                return Err(kfail(format!(
+                    "{} [[output]] tables: one output (the kernel's storage texture) is supported so far",
+                    tables.len()
+                )));
+            }
+            let o = RawOutput::deserialize(tables[0].clone()).map_err(|e| kfail(format!("[[output]]: {e}")))?;
+            if let Some(r) = &o.resource
+                && r.is_empty()
+            {
+                return Err(kfail("[[output]] resource must name the kernel's storage texture".into()));
+            }
+            (view(o.view.as_deref().unwrap_or("display"))?, o.partial)
+        }
+        Some(other) => {
+            return Err(kfail(format!(
+                "output = {other} is not valid; expected \"display\", \"hdr\" or [[output]] tables"
+            )));
+        }
     };
     let opaque_display = match raw.display_alpha.as_deref() {
         None | Some("keep") => false,
@@ -320,6 +367,39 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             _ => return Err(kfail(format!("specialize = [\"{n}\"]: \"{n}\" must name an enum param"))),
         }
     }
+    if raw.passes.len() > 1 {
+        return Err(kfail(format!("{} [[pass]] tables: one pass is supported so far", raw.passes.len())));
+    }
+    let pass = raw.passes.first();
+    let entry = pass.and_then(|p| p.entry.clone()).unwrap_or_else(|| "main".into());
+    if entry.is_empty() || !entry.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(kfail(format!("[[pass]] entry = \"{entry}\" is not a WGSL function name")));
+    }
+    let workgroups = match pass.and_then(|p| p.workgroups.as_ref()) {
+        None => None,
+        Some(list) if list.len() == 3 => {
+            let mut out = Vec::new();
+            for v in list {
+                let text = match v {
+                    toml::Value::Integer(n) if *n >= 1 => n.to_string(),
+                    toml::Value::String(s) => s.clone(),
+                    other => {
+                        return Err(kfail(format!(
+                            "[[pass]] workgroups entry {other} is not valid; expected a count >= 1, a param name or an expression"
+                        )));
+                    }
+                };
+                let e = crate::expr::Expr::parse(&text, params)
+                    .map_err(|e| kfail(format!("[[pass]] workgroups entry \"{text}\": {e}")))?;
+                out.push(e);
+            }
+            let [x, y, z]: [crate::expr::Expr; 3] = out.try_into().expect("three entries");
+            Some([x, y, z])
+        }
+        Some(list) => {
+            return Err(kfail(format!("[[pass]] workgroups has {} entries; expected [x, y, z]", list.len())));
+        }
+    };
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
         name: leak(name),
@@ -327,6 +407,9 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         shader: leak(shader),
         output,
         opaque_display,
+        entry: leak(entry),
+        workgroups,
+        partial,
         work,
         output_range: raw.output_range.map(|[a, b]| (a, b)),
         hash_plane,

@@ -365,7 +365,7 @@ fn baseline<'a>(
             golden,
             raw_hash: r.raw.content_hash(),
         };
-        let o = judge_case(gpu, manifest, &b, &r.raw, &vista_render::quantize16(r.display()));
+        let o = judge_case(gpu, manifest, &b, &r);
         if !o.passed() {
             return Err(GoldenError::BadInput(format!(
                 "case {} fails before any mutation ({}); fix or bless it before mutating",
@@ -398,9 +398,9 @@ fn judge_case(
     gpu: &Renderer,
     manifest: &Manifest,
     b: &CaseBaseline,
-    raw: &Image,
-    actual: &Image,
+    r: &vista_render::Rendered,
 ) -> vista_golden::Outcome {
+    let actual = vista_render::quantize16(r.display());
     let shader = b.case.kernel.shader();
     let run = vista_golden::RunInfo {
         backend: gpu.backend().to_string(),
@@ -411,8 +411,9 @@ fn judge_case(
     let files = gpu.shader_file_hashes(shader).unwrap_or_default();
     let path = std::path::PathBuf::from(b.case.golden_rel_path());
     let observed = Observed {
-        raw,
-        actual,
+        raw: &r.raw,
+        unwritten: r.unwritten,
+        actual: &actual,
         repeat_identical: None,
         shader_files: &files,
         golden: GoldenRead::Present { path: &path, hash: &b.golden_hash, image: Ok(&b.golden) },
@@ -447,7 +448,7 @@ fn judge(gpu: &Renderer, manifest: &Manifest, kernel: &Kernel, base: &Baseline, 
             Err(e) => return report(failed(&e), None, false, n + 1),
         };
         identical &= r.raw.content_hash() == b.raw_hash;
-        let o = judge_case(gpu, manifest, b, &r.raw, &vista_render::quantize16(r.display()));
+        let o = judge_case(gpu, manifest, b, &r);
         if !o.passed() {
             let why = o.problems.first().cloned().unwrap_or_default();
             return report("killed", Some((c.id.clone(), why)), false, n + 1);

@@ -81,6 +81,8 @@ pub struct Rendered {
     pub raw: Image,
     /// Timing of the run.
     pub stats: RunStats,
+    /// Texels of the output the kernel never wrote (they read 0 in `raw`).
+    pub unwritten: u64,
     to_display: DisplayMap,
     /// Display values, made on first use unless they are `raw` itself: a
     /// benchmark or a raw-only caller never pays for a second image.
@@ -180,6 +182,13 @@ pub struct Plan {
     pub kernel: String,
     /// The kernel file as composed for these params (`Kernel::shader_for`).
     pub shader: String,
+    /// The compute entry point (the manifest's, default `main`).
+    pub entry: String,
+    /// The entry point's workgroup size, from naga's reflection.
+    pub workgroup_size: [u32; 3],
+    /// Workgroups dispatched: the manifest's `workgroups`, else enough of
+    /// `workgroup_size` to cover the output.
+    pub workgroups: [u32; 3],
     /// Binding 0's bytes.
     pub uniforms: Vec<u8>,
     /// Binding 2's words (Perlin's permutation and its packed chains).
@@ -212,8 +221,36 @@ pub fn plan(
         other => RenderError::Gpu(other),
     })?;
     let layout = kernel.layout(&module).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let entry = kernel.entry();
+    let workgroup_size = module
+        .entry_points
+        .iter()
+        .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
+        .map(|e| e.workgroup_size)
+        .ok_or_else(|| {
+            let compute: Vec<&str> = module
+                .entry_points
+                .iter()
+                .filter(|e| e.stage == naga::ShaderStage::Compute)
+                .map(|e| e.name.as_str())
+                .collect();
+            RenderError::BadInput(format!(
+                "kernel {}: {} has no compute entry point '{entry}'; its compute entry points: {}",
+                kernel.name(),
+                shader,
+                if compute.is_empty() { "none".to_string() } else { compute.join(", ") }
+            ))
+        })?;
+    let workgroups = match kernel.workgroups(p, width, height).map_err(|e| RenderError::BadInput(e.to_string()))? {
+        Some(count) => count,
+        // Cover the output: the workgroup size is the shader's, never assumed.
+        None => [width.div_ceil(workgroup_size[0]), height.div_ceil(workgroup_size[1]), 1],
+    };
     Ok(Plan {
         kernel: kernel.name().to_string(),
+        entry: entry.to_string(),
+        workgroup_size,
+        workgroups,
         uniforms: kernel.uniforms(&layout, p, width, height),
         table: kernel.table(&layout, p),
         shader,
@@ -228,13 +265,21 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
     let job = Dispatch {
         shaders: &gpu.shaders,
         shader: &plan.shader,
+        entry: &plan.entry,
+        workgroups: plan.workgroups,
         uniforms: &plan.uniforms,
         table: &plan.table,
         width: plan.width,
         height: plan.height,
     };
-    let (raw, stats) = gpu.ctx.run(&job)?;
-    Ok(Rendered { raw, stats, to_display: plan.display, display: OnceLock::new() })
+    let out = gpu.ctx.run(&job)?;
+    Ok(Rendered {
+        raw: out.image,
+        stats: out.stats,
+        unwritten: out.unwritten,
+        to_display: plan.display,
+        display: OnceLock::new(),
+    })
 }
 
 /// Renders `kernel` with `p` at `width` x `height`: [`plan`], then [`run`].
