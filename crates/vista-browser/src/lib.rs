@@ -3,10 +3,11 @@
 //! browser is driven over the DevTools protocol through
 //! `--remote-debugging-pipe` ([`cdp`]); the page side is `runner.js`.
 //!
-//! The I/O contract is the one vista's wgpu path has: binding 0 a uniform
-//! buffer, binding 1 an `rgba32float` write-only storage texture, binding 2
-//! a read-only `array<u32>`; the entry point and the workgroup count the
-//! job names; the output filled with the job's sentinel before the kernel.
+//! The I/O contract is the one vista's wgpu path has: the job's slots (a
+//! uniform buffer, a read-only `array<u32>` table, a write-only storage
+//! texture of the job's format, each at its own group and binding), the
+//! entry point and workgroup count the job names, the output filled with
+//! the job's sentinel texel before the kernel, its texel bytes read back.
 //!
 //! One [`Browser`] holds one Chromium process, reused across runs. Every
 //! protocol call has a watchdog; a run that overruns it, a page error or a
@@ -82,18 +83,34 @@ pub struct Job<'a> {
     pub entry: &'a str,
     /// Workgroups dispatched along x, y and z.
     pub workgroups: [u32; 3],
-    /// The bits every channel of the output holds before the kernel runs.
-    pub sentinel: u32,
+    /// Every binding the entry point uses.
+    pub slots: &'a [Slot],
+    /// The output's storage format (WGSL and WebGPU share the names).
+    pub format: &'a str,
+    /// Bytes of one output texel.
+    pub texel_bytes: u32,
+    /// One texel's bytes: the output holds it everywhere before the kernel runs.
+    pub fill: &'a [u8],
     pub uniforms: &'a [u8],
     pub table: &'a [u32],
     pub width: u32,
     pub height: u32,
 }
 
-/// The texture as the kernel wrote it, row-major RGBA, and the page's timings.
+/// One binding of a job: its group, number and what feeds it
+/// (`uniform`, `table` or `output`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Slot {
+    pub group: u32,
+    pub binding: u32,
+    pub kind: &'static str,
+}
+
+/// The texture as the kernel wrote it (its texel bytes, row-major,
+/// unpadded) and the page's timings.
 #[derive(Debug, Clone)]
 pub struct Output {
-    pub rgba: Vec<[f32; 4]>,
+    pub bytes: Vec<u8>,
     /// Submit to `onSubmittedWorkDone` of the compute pass.
     pub kernel: Duration,
     /// Copy, map and unpad in the page (not the DevTools transfer).
@@ -180,7 +197,10 @@ impl Browser {
             "wgsl": job.wgsl,
             "entry": job.entry,
             "workgroups": job.workgroups,
-            "sentinel": job.sentinel,
+            "slots": job.slots,
+            "format": job.format,
+            "texel_bytes": job.texel_bytes,
+            "fill": B64.encode(job.fill),
             "uniforms": B64.encode(job.uniforms),
             "table": B64.encode(&table),
             "width": job.width,
@@ -194,7 +214,7 @@ impl Browser {
             bytes: usize,
         }
         let ran: Ran = parse_ok(&reply).map_err(|message| BrowserError::Page { case: job.label.into(), message })?;
-        let expected = job.width as usize * job.height as usize * 16;
+        let expected = job.width as usize * job.height as usize * job.texel_bytes as usize;
         if ran.bytes != expected {
             return Err(BrowserError::Page {
                 case: job.label.into(),
@@ -216,12 +236,8 @@ impl Browser {
                 message: format!("received {} output bytes, expected {expected}", bytes.len()),
             });
         }
-        let rgba = bytes
-            .chunks_exact(16)
-            .map(|px| std::array::from_fn(|c| f32::from_le_bytes(px[c * 4..c * 4 + 4].try_into().expect("4 bytes"))))
-            .collect();
         Ok(Output {
-            rgba,
+            bytes,
             kernel: Duration::from_secs_f64(ran.kernel_ms.max(0.0) / 1e3),
             readback: Duration::from_secs_f64(ran.readback_ms.max(0.0) / 1e3),
             total: start.elapsed(),

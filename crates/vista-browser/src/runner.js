@@ -3,7 +3,7 @@
 // back as data, never as an exception the protocol would flatten.
 "use strict";
 
-const vista = { device: null, layout: null, pipelineLayout: null, pipelines: new Map(), out: null, lost: null };
+const vista = { device: null, pipelines: new Map(), out: null, lost: null };
 
 function fail(e) {
   return JSON.stringify({ ok: false, error: String((e && e.message) || e) });
@@ -41,15 +41,6 @@ async function vistaInit() {
       vista.lost = `${info.reason}: ${info.message}`;
       vista.device = null;
     });
-    const C = GPUShaderStage.COMPUTE;
-    vista.layout = device.createBindGroupLayout({
-      entries: [
-        { binding: 0, visibility: C, buffer: { type: "uniform" } },
-        { binding: 1, visibility: C, storageTexture: { access: "write-only", format: "rgba32float", viewDimension: "2d" } },
-        { binding: 2, visibility: C, buffer: { type: "read-only-storage" } },
-      ],
-    });
-    vista.pipelineLayout = device.createPipelineLayout({ bindGroupLayouts: [vista.layout] });
     vista.device = device;
     vista.pipelines.clear();
     const i = adapter.info;
@@ -67,11 +58,28 @@ async function vistaInit() {
   }
 }
 
-async function pipeline(key, wgsl, entry) {
-  key = `${key}@${entry}`;
+// One bind group layout per group up to the highest the job binds.
+function groupLayouts(d, slots, format) {
+  const C = GPUShaderStage.COMPUTE;
+  const count = slots.reduce((m, s) => Math.max(m, s.group + 1), 0);
+  const groups = [];
+  for (let g = 0; g < count; g++) {
+    const entries = slots.filter((s) => s.group === g).map((s) => {
+      if (s.kind === "uniform") return { binding: s.binding, visibility: C, buffer: { type: "uniform" } };
+      if (s.kind === "table") return { binding: s.binding, visibility: C, buffer: { type: "read-only-storage" } };
+      return { binding: s.binding, visibility: C, storageTexture: { access: "write-only", format, viewDimension: "2d" } };
+    });
+    groups.push(d.createBindGroupLayout({ entries }));
+  }
+  return groups;
+}
+
+async function pipeline(job) {
+  const key = `${job.key}@${job.entry}${JSON.stringify(job.slots)}${job.format}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
   const d = vista.device;
+  const wgsl = job.wgsl;
   d.pushErrorScope("validation");
   const module = d.createShaderModule({ code: wgsl, label: key });
   const info = await module.getCompilationInfo();
@@ -82,22 +90,26 @@ async function pipeline(key, wgsl, entry) {
     throw new Error(`Tint rejected the WGSL: ${lines.join("; ")}`);
   }
   let p;
+  const groups = groupLayouts(d, job.slots, job.format);
   try {
-    p = await d.createComputePipelineAsync({ layout: vista.pipelineLayout, compute: { module, entryPoint: entry } });
+    const layout = d.createPipelineLayout({ bindGroupLayouts: groups });
+    p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: job.entry } });
   } finally {
     const e = await d.popErrorScope();
     if (e) throw new Error(`pipeline: ${e.message}`);
   }
-  vista.pipelines.set(key, p);
-  return p;
+  const compiled = { pipeline: p, groups };
+  vista.pipelines.set(key, compiled);
+  return compiled;
 }
 
-// job: { key, wgsl, entry, workgroups [x, y, z], sentinel (u32 bits), uniforms (base64), table (base64), width, height }
+// job: { key, wgsl, entry, workgroups [x, y, z], slots [{group, binding, kind}], format, texel_bytes,
+//        fill (one texel, base64), uniforms (base64), table (base64), width, height }
 async function vistaRun(job) {
   try {
     const d = vista.device;
     if (!d) throw new Error(`the WebGPU device is gone (${vista.lost || "never created"})`);
-    const p = await pipeline(job.key, job.wgsl, job.entry);
+    const compiled = await pipeline(job);
     const start = performance.now();
     d.pushErrorScope("out-of-memory");
     d.pushErrorScope("validation");
@@ -110,25 +122,28 @@ async function vistaRun(job) {
     new Uint8Array(table.getMappedRange()).set(words);
     table.unmap();
     const size = { width: job.width, height: job.height };
-    const texture = d.createTexture({ size, format: "rgba32float", usage: GPUTextureUsage.STORAGE_BINDING | GPUTextureUsage.COPY_SRC | GPUTextureUsage.COPY_DST });
-    // Every texel starts as the sentinel, so Rust can count those never written.
-    d.queue.writeTexture({ texture }, new Uint32Array(job.width * job.height * 4).fill(job.sentinel), { bytesPerRow: job.width * 16, rowsPerImage: job.height }, size);
-    const rowBytes = job.width * 16;
+    const texture = d.createTexture({ size, format: job.format, usage: GPUTextureUsage.STORAGE_BINDING | GPUTextureUsage.COPY_SRC | GPUTextureUsage.COPY_DST });
+    // Every texel starts as the sentinel texel, so Rust can count those never written.
+    const rowBytes = job.width * job.texel_bytes;
+    const texel = fromBase64(job.fill);
+    const filled = new Uint8Array(rowBytes * job.height);
+    for (let i = 0; i < filled.length; i += texel.length) filled.set(texel, i);
+    d.queue.writeTexture({ texture }, filled, { bytesPerRow: rowBytes, rowsPerImage: job.height }, size);
     const paddedRow = Math.ceil(rowBytes / 256) * 256;
     const readback = d.createBuffer({ size: paddedRow * job.height, usage: GPUBufferUsage.COPY_DST | GPUBufferUsage.MAP_READ });
-    const group = d.createBindGroup({
-      layout: vista.layout,
-      entries: [
-        { binding: 0, resource: { buffer: uniforms } },
-        { binding: 1, resource: texture.createView() },
-        { binding: 2, resource: { buffer: table } },
-      ],
-    });
+    const view = texture.createView();
+    const resource = (kind) => (kind === "uniform" ? { buffer: uniforms } : kind === "table" ? { buffer: table } : view);
+    const bindGroups = compiled.groups.map((layout, g) =>
+      d.createBindGroup({
+        layout,
+        entries: job.slots.filter((s) => s.group === g).map((s) => ({ binding: s.binding, resource: resource(s.kind) })),
+      }),
+    );
     // Two submissions, so the kernel and the readback are timed apart as on wgpu.
     const compute = d.createCommandEncoder();
     const pass = compute.beginComputePass();
-    pass.setPipeline(p);
-    pass.setBindGroup(0, group);
+    pass.setPipeline(compiled.pipeline);
+    bindGroups.forEach((group, g) => pass.setBindGroup(g, group));
     pass.dispatchWorkgroups(job.workgroups[0], job.workgroups[1], job.workgroups[2]);
     pass.end();
     const copy = d.createCommandEncoder();

@@ -62,9 +62,25 @@ fn main() {
 /// output of one that did not).
 fn failure(r: Result<vista_browser::Output, BrowserError>, what: &str) -> BrowserError {
     match r {
-        Ok(out) => panic!("{what}: {} texels came back", out.rgba.len()),
+        Ok(out) => panic!("{what}: {} texels came back", rgba(&out).len()),
         Err(e) => e,
     }
+}
+
+/// vista's three bindings at their usual places.
+const SLOTS: [vista_browser::Slot; 3] = [
+    vista_browser::Slot { group: 0, binding: 0, kind: "uniform" },
+    vista_browser::Slot { group: 0, binding: 1, kind: "output" },
+    vista_browser::Slot { group: 0, binding: 2, kind: "table" },
+];
+const FILL: [u8; 16] = [0; 16];
+
+/// The output's rgba32float texels.
+fn rgba(out: &vista_browser::Output) -> Vec<[f32; 4]> {
+    out.bytes
+        .chunks_exact(16)
+        .map(|t| std::array::from_fn(|c| f32::from_le_bytes(t[c * 4..c * 4 + 4].try_into().unwrap())))
+        .collect()
 }
 
 fn uniforms(w: u32, h: u32, scale: f32) -> Vec<u8> {
@@ -83,24 +99,27 @@ fn a_kernel_runs_and_reads_back_every_texel() {
         wgsl: GRADIENT,
         entry: "main",
         workgroups: [w.div_ceil(8), h.div_ceil(8), 1],
-        sentinel: 0x7FC0_DEAD,
+        slots: &SLOTS,
+        format: "rgba32float",
+        texel_bytes: 16,
+        fill: &FILL,
         uniforms: &u,
         table: &table,
         width: w,
         height: h,
     };
     let out = b.run(&job).unwrap();
-    assert_eq!(out.rgba.len(), (w * h) as usize);
+    assert_eq!(rgba(&out).len(), (w * h) as usize);
     for y in 0..h {
         for x in 0..w {
-            let px = out.rgba[(y * w + x) as usize];
+            let px = rgba(&out)[(y * w + x) as usize];
             assert_eq!(px, [x as f32 * 0.5, y as f32, table[((x + y) % 4) as usize] as f32, 1.0], "({x}, {y})");
         }
     }
     // The same browser serves a second run with other uniforms.
     let u = uniforms(w, h, 2.0);
     let out = b.run(&Job { uniforms: &u, ..job }).unwrap();
-    assert_eq!(out.rgba[(w - 1) as usize][0], (w - 1) as f32 * 2.0);
+    assert_eq!(rgba(&out)[(w - 1) as usize][0], (w - 1) as f32 * 2.0);
 }
 
 fn tint_errors_name_the_case_and_the_next_run_works() {
@@ -114,7 +133,10 @@ fn tint_errors_name_the_case_and_the_next_run_works() {
         wgsl: &bad,
         entry: "main",
         workgroups: [1, 1, 1],
-        sentinel: 0x7FC0_DEAD,
+        slots: &SLOTS,
+        format: "rgba32float",
+        texel_bytes: 16,
+        fill: &FILL,
         uniforms: &u,
         table: &table,
         width: 8,
@@ -123,7 +145,7 @@ fn tint_errors_name_the_case_and_the_next_run_works() {
     let e = failure(b.run(&job), "Tint accepted a type error").to_string();
     assert!(e.starts_with("case-bad: in the browser: Tint rejected the WGSL: line"), "{e}");
     let good = Job { label: "case-good", key: "good", wgsl: GRADIENT, ..job };
-    assert_eq!(b.run(&good).unwrap().rgba.len(), 64);
+    assert_eq!(b.run(&good).map(|o| rgba(&o)).unwrap().len(), 64);
 }
 
 fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
@@ -141,7 +163,10 @@ fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
         wgsl: &forever,
         entry: "main",
         workgroups: [8, 8, 1],
-        sentinel: 0x7FC0_DEAD,
+        slots: &SLOTS,
+        format: "rgba32float",
+        texel_bytes: 16,
+        fill: &FILL,
         uniforms: &u,
         table: &table,
         width: 64,
@@ -154,11 +179,11 @@ fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
     assert!(e.to_string().starts_with("case-hang: "), "{e}");
     assert!(took < Duration::from_secs(30), "{took:?}");
     let good = Job { label: "after-hang", key: "good", wgsl: GRADIENT, ..job };
-    assert_eq!(b.run(&good).unwrap().rgba.len(), 64 * 64);
+    assert_eq!(b.run(&good).map(|o| rgba(&o)).unwrap().len(), 64 * 64);
 
     b.crash_page_for_test();
     let e = failure(b.run(&Job { label: "case-crash", ..good.clone() }), "the crashed page returned");
     assert!(matches!(e, BrowserError::Died { .. }), "{e}");
     assert!(e.to_string().starts_with("case-crash: "), "{e}");
-    assert_eq!(b.run(&good).unwrap().rgba.len(), 64 * 64, "a fresh browser after the crash");
+    assert_eq!(b.run(&good).map(|o| rgba(&o)).unwrap().len(), 64 * 64, "a fresh browser after the crash");
 }

@@ -1077,6 +1077,136 @@ fn unwritten_texels_fail_unless_the_output_is_partial() {
     );
 }
 
+/// A kernel with its own bind layout: the uniform at @group(1) @binding(3),
+/// the output at @group(0) @binding(0) in `format`.
+fn bound_shader(format: &str) -> String {
+    format!(
+        r#"struct Params {{
+    width: u32,
+    height: u32,
+    gain: f32,
+}}
+@group(1) @binding(3) var<uniform> cfg: Params;
+@group(0) @binding(0) var img: texture_storage_2d<{format}, write>;
+@compute @workgroup_size(4, 4)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
+    if id.x >= cfg.width || id.y >= cfg.height {{
+        return;
+    }}
+    let u = (f32(id.x) + 0.5) / f32(cfg.width);
+    let v = (f32(id.y) + 0.5) / f32(cfg.height);
+    textureStore(img, id.xy, vec4(u, v, cfg.gain * u * v, 1.0));
+}}
+"#
+    )
+}
+
+/// Any group and binding, any float storage format of the output, on every
+/// implementation: the same gradient, quantised by the format.
+fn any_binding_and_output_format_on_every_backend() {
+    let d = kernel_project(K_MANIFEST, &bound_shader("rgba32float"));
+    let (r, out) = render_exr(d.path(), "19x13", "ref");
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let reference = vista_image::load(&out).unwrap();
+    // (format, largest difference from the f32 render, channels kept)
+    for (format, tol, channels) in [
+        ("rgba8unorm", 0.5 / 255.0 + 1e-6, 4),
+        ("rgba8snorm", 0.5 / 127.0 + 1e-6, 4),
+        ("rgba16float", 2e-3, 4),
+        ("r32float", 1e-6, 1),
+        ("rg32float", 1e-6, 2),
+    ] {
+        let d = kernel_project(K_MANIFEST, &bound_shader(format));
+        for backend in ["lavapipe", "swiftshader", "browser"] {
+            let out = d.path().join(format!("{backend}.exr"));
+            let args = ["render", "k", "--size", "19x13", "--backend", backend, "-o", out.to_str().unwrap()];
+            let r = vista_in(Some(d.path()), &[], &args);
+            assert_eq!(r.code, 0, "{format} on {backend}: {}", r.stderr);
+            let img = vista_image::load(&out).unwrap();
+            for (a, b) in img.data.iter().zip(&reference.data) {
+                for c in 0..4 {
+                    // Channels the format lacks read 0 (alpha 1).
+                    let want = if c < channels {
+                        b[c]
+                    } else if c == 3 {
+                        1.0
+                    } else {
+                        0.0
+                    };
+                    assert!((a[c] - want).abs() <= tol, "{format} on {backend}: {a:?} vs {b:?}");
+                }
+            }
+        }
+    }
+}
+
+/// Point 8's Mandelbrot shape: @workgroup_size(1), an rgba8unorm output at
+/// binding 0 and no uniform at all (the size comes from textureDimensions).
+fn a_kernel_without_a_uniform_renders() {
+    let manifest = "summary = \"escape-time Mandelbrot, no params\"\n";
+    let shader = r#"@group(0) @binding(0) var frame: texture_storage_2d<rgba8unorm, write>;
+@compute @workgroup_size(1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(frame);
+    if id.x >= size.x || id.y >= size.y {
+        return;
+    }
+    let c = vec2(-2.2 + 3.0 * (f32(id.x) + 0.5) / f32(size.x), -1.2 + 2.4 * (f32(id.y) + 0.5) / f32(size.y));
+    var z = vec2(0.0);
+    var n = 0u;
+    loop {
+        if n >= 64u || dot(z, z) > 4.0 {
+            break;
+        }
+        z = vec2(z.x * z.x - z.y * z.y, 2.0 * z.x * z.y) + c;
+        n += 1u;
+    }
+    let t = f32(n) / 64.0;
+    textureStore(frame, id.xy, vec4(t, t * t, sqrt(t), 1.0));
+}
+"#;
+    let d = kernel_project(manifest, shader);
+    let (r, out) = render_exr(d.path(), "48x32", "m");
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let img = vista_image::load(&out).unwrap();
+    // Inside the set (c = 0 at pixel (35, 16)) every step ran; far outside few did.
+    assert_eq!(img.get(35, 16), [1.0, 1.0, 1.0, 1.0]);
+    assert!(img.get(0, 0)[0] < 0.1, "{:?}", img.get(0, 0));
+}
+
+/// A reached global that vista does not feed is refused before GPU work,
+/// naming the pass, the variable, its group/binding and WGSL type, and the
+/// resource kind that would feed it.
+fn unfed_globals_are_refused() {
+    let extra = [
+        (
+            "@group(0) @binding(3) var<storage, read_write> hist: array<atomic<u32>>;",
+            "atomicAdd(&hist[0], 1u);",
+            "hist (@group(0) @binding(3), var<storage, read_write>",
+            "a buffer resource",
+        ),
+        (
+            "@group(2) @binding(0) var lut: texture_2d<f32>;",
+            "let l = textureLoad(lut, vec2(0), 0);",
+            "lut (@group(2) @binding(0), texture_2d<f32>)",
+            "a texture resource",
+        ),
+        (
+            "@group(0) @binding(4) var second: texture_storage_2d<rgba32float, write>;",
+            "textureStore(second, id.xy, vec4(1.0));",
+            "second (@group(0) @binding(4)) is a second output texture after output",
+            "one is supported so far",
+        ),
+    ];
+    for (decl, use_it, named, feed) in extra {
+        let shader = K_SHADER
+            .replace("@compute", &format!("{decl}\n@compute"))
+            .replace("    textureStore(output", &format!("    {use_it}\n    textureStore(output"));
+        let r = render_k(K_MANIFEST, &shader);
+        assert_rejected(&r, 2, &["kernel k", "pass main", named, feed]);
+    }
+}
+
 fn a_kernel_described_as_data_renders() {
     let r = render_k(K_MANIFEST, K_SHADER);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -1681,6 +1811,9 @@ fn main() {
         (Gpu, "bless_refuses_what_check_would_fail", bless_refuses_what_check_would_fail),
         (Gpu, "workgroup_size_comes_from_reflection_not_8x8", workgroup_size_comes_from_reflection_not_8x8),
         (Gpu, "the_manifest_names_the_entry_point", the_manifest_names_the_entry_point),
+        (Gpu, "any_binding_and_output_format_on_every_backend", any_binding_and_output_format_on_every_backend),
+        (Gpu, "a_kernel_without_a_uniform_renders", a_kernel_without_a_uniform_renders),
+        (Cpu, "unfed_globals_are_refused", unfed_globals_are_refused),
         (Gpu, "unwritten_texels_fail_unless_the_output_is_partial", unwritten_texels_fail_unless_the_output_is_partial),
         (
             Gpu,

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use vista_image::Image;
 use wgpu::util::DeviceExt;
 
+use crate::format::OutputFormat;
 use crate::shaders::ShaderSet;
 use crate::{GpuError, INSTALL_HINT};
 
@@ -205,6 +206,10 @@ pub struct Dispatch<'a> {
     /// Workgroups dispatched along x, y and z (the plan derives them from
     /// the entry point's reflected workgroup size; nothing here assumes 8 x 8).
     pub workgroups: [u32; 3],
+    /// Every binding the entry point uses, and what feeds it.
+    pub slots: &'a [Slot],
+    /// The output's storage format (its WGSL name).
+    pub format: &'a str,
     /// Uniform block for binding 0 (padded to 16 bytes by the caller).
     pub uniforms: &'a [u8],
     /// Read-only u32 table for binding 2.
@@ -226,11 +231,31 @@ pub struct RunStats {
     pub total: Duration,
 }
 
-/// What the output texture holds before the kernel runs: a NaN with a
-/// payload no arithmetic produces (operations give the canonical NaN), in
-/// all four channels. A texel still holding it after the run was never
-/// written; it is read back as 0, as from a fresh texture.
+/// What each 32-bit channel of the output holds before the kernel runs
+/// (sentinel 0 of the 32-bit formats): a NaN with a payload no arithmetic
+/// produces (operations give the canonical NaN). A texel still holding the
+/// sentinel after the run was never written; it is read back as 0, as
+/// from a fresh texture. See [`crate::OutputFormat`] for the others.
 pub const UNWRITTEN: u32 = 0x7FC0_DEAD;
+
+/// What feeds a binding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SlotKind {
+    /// The uniform bytes.
+    Uniform,
+    /// The read-only u32 table.
+    Table,
+    /// The write-only output texture.
+    Output,
+}
+
+/// One binding of a dispatch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Slot {
+    pub group: u32,
+    pub binding: u32,
+    pub kind: SlotKind,
+}
 
 /// A run's output: the image, its timing, and how many texels the kernel
 /// never wrote.
@@ -265,9 +290,9 @@ enum Engine {
 struct WgpuEngine {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    layout: wgpu::BindGroupLayout,
-    pipeline_layout: wgpu::PipelineLayout,
-    pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
+    /// Pipelines with their bind group layouts (one per group up to the
+    /// highest the kernel binds), by shader hash, entry, slots and format.
+    pipelines: Mutex<HashMap<String, Arc<Compiled>>>,
     /// The last run's output texture, readback and sentinel buffers, which
     /// the next run of the same size takes instead of allocating its own:
     /// fresh ones cost a page fault per 4 KiB as they are first written
@@ -278,12 +303,18 @@ struct WgpuEngine {
     scratch: Mutex<Option<Scratch>>,
 }
 
+struct Compiled {
+    pipeline: wgpu::ComputePipeline,
+    groups: Vec<wgpu::BindGroupLayout>,
+}
+
 struct Scratch {
     width: u32,
     height: u32,
+    format: wgpu::TextureFormat,
     texture: wgpu::Texture,
     readback: wgpu::Buffer,
-    /// The output's size of [`UNWRITTEN`] texels, copied over the texture
+    /// The output's size of sentinel-0 texels, copied over the texture
     /// before every run.
     sentinel: wgpu::Buffer,
 }
@@ -374,46 +405,10 @@ impl Context {
             ..Default::default()
         }))
         .map_err(|e| GpuError::Device { adapter: info.name.clone(), message: e.to_string() })?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("vista kernel io"),
-            entries: &[
-                entry(
-                    0,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
-                entry(
-                    1,
-                    wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: wgpu::TextureFormat::Rgba32Float,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                ),
-                entry(
-                    2,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("vista kernel"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
         Ok(Context {
             engine: Engine::Wgpu(Box::new(WgpuEngine {
                 device,
                 queue,
-                layout,
-                pipeline_layout,
                 pipelines: Mutex::new(HashMap::new()),
                 scratch: Mutex::new(None),
             })),
@@ -506,44 +501,94 @@ impl Context {
             .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))
     }
 
-    /// Compiles (once per source hash) the pipeline of a kernel file. The
-    /// cache is keyed by the hash of the file and its imports, so two
-    /// projects (or an edited copy) never share a stale pipeline.
-    fn pipeline(
-        &self,
-        w: &WgpuEngine,
-        shaders: &ShaderSet,
-        shader: &str,
-        entry: &str,
-    ) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
-        let key = format!("{shader}#{}@{entry}", shaders.source_hash(shader)?);
+    /// Compiles (once per source hash, entry, slots and format) the pipeline
+    /// of a kernel file, with a bind group layout per group from the job's
+    /// slots. The cache is keyed by the hash of the file and its imports, so
+    /// two projects (or an edited copy) never share a stale pipeline.
+    fn pipeline(&self, w: &WgpuEngine, job: &Dispatch<'_>, format: &OutputFormat) -> Result<Arc<Compiled>, GpuError> {
+        let key = format!(
+            "{}#{}@{}{:?}{}",
+            job.shader,
+            job.shaders.source_hash(job.shader)?,
+            job.entry,
+            job.slots,
+            format.name
+        );
         if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
         }
-        let module = shaders.compose(shader)?;
+        let module = job.shaders.compose(job.shader)?;
         let scope = w.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let sm = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(shader),
+            label: Some(job.shader),
             source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned((*module).clone())),
         });
+        let last = job.slots.iter().map(|s| s.group).max();
+        let groups: Vec<wgpu::BindGroupLayout> = (0..last.map_or(0, |g| g + 1))
+            .map(|g| {
+                let entries: Vec<wgpu::BindGroupLayoutEntry> = job
+                    .slots
+                    .iter()
+                    .filter(|s| s.group == g)
+                    .map(|s| {
+                        let ty = match s.kind {
+                            SlotKind::Uniform => wgpu::BindingType::Buffer {
+                                ty: wgpu::BufferBindingType::Uniform,
+                                has_dynamic_offset: false,
+                                min_binding_size: None,
+                            },
+                            SlotKind::Table => wgpu::BindingType::Buffer {
+                                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                                has_dynamic_offset: false,
+                                min_binding_size: None,
+                            },
+                            SlotKind::Output => wgpu::BindingType::StorageTexture {
+                                access: wgpu::StorageTextureAccess::WriteOnly,
+                                format: format.wgpu,
+                                view_dimension: wgpu::TextureViewDimension::D2,
+                            },
+                        };
+                        wgpu::BindGroupLayoutEntry {
+                            binding: s.binding,
+                            visibility: wgpu::ShaderStages::COMPUTE,
+                            ty,
+                            count: None,
+                        }
+                    })
+                    .collect();
+                w.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("vista group"),
+                    entries: &entries,
+                })
+            })
+            .collect();
+        let layouts: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(Some).collect();
+        let pipeline_layout = w.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(job.shader),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
         let pipeline = w.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(shader),
-            layout: Some(&w.pipeline_layout),
+            label: Some(job.shader),
+            layout: Some(&pipeline_layout),
             module: &sm,
-            entry_point: Some(entry),
+            entry_point: Some(job.entry),
             compilation_options: Default::default(),
             cache: None,
         });
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Validation { what: shader.to_string(), message: e.to_string() });
+            return Err(GpuError::Validation { what: job.shader.to_string(), message: e.to_string() });
         }
-        let pipeline = Arc::new(pipeline);
-        w.pipelines.lock().expect("pipeline cache").insert(key, pipeline.clone());
-        Ok(pipeline)
+        let compiled = Arc::new(Compiled { pipeline, groups });
+        w.pipelines.lock().expect("pipeline cache").insert(key, compiled.clone());
+        Ok(compiled)
     }
 
     /// Runs one dispatch and reads the output texture back, counting the
-    /// texels the kernel never wrote.
+    /// texels the kernel never wrote: the texture starts as sentinel 0; a
+    /// texel still holding it after the run may yet have been written with
+    /// those very bits, so only then the job runs again over sentinel 1,
+    /// and a texel holding each run's sentinel is unwritten.
     pub fn run(&self, job: &Dispatch<'_>) -> Result<Readback, GpuError> {
         let max = self.max_dimension();
         if job.width == 0 || job.height == 0 || job.width > max || job.height > max {
@@ -552,42 +597,101 @@ impl Context {
                 job.width, job.height
             )));
         }
-        let w = match &self.engine {
-            Engine::Wgpu(w) => w,
-            Engine::Browser(b) => return self.run_in_browser(b, job),
+        let format = OutputFormat::parse(job.format)?;
+        let start = Instant::now();
+        let (first, mut stats) = self.run_over(job, &format, 0)?;
+        let tb = format.texel_bytes();
+        let s0 = format.sentinel(0);
+        let suspects: Vec<usize> =
+            first.chunks_exact(tb).enumerate().filter(|(_, t)| *t == s0.as_slice()).map(|(i, _)| i).collect();
+        let unwritten: Vec<usize> = match suspects.is_empty() {
+            true => suspects,
+            false => {
+                let (second, _) = self.run_over(job, &format, 1)?;
+                let s1 = format.sentinel(1);
+                suspects.into_iter().filter(|&i| second[i * tb..(i + 1) * tb] == s1[..]).collect()
+            }
         };
-        let pipeline = self.pipeline(w, job.shaders, job.shader, job.entry)?;
+        let mut image = decode(&first, &format, job.width, job.height);
+        for &i in &unwritten {
+            image.data[i] = [0.0; 4];
+        }
+        stats.total = start.elapsed();
+        Ok(Readback { image, stats, unwritten: unwritten.len() as u64 })
+    }
+
+    /// One run over sentinel `which`: the output's texel bytes, row after
+    /// row, unpadded.
+    fn run_over(
+        &self,
+        job: &Dispatch<'_>,
+        format: &OutputFormat,
+        which: usize,
+    ) -> Result<(Vec<u8>, RunStats), GpuError> {
+        match &self.engine {
+            Engine::Wgpu(w) => self.run_wgpu(w, job, format, which),
+            Engine::Browser(b) => self.run_in_browser(b, job, format, which),
+        }
+    }
+
+    fn run_wgpu(
+        &self,
+        w: &WgpuEngine,
+        job: &Dispatch<'_>,
+        format: &OutputFormat,
+        which: usize,
+    ) -> Result<(Vec<u8>, RunStats), GpuError> {
+        let compiled = self.pipeline(w, job, format)?;
         let start = Instant::now();
         let d = &w.device;
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-        let uniforms = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("params"),
-            contents: job.uniforms,
-            usage: wgpu::BufferUsages::UNIFORM,
+        let has = |k: SlotKind| job.slots.iter().any(|s| s.kind == k);
+        let uniforms = has(SlotKind::Uniform).then(|| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("params"),
+                contents: job.uniforms,
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
         });
-        let table_words: Vec<u32> = if job.table.is_empty() { vec![0; 4] } else { job.table.to_vec() };
-        let table = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("table"),
-            contents: &words_to_bytes(&table_words),
-            usage: wgpu::BufferUsages::STORAGE,
+        let table = has(SlotKind::Table).then(|| {
+            let words: Vec<u32> = if job.table.is_empty() { vec![0; 4] } else { job.table.to_vec() };
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("table"),
+                contents: &words_to_bytes(&words),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
         });
         let extent = wgpu::Extent3d { width: job.width, height: job.height, depth_or_array_layers: 1 };
         // Buffer rows must be 256-byte aligned; unpadded again after mapping.
-        let row_bytes = job.width * 16;
+        let row_bytes = job.width * format.texel_bytes() as u32;
         let padded_row = row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let kept = w.scratch.lock().expect("scratch").take().filter(|s| (s.width, s.height) == (job.width, job.height));
+        let fill = |which: usize| {
+            let texels = (padded_row as usize / format.texel_bytes()) * job.height as usize;
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("unwritten sentinel"),
+                contents: &format.sentinel(which).repeat(texels + 1),
+                usage: wgpu::BufferUsages::COPY_SRC,
+            })
+        };
+        let kept = w
+            .scratch
+            .lock()
+            .expect("scratch")
+            .take()
+            .filter(|s| (s.width, s.height, s.format) == (job.width, job.height, format.wgpu));
         let Scratch { texture, readback, sentinel, .. } = match kept {
             Some(s) => s,
             None => Scratch {
                 width: job.width,
                 height: job.height,
+                format: format.wgpu,
                 texture: d.create_texture(&wgpu::TextureDescriptor {
                     label: Some("output"),
                     size: extent,
                     mip_level_count: 1,
                     sample_count: 1,
                     dimension: wgpu::TextureDimension::D2,
-                    format: wgpu::TextureFormat::Rgba32Float,
+                    format: format.wgpu,
                     usage: wgpu::TextureUsages::STORAGE_BINDING
                         | wgpu::TextureUsages::COPY_SRC
                         | wgpu::TextureUsages::COPY_DST,
@@ -599,23 +703,32 @@ impl Context {
                     usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
                     mapped_at_creation: false,
                 }),
-                sentinel: d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("unwritten sentinel"),
-                    contents: &UNWRITTEN.to_le_bytes().repeat((padded_row / 4 * job.height) as usize),
-                    usage: wgpu::BufferUsages::COPY_SRC,
-                }),
+                sentinel: fill(0),
             },
         };
+        let other_fill = (which != 0).then(|| fill(which));
         let view = texture.create_view(&Default::default());
-        let bind_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("io"),
-            layout: &w.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 2, resource: table.as_entire_binding() },
-            ],
-        });
+        let groups: Vec<wgpu::BindGroup> = compiled
+            .groups
+            .iter()
+            .enumerate()
+            .map(|(g, layout)| {
+                let entries: Vec<wgpu::BindGroupEntry> = job
+                    .slots
+                    .iter()
+                    .filter(|s| s.group == g as u32)
+                    .map(|s| wgpu::BindGroupEntry {
+                        binding: s.binding,
+                        resource: match s.kind {
+                            SlotKind::Uniform => uniforms.as_ref().expect("a uniform slot").as_entire_binding(),
+                            SlotKind::Table => table.as_ref().expect("a table slot").as_entire_binding(),
+                            SlotKind::Output => wgpu::BindingResource::TextureView(&view),
+                        },
+                    })
+                    .collect();
+                d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("io"), layout, entries: &entries })
+            })
+            .collect();
         // Three submissions: the sentinel fill (untimed), then the kernel and
         // the readback, timed apart.
         let layout = wgpu::TexelCopyBufferLayout {
@@ -623,17 +736,19 @@ impl Context {
             bytes_per_row: Some(padded_row),
             rows_per_image: Some(job.height),
         };
-        let mut fill = d.create_command_encoder(&Default::default());
-        fill.copy_buffer_to_texture(
-            wgpu::TexelCopyBufferInfo { buffer: &sentinel, layout },
+        let mut fill_pass = d.create_command_encoder(&Default::default());
+        fill_pass.copy_buffer_to_texture(
+            wgpu::TexelCopyBufferInfo { buffer: other_fill.as_ref().unwrap_or(&sentinel), layout },
             texture.as_image_copy(),
             extent,
         );
         let mut compute = d.create_command_encoder(&Default::default());
         {
             let mut pass = compute.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_pipeline(&compiled.pipeline);
+            for (g, group) in groups.iter().enumerate() {
+                pass.set_bind_group(g as u32, group, &[]);
+            }
             let [x, y, z] = job.workgroups;
             pass.dispatch_workgroups(x, y, z);
         }
@@ -647,7 +762,7 @@ impl Context {
             return Err(GpuError::Validation { what: job.shader.to_string(), message: e.to_string() });
         }
         let _serial = self.submit_lock.lock().expect("submit lock");
-        let index = w.queue.submit([fill.finish()]);
+        let index = w.queue.submit([fill_pass.finish()]);
         self.wait(w, index, job.shader)?;
         let gpu_start = Instant::now();
         let index = w.queue.submit([compute.finish()]);
@@ -670,17 +785,17 @@ impl Context {
                 return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs_f64() });
             }
         }
-        let (image, unwritten) = {
+        let bytes = {
             let mapped = readback
                 .slice(..)
                 .get_mapped_range()
                 .map_err(|e| GpuError::Validation { what: "readback map".into(), message: e.to_string() })?;
-            unpad_rows(&mapped, job.width, job.height, padded_row)
+            unpad(&mapped, row_bytes, job.height, padded_row)
         };
         readback.unmap();
         let readback_time = copy_start.elapsed();
         *w.scratch.lock().expect("scratch") =
-            Some(Scratch { width: job.width, height: job.height, texture, readback, sentinel });
+            Some(Scratch { width: job.width, height: job.height, format: format.wgpu, texture, readback, sentinel });
         if self.validate {
             let messages = crate::validation::take();
             if !messages.is_empty() {
@@ -691,12 +806,18 @@ impl Context {
             }
         }
         let stats = RunStats { gpu_wall, kernel, readback: readback_time, total: start.elapsed() };
-        Ok(Readback { image, stats, unwritten })
+        Ok((bytes, stats))
     }
 
     /// The same job in headless Chromium: naga's WGSL of the composed
-    /// module, the same uniform bytes and table, the same readback layout.
-    fn run_in_browser(&self, b: &BrowserEngine, job: &Dispatch<'_>) -> Result<Readback, GpuError> {
+    /// module, the same slots, uniform bytes, table, sentinel and readback.
+    fn run_in_browser(
+        &self,
+        b: &BrowserEngine,
+        job: &Dispatch<'_>,
+        format: &OutputFormat,
+        which: usize,
+    ) -> Result<(Vec<u8>, RunStats), GpuError> {
         let key = format!("{}#{}", job.shader, job.shaders.source_hash(job.shader)?);
         let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
         let wgsl = match cached {
@@ -707,6 +828,19 @@ impl Context {
                 w
             }
         };
+        let slots: Vec<vista_browser::Slot> = job
+            .slots
+            .iter()
+            .map(|s| vista_browser::Slot {
+                group: s.group,
+                binding: s.binding,
+                kind: match s.kind {
+                    SlotKind::Uniform => "uniform",
+                    SlotKind::Table => "table",
+                    SlotKind::Output => "output",
+                },
+            })
+            .collect();
         let _serial = self.submit_lock.lock().expect("submit lock");
         let out = b
             .browser
@@ -716,7 +850,10 @@ impl Context {
                 wgsl: &wgsl,
                 entry: job.entry,
                 workgroups: job.workgroups,
-                sentinel: UNWRITTEN,
+                slots: &slots,
+                format: format.name,
+                texel_bytes: format.texel_bytes() as u32,
+                fill: &format.sentinel(which),
                 uniforms: job.uniforms,
                 table: job.table,
                 width: job.width,
@@ -729,17 +866,13 @@ impl Context {
                 }
                 other => GpuError::Device { adapter: self.info.name.clone(), message: other.to_string() },
             })?;
-        let mut rgba = out.rgba;
-        let unwritten = take_unwritten(&mut rgba);
-        let image = Image::from_raw(job.width, job.height, rgba)
-            .map_err(|e| GpuError::Request(format!("browser readback: {e}")))?;
         let stats = RunStats {
             gpu_wall: out.kernel + out.readback,
             kernel: out.kernel,
             readback: out.readback,
             total: out.total,
         };
-        Ok(Readback { image, stats, unwritten })
+        Ok((out.bytes, stats))
     }
 
     /// Blocks until `index` completes, or fails after the watchdog timeout.
@@ -756,42 +889,38 @@ impl Context {
     }
 }
 
-fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
-}
-
 fn words_to_bytes(words: &[u32]) -> Vec<u8> {
     words.iter().flat_map(|w| w.to_le_bytes()).collect()
 }
 
-/// Counts the texels whose four channels all hold [`UNWRITTEN`] and sets
-/// them to 0, as a fresh texture reads.
-fn take_unwritten(texels: &mut [[f32; 4]]) -> u64 {
-    let mut n = 0;
-    for px in texels.iter_mut().filter(|px| px.iter().all(|c| c.to_bits() == UNWRITTEN)) {
-        *px = [0.0; 4];
-        n += 1;
+/// Copies `height` rows of `row_bytes` out of a buffer whose rows are
+/// `padded_row` bytes apart.
+pub(crate) fn unpad(bytes: &[u8], row_bytes: u32, height: u32, padded_row: u32) -> Vec<u8> {
+    let (row, padded) = (row_bytes as usize, padded_row as usize);
+    let mut out = Vec::with_capacity(row * height as usize);
+    for y in 0..height as usize {
+        out.extend_from_slice(&bytes[y * padded..][..row]);
     }
-    n
+    out
 }
 
-/// Copies `height` rows of `width` RGBA f32 texels out of a buffer whose rows
-/// are `padded_row` bytes apart; texels never written read 0 and are counted.
-pub(crate) fn unpad_rows(bytes: &[u8], width: u32, height: u32, padded_row: u32) -> (Image, u64) {
-    let (w, row, padded) = (width as usize, width as usize * 16, padded_row as usize);
-    // Written in place (no per-pixel push), so even the tests' opt-level 1
-    // build turns it into straight copies.
-    let mut data = vec![[0.0f32; 4]; w * height as usize];
-    for (y, dst) in data.chunks_exact_mut(w).enumerate() {
-        let src = &bytes[y * padded..][..row];
-        for (px, texel) in dst.iter_mut().zip(src.chunks_exact(16)) {
+/// Texel bytes of `format`, row-major, as an f32 RGBA image.
+pub(crate) fn decode(bytes: &[u8], format: &OutputFormat, width: u32, height: u32) -> Image {
+    let mut data = vec![[0.0f32; 4]; width as usize * height as usize];
+    if format.wgpu == wgpu::TextureFormat::Rgba32Float {
+        // Written in place (no per-pixel push), so even the tests' opt-level 1
+        // build turns it into straight copies.
+        for (px, texel) in data.iter_mut().zip(bytes.chunks_exact(16)) {
             for (c, b) in px.iter_mut().zip(texel.chunks_exact(4)) {
                 *c = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
             }
         }
+    } else {
+        for (px, texel) in data.iter_mut().zip(bytes.chunks_exact(format.texel_bytes())) {
+            *px = format.decode(texel);
+        }
     }
-    let unwritten = take_unwritten(&mut data);
-    (Image::from_raw(width, height, data).expect("unpadded rows fill the image"), unwritten)
+    Image::from_raw(width, height, data).expect("one texel per pixel")
 }
 
 /// Picks the adapter matching `choice` from those enumerated.
@@ -820,8 +949,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn unpad_rows_skips_row_padding() {
-        // 3 x 2 image, rows padded to 256 bytes: padding bytes are garbage.
+    fn unpad_skips_row_padding_and_decode_reads_the_format() {
+        // 3 x 2 rgba32float texels, rows padded to 256 bytes: padding bytes are garbage.
         let (w, h, padded) = (3u32, 2u32, 256u32);
         let mut bytes = vec![0xAB_u8; (padded * h) as usize];
         for y in 0..h {
@@ -833,17 +962,11 @@ mod tests {
                 }
             }
         }
-        // Texel (1, 1) still holds the sentinel in all four channels.
-        for c in 0..4 {
-            let at = (padded + 16 + c * 4) as usize;
-            bytes[at..at + 4].copy_from_slice(&UNWRITTEN.to_le_bytes());
-        }
-        // Texel (0, 1) holds it in one channel only: written.
-        bytes[padded as usize..][..4].copy_from_slice(&UNWRITTEN.to_le_bytes());
-        let (img, unwritten) = unpad_rows(&bytes, w, h, padded);
+        let rgba32 = OutputFormat::parse("rgba32float").unwrap();
+        let img = decode(&unpad(&bytes, w * 16, h, padded), &rgba32, w, h);
         assert_eq!(img.get(2, 1), [120.0, 121.0, 122.0, 123.0]);
         assert_eq!(img.get(0, 0), [0.0, 1.0, 2.0, 3.0]);
-        assert_eq!((unwritten, img.get(1, 1)), (1, [0.0; 4]));
-        assert_eq!(img.get(0, 1)[0].to_bits(), UNWRITTEN);
+        let r8 = OutputFormat::parse("rgba8unorm").unwrap();
+        assert_eq!(decode(&[255, 0, 51, 255], &r8, 1, 1).get(0, 0), [1.0, 0.0, 0.2, 1.0]);
     }
 }

@@ -8,13 +8,15 @@
 //! size; meaning lives in `vista-kernels`, the plan in `vista-render`.
 
 mod context;
+mod format;
 mod shaders;
 pub mod validation;
 
 pub use context::{
     AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dispatch, GpuConfig, Readback, RunStats,
-    SWIFTSHADER_HINT, UNWRITTEN, VALIDATION_LAYER_JSON,
+    SWIFTSHADER_HINT, Slot, SlotKind, UNWRITTEN, VALIDATION_LAYER_JSON,
 };
+pub use format::{OutputFormat, format_names};
 pub use shaders::{ShaderSet, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.

@@ -1,5 +1,6 @@
 //! The uniform block of a kernel, from naga's reflection of its composed
-//! WGSL: the `Params` struct at `@group(0) @binding(0)` is walked (nested
+//! WGSL: the uniform struct the entry point reaches, at whatever group and
+//! binding it is declared ([`crate::bindings`]), is walked (nested
 //! structs included) into leaf fields with their WGSL type and byte offset,
 //! checked against the manifest by name and type, and filled from a
 //! [`ParamSet`]. Offsets, alignment and padding all come from naga, so a
@@ -57,20 +58,24 @@ pub struct UniformLayout {
     /// The struct's byte size (naga's span).
     pub size: u32,
     pub fields: Vec<Field>,
-    /// Whether the module declares binding 2 (the Perlin permutation).
+    /// Whether the entry point reads the u32 table (the Perlin permutation).
     pub uses_table: bool,
+    /// Every binding the entry point reaches and what feeds it.
+    pub bindings: Vec<crate::bindings::Binding>,
 }
 
 /// Reflects the uniform block of `module` for `kernel` (named in errors).
-pub fn reflect(kernel: &str, shader: &str, module: &naga::Module) -> Result<UniformLayout, ParamError> {
+pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<UniformLayout, ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
-    let bound = |b: u32| {
-        module.global_variables.iter().find(|(_, v)| v.binding.as_ref().is_some_and(|r| r.group == 0 && r.binding == b))
+    let bindings = crate::bindings::reflect(kernel, shader, entry, module)?;
+    let uses_table = bindings.iter().any(|b| b.feed == crate::bindings::Feed::Table);
+    let Some(uniform) = bindings.iter().find(|b| b.feed == crate::bindings::Feed::Uniform) else {
+        // No uniform: the kernel takes no params (a param would feed nothing).
+        return Ok(UniformLayout { size: 0, fields: Vec::new(), uses_table, bindings });
     };
-    let (_, var) = bound(0)
-        .ok_or_else(|| bad(format!("{shader} declares no `@group(0) @binding(0) var<uniform> params: Params`")))?;
+    let var = &module.global_variables[uniform.global];
     let TypeInner::Struct { members, span } = &module.types[var.ty].inner else {
-        return Err(bad(format!("{shader}: binding 0 must be a struct (Params), not a bare value")));
+        unreachable!("bindings::reflect feeds only struct uniforms");
     };
     let mut fields = Vec::new();
     walk(module, members, 0, "", shader, &mut fields).map_err(bad)?;
@@ -79,7 +84,7 @@ pub fn reflect(kernel: &str, shader: &str, module: &naga::Module) -> Result<Unif
             return Err(bad(format!("{shader}: Params fields {} and {} share the name '{}'", g.path, f.path, f.name)));
         }
     }
-    Ok(UniformLayout { size: *span, fields, uses_table: bound(2).is_some() })
+    Ok(UniformLayout { size: *span, fields, uses_table, bindings })
 }
 
 fn walk(
@@ -250,7 +255,8 @@ default = -3
     fn module(params_struct: &str) -> naga::Module {
         let src = format!(
             "{params_struct}\n@group(0) @binding(0) var<uniform> params: Params;\n\
-             @compute @workgroup_size(8, 8) fn main() {{ let w = params.width; }}\n"
+             @group(0) @binding(1) var out: texture_storage_2d<rgba32float, write>;\n\
+             @compute @workgroup_size(8, 8) fn main() {{ textureStore(out, vec2(0u), vec4(f32(params.width))); }}\n"
         );
         naga::front::wgsl::parse_str(&src).unwrap()
     }

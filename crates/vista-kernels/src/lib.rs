@@ -64,6 +64,7 @@ pub mod cpu32;
 pub mod cpu64;
 
 pub mod atmosphere;
+pub mod bindings;
 pub mod cloudmap;
 pub mod clouds;
 pub mod expr;
@@ -381,7 +382,7 @@ impl Kernel {
 
     /// Reflects and checks the uniform layout of this kernel's composed module.
     pub fn layout(&self, module: &naga::Module) -> Result<UniformLayout, ParamError> {
-        let l = layout::reflect(self.name(), self.shader(), module)?;
+        let l = layout::reflect(self.name(), self.shader(), self.entry(), module)?;
         layout::check(self, &l)?;
         Ok(l)
     }

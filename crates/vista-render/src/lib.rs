@@ -189,9 +189,13 @@ pub struct Plan {
     /// Workgroups dispatched: the manifest's `workgroups`, else enough of
     /// `workgroup_size` to cover the output.
     pub workgroups: [u32; 3],
-    /// Binding 0's bytes.
+    /// Every binding the entry point reaches, and what feeds it.
+    pub slots: Vec<vista_gpu::Slot>,
+    /// The output's storage format (its WGSL name).
+    pub format: &'static str,
+    /// The uniform block's bytes.
     pub uniforms: Vec<u8>,
-    /// Binding 2's words (Perlin's permutation and its packed chains).
+    /// The table's words (Perlin's permutation and its packed chains).
     pub table: Vec<u32>,
     /// Output width in pixels.
     pub width: u32,
@@ -227,20 +231,29 @@ pub fn plan(
         .iter()
         .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
         .map(|e| e.workgroup_size)
-        .ok_or_else(|| {
-            let compute: Vec<&str> = module
-                .entry_points
-                .iter()
-                .filter(|e| e.stage == naga::ShaderStage::Compute)
-                .map(|e| e.name.as_str())
-                .collect();
-            RenderError::BadInput(format!(
-                "kernel {}: {} has no compute entry point '{entry}'; its compute entry points: {}",
-                kernel.name(),
-                shader,
-                if compute.is_empty() { "none".to_string() } else { compute.join(", ") }
-            ))
-        })?;
+        .expect("Kernel::layout refuses an unknown entry point");
+    use vista_kernels::bindings::Feed;
+    let slots: Vec<vista_gpu::Slot> = layout
+        .bindings
+        .iter()
+        .map(|b| vista_gpu::Slot {
+            group: b.group,
+            binding: b.binding,
+            kind: match b.feed {
+                Feed::Uniform => vista_gpu::SlotKind::Uniform,
+                Feed::Table => vista_gpu::SlotKind::Table,
+                Feed::Output(_) => vista_gpu::SlotKind::Output,
+            },
+        })
+        .collect();
+    let format = layout
+        .bindings
+        .iter()
+        .find_map(|b| match b.feed {
+            Feed::Output(f) => Some(f),
+            _ => None,
+        })
+        .expect("Kernel::layout refuses a pass without an output");
     let workgroups = match kernel.workgroups(p, width, height).map_err(|e| RenderError::BadInput(e.to_string()))? {
         Some(count) => count,
         // Cover the output: the workgroup size is the shader's, never assumed.
@@ -251,6 +264,8 @@ pub fn plan(
         entry: entry.to_string(),
         workgroup_size,
         workgroups,
+        slots,
+        format,
         uniforms: kernel.uniforms(&layout, p, width, height),
         table: kernel.table(&layout, p),
         shader,
@@ -267,6 +282,8 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         shader: &plan.shader,
         entry: &plan.entry,
         workgroups: plan.workgroups,
+        slots: &plan.slots,
+        format: plan.format,
         uniforms: &plan.uniforms,
         table: &plan.table,
         width: plan.width,

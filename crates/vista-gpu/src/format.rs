@@ -1,0 +1,178 @@
+//! The output texture's storage format: its wgpu format, texel size, the
+//! two sentinel texels that find unwritten texels, and the decoding of its
+//! texels into f32 RGBA (missing channels read 0, alpha 1, as a shader's
+//! load of the format does).
+
+use crate::GpuError;
+
+/// How a channel is stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Channel {
+    Unorm8,
+    Snorm8,
+    Uint8,
+    Sint8,
+    Float16,
+    Uint16,
+    Sint16,
+    Float32,
+    Uint32,
+    Sint32,
+}
+
+impl Channel {
+    fn bytes(self) -> usize {
+        match self {
+            Channel::Unorm8 | Channel::Snorm8 | Channel::Uint8 | Channel::Sint8 => 1,
+            Channel::Float16 | Channel::Uint16 | Channel::Sint16 => 2,
+            _ => 4,
+        }
+    }
+
+    fn decode(self, b: &[u8]) -> f32 {
+        match self {
+            Channel::Unorm8 => b[0] as f32 / 255.0,
+            Channel::Snorm8 => (b[0] as i8 as f32 / 127.0).max(-1.0),
+            Channel::Uint8 => b[0] as f32,
+            Channel::Sint8 => b[0] as i8 as f32,
+            Channel::Float16 => f16_to_f32(u16::from_le_bytes([b[0], b[1]])),
+            Channel::Uint16 => u16::from_le_bytes([b[0], b[1]]) as f32,
+            Channel::Sint16 => i16::from_le_bytes([b[0], b[1]]) as f32,
+            Channel::Float32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            Channel::Uint32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+            Channel::Sint32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+        }
+    }
+
+    /// One channel of sentinel texel `which` (0 or 1): for 32-bit floats a
+    /// NaN payload no arithmetic produces, for 16-bit floats the same idea,
+    /// otherwise a bit pattern a kernel writes only by coincidence, which
+    /// the second sentinel then tells apart.
+    fn sentinel(self, which: usize) -> Vec<u8> {
+        match (self.bytes(), which) {
+            (4, 0) => crate::UNWRITTEN.to_le_bytes().to_vec(),
+            (4, _) => 0x7FC0_BEEFu32.to_le_bytes().to_vec(),
+            (2, 0) => 0x7E5Au16.to_le_bytes().to_vec(),
+            (2, _) => 0x7E3Cu16.to_le_bytes().to_vec(),
+            (_, 0) => vec![0xA5],
+            (_, _) => vec![0x5A],
+        }
+    }
+}
+
+/// Half-precision bits to f32 (IEEE 754 binary16).
+fn f16_to_f32(h: u16) -> f32 {
+    let sign = ((h >> 15) as u32) << 31;
+    let exp = ((h >> 10) & 0x1f) as u32;
+    let frac = (h & 0x3ff) as u32;
+    let bits = match (exp, frac) {
+        (0, 0) => sign,
+        (0, f) => {
+            // Subnormal: normalise the fraction.
+            let shift = f.leading_zeros() - 21;
+            sign | ((127 - 15 + 1 - shift) << 23) | ((f << shift) & 0x3ff) << 13
+        }
+        (0x1f, f) => sign | 0x7f80_0000 | (f << 13),
+        (e, f) => sign | ((e + 127 - 15) << 23) | (f << 13),
+    };
+    f32::from_bits(bits)
+}
+
+/// A storage format an output may have.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputFormat {
+    /// The WGSL (and WebGPU) name.
+    pub name: &'static str,
+    pub wgpu: wgpu::TextureFormat,
+    channels: &'static [Channel],
+}
+
+/// Every write-only storage format an output may have (WebGPU's core set;
+/// `bgra8unorm` needs an optional feature and is refused as unsupported).
+const FORMATS: &[(&str, wgpu::TextureFormat, &[Channel])] = {
+    use Channel::*;
+    use wgpu::TextureFormat as F;
+    &[
+        ("rgba8unorm", F::Rgba8Unorm, &[Unorm8, Unorm8, Unorm8, Unorm8]),
+        ("rgba8snorm", F::Rgba8Snorm, &[Snorm8, Snorm8, Snorm8, Snorm8]),
+        ("rgba8uint", F::Rgba8Uint, &[Uint8, Uint8, Uint8, Uint8]),
+        ("rgba8sint", F::Rgba8Sint, &[Sint8, Sint8, Sint8, Sint8]),
+        ("rgba16float", F::Rgba16Float, &[Float16, Float16, Float16, Float16]),
+        ("rgba16uint", F::Rgba16Uint, &[Uint16, Uint16, Uint16, Uint16]),
+        ("rgba16sint", F::Rgba16Sint, &[Sint16, Sint16, Sint16, Sint16]),
+        ("rgba32float", F::Rgba32Float, &[Float32, Float32, Float32, Float32]),
+        ("rgba32uint", F::Rgba32Uint, &[Uint32, Uint32, Uint32, Uint32]),
+        ("rgba32sint", F::Rgba32Sint, &[Sint32, Sint32, Sint32, Sint32]),
+        ("r32float", F::R32Float, &[Float32]),
+        ("r32uint", F::R32Uint, &[Uint32]),
+        ("r32sint", F::R32Sint, &[Sint32]),
+        ("rg32float", F::Rg32Float, &[Float32, Float32]),
+        ("rg32uint", F::Rg32Uint, &[Uint32, Uint32]),
+        ("rg32sint", F::Rg32Sint, &[Sint32, Sint32]),
+    ]
+};
+
+/// The names [`OutputFormat::parse`] accepts.
+pub fn format_names() -> Vec<&'static str> {
+    FORMATS.iter().map(|f| f.0).collect()
+}
+
+impl OutputFormat {
+    /// The format of a WGSL storage format name.
+    pub fn parse(name: &str) -> Result<OutputFormat, GpuError> {
+        FORMATS
+            .iter()
+            .find(|f| f.0 == name)
+            .map(|&(name, wgpu, channels)| OutputFormat { name, wgpu, channels })
+            .ok_or_else(|| {
+                GpuError::Request(format!(
+                    "output format {name} is not supported; supported: {}",
+                    format_names().join(", ")
+                ))
+            })
+    }
+
+    /// Bytes of one texel.
+    pub fn texel_bytes(&self) -> usize {
+        self.channels.iter().map(|c| c.bytes()).sum()
+    }
+
+    /// Sentinel texel 0 or 1.
+    pub fn sentinel(&self, which: usize) -> Vec<u8> {
+        self.channels.iter().flat_map(|c| c.sentinel(which)).collect()
+    }
+
+    /// One texel as f32 RGBA.
+    pub fn decode(&self, texel: &[u8]) -> [f32; 4] {
+        let mut out = [0.0, 0.0, 0.0, 1.0];
+        let mut at = 0;
+        for (i, c) in self.channels.iter().enumerate() {
+            out[i] = c.decode(&texel[at..]);
+            at += c.bytes();
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texels_decode_per_format() {
+        let f = |n| OutputFormat::parse(n).unwrap();
+        assert_eq!(f("rgba8unorm").decode(&[0, 255, 51, 255]), [0.0, 1.0, 0.2, 1.0]);
+        assert_eq!(f("rgba8snorm").decode(&[0x81, 0x80, 127, 0]), [-1.0, -1.0, 1.0, 0.0]);
+        assert_eq!(f("r32float").decode(&2.5f32.to_le_bytes()), [2.5, 0.0, 0.0, 1.0]);
+        let rg: Vec<u8> = [7u32, 9].iter().flat_map(|v| v.to_le_bytes()).collect();
+        assert_eq!(f("rg32uint").decode(&rg), [7.0, 9.0, 0.0, 1.0]);
+        // binary16: 1.0, -2.0, 65504, the smallest subnormal.
+        let h: Vec<u8> = [0x3C00u16, 0xC000, 0x7BFF, 0x0001].iter().flat_map(|v| v.to_le_bytes()).collect();
+        assert_eq!(f("rgba16float").decode(&h), [1.0, -2.0, 65504.0, 2f32.powi(-24)]);
+        assert!(f16_to_f32(0x7E5A).is_nan() && f16_to_f32(0x7C00).is_infinite());
+        assert_eq!(f("rgba16float").texel_bytes(), 8);
+        assert_ne!(f("rgba8uint").sentinel(0), f("rgba8uint").sentinel(1));
+        let e = OutputFormat::parse("bgra8unorm").unwrap_err().to_string();
+        assert!(e.contains("bgra8unorm is not supported") && e.contains("rgba16float"), "{e}");
+    }
+}

@@ -1,0 +1,244 @@
+//! Every global an entry point reaches, from naga's reflection of the
+//! composed module, and what feeds it. So far vista feeds three kinds: the
+//! uniform block (params), the read-only u32 table (Perlin's permutation)
+//! and one write-only 2D storage texture (the output), each at whatever
+//! group and binding the kernel declares. Any other reached global is
+//! refused before GPU work, naming the entry point, the variable, its
+//! group/binding and WGSL type, and which resource kind would feed it.
+
+use naga::{AddressSpace, Handle, ImageClass, ImageDimension, ScalarKind, StorageAccess, TypeInner};
+
+use crate::ParamError;
+
+/// What feeds a binding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Feed {
+    /// The params, packed by name (`var<uniform>` of a struct).
+    Uniform,
+    /// The u32 table (`var<storage, read>` of `array<u32>`).
+    Table,
+    /// The output: a write-only `texture_storage_2d` of this format.
+    Output(&'static str),
+}
+
+/// One binding the entry point reaches.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Binding {
+    pub group: u32,
+    pub binding: u32,
+    /// The WGSL variable name.
+    pub name: String,
+    pub feed: Feed,
+    pub(crate) global: Handle<naga::GlobalVariable>,
+}
+
+/// The storage formats an output may have, by naga's name for them.
+fn format_name(f: naga::StorageFormat) -> Option<&'static str> {
+    use naga::StorageFormat as S;
+    Some(match f {
+        S::Rgba8Unorm => "rgba8unorm",
+        S::Rgba8Snorm => "rgba8snorm",
+        S::Rgba8Uint => "rgba8uint",
+        S::Rgba8Sint => "rgba8sint",
+        S::Rgba16Float => "rgba16float",
+        S::Rgba16Uint => "rgba16uint",
+        S::Rgba16Sint => "rgba16sint",
+        S::Rgba32Float => "rgba32float",
+        S::Rgba32Uint => "rgba32uint",
+        S::Rgba32Sint => "rgba32sint",
+        S::R32Float => "r32float",
+        S::R32Uint => "r32uint",
+        S::R32Sint => "r32sint",
+        S::Rg32Float => "rg32float",
+        S::Rg32Uint => "rg32uint",
+        S::Rg32Sint => "rg32sint",
+        _ => return None,
+    })
+}
+
+/// A WGSL spelling of a global's type, for messages.
+pub fn wgsl_type(module: &naga::Module, var: &naga::GlobalVariable) -> String {
+    let ty = &module.types[var.ty];
+    let inner = match &ty.inner {
+        TypeInner::Image { dim, arrayed, class } => {
+            let dim = match (dim, arrayed) {
+                (ImageDimension::D1, _) => "1d",
+                (ImageDimension::D2, false) => "2d",
+                (ImageDimension::D2, true) => "2d_array",
+                (ImageDimension::D3, _) => "3d",
+                (ImageDimension::Cube, false) => "cube",
+                (ImageDimension::Cube, true) => "cube_array",
+            };
+            match class {
+                ImageClass::Storage { format, access } => {
+                    let access = match (access.contains(StorageAccess::LOAD), access.contains(StorageAccess::STORE)) {
+                        (true, true) => "read_write",
+                        (true, false) => "read",
+                        _ => "write",
+                    };
+                    let f = format_name(*format)
+                        .map(str::to_string)
+                        .unwrap_or_else(|| format!("{format:?}").to_lowercase());
+                    format!("texture_storage_{dim}<{f}, {access}>")
+                }
+                ImageClass::Depth { .. } => format!("texture_depth_{dim}"),
+                ImageClass::Sampled { kind, .. } => {
+                    let k = match kind {
+                        ScalarKind::Sint => "i32",
+                        ScalarKind::Uint => "u32",
+                        _ => "f32",
+                    };
+                    format!("texture_{dim}<{k}>")
+                }
+                ImageClass::External => "texture_external".into(),
+            }
+        }
+        TypeInner::Sampler { comparison: true } => "sampler_comparison".into(),
+        TypeInner::Sampler { comparison: false } => "sampler".into(),
+        _ => ty
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("{:?}", ty.inner).split([' ', '{', '(']).next().unwrap_or("?").to_lowercase()),
+    };
+    match var.space {
+        AddressSpace::Uniform => format!("var<uniform> {inner}"),
+        AddressSpace::Storage { access } if access.contains(StorageAccess::STORE) => {
+            format!("var<storage, read_write> {inner}")
+        }
+        AddressSpace::Storage { .. } => format!("var<storage, read> {inner}"),
+        _ => inner,
+    }
+}
+
+/// The globals `entry` reaches, directly or through the functions it calls.
+fn reached(module: &naga::Module, entry: &naga::Function) -> Vec<Handle<naga::GlobalVariable>> {
+    fn calls(block: &naga::Block, out: &mut Vec<Handle<naga::Function>>) {
+        for s in block.iter() {
+            match s {
+                naga::Statement::Block(b) => calls(b, out),
+                naga::Statement::If { accept, reject, .. } => {
+                    calls(accept, out);
+                    calls(reject, out);
+                }
+                naga::Statement::Switch { cases, .. } => cases.iter().for_each(|c| calls(&c.body, out)),
+                naga::Statement::Loop { body, continuing, .. } => {
+                    calls(body, out);
+                    calls(continuing, out);
+                }
+                naga::Statement::Call { function, .. } => out.push(*function),
+                _ => {}
+            }
+        }
+    }
+    let mut globals = Vec::new();
+    let mut seen: Vec<Handle<naga::Function>> = Vec::new();
+    let mut work: Vec<&naga::Function> = vec![entry];
+    while let Some(f) = work.pop() {
+        for (_, e) in f.expressions.iter() {
+            if let naga::Expression::GlobalVariable(g) = e
+                && !globals.contains(g)
+            {
+                globals.push(*g);
+            }
+        }
+        let mut called = Vec::new();
+        calls(&f.body, &mut called);
+        for h in called {
+            if !seen.contains(&h) {
+                seen.push(h);
+                work.push(&module.functions[h]);
+            }
+        }
+    }
+    globals
+}
+
+/// Every binding `entry` of `module` reaches, each with what feeds it; a
+/// reached global nothing feeds, a second uniform or output, or an unknown
+/// entry point is refused.
+pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<Vec<Binding>, ParamError> {
+    let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
+    let ep = module.entry_points.iter().find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute).ok_or_else(
+        || {
+            let compute: Vec<&str> = module
+                .entry_points
+                .iter()
+                .filter(|e| e.stage == naga::ShaderStage::Compute)
+                .map(|e| e.name.as_str())
+                .collect();
+            bad(format!(
+                "{shader} has no compute entry point '{entry}'; its compute entry points: {}",
+                if compute.is_empty() { "none".to_string() } else { compute.join(", ") }
+            ))
+        },
+    )?;
+    let mut out: Vec<Binding> = Vec::new();
+    // In binding order, so that every message names the same variable first.
+    let mut globals = reached(module, &ep.function);
+    globals.sort_by_key(|g| module.global_variables[*g].binding.as_ref().map(|b| (b.group, b.binding)));
+    for g in globals {
+        let var = &module.global_variables[g];
+        let Some(rb) = &var.binding else { continue };
+        let name = var.name.clone().unwrap_or_default();
+        let unfed = |feed: &str| {
+            bad(format!(
+                "pass {entry}: {name} (@group({}) @binding({}), {}) is fed by nothing; it needs {feed}, which vista \
+                 does not feed yet",
+                rb.group,
+                rb.binding,
+                wgsl_type(module, var)
+            ))
+        };
+        let feed = match (&var.space, &module.types[var.ty].inner) {
+            (AddressSpace::Uniform, TypeInner::Struct { .. }) => Feed::Uniform,
+            (AddressSpace::Uniform, _) => {
+                return Err(unfed("a uniform of a bare value (params packed into a struct work)"));
+            }
+            (AddressSpace::Storage { access }, TypeInner::Array { base, .. })
+                if !access.contains(StorageAccess::STORE)
+                    && matches!(module.types[*base].inner, TypeInner::Scalar(s) if s.kind == ScalarKind::Uint && s.width == 4) =>
+            {
+                Feed::Table
+            }
+            (AddressSpace::Storage { .. }, _) => {
+                return Err(unfed("a buffer resource ([[resource]] kind = \"buffer\")"));
+            }
+            (
+                _,
+                TypeInner::Image {
+                    dim: ImageDimension::D2,
+                    arrayed: false,
+                    class: ImageClass::Storage { format, access },
+                },
+            ) if !access.contains(StorageAccess::LOAD) => match format_name(*format) {
+                Some(f) => Feed::Output(f),
+                None => return Err(unfed("an output texture of a supported format (not bgra8unorm or a packed one)")),
+            },
+            (_, TypeInner::Image { .. }) => return Err(unfed("a texture resource ([[resource]] kind = \"texture\")")),
+            (_, TypeInner::Sampler { .. }) => {
+                return Err(unfed("a sampler resource ([[resource]] kind = \"sampler\")"));
+            }
+            _ => return Err(unfed("a resource")),
+        };
+        for kind in [Feed::Uniform, Feed::Output("")] {
+            let same = |f: &Feed| std::mem::discriminant(f) == std::mem::discriminant(&kind);
+            if same(&feed)
+                && let Some(first) = out.iter().find(|b| same(&b.feed))
+            {
+                return Err(bad(format!(
+                    "pass {entry}: {name} (@group({}) @binding({})) is a second {} after {}; one is supported so far",
+                    rb.group,
+                    rb.binding,
+                    if kind == Feed::Uniform { "uniform" } else { "output texture" },
+                    first.name
+                )));
+            }
+        }
+        out.push(Binding { group: rb.group, binding: rb.binding, name, feed, global: g });
+    }
+    if !out.iter().any(|b| matches!(b.feed, Feed::Output(_))) {
+        return Err(bad(format!("pass {entry} of {shader} writes no texture_storage_2d output")));
+    }
+    out.sort_by_key(|b| (b.group, b.binding));
+    Ok(out)
+}
