@@ -1207,6 +1207,48 @@ fn unfed_globals_are_refused() {
     }
 }
 
+/// A project module outside lib/ with its own import path, as real kernels
+/// import theirs; its hash is the kernel's provenance, so editing it makes
+/// check name the file.
+fn a_foreign_import_path_composes_and_is_named_when_edited() {
+    let module = "#define_import_path mylib::sky::tone\n\nfn tone(x: f32) -> f32 {\n    return x * x;\n}\n";
+    let shader = gradient_shader("main", "8, 8", "params.height")
+        .replace("struct Params", "#import mylib::sky::tone::{tone}\n\nstruct Params")
+        .replace("params.gain * u * v", "tone(params.gain * u * v)");
+    let d = kernel_project(K_MANIFEST, &shader);
+    std::fs::create_dir_all(d.path().join("shaders/mylib/sky")).unwrap();
+    std::fs::write(d.path().join("shaders/mylib/sky/tone.wgsl"), module).unwrap();
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    std::fs::write(cases_path(d.path()), "[[case]]\nid = \"t\"\nkernel = \"k\"\nsize = \"16x16\"\n").unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let manifest = std::fs::read_to_string(d.path().join("golden/manifest.toml")).unwrap();
+    assert!(manifest.contains("\"mylib/sky/tone.wgsl\""), "{manifest}");
+    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0);
+    std::fs::write(d.path().join("shaders/mylib/sky/tone.wgsl"), module.replace("x * x", "x * x * x")).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("changed shader files: mylib/sky/tone.wgsl"), "{}", c.stdout);
+}
+
+/// Manifest defs with values reach the kernel and the modules it imports.
+fn valued_defs_reach_imported_modules() {
+    let module = "#define_import_path mylib::steps\n\n#if STEPS == 3\nconst K: f32 = 0.25;\n#else\nconst K: f32 = 1.0;\n#endif\n\
+                  fn k() -> f32 {\n    return K;\n}\n";
+    let shader = gradient_shader("main", "8, 8", "params.height")
+        .replace("struct Params", "#import mylib::steps::k\n\nstruct Params")
+        .replace("vec4(u, v, params.gain * u * v, 1.0)", "vec4(k(), params.gain, 0.0, 1.0)");
+    for (defs, want) in [("{ STEPS = 3, FIRST = true }", 0.25), ("{ STEPS = 4 }", 1.0)] {
+        let d = kernel_project(&format!("defs = {defs}\n{K_MANIFEST}"), &shader);
+        std::fs::create_dir_all(d.path().join("shaders/mylib")).unwrap();
+        std::fs::write(d.path().join("shaders/mylib/steps.wgsl"), module).unwrap();
+        let (r, out) = render_exr(d.path(), "8x8", "d");
+        assert_eq!(r.code, 0, "{defs}: {}", r.stderr);
+        assert_eq!(vista_image::load(&out).unwrap().get(3, 3)[0], want, "{defs}");
+    }
+    let d = kernel_project(&format!("defs = {{ STEPS = 2.5 }}\n{K_MANIFEST}"), &shader);
+    assert_rejected(&render_exr(d.path(), "8x8", "d").0, 2, &["defs: STEPS = 2.5 is not valid", "an integer"]);
+}
+
 fn a_kernel_described_as_data_renders() {
     let r = render_k(K_MANIFEST, K_SHADER);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -1814,6 +1856,12 @@ fn main() {
         (Gpu, "any_binding_and_output_format_on_every_backend", any_binding_and_output_format_on_every_backend),
         (Gpu, "a_kernel_without_a_uniform_renders", a_kernel_without_a_uniform_renders),
         (Cpu, "unfed_globals_are_refused", unfed_globals_are_refused),
+        (Gpu, "valued_defs_reach_imported_modules", valued_defs_reach_imported_modules),
+        (
+            Gpu,
+            "a_foreign_import_path_composes_and_is_named_when_edited",
+            a_foreign_import_path_composes_and_is_named_when_edited,
+        ),
         (Gpu, "unwritten_texels_fail_unless_the_output_is_partial", unwritten_texels_fail_unless_the_output_is_partial),
         (
             Gpu,

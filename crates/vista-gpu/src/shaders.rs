@@ -37,7 +37,9 @@ impl ShaderSet {
         let mut lib = Vec::new();
         let mut kernels = BTreeMap::new();
         for (rel, text, origin) in files {
-            if rel.starts_with("lib/") {
+            // An import module is a file under lib/ or any file with its own
+            // `#define_import_path` (a project's foreign module layout).
+            if rel.starts_with("lib/") || import_path(&text).is_some() {
                 lib.push((rel, text));
             } else {
                 kernels.insert(rel, (text, origin));
@@ -164,9 +166,9 @@ impl ShaderSet {
 
     /// Library files reachable from `source` through `#import`, in `lib` order.
     fn imported_lib(&self, source: &str) -> Vec<&(String, String)> {
-        let path_of = |src: &str| {
-            src.lines().find_map(|l| l.trim().strip_prefix("#define_import_path").map(|p| p.trim().to_string()))
-        };
+        let path_of = |src: &str| import_path(src);
+        let defined: Vec<String> = self.lib.iter().filter_map(|e| import_path(&e.1)).collect();
+        let imports = |src: &str| imports(src, &defined);
         let mut wanted: Vec<String> = imports(source);
         let mut used = vec![false; self.lib.len()];
         while let Some(module) = wanted.pop() {
@@ -181,21 +183,28 @@ impl ShaderSet {
     }
 }
 
-/// Module paths named by `#import` lines (`#import vista::noise::{a, b}` and
-/// `#import vista::noise` both name `vista::noise`; only `vista::X` paths are ours).
-fn imports(source: &str) -> Vec<String> {
+/// The path a module declares with `#define_import_path`, if any.
+fn import_path(source: &str) -> Option<String> {
+    source.lines().find_map(|l| l.trim().strip_prefix("#define_import_path").map(|p| p.trim().to_string()))
+}
+
+/// Module paths named by `#import` lines: for each, the longest declared
+/// module path it starts with (`#import vista::noise::{a, b}`,
+/// `#import vista::noise`, `#import mylib::sky::types as t` and
+/// `#import mylib::sky::types::scale` all name their module).
+fn imports(source: &str, defined: &[String]) -> Vec<String> {
     source
         .lines()
         .filter_map(|l| l.trim().strip_prefix("#import"))
         .filter_map(|rest| {
-            let path: Vec<&str> = rest.trim().split("::").take(2).collect();
-            match path.as_slice() {
-                ["vista", m] => {
-                    let m: String = m.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
-                    Some(format!("vista::{m}"))
-                }
-                _ => None,
-            }
+            let text = rest.trim();
+            let text = text.split(" as ").next().unwrap_or(text).trim();
+            let text = text.split("::{").next().unwrap_or(text).trim();
+            defined
+                .iter()
+                .filter(|p| text == p.as_str() || text.starts_with(&format!("{p}::")))
+                .max_by_key(|p| p.len())
+                .cloned()
         })
         .collect()
 }
@@ -211,11 +220,26 @@ pub fn validate(name: &str, module: &naga::Module) -> Result<naga::valid::Module
         .map_err(|e| GpuError::Shader(format!("{name}: naga validation failed: {}", e.emit_to_string(""))))
 }
 
-/// The shader defs after `?` in a kernel name (`fbm.wgsl?A&B`), all `true`.
+/// The shader defs after `?` in a kernel name (`fbm.wgsl?A&B&N=10&F=false`):
+/// a bare name is `true`, `NAME=value` a bool or an integer (i32, else u32).
 fn shader_defs(name: &str) -> HashMap<String, naga_oil::compose::ShaderDefValue> {
+    use naga_oil::compose::ShaderDefValue as V;
     let defs = name.split_once('?').map_or("", |(_, d)| d);
     defs.split('&')
         .filter(|d| !d.is_empty())
-        .map(|d| (d.to_string(), naga_oil::compose::ShaderDefValue::Bool(true)))
+        .map(|d| match d.split_once('=') {
+            None => (d.to_string(), V::Bool(true)),
+            Some((k, v)) => {
+                let value = match v {
+                    "true" => V::Bool(true),
+                    "false" => V::Bool(false),
+                    _ => match v.parse::<i32>() {
+                        Ok(i) => V::Int(i),
+                        Err(_) => V::UInt(v.parse().unwrap_or_default()),
+                    },
+                };
+                (k.to_string(), value)
+            }
+        })
         .collect()
 }

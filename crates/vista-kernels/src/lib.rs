@@ -359,13 +359,14 @@ impl Kernel {
     }
 
     /// The kernel file to compose for `p`: [`Self::shader`], followed by
-    /// the naga_oil shader defs `p` selects after `?`, joined by `&`:
+    /// the naga_oil shader defs after `?`, joined by `&`: the manifest's
+    /// `defs` as `NAME=value`, then those `p` selects:
     /// `VISTA_HASH_PLANE` on a hash plane, then `NAME_IS_VALUE` (upper case)
     /// for each param the manifest lists under `specialize`, e.g.
     /// `fbm.wgsl?VISTA_HASH_PLANE&BASIS_IS_PERLIN`. Each distinct name is
     /// composed, cached and compiled as its own pipeline.
     pub fn shader_for(&self, p: &ParamSet) -> String {
-        let mut defs: Vec<String> = Vec::new();
+        let mut defs: Vec<String> = self.manifest.defs.clone();
         if self.hash_plane(p).is_some() {
             defs.push("VISTA_HASH_PLANE".into());
         }

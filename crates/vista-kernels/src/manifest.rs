@@ -43,6 +43,9 @@ struct RawManifest {
     output: Option<toml::Value>,
     #[serde(default, rename = "pass")]
     passes: Vec<RawPass>,
+    /// naga_oil shader defs: bool or integer values.
+    #[serde(default)]
+    defs: toml::Table,
     display_alpha: Option<String>,
     #[serde(default)]
     work: Vec<String>,
@@ -124,6 +127,9 @@ pub struct Manifest {
     pub workgroups: Option<[crate::expr::Expr; 3]>,
     /// Texels the kernel leaves unwritten are allowed (`[[output]] partial`).
     pub partial: bool,
+    /// naga_oil shader defs (`defs = { MAX_LIGHTS = 10, FIRST_PASS = true }`),
+    /// as `NAME=value` in declaration order.
+    pub defs: Vec<String>,
     pub work: Vec<WorkFactor>,
     pub output_range: Option<(f64, f64)>,
     /// The z every fbm2/ridged2 call of the shader takes.
@@ -400,6 +406,23 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             return Err(kfail(format!("[[pass]] workgroups has {} entries; expected [x, y, z]", list.len())));
         }
     };
+    let mut defs = Vec::new();
+    for (k, v) in &raw.defs {
+        if k.is_empty() || !k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(kfail(format!("defs: '{k}' is not a shader def name (letters, digits and '_')")));
+        }
+        match v {
+            toml::Value::Boolean(b) => defs.push(format!("{k}={b}")),
+            toml::Value::Integer(i) if (i32::MIN as i64..=u32::MAX as i64).contains(i) => defs.push(format!("{k}={i}")),
+            other => {
+                return Err(kfail(format!(
+                    "defs: {k} = {other} is not valid; expected true, false or an integer in [{}, {}]",
+                    i32::MIN,
+                    u32::MAX
+                )));
+            }
+        }
+    }
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
         name: leak(name),
@@ -410,6 +433,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         entry: leak(entry),
         workgroups,
         partial,
+        defs,
         work,
         output_range: raw.output_range.map(|[a, b]| (a, b)),
         hash_plane,
