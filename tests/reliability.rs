@@ -121,6 +121,9 @@ fn value_strategy(spec: &ParamSpec) -> BoxedStrategy<String> {
         ]
         .prop_map(|v| v.to_string())
         .boxed(),
+        Kind::IntVector { n, min, max } => proptest::collection::vec(min..=max, n)
+            .prop_map(|v| v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","))
+            .boxed(),
         Kind::Vector { n, min, max } => proptest::collection::vec(min..=max, n)
             .prop_map(|v| v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","))
             .boxed(),

@@ -1249,6 +1249,85 @@ fn valued_defs_reach_imported_modules() {
     assert_rejected(&render_exr(d.path(), "8x8", "d").0, 2, &["defs: STEPS = 2.5 is not valid", "an integer"]);
 }
 
+/// A uniform as real kernels lay theirs out: a matrix, integer vectors, an
+/// array and padding fields, packed from the manifest's params by name on
+/// every implementation.
+fn matrices_integer_vectors_arrays_and_padding_are_packed() {
+    let manifest = r#"summary = "a camera-style uniform"
+[[param]]
+name = "view"
+type = "mat4x4<f32>"
+range = [-4, 4]
+default = [1, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1, 0, 0.25, -0.5, 0, 1]
+[[param]]
+name = "cells"
+type = "vec2<u32>"
+range = [1, 64]
+default = [4, 2]
+[[param]]
+name = "tint"
+type = "array<vec4<f32>, 2>"
+range = [0, 1]
+default = [[1, 0.5, 0.25, 1], [0.5, 0.5, 0.5, 1]]
+[[param]]
+name = "shift"
+type = "vec2i"
+range = [-8, 8]
+default = [0, 0]
+"#;
+    let shader = r#"struct Camera {
+    view: mat4x4<f32>,
+    cells: vec2<u32>,
+    _padding: vec2<u32>,
+}
+struct Params {
+    width: u32,
+    height: u32,
+    cam: Camera,
+    tint: array<vec4<f32>, 2>,
+    shift: vec2<i32>,
+    _pad: vec2<f32>,
+}
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(f32(params.width), f32(params.height));
+    let p = params.cam.view * vec4(uv, 0.0, 1.0);
+    let cell = vec2<u32>(uv * vec2<f32>(params.cam.cells)) + vec2<u32>(params.shift);
+    let t = params.tint[(cell.x + cell.y) % 2u];
+    textureStore(output, id.xy, vec4(p.x * t.x, p.y * t.y, f32(cell.x) / 8.0, t.w));
+}
+"#;
+    let d = kernel_project(manifest, shader);
+    let (w, h) = (16u32, 8u32);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("{backend}.exr"));
+        let args =
+            ["render", "k", "--size", "16x8", "--set", "shift=1,0", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        let img = vista_image::load(&out).unwrap();
+        for y in 0..h {
+            for x in 0..w {
+                let (u, v) = ((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                let (px, py) = (u + 0.25, 2.0 * v - 0.5);
+                let (cx, cy) = ((u * 4.0) as u32 + 1, (v * 2.0) as u32);
+                let t = if (cx + cy) % 2 == 0 { [1.0, 0.5] } else { [0.5, 0.5] };
+                let want = [px * t[0], py * t[1], cx as f32 / 8.0, 1.0];
+                let got = img.get(x, y);
+                assert!(
+                    got.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-5),
+                    "{backend} ({x}, {y}): {got:?} vs {want:?}"
+                );
+            }
+        }
+    }
+}
+
 fn a_kernel_described_as_data_renders() {
     let r = render_k(K_MANIFEST, K_SHADER);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -1857,6 +1936,11 @@ fn main() {
         (Gpu, "a_kernel_without_a_uniform_renders", a_kernel_without_a_uniform_renders),
         (Cpu, "unfed_globals_are_refused", unfed_globals_are_refused),
         (Gpu, "valued_defs_reach_imported_modules", valued_defs_reach_imported_modules),
+        (
+            Gpu,
+            "matrices_integer_vectors_arrays_and_padding_are_packed",
+            matrices_integer_vectors_arrays_and_padding_are_packed,
+        ),
         (
             Gpu,
             "a_foreign_import_path_composes_and_is_named_when_edited",

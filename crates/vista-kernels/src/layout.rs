@@ -8,40 +8,31 @@
 
 use naga::{ScalarKind, TypeInner, VectorSize};
 
-use crate::params::{ParamType, Value};
+use crate::params::{ParamType, Scalar, Value};
 use crate::{Kernel, ParamError, ParamSet};
 
-/// The WGSL type of one leaf field.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FieldType {
-    U32,
-    I32,
-    F32,
-    /// `vecN<f32>`.
-    VecF32(u8),
+/// The WGSL type of one leaf field: its scalar, its normalised WGSL name,
+/// and the byte offset of each component from the field's offset (vector
+/// components 4 bytes apart, matrix columns and array elements at naga's
+/// strides).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FieldType {
+    pub scalar: Scalar,
+    pub name: String,
+    pub components: Vec<u32>,
 }
 
 impl FieldType {
     pub fn wgsl(&self) -> String {
-        match self {
-            FieldType::U32 => "u32".into(),
-            FieldType::I32 => "i32".into(),
-            FieldType::F32 => "f32".into(),
-            FieldType::VecF32(n) => format!("vec{n}<f32>"),
-        }
+        self.name.clone()
     }
 
-    fn of(param: ParamType) -> FieldType {
-        match param {
-            ParamType::U32 | ParamType::Bool | ParamType::Enum => FieldType::U32,
-            ParamType::I32 => FieldType::I32,
-            ParamType::F32 => FieldType::F32,
-            ParamType::Vec(n) => FieldType::VecF32(n),
-        }
+    fn scalar(scalar: Scalar) -> FieldType {
+        FieldType { scalar, name: scalar.wgsl().into(), components: vec![0] }
     }
 }
 
-/// One leaf of the `Params` struct: its name (nested structs are walked;
+/// One leaf of the uniform struct: its name (nested structs are walked;
 /// leaves are matched by their own name), type and absolute byte offset.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Field {
@@ -101,35 +92,78 @@ fn walk(
         let offset = base + m.offset;
         let unsupported = |what: &str| {
             Err(format!(
-                "{shader}: Params field {path} is {what}; allowed: u32, i32, f32, vec2/3/4<f32>, nested structs"
+                "{shader}: Params field {path} is {what}; allowed: u32, i32, f32, vecN of them, matCxR<f32>, \
+                 fixed-size arrays of these, nested structs"
             ))
         };
         let ty = match &module.types[m.ty].inner {
-            TypeInner::Scalar(s) if s.width == 4 => match s.kind {
-                ScalarKind::Uint => FieldType::U32,
-                ScalarKind::Sint => FieldType::I32,
-                ScalarKind::Float => FieldType::F32,
-                _ => return unsupported("a bool or abstract scalar"),
-            },
-            TypeInner::Vector { size, scalar } if scalar.kind == ScalarKind::Float && scalar.width == 4 => {
-                FieldType::VecF32(match size {
-                    VectorSize::Bi => 2,
-                    VectorSize::Tri => 3,
-                    VectorSize::Quad => 4,
-                })
-            }
             TypeInner::Struct { members, .. } => {
                 walk(module, members, offset, &path, shader, out)?;
                 continue;
             }
-            TypeInner::Vector { .. } => return unsupported("an integer vector"),
-            TypeInner::Matrix { .. } => return unsupported("a matrix"),
-            TypeInner::Array { .. } => return unsupported("an array"),
-            _ => return unsupported("of an unsupported type"),
+            inner => match leaf_type(module, inner) {
+                Ok(t) => t,
+                Err(what) => return unsupported(what),
+            },
         };
         out.push(Field { name, path, ty, offset });
     }
     Ok(())
+}
+
+fn scalar_of(s: &naga::Scalar) -> Option<Scalar> {
+    match (s.kind, s.width) {
+        (ScalarKind::Float, 4) => Some(Scalar::F32),
+        (ScalarKind::Uint, 4) => Some(Scalar::U32),
+        (ScalarKind::Sint, 4) => Some(Scalar::I32),
+        _ => None,
+    }
+}
+
+fn size_of(v: VectorSize) -> u32 {
+    match v {
+        VectorSize::Bi => 2,
+        VectorSize::Tri => 3,
+        VectorSize::Quad => 4,
+    }
+}
+
+/// The leaf type of a non-struct member, or what it is instead.
+fn leaf_type(module: &naga::Module, inner: &TypeInner) -> Result<FieldType, &'static str> {
+    match inner {
+        TypeInner::Scalar(s) => scalar_of(s).map(FieldType::scalar).ok_or("a bool or abstract scalar"),
+        TypeInner::Vector { size, scalar } => {
+            let sc = scalar_of(scalar).ok_or("a vector of bools")?;
+            let n = size_of(*size);
+            Ok(FieldType {
+                scalar: sc,
+                name: format!("vec{n}<{}>", sc.wgsl()),
+                components: (0..n).map(|i| 4 * i).collect(),
+            })
+        }
+        TypeInner::Matrix { columns, rows, scalar } => {
+            if scalar_of(scalar) != Some(Scalar::F32) {
+                return Err("a matrix of f16");
+            }
+            let (c, r) = (size_of(*columns), size_of(*rows));
+            // A column is a vecR: vec2 aligns to 8 bytes, vec3 and vec4 to 16.
+            let stride = if r == 2 { 8 } else { 16 };
+            let components = (0..c).flat_map(|col| (0..r).map(move |row| col * stride + 4 * row)).collect();
+            Ok(FieldType { scalar: Scalar::F32, name: format!("mat{c}x{r}<f32>"), components })
+        }
+        TypeInner::Array { base, size: naga::ArraySize::Constant(n), stride } => {
+            let elem = match &module.types[*base].inner {
+                TypeInner::Struct { .. } => return Err("an array of structs"),
+                TypeInner::Array { .. } => return Err("an array of arrays"),
+                other => leaf_type(module, other)?,
+            };
+            let components = (0..n.get()).flat_map(|i| elem.components.iter().map(move |c| i * stride + c)).collect();
+            Ok(FieldType { scalar: elem.scalar, name: format!("array<{}, {n}>", elem.name), components })
+        }
+        TypeInner::Array { .. } => Err("a runtime-sized array"),
+        TypeInner::Atomic(_) => Err("an atomic"),
+        _ => Err("of an unsupported type"),
+    }
 }
 
 /// Params that vista consumes on the host, so the shader may leave them out:
@@ -144,12 +178,17 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
     let bad = |message: String| ParamError::Layout { kernel: kernel.name().to_string(), message };
     for f in &layout.fields {
         if f.name == "width" || f.name == "height" {
-            if f.ty != FieldType::U32 {
+            if f.ty.name != "u32" {
                 return Err(bad(format!("Params field {} is WGSL {} but the image size is u32", f.path, f.ty.wgsl())));
             }
             continue;
         }
-        let Some(spec) = kernel.params().iter().find(|s| s.name == f.name) else {
+        let spec = kernel.params().iter().find(|s| s.name == f.name);
+        // `_`-prefixed leaves are padding: zero unless a param names them.
+        if spec.is_none() && f.name.starts_with('_') {
+            continue;
+        }
+        let Some(spec) = spec else {
             return Err(bad(format!(
                 "Params field {} (WGSL {}) has no param in {}; declare a [[param]] named {} or compute it in WGSL",
                 f.path,
@@ -158,8 +197,8 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
                 f.name
             )));
         };
-        let want = FieldType::of(spec.ty);
-        if want != f.ty {
+        let want = spec.ty.wgsl();
+        if want != f.ty.name {
             return Err(bad(format!(
                 "Params field {} is WGSL {} but {} declares param {} as {} (WGSL {})",
                 f.path,
@@ -167,7 +206,7 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
                 kernel.origin(),
                 spec.name,
                 spec.ty.name(),
-                want.wgsl()
+                want
             )));
         }
     }
@@ -179,7 +218,7 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
                 spec.ty.name(),
                 kernel.shader(),
                 spec.name,
-                FieldType::of(spec.ty).wgsl()
+                spec.ty.wgsl()
             )));
         }
     }
@@ -194,28 +233,33 @@ pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, h
         bytes[offset as usize..offset as usize + 4].copy_from_slice(&word);
     };
     for f in &layout.fields {
-        match f.name.as_str() {
-            "width" => put(f.offset, width.to_le_bytes()),
-            "height" => put(f.offset, height.to_le_bytes()),
+        let words: Vec<[u8; 4]> = match f.name.as_str() {
+            "width" => vec![width.to_le_bytes()],
+            "height" => vec![height.to_le_bytes()],
             name => {
-                let spec = kernel.params().iter().find(|s| s.name == name).expect("checked layout");
-                match (p.value(name).expect("resolved params hold every param"), spec.ty) {
-                    (Value::Int(v), ParamType::I32) => put(f.offset, (*v as i32).to_le_bytes()),
-                    (Value::Int(v), _) => put(f.offset, (*v as u32).to_le_bytes()),
-                    (Value::Float(v), _) => put(f.offset, (*v as f32).to_le_bytes()),
-                    (Value::Bool(b), _) => put(f.offset, (*b as u32).to_le_bytes()),
-                    (Value::Enum(s), _) => {
+                let Some(spec) = kernel.params().iter().find(|s| s.name == name) else {
+                    continue; // padding: stays zero
+                };
+                let scalar = |v: f64| match f.ty.scalar {
+                    Scalar::F32 => (v as f32).to_le_bytes(),
+                    Scalar::U32 => (v as u32).to_le_bytes(),
+                    Scalar::I32 => (v as i32).to_le_bytes(),
+                };
+                match p.value(name).expect("resolved params hold every param") {
+                    Value::Int(v) if spec.ty == ParamType::I32 => vec![(*v as i32).to_le_bytes()],
+                    Value::Int(v) => vec![(*v as u32).to_le_bytes()],
+                    Value::Float(v) => vec![(*v as f32).to_le_bytes()],
+                    Value::Bool(b) => vec![(*b as u32).to_le_bytes()],
+                    Value::Enum(s) => {
                         let crate::Kind::Enum(names) = spec.kind else { unreachable!("enum value of an enum param") };
-                        let index = names.iter().position(|n| n == s).expect("validated enum value") as u32;
-                        put(f.offset, index.to_le_bytes())
+                        vec![(names.iter().position(|n| n == s).expect("validated enum value") as u32).to_le_bytes()]
                     }
-                    (Value::Vector(v), _) => {
-                        for (i, c) in v.iter().enumerate() {
-                            put(f.offset + 4 * i as u32, (*c as f32).to_le_bytes());
-                        }
-                    }
+                    Value::Vector(v) => v.iter().map(|c| scalar(*c)).collect(),
                 }
             }
+        };
+        for (word, at) in words.iter().zip(&f.ty.components) {
+            put(f.offset + at, *word);
         }
     }
     bytes
@@ -291,11 +335,75 @@ default = -3
         let m = module("struct A { fov: f32 }\nstruct Params { width: u32, height: u32, a: A, fov: f32 }");
         let e = k.layout(&m).unwrap_err().to_string();
         assert!(e.contains("Params fields a.fov and fov share the name 'fov'"), "{e}");
-        let m = module("struct Params { width: u32, height: u32, m: mat2x2<f32> }");
+        let m = module("struct A { x: f32 }\nstruct Params { width: u32, height: u32, m: array<A, 2> }");
         let e = k.layout(&m).unwrap_err().to_string();
-        assert!(e.contains("Params field m is a matrix"), "{e}");
+        assert!(e.contains("Params field m is an array of structs"), "{e}");
         let m = module("struct Params { width: u32, height: f32 }");
         let e = k.layout(&m).unwrap_err().to_string();
         assert!(e.contains("Params field height is WGSL f32 but the image size is u32"), "{e}");
+    }
+
+    const LEAVES: &str = r#"summary = "every leaf type"
+[[param]]
+name = "view"
+type = "mat4x4<f32>"
+range = [-100, 100]
+default = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16]
+[[param]]
+name = "res"
+type = "vec2u"
+range = [0, 4096]
+default = [640, 480]
+[[param]]
+name = "weights"
+type = "array<vec4<f32>, 2>"
+range = [0, 1]
+default = [[0.5, 0.25, 0.125, 1], [0, 0.75, 1, 0.5]]
+[[param]]
+name = "offs"
+type = "vec3<i32>"
+range = [-9, 9]
+default = [-1, 2, -3]
+[[param]]
+name = "rot"
+type = "mat3x3f"
+range = [-1, 1]
+default = [1, 0, 0, 0, 1, 0, 0, 0, -1]
+"#;
+
+    #[test]
+    fn matrices_integer_vectors_arrays_and_padding_pack_at_naga_offsets() {
+        let k = Kernel::from_manifest("leaves", "leaves.toml", LEAVES).unwrap();
+        let m = module(
+            "struct Params { width: u32, height: u32, view: mat4x4<f32>, res: vec2<u32>, _pad0: u32, \
+             weights: array<vec4<f32>, 2>, offs: vec3<i32>, rot: mat3x3<f32>, _pad1: vec4<f32> }",
+        );
+        let layout = k.layout(&m).unwrap();
+        let p = k.resolve(None, &[("res".into(), "1920,1080".into())]).unwrap();
+        let b = k.uniforms(&layout, &p, 3, 2);
+        let word = |o: u32| u32::from_le_bytes(b[o as usize..o as usize + 4].try_into().unwrap());
+        let f = |o: u32| f32::from_bits(word(o));
+        // mat4x4 at 16, column after column.
+        assert_eq!((16..80).step_by(4).map(f).collect::<Vec<_>>(), (1..=16).map(|v| v as f32).collect::<Vec<_>>());
+        assert_eq!((word(80), word(84), word(88)), (1920, 1080, 0), "vec2<u32>, then _pad0 zero");
+        assert_eq!([f(96), f(100), f(108), f(116), f(124)], [0.5, 0.25, 1.0, 0.75, 0.5], "array stride 16");
+        assert_eq!([word(128) as i32, word(132) as i32, word(136) as i32], [-1, 2, -3]);
+        // mat3x3 at 144: columns 16 bytes apart, the fourth word of each is padding.
+        assert_eq!([f(144), f(160 + 4), f(176 + 8), f(156)], [1.0, 1.0, -1.0, 0.0]);
+        assert!((192..208).step_by(4).all(|o| word(o) == 0), "_pad1 stays zero");
+        // A param whose WGSL type differs from its field is refused, naming both.
+        let m = module(
+            "struct Params { width: u32, height: u32, view: mat4x4<f32>, res: vec2<i32>, \
+                        weights: array<vec4<f32>, 2>, offs: vec3<i32>, rot: mat3x3<f32> }",
+        );
+        let e = k.layout(&m).unwrap_err().to_string();
+        assert!(
+            e.contains("Params field res is WGSL vec2<i32> but leaves.toml declares param res as vec2<u32>"),
+            "{e}"
+        );
+        assert!(
+            k.resolve(None, &[("res".into(), "1,2.5".into())]).unwrap_err().to_string().contains("integers"),
+            "an integer vector takes integers"
+        );
     }
 }

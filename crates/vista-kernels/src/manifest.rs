@@ -218,7 +218,11 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             return Err(pfail("declared twice".into()));
         }
         let ty = ParamType::from_name(&p.ty).ok_or_else(|| {
-            pfail(format!("type = \"{}\" is not valid; expected u32|i32|f32|bool|vec2|vec3|vec4|enum", p.ty))
+            pfail(format!(
+                "type = \"{}\" is not valid; expected u32|i32|f32|bool|vec2|vec3|vec4|enum or a WGSL leaf type \
+                 (vec2<u32>, vec3i, mat4x4<f32>, array<vec4<f32>, 4>, ...)",
+                p.ty
+            ))
         })?;
         let range = |limits: (f64, f64)| -> Result<(f64, f64), ParamError> {
             let [lo, hi] = p.range.ok_or_else(|| pfail(format!("type {} needs range = [min, max]", p.ty)))?;
@@ -262,6 +266,20 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
                 let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
                 Kind::Vector { n: n as usize, min, max }
             }
+            ParamType::Wgsl(leaf) => match leaf.scalar {
+                crate::params::Scalar::F32 => {
+                    let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
+                    Kind::Vector { n: leaf.count, min, max }
+                }
+                crate::params::Scalar::U32 => {
+                    let (min, max) = int(range((0.0, u32::MAX as f64))?)?;
+                    Kind::IntVector { n: leaf.count, min, max }
+                }
+                crate::params::Scalar::I32 => {
+                    let (min, max) = int(range((i32::MIN as f64, i32::MAX as f64))?)?;
+                    Kind::IntVector { n: leaf.count, min, max }
+                }
+            },
             ParamType::Bool => {
                 no_range("bool")?;
                 Kind::Bool

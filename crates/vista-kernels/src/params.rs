@@ -20,10 +20,82 @@ pub enum Kind {
     Int { min: i64, max: i64 },
     /// `n` comma-separated reals, each in `[min, max]`.
     Vector { n: usize, min: f64, max: f64 },
+    /// `n` comma-separated integers, each in `[min, max]`.
+    IntVector { n: usize, min: i64, max: i64 },
     /// One name out of a fixed list.
     Enum(&'static [&'static str]),
     /// true | false (also 1 | 0).
     Bool,
+}
+
+/// The scalar of a WGSL leaf.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scalar {
+    F32,
+    U32,
+    I32,
+}
+
+impl Scalar {
+    pub fn wgsl(self) -> &'static str {
+        match self {
+            Scalar::F32 => "f32",
+            Scalar::U32 => "u32",
+            Scalar::I32 => "i32",
+        }
+    }
+}
+
+/// A uniform leaf spelled as WGSL spells it: `vec2<u32>`, `mat4x4<f32>`,
+/// `array<vec4<f32>, 4>`: its scalar, its number of components, and its
+/// normalised WGSL name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Leaf {
+    pub scalar: Scalar,
+    pub count: usize,
+    pub name: &'static str,
+}
+
+/// Parses a WGSL type a uniform leaf may have: a scalar, `vecN<T>` (or
+/// `vecNf|u|i`), `matCxR<f32>` (or `matCxRf`), or `array<T, N>` of those.
+/// Returns the scalar, the component count and the normalised name.
+pub fn wgsl_leaf(text: &str) -> Option<(Scalar, usize, String)> {
+    let t: String = text.chars().filter(|c| !c.is_whitespace()).collect();
+    let scalar = |s: &str| match s {
+        "f32" | "f" => Some(Scalar::F32),
+        "u32" | "u" => Some(Scalar::U32),
+        "i32" | "i" => Some(Scalar::I32),
+        _ => None,
+    };
+    if let Some(sc) = scalar(&t).filter(|_| t.len() == 3) {
+        return Some((sc, 1, sc.wgsl().to_string()));
+    }
+    if let Some(inner) = t.strip_prefix("array<").and_then(|r| r.strip_suffix('>')) {
+        let (elem, n) = inner.rsplit_once(',')?;
+        let n: usize = n.parse().ok().filter(|n| (1..=1024).contains(n))?;
+        let (sc, c, name) = wgsl_leaf(elem)?;
+        if name.starts_with("array") {
+            return None;
+        }
+        return Some((sc, c * n, format!("array<{name}, {n}>")));
+    }
+    if let Some(rest) = t.strip_prefix("vec") {
+        let n: usize = rest.get(..1)?.parse().ok().filter(|n| (2..=4).contains(n))?;
+        let sc = match &rest[1..] {
+            r if r.starts_with('<') && r.ends_with('>') => scalar(&r[1..r.len() - 1])?,
+            r => scalar(r)?,
+        };
+        return Some((sc, n, format!("vec{n}<{}>", sc.wgsl())));
+    }
+    if let Some(rest) = t.strip_prefix("mat") {
+        let c: usize = rest.get(..1)?.parse().ok().filter(|n| (2..=4).contains(n))?;
+        let r: usize = rest.get(2..3)?.parse().ok().filter(|n| (2..=4).contains(n))?;
+        if rest.get(1..2) != Some("x") || !matches!(&rest[3..], "<f32>" | "f") {
+            return None;
+        }
+        return Some((Scalar::F32, c * r, format!("mat{c}x{r}<f32>")));
+    }
+    None
 }
 
 /// The manifest's `type`: what the WGSL `Params` field must be.
@@ -38,6 +110,8 @@ pub enum ParamType {
     Vec(u8),
     /// Carried as the u32 index of the value in its list.
     Enum,
+    /// A leaf spelled in WGSL (integer vectors, matrices, arrays).
+    Wgsl(Leaf),
 }
 
 impl ParamType {
@@ -51,8 +125,28 @@ impl ParamType {
             "vec3" => ParamType::Vec(3),
             "vec4" => ParamType::Vec(4),
             "enum" => ParamType::Enum,
-            _ => return None,
+            other => {
+                let (scalar, count, name) = wgsl_leaf(other)?;
+                match (scalar, count, name.as_str()) {
+                    (Scalar::F32, 1, "f32") => ParamType::F32,
+                    (Scalar::U32, 1, "u32") => ParamType::U32,
+                    (Scalar::I32, 1, "i32") => ParamType::I32,
+                    (Scalar::F32, n, v) if v.starts_with("vec") => ParamType::Vec(n as u8),
+                    _ => ParamType::Wgsl(Leaf { scalar, count, name: Box::leak(name.into_boxed_str()) }),
+                }
+            }
         })
+    }
+
+    /// The WGSL type of the field this param feeds.
+    pub fn wgsl(&self) -> String {
+        match self {
+            ParamType::U32 | ParamType::Bool | ParamType::Enum => "u32".into(),
+            ParamType::I32 => "i32".into(),
+            ParamType::F32 => "f32".into(),
+            ParamType::Vec(n) => format!("vec{n}<f32>"),
+            ParamType::Wgsl(l) => l.name.into(),
+        }
     }
 
     /// The manifest's name of this type.
@@ -66,6 +160,7 @@ impl ParamType {
             ParamType::Vec(3) => "vec3",
             ParamType::Vec(_) => "vec4",
             ParamType::Enum => "enum",
+            ParamType::Wgsl(l) => l.name,
         }
     }
 }
@@ -90,6 +185,9 @@ impl Kind {
             Kind::Int { min, max } => format!("integer in [{min}, {max}]"),
             Kind::Vector { n, min, max } => {
                 format!("{n} comma-separated numbers each in [{min}, {max}]")
+            }
+            Kind::IntVector { n, min, max } => {
+                format!("{n} comma-separated integers each in [{min}, {max}]")
             }
             Kind::Enum(names) => format!("one of {}", names.join("|")),
             Kind::Bool => "true|false".into(),
@@ -168,6 +266,20 @@ pub fn parse_value(spec: &ParamSpec, text: &str) -> Result<Value, ParamError> {
             }
             let v = parts.into_iter().map(real).collect::<Result<Vec<f64>, _>>()?;
             if v.iter().all(|c| (min..=max).contains(c)) { Ok(Value::Vector(v)) } else { Err(out_of_range()) }
+        }
+        Kind::IntVector { n, min, max } => {
+            let parts: Vec<&str> = t.split(',').collect();
+            if parts.len() != n {
+                return Err(bad(spec.kind.range_text()));
+            }
+            let v = parts
+                .into_iter()
+                .map(|p| p.trim().parse::<i64>().map_err(|_| bad(spec.kind.range_text())))
+                .collect::<Result<Vec<i64>, _>>()?;
+            match v.iter().all(|c| (min..=max).contains(c)) {
+                true => Ok(Value::Vector(v.into_iter().map(|c| c as f64).collect())),
+                false => Err(out_of_range()),
+            }
         }
         Kind::Enum(names) => names
             .iter()
