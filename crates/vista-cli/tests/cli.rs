@@ -1664,6 +1664,48 @@ fn the_example_project_works_with_a_copied_binary() {
 /// Expectations are data in golden/cases.toml: a failure they name passes
 /// the run (reported xfail with the reason), an expected failure that
 /// passes fails the run, and a bad expectation is refused.
+/// examples/real-kernels, kernels shaped like real ones (their own entry
+/// names, workgroup sizes, groups, formats, padding fields, import paths and
+/// a valued def), checked against their committed goldens with a copied
+/// binary on lavapipe, SwiftShader and in Chromium.
+fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
+    let t = tmp();
+    let (bin, root) = (t.path().join("vista"), t.path().join("real"));
+    std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
+    copy_tree(&repo().join("examples/real-kernels"), &root);
+    let run = |args: &[&str]| run_in(&bin, &root, &[], args);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let check = run(&["check", "--backend", backend]);
+        assert_eq!(check.code, 0, "{backend}: {}{}", check.stdout, check.stderr);
+        assert!(check.stdout.contains("4 passed, 0 failed"), "{backend}: {}", check.stdout);
+    }
+    // GRADE_STEPS = 5 reaches the imported module: five bands, at their centres.
+    let r = run(&["render", "poster", "--size", "64x64", "-o", "poster.exr"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let img = vista_image::load(&root.join("poster.exr")).unwrap();
+    let mut bands: Vec<f32> = img.data.iter().map(|p| (p[0] * 10.0).round() / 10.0).collect();
+    bands.sort_by(f32::total_cmp);
+    bands.dedup();
+    assert_eq!(bands, [0.1, 0.3, 0.5, 0.7, 0.9], "bands of the posterized red channel");
+    // The terrain's uniform is set by name like any kernel's, matrix included.
+    let r = run(&[
+        "render",
+        "terrain",
+        "--set",
+        "model=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1",
+        "--set",
+        "tiles=1,1",
+        "-o",
+        "t.png",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_rejected(
+        &run(&["render", "terrain", "--set", "tiles=1,2.5", "-o", "t.png"]),
+        2,
+        &["tiles=1,2.5", "integers"],
+    );
+}
+
 fn expected_failures_are_data_and_an_unexpected_pass_fails() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -1936,6 +1978,11 @@ fn main() {
         (Gpu, "a_kernel_without_a_uniform_renders", a_kernel_without_a_uniform_renders),
         (Cpu, "unfed_globals_are_refused", unfed_globals_are_refused),
         (Gpu, "valued_defs_reach_imported_modules", valued_defs_reach_imported_modules),
+        (
+            Gpu,
+            "the_real_kernels_example_passes_on_every_backend_with_a_copied_binary",
+            the_real_kernels_example_passes_on_every_backend_with_a_copied_binary,
+        ),
         (
             Gpu,
             "matrices_integer_vectors_arrays_and_padding_are_packed",
