@@ -91,6 +91,8 @@ pub struct Job<'a> {
     pub texel_bytes: u32,
     /// One texel's bytes: the output holds it everywhere before the kernel runs.
     pub fill: &'a [u8],
+    /// Values of pipeline-overridable constants, by name.
+    pub constants: &'a [(String, f64)],
     pub uniforms: &'a [u8],
     pub table: &'a [u32],
     pub width: u32,
@@ -201,6 +203,7 @@ impl Browser {
             "format": job.format,
             "texel_bytes": job.texel_bytes,
             "fill": B64.encode(job.fill),
+            "constants": job.constants.iter().cloned().collect::<std::collections::BTreeMap<String, f64>>(),
             "uniforms": B64.encode(job.uniforms),
             "table": B64.encode(&table),
             "width": job.width,

@@ -1328,6 +1328,51 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+/// `override` constants: the manifest's `overrides` and params of the same
+/// name feed them, on every implementation, workgroup sizes included; one
+/// with neither a default nor a value is refused.
+fn overrides_take_manifest_values_and_params() {
+    let shader = gradient_shader("main", "BLOCK, 2", "params.height")
+        .replace("struct Params", "override BLOCK: u32 = 8u;\noverride GAIN: f32;\n\nstruct Params")
+        .replace("params.gain * u * v", "GAIN * params.gain");
+    let manifest = format!(
+        "overrides = {{ GAIN = 0.5 }}\n{K_MANIFEST}[[param]]\nname = \"BLOCK\"\ntype = \"u32\"\nrange = [1, 64]\ndefault = 4\n"
+    );
+    let d = kernel_project(&manifest, &shader);
+    let mut first: Option<vista_image::Image> = None;
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        for block in ["1", "16"] {
+            let out = d.path().join(format!("{backend}{block}.exr"));
+            let set = format!("BLOCK={block}");
+            let args =
+                ["render", "k", "--size", "21x9", "--set", &set, "--backend", backend, "-o", out.to_str().unwrap()];
+            let r = vista_in(Some(d.path()), &[], &args);
+            assert_eq!(r.code, 0, "{backend} BLOCK={block}: {}", r.stderr);
+            let img = vista_image::load(&out).unwrap();
+            assert!(img.data.iter().all(|p| p[2] == 0.25), "{backend}: GAIN 0.5 x gain 0.5");
+            match &first {
+                None => first = Some(img),
+                Some(f) => assert!(
+                    vista_image::metrics::compare_hdr(f, &img).unwrap().max_abs <= 1e-6,
+                    "{backend} BLOCK={block} differs"
+                ),
+            }
+        }
+    }
+    let d = kernel_project(&manifest.replace("overrides = { GAIN = 0.5 }", ""), &shader);
+    assert_rejected(
+        &render_exr(d.path(), "8x8", "o").0,
+        2,
+        &["override GAIN of k.wgsl has neither a default nor a value"],
+    );
+    let d = kernel_project(&manifest.replace("GAIN = 0.5", "GAIN = 0.5, GAINS = 2"), &shader);
+    assert_rejected(
+        &render_exr(d.path(), "8x8", "o").0,
+        2,
+        &["overrides: GAINS is not an override of k.wgsl", "BLOCK, GAIN"],
+    );
+}
+
 fn a_kernel_described_as_data_renders() {
     let r = render_k(K_MANIFEST, K_SHADER);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -1978,6 +2023,7 @@ fn main() {
         (Gpu, "a_kernel_without_a_uniform_renders", a_kernel_without_a_uniform_renders),
         (Cpu, "unfed_globals_are_refused", unfed_globals_are_refused),
         (Gpu, "valued_defs_reach_imported_modules", valued_defs_reach_imported_modules),
+        (Gpu, "overrides_take_manifest_values_and_params", overrides_take_manifest_values_and_params),
         (
             Gpu,
             "the_real_kernels_example_passes_on_every_backend_with_a_copied_binary",

@@ -210,6 +210,8 @@ pub struct Dispatch<'a> {
     pub slots: &'a [Slot],
     /// The output's storage format (its WGSL name).
     pub format: &'a str,
+    /// Values of the module's pipeline-overridable constants, by name.
+    pub constants: &'a [(String, f64)],
     /// Uniform block for binding 0 (padded to 16 bytes by the caller).
     pub uniforms: &'a [u8],
     /// Read-only u32 table for binding 2.
@@ -495,10 +497,37 @@ impl Context {
     /// The composed kernel as one WGSL source, as naga writes it back: what
     /// the browser backend hands to Tint.
     pub fn wgsl_source(shaders: &ShaderSet, shader: &str) -> Result<String, GpuError> {
+        Context::wgsl_source_with(shaders, shader, "main", &[])
+    }
+
+    /// The same, with `override` constants resolved to `constants` for
+    /// `entry` first: naga's WGSL writer keeps an `override` but writes an
+    /// overridden `@workgroup_size` as its placeholder, so the page gets the
+    /// values baked in instead of pipeline constants.
+    pub fn wgsl_source_with(
+        shaders: &ShaderSet,
+        shader: &str,
+        entry: &str,
+        constants: &[(String, f64)],
+    ) -> Result<String, GpuError> {
         let module = shaders.compose(shader)?;
         let info = crate::shaders::validate(shader, &module)?;
-        naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
-            .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))
+        let write = |m: &naga::Module, i: &naga::valid::ModuleInfo| {
+            naga::back::wgsl::write_string(m, i, naga::back::wgsl::WriterFlags::empty())
+                .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))
+        };
+        if module.overrides.is_empty() {
+            return write(&module, &info);
+        }
+        let map: naga::back::PipelineConstants = constants.iter().cloned().collect();
+        let (resolved, resolved_info) = naga::back::pipeline_constants::process_overrides(
+            &module,
+            &info,
+            Some((naga::ShaderStage::Compute, entry)),
+            &map,
+        )
+        .map_err(|e| GpuError::Shader(format!("{shader}: override values do not resolve: {e}")))?;
+        write(&resolved, &resolved_info)
     }
 
     /// Compiles (once per source hash, entry, slots and format) the pipeline
@@ -507,12 +536,13 @@ impl Context {
     /// two projects (or an edited copy) never share a stale pipeline.
     fn pipeline(&self, w: &WgpuEngine, job: &Dispatch<'_>, format: &OutputFormat) -> Result<Arc<Compiled>, GpuError> {
         let key = format!(
-            "{}#{}@{}{:?}{}",
+            "{}#{}@{}{:?}{}{:?}",
             job.shader,
             job.shaders.source_hash(job.shader)?,
             job.entry,
             job.slots,
-            format.name
+            format.name,
+            job.constants
         );
         if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
@@ -573,7 +603,10 @@ impl Context {
             layout: Some(&pipeline_layout),
             module: &sm,
             entry_point: Some(job.entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &job.constants.iter().map(|(k, v)| (k.as_str(), *v)).collect::<Vec<_>>(),
+                ..Default::default()
+            },
             cache: None,
         });
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -818,12 +851,12 @@ impl Context {
         format: &OutputFormat,
         which: usize,
     ) -> Result<(Vec<u8>, RunStats), GpuError> {
-        let key = format!("{}#{}", job.shader, job.shaders.source_hash(job.shader)?);
+        let key = format!("{}#{}@{}{:?}", job.shader, job.shaders.source_hash(job.shader)?, job.entry, job.constants);
         let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
         let wgsl = match cached {
             Some(w) => w,
             None => {
-                let w = Arc::new(Context::wgsl_source(job.shaders, job.shader)?);
+                let w = Arc::new(Context::wgsl_source_with(job.shaders, job.shader, job.entry, job.constants)?);
                 b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
                 w
             }
@@ -854,6 +887,8 @@ impl Context {
                 format: format.name,
                 texel_bytes: format.texel_bytes() as u32,
                 fill: &format.sentinel(which),
+                // Baked into the WGSL above.
+                constants: &[],
                 uniforms: job.uniforms,
                 table: job.table,
                 width: job.width,

@@ -116,6 +116,21 @@ impl ShaderSet {
 
     fn compose_uncached(&self, name: &str) -> Result<naga::Module, GpuError> {
         let (source, origin) = self.kernel_source(name)?;
+        // A file without preprocessor directives needs no composition; naga
+        // parses it directly. naga_oil 0.23 loses the expressions of an
+        // `override` named in `@workgroup_size` ("Handle N of Expression is
+        // either not present"), so such kernels work when they import nothing.
+        if !source.lines().any(|l| l.trim_start().starts_with('#')) {
+            let module = naga::front::wgsl::parse_str(source).map_err(|e| {
+                GpuError::Shader(format!(
+                    "WGSL error ({}):\n{}",
+                    self.label,
+                    e.emit_to_string_with_path(source, origin)
+                ))
+            })?;
+            validate(name, &module)?;
+            return Ok(module);
+        }
         let mut composer = self.composer()?;
         let module = composer
             .make_naga_module(NagaModuleDescriptor {

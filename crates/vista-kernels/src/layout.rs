@@ -53,6 +53,8 @@ pub struct UniformLayout {
     pub uses_table: bool,
     /// Every binding the entry point reaches and what feeds it.
     pub bindings: Vec<crate::bindings::Binding>,
+    /// The module's `override` constants by name (a param may feed one).
+    pub overrides: Vec<String>,
 }
 
 /// Reflects the uniform block of `module` for `kernel` (named in errors).
@@ -62,7 +64,13 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
     let uses_table = bindings.iter().any(|b| b.feed == crate::bindings::Feed::Table);
     let Some(uniform) = bindings.iter().find(|b| b.feed == crate::bindings::Feed::Uniform) else {
         // No uniform: the kernel takes no params (a param would feed nothing).
-        return Ok(UniformLayout { size: 0, fields: Vec::new(), uses_table, bindings });
+        return Ok(UniformLayout {
+            size: 0,
+            fields: Vec::new(),
+            uses_table,
+            bindings,
+            overrides: override_names(module),
+        });
     };
     let var = &module.global_variables[uniform.global];
     let TypeInner::Struct { members, span } = &module.types[var.ty].inner else {
@@ -75,7 +83,11 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
             return Err(bad(format!("{shader}: Params fields {} and {} share the name '{}'", g.path, f.path, f.name)));
         }
     }
-    Ok(UniformLayout { size: *span, fields, uses_table, bindings })
+    Ok(UniformLayout { size: *span, fields, uses_table, bindings, overrides: override_names(module) })
+}
+
+fn override_names(module: &naga::Module) -> Vec<String> {
+    module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect()
 }
 
 fn walk(
@@ -211,7 +223,8 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
         }
     }
     for spec in kernel.params() {
-        if !layout.fields.iter().any(|f| f.name == spec.name) && !host_only(kernel, spec.name) {
+        let feeds_override = layout.overrides.iter().any(|o| o == spec.name);
+        if !layout.fields.iter().any(|f| f.name == spec.name) && !host_only(kernel, spec.name) && !feeds_override {
             return Err(bad(format!(
                 "param {} ({}) has no field in the Params struct of {}; add `{}: {}` to it",
                 spec.name,

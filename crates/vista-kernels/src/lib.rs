@@ -381,6 +381,53 @@ impl Kernel {
         }
     }
 
+    /// The value of every `override` constant of `module` for `p`: a param
+    /// of its name, else the manifest's `overrides`, else its default
+    /// (`None` in the list: naga takes the default). An override with
+    /// neither, or a manifest value naming no override, is refused.
+    pub fn overrides(&self, module: &naga::Module, p: &ParamSet) -> Result<Vec<(String, f64)>, ParamError> {
+        let bad = |message: String| ParamError::Layout { kernel: self.name().to_string(), message };
+        let names: Vec<&str> = module.overrides.iter().filter_map(|(_, o)| o.name.as_deref()).collect();
+        for (k, _) in &self.manifest.overrides {
+            if !names.contains(k) {
+                return Err(bad(format!(
+                    "overrides: {k} is not an override of {}; its overrides: {}",
+                    self.shader(),
+                    if names.is_empty() { "none".to_string() } else { names.join(", ") }
+                )));
+            }
+        }
+        let mut out = Vec::new();
+        for (_, o) in module.overrides.iter() {
+            let Some(name) = o.name.as_deref() else { continue };
+            let value = match p.value(name) {
+                Some(Value::Int(v)) => Some(*v as f64),
+                Some(Value::Float(v)) => Some(*v),
+                Some(Value::Bool(b)) => Some(*b as u8 as f64),
+                Some(Value::Enum(v)) => match self.params().iter().find(|s| s.name == name).map(|s| s.kind) {
+                    Some(crate::Kind::Enum(names)) => names.iter().position(|n| n == v).map(|i| i as f64),
+                    _ => None,
+                },
+                Some(Value::Vector(_)) => {
+                    return Err(bad(format!("param {name} is a vector; an override takes one number")));
+                }
+                None => self.manifest.overrides.iter().find(|(k, _)| *k == name).map(|(_, v)| *v),
+            };
+            match (value, o.init) {
+                (Some(v), _) => out.push((name.to_string(), v)),
+                (None, Some(_)) => {}
+                (None, None) => {
+                    return Err(bad(format!(
+                        "override {name} of {} has neither a default nor a value; give it one in the manifest \
+                         (overrides = {{ {name} = ... }}) or a param named {name}",
+                        self.shader()
+                    )));
+                }
+            }
+        }
+        Ok(out)
+    }
+
     /// Reflects and checks the uniform layout of this kernel's composed module.
     pub fn layout(&self, module: &naga::Module) -> Result<UniformLayout, ParamError> {
         let l = layout::reflect(self.name(), self.shader(), self.entry(), module)?;

@@ -46,6 +46,9 @@ struct RawManifest {
     /// naga_oil shader defs: bool or integer values.
     #[serde(default)]
     defs: toml::Table,
+    /// Values of the shader's pipeline-overridable constants.
+    #[serde(default)]
+    overrides: toml::Table,
     display_alpha: Option<String>,
     #[serde(default)]
     work: Vec<String>,
@@ -130,6 +133,9 @@ pub struct Manifest {
     /// naga_oil shader defs (`defs = { MAX_LIGHTS = 10, FIRST_PASS = true }`),
     /// as `NAME=value` in declaration order.
     pub defs: Vec<String>,
+    /// Values of `override` constants (`overrides = { BLOCK = 128 }`); a
+    /// param of an override's name feeds it too, and wins.
+    pub overrides: Vec<(&'static str, f64)>,
     pub work: Vec<WorkFactor>,
     pub output_range: Option<(f64, f64)>,
     /// The z every fbm2/ridged2 call of the shader takes.
@@ -441,6 +447,18 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             }
         }
     }
+    let mut overrides = Vec::new();
+    for (k, v) in &raw.overrides {
+        let value = match v {
+            toml::Value::Boolean(b) => *b as u8 as f64,
+            toml::Value::Integer(i) => *i as f64,
+            toml::Value::Float(f) if f.is_finite() => *f,
+            other => {
+                return Err(kfail(format!("overrides: {k} = {other} is not valid; expected a number or a bool")));
+            }
+        };
+        overrides.push((leak(k.as_str()), value));
+    }
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
         name: leak(name),
@@ -452,6 +470,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         workgroups,
         partial,
         defs,
+        overrides,
         work,
         output_range: raw.output_range.map(|[a, b]| (a, b)),
         hash_plane,

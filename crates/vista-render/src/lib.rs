@@ -193,6 +193,9 @@ pub struct Plan {
     pub slots: Vec<vista_gpu::Slot>,
     /// The output's storage format (its WGSL name).
     pub format: &'static str,
+    /// Values of the module's `override` constants (params, the manifest's
+    /// `overrides`; absent ones take their defaults).
+    pub constants: Vec<(String, f64)>,
     /// The uniform block's bytes.
     pub uniforms: Vec<u8>,
     /// The table's words (Perlin's permutation and its packed chains).
@@ -226,12 +229,9 @@ pub fn plan(
     })?;
     let layout = kernel.layout(&module).map_err(|e| RenderError::BadInput(e.to_string()))?;
     let entry = kernel.entry();
-    let workgroup_size = module
-        .entry_points
-        .iter()
-        .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
-        .map(|e| e.workgroup_size)
-        .expect("Kernel::layout refuses an unknown entry point");
+    let constants = kernel.overrides(&module, p).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let workgroup_size = workgroup_size(&module, entry, &constants)
+        .map_err(|e| RenderError::BadInput(format!("kernel {}: {shader}: {e}", kernel.name())))?;
     use vista_kernels::bindings::Feed;
     let slots: Vec<vista_gpu::Slot> = layout
         .bindings
@@ -266,6 +266,7 @@ pub fn plan(
         workgroups,
         slots,
         format,
+        constants,
         uniforms: kernel.uniforms(&layout, p, width, height),
         table: kernel.table(&layout, p),
         shader,
@@ -273,6 +274,30 @@ pub fn plan(
         height,
         display: kernel.display_map(p),
     })
+}
+
+/// The entry point's workgroup size; where it names `override`s, their
+/// values are substituted first (naga's pipeline-constant pass).
+fn workgroup_size(module: &naga::Module, entry: &str, constants: &[(String, f64)]) -> Result<[u32; 3], String> {
+    let ep = module
+        .entry_points
+        .iter()
+        .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
+        .expect("Kernel::layout refuses an unknown entry point");
+    if ep.workgroup_size_overrides.is_none() {
+        return Ok(ep.workgroup_size);
+    }
+    let info = vista_gpu::validate(entry, module).map_err(|e| e.to_string())?;
+    let map: naga::back::PipelineConstants = constants.iter().cloned().collect();
+    let (resolved, _) = naga::back::pipeline_constants::process_overrides(
+        module,
+        &info,
+        Some((naga::ShaderStage::Compute, entry)),
+        &map,
+    )
+    .map_err(|e| format!("override values do not resolve: {e}"))?;
+    let ep = resolved.entry_points.iter().find(|e| e.name == entry).expect("the same entry point");
+    Ok(ep.workgroup_size)
 }
 
 /// Runs a plan on the renderer's engine.
@@ -284,6 +309,7 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         workgroups: plan.workgroups,
         slots: &plan.slots,
         format: plan.format,
+        constants: &plan.constants,
         uniforms: &plan.uniforms,
         table: &plan.table,
         width: plan.width,
