@@ -25,6 +25,15 @@ fi
 if echo "$results" | grep -vqE ' 0 passed; 0 failed; [1-9][0-9]* ignored'; then
     echo "$results"; echo "no-gpu-skips: a GPU test passed or failed without an adapter instead of being ignored"; exit 1
 fi
+# The skip run must leave the last real report whole: every file it links exists.
+report=target/vista-report
+if [ -f "$report/index.html" ]; then
+    broken=$(grep -oE '(src|href|data-src)="[^"#:]+\.(png|js)"' "$report/index.html" | sed -E 's/^[a-z-]+="//; s/"$//' |
+        while read -r f; do [ -f "$report/$f" ] || echo "$f"; done | head -3)
+    if [ -n "$broken" ]; then
+        echo "no-gpu-skips: the run without an adapter broke $report/index.html: it links missing $broken"; exit 1
+    fi
+fi
 skipped=$(echo "$results" | awk '{ for (i = 1; i <= NF; i++) if ($(i + 1) ~ /^ignored/) s += $i } END { print s }')
 echo "no-gpu-skips: without an adapter all $skipped GPU tests of ${#suites[@]} suites are reported ignored, none ok"
 

@@ -22,12 +22,14 @@ fn main() {
         None => project.report_dir().expect("repository root"),
     };
     let outcomes = Arc::new(Mutex::new(Vec::new()));
-    if !args.list {
-        vista_report::clear_case_folders(&report_dir).unwrap_or_else(|e| panic!("cannot clear the report: {e}"));
-    }
 
     // Listing must work without a device (nextest lists before it runs).
     let missing = if args.list { None } else { common::renderer().err() };
+    // A run that will render clears the last report's case folders; one that
+    // skips (no adapter) leaves the last report whole.
+    if !args.list && missing.is_none() {
+        vista_report::clear_case_folders(&report_dir).unwrap_or_else(|e| panic!("cannot clear the report: {e}"));
+    }
     let no_gpu = missing.is_some();
     if let Some(e) = &missing {
         if allow_no_gpu() {

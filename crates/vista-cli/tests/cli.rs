@@ -1373,6 +1373,36 @@ fn overrides_take_manifest_values_and_params() {
     );
 }
 
+/// A project kernel named like a built-in but with other params is a kernel
+/// of its own: it renders, checks and benches without the built-in's CPU
+/// reference (which read the built-in's params and panicked, exit 101).
+fn a_project_kernel_named_like_a_builtin_does_not_get_its_reference() {
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    for sub in ["kernels", "shaders"] {
+        std::fs::create_dir(d.path().join(sub)).unwrap();
+    }
+    let manifest = std::fs::read_to_string(repo().join("kernels/fbm.toml")).unwrap();
+    let start = manifest.find("[[param]]\nname = \"octave_rotation_deg\"").expect("the fbm manifest");
+    let end = start + manifest[start..].find("\n\n").unwrap() + 2;
+    let manifest = format!("{}{}", &manifest[..start], &manifest[end..]).replace("octave_rotation_deg = 36.87\n", "");
+    std::fs::write(d.path().join("kernels/fbm.toml"), manifest).unwrap();
+    let shader = std::fs::read_to_string(repo().join("shaders/fbm.wgsl")).unwrap();
+    let shader =
+        shader.replace("    octave_rotation_deg: f32,\n", "").replace("radians(params.octave_rotation_deg)", "0.0");
+    std::fs::write(d.path().join("shaders/fbm.wgsl"), shader).unwrap();
+    let out = d.path().join("f.png");
+    let r = vista_in(Some(d.path()), &[], &["render", "fbm", "--size", "16x16", "-o", out.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["bench", "fbm", "--cpu", "--size", "8x8"]),
+        2,
+        &["fbm has no CPU reference"],
+    );
+    // The unchanged built-in keeps its reference.
+    assert_eq!(vista(&["bench", "fbm", "--cpu", "--size", "8x8", "--runs", "1"]).code, 0);
+}
+
 fn a_kernel_described_as_data_renders() {
     let r = render_k(K_MANIFEST, K_SHADER);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -2023,6 +2053,11 @@ fn main() {
         (Gpu, "a_kernel_without_a_uniform_renders", a_kernel_without_a_uniform_renders),
         (Cpu, "unfed_globals_are_refused", unfed_globals_are_refused),
         (Gpu, "valued_defs_reach_imported_modules", valued_defs_reach_imported_modules),
+        (
+            Gpu,
+            "a_project_kernel_named_like_a_builtin_does_not_get_its_reference",
+            a_project_kernel_named_like_a_builtin_does_not_get_its_reference,
+        ),
         (Gpu, "overrides_take_manifest_values_and_params", overrides_take_manifest_values_and_params),
         (
             Gpu,

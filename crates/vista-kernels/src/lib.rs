@@ -207,10 +207,15 @@ impl std::fmt::Debug for Kernel {
 
 impl Kernel {
     /// Parses a manifest (`origin` names it in errors) and attaches the CPU
-    /// reference registered under `name`.
+    /// reference registered under `name`, but only while the manifest
+    /// declares the built-in's params (names and types): a project kernel
+    /// that shares a built-in's name with other params is a kernel of its
+    /// own, with goldens and guards but no reference (the reference reads
+    /// the built-in's params, and would find them missing).
     pub fn from_manifest(name: &str, origin: &str, text: &str) -> Result<Kernel, ParamError> {
         let manifest = manifest::parse(name, origin, text)?;
-        Ok(Kernel { cpu: cpu_reference(manifest.name), manifest, origin: Box::leak(origin.into()) })
+        let cpu = cpu_reference(manifest.name).filter(|_| same_params_as_builtin(&manifest));
+        Ok(Kernel { cpu, manifest, origin: Box::leak(origin.into()) })
     }
 
     pub fn name(&self) -> &'static str {
@@ -466,6 +471,17 @@ impl Kernel {
 }
 
 /// A project's kernels: its `kernels/*.toml` over the built-ins, by name.
+/// Whether `m` declares the params of the built-in kernel of its name.
+fn same_params_as_builtin(m: &manifest::Manifest) -> bool {
+    let file = format!("{}.toml", m.name);
+    let Some((_, text)) = vista_project::builtin::KERNELS.iter().find(|(rel, _)| *rel == file) else {
+        return false;
+    };
+    let Ok(builtin) = manifest::parse(m.name, "<built-in>", text) else { return false };
+    let sig = |ps: &[ParamSpec]| ps.iter().map(|p| (p.name, p.ty)).collect::<Vec<_>>();
+    sig(builtin.params) == sig(m.params)
+}
+
 #[derive(Debug, Clone)]
 pub struct Registry {
     kernels: Vec<&'static Kernel>,
