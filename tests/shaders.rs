@@ -57,9 +57,9 @@ fn uniform_blocks_are_packed_by_name_at_naga_offsets() {
         let module = set.compose(k.shader()).unwrap();
         let layout = k.layout(&module).unwrap_or_else(|e| panic!("{e}"));
         let p = k.resolve(k.presets().last().map(|p| p.name), &[]).unwrap();
-        let bytes = k.uniforms(&layout, &p, 64, 32);
+        let bytes = k.uniforms(&layout, &p, 64, 32).remove(0);
         assert_eq!(bytes.len() % 16, 0);
-        assert!(bytes.len() as u32 >= layout.size);
+        assert!(bytes.len() as u32 >= layout.blocks[0].size);
         let word = |at: u32| u32::from_le_bytes(bytes[at as usize..at as usize + 4].try_into().unwrap());
         let float = |at: u32| f32::from_bits(word(at));
         for f in &layout.fields {

@@ -93,7 +93,8 @@ pub struct Job<'a> {
     pub fill: &'a [u8],
     /// Values of pipeline-overridable constants, by name.
     pub constants: &'a [(String, f64)],
-    pub uniforms: &'a [u8],
+    /// The bytes of each uniform block.
+    pub uniforms: &'a [Vec<u8>],
     pub table: &'a [u32],
     pub width: u32,
     pub height: u32,
@@ -106,6 +107,8 @@ pub struct Slot {
     pub group: u32,
     pub binding: u32,
     pub kind: &'static str,
+    /// Which of the job's uniform blocks a `uniform` slot takes.
+    pub index: u32,
 }
 
 /// The texture as the kernel wrote it (its texel bytes, row-major,
@@ -204,7 +207,7 @@ impl Browser {
             "texel_bytes": job.texel_bytes,
             "fill": B64.encode(job.fill),
             "constants": job.constants.iter().cloned().collect::<std::collections::BTreeMap<String, f64>>(),
-            "uniforms": B64.encode(job.uniforms),
+            "uniforms": job.uniforms.iter().map(|u| B64.encode(u)).collect::<Vec<_>>(),
             "table": B64.encode(&table),
             "width": job.width,
             "height": job.height,

@@ -103,8 +103,8 @@ async function pipeline(job) {
   return compiled;
 }
 
-// job: { key, wgsl, entry, workgroups [x, y, z], slots [{group, binding, kind}], format, texel_bytes,
-//        fill (one texel, base64), uniforms (base64), table (base64), width, height }
+// job: { key, wgsl, entry, workgroups [x, y, z], slots [{group, binding, kind, index}], format, texel_bytes,
+//        fill (one texel, base64), uniforms [base64, one per block], table (base64), width, height }
 async function vistaRun(job) {
   try {
     const d = vista.device;
@@ -113,10 +113,13 @@ async function vistaRun(job) {
     const start = performance.now();
     d.pushErrorScope("out-of-memory");
     d.pushErrorScope("validation");
-    const bytes = fromBase64(job.uniforms);
-    const uniforms = d.createBuffer({ size: Math.max(16, Math.ceil(bytes.length / 16) * 16), usage: GPUBufferUsage.UNIFORM, mappedAtCreation: true });
-    new Uint8Array(uniforms.getMappedRange()).set(bytes);
-    uniforms.unmap();
+    const uniforms = job.uniforms.map((b64) => {
+      const bytes = fromBase64(b64);
+      const buffer = d.createBuffer({ size: Math.max(16, Math.ceil(bytes.length / 16) * 16), usage: GPUBufferUsage.UNIFORM, mappedAtCreation: true });
+      new Uint8Array(buffer.getMappedRange()).set(bytes);
+      buffer.unmap();
+      return buffer;
+    });
     const words = fromBase64(job.table);
     const table = d.createBuffer({ size: Math.max(16, Math.ceil(words.length / 4) * 4), usage: GPUBufferUsage.STORAGE, mappedAtCreation: true });
     new Uint8Array(table.getMappedRange()).set(words);
@@ -132,11 +135,11 @@ async function vistaRun(job) {
     const paddedRow = Math.ceil(rowBytes / 256) * 256;
     const readback = d.createBuffer({ size: paddedRow * job.height, usage: GPUBufferUsage.COPY_DST | GPUBufferUsage.MAP_READ });
     const view = texture.createView();
-    const resource = (kind) => (kind === "uniform" ? { buffer: uniforms } : kind === "table" ? { buffer: table } : view);
+    const resource = (s) => (s.kind === "uniform" ? { buffer: uniforms[s.index] } : s.kind === "table" ? { buffer: table } : view);
     const bindGroups = compiled.groups.map((layout, g) =>
       d.createBindGroup({
         layout,
-        entries: job.slots.filter((s) => s.group === g).map((s) => ({ binding: s.binding, resource: resource(s.kind) })),
+        entries: job.slots.filter((s) => s.group === g).map((s) => ({ binding: s.binding, resource: resource(s) })),
       }),
     );
     // Two submissions, so the kernel and the readback are timed apart as on wgpu.
@@ -165,7 +168,7 @@ async function vistaRun(job) {
     for (let y = 0; y < job.height; y++) out.set(padded.subarray(y * paddedRow, y * paddedRow + rowBytes), y * rowBytes);
     readback.unmap();
     const readbackMs = performance.now() - copyStart;
-    for (const b of [uniforms, table, readback]) b.destroy();
+    for (const b of [...uniforms, table, readback]) b.destroy();
     texture.destroy();
     if (!vista.device) throw new Error(`the WebGPU device was lost during the run (${vista.lost})`);
     vista.out = out;

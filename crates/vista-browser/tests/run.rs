@@ -69,9 +69,9 @@ fn failure(r: Result<vista_browser::Output, BrowserError>, what: &str) -> Browse
 
 /// vista's three bindings at their usual places.
 const SLOTS: [vista_browser::Slot; 3] = [
-    vista_browser::Slot { group: 0, binding: 0, kind: "uniform" },
-    vista_browser::Slot { group: 0, binding: 1, kind: "output" },
-    vista_browser::Slot { group: 0, binding: 2, kind: "table" },
+    vista_browser::Slot { group: 0, binding: 0, kind: "uniform", index: 0 },
+    vista_browser::Slot { group: 0, binding: 1, kind: "output", index: 0 },
+    vista_browser::Slot { group: 0, binding: 2, kind: "table", index: 0 },
 ];
 const FILL: [u8; 16] = [0; 16];
 
@@ -104,7 +104,7 @@ fn a_kernel_runs_and_reads_back_every_texel() {
         texel_bytes: 16,
         fill: &FILL,
         constants: &[],
-        uniforms: &u,
+        uniforms: std::slice::from_ref(&u),
         table: &table,
         width: w,
         height: h,
@@ -119,7 +119,7 @@ fn a_kernel_runs_and_reads_back_every_texel() {
     }
     // The same browser serves a second run with other uniforms.
     let u = uniforms(w, h, 2.0);
-    let out = b.run(&Job { uniforms: &u, ..job }).unwrap();
+    let out = b.run(&Job { uniforms: std::slice::from_ref(&u), ..job }).unwrap();
     assert_eq!(rgba(&out)[(w - 1) as usize][0], (w - 1) as f32 * 2.0);
 }
 
@@ -139,7 +139,7 @@ fn tint_errors_name_the_case_and_the_next_run_works() {
         texel_bytes: 16,
         fill: &FILL,
         constants: &[],
-        uniforms: &u,
+        uniforms: std::slice::from_ref(&u),
         table: &table,
         width: 8,
         height: 8,
@@ -170,7 +170,7 @@ fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
         texel_bytes: 16,
         fill: &FILL,
         constants: &[],
-        uniforms: &u,
+        uniforms: std::slice::from_ref(&u),
         table: &table,
         width: 64,
         height: 64,

@@ -1403,6 +1403,62 @@ fn a_project_kernel_named_like_a_builtin_does_not_get_its_reference() {
     assert_eq!(vista(&["bench", "fbm", "--cpu", "--size", "8x8", "--runs", "1"]).code, 0);
 }
 
+/// Several uniform globals, a bare one among them: params reach a leaf by
+/// its bare name where that is unambiguous, else as `variable.path`; a bare
+/// name that leaves of two uniforms share is refused, naming both.
+fn several_uniforms_are_packed_by_variable_path() {
+    let shader = r#"struct Frame {
+    width: u32,
+    height: u32,
+    gain: f32,
+}
+struct Flip {
+    value: f32,
+    gain: f32,
+}
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var<uniform> flip: Flip;
+@group(2) @binding(5) var<uniform> bias: f32;
+@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= frame.width || id.y >= frame.height {
+        return;
+    }
+    textureStore(output, id.xy, vec4(frame.gain, flip.gain * flip.value, bias, 1.0));
+}
+"#;
+    let param = |name: &str, default: f32| {
+        format!("[[param]]\nname = \"{name}\"\ntype = \"f32\"\nrange = [0, 1]\ndefault = {default}\n")
+    };
+    let manifest = format!(
+        "summary = \"three uniforms\"\n{}{}{}{}",
+        param("frame.gain", 0.25),
+        param("flip.gain", 0.5),
+        param("value", 0.5),
+        param("bias", 0.75)
+    );
+    let d = kernel_project(&manifest, shader);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("{backend}.exr"));
+        let args =
+            ["render", "k", "--size", "9x5", "--set", "flip.gain=1", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        let img = vista_image::load(&out).unwrap();
+        assert!(img.data.iter().all(|p| *p == [0.25, 0.5, 0.75, 1.0]), "{backend}: {:?}", img.get(0, 0));
+    }
+    let ambiguous = manifest
+        .replace("name = \"frame.gain\"", "name = \"gain\"")
+        .replace("name = \"flip.gain\"", "name = \"other\"");
+    let d = kernel_project(&ambiguous, shader);
+    assert_rejected(
+        &render_exr(d.path(), "8x8", "a").0,
+        2,
+        &["param gain is ambiguous", "frame.gain, flip.gain", "name one as frame.gain or flip.gain"],
+    );
+}
+
 fn a_kernel_described_as_data_renders() {
     let r = render_k(K_MANIFEST, K_SHADER);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -2053,6 +2109,7 @@ fn main() {
         (Gpu, "a_kernel_without_a_uniform_renders", a_kernel_without_a_uniform_renders),
         (Cpu, "unfed_globals_are_refused", unfed_globals_are_refused),
         (Gpu, "valued_defs_reach_imported_modules", valued_defs_reach_imported_modules),
+        (Gpu, "several_uniforms_are_packed_by_variable_path", several_uniforms_are_packed_by_variable_path),
         (
             Gpu,
             "a_project_kernel_named_like_a_builtin_does_not_get_its_reference",

@@ -212,8 +212,8 @@ pub struct Dispatch<'a> {
     pub format: &'a str,
     /// Values of the module's pipeline-overridable constants, by name.
     pub constants: &'a [(String, f64)],
-    /// Uniform block for binding 0 (padded to 16 bytes by the caller).
-    pub uniforms: &'a [u8],
+    /// The bytes of each uniform block (padded to 16 bytes by the caller).
+    pub uniforms: &'a [Vec<u8>],
     /// Read-only u32 table for binding 2.
     pub table: &'a [u32],
     pub width: u32,
@@ -243,8 +243,8 @@ pub const UNWRITTEN: u32 = 0x7FC0_DEAD;
 /// What feeds a binding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SlotKind {
-    /// The uniform bytes.
-    Uniform,
+    /// The bytes of uniform block `n` of the job's `uniforms`.
+    Uniform(usize),
     /// The read-only u32 table.
     Table,
     /// The write-only output texture.
@@ -562,7 +562,7 @@ impl Context {
                     .filter(|s| s.group == g)
                     .map(|s| {
                         let ty = match s.kind {
-                            SlotKind::Uniform => wgpu::BindingType::Buffer {
+                            SlotKind::Uniform(_) => wgpu::BindingType::Buffer {
                                 ty: wgpu::BufferBindingType::Uniform,
                                 has_dynamic_offset: false,
                                 min_binding_size: None,
@@ -679,13 +679,17 @@ impl Context {
         let d = &w.device;
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
         let has = |k: SlotKind| job.slots.iter().any(|s| s.kind == k);
-        let uniforms = has(SlotKind::Uniform).then(|| {
-            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("params"),
-                contents: job.uniforms,
-                usage: wgpu::BufferUsages::UNIFORM,
+        let uniforms: Vec<wgpu::Buffer> = job
+            .uniforms
+            .iter()
+            .map(|bytes| {
+                d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("params"),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::UNIFORM,
+                })
             })
-        });
+            .collect();
         let table = has(SlotKind::Table).then(|| {
             let words: Vec<u32> = if job.table.is_empty() { vec![0; 4] } else { job.table.to_vec() };
             d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -753,7 +757,7 @@ impl Context {
                     .map(|s| wgpu::BindGroupEntry {
                         binding: s.binding,
                         resource: match s.kind {
-                            SlotKind::Uniform => uniforms.as_ref().expect("a uniform slot").as_entire_binding(),
+                            SlotKind::Uniform(n) => uniforms[n].as_entire_binding(),
                             SlotKind::Table => table.as_ref().expect("a table slot").as_entire_binding(),
                             SlotKind::Output => wgpu::BindingResource::TextureView(&view),
                         },
@@ -868,9 +872,13 @@ impl Context {
                 group: s.group,
                 binding: s.binding,
                 kind: match s.kind {
-                    SlotKind::Uniform => "uniform",
+                    SlotKind::Uniform(_) => "uniform",
                     SlotKind::Table => "table",
                     SlotKind::Output => "output",
+                },
+                index: match s.kind {
+                    SlotKind::Uniform(n) => n as u32,
+                    _ => 0,
                 },
             })
             .collect();

@@ -1,6 +1,6 @@
 //! Every global an entry point reaches, from naga's reflection of the
 //! composed module, and what feeds it. So far vista feeds three kinds: the
-//! uniform block (params), the read-only u32 table (Perlin's permutation)
+//! uniform blocks (params), the read-only u32 table (Perlin's permutation)
 //! and one write-only 2D storage texture (the output), each at whatever
 //! group and binding the kernel declares. Any other reached global is
 //! refused before GPU work, naming the entry point, the variable, its
@@ -190,10 +190,7 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
             ))
         };
         let feed = match (&var.space, &module.types[var.ty].inner) {
-            (AddressSpace::Uniform, TypeInner::Struct { .. }) => Feed::Uniform,
-            (AddressSpace::Uniform, _) => {
-                return Err(unfed("a uniform of a bare value (params packed into a struct work)"));
-            }
+            (AddressSpace::Uniform, _) => Feed::Uniform,
             (AddressSpace::Storage { access }, TypeInner::Array { base, .. })
                 if !access.contains(StorageAccess::STORE)
                     && matches!(module.types[*base].inner, TypeInner::Scalar(s) if s.kind == ScalarKind::Uint && s.width == 4) =>
@@ -220,19 +217,14 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
             }
             _ => return Err(unfed("a resource")),
         };
-        for kind in [Feed::Uniform, Feed::Output("")] {
-            let same = |f: &Feed| std::mem::discriminant(f) == std::mem::discriminant(&kind);
-            if same(&feed)
-                && let Some(first) = out.iter().find(|b| same(&b.feed))
-            {
-                return Err(bad(format!(
-                    "pass {entry}: {name} (@group({}) @binding({})) is a second {} after {}; one is supported so far",
-                    rb.group,
-                    rb.binding,
-                    if kind == Feed::Uniform { "uniform" } else { "output texture" },
-                    first.name
-                )));
-            }
+        if let Feed::Output(_) = feed
+            && let Some(first) = out.iter().find(|b| matches!(b.feed, Feed::Output(_)))
+        {
+            return Err(bad(format!(
+                "pass {entry}: {name} (@group({}) @binding({})) is a second output texture after {}; one is \
+                 supported so far",
+                rb.group, rb.binding, first.name
+            )));
         }
         out.push(Binding { group: rb.group, binding: rb.binding, name, feed, global: g });
     }

@@ -40,14 +40,32 @@ pub struct Field {
     /// `outer.inner` for a field inside a nested struct, for messages.
     pub path: String,
     pub ty: FieldType,
+    /// Byte offset within its block.
     pub offset: u32,
+    /// Index of its block in [`UniformLayout::blocks`].
+    pub block: usize,
+    /// `variable.path`: the name that always reaches it (the variable as
+    /// the declaring module spells it).
+    pub key: String,
 }
 
-/// The reflected uniform block.
+/// One uniform global.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Block {
+    pub group: u32,
+    pub binding: u32,
+    /// The WGSL variable name.
+    pub var: String,
+    /// Its byte size (naga's span).
+    pub size: u32,
+}
+
+/// The reflected uniform blocks.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct UniformLayout {
-    /// The struct's byte size (naga's span).
-    pub size: u32,
+    /// Every uniform global the entry point reaches, in binding order.
+    pub blocks: Vec<Block>,
+    /// The leaves of every block.
     pub fields: Vec<Field>,
     /// Whether the entry point reads the u32 table (the Perlin permutation).
     pub uses_table: bool,
@@ -62,28 +80,43 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
     let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
     let bindings = crate::bindings::reflect(kernel, shader, entry, module)?;
     let uses_table = bindings.iter().any(|b| b.feed == crate::bindings::Feed::Table);
-    let Some(uniform) = bindings.iter().find(|b| b.feed == crate::bindings::Feed::Uniform) else {
-        // No uniform: the kernel takes no params (a param would feed nothing).
-        return Ok(UniformLayout {
-            size: 0,
-            fields: Vec::new(),
-            uses_table,
-            bindings,
-            overrides: override_names(module),
-        });
-    };
-    let var = &module.global_variables[uniform.global];
-    let TypeInner::Struct { members, span } = &module.types[var.ty].inner else {
-        unreachable!("bindings::reflect feeds only struct uniforms");
-    };
-    let mut fields = Vec::new();
-    walk(module, members, 0, "", shader, &mut fields).map_err(bad)?;
-    for (i, f) in fields.iter().enumerate() {
-        if let Some(g) = fields[..i].iter().find(|g| g.name == f.name) {
-            return Err(bad(format!("{shader}: Params fields {} and {} share the name '{}'", g.path, f.path, f.name)));
+    let (mut blocks, mut fields) = (Vec::new(), Vec::new());
+    for uniform in bindings.iter().filter(|b| b.feed == crate::bindings::Feed::Uniform) {
+        let var = &module.global_variables[uniform.global];
+        let name = uniform.name.clone();
+        let block = blocks.len();
+        let start = fields.len();
+        let size = match &module.types[var.ty].inner {
+            TypeInner::Struct { members, span } => {
+                walk(module, members, 0, "", shader, &mut fields).map_err(bad)?;
+                *span
+            }
+            // A bare value (`var<uniform> g: f32`) is one leaf named by its variable.
+            inner => {
+                let ty = leaf_type(module, inner).map_err(|what| {
+                    bad(format!("{shader}: uniform {name} is {what}; allowed: the leaf types of a struct field"))
+                })?;
+                fields.push(Field { name: name.clone(), path: name.clone(), ty, offset: 0, block, key: name.clone() });
+                module.types[var.ty].inner.size(module.to_ctx())
+            }
+        };
+        for f in &mut fields[start..] {
+            f.block = block;
+            if f.key.is_empty() {
+                f.key = format!("{name}.{}", f.path);
+            }
         }
+        for (i, f) in fields[start..].iter().enumerate() {
+            if let Some(g) = fields[start..start + i].iter().find(|g| g.name == f.name) {
+                return Err(bad(format!(
+                    "{shader}: Params fields {} and {} share the name '{}'",
+                    g.path, f.path, f.name
+                )));
+            }
+        }
+        blocks.push(Block { group: uniform.group, binding: uniform.binding, var: name, size });
     }
-    Ok(UniformLayout { size: *span, fields, uses_table, bindings, overrides: override_names(module) })
+    Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module) })
 }
 
 fn override_names(module: &naga::Module) -> Vec<String> {
@@ -118,7 +151,7 @@ fn walk(
                 Err(what) => return unsupported(what),
             },
         };
-        out.push(Field { name, path, ty, offset });
+        out.push(Field { name, path, ty, offset, block: 0, key: String::new() });
     }
     Ok(())
 }
@@ -184,8 +217,16 @@ fn host_only(kernel: &Kernel, name: &str) -> bool {
     kernel.output() == crate::Output::Hdr && name == "exposure"
 }
 
+/// The param feeding `f`, if any: one named by its `variable.path`, else
+/// one named by its bare leaf name.
+fn param_of<'k>(kernel: &'k Kernel, f: &Field) -> Option<&'k crate::ParamSpec> {
+    let params = kernel.params();
+    params.iter().find(|s| s.name == f.key).or_else(|| params.iter().find(|s| s.name == f.name))
+}
+
 /// Refuses a layout that does not match the manifest: a field with no
-/// param, a param with no field, or a type mismatch.
+/// param, a param with no field, a bare param name that leaves of two
+/// uniforms share, or a type mismatch.
 pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.name().to_string(), message };
     for f in &layout.fields {
@@ -195,18 +236,19 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
             }
             continue;
         }
-        let spec = kernel.params().iter().find(|s| s.name == f.name);
+        let spec = param_of(kernel, f);
         // `_`-prefixed leaves are padding: zero unless a param names them.
         if spec.is_none() && f.name.starts_with('_') {
             continue;
         }
         let Some(spec) = spec else {
             return Err(bad(format!(
-                "Params field {} (WGSL {}) has no param in {}; declare a [[param]] named {} or compute it in WGSL",
+                "Params field {} (WGSL {}) has no param in {}; declare a [[param]] named {} (or {}) or compute it in WGSL",
                 f.path,
                 f.ty.wgsl(),
                 kernel.origin(),
-                f.name
+                f.name,
+                f.key
             )));
         };
         let want = spec.ty.wgsl();
@@ -223,8 +265,18 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
         }
     }
     for spec in kernel.params() {
+        let by_key: Vec<&Field> = layout.fields.iter().filter(|f| f.key == spec.name).collect();
+        let by_name: Vec<&Field> = layout.fields.iter().filter(|f| f.name == spec.name).collect();
+        if by_key.is_empty() && by_name.len() > 1 {
+            return Err(bad(format!(
+                "param {} is ambiguous: leaves of two uniforms share the name ({}); name one as {}",
+                spec.name,
+                by_name.iter().map(|f| f.key.as_str()).collect::<Vec<_>>().join(", "),
+                by_name.iter().map(|f| f.key.as_str()).collect::<Vec<_>>().join(" or ")
+            )));
+        }
         let feeds_override = layout.overrides.iter().any(|o| o == spec.name);
-        if !layout.fields.iter().any(|f| f.name == spec.name) && !host_only(kernel, spec.name) && !feeds_override {
+        if by_key.is_empty() && by_name.is_empty() && !host_only(kernel, spec.name) && !feeds_override {
             return Err(bad(format!(
                 "param {} ({}) has no field in the Params struct of {}; add `{}: {}` to it",
                 spec.name,
@@ -238,21 +290,23 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
     Ok(())
 }
 
-/// The uniform bytes for `p` at `width` x `height`, padded to a multiple of
-/// 16 bytes. The layout must have passed [`check`].
-pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, height: u32) -> Vec<u8> {
-    let mut bytes = vec![0u8; (layout.size.div_ceil(16).max(1) * 16) as usize];
-    let mut put = |offset: u32, word: [u8; 4]| {
-        bytes[offset as usize..offset as usize + 4].copy_from_slice(&word);
+/// Each uniform block's bytes for `p` at `width` x `height`, padded to a
+/// multiple of 16 bytes. The layout must have passed [`check`].
+pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, height: u32) -> Vec<Vec<u8>> {
+    let mut blocks: Vec<Vec<u8>> =
+        layout.blocks.iter().map(|b| vec![0u8; (b.size.div_ceil(16).max(1) * 16) as usize]).collect();
+    let mut put = |block: usize, offset: u32, word: [u8; 4]| {
+        blocks[block][offset as usize..offset as usize + 4].copy_from_slice(&word);
     };
     for f in &layout.fields {
         let words: Vec<[u8; 4]> = match f.name.as_str() {
             "width" => vec![width.to_le_bytes()],
             "height" => vec![height.to_le_bytes()],
-            name => {
-                let Some(spec) = kernel.params().iter().find(|s| s.name == name) else {
+            _ => {
+                let Some(spec) = param_of(kernel, f) else {
                     continue; // padding: stays zero
                 };
+                let name = spec.name;
                 let scalar = |v: f64| match f.ty.scalar {
                     Scalar::F32 => (v as f32).to_le_bytes(),
                     Scalar::U32 => (v as u32).to_le_bytes(),
@@ -272,10 +326,10 @@ pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, h
             }
         };
         for (word, at) in words.iter().zip(&f.ty.components) {
-            put(f.offset + at, *word);
+            put(f.block, f.offset + at, *word);
         }
     }
-    bytes
+    blocks
 }
 
 #[cfg(test)]
@@ -333,7 +387,7 @@ default = -3
         assert_eq!(at("mode").1, 32);
         assert!(!layout.uses_table);
         let p = k.resolve(None, &[]).unwrap();
-        let b = k.uniforms(&layout, &p, 7, 5);
+        let b = k.uniforms(&layout, &p, 7, 5).remove(0);
         let word = |o: usize| u32::from_le_bytes(b[o..o + 4].try_into().unwrap());
         assert_eq!((word(0), word(4)), (7, 5));
         assert_eq!([f32::from_bits(word(16)), f32::from_bits(word(20)), f32::from_bits(word(24))], [1.0, 2.0, 3.0]);
@@ -393,7 +447,7 @@ default = [1, 0, 0, 0, 1, 0, 0, 0, -1]
         );
         let layout = k.layout(&m).unwrap();
         let p = k.resolve(None, &[("res".into(), "1920,1080".into())]).unwrap();
-        let b = k.uniforms(&layout, &p, 3, 2);
+        let b = k.uniforms(&layout, &p, 3, 2).remove(0);
         let word = |o: u32| u32::from_le_bytes(b[o as usize..o as usize + 4].try_into().unwrap());
         let f = |o: u32| f32::from_bits(word(o));
         // mat4x4 at 16, column after column.

@@ -440,8 +440,9 @@ impl Kernel {
         Ok(l)
     }
 
-    /// The uniform block for `p` at `width` x `height`.
-    pub fn uniforms(&self, layout: &UniformLayout, p: &ParamSet, width: u32, height: u32) -> Vec<u8> {
+    /// Each uniform block's bytes for `p` at `width` x `height`, in
+    /// [`UniformLayout::blocks`] order.
+    pub fn uniforms(&self, layout: &UniformLayout, p: &ParamSet, width: u32, height: u32) -> Vec<Vec<u8>> {
         layout::pack(self, layout, p, width, height)
     }
 

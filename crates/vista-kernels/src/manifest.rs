@@ -214,8 +214,11 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let mut params: Vec<ParamSpec> = Vec::new();
     for p in &raw.params {
         let pfail = |message: String| kfail(format!("param {}: {message}", p.name));
-        if p.name.is_empty() || !p.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            return Err(pfail("a name uses only letters, digits and '_' (it names a WGSL field)".into()));
+        let ident = |w: &str| !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !p.name.split('.').all(ident) {
+            return Err(pfail(
+                "a name is a WGSL field name, or variable.path (letters, digits and '_' between dots)".into(),
+            ));
         }
         if RESERVED.contains(&p.name.as_str()) {
             return Err(pfail(format!("'{}' is reserved (width and height are the image size)", p.name)));

@@ -196,8 +196,8 @@ pub struct Plan {
     /// Values of the module's `override` constants (params, the manifest's
     /// `overrides`; absent ones take their defaults).
     pub constants: Vec<(String, f64)>,
-    /// The uniform block's bytes.
-    pub uniforms: Vec<u8>,
+    /// Each uniform block's bytes, in the layout's block order.
+    pub uniforms: Vec<Vec<u8>>,
     /// The table's words (Perlin's permutation and its packed chains).
     pub table: Vec<u32>,
     /// Output width in pixels.
@@ -240,7 +240,13 @@ pub fn plan(
             group: b.group,
             binding: b.binding,
             kind: match b.feed {
-                Feed::Uniform => vista_gpu::SlotKind::Uniform,
+                Feed::Uniform => vista_gpu::SlotKind::Uniform(
+                    layout
+                        .blocks
+                        .iter()
+                        .position(|u| (u.group, u.binding) == (b.group, b.binding))
+                        .expect("every uniform binding is a block"),
+                ),
                 Feed::Table => vista_gpu::SlotKind::Table,
                 Feed::Output(_) => vista_gpu::SlotKind::Output,
             },
