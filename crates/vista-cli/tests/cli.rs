@@ -1835,6 +1835,24 @@ fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
         2,
         &["tiles=1,2.5", "integers"],
     );
+    // Everything else follows for such kernels: the matrix, the validation
+    // layer, mutation testing from their own entry point, sweeps, benches.
+    let matrix = run(&["check", "--matrix"]);
+    assert!(matrix.code == 0 && matrix.stdout.contains("4 cases x 3 backends, 0 failed"), "{}", matrix.stdout);
+    let validated = run_in(&bin, &root, &[("VISTA_VALIDATION", "1")], &["check"]);
+    assert_eq!(validated.code, 0, "{}{}", validated.stdout, validated.stderr);
+    let mutate = run(&["mutate", "--kernel", "terrain", "--sample", "4", "--json", "m.json"]);
+    assert_eq!(mutate.code, 0, "{}", mutate.stderr);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root.join("m.json")).unwrap()).unwrap();
+    assert_eq!(report["mutants"].as_array().unwrap().len(), 4, "mutants of functions `height` reaches");
+    assert!(report["kernels"]["terrain"]["killed"].as_u64().unwrap() > 0, "{report}");
+    let sweep = run(&[
+        "sweep", "terrain", "--param", "octaves", "--values", "1,2,4", "--size", "32x32", "--runs", "1", "--out", "sw",
+    ]);
+    assert_eq!(sweep.code, 0, "{}", sweep.stderr);
+    let bench = run(&["bench", "mandelbrot", "--size", "64x64", "--runs", "2", "--json"]);
+    assert!(bench.code == 0 && bench.stdout.contains("\"mpix_per_s\":"), "{}", bench.stderr);
 }
 
 fn expected_failures_are_data_and_an_unexpected_pass_fails() {

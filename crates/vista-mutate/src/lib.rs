@@ -264,7 +264,7 @@ pub struct Planned {
 /// The deterministic plan: per kernel (sorted by name), every mutant of its
 /// import closure in source order, shuffled by `seed` and cut to `sample`;
 /// then this partition's slice (every n-th from the k-th). Only functions
-/// the kernel's `main` reaches (by name, through calls, across the closure)
+/// the kernel's entry point (`main` unless the manifest names another) reaches (by name, through calls, across the closure)
 /// are mutated: a function it never calls cannot change its output, so its
 /// mutants would only be `equivalent?` noise.
 pub fn plan(
@@ -286,7 +286,7 @@ pub fn plan(
             .iter()
             .flat_map(|f| mutants::functions(&f.text).into_iter().map(move |g| (f.rel.as_str(), g)))
             .collect();
-        let mut reached: Vec<bool> = fns.iter().map(|(rel, g)| *rel == k.shader() && g.name == "main").collect();
+        let mut reached: Vec<bool> = fns.iter().map(|(rel, g)| *rel == k.shader() && g.name == k.entry()).collect();
         let mut work: Vec<String> =
             fns.iter().zip(&reached).filter(|(_, r)| **r).flat_map(|((_, g), _)| g.calls.clone()).collect();
         while let Some(name) = work.pop() {
