@@ -1679,6 +1679,12 @@ fn the_report_works_in_a_real_browser() {
     let summary = eval("[...document.querySelectorAll('#summary a')].map(a => a.getAttribute('href')).join(' ')");
     assert_eq!(summary, serde_json::json!("#case-marble-default"), "the summary lists exactly the failure");
     assert_eq!(eval("document.querySelector('#case-marble-calm').hidden"), serde_json::json!(true), "failures only");
+    // Every summary row holds its own thumbnails: none hangs into the row below.
+    let staircase = eval(
+        "[...document.querySelectorAll('details.case > summary')].filter(s => { const t = s.querySelector('.thumbs'); \
+         return t && t.getBoundingClientRect().bottom > s.getBoundingClientRect().bottom + 0.5; }).length",
+    );
+    assert_eq!(staircase, serde_json::json!(0), "thumbnails overflow their summary rows");
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR"));
     let shot = |name: &str| std::fs::write(shots.join(name), page.screenshot(wait).unwrap()).unwrap();
     shot("report-summary.png");
