@@ -44,12 +44,15 @@ enum Command {
     },
     /// Render one kernel to a PNG (display values) or EXR (raw/linear values).
     Render {
+        /// The kernel's name (`vista list` shows them).
         kernel: String,
+        /// A preset of the kernel (default: its defaults).
         #[arg(long)]
         preset: Option<String>,
         /// Parameter override NAME=VALUE (repeatable; vectors comma-separated).
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
+        /// Image size, WIDTHxHEIGHT.
         #[arg(long, default_value = "256x256")]
         size: String,
         /// Write only this rectangle of the rendered image: X,Y,W,H in pixels
@@ -59,13 +62,17 @@ enum Command {
         /// Repeat every written pixel N x N times (nearest neighbour, 1-16).
         #[arg(long, value_name = "N", default_value_t = 1)]
         zoom: u32,
+        /// The image to write: .png (display values, 16-bit) or .exr (raw values).
         #[arg(short, long)]
         out: PathBuf,
     },
     /// Compare two images (PNG or EXR): PSNR, SSIM, max-abs, bad pixels, NaN/Inf.
     Compare {
+        /// The reference image (PNG or EXR).
         a: PathBuf,
+        /// The image compared with it.
         b: PathBuf,
+        /// Print every metric as one JSON object.
         #[arg(long)]
         json: bool,
         /// PSNR peak = max of A (for HDR/EXR data) instead of 1.
@@ -81,6 +88,7 @@ enum Command {
     },
     /// Render golden cases and compare them with their goldens.
     Check {
+        /// Only the cases whose id matches this glob.
         #[arg(long = "case", value_name = "GLOB")]
         case: Option<String>,
         /// Where the HTML report and case images go (default: <root>/target/vista-report).
@@ -92,8 +100,10 @@ enum Command {
     },
     /// Re-render cases and write their goldens (refused under CI=true without --force).
     Bless {
+        /// Only the cases whose id matches this glob.
         #[arg(long = "case", value_name = "GLOB")]
         case: Option<String>,
+        /// Bless even under CI=true.
         #[arg(long)]
         force: bool,
         /// Delete golden images that no case refers to.
@@ -107,13 +117,16 @@ enum Command {
     /// Mutation testing: single-token mutants of a kernel's WGSL against its
     /// golden cases and CPU reference; prints the score and the survivors.
     Mutate {
+        /// Only this kernel's mutants (against its golden cases).
         #[arg(long, conflicts_with = "case")]
         kernel: Option<String>,
+        /// The kernels of the cases whose id matches this glob, against those cases.
         #[arg(long = "case", value_name = "GLOB")]
         case: Option<String>,
         /// Mutants per kernel, sampled with --seed (default: all).
         #[arg(long)]
         sample: Option<usize>,
+        /// The sampling seed: the same seed, the same mutants.
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Worker threads sharing the device.
@@ -135,15 +148,21 @@ enum Command {
     },
     /// Median kernel throughput after a warm-up (excludes device creation and compilation).
     Bench {
+        /// The kernel's name.
         kernel: String,
+        /// A preset of the kernel.
         #[arg(long)]
         preset: Option<String>,
+        /// Parameter override NAME=VALUE (repeatable).
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
+        /// Image size, WIDTHxHEIGHT.
         #[arg(long, default_value = "1024x1024")]
         size: String,
+        /// Timed runs after the warm-up (the median is reported).
         #[arg(long, default_value_t = 7)]
         runs: u32,
+        /// Print the result as one JSON object (field mpix_per_s among them).
         #[arg(long)]
         json: bool,
         /// Also time the kernel's CPU reference built in f32 on all cores
@@ -325,7 +344,8 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
                     o.display()
                 );
             }
-            println!("blessed {} cases on {}", summary.rows.len(), ctx.adapter_description());
+            let n = summary.rows.len();
+            println!("blessed {n} case{} on {}", if n == 1 { "" } else { "s" }, ctx.adapter_description());
             Ok(0)
         }
         Command::Sweep(args) => sweep::sweep(project, config, args),

@@ -442,6 +442,7 @@ fn missing_golden_fails_with_the_bless_command_and_is_not_created() {
     let r = vista_in(Some(d.path()), &[], &["check"]);
     assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("does not exist") && r.stdout.contains("bless --case 'a'"), "{}", r.stdout);
+    assert!(!r.stdout.contains("no comparison"), "the problem line says it all: {}", r.stdout);
     assert!(r.stdout.contains("index.html#case-a"), "{}", r.stdout);
     assert!(report(d.path()).join("a/actual.png").exists() && report(d.path()).join("a/actual8.png").exists());
     assert!(!golden(d.path(), "fbm", "a").exists(), "check must never create a golden");
@@ -462,6 +463,11 @@ fn bless_then_check_passes_and_bless_is_refused_in_ci() {
     let forced = vista_in(Some(d.path()), &[("CI", "true")], &["bless", "--force", "--case", "a"]);
     assert_eq!(forced.code, 0, "{}", forced.stderr);
     assert!(forced.stdout.contains("unchanged"), "{}", forced.stdout);
+    assert!(
+        forced.stdout.contains("blessed 1 case on ") && b.stdout.contains("blessed 3 cases on "),
+        "{}",
+        forced.stdout
+    );
 }
 
 fn a_changed_render_fails_check_with_metrics_and_images() {

@@ -104,24 +104,22 @@ impl Outcome {
     /// (for a failure) the bless command.
     pub fn explain(&self, report_dir: &std::path::Path) -> String {
         let mut s = String::new();
-        match &self.metrics {
-            Some(m) => {
-                s += &format!(
-                    "  PSNR {} (>= {:.1} dB, {} driver) | SSIM {:.5}{} | FLIP {} | max-abs {:.3e} | bad pixels {} \
+        // A missing golden or an error explains itself in its problem line.
+        if let Some(m) = &self.metrics {
+            s += &format!(
+                "  PSNR {} (>= {:.1} dB, {} driver) | SSIM {:.5}{} | FLIP {} | max-abs {:.3e} | bad pixels {} \
                      ({:.3}%, > {BAD_PIXEL_LIMIT}) | NaN/Inf {}\n",
-                    metrics::format_psnr(m.psnr),
-                    self.psnr_threshold,
-                    if self.same_driver { "same" } else { "other" },
-                    m.ssim,
-                    self.min_ssim.map(|t| format!(" (>= {t})")).unwrap_or_default(),
-                    m.flip_mean.map(|f| format!("{f:.5}")).unwrap_or_else(|| "-".into()),
-                    m.max_abs,
-                    m.bad_pixels,
-                    self.bad_percent().unwrap_or(0.0),
-                    m.nan
-                );
-            }
-            None => s += &format!("  {:?}: no comparison\n", self.verdict),
+                metrics::format_psnr(m.psnr),
+                self.psnr_threshold,
+                if self.same_driver { "same" } else { "other" },
+                m.ssim,
+                self.min_ssim.map(|t| format!(" (>= {t})")).unwrap_or_default(),
+                m.flip_mean.map(|f| format!("{f:.5}")).unwrap_or_else(|| "-".into()),
+                m.max_abs,
+                m.bad_pixels,
+                self.bad_percent().unwrap_or(0.0),
+                m.nan
+            );
         }
         if !self.changed_files.is_empty() {
             s += &format!("  changed shader files: {}\n", self.changed_files.join(", "));

@@ -340,8 +340,8 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
         if let Some(cmd) = bless_all_command(&ids) {
             let _ = write!(
                 summary,
-                "<p>If every change is intended, bless all {} after review: <code class=\"cmd\">{}</code></p>",
-                ids.len(),
+                "<p>If every change is intended, bless {} after review: <code class=\"cmd\">{}</code></p>",
+                if ids.len() == 1 { "it".to_string() } else { format!("all {}", ids.len()) },
                 html_escape(&cmd)
             );
         }
