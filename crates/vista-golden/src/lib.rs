@@ -21,7 +21,7 @@ pub use check::{
     BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, first_out_of_range, guards, judge,
     unwritten_problem,
 };
-pub use run::{CheckOptions, Checked, check_case};
+pub use run::{CheckOptions, Checked, check_case, run_info};
 pub use store::{Manifest, ManifestEntry, Store};
 
 use vista_gpu::GpuError;

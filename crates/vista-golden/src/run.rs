@@ -27,16 +27,22 @@ pub struct Checked {
     pub expected: Option<Image>,
 }
 
+/// This run's side of `case`'s provenance: backend, adapter, params hash
+/// and the hash of the WGSL the renderer's shaders give the kernel.
+pub fn run_info(ctx: &Renderer, case: &Case) -> RunInfo {
+    RunInfo {
+        backend: ctx.backend().to_string(),
+        adapter: ctx.adapter_description(),
+        params_hash: params_hash(case),
+        shader_hash: ctx.shader_hash(case.kernel.shader()).unwrap_or_else(|e| format!("unavailable: {e}")),
+    }
+}
+
 /// Renders `case` and judges it against its golden and manifest entry
 /// (errors become `Verdict::Error`).
 pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Case, opts: &CheckOptions) -> Checked {
     let shader = case.kernel.shader();
-    let run = RunInfo {
-        backend: ctx.backend().to_string(),
-        adapter: ctx.adapter_description(),
-        params_hash: params_hash(case),
-        shader_hash: ctx.shader_hash(shader).unwrap_or_else(|e| format!("unavailable: {e}")),
-    };
+    let run = run_info(ctx, case);
     let entry = manifest.case.get(&case.id);
     let rendered = render(ctx, case.kernel, &case.params, case.width, case.height).map_err(|e| e.to_string());
     let r = match rendered {

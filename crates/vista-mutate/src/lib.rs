@@ -401,14 +401,8 @@ fn judge_case(
     r: &vista_render::Rendered,
 ) -> vista_golden::Outcome {
     let actual = vista_render::quantize16(r.display());
-    let shader = b.case.kernel.shader();
-    let run = vista_golden::RunInfo {
-        backend: gpu.backend().to_string(),
-        adapter: gpu.adapter_description(),
-        params_hash: vista_golden::store::params_hash(b.case),
-        shader_hash: gpu.shader_hash(shader).unwrap_or_default(),
-    };
-    let files = gpu.shader_file_hashes(shader).unwrap_or_default();
+    let run = vista_golden::run_info(gpu, b.case);
+    let files = gpu.shader_file_hashes(b.case.kernel.shader()).unwrap_or_default();
     let path = std::path::PathBuf::from(b.case.golden_rel_path());
     let observed = Observed {
         raw: &r.raw,
