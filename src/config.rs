@@ -7,8 +7,10 @@
 use std::ffi::OsString;
 use std::path::PathBuf;
 
+use std::time::Duration;
 use vista_golden::GoldenError;
-use vista_gpu::{AdapterSettings, GpuConfig};
+
+use vista_gpu::{AdapterChoice, AdapterSettings, GpuConfig};
 use vista_render::RenderLimits;
 
 /// Everything vista's libraries are told from outside.
@@ -71,7 +73,25 @@ impl Config {
             })?,
         };
         Ok(Config {
-            gpu: GpuConfig::from_lookup(&adapter, get)?,
+            gpu: GpuConfig {
+                adapter: AdapterChoice::from_settings(&adapter)?,
+                validate: truthy("VISTA_VALIDATION", text("VISTA_VALIDATION"))?,
+                timeout: match text("VISTA_GPU_TIMEOUT_S").filter(|v| !v.is_empty()) {
+                    None => vista_gpu::DEFAULT_TIMEOUT,
+                    Some(v) => v
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|s| s.is_finite() && *s >= 0.0)
+                        .map(Duration::from_secs_f64)
+                        .ok_or_else(|| {
+                            GoldenError::BadInput(format!(
+                                "VISTA_GPU_TIMEOUT_S={v} is not valid; expected a number of seconds >= 0"
+                            ))
+                        })?,
+                },
+                wgpu_backends: text("WGPU_BACKEND").filter(|v| !v.is_empty()),
+                browser: vista_browser::BrowserConfig::from_lookup(get),
+            },
             limits: RenderLimits { max_work },
             // CI systems spell it true, 1 or their own name (CI=woodpecker).
             in_ci: text("CI").is_some_and(|v| !matches!(v.to_ascii_lowercase().as_str(), "" | "0" | "false")),

@@ -91,8 +91,6 @@ pub struct Job<'a> {
     pub texel_bytes: u32,
     /// One texel's bytes: the output holds it everywhere before the kernel runs.
     pub fill: &'a [u8],
-    /// Values of pipeline-overridable constants, by name.
-    pub constants: &'a [(String, f64)],
     /// The bytes of each uniform block.
     pub uniforms: &'a [Vec<u8>],
     pub table: &'a [u32],
@@ -206,7 +204,6 @@ impl Browser {
             "format": job.format,
             "texel_bytes": job.texel_bytes,
             "fill": B64.encode(job.fill),
-            "constants": job.constants.iter().cloned().collect::<std::collections::BTreeMap<String, f64>>(),
             "uniforms": job.uniforms.iter().map(|u| B64.encode(u)).collect::<Vec<_>>(),
             "table": B64.encode(&table),
             "width": job.width,

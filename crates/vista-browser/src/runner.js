@@ -75,7 +75,7 @@ function groupLayouts(d, slots, format) {
 }
 
 async function pipeline(job) {
-  const key = `${job.key}@${job.entry}${JSON.stringify(job.slots)}${job.format}${JSON.stringify(job.constants)}`;
+  const key = `${job.key}@${job.entry}${JSON.stringify(job.slots)}${job.format}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
   const d = vista.device;
@@ -93,7 +93,7 @@ async function pipeline(job) {
   const groups = groupLayouts(d, job.slots, job.format);
   try {
     const layout = d.createPipelineLayout({ bindGroupLayouts: groups });
-    p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: job.entry, constants: job.constants } });
+    p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: job.entry } });
   } finally {
     const e = await d.popErrorScope();
     if (e) throw new Error(`pipeline: ${e.message}`);

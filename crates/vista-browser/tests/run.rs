@@ -75,6 +75,26 @@ const SLOTS: [vista_browser::Slot; 3] = [
 ];
 const FILL: [u8; 16] = [0; 16];
 
+/// A job over vista's usual bindings and an rgba32float output, 8 x 8
+/// workgroups covering `w` x `h`.
+fn job<'a>(label: &'a str, key: &'a str, wgsl: &'a str, u: &'a Vec<u8>, table: &'a [u32], w: u32, h: u32) -> Job<'a> {
+    Job {
+        label,
+        key,
+        wgsl,
+        entry: "main",
+        workgroups: [w.div_ceil(8), h.div_ceil(8), 1],
+        slots: &SLOTS,
+        format: "rgba32float",
+        texel_bytes: 16,
+        fill: &FILL,
+        uniforms: std::slice::from_ref(u),
+        table,
+        width: w,
+        height: h,
+    }
+}
+
 /// The output's rgba32float texels.
 fn rgba(out: &vista_browser::Output) -> Vec<[f32; 4]> {
     out.bytes
@@ -93,22 +113,7 @@ fn a_kernel_runs_and_reads_back_every_texel() {
     let (w, h) = (37u32, 11u32);
     let table = [10u32, 20, 30, 40];
     let u = uniforms(w, h, 0.5);
-    let job = Job {
-        label: "gradient",
-        key: "g1",
-        wgsl: GRADIENT,
-        entry: "main",
-        workgroups: [w.div_ceil(8), h.div_ceil(8), 1],
-        slots: &SLOTS,
-        format: "rgba32float",
-        texel_bytes: 16,
-        fill: &FILL,
-        constants: &[],
-        uniforms: std::slice::from_ref(&u),
-        table: &table,
-        width: w,
-        height: h,
-    };
+    let job = job("gradient", "g1", GRADIENT, &u, &table, w, h);
     let out = b.run(&job).unwrap();
     assert_eq!(rgba(&out).len(), (w * h) as usize);
     for y in 0..h {
@@ -128,22 +133,7 @@ fn tint_errors_name_the_case_and_the_next_run_works() {
     let bad = GRADIENT.replace("f32(id.y)", "id.y");
     let u = uniforms(8, 8, 1.0);
     let table = [0u32; 4];
-    let job = Job {
-        label: "case-bad",
-        key: "bad",
-        wgsl: &bad,
-        entry: "main",
-        workgroups: [1, 1, 1],
-        slots: &SLOTS,
-        format: "rgba32float",
-        texel_bytes: 16,
-        fill: &FILL,
-        constants: &[],
-        uniforms: std::slice::from_ref(&u),
-        table: &table,
-        width: 8,
-        height: 8,
-    };
+    let job = job("case-bad", "bad", &bad, &u, &table, 8, 8);
     let e = failure(b.run(&job), "Tint accepted a type error").to_string();
     assert!(e.starts_with("case-bad: in the browser: Tint rejected the WGSL: line"), "{e}");
     let good = Job { label: "case-good", key: "good", wgsl: GRADIENT, ..job };
@@ -159,22 +149,7 @@ fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
     );
     let u = uniforms(64, 64, 1.0);
     let table = [0u32; 4];
-    let job = Job {
-        label: "case-hang",
-        key: "hang",
-        wgsl: &forever,
-        entry: "main",
-        workgroups: [8, 8, 1],
-        slots: &SLOTS,
-        format: "rgba32float",
-        texel_bytes: 16,
-        fill: &FILL,
-        constants: &[],
-        uniforms: std::slice::from_ref(&u),
-        table: &table,
-        width: 64,
-        height: 64,
-    };
+    let job = job("case-hang", "hang", &forever, &u, &table, 64, 64);
     let start = std::time::Instant::now();
     let e = failure(b.run(&job), "the hung kernel returned");
     let took = start.elapsed();

@@ -73,46 +73,6 @@ impl Default for GpuConfig {
     }
 }
 
-impl GpuConfig {
-    /// The configuration of these adapter settings, with the other settings
-    /// looked up by name (the edge passes `std::env::var_os`):
-    /// `VISTA_VALIDATION`, `VISTA_GPU_TIMEOUT_S`, `WGPU_BACKEND`, and the
-    /// browser's `VISTA_CHROMIUM` and `PATH`. A value that does not parse is
-    /// bad input, named.
-    pub fn from_lookup(
-        adapter: &AdapterSettings,
-        get: &dyn Fn(&str) -> Option<std::ffi::OsString>,
-    ) -> Result<GpuConfig, GpuError> {
-        let text = |k: &str| get(k).map(|v| v.to_string_lossy().into_owned()).filter(|v| !v.is_empty());
-        let validate = match text("VISTA_VALIDATION").as_deref() {
-            None | Some("0") => false,
-            Some(v) if v.eq_ignore_ascii_case("false") => false,
-            Some(v) if v == "1" || v.eq_ignore_ascii_case("true") => true,
-            Some(v) => {
-                return Err(GpuError::Request(format!("VISTA_VALIDATION={v} is not valid; expected 1|0|true|false")));
-            }
-        };
-        let timeout = match text("VISTA_GPU_TIMEOUT_S") {
-            None => DEFAULT_TIMEOUT,
-            Some(v) => match v.parse::<f64>() {
-                Ok(s) if s.is_finite() && s >= 0.0 => Duration::from_secs_f64(s),
-                _ => {
-                    return Err(GpuError::Request(format!(
-                        "VISTA_GPU_TIMEOUT_S={v} is not valid; expected a number of seconds >= 0"
-                    )));
-                }
-            },
-        };
-        Ok(GpuConfig {
-            adapter: AdapterChoice::from_settings(adapter)?,
-            validate,
-            timeout,
-            wgpu_backends: text("WGPU_BACKEND"),
-            browser: vista_browser::BrowserConfig::from_lookup(get),
-        })
-    }
-}
-
 impl AdapterChoice {
     /// The adapter of a backend name: lavapipe | swiftshader | gpu.
     pub fn of_backend(name: &str) -> Result<AdapterChoice, GpuError> {
@@ -495,39 +455,21 @@ impl Context {
     }
 
     /// The composed kernel as one WGSL source, as naga writes it back: what
-    /// the browser backend hands to Tint.
-    pub fn wgsl_source(shaders: &ShaderSet, shader: &str) -> Result<String, GpuError> {
-        Context::wgsl_source_with(shaders, shader, "main", &[])
-    }
-
-    /// The same, with `override` constants resolved to `constants` for
-    /// `entry` first: naga's WGSL writer keeps an `override` but writes an
-    /// overridden `@workgroup_size` as its placeholder, so the page gets the
-    /// values baked in instead of pipeline constants.
-    pub fn wgsl_source_with(
+    /// the browser backend hands to Tint. `override` constants are first
+    /// resolved to `constants` for `entry`: naga's WGSL writer keeps an
+    /// `override` but writes an overridden `@workgroup_size` as its
+    /// placeholder, so the page gets the values baked in instead of
+    /// pipeline constants.
+    pub fn wgsl_source(
         shaders: &ShaderSet,
         shader: &str,
         entry: &str,
         constants: &[(String, f64)],
     ) -> Result<String, GpuError> {
         let module = shaders.compose(shader)?;
-        let info = crate::shaders::validate(shader, &module)?;
-        let write = |m: &naga::Module, i: &naga::valid::ModuleInfo| {
-            naga::back::wgsl::write_string(m, i, naga::back::wgsl::WriterFlags::empty())
-                .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))
-        };
-        if module.overrides.is_empty() {
-            return write(&module, &info);
-        }
-        let map: naga::back::PipelineConstants = constants.iter().cloned().collect();
-        let (resolved, resolved_info) = naga::back::pipeline_constants::process_overrides(
-            &module,
-            &info,
-            Some((naga::ShaderStage::Compute, entry)),
-            &map,
-        )
-        .map_err(|e| GpuError::Shader(format!("{shader}: override values do not resolve: {e}")))?;
-        write(&resolved, &resolved_info)
+        let (resolved, info) = crate::shaders::resolve_overrides(shader, &module, entry, constants)?;
+        naga::back::wgsl::write_string(&resolved, &info, naga::back::wgsl::WriterFlags::empty())
+            .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))
     }
 
     /// Compiles (once per source hash, entry, slots and format) the pipeline
@@ -632,20 +574,14 @@ impl Context {
         }
         let format = OutputFormat::parse(job.format)?;
         let start = Instant::now();
-        let (first, mut stats) = self.run_over(job, &format, 0)?;
-        let tb = format.texel_bytes();
-        let s0 = format.sentinel(0);
-        let suspects: Vec<usize> =
-            first.chunks_exact(tb).enumerate().filter(|(_, t)| *t == s0.as_slice()).map(|(i, _)| i).collect();
+        let (Texels { mut image, holding_sentinel: suspects }, mut stats) = self.run_over(job, &format, 0)?;
         let unwritten: Vec<usize> = match suspects.is_empty() {
             true => suspects,
             false => {
                 let (second, _) = self.run_over(job, &format, 1)?;
-                let s1 = format.sentinel(1);
-                suspects.into_iter().filter(|&i| second[i * tb..(i + 1) * tb] == s1[..]).collect()
+                suspects.into_iter().filter(|i| second.holding_sentinel.binary_search(i).is_ok()).collect()
             }
         };
-        let mut image = decode(&first, &format, job.width, job.height);
         for &i in &unwritten {
             image.data[i] = [0.0; 4];
         }
@@ -653,14 +589,14 @@ impl Context {
         Ok(Readback { image, stats, unwritten: unwritten.len() as u64 })
     }
 
-    /// One run over sentinel `which`: the output's texel bytes, row after
-    /// row, unpadded.
+    /// One run over sentinel `which`: the output decoded, and the texels
+    /// still holding that sentinel.
     fn run_over(
         &self,
         job: &Dispatch<'_>,
         format: &OutputFormat,
         which: usize,
-    ) -> Result<(Vec<u8>, RunStats), GpuError> {
+    ) -> Result<(Texels, RunStats), GpuError> {
         match &self.engine {
             Engine::Wgpu(w) => self.run_wgpu(w, job, format, which),
             Engine::Browser(b) => self.run_in_browser(b, job, format, which),
@@ -673,7 +609,7 @@ impl Context {
         job: &Dispatch<'_>,
         format: &OutputFormat,
         which: usize,
-    ) -> Result<(Vec<u8>, RunStats), GpuError> {
+    ) -> Result<(Texels, RunStats), GpuError> {
         let compiled = self.pipeline(w, job, format)?;
         let start = Instant::now();
         let d = &w.device;
@@ -822,12 +758,12 @@ impl Context {
                 return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs_f64() });
             }
         }
-        let bytes = {
+        let texels = {
             let mapped = readback
                 .slice(..)
                 .get_mapped_range()
                 .map_err(|e| GpuError::Validation { what: "readback map".into(), message: e.to_string() })?;
-            unpad(&mapped, row_bytes, job.height, padded_row)
+            read_texels(&mapped, padded_row as usize, format, job.width, job.height, &format.sentinel(which))
         };
         readback.unmap();
         let readback_time = copy_start.elapsed();
@@ -843,7 +779,7 @@ impl Context {
             }
         }
         let stats = RunStats { gpu_wall, kernel, readback: readback_time, total: start.elapsed() };
-        Ok((bytes, stats))
+        Ok((texels, stats))
     }
 
     /// The same job in headless Chromium: naga's WGSL of the composed
@@ -854,13 +790,14 @@ impl Context {
         job: &Dispatch<'_>,
         format: &OutputFormat,
         which: usize,
-    ) -> Result<(Vec<u8>, RunStats), GpuError> {
+    ) -> Result<(Texels, RunStats), GpuError> {
+        // Override values are baked into the page's WGSL (see `wgsl_source`).
         let key = format!("{}#{}@{}{:?}", job.shader, job.shaders.source_hash(job.shader)?, job.entry, job.constants);
         let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
         let wgsl = match cached {
             Some(w) => w,
             None => {
-                let w = Arc::new(Context::wgsl_source_with(job.shaders, job.shader, job.entry, job.constants)?);
+                let w = Arc::new(Context::wgsl_source(job.shaders, job.shader, job.entry, job.constants)?);
                 b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
                 w
             }
@@ -895,8 +832,6 @@ impl Context {
                 format: format.name,
                 texel_bytes: format.texel_bytes() as u32,
                 fill: &format.sentinel(which),
-                // Baked into the WGSL above.
-                constants: &[],
                 uniforms: job.uniforms,
                 table: job.table,
                 width: job.width,
@@ -915,7 +850,8 @@ impl Context {
             readback: out.readback,
             total: out.total,
         };
-        Ok((out.bytes, stats))
+        let row = job.width as usize * format.texel_bytes();
+        Ok((read_texels(&out.bytes, row, format, job.width, job.height, &format.sentinel(which)), stats))
     }
 
     /// Blocks until `index` completes, or fails after the watchdog timeout.
@@ -936,34 +872,39 @@ fn words_to_bytes(words: &[u32]) -> Vec<u8> {
     words.iter().flat_map(|w| w.to_le_bytes()).collect()
 }
 
-/// Copies `height` rows of `row_bytes` out of a buffer whose rows are
-/// `padded_row` bytes apart.
-pub(crate) fn unpad(bytes: &[u8], row_bytes: u32, height: u32, padded_row: u32) -> Vec<u8> {
-    let (row, padded) = (row_bytes as usize, padded_row as usize);
-    let mut out = Vec::with_capacity(row * height as usize);
-    for y in 0..height as usize {
-        out.extend_from_slice(&bytes[y * padded..][..row]);
-    }
-    out
+/// One run's output: decoded, and the indices (ascending) of the texels
+/// whose bytes are the run's sentinel texel.
+struct Texels {
+    image: Image,
+    holding_sentinel: Vec<usize>,
 }
 
-/// Texel bytes of `format`, row-major, as an f32 RGBA image.
-pub(crate) fn decode(bytes: &[u8], format: &OutputFormat, width: u32, height: u32) -> Image {
-    let mut data = vec![[0.0f32; 4]; width as usize * height as usize];
-    if format.wgpu == wgpu::TextureFormat::Rgba32Float {
-        // Written in place (no per-pixel push), so even the tests' opt-level 1
-        // build turns it into straight copies.
-        for (px, texel) in data.iter_mut().zip(bytes.chunks_exact(16)) {
-            for (c, b) in px.iter_mut().zip(texel.chunks_exact(4)) {
-                *c = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+/// Decodes `height` rows of `width` texels of `format`, rows `stride` bytes
+/// apart (a readback buffer pads them to 256 bytes), into f32 RGBA, noting
+/// the texels that hold `sentinel`: one pass over the mapped memory.
+fn read_texels(bytes: &[u8], stride: usize, format: &OutputFormat, width: u32, height: u32, sentinel: &[u8]) -> Texels {
+    let (w, tb) = (width as usize, format.texel_bytes());
+    let mut data = vec![[0.0f32; 4]; w * height as usize];
+    let mut holding_sentinel = Vec::new();
+    let rgba32 = format.wgpu == wgpu::TextureFormat::Rgba32Float;
+    for (y, dst) in data.chunks_exact_mut(w).enumerate() {
+        let row = &bytes[y * stride..][..w * tb];
+        for (x, (px, texel)) in dst.iter_mut().zip(row.chunks_exact(tb)).enumerate() {
+            if texel == sentinel {
+                holding_sentinel.push(y * w + x);
+            }
+            if rgba32 {
+                // Written in place (no per-pixel push), so even the tests'
+                // opt-level 1 build turns it into straight copies.
+                for (c, b) in px.iter_mut().zip(texel.chunks_exact(4)) {
+                    *c = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+                }
+            } else {
+                *px = format.decode(texel);
             }
         }
-    } else {
-        for (px, texel) in data.iter_mut().zip(bytes.chunks_exact(format.texel_bytes())) {
-            *px = format.decode(texel);
-        }
     }
-    Image::from_raw(width, height, data).expect("one texel per pixel")
+    Texels { image: Image::from_raw(width, height, data).expect("one texel per pixel"), holding_sentinel }
 }
 
 /// Picks the adapter matching `choice` from those enumerated.
@@ -992,24 +933,28 @@ mod tests {
     use super::*;
 
     #[test]
-    fn unpad_skips_row_padding_and_decode_reads_the_format() {
+    fn texels_skip_row_padding_decode_the_format_and_find_the_sentinel() {
         // 3 x 2 rgba32float texels, rows padded to 256 bytes: padding bytes are garbage.
-        let (w, h, padded) = (3u32, 2u32, 256u32);
-        let mut bytes = vec![0xAB_u8; (padded * h) as usize];
+        let (w, h, padded) = (3u32, 2u32, 256usize);
+        let mut bytes = vec![0xAB_u8; padded * h as usize];
         for y in 0..h {
             for x in 0..w {
                 for c in 0..4 {
                     let v = (y * 100 + x * 10 + c) as f32;
-                    let at = (y * padded + x * 16 + c * 4) as usize;
+                    let at = y as usize * padded + (x * 16 + c * 4) as usize;
                     bytes[at..at + 4].copy_from_slice(&v.to_le_bytes());
                 }
             }
         }
         let rgba32 = OutputFormat::parse("rgba32float").unwrap();
-        let img = decode(&unpad(&bytes, w * 16, h, padded), &rgba32, w, h);
-        assert_eq!(img.get(2, 1), [120.0, 121.0, 122.0, 123.0]);
-        assert_eq!(img.get(0, 0), [0.0, 1.0, 2.0, 3.0]);
+        let sentinel = rgba32.sentinel(0);
+        bytes[padded + 16..padded + 32].copy_from_slice(&sentinel);
+        let t = read_texels(&bytes, padded, &rgba32, w, h, &sentinel);
+        assert_eq!(t.image.get(2, 1), [120.0, 121.0, 122.0, 123.0]);
+        assert_eq!(t.image.get(0, 0), [0.0, 1.0, 2.0, 3.0]);
+        assert_eq!(t.holding_sentinel, [4], "texel (1, 1)");
         let r8 = OutputFormat::parse("rgba8unorm").unwrap();
-        assert_eq!(decode(&[255, 0, 51, 255], &r8, 1, 1).get(0, 0), [1.0, 0.0, 0.2, 1.0]);
+        let t = read_texels(&[255, 0, 51, 255], 4, &r8, 1, 1, &r8.sentinel(0));
+        assert_eq!((t.image.get(0, 0), t.holding_sentinel.len()), ([1.0, 0.0, 0.2, 1.0], 0));
     }
 }

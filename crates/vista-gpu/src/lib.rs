@@ -17,7 +17,7 @@ pub use context::{
     SWIFTSHADER_HINT, Slot, SlotKind, UNWRITTEN, VALIDATION_LAYER_JSON,
 };
 pub use format::{OutputFormat, format_names};
-pub use shaders::{ShaderSet, validate};
+pub use shaders::{ShaderSet, resolve_overrides, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
 pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \

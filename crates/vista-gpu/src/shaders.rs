@@ -198,6 +198,31 @@ impl ShaderSet {
     }
 }
 
+/// `module` validated, with its `override` constants resolved to
+/// `constants` for compute entry point `entry` (absent ones take their
+/// defaults) when it has any: naga's pipeline-constant pass, which also
+/// settles an overridden `@workgroup_size`.
+pub fn resolve_overrides(
+    name: &str,
+    module: &naga::Module,
+    entry: &str,
+    constants: &[(String, f64)],
+) -> Result<(naga::Module, naga::valid::ModuleInfo), GpuError> {
+    let info = validate(name, module)?;
+    if module.overrides.is_empty() {
+        return Ok((module.clone(), info));
+    }
+    let map: naga::back::PipelineConstants = constants.iter().cloned().collect();
+    let (resolved, resolved_info) = naga::back::pipeline_constants::process_overrides(
+        module,
+        &info,
+        Some((naga::ShaderStage::Compute, entry)),
+        &map,
+    )
+    .map_err(|e| GpuError::Shader(format!("{name}: override values do not resolve: {e}")))?;
+    Ok((resolved.into_owned(), resolved_info.into_owned()))
+}
+
 /// The path a module declares with `#define_import_path`, if any.
 fn import_path(source: &str) -> Option<String> {
     source.lines().find_map(|l| l.trim().strip_prefix("#define_import_path").map(|p| p.trim().to_string()))

@@ -283,27 +283,23 @@ pub fn plan(
 }
 
 /// The entry point's workgroup size; where it names `override`s, their
-/// values are substituted first (naga's pipeline-constant pass).
+/// values are substituted first.
 fn workgroup_size(module: &naga::Module, entry: &str, constants: &[(String, f64)]) -> Result<[u32; 3], String> {
-    let ep = module
-        .entry_points
-        .iter()
-        .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
-        .expect("Kernel::layout refuses an unknown entry point");
-    if ep.workgroup_size_overrides.is_none() {
-        return Ok(ep.workgroup_size);
+    let find = |m: &naga::Module| {
+        m.entry_points
+            .iter()
+            .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
+            .map(|e| (e.workgroup_size, e.workgroup_size_overrides.is_some()))
+            .expect("Kernel::layout refuses an unknown entry point")
+    };
+    match find(module) {
+        (size, false) => Ok(size),
+        (_, true) => {
+            let (resolved, _) =
+                vista_gpu::resolve_overrides(entry, module, entry, constants).map_err(|e| e.to_string())?;
+            Ok(find(&resolved).0)
+        }
     }
-    let info = vista_gpu::validate(entry, module).map_err(|e| e.to_string())?;
-    let map: naga::back::PipelineConstants = constants.iter().cloned().collect();
-    let (resolved, _) = naga::back::pipeline_constants::process_overrides(
-        module,
-        &info,
-        Some((naga::ShaderStage::Compute, entry)),
-        &map,
-    )
-    .map_err(|e| format!("override values do not resolve: {e}"))?;
-    let ep = resolved.entry_points.iter().find(|e| e.name == entry).expect("the same entry point");
-    Ok(ep.workgroup_size)
 }
 
 /// Runs a plan on the renderer's engine.
