@@ -66,6 +66,9 @@ pub struct AdapterInfo {
     pub description: String,
     pub user_agent: String,
     pub max_dimension: u32,
+    /// The device's features (the page requests every one the adapter has).
+    #[serde(default)]
+    pub features: Vec<String>,
     /// "Chrome/156.0.8078.114" from `Browser.getVersion`.
     #[serde(skip)]
     pub product: String,
@@ -87,6 +90,12 @@ pub struct Job<'a> {
     pub slots: &'a [Slot],
     /// The output's storage format (WGSL and WebGPU share the names).
     pub format: &'a str,
+    /// The texture's and its view's WebGPU dimension ("2d", "2d-array").
+    pub dimension: (&'a str, &'a str),
+    /// Array layers or depth; read back stacked top to bottom.
+    pub layers: u32,
+    /// The output is bound `read-write` rather than `write-only`.
+    pub read_write: bool,
     /// Bytes of one output texel.
     pub texel_bytes: u32,
     /// One texel's bytes: the output holds it everywhere before the kernel runs.
@@ -202,6 +211,10 @@ impl Browser {
             "workgroups": job.workgroups,
             "slots": job.slots,
             "format": job.format,
+            "dimension": job.dimension.0,
+            "view_dimension": job.dimension.1,
+            "layers": job.layers,
+            "access": if job.read_write { "read-write" } else { "write-only" },
             "texel_bytes": job.texel_bytes,
             "fill": B64.encode(job.fill),
             "uniforms": job.uniforms.iter().map(|u| B64.encode(u)).collect::<Vec<_>>(),
@@ -217,7 +230,7 @@ impl Browser {
             bytes: usize,
         }
         let ran: Ran = parse_ok(&reply).map_err(|message| BrowserError::Page { case: job.label.into(), message })?;
-        let expected = job.width as usize * job.height as usize * job.texel_bytes as usize;
+        let expected = job.width as usize * job.height as usize * job.layers as usize * job.texel_bytes as usize;
         if ran.bytes != expected {
             return Err(BrowserError::Page {
                 case: job.label.into(),

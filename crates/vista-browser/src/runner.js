@@ -30,7 +30,11 @@ async function vistaInit() {
     const adapter = await navigator.gpu.requestAdapter();
     if (!adapter) throw new Error("requestAdapter() gave no adapter (--use-webgpu-adapter=swiftshader)");
     const l = adapter.limits;
+    // Every feature the adapter has: read_write storage formats beyond the
+    // core set come with texture-formats-tier2.
+    const features = [...adapter.features];
     const device = await adapter.requestDevice({
+      requiredFeatures: features,
       requiredLimits: {
         maxTextureDimension2D: l.maxTextureDimension2D,
         maxBufferSize: l.maxBufferSize,
@@ -52,6 +56,7 @@ async function vistaInit() {
       description: i.description,
       user_agent: navigator.userAgent,
       max_dimension: device.limits.maxTextureDimension2D,
+      features: [...device.features],
     });
   } catch (e) {
     return fail(e);
@@ -59,7 +64,7 @@ async function vistaInit() {
 }
 
 // One bind group layout per group up to the highest the job binds.
-function groupLayouts(d, slots, format) {
+function groupLayouts(d, slots, job) {
   const C = GPUShaderStage.COMPUTE;
   const count = slots.reduce((m, s) => Math.max(m, s.group + 1), 0);
   const groups = [];
@@ -67,7 +72,11 @@ function groupLayouts(d, slots, format) {
     const entries = slots.filter((s) => s.group === g).map((s) => {
       if (s.kind === "uniform") return { binding: s.binding, visibility: C, buffer: { type: "uniform" } };
       if (s.kind === "table") return { binding: s.binding, visibility: C, buffer: { type: "read-only-storage" } };
-      return { binding: s.binding, visibility: C, storageTexture: { access: "write-only", format, viewDimension: "2d" } };
+      return {
+        binding: s.binding,
+        visibility: C,
+        storageTexture: { access: job.access, format: job.format, viewDimension: job.view_dimension },
+      };
     });
     groups.push(d.createBindGroupLayout({ entries }));
   }
@@ -75,7 +84,7 @@ function groupLayouts(d, slots, format) {
 }
 
 async function pipeline(job) {
-  const key = `${job.key}@${job.entry}${JSON.stringify(job.slots)}${job.format}`;
+  const key = `${job.key}@${job.entry}${JSON.stringify(job.slots)}${job.format}${job.view_dimension}${job.access}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
   const d = vista.device;
@@ -90,7 +99,7 @@ async function pipeline(job) {
     throw new Error(`Tint rejected the WGSL: ${lines.join("; ")}`);
   }
   let p;
-  const groups = groupLayouts(d, job.slots, job.format);
+  const groups = groupLayouts(d, job.slots, job);
   try {
     const layout = d.createPipelineLayout({ bindGroupLayouts: groups });
     p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: job.entry } });
@@ -103,8 +112,10 @@ async function pipeline(job) {
   return compiled;
 }
 
-// job: { key, wgsl, entry, workgroups [x, y, z], slots [{group, binding, kind, index}], format, texel_bytes,
-//        fill (one texel, base64), uniforms [base64, one per block], table (base64), width, height }
+// job: { key, wgsl, entry, workgroups [x, y, z], slots [{group, binding, kind, index}], format, dimension,
+//        view_dimension, layers, access, texel_bytes, fill (one texel, base64), uniforms [base64, one per block],
+//        table (base64), width, height }
+// Layers (2d-array) and slices (3d) are read back stacked top to bottom.
 async function vistaRun(job) {
   try {
     const d = vista.device;
@@ -124,17 +135,18 @@ async function vistaRun(job) {
     const table = d.createBuffer({ size: Math.max(16, Math.ceil(words.length / 4) * 4), usage: GPUBufferUsage.STORAGE, mappedAtCreation: true });
     new Uint8Array(table.getMappedRange()).set(words);
     table.unmap();
-    const size = { width: job.width, height: job.height };
-    const texture = d.createTexture({ size, format: job.format, usage: GPUTextureUsage.STORAGE_BINDING | GPUTextureUsage.COPY_SRC | GPUTextureUsage.COPY_DST });
+    const size = { width: job.width, height: job.height, depthOrArrayLayers: job.layers };
+    const rows = job.height * job.layers;
+    const texture = d.createTexture({ size, dimension: job.dimension, format: job.format, usage: GPUTextureUsage.STORAGE_BINDING | GPUTextureUsage.COPY_SRC | GPUTextureUsage.COPY_DST });
     // Every texel starts as the sentinel texel, so Rust can count those never written.
     const rowBytes = job.width * job.texel_bytes;
     const texel = fromBase64(job.fill);
-    const filled = new Uint8Array(rowBytes * job.height);
+    const filled = new Uint8Array(rowBytes * rows);
     for (let i = 0; i < filled.length; i += texel.length) filled.set(texel, i);
     d.queue.writeTexture({ texture }, filled, { bytesPerRow: rowBytes, rowsPerImage: job.height }, size);
     const paddedRow = Math.ceil(rowBytes / 256) * 256;
-    const readback = d.createBuffer({ size: paddedRow * job.height, usage: GPUBufferUsage.COPY_DST | GPUBufferUsage.MAP_READ });
-    const view = texture.createView();
+    const readback = d.createBuffer({ size: paddedRow * rows, usage: GPUBufferUsage.COPY_DST | GPUBufferUsage.MAP_READ });
+    const view = texture.createView({ dimension: job.view_dimension });
     const resource = (s) => (s.kind === "uniform" ? { buffer: uniforms[s.index] } : s.kind === "table" ? { buffer: table } : view);
     const bindGroups = compiled.groups.map((layout, g) =>
       d.createBindGroup({
@@ -164,8 +176,8 @@ async function vistaRun(job) {
     d.queue.submit([copy.finish()]);
     await readback.mapAsync(GPUMapMode.READ);
     const padded = new Uint8Array(readback.getMappedRange());
-    const out = new Uint8Array(rowBytes * job.height);
-    for (let y = 0; y < job.height; y++) out.set(padded.subarray(y * paddedRow, y * paddedRow + rowBytes), y * rowBytes);
+    const out = new Uint8Array(rowBytes * rows);
+    for (let y = 0; y < rows; y++) out.set(padded.subarray(y * paddedRow, y * paddedRow + rowBytes), y * rowBytes);
     readback.unmap();
     const readbackMs = performance.now() - copyStart;
     for (const b of [...uniforms, table, readback]) b.destroy();

@@ -260,13 +260,14 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             let k = registry(project)?.find(&kernel).map_err(bad)?;
             let p = k.resolve(preset.as_deref(), &parse_sets(&set)?).map_err(bad)?;
             let (w, h) = vista_kernels::parse_size(&size).map_err(bad)?;
-            let rect = crop.as_deref().map(|c| parse_crop(c, w, h)).transpose()?;
             if !(1..=16).contains(&zoom) {
                 return Err(bad(format!("--zoom {zoom} is out of range; allowed: 1 to 16")));
             }
             check_output_path(&out)?;
             let shaders = vista_render::shader_set(project)?;
             let plan = vista_render::plan(&shaders, k, &p, w, h, &config.limits)?;
+            // Layers and slices are stacked top to bottom: crop that image.
+            let rect = crop.as_deref().map(|c| parse_crop(c, plan.width, plan.height * plan.layers)).transpose()?;
             let ctx = &Renderer { ctx: Context::shared(&config.gpu)?, shaders, limits: config.limits };
             let r = vista_render::run(ctx, &plan)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
@@ -278,8 +279,22 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
                 img = img.zoom(zoom);
             }
             vista_image::save(&out, &img)?;
+            let shape = match plan.dimension {
+                vista_gpu::Dimension::D2 if plan.layers == 1 && (plan.width, plan.height) == (w, h) => {
+                    format!("{w}x{h}")
+                }
+                d => format!(
+                    "{}x{}x{} ({} output, stacked {}x{})",
+                    plan.width,
+                    plan.height,
+                    plan.layers,
+                    d.name(),
+                    plan.width,
+                    plan.height * plan.layers
+                ),
+            };
             eprintln!(
-                "rendered {kernel} {w}x{h} on {} in {:.1} ms -> {}",
+                "rendered {kernel} {shape} on {} in {:.1} ms -> {}",
                 ctx.adapter_description(),
                 r.stats.gpu_wall.as_secs_f64() * 1e3,
                 out.display()

@@ -27,7 +27,10 @@ pub struct Agreement {
 pub fn agreement(kernel: &Kernel, gpu: &Image, reference: &Image) -> Agreement {
     let peak = match kernel.output() {
         Output::Display => 1.0,
-        Output::Hdr => reference.data.iter().flat_map(|p| p[..3].iter()).fold(0.0f64, |m, v| m.max(*v as f64)),
+        // The reference's own peak: HDR radiance, or a normalised view's max.
+        Output::Hdr | Output::Normalize => {
+            reference.data.iter().flat_map(|p| p[..3].iter()).fold(0.0f64, |m, v| m.max(*v as f64))
+        }
     };
     let (mut se, mut max_abs) = (0.0f64, 0.0f64);
     for (g, c) in gpu.data.iter().zip(&reference.data) {

@@ -63,7 +63,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         // The checks of `vista check` that need no golden, with the same
         // words: a golden is never blessed from output check would fail.
         let again = render(ctx, case.kernel, &case.params, case.width, case.height)?;
-        let (problems, _) = crate::guards(case, &r.raw, r.unwritten, Some(again.raw.bit_identical(&r.raw)));
+        let (problems, _) = crate::guards(case, &r.raw, r.format, r.unwritten, Some(again.raw.bit_identical(&r.raw)));
         if !problems.is_empty() {
             return Err(GoldenError::Rejected(format!(
                 "case {}: {}; refusing to bless it (vista check would fail it); nothing was written",

@@ -55,6 +55,8 @@ struct RawCase {
 /// `expect_fail = [{ backend = "swiftshader", driver = "SwiftShader", reason = "why" }]`.
 /// It matches when the backend is equal and the adapter description
 /// contains `driver` (empty: any). An expected failure that passes fails.
+/// With `unsupported = "feature"` it holds only where the case is reported
+/// unsupported for lack of that feature (SPEC 14), not for any failure.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Expectation {
@@ -62,6 +64,8 @@ pub struct Expectation {
     #[serde(default)]
     pub driver: String,
     pub reason: String,
+    #[serde(default)]
+    pub unsupported: String,
 }
 
 impl Expectation {

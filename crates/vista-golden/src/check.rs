@@ -155,6 +155,8 @@ pub struct Observed<'a> {
     pub raw: &'a Image,
     /// Texels of the output the kernel never wrote.
     pub unwritten: u64,
+    /// The output's storage format: an integer one compares exactly.
+    pub format: &'a str,
     /// Display values as a 16-bit PNG holds them (`vista_render::quantize16`).
     pub actual: &'a Image,
     /// Whether a second render in this process was bit-identical; `None`
@@ -172,6 +174,7 @@ pub struct Observed<'a> {
 pub fn guards(
     case: &Case,
     raw: &Image,
+    format: &str,
     unwritten: u64,
     repeat_identical: Option<bool>,
 ) -> (Vec<String>, Option<(u32, u32, String)>) {
@@ -187,7 +190,7 @@ pub fn guards(
             raw.get(x, y)
         ));
     }
-    let (lo, hi) = case.kernel.output_bounds(&case.params);
+    let (lo, hi) = case.kernel.output_bounds_of(&case.params, format);
     if let Some((x, y, v)) = first_out_of_bounds(raw, lo, hi) {
         first_bad.get_or_insert((x, y, format!("{v} outside [{lo}, {hi}]")));
         problems.push(format!("raw output {v} at ({x}, {y}) is outside the kernel's range [{lo}, {hi}]"));
@@ -241,6 +244,8 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
             out.problems.push(e);
         }
         Ok(obs) => {
+            // The image's own size: layers and slices are stacked top to bottom.
+            (out.width, out.height) = (obs.raw.width, obs.raw.height);
             compare(case, entry, &obs, &mut out);
             if out.verdict == Verdict::Pass && !out.problems.is_empty() {
                 out.verdict = Verdict::Fail;
@@ -253,6 +258,16 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
             out.problems.push(format!(
                 "expected to fail on {} (driver '{}': {}) but passed: remove the expectation from golden/cases.toml",
                 x.backend, x.driver, x.reason
+            ));
+        } else if !x.unsupported.is_empty()
+            && !out
+                .problems
+                .iter()
+                .any(|p| p.starts_with("unsupported on ") && p.contains(&format!("needs {}", x.unsupported)))
+        {
+            out.problems.push(format!(
+                "expected to be unsupported on {} for lack of {} ({}), but it failed otherwise",
+                x.backend, x.unsupported, x.reason
             ));
         } else {
             out.notes.push(format!(
@@ -270,7 +285,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
 }
 
 fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut Outcome) {
-    let (problems, first_bad) = guards(case, obs.raw, obs.unwritten, obs.repeat_identical);
+    let (problems, first_bad) = guards(case, obs.raw, obs.format, obs.unwritten, obs.repeat_identical);
     out.problems.extend(problems);
     out.first_bad = first_bad;
     let run = out.run.clone();
@@ -294,7 +309,16 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
                     out.changed_files = changed_files(&e.shader_files, obs.shader_files);
                 }
             }
-            if e.params_hash != run.params_hash {
+            if vista_kernels::is_integer_format(obs.format) && e.raw_hash != obs.raw.content_hash() {
+                // Integers compare exactly, on any driver and after any edit.
+                out.problems.push(format!(
+                    "raw values differ from the blessed ones: a {} output compares exactly (raw hash {} vs \
+                     manifest {})",
+                    obs.format,
+                    obs.raw.content_hash(),
+                    e.raw_hash
+                ));
+            } else if e.params_hash != run.params_hash {
                 out.notes.push("case parameters changed since the last bless".into());
             } else if out.same_driver && e.shader_hash == run.shader_hash && e.raw_hash != obs.raw.content_hash() {
                 out.problems.push(format!(

@@ -85,6 +85,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
             };
             let observed = Observed {
                 unwritten: r.unwritten,
+                format: r.format,
                 raw: &r.raw,
                 actual: &actual,
                 repeat_identical: *repeat_identical,

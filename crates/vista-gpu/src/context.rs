@@ -170,6 +170,14 @@ pub struct Dispatch<'a> {
     pub slots: &'a [Slot],
     /// The output's storage format (its WGSL name).
     pub format: &'a str,
+    /// The output's dimension; its layers (2d-array) or depth (3d) are
+    /// read back stacked top to bottom, one `height`-row image each.
+    pub dimension: Dimension,
+    pub layers: u32,
+    /// The output is `read_write`: it starts as zeros (a resource's
+    /// default contents), since the kernel may read a texel before writing
+    /// it, and texels left as they were are not counted as unwritten.
+    pub read_write: bool,
     /// Values of the module's pipeline-overridable constants, by name.
     pub constants: &'a [(String, f64)],
     /// The bytes of each uniform block (padded to 16 bytes by the caller).
@@ -200,6 +208,53 @@ pub struct RunStats {
 /// from a fresh texture. See [`crate::OutputFormat`] for the others.
 pub const UNWRITTEN: u32 = 0x7FC0_DEAD;
 
+/// An output texture's dimension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Dimension {
+    D1,
+    D2,
+    D2Array,
+    D3,
+}
+
+impl Dimension {
+    fn texture(self) -> wgpu::TextureDimension {
+        match self {
+            Dimension::D1 => wgpu::TextureDimension::D1,
+            Dimension::D2 | Dimension::D2Array => wgpu::TextureDimension::D2,
+            Dimension::D3 => wgpu::TextureDimension::D3,
+        }
+    }
+
+    fn view(self) -> wgpu::TextureViewDimension {
+        match self {
+            Dimension::D1 => wgpu::TextureViewDimension::D1,
+            Dimension::D2 => wgpu::TextureViewDimension::D2,
+            Dimension::D2Array => wgpu::TextureViewDimension::D2Array,
+            Dimension::D3 => wgpu::TextureViewDimension::D3,
+        }
+    }
+
+    /// The manifest's name (and WebGPU's view dimension).
+    pub fn name(self) -> &'static str {
+        self.web().1
+    }
+
+    /// WebGPU's names: the texture's dimension and its view's.
+    fn web(self) -> (&'static str, &'static str) {
+        match self {
+            Dimension::D1 => ("1d", "1d"),
+            Dimension::D2 => ("2d", "2d"),
+            Dimension::D2Array => ("2d", "2d-array"),
+            Dimension::D3 => ("3d", "3d"),
+        }
+    }
+}
+
+/// Storage formats every WebGPU device may bind `read_write` (the core
+/// set); others need an adapter feature.
+const CORE_READ_WRITE: &[&str] = &["r32float", "r32uint", "r32sint"];
+
 /// What feeds a binding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SlotKind {
@@ -207,7 +262,7 @@ pub enum SlotKind {
     Uniform(usize),
     /// The read-only u32 table.
     Table,
-    /// The write-only output texture.
+    /// The output texture (write-only or read_write).
     Output,
 }
 
@@ -263,6 +318,8 @@ struct WgpuEngine {
     /// the sentinel over the texture, so a texel a kernel leaves unwritten
     /// is counted, and never shows an earlier run's value.
     scratch: Mutex<Option<Scratch>>,
+    /// Storage formats this device binds `read_write`.
+    read_write: Vec<&'static str>,
 }
 
 struct Compiled {
@@ -273,6 +330,8 @@ struct Compiled {
 struct Scratch {
     width: u32,
     height: u32,
+    layers: u32,
+    dimension: Dimension,
     format: wgpu::TextureFormat,
     texture: wgpu::Texture,
     readback: wgpu::Buffer,
@@ -283,6 +342,8 @@ struct Scratch {
 
 struct BrowserEngine {
     browser: vista_browser::Browser,
+    /// The WebGPU device's features (requested: every one the adapter has).
+    features: Vec<String>,
     /// naga's WGSL of each composed kernel, by source hash.
     sources: Mutex<HashMap<String, Arc<String>>>,
 }
@@ -360,9 +421,26 @@ impl Context {
             hint: choice.hint(),
         })?;
         let info = adapter.get_info();
+        // Adapter-specific format features: read_write storage beyond the
+        // core r32 formats, where the driver has it.
+        let specific = wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+        let required_features = adapter.features() & specific;
+        let read_write = crate::format::format_names()
+            .into_iter()
+            .filter(|name| {
+                CORE_READ_WRITE.contains(name)
+                    || (!required_features.is_empty()
+                        && OutputFormat::parse(name).is_ok_and(|f| {
+                            adapter
+                                .get_texture_format_features(f.wgpu)
+                                .flags
+                                .contains(wgpu::TextureFormatFeatureFlags::STORAGE_READ_WRITE)
+                        }))
+            })
+            .collect();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("vista"),
-            required_features: wgpu::Features::empty(),
+            required_features,
             required_limits: adapter.limits(),
             ..Default::default()
         }))
@@ -373,6 +451,7 @@ impl Context {
                 queue,
                 pipelines: Mutex::new(HashMap::new()),
                 scratch: Mutex::new(None),
+                read_write,
             })),
             info,
             backend: choice.backend_name(),
@@ -400,7 +479,11 @@ impl Context {
         info.driver = format!("{} Dawn/Tint", b.product);
         info.driver_info = b.description.clone();
         Ok(Context {
-            engine: Engine::Browser(Box::new(BrowserEngine { browser, sources: Mutex::new(HashMap::new()) })),
+            engine: Engine::Browser(Box::new(BrowserEngine {
+                features: browser.info().features.clone(),
+                browser,
+                sources: Mutex::new(HashMap::new()),
+            })),
             info,
             backend: AdapterChoice::Browser.backend_name(),
             timeout,
@@ -478,13 +561,15 @@ impl Context {
     /// two projects (or an edited copy) never share a stale pipeline.
     fn pipeline(&self, w: &WgpuEngine, job: &Dispatch<'_>, format: &OutputFormat) -> Result<Arc<Compiled>, GpuError> {
         let key = format!(
-            "{}#{}@{}{:?}{}{:?}",
+            "{}#{}@{}{:?}{}{:?}{:?}{}",
             job.shader,
             job.shaders.source_hash(job.shader)?,
             job.entry,
             job.slots,
             format.name,
-            job.constants
+            job.constants,
+            job.dimension,
+            job.read_write
         );
         if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
@@ -515,9 +600,12 @@ impl Context {
                                 min_binding_size: None,
                             },
                             SlotKind::Output => wgpu::BindingType::StorageTexture {
-                                access: wgpu::StorageTextureAccess::WriteOnly,
+                                access: match job.read_write {
+                                    true => wgpu::StorageTextureAccess::ReadWrite,
+                                    false => wgpu::StorageTextureAccess::WriteOnly,
+                                },
                                 format: format.wgpu,
-                                view_dimension: wgpu::TextureViewDimension::D2,
+                                view_dimension: job.dimension.view(),
                             },
                         };
                         wgpu::BindGroupLayoutEntry {
@@ -573,8 +661,29 @@ impl Context {
             )));
         }
         let format = OutputFormat::parse(job.format)?;
+        if job.read_write && !CORE_READ_WRITE.contains(&format.name) {
+            let (supported, feature) = match &self.engine {
+                Engine::Wgpu(w) => (
+                    w.read_write.contains(&format.name),
+                    "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES with STORAGE_READ_WRITE for this format",
+                ),
+                Engine::Browser(b) => {
+                    (b.features.iter().any(|f| f == "texture-formats-tier2"), "texture-formats-tier2")
+                }
+            };
+            if !supported {
+                return Err(GpuError::Unsupported {
+                    adapter: self.adapter_description(),
+                    what: format!("a read_write {} storage texture", format.name),
+                    feature: feature.to_string(),
+                });
+            }
+        }
         let start = Instant::now();
         let (Texels { mut image, holding_sentinel: suspects }, mut stats) = self.run_over(job, &format, 0)?;
+        // A read_write output starts as zeros: nothing tells a texel left
+        // as it was from one never written.
+        let suspects = if job.read_write { Vec::new() } else { suspects };
         let unwritten: Vec<usize> = match suspects.is_empty() {
             true => suspects,
             false => {
@@ -634,36 +743,45 @@ impl Context {
                 usage: wgpu::BufferUsages::STORAGE,
             })
         });
-        let extent = wgpu::Extent3d { width: job.width, height: job.height, depth_or_array_layers: 1 };
+        let extent = wgpu::Extent3d { width: job.width, height: job.height, depth_or_array_layers: job.layers };
+        let rows = job.height * job.layers;
         // Buffer rows must be 256-byte aligned; unpadded again after mapping.
         let row_bytes = job.width * format.texel_bytes() as u32;
         let padded_row = row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        // A read_write output starts as zeros (see `Dispatch::read_write`).
+        let fill_texel = |which: usize| match job.read_write {
+            true => vec![0u8; format.texel_bytes()],
+            false => format.sentinel(which),
+        };
         let fill = |which: usize| {
-            let texels = (padded_row as usize / format.texel_bytes()) * job.height as usize;
+            let texels = (padded_row as usize / format.texel_bytes()) * rows as usize;
             d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("unwritten sentinel"),
-                contents: &format.sentinel(which).repeat(texels + 1),
+                contents: &fill_texel(which).repeat(texels + 1),
                 usage: wgpu::BufferUsages::COPY_SRC,
             })
         };
+        let shape = (job.width, job.height, job.layers, job.dimension, format.wgpu);
         let kept = w
             .scratch
             .lock()
             .expect("scratch")
             .take()
-            .filter(|s| (s.width, s.height, s.format) == (job.width, job.height, format.wgpu));
+            .filter(|s| (s.width, s.height, s.layers, s.dimension, s.format) == shape && !job.read_write);
         let Scratch { texture, readback, sentinel, .. } = match kept {
             Some(s) => s,
             None => Scratch {
                 width: job.width,
                 height: job.height,
+                layers: job.layers,
+                dimension: job.dimension,
                 format: format.wgpu,
                 texture: d.create_texture(&wgpu::TextureDescriptor {
                     label: Some("output"),
                     size: extent,
                     mip_level_count: 1,
                     sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
+                    dimension: job.dimension.texture(),
                     format: format.wgpu,
                     usage: wgpu::TextureUsages::STORAGE_BINDING
                         | wgpu::TextureUsages::COPY_SRC
@@ -672,7 +790,7 @@ impl Context {
                 }),
                 readback: d.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("readback"),
-                    size: padded_row as u64 * job.height as u64,
+                    size: padded_row as u64 * rows as u64,
                     usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
                     mapped_at_creation: false,
                 }),
@@ -680,7 +798,8 @@ impl Context {
             },
         };
         let other_fill = (which != 0).then(|| fill(which));
-        let view = texture.create_view(&Default::default());
+        let view = texture
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(job.dimension.view()), ..Default::default() });
         let groups: Vec<wgpu::BindGroup> = compiled
             .groups
             .iter()
@@ -763,12 +882,20 @@ impl Context {
                 .slice(..)
                 .get_mapped_range()
                 .map_err(|e| GpuError::Validation { what: "readback map".into(), message: e.to_string() })?;
-            read_texels(&mapped, padded_row as usize, format, job.width, job.height, &format.sentinel(which))
+            read_texels(&mapped, padded_row as usize, format, job.width, rows, &format.sentinel(which))
         };
         readback.unmap();
         let readback_time = copy_start.elapsed();
-        *w.scratch.lock().expect("scratch") =
-            Some(Scratch { width: job.width, height: job.height, format: format.wgpu, texture, readback, sentinel });
+        *w.scratch.lock().expect("scratch") = Some(Scratch {
+            width: job.width,
+            height: job.height,
+            layers: job.layers,
+            dimension: job.dimension,
+            format: format.wgpu,
+            texture,
+            readback,
+            sentinel,
+        });
         if self.validate {
             let messages = crate::validation::take();
             if !messages.is_empty() {
@@ -793,6 +920,9 @@ impl Context {
     ) -> Result<(Texels, RunStats), GpuError> {
         // Override values are baked into the page's WGSL (see `wgsl_source`).
         let key = format!("{}#{}@{}{:?}", job.shader, job.shaders.source_hash(job.shader)?, job.entry, job.constants);
+        // The page's pipeline cache keys on this with the slots and format;
+        // dimension and access change the bind group layout too.
+        let key = format!("{key}{:?}{}", job.dimension, job.read_write);
         let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
         let wgsl = match cached {
             Some(w) => w,
@@ -830,8 +960,14 @@ impl Context {
                 workgroups: job.workgroups,
                 slots: &slots,
                 format: format.name,
+                dimension: job.dimension.web(),
+                layers: job.layers,
+                read_write: job.read_write,
                 texel_bytes: format.texel_bytes() as u32,
-                fill: &format.sentinel(which),
+                fill: &match job.read_write {
+                    true => vec![0u8; format.texel_bytes()],
+                    false => format.sentinel(which),
+                },
                 uniforms: job.uniforms,
                 table: job.table,
                 width: job.width,
@@ -851,7 +987,8 @@ impl Context {
             total: out.total,
         };
         let row = job.width as usize * format.texel_bytes();
-        Ok((read_texels(&out.bytes, row, format, job.width, job.height, &format.sentinel(which)), stats))
+        let rows = job.height * job.layers;
+        Ok((read_texels(&out.bytes, row, format, job.width, rows, &format.sentinel(which)), stats))
     }
 
     /// Blocks until `index` completes, or fails after the watchdog timeout.

@@ -13,8 +13,8 @@ mod shaders;
 pub mod validation;
 
 pub use context::{
-    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dispatch, GpuConfig, Readback, RunStats,
-    SWIFTSHADER_HINT, Slot, SlotKind, UNWRITTEN, VALIDATION_LAYER_JSON,
+    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dimension, Dispatch, GpuConfig, Readback,
+    RunStats, SWIFTSHADER_HINT, Slot, SlotKind, UNWRITTEN, VALIDATION_LAYER_JSON,
 };
 pub use format::{OutputFormat, format_names};
 pub use shaders::{ShaderSet, resolve_overrides, validate};
@@ -39,4 +39,8 @@ pub enum GpuError {
     Timeout { what: String, seconds: f64 },
     #[error("{0}")]
     Request(String),
+    /// The kernel needs a feature or limit this backend lacks (SPEC 14,
+    /// "Features and limits"): the case is unsupported here, not broken.
+    #[error("unsupported on {adapter}: {what} needs {feature}, which this backend lacks")]
+    Unsupported { adapter: String, what: String, feature: String },
 }

@@ -1,7 +1,8 @@
 //! Every global an entry point reaches, from naga's reflection of the
 //! composed module, and what feeds it. So far vista feeds three kinds: the
 //! uniform blocks (params), the read-only u32 table (Perlin's permutation)
-//! and one write-only 2D storage texture (the output), each at whatever
+//! and one written storage texture (the output: 1d, 2d, 2d-array or 3d,
+//! write or read_write), each at whatever
 //! group and binding the kernel declares. Any other reached global is
 //! refused before GPU work, naming the entry point, the variable, its
 //! group/binding and WGSL type, and which resource kind would feed it.
@@ -17,8 +18,8 @@ pub enum Feed {
     Uniform,
     /// The u32 table (`var<storage, read>` of `array<u32>`).
     Table,
-    /// The output: a write-only `texture_storage_2d` of this format.
-    Output(&'static str),
+    /// The output: a write or read_write storage texture.
+    Output(crate::resources::Storage),
 }
 
 /// One binding the entry point reaches.
@@ -31,6 +32,26 @@ pub struct Binding {
     pub feed: Feed,
     pub(crate) global: Handle<naga::GlobalVariable>,
 }
+
+/// The storage formats an output may have (SPEC 14's list).
+pub const STORAGE_FORMATS: &[&str] = &[
+    "rgba8unorm",
+    "rgba8snorm",
+    "rgba8uint",
+    "rgba8sint",
+    "rgba16float",
+    "rgba16uint",
+    "rgba16sint",
+    "rgba32float",
+    "rgba32uint",
+    "rgba32sint",
+    "r32float",
+    "r32uint",
+    "r32sint",
+    "rg32float",
+    "rg32uint",
+    "rg32sint",
+];
 
 /// The storage formats an output may have, by naga's name for them.
 fn format_name(f: naga::StorageFormat) -> Option<&'static str> {
@@ -54,6 +75,35 @@ fn format_name(f: naga::StorageFormat) -> Option<&'static str> {
         S::Rg32Sint => "rg32sint",
         _ => return None,
     })
+}
+
+/// A name as its declaring module spells it, and that module's import
+/// path where naga_oil decorated it (`frameX_naga_oil_mod_X<base32>X`:
+/// an item of an imported module).
+pub fn undecorate(name: &str) -> (String, Option<String>) {
+    const PRE: &str = "X_naga_oil_mod_X";
+    let Some((item, rest)) = name.split_once(PRE) else { return (name.to_string(), None) };
+    let encoded = rest.strip_suffix('X').unwrap_or(rest);
+    // RFC 4648 base32 without padding, as naga_oil writes it.
+    let (mut bits, mut acc, mut out) = (0u32, 0u32, Vec::new());
+    for c in encoded.bytes() {
+        let v = match c {
+            b'A'..=b'Z' => c - b'A',
+            b'2'..=b'7' => c - b'2' + 26,
+            _ => return (name.to_string(), None),
+        };
+        acc = (acc << 5) | v as u32;
+        bits += 5;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+            acc &= (1 << bits) - 1;
+        }
+    }
+    match String::from_utf8(out) {
+        Ok(module) => (item.to_string(), Some(module)),
+        Err(_) => (name.to_string(), None),
+    }
 }
 
 /// A WGSL spelling of a global's type, for messages.
@@ -179,7 +229,7 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
     for g in globals {
         let var = &module.global_variables[g];
         let Some(rb) = &var.binding else { continue };
-        let name = var.name.clone().unwrap_or_default();
+        let name = undecorate(var.name.as_deref().unwrap_or_default()).0;
         let unfed = |feed: &str| {
             bad(format!(
                 "pass {entry}: {name} (@group({}) @binding({}), {}) is fed by nothing; it needs {feed}, which vista \
@@ -200,17 +250,25 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
             (AddressSpace::Storage { .. }, _) => {
                 return Err(unfed("a buffer resource ([[resource]] kind = \"buffer\")"));
             }
-            (
-                _,
-                TypeInner::Image {
-                    dim: ImageDimension::D2,
-                    arrayed: false,
-                    class: ImageClass::Storage { format, access },
-                },
-            ) if !access.contains(StorageAccess::LOAD) => match format_name(*format) {
-                Some(f) => Feed::Output(f),
-                None => return Err(unfed("an output texture of a supported format (not bgra8unorm or a packed one)")),
-            },
+            (_, TypeInner::Image { dim, arrayed, class: ImageClass::Storage { format, access } })
+                if access.contains(StorageAccess::STORE) =>
+            {
+                use crate::resources::{Access, Dimension};
+                let dimension = match (dim, arrayed) {
+                    (ImageDimension::D1, _) => Dimension::D1,
+                    (ImageDimension::D2, false) => Dimension::D2,
+                    (ImageDimension::D2, true) => Dimension::D2Array,
+                    (ImageDimension::D3, _) => Dimension::D3,
+                    _ => return Err(unfed("a storage texture of dimension 1d, 2d, 2d-array or 3d")),
+                };
+                let access = if access.contains(StorageAccess::LOAD) { Access::ReadWrite } else { Access::Write };
+                match format_name(*format) {
+                    Some(format) => Feed::Output(crate::resources::Storage { format, dimension, access }),
+                    None => {
+                        return Err(unfed("an output texture of a supported format (not bgra8unorm or a packed one)"));
+                    }
+                }
+            }
             (_, TypeInner::Image { .. }) => return Err(unfed("a texture resource ([[resource]] kind = \"texture\")")),
             (_, TypeInner::Sampler { .. }) => {
                 return Err(unfed("a sampler resource ([[resource]] kind = \"sampler\")"));
@@ -229,7 +287,10 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
         out.push(Binding { group: rb.group, binding: rb.binding, name, feed, global: g });
     }
     if !out.iter().any(|b| matches!(b.feed, Feed::Output(_))) {
-        return Err(bad(format!("pass {entry} of {shader} writes no texture_storage_2d output")));
+        return Err(bad(format!(
+            "pass {entry} of {shader} writes no storage texture (texture_storage_{{1d,2d,2d_array,3d}} with write or \
+             read_write access)"
+        )));
     }
     out.sort_by_key(|b| (b.group, b.binding));
     Ok(out)

@@ -160,6 +160,15 @@ fn describe(t: Option<&Tok>) -> String {
 
 impl Expr {
     /// Parses `text` over `params`.
+    /// Whether the expression reads param (or size) `name`.
+    pub fn mentions(&self, name: &str) -> bool {
+        match self {
+            Expr::Num(_) => false,
+            Expr::Name(n) => *n == name,
+            Expr::Bin(_, a, b) | Expr::CeilDiv(a, b) => a.mentions(name) || b.mentions(name),
+        }
+    }
+
     pub fn parse(text: &str, params: &[ParamSpec]) -> Result<Expr, String> {
         let mut p = Parser { toks: lex(text)?, at: 0, params };
         let e = p.sum()?;

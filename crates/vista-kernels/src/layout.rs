@@ -44,9 +44,13 @@ pub struct Field {
     pub offset: u32,
     /// Index of its block in [`UniformLayout::blocks`].
     pub block: usize,
-    /// `variable.path`: the name that always reaches it (the variable as
-    /// the declaring module spells it).
+    /// `variable.path`: the name that reaches it wherever no other module
+    /// declares a uniform of the same name (the variable as its declaring
+    /// module spells it, without naga_oil's decoration).
     pub key: String,
+    /// `module::path::variable.path` for a uniform an imported module
+    /// declares (else `key`): the name that always reaches it.
+    pub qualified: String,
 }
 
 /// One uniform global.
@@ -61,7 +65,7 @@ pub struct Block {
 }
 
 /// The reflected uniform blocks.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct UniformLayout {
     /// Every uniform global the entry point reaches, in binding order.
     pub blocks: Vec<Block>,
@@ -73,6 +77,9 @@ pub struct UniformLayout {
     pub bindings: Vec<crate::bindings::Binding>,
     /// The module's `override` constants by name (a param may feed one).
     pub overrides: Vec<String>,
+    /// The storage texture the pass writes, and its resource
+    /// ([`Kernel::layout`] applies the manifest's `bind`).
+    pub output: crate::resources::Target,
 }
 
 /// Reflects the uniform block of `module` for `kernel` (named in errors).
@@ -84,6 +91,7 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
     for uniform in bindings.iter().filter(|b| b.feed == crate::bindings::Feed::Uniform) {
         let var = &module.global_variables[uniform.global];
         let name = uniform.name.clone();
+        let from = crate::bindings::undecorate(var.name.as_deref().unwrap_or_default()).1;
         let block = blocks.len();
         let start = fields.len();
         let size = match &module.types[var.ty].inner {
@@ -96,15 +104,21 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
                 let ty = leaf_type(module, inner).map_err(|what| {
                     bad(format!("{shader}: uniform {name} is {what}; allowed: the leaf types of a struct field"))
                 })?;
-                fields.push(Field { name: name.clone(), path: name.clone(), ty, offset: 0, block, key: name.clone() });
+                let (path, key, qualified) = (String::new(), String::new(), String::new());
+                fields.push(Field { name: name.clone(), path, ty, offset: 0, block, key, qualified });
                 module.types[var.ty].inner.size(module.to_ctx())
             }
         };
         for f in &mut fields[start..] {
             f.block = block;
-            if f.key.is_empty() {
-                f.key = format!("{name}.{}", f.path);
+            f.key = if f.path.is_empty() { name.clone() } else { format!("{name}.{}", f.path) };
+            if f.path.is_empty() {
+                f.path = name.clone();
             }
+            f.qualified = match &from {
+                Some(m) => format!("{m}::{}", f.key),
+                None => f.key.clone(),
+            };
         }
         for (i, f) in fields[start..].iter().enumerate() {
             if let Some(g) = fields[start..start + i].iter().find(|g| g.name == f.name) {
@@ -116,7 +130,16 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
         }
         blocks.push(Block { group: uniform.group, binding: uniform.binding, var: name, size });
     }
-    Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module) })
+    let output = bindings
+        .iter()
+        .find_map(|b| match b.feed {
+            crate::bindings::Feed::Output(storage) => {
+                Some(crate::resources::Target { var: b.name.clone(), storage, resource: None })
+            }
+            _ => None,
+        })
+        .expect("bindings::reflect refuses a pass without an output");
+    Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module), output })
 }
 
 fn override_names(module: &naga::Module) -> Vec<String> {
@@ -138,7 +161,7 @@ fn walk(
         let unsupported = |what: &str| {
             Err(format!(
                 "{shader}: Params field {path} is {what}; allowed: u32, i32, f32, vecN of them, matCxR<f32>, \
-                 fixed-size arrays of these, nested structs"
+                 fixed-size arrays of these, nested structs and fixed-size arrays of structs"
             ))
         };
         let ty = match &module.types[m.ty].inner {
@@ -146,12 +169,41 @@ fn walk(
                 walk(module, members, offset, &path, shader, out)?;
                 continue;
             }
+            // An array of structs feeds like a struct of arrays: one param
+            // per leaf of the element, a list over the elements
+            // (`lights.color`: array<vec3<f32>, 4>).
+            TypeInner::Array { base, size: naga::ArraySize::Constant(n), stride }
+                if matches!(module.types[*base].inner, TypeInner::Struct { .. }) =>
+            {
+                let TypeInner::Struct { members, .. } = &module.types[*base].inner else { unreachable!() };
+                let mut element = Vec::new();
+                walk(module, members, 0, "", shader, &mut element)?;
+                for leaf in element {
+                    let components = (0..n.get())
+                        .flat_map(|i| leaf.ty.components.iter().map(move |c| i * stride + leaf.offset + c))
+                        .collect();
+                    out.push(Field {
+                        name: leaf.name,
+                        path: format!("{path}.{}", leaf.path),
+                        ty: FieldType {
+                            scalar: leaf.ty.scalar,
+                            name: format!("array<{}, {n}>", leaf.ty.name),
+                            components,
+                        },
+                        offset,
+                        block: 0,
+                        key: String::new(),
+                        qualified: String::new(),
+                    });
+                }
+                continue;
+            }
             inner => match leaf_type(module, inner) {
                 Ok(t) => t,
                 Err(what) => return unsupported(what),
             },
         };
-        out.push(Field { name, path, ty, offset, block: 0, key: String::new() });
+        out.push(Field { name, path, ty, offset, block: 0, key: String::new(), qualified: String::new() });
     }
     Ok(())
 }
@@ -213,15 +265,24 @@ fn leaf_type(module: &naga::Module, inner: &TypeInner) -> Result<FieldType, &'st
 
 /// Params that vista consumes on the host, so the shader may leave them out:
 /// `exposure` of an HDR kernel (the PNG tone map).
+/// Whether param `name` feeds something other than a uniform leaf or an
+/// override: the hdr view's exposure, a `workgroups` or `size` expression.
 fn host_only(kernel: &Kernel, name: &str) -> bool {
-    kernel.output() == crate::Output::Hdr && name == "exposure"
+    let m = &kernel.manifest;
+    (kernel.output() == crate::Output::Hdr && name == "exposure")
+        || m.workgroups.iter().flatten().any(|e| e.mentions(name))
+        || m.resources.iter().filter_map(|r| r.size.as_ref()).flatten().any(|e| e.mentions(name))
 }
 
 /// The param feeding `f`, if any: one named by its `variable.path`, else
 /// one named by its bare leaf name.
 fn param_of<'k>(kernel: &'k Kernel, f: &Field) -> Option<&'k crate::ParamSpec> {
     let params = kernel.params();
-    params.iter().find(|s| s.name == f.key).or_else(|| params.iter().find(|s| s.name == f.name))
+    params
+        .iter()
+        .find(|s| s.name == f.qualified)
+        .or_else(|| params.iter().find(|s| s.name == f.key))
+        .or_else(|| params.iter().find(|s| s.name == f.name))
 }
 
 /// Refuses a layout that does not match the manifest: a field with no
@@ -265,7 +326,18 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
         }
     }
     for spec in kernel.params() {
+        let by_qualified = layout.fields.iter().any(|f| f.qualified == spec.name);
         let by_key: Vec<&Field> = layout.fields.iter().filter(|f| f.key == spec.name).collect();
+        if !by_qualified && by_key.len() > 1 {
+            return Err(bad(format!(
+                "param {} is ambiguous: uniforms of two modules share the name ({}); name one as {}",
+                spec.name,
+                by_key.iter().map(|f| f.qualified.as_str()).collect::<Vec<_>>().join(", "),
+                by_key.iter().map(|f| f.qualified.as_str()).collect::<Vec<_>>().join(" or ")
+            )));
+        }
+        let by_key: Vec<&Field> =
+            if by_qualified { layout.fields.iter().filter(|f| f.qualified == spec.name).collect() } else { by_key };
         let by_name: Vec<&Field> = layout.fields.iter().filter(|f| f.name == spec.name).collect();
         if by_key.is_empty() && by_name.len() > 1 {
             return Err(bad(format!(
@@ -402,9 +474,9 @@ default = -3
         let m = module("struct A { fov: f32 }\nstruct Params { width: u32, height: u32, a: A, fov: f32 }");
         let e = k.layout(&m).unwrap_err().to_string();
         assert!(e.contains("Params fields a.fov and fov share the name 'fov'"), "{e}");
-        let m = module("struct A { x: f32 }\nstruct Params { width: u32, height: u32, m: array<A, 2> }");
+        let m = module("struct Params { width: u32, height: u32, m: array<array<f32, 2>, 2> }");
         let e = k.layout(&m).unwrap_err().to_string();
-        assert!(e.contains("Params field m is an array of structs"), "{e}");
+        assert!(e.contains("Params field m is an array of arrays"), "{e}");
         let m = module("struct Params { width: u32, height: f32 }");
         let e = k.layout(&m).unwrap_err().to_string();
         assert!(e.contains("Params field height is WGSL f32 but the image size is u32"), "{e}");
@@ -472,5 +544,39 @@ default = [1, 0, 0, 0, 1, 0, 0, 0, -1]
             k.resolve(None, &[("res".into(), "1,2.5".into())]).unwrap_err().to_string().contains("integers"),
             "an integer vector takes integers"
         );
+    }
+
+    const LIGHTS: &str = r#"summary = "an array of structs"
+[[param]]
+name = "pos"
+type = "array<vec3<f32>, 2>"
+range = [-10, 10]
+default = [[1, 2, 3], [4, 5, 6]]
+[[param]]
+name = "params.lights.power"
+type = "array<f32, 2>"
+range = [0, 100]
+default = [7, 8]
+"#;
+
+    #[test]
+    fn arrays_of_structs_pack_as_a_struct_of_arrays() {
+        let k = Kernel::from_manifest("lights", "lights.toml", LIGHTS).unwrap();
+        let m = module(
+            "struct Light { pos: vec3<f32>, power: f32 }\n\
+             struct Params { width: u32, height: u32, lights: array<Light, 2> }",
+        );
+        let layout = k.layout(&m).unwrap();
+        let b = k.uniforms(&layout, &k.resolve(None, &[]).unwrap(), 3, 2).remove(0);
+        let f = |o: usize| f32::from_le_bytes(b[o..o + 4].try_into().unwrap());
+        // The array starts at 16; each Light is 16 bytes: pos, then power in its padding.
+        assert_eq!((16..48).step_by(4).map(f).collect::<Vec<_>>(), [1.0, 2.0, 3.0, 7.0, 4.0, 5.0, 6.0, 8.0]);
+    }
+
+    #[test]
+    fn naga_oil_decoration_is_read_back_as_the_module_path() {
+        let decorated = "frameX_naga_oil_mod_XNV4WY2LCHI5GGYLNMVZGCX";
+        assert_eq!(crate::bindings::undecorate(decorated), ("frame".to_string(), Some("mylib::camera".to_string())));
+        assert_eq!(crate::bindings::undecorate("frame"), ("frame".to_string(), None));
     }
 }

@@ -76,6 +76,7 @@ pub mod manifest;
 pub mod noise;
 pub mod params;
 pub mod phase;
+pub mod resources;
 pub mod ridged;
 
 use std::sync::OnceLock;
@@ -117,6 +118,9 @@ pub enum Output {
     Display,
     /// The kernel writes linear radiance; display = tonemap(exposure).
     Hdr,
+    /// Display = (raw - min) / (max - min) over the image's finite RGB
+    /// values (`view = "normalize"`; the default for integer formats).
+    Normalize,
 }
 
 /// What Rust keeps for a built-in kernel because data cannot say it: the
@@ -170,6 +174,7 @@ pub fn cpu_reference(name: &str) -> Option<&'static dyn CpuReference> {
 pub struct DisplayMap {
     exposure: Option<f32>,
     opaque: bool,
+    normalize: bool,
 }
 
 impl DisplayMap {
@@ -178,6 +183,7 @@ impl DisplayMap {
     pub fn apply(&self, raw: &Image) -> Option<Image> {
         let mut out = match self.exposure {
             Some(e) => vista_image::tonemap(raw, e),
+            None if self.normalize => normalized(raw),
             None if self.opaque => raw.clone(),
             None => return None,
         };
@@ -188,6 +194,23 @@ impl DisplayMap {
         }
         Some(out)
     }
+}
+
+/// `raw` mapped to [0, 1] by the min and max of its finite RGB values (a
+/// constant image maps to 0), alpha 1; non-finite values map to 0.
+fn normalized(raw: &Image) -> Image {
+    let finite = raw.data.iter().flat_map(|p| p[..3].iter().copied()).filter(|v| v.is_finite());
+    let (lo, hi) = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let span = if hi > lo { (hi as f64 - lo as f64) as f32 } else { f32::INFINITY };
+    let map = |v: f32| if v.is_finite() { ((v - lo) / span).clamp(0.0, 1.0) } else { 0.0 };
+    let data = raw.data.iter().map(|p| [map(p[0]), map(p[1]), map(p[2]), 1.0]).collect();
+    Image::from_raw(raw.width, raw.height, data).expect("same size")
+}
+
+/// Whether a storage format holds integers (compared exactly, shown
+/// normalised by default).
+pub fn is_integer_format(format: &str) -> bool {
+    format.ends_with("uint") || format.ends_with("sint")
 }
 
 /// One kernel: its manifest, where it came from, and its CPU reference if
@@ -266,8 +289,18 @@ impl Kernel {
         }
         Ok(Some(out))
     }
+    /// The PNG view the manifest gives (default display).
     pub fn output(&self) -> Output {
-        self.manifest.output
+        self.manifest.output.unwrap_or(Output::Display)
+    }
+    /// The PNG view of an output of `format`: the manifest's, else
+    /// normalize for an integer format and display otherwise.
+    pub fn view(&self, format: &str) -> Output {
+        match self.manifest.output {
+            Some(v) => v,
+            None if is_integer_format(format) => Output::Normalize,
+            None => Output::Display,
+        }
     }
     /// Whether a CPU reference is registered for this kernel.
     pub fn has_reference(&self) -> bool {
@@ -290,9 +323,16 @@ impl Kernel {
 
     /// How this kernel's display values follow from its raw output for `p`.
     pub fn display_map(&self, p: &ParamSet) -> DisplayMap {
+        self.display_map_of(p, "rgba32float")
+    }
+
+    /// The display map of an output of `format` (see [`Kernel::view`]).
+    pub fn display_map_of(&self, p: &ParamSet, format: &str) -> DisplayMap {
+        let view = self.view(format);
         DisplayMap {
-            exposure: (self.output() == Output::Hdr).then(|| p.f32("exposure")),
+            exposure: (view == Output::Hdr).then(|| p.f32("exposure")),
             opaque: self.manifest.opaque_display,
+            normalize: view == Output::Normalize,
         }
     }
 
@@ -310,13 +350,20 @@ impl Kernel {
 
     /// Inclusive bounds every RGB value of the raw output must respect.
     pub fn output_bounds(&self, p: &ParamSet) -> (f32, f32) {
+        self.output_bounds_of(p, "rgba32float")
+    }
+
+    /// The bounds of an output of `format`: a normalised view (an integer
+    /// format's default) bounds nothing but finiteness.
+    pub fn output_bounds_of(&self, p: &ParamSet, format: &str) -> (f32, f32) {
         if let Some(b) = self.cpu.and_then(|c| c.output_bounds(p)) {
             return b;
         }
-        match (self.manifest.output_range, self.output()) {
+        match (self.manifest.output_range, self.view(format)) {
             (Some((lo, hi)), _) => (lo as f32, hi as f32),
             (None, Output::Display) => (0.0, 1.0),
             (None, Output::Hdr) => (0.0, f32::INFINITY),
+            (None, Output::Normalize) => (f32::NEG_INFINITY, f32::INFINITY),
         }
     }
 
@@ -435,8 +482,9 @@ impl Kernel {
 
     /// Reflects and checks the uniform layout of this kernel's composed module.
     pub fn layout(&self, module: &naga::Module) -> Result<UniformLayout, ParamError> {
-        let l = layout::reflect(self.name(), self.shader(), self.entry(), module)?;
+        let mut l = layout::reflect(self.name(), self.shader(), self.entry(), module)?;
         layout::check(self, &l)?;
+        l.output = resources::resolve(&self.manifest, &l.bindings, module)?;
         Ok(l)
     }
 

@@ -6,7 +6,8 @@
 //! ```toml
 //! summary = "one line"             # shown by vista list
 //! shader = "hybrid.wgsl"           # under shaders/; default "<name>.wgsl"
-//! output = "display"               # display | hdr (PNG = 1 - exp(-exposure L), sRGB)
+//! output = "display"               # display | hdr (PNG = 1 - exp(-exposure L), sRGB) | normalize (min..max);
+//!                                  # default display, normalize for an integer storage format
 //! display_alpha = "keep"           # keep | opaque (PNG alpha = 1; the RGB is already composited)
 //! work = ["octaves"]               # product of entries, each `name` or a sum `a + b + 3`
 //! output_range = [0.0, 1.0]        # NaN/range guard of the raw RGB (default: display [0, 1], hdr [0, inf))
@@ -15,6 +16,20 @@
 //!                                  # or an integer: every such call samples that fixed z
 //! specialize = ["basis"]           # optional: enum params fixed when the shader is composed
 //!                                  # (naga_oil def BASIS_IS_PERLIN etc.; one pipeline per value)
+//! [[resource]]                     # SPEC 14, so far the output texture (resources.rs)
+//! name = "sky"
+//! kind = "texture"
+//! format = "rgba16float"           # optional; must match the binding
+//! dimension = "2d-array"           # 1d | 2d | 2d-array | 3d; must match the binding
+//! size = ["width", "width", 6]     # numbers, params, width, height, + - * /, ceil_div(a, b)
+//! [[pass]]                         # one so far
+//! entry = "bake_faces"             # default main
+//! workgroups = [1, 1, 6]           # optional: else the output covered with the reflected size
+//! bind = { sky_faces = "sky" }     # WGSL variable -> resource
+//! [[output]]                       # one so far
+//! resource = "sky"                 # a resource, or the WGSL variable of the written texture
+//! view = "hdr"                     # as output = "..."
+//! partial = false                  # true: unwritten texels allowed
 //! [[param]]
 //! name = "octaves"
 //! type = "u32"                     # u32 | i32 | f32 | bool | vec2 | vec3 | vec4 | enum
@@ -43,6 +58,9 @@ struct RawManifest {
     output: Option<toml::Value>,
     #[serde(default, rename = "pass")]
     passes: Vec<RawPass>,
+    /// `[[resource]]` tables (SPEC 14): so far the output texture.
+    #[serde(default, rename = "resource")]
+    resources: Vec<toml::Value>,
     /// naga_oil shader defs: bool or integer values.
     #[serde(default)]
     defs: toml::Table,
@@ -71,6 +89,8 @@ struct RawManifest {
 struct RawPass {
     entry: Option<String>,
     workgroups: Option<Vec<toml::Value>>,
+    /// WGSL variable name -> resource name.
+    bind: Option<toml::Table>,
 }
 
 /// An `[[output]]` table: so far the kernel's one storage-texture output.
@@ -121,7 +141,9 @@ pub struct Manifest {
     pub name: &'static str,
     pub summary: &'static str,
     pub shader: &'static str,
-    pub output: Output,
+    /// The PNG view, where the manifest gives one (else display, or
+    /// normalize for an integer format: `Kernel::view`).
+    pub output: Option<Output>,
     pub opaque_display: bool,
     /// The compute entry point (`[[pass]] entry`, default `main`).
     pub entry: &'static str,
@@ -130,6 +152,12 @@ pub struct Manifest {
     pub workgroups: Option<[crate::expr::Expr; 3]>,
     /// Texels the kernel leaves unwritten are allowed (`[[output]] partial`).
     pub partial: bool,
+    /// `[[resource]]` tables: so far textures, the output among them.
+    pub resources: Vec<crate::resources::TextureResource>,
+    /// The pass's `bind`: WGSL variable name -> resource name.
+    pub bind: Vec<(String, String)>,
+    /// `[[output]] resource`: a resource's name or the WGSL variable.
+    pub output_resource: Option<&'static str>,
     /// naga_oil shader defs (`defs = { MAX_LIGHTS = 10, FIRST_PASS = true }`),
     /// as `NAME=value` in declaration order.
     pub defs: Vec<String>,
@@ -149,7 +177,7 @@ pub struct Manifest {
     pub sweep_reference: &'static [(&'static str, &'static str)],
 }
 
-fn leak(s: impl Into<String>) -> &'static str {
+pub(crate) fn leak(s: impl Into<String>) -> &'static str {
     Box::leak(s.into().into_boxed_str())
 }
 
@@ -179,11 +207,12 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let view = |v: &str| match v {
         "display" => Ok(Output::Display),
         "hdr" => Ok(Output::Hdr),
-        other => Err(kfail(format!("output view \"{other}\" is not valid; expected display|hdr"))),
+        "normalize" => Ok(Output::Normalize),
+        other => Err(kfail(format!("output view \"{other}\" is not valid; expected display|hdr|normalize"))),
     };
-    let (output, partial) = match &raw.output {
-        None => (Output::Display, false),
-        Some(toml::Value::String(s)) => (view(s)?, false),
+    let (output, partial, output_resource) = match &raw.output {
+        None => (None, false, None),
+        Some(toml::Value::String(s)) => (Some(view(s)?), false, None),
         Some(toml::Value::Array(tables)) => {
             if tables.len() != 1 {
                 return Err(kfail(format!(
@@ -197,7 +226,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             {
                 return Err(kfail("[[output]] resource must name the kernel's storage texture".into()));
             }
-            (view(o.view.as_deref().unwrap_or("display"))?, o.partial)
+            (o.view.as_deref().map(view).transpose()?, o.partial, o.resource.map(leak))
         }
         Some(other) => {
             return Err(kfail(format!(
@@ -215,9 +244,13 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     for p in &raw.params {
         let pfail = |message: String| kfail(format!("param {}: {message}", p.name));
         let ident = |w: &str| !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-        if !p.name.split('.').all(ident) {
+        // `module::path::variable.path`: the module's path, then the name.
+        let (module, local) = p.name.rsplit_once("::").unwrap_or(("", &p.name));
+        if !local.split('.').all(ident) || !(module.is_empty() || module.split("::").all(ident)) {
             return Err(pfail(
-                "a name is a WGSL field name, or variable.path (letters, digits and '_' between dots)".into(),
+                "a name is a WGSL field name, variable.path or module::path::variable.path (letters, digits and \
+                 '_' between dots)"
+                    .into(),
             ));
         }
         if RESERVED.contains(&p.name.as_str()) {
@@ -379,7 +412,9 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     {
         return Err(kfail(format!("output_range = [{lo}, {hi}] is not valid; expected min <= max")));
     }
-    if output == Output::Hdr && !params.iter().any(|p| p.name == "exposure" && matches!(p.kind, Kind::Float { .. })) {
+    if output == Some(Output::Hdr)
+        && !params.iter().any(|p| p.name == "exposure" && matches!(p.kind, Kind::Float { .. }))
+    {
         return Err(kfail("output = \"hdr\" needs an f32 param named exposure (the PNG tone map)".into()));
     }
     let hash_plane = match &raw.hash_plane {
@@ -433,6 +468,18 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             return Err(kfail(format!("[[pass]] workgroups has {} entries; expected [x, y, z]", list.len())));
         }
     };
+    let (resources, bind) =
+        crate::resources::parse(&raw.resources, pass.and_then(|p| p.bind.as_ref()), params, &kfail)?;
+    if let Some(named) = output_resource
+        && !resources.is_empty()
+        && !resources.iter().any(|r| r.name == named)
+    {
+        let names: Vec<&str> = resources.iter().map(|r| r.name).collect();
+        return Err(kfail(format!(
+            "[[output]] resource = \"{named}\" names no resource; resources: {}",
+            names.join(", ")
+        )));
+    }
     let mut defs = Vec::new();
     for (k, v) in &raw.defs {
         if k.is_empty() || !k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
@@ -472,6 +519,9 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         entry: leak(entry),
         workgroups,
         partial,
+        resources,
+        bind,
+        output_resource,
         defs,
         overrides,
         work,

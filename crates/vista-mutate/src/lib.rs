@@ -407,6 +407,7 @@ fn judge_case(
     let observed = Observed {
         raw: &r.raw,
         unwritten: r.unwritten,
+        format: r.format,
         actual: &actual,
         repeat_identical: None,
         shader_files: &files,

@@ -83,6 +83,8 @@ pub struct Rendered {
     pub stats: RunStats,
     /// Texels of the output the kernel never wrote (they read 0 in `raw`).
     pub unwritten: u64,
+    /// The output's storage format (an integer one compares exactly).
+    pub format: &'static str,
     to_display: DisplayMap,
     /// Display values, made on first use unless they are `raw` itself: a
     /// benchmark or a raw-only caller never pays for a second image.
@@ -193,6 +195,14 @@ pub struct Plan {
     pub slots: Vec<vista_gpu::Slot>,
     /// The output's storage format (its WGSL name).
     pub format: &'static str,
+    /// The output's dimension, and its layers (2d-array) or depth (3d):
+    /// read back stacked top to bottom into one `width` x `height * layers`
+    /// image.
+    pub dimension: vista_gpu::Dimension,
+    /// Array layers (2d-array) or depth (3d); 1 otherwise.
+    pub layers: u32,
+    /// The output is bound `read_write` (it starts as zeros).
+    pub read_write: bool,
     /// Values of the module's `override` constants (params, the manifest's
     /// `overrides`; absent ones take their defaults).
     pub constants: Vec<(String, f64)>,
@@ -202,7 +212,7 @@ pub struct Plan {
     pub table: Vec<u32>,
     /// Output width in pixels.
     pub width: u32,
-    /// Output height in pixels.
+    /// Output height in pixels (of one layer; 1 for a 1d output).
     pub height: u32,
     /// Raw output to display values.
     pub display: DisplayMap,
@@ -252,18 +262,25 @@ pub fn plan(
             },
         })
         .collect();
-    let format = layout
-        .bindings
-        .iter()
-        .find_map(|b| match b.feed {
-            Feed::Output(f) => Some(f),
-            _ => None,
-        })
-        .expect("Kernel::layout refuses a pass without an output");
+    let target = &layout.output;
+    let format = target.storage.format;
+    let extent = target.extent(kernel.name(), p, width, height).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    use vista_kernels::resources::{Access, Dimension};
+    let dimension = match target.storage.dimension {
+        Dimension::D1 => vista_gpu::Dimension::D1,
+        Dimension::D2 => vista_gpu::Dimension::D2,
+        Dimension::D2Array => vista_gpu::Dimension::D2Array,
+        Dimension::D3 => vista_gpu::Dimension::D3,
+    };
     let workgroups = match kernel.workgroups(p, width, height).map_err(|e| RenderError::BadInput(e.to_string()))? {
         Some(count) => count,
-        // Cover the output: the workgroup size is the shader's, never assumed.
-        None => [width.div_ceil(workgroup_size[0]), height.div_ceil(workgroup_size[1]), 1],
+        // Cover the output, layers and slices along z: the workgroup size
+        // is the shader's, never assumed.
+        None => [
+            extent.width.div_ceil(workgroup_size[0]),
+            extent.height.div_ceil(workgroup_size[1]),
+            extent.layers.div_ceil(workgroup_size[2]),
+        ],
     };
     Ok(Plan {
         kernel: kernel.name().to_string(),
@@ -272,13 +289,16 @@ pub fn plan(
         workgroups,
         slots,
         format,
+        dimension,
+        layers: extent.layers,
+        read_write: target.storage.access == Access::ReadWrite,
         constants,
         uniforms: kernel.uniforms(&layout, p, width, height),
         table: kernel.table(&layout, p),
         shader,
-        width,
-        height,
-        display: kernel.display_map(p),
+        width: extent.width,
+        height: extent.height,
+        display: kernel.display_map_of(p, format),
     })
 }
 
@@ -311,6 +331,9 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         workgroups: plan.workgroups,
         slots: &plan.slots,
         format: plan.format,
+        dimension: plan.dimension,
+        layers: plan.layers,
+        read_write: plan.read_write,
         constants: &plan.constants,
         uniforms: &plan.uniforms,
         table: &plan.table,
@@ -322,6 +345,7 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         raw: out.image,
         stats: out.stats,
         unwritten: out.unwritten,
+        format: plan.format,
         to_display: plan.display,
         display: OnceLock::new(),
     })

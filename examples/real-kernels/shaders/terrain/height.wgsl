@@ -1,7 +1,9 @@
 // A shaded height map from a sum of rotated sine ridges, laid out the way
 // engine code lays out its uniforms: a model matrix, an integer tile count,
 // an explicit padding field, twenty fields in all, in bind group 1; the
-// output in group 0 at binding 3; entry point `height`, 16 x 4 workgroups.
+// map in group 0 at binding 3, read_write, as an erosion or stamping pass
+// binds it: the shading is added onto what the map holds (zeros before the
+// first pass); entry point `height`, 16 x 4 workgroups.
 //
 // h(p) = sum_i a g^i sin(f l^i (d_i . p) + 1.7 i + 0.37 s), d_i the unit
 // vector at i times the golden angle; normalised to [0, 1] by the sum of
@@ -32,7 +34,7 @@ struct TerrainUniforms {
 }
 
 @group(1) @binding(0) var<uniform> terrain: TerrainUniforms;
-@group(0) @binding(3) var height_map: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(3) var height_map: texture_storage_2d<rgba32float, read_write>;
 
 const GOLDEN_ANGLE: f32 = 2.39996323;
 
@@ -77,5 +79,6 @@ fn height(@builtin(global_invocation_id) id: vec3<u32>) {
         albedo = terrain.snow;
     }
     let lit = albedo * (terrain.ambient + (1.0 - terrain.ambient) * lambert);
-    textureStore(height_map, id.xy, vec4(lit, 1.0));
+    let below = textureLoad(height_map, id.xy);
+    textureStore(height_map, id.xy, vec4(below.rgb + lit, 1.0));
 }
