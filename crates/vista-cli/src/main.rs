@@ -254,7 +254,13 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             } else {
                 list(&kernels);
             }
-            Ok(0)
+            // A broken manifest is shown, and fails the listing, but hides
+            // no other kernel.
+            for (name, e) in kernels.broken() {
+                println!("{name} — broken manifest: {e}\n");
+                eprintln!("error: kernel {name} is not usable: {e}");
+            }
+            Ok(if kernels.broken().is_empty() { 0 } else { 2 })
         }
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             let k = registry(project)?.find(&kernel).map_err(bad)?;

@@ -1265,6 +1265,26 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     assert_eq!(view.get(15, 15)[1], 1.0, "the largest value maps to 1");
 }
 
+/// One broken manifest breaks only its own kernel: a built-in and the
+/// project's other kernels still render; `vista list` shows the broken one
+/// with its error (exit 2); asking for it gives the error.
+fn a_broken_manifest_breaks_only_its_kernel() {
+    let d = kernel_project(K_MANIFEST, K_SHADER);
+    std::fs::write(d.path().join("kernels/bad.toml"), "summary = 3\n").unwrap();
+    for kernel in ["fbm", "k"] {
+        let out = d.path().join(format!("{kernel}.png"));
+        let r = vista_in(Some(d.path()), &[], &["render", kernel, "--size", "8x8", "-o", out.to_str().unwrap()]);
+        assert_eq!(r.code, 0, "{kernel}: {}", r.stderr);
+    }
+    let out = d.path().join("bad.png");
+    let r = vista_in(Some(d.path()), &[], &["render", "bad", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    assert_rejected(&r, 2, &["kernels/bad.toml", "line 1", "expected a string"]);
+    let l = vista_in(Some(d.path()), &[], &["list"]);
+    assert_eq!(l.code, 2, "{}", l.stderr);
+    assert!(l.stdout.contains("k — test kernel") && l.stdout.contains("bad — broken manifest"), "{}", l.stdout);
+    assert!(l.stderr.contains("kernel bad is not usable"), "{}", l.stderr);
+}
+
 /// The manifest names the entry point; an unknown one lists the shader's.
 fn the_manifest_names_the_entry_point() {
     let manifest = format!("{K_MANIFEST}[[pass]]\nentry = \"height\"\n");
@@ -2428,6 +2448,7 @@ fn main() {
         (Gpu, "workgroup_size_comes_from_reflection_not_8x8", workgroup_size_comes_from_reflection_not_8x8),
         (Gpu, "the_manifest_names_the_entry_point", the_manifest_names_the_entry_point),
         (Gpu, "layered_outputs_stack_and_follow_reflection", layered_outputs_stack_and_follow_reflection),
+        (Gpu, "a_broken_manifest_breaks_only_its_kernel", a_broken_manifest_breaks_only_its_kernel),
         (
             Gpu,
             "integer_outputs_compare_exactly_and_show_normalized",

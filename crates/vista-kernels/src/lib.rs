@@ -531,24 +531,35 @@ fn same_params_as_builtin(m: &manifest::Manifest) -> bool {
     sig(builtin.params) == sig(m.params)
 }
 
+/// A project's kernels. A manifest that does not parse breaks only its own
+/// kernel: the others (built-in or not) still run, and asking for the
+/// broken one gives its error.
 #[derive(Debug, Clone)]
 pub struct Registry {
     kernels: Vec<&'static Kernel>,
+    broken: Vec<(String, ParamError)>,
 }
 
 impl Registry {
     /// Parses every manifest (`<name>.toml` files; the name is the stem).
     pub fn from_files(files: &[vista_project::SourceFile]) -> Result<Registry, ParamError> {
-        let mut kernels = Vec::new();
+        let (mut kernels, mut broken) = (Vec::new(), Vec::new());
         for f in files {
             let Some(name) = f.rel.strip_suffix(".toml") else { continue };
             if name.contains('/') {
                 continue;
             }
-            let k = Kernel::from_manifest(name, &f.origin, &f.text)?;
-            kernels.push(&*Box::leak(Box::new(k)));
+            match Kernel::from_manifest(name, &f.origin, &f.text) {
+                Ok(k) => kernels.push(&*Box::leak(Box::new(k))),
+                Err(e) => broken.push((name.to_string(), e)),
+            }
         }
-        Ok(Registry { kernels })
+        Ok(Registry { kernels, broken })
+    }
+
+    /// Kernels whose manifest does not parse, with the error.
+    pub fn broken(&self) -> &[(String, ParamError)] {
+        &self.broken
     }
 
     /// The project's kernels (its manifests layered over the built-ins).
@@ -563,8 +574,12 @@ impl Registry {
     pub fn builtin() -> &'static Registry {
         static BUILTIN: OnceLock<Registry> = OnceLock::new();
         BUILTIN.get_or_init(|| {
-            Registry::of_project(&vista_project::Project::builtin_only())
-                .unwrap_or_else(|e| panic!("a built-in manifest is invalid: {e}"))
+            let r = Registry::of_project(&vista_project::Project::builtin_only())
+                .unwrap_or_else(|e| panic!("the built-in manifests cannot be read: {e}"));
+            if let Some((name, e)) = r.broken.first() {
+                panic!("built-in manifest {name} is invalid: {e}");
+            }
+            r
         })
     }
 
@@ -574,6 +589,9 @@ impl Registry {
 
     /// Looks a kernel up by name.
     pub fn find(&self, name: &str) -> Result<&'static Kernel, ParamError> {
+        if let Some((_, e)) = self.broken.iter().find(|(n, _)| n == name) {
+            return Err(e.clone());
+        }
         self.kernels.iter().copied().find(|k| k.name() == name).ok_or_else(|| ParamError::UnknownKernel {
             name: name.to_string(),
             valid: self.kernels.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),

@@ -97,6 +97,9 @@ pub struct Point {
     /// Work per pixel of the point's settings: the manifest's estimate,
     /// averaged over the image's rays where it varies per ray.
     pub work: f64,
+    /// The point's settings are the reference's own: its PSNR is inf by
+    /// construction, so it is never the answer to "cheapest".
+    pub is_reference: bool,
 }
 
 /// A finished sweep: `curve.json` is this, serialised.
@@ -213,7 +216,14 @@ pub fn run(
             Metric::Display => metrics::compare(reference.display(), r.display())?,
             Metric::Linear => metrics::compare_hdr(&reference.raw, &r.raw)?,
         };
-        out.push(Point { x: xv.clone(), y: yv.clone(), metrics: m, gpu_ms, work: k.mean_work_per_pixel(p, w, h) });
+        out.push(Point {
+            x: xv.clone(),
+            y: yv.clone(),
+            metrics: m,
+            gpu_ms,
+            work: k.mean_work_per_pixel(p, w, h),
+            is_reference: p.canonical() == reference_params.canonical(),
+        });
     }
     progress(total, total, "done");
     Ok(Sweep {
@@ -230,11 +240,12 @@ fn fmt_psnr(p: f64) -> String {
 }
 
 impl Sweep {
-    /// The cheapest point reaching the target PSNR: least work, then least time.
+    /// The cheapest point reaching the target PSNR: least work, then least
+    /// time; never the reference's own settings.
     pub fn cheapest(&self) -> Option<&Point> {
         self.points
             .iter()
-            .filter(|p| p.metrics.psnr >= self.spec.target_psnr)
+            .filter(|p| p.metrics.psnr >= self.spec.target_psnr && !p.is_reference)
             .min_by(|a, b| a.work.total_cmp(&b.work).then(a.gpu_ms.total_cmp(&b.gpu_ms)))
     }
 
@@ -293,7 +304,11 @@ impl Sweep {
             "setting", "PSNR dB", "SSIM", "FLIP", "max abs", "gpu ms"
         );
         for p in &self.points {
-            let mark = if p.metrics.psnr >= self.spec.target_psnr { "" } else { "  (below target)" };
+            let mark = match (p.is_reference, p.metrics.psnr >= self.spec.target_psnr) {
+                (true, _) => "  (the reference itself)",
+                (false, true) => "",
+                (false, false) => "  (below target)",
+            };
             let _ = writeln!(
                 s,
                 "{:<32} {:>9} {:>8.4} {:>9} {:>11.3e} {:>10.2}{mark}",
@@ -317,7 +332,8 @@ impl Sweep {
                 );
             }
             None => {
-                let _ = writeln!(s, "no swept setting reaches {:.1} dB", self.spec.target_psnr);
+                let but = if self.points.iter().any(|p| p.is_reference) { " except the reference itself" } else { "" };
+                let _ = writeln!(s, "no swept setting{but} reaches {:.1} dB", self.spec.target_psnr);
             }
         }
         s

@@ -5,7 +5,7 @@ use vista_sweep::{Axis, Metric, Point, Sweep, SweepSpec};
 
 fn point(x: &str, y: Option<&str>, psnr: f64, gpu_ms: f64, work: f64) -> Point {
     let metrics = Metrics { psnr, ssim: 0.99, max_abs: 0.01, bad_pixels: 3, nan: 0, mse: 1e-4, flip_mean: Some(0.002) };
-    Point { x: x.into(), y: y.map(Into::into), metrics, gpu_ms, work }
+    Point { x: x.into(), y: y.map(Into::into), metrics, gpu_ms, work, is_reference: false }
 }
 
 fn sweep(y: Option<Axis>, points: Vec<Point>) -> Sweep {
@@ -37,6 +37,23 @@ fn cheapest_is_the_least_work_point_reaching_the_target() {
     );
     assert_eq!(s.cheapest().unwrap().x, "32");
     assert!(s.table().contains("cheapest reaching 40.0 dB: steps=32 (41.00 dB, 2.00 ms)"), "{}", s.table());
+}
+
+/// A swept value equal to the reference renders the reference itself (inf
+/// dB); it is marked and never picked, however cheap.
+#[test]
+fn the_reference_itself_is_never_the_cheapest() {
+    let mut same = point("2", None, f64::INFINITY, 0.5, 1.0);
+    same.is_reference = true;
+    let s = sweep(None, vec![point("0.5", None, 9.8, 1.0, 1.0), same.clone()]);
+    assert!(s.cheapest().is_none());
+    let t = s.table();
+    assert!(
+        t.contains("(the reference itself)") && t.contains("no swept setting except the reference itself reaches"),
+        "{t}"
+    );
+    let s = sweep(None, vec![point("1", None, 45.0, 2.0, 4.0), same]);
+    assert_eq!(s.cheapest().unwrap().x, "1");
 }
 
 #[test]
