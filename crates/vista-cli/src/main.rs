@@ -13,6 +13,7 @@ use vista_project::Project;
 use vista_render::Renderer;
 
 mod bench;
+mod init;
 mod matrix;
 mod mutate;
 mod sweep;
@@ -20,8 +21,8 @@ mod sweep;
 #[derive(Parser)]
 #[command(name = "vista", version, about = "Headless GPU compute validation for procedural WGSL kernels")]
 struct Cli {
-    /// Adapter: cpu (lavapipe, default) or gpu (hardware). Same as VISTA_ADAPTER.
-    #[arg(long, global = true)]
+    /// Deprecated, hidden: `--adapter cpu|gpu` is `--backend lavapipe|gpu`.
+    #[arg(long, global = true, hide = true)]
     adapter: Option<String>,
     /// Implementation: lavapipe (default), swiftshader, browser (headless Chromium WebGPU) or gpu. Same as VISTA_BACKEND.
     #[arg(long, global = true, value_name = "NAME")]
@@ -36,6 +37,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Write a starter project into DIR that bless and check pass right away.
+    ///
+    /// vista.toml, kernels/rings.toml, shaders/rings.wgsl and
+    /// golden/cases.toml (two cases), into DIR (default: the current
+    /// directory). Never overwrites a file.
+    Init {
+        /// Where to write it (created if missing).
+        #[arg(default_value = ".")]
+        dir: PathBuf,
+    },
     /// List kernels with their parameters (ranges, defaults) and presets.
     List {
         /// Print only `KERNEL PRESET` lines (for scripts).
@@ -188,6 +199,12 @@ fn main() -> ExitCode {
     #[cfg(unix)]
     die_quietly_on_closed_pipe();
     let cli = Cli::parse();
+    if let Some(a) = &cli.adapter {
+        let instead = if a == "cpu" { "lavapipe" } else { a.as_str() };
+        eprintln!(
+            "note: --adapter is deprecated; it is --backend {instead} (--backend lavapipe|swiftshader|browser|gpu)"
+        );
+    }
     // The one configuration: flags first, then the environment, read here once.
     let flags = vista::Flags { backend: cli.backend.clone(), adapter: cli.adapter.clone() };
     let config = match vista::Config::from_env(&flags) {
@@ -206,6 +223,26 @@ fn main() -> ExitCode {
                 return ExitCode::from(2);
             }
         }
+    }
+    // init makes a project, so it needs none.
+    if let Command::Init { dir } = &cli.command {
+        return match init::init(dir) {
+            Ok(written) => {
+                for p in &written {
+                    println!("wrote {}", p.display());
+                }
+                println!(
+                    "next: cd {} && vista bless && vista check   (then edit kernels/rings.toml and \
+                     shaders/rings.wgsl, or add your own kernel beside them)",
+                    dir.display()
+                );
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::from(e.exit_code() as u8)
+            }
+        };
     }
     let project = match std::env::current_dir()
         .map_err(|e| GoldenError::BadInput(format!("cannot read the current directory: {e}")))
@@ -243,6 +280,7 @@ fn bad(e: impl std::fmt::Display) -> GoldenError {
 
 fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenError> {
     match cmd {
+        Command::Init { .. } => unreachable!("init runs before a project is found"),
         Command::List { names } => {
             let kernels = registry(project)?;
             if names {

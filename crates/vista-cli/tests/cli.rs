@@ -1285,6 +1285,165 @@ fn a_broken_manifest_breaks_only_its_kernel() {
     assert!(l.stderr.contains("kernel bad is not usable"), "{}", l.stderr);
 }
 
+/// `vista init DIR` writes a project that blesses and checks right away,
+/// from outside any project; it never overwrites a file.
+fn init_writes_a_project_that_blesses_and_checks() {
+    let t = tmp();
+    let dir = t.path().join("mine");
+    let r = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), t.path(), &[], &["init", "mine"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(r.stdout.contains("next: cd mine && vista bless && vista check"), "{}", r.stdout);
+    let b = vista_in(Some(&dir), &[], &["bless"]);
+    assert!(b.code == 0 && b.stdout.contains("blessed 2 cases"), "{}{}", b.stdout, b.stderr);
+    let c = vista_in(Some(&dir), &[], &["check"]);
+    assert!(c.code == 0 && c.stdout.contains("2 passed, 0 failed"), "{}", c.stdout);
+    // A second init refuses, naming the file, and changes nothing.
+    let before = std::fs::read_to_string(dir.join("kernels/rings.toml")).unwrap();
+    std::fs::write(dir.join("kernels/rings.toml"), format!("{before}# mine\n")).unwrap();
+    let again = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), t.path(), &[], &["init", "mine"]);
+    assert_rejected(&again, 2, &["mine/vista.toml exists", "never overwrites"]);
+    assert!(std::fs::read_to_string(dir.join("kernels/rings.toml")).unwrap().ends_with("# mine\n"));
+    // One existing file is enough to refuse, before anything is written.
+    let other = t.path().join("other");
+    std::fs::create_dir_all(other.join("golden")).unwrap();
+    std::fs::write(other.join("golden/cases.toml"), "").unwrap();
+    let r = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), t.path(), &[], &["init", "other"]);
+    assert_rejected(&r, 2, &["golden/cases.toml exists"]);
+    assert!(!other.join("vista.toml").exists(), "init wrote before refusing");
+}
+
+/// `--adapter` is folded into `--backend`: hidden from help, still
+/// accepted, with a note naming the `--backend` spelling.
+fn adapter_is_a_hidden_alias_of_backend() {
+    let help = vista(&["render", "--help"]);
+    assert!(!help.stdout.contains("--adapter") && help.stdout.contains("--backend"), "{}", help.stdout);
+    let r = vista(&["--adapter", "cpu", "list", "--names"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(r.stderr.contains("--adapter is deprecated; it is --backend lavapipe"), "{}", r.stderr);
+}
+
+/// The names serde lists in "unknown field `zzz`, expected one of `a`, `b`".
+fn expected_fields(error: &str) -> std::collections::BTreeSet<String> {
+    let list = error.split("expected").nth(1).unwrap_or_else(|| panic!("no field list in: {error}"));
+    list.split('`').skip(1).step_by(2).map(str::to_string).collect()
+}
+
+/// Backticked names at the top level of `text` (parenthesised asides
+/// dropped), each cut at its first space: `kind = "texture"` is `kind`.
+fn backticked(text: &str) -> std::collections::BTreeSet<String> {
+    let mut t = text.to_string();
+    // Innermost first: the last '(' has no '(' before its ')'.
+    while let Some(open) = t.rfind('(') {
+        let Some(close) = t[open..].find(')') else { break };
+        t.replace_range(open..open + close + 1, "");
+    }
+    t.split('`').skip(1).step_by(2).map(|w| w.split(' ').next().unwrap().to_string()).collect()
+}
+
+/// The first column of the markdown table under `heading` in `doc`.
+fn table_keys(doc: &str, heading: &str) -> std::collections::BTreeSet<String> {
+    let at = doc.find(heading).unwrap_or_else(|| panic!("README has no {heading}"));
+    doc[at..]
+        .lines()
+        .skip_while(|l| !l.starts_with('|'))
+        .take_while(|l| l.starts_with('|'))
+        .skip(2)
+        .filter_map(|l| l.split('|').nth(1).and_then(|c| c.trim().split('`').nth(1)).map(str::to_string))
+        .collect()
+}
+
+/// The README's schemas are the parsers' own key lists: each is compared
+/// with the list serde (or the resource parser) gives for an unknown key,
+/// so neither can drift.
+fn readme_schemas_match_the_parsers() {
+    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let err = |manifest: &str, file: &str, text: &str, args: &[&str]| {
+        let d = kernel_project(manifest, K_SHADER);
+        std::fs::create_dir_all(d.path().join("golden")).unwrap();
+        std::fs::write(d.path().join(file), text).unwrap();
+        let r = vista_in(Some(d.path()), &[], args);
+        assert_ne!(r.code, 0, "{file}: {}", r.stdout);
+        r.stderr
+    };
+    let top = expected_fields(&err(
+        K_MANIFEST,
+        "kernels/x.toml",
+        "zzz = 1\nsummary = \"x\"\n",
+        &["render", "x", "-o", "x.png"],
+    ));
+    assert_eq!(table_keys(&readme, "### Kernel manifest"), top, "README's kernel manifest table");
+    let param = "summary = \"x\"\n[[param]]\nname = \"q\"\ntype = \"f32\"\nrange = [0, 1]\ndefault = 0\nzzz = 1\n";
+    let param = expected_fields(&err(K_MANIFEST, "kernels/x.toml", param, &["render", "x", "-o", "x.png"]));
+    let para = readme.split("`[[param]]` keys:").nth(1).unwrap().split("\n\n").next().unwrap();
+    assert_eq!(backticked(para), param, "README's [[param]] keys");
+    let row = |key: &str| {
+        let line = readme.lines().find(|l| l.starts_with(&format!("| `{key}` |"))).unwrap();
+        backticked(line.rsplit('|').nth(1).unwrap())
+    };
+    let pass = expected_fields(&err(
+        K_MANIFEST,
+        "kernels/x.toml",
+        "summary = \"x\"\n[[pass]]\nzzz = 1\n",
+        &["render", "x", "-o", "x.png"],
+    ));
+    assert_eq!(row("pass"), pass, "README's pass row");
+    let output = expected_fields(&err(
+        K_MANIFEST,
+        "kernels/x.toml",
+        "summary = \"x\"\n[[output]]\nzzz = 1\n",
+        &["render", "x", "-o", "x.png"],
+    ));
+    let out_row = readme.lines().find(|l| l.starts_with("| `output` tables")).unwrap();
+    assert_eq!(backticked(out_row.rsplit('|').nth(1).unwrap()), output, "README's [[output]] row");
+    let resource = err(
+        K_MANIFEST,
+        "kernels/x.toml",
+        "summary = \"x\"\n[[resource]]\nname = \"r\"\nzzz = 1\n",
+        &["render", "x", "-o", "x.png"],
+    );
+    let allowed: std::collections::BTreeSet<String> =
+        resource.split("allowed: ").nth(1).unwrap().trim().split(", ").map(str::to_string).collect();
+    let res_row = row("resource");
+    assert!(allowed.iter().all(|k| res_row.contains(k)), "README's resource row {res_row:?} lacks one of {allowed:?}");
+    let cases = expected_fields(&err(
+        K_MANIFEST,
+        "golden/cases.toml",
+        "[[case]]\nid = \"a\"\nkernel = \"k\"\nzzz = 1\n",
+        &["check"],
+    ));
+    assert_eq!(table_keys(&readme, "### Cases"), cases, "README's case table");
+    let vista_toml = expected_fields(&err(K_MANIFEST, "vista.toml", "zzz = 1\n", &["list"]));
+    let layout_row = readme.lines().find(|l| l.starts_with("| `vista.toml` |")).unwrap();
+    assert!(vista_toml.iter().all(|k| layout_row.contains(&format!("`{k}`"))), "{layout_row} lacks {vista_toml:?}");
+}
+
+/// Every command of the README's newcomer path runs as shown, in order,
+/// from an empty directory (the `cd` included).
+fn readme_newcomer_commands_run_as_shown() {
+    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let section = readme.split("## Validate your own kernel").nth(1).unwrap();
+    let block = section.split("```sh\n").nth(1).unwrap().split("```").next().unwrap();
+    let t = tmp();
+    let mut dir = t.path().to_path_buf();
+    let mut ran = 0;
+    for line in block.lines() {
+        let command = line.split('#').next().unwrap().trim();
+        let words: Vec<&str> = command.split_whitespace().collect();
+        match words.as_slice() {
+            [] => {}
+            ["cd", to] => dir = dir.join(to),
+            ["vista", args @ ..] => {
+                let r = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), &dir, &[], args);
+                assert_eq!(r.code, 0, "README: `{command}`: {}{}", r.stdout, r.stderr);
+                ran += 1;
+            }
+            other => panic!("README's newcomer block has a line the test cannot run: {other:?}"),
+        }
+    }
+    assert!(ran >= 5, "ran {ran} commands");
+    assert!(dir.join("golden/rings/rings-dense.png").exists() && dir.join("target/vista-report/index.html").exists());
+}
+
 /// The manifest names the entry point; an unknown one lists the shader's.
 fn the_manifest_names_the_entry_point() {
     let manifest = format!("{K_MANIFEST}[[pass]]\nentry = \"height\"\n");
@@ -2449,6 +2608,10 @@ fn main() {
         (Gpu, "the_manifest_names_the_entry_point", the_manifest_names_the_entry_point),
         (Gpu, "layered_outputs_stack_and_follow_reflection", layered_outputs_stack_and_follow_reflection),
         (Gpu, "a_broken_manifest_breaks_only_its_kernel", a_broken_manifest_breaks_only_its_kernel),
+        (Cpu, "adapter_is_a_hidden_alias_of_backend", adapter_is_a_hidden_alias_of_backend),
+        (Cpu, "readme_schemas_match_the_parsers", readme_schemas_match_the_parsers),
+        (Gpu, "readme_newcomer_commands_run_as_shown", readme_newcomer_commands_run_as_shown),
+        (Gpu, "init_writes_a_project_that_blesses_and_checks", init_writes_a_project_that_blesses_and_checks),
         (
             Gpu,
             "integer_outputs_compare_exactly_and_show_normalized",
