@@ -2189,6 +2189,35 @@ fn the_report_works_in_a_real_browser() {
         linear.as_str().unwrap().starts_with('0') && linear != serde_json::json!("1/655351/40961/2551/161"),
         "{linear}"
     );
+    // A missing golden: the render alone, at full size, in a viewer; every
+    // control labelled; case names on one line.
+    let cases = root.join("golden/cases.toml");
+    let more = "\n[[case]]\nid = \"marble-calm-but-not-yet-blessed\"\nkernel = \"marble\"\npreset = \"calm\"\nsize = \"40x24\"\n";
+    std::fs::write(&cases, std::fs::read_to_string(&cases).unwrap() + more).unwrap();
+    assert_eq!(vista_in(Some(&root), &[], &["check"]).code, 1);
+    page.navigate(&format!("file://{}", index.display()), wait).unwrap();
+    let missing = "document.querySelector('#case-marble-calm-but-not-yet-blessed .viewer')";
+    let start = std::time::Instant::now();
+    while eval(&format!("!!{missing}.querySelector('canvas.img')")) != serde_json::json!(true) {
+        assert!(start.elapsed().as_secs() < 20, "the missing case's viewer never loaded");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let canvas = eval(&format!(
+        "const c = {missing}.querySelector('canvas.img'); [c.width, c.height, !!{missing}.querySelector('canvas.heat')]"
+    ));
+    assert_eq!(canvas, serde_json::json!([40, 24, false]), "the render alone, at its size");
+    let label = eval(&format!("{missing}.querySelector('.img-label').textContent"));
+    assert!(label.as_str().unwrap().contains("no golden of this size yet"), "{label}");
+    let unlabelled = eval(
+        "[...document.querySelectorAll('#controls input, #controls select')].filter(e => !e.closest('label')).map(e => e.id).join(' ')",
+    );
+    assert_eq!(unlabelled, serde_json::json!(""), "controls without a label");
+    let wraps = eval(
+        "[...document.querySelectorAll('#summary td.id, summary .id')].filter(e => getComputedStyle(e).whiteSpace !== 'nowrap').length",
+    );
+    assert_eq!(wraps, serde_json::json!(0), "case names may wrap");
+    eval(&format!("{missing}.scrollIntoView()"));
+    shot("report-missing.png");
     let errors = page.errors();
     assert!(errors.is_empty(), "console errors: {errors:?}");
 }

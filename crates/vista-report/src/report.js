@@ -68,7 +68,9 @@ class Viewer {
   load(d) {
     this.w = d.w;
     this.h = d.h;
-    this.exp = decode(d.expected);
+    // No golden of this size: the render alone, at full size, to review.
+    this.alone = d.expected === null;
+    this.exp = this.alone ? null : decode(d.expected);
     this.act = decode(d.actual);
     this.firstBad = d.first_bad;
     this.build();
@@ -77,23 +79,30 @@ class Viewer {
   }
 
   build() {
+    if (this.alone) {
+      this.el.innerHTML =
+        '<div class="vbar">zoom <button class="zoom-out" title="zoom out (-)">-</button> <span class="zv"></span> ' +
+        '<button class="zoom-in" title="zoom in (+)">+</button>' +
+        '<span class="readout">move the cursor over the image</span></div>' +
+        '<div class="views"><div class="pane"><div class="label img-label"></div><div class="scroll"><canvas class="img"></canvas></div></div></div>';
+    } else {
+      this.buildCompare();
+    }
+    this.wire();
+  }
+
+  buildCompare() {
     this.el.innerHTML =
       '<div class="vbar"><button data-show="expected">expected</button><button data-show="actual">actual</button>' +
       '<button class="flip" title="key f">flip (f)</button><button class="slide">slider</button>' +
-      ' zoom <button class="zoom-out">-</button> <span class="zv"></span> <button class="zoom-in">+</button>' +
+      ' zoom <button class="zoom-out" title="zoom out (-)">-</button> <span class="zv"></span> <button class="zoom-in" title="zoom in (+)">+</button>' +
       '<span class="readout">move the cursor over an image</span></div>' +
       '<div class="views"><div class="pane"><div class="label img-label"></div><div class="scroll"><canvas class="img"></canvas></div>' +
-      '<input type="range" class="split" min="0" max="1" step="0.001" value="0.5" hidden></div>' +
+      '<input type="range" class="split" min="0" max="1" step="0.001" value="0.5" hidden ' +
+      'title="where the image switches from expected (left) to actual (right)" aria-label="slider position"></div>' +
       '<div class="pane"><div class="label">heat map: max |actual - expected| over R, G, B</div><div class="scroll"><canvas class="heat"></canvas></div>' +
       '<div class="legend"><canvas width="256" height="1"></canvas><div class="ticks"></div></div></div></div>';
     const q = (s) => this.el.querySelector(s);
-    this.canvas = q("canvas.img");
-    this.heat = q("canvas.heat");
-    for (const c of [this.canvas, this.heat]) {
-      c.width = this.w;
-      c.height = this.h;
-    }
-    this.scrolls = [...this.el.querySelectorAll(".scroll")];
     for (const b of this.el.querySelectorAll("button[data-show]")) {
       b.onclick = () => this.show(b.dataset.show);
     }
@@ -107,6 +116,18 @@ class Viewer {
       this.split = Number(e.target.value);
       this.draw();
     };
+  }
+
+  // Canvases, zoom, scroll sync, readout and panning: both layouts.
+  wire() {
+    const q = (s) => this.el.querySelector(s);
+    this.canvas = q("canvas.img");
+    this.heat = q("canvas.heat");
+    for (const c of [this.canvas, this.heat].filter(Boolean)) {
+      c.width = this.w;
+      c.height = this.h;
+    }
+    this.scrolls = [...this.el.querySelectorAll(".scroll")];
     q("button.zoom-in").onclick = () => this.setZoom(this.zoom * 2);
     q("button.zoom-out").onclick = () => this.setZoom(this.zoom / 2);
     for (const s of this.scrolls) {
@@ -145,7 +166,7 @@ class Viewer {
   setZoom(z) {
     this.zoom = Math.min(32, Math.max(1, z));
     this.el.querySelector(".zv").textContent = this.zoom + "x";
-    for (const c of [this.canvas, this.heat]) {
+    for (const c of [this.canvas, this.heat].filter(Boolean)) {
       c.style.width = this.w * this.zoom + "px";
       c.style.height = this.h * this.zoom + "px";
     }
@@ -176,10 +197,21 @@ class Viewer {
   }
 
   flip() {
+    if (this.alone) return;
     this.show(this.showing === "actual" ? "expected" : "actual");
   }
 
   draw() {
+    if (this.alone) {
+      const img = new ImageData(this.w, this.h);
+      for (let i = 0; i < this.w * this.h; i++) {
+        for (let c = 0; c < 3; c++) img.data[4 * i + c] = Math.round(this.act[3 * i + c] / 257);
+        img.data[4 * i + 3] = 255;
+      }
+      this.canvas.getContext("2d").putImageData(img, 0, 0);
+      this.el.querySelector(".img-label").textContent = "actual: no golden of this size yet; review it, then bless it";
+      return;
+    }
     const img = new ImageData(this.w, this.h);
     const cut = Math.round(this.split * this.w);
     for (let y = 0; y < this.h; y++) {
@@ -205,7 +237,7 @@ class Viewer {
   }
 
   drawHeat() {
-    if (!this.heat) return;
+    if (!this.heat || this.alone) return;
     const n = this.w * this.h;
     let max = 1 / 65535;
     for (let i = 0; i < n; i++) max = Math.max(max, this.diffAt(i));
@@ -236,6 +268,10 @@ class Viewer {
     if (x < 0 || y < 0 || x >= this.w || y >= this.h) return;
     const i = y * this.w + x;
     const px = (a) => [0, 1, 2].map((k) => fmt(a[3 * i + k])).join(" ");
+    if (this.alone) {
+      this.el.querySelector(".readout").textContent = `(${x}, ${y})  actual ${px(this.act)}`;
+      return;
+    }
     const diff = [0, 1, 2].map((k) => {
       const d = this.act[3 * i + k] - this.exp[3 * i + k];
       return (d >= 0 ? "+" : "") + d;
@@ -263,6 +299,6 @@ heatMax.addEventListener("input", () => viewers.forEach((v) => v.drawHeat()));
 
 document.addEventListener("keydown", (e) => {
   if (e.key !== "f" || e.target.tagName === "INPUT" || e.target.tagName === "SELECT") return;
-  const v = active || [...viewers.values()].find((x) => x.canvas);
+  const v = active || [...viewers.values()].find((x) => x.canvas && !x.alone);
   if (v && v.canvas) v.flip();
 });

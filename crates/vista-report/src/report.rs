@@ -84,18 +84,19 @@ pub fn write_case_files(
     };
     out.files.actual = write("actual.png", actual, true)?;
     out.files.actual8 = write("actual8.png", actual, false)?;
-    let Some(expected) = expected else {
-        return Ok(());
-    };
-    out.files.expected = write("expected.png", expected, true)?;
-    out.files.expected8 = write("expected8.png", expected, false)?;
-    if (expected.width, expected.height) != (actual.width, actual.height) {
-        return Ok(());
+    if let Some(expected) = expected {
+        out.files.expected = write("expected.png", expected, true)?;
+        out.files.expected8 = write("expected8.png", expected, false)?;
     }
-    let heat = vista_image::diff_heatmap_log(expected, actual);
-    out.files.diff = write("diff.png", &heat, true)?;
-    out.files.diff8 = write("diff8.png", &heat, false)?;
-    let view = view_js(&id, expected, actual, out.first_bad.as_ref().map(|b| (b.0, b.1)));
+    // The viewer compares where both have one size; otherwise (a missing
+    // golden, a size change) it shows the render alone, at full size.
+    let comparable = expected.filter(|e| (e.width, e.height) == (actual.width, actual.height));
+    if let Some(expected) = comparable {
+        let heat = vista_image::diff_heatmap_log(expected, actual);
+        out.files.diff = write("diff.png", &heat, true)?;
+        out.files.diff8 = write("diff8.png", &heat, false)?;
+    }
+    let view = view_js(&id, comparable, actual, out.first_bad.as_ref().map(|b| (b.0, b.1)));
     vista_image::atomic_write(&case_dir.join("view.js"), view.as_bytes())?;
     out.files.view = Some(format!("{id}/view.js"));
     Ok(())
@@ -113,8 +114,9 @@ pub struct RunSummary {
 }
 
 /// The viewer's data for one case: both images' 16-bit display values
-/// (RGB, little-endian u16, base64) and the first bad pixel.
-pub fn view_js(id: &str, expected: &Image, actual: &Image, first_bad: Option<(u32, u32)>) -> String {
+/// (RGB, little-endian u16, base64; `expected` null when there is no
+/// golden of the render's size) and the first bad pixel.
+pub fn view_js(id: &str, expected: Option<&Image>, actual: &Image, first_bad: Option<(u32, u32)>) -> String {
     let u16s = |img: &Image| {
         let bytes: Vec<u8> = img
             .data
@@ -126,9 +128,9 @@ pub fn view_js(id: &str, expected: &Image, actual: &Image, first_bad: Option<(u3
     };
     let data = serde_json::json!({
         "id": id,
-        "w": expected.width,
-        "h": expected.height,
-        "expected": u16s(expected),
+        "w": actual.width,
+        "h": actual.height,
+        "expected": expected.map(u16s),
         "actual": u16s(actual),
         "first_bad": first_bad.map(|(x, y)| [x, y]),
     });
@@ -285,7 +287,7 @@ fn case_section(o: &Outcome) -> String {
     };
     format!(
         "<details class=\"case {cls}\" id=\"{anchor}\" data-failing=\"{failing}\"{open}>\
-         <summary><span class=\"verdict\">{verdict}</span> <b>{id}</b> <span class=\"kernel\">{kernel}</span> \
+         <summary><span class=\"verdict\">{verdict}</span> <b class=\"id\">{id}</b> <span class=\"kernel\">{kernel}</span> \
          <span class=\"psnr\">PSNR {psnr}</span> <span class=\"ms\">{gpu:.1} ms</span> \
          <span class=\"thumbs\">{e}{a}{d}</span></summary>\
          <div class=\"body\"><div class=\"cols\"><div>{metrics}{first_bad}{msgs}\
@@ -321,7 +323,7 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
         for o in &failing {
             let _ = write!(
                 summary,
-                "<tr><td><a href=\"#{}\">{}</a></td><td>{}</td><td>{}</td><td>&ge; {:.1} dB</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                "<tr><td class=\"id\"><a href=\"#{}\">{}</a></td><td>{}</td><td>{}</td><td>&ge; {:.1} dB</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 anchor(&o.id),
                 html_escape(&o.id),
                 verdict_word(o),
@@ -379,7 +381,8 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
          <section id=\"controls\"><label><input type=\"checkbox\" id=\"failures-only\"{checked}> failures only</label> \
          <label>heat map scale <select id=\"heat-scale\"><option value=\"log\">log, fixed: 1/65535 .. 1 (same in every case)</option>\
          <option value=\"max\">linear, 0 .. this case's max</option><option value=\"fixed\">linear, 0 .. the value on the right</option></select></label> \
-         <input id=\"heat-max\" type=\"number\" value=\"0.0039216\" step=\"any\" min=\"0\" title=\"difference drawn white (linear, fixed)\"> \
+         <label>white at <input id=\"heat-max\" type=\"number\" value=\"0.0039216\" step=\"any\" min=\"0\" \
+         title=\"the difference drawn white on the fixed linear scale (0.0039216 = 1/255)\"> (fixed linear scale)</label> \
          <span class=\"help\">In a viewer: <kbd>f</kbd> flips expected/actual, the wheel or +/- zooms (all views together), drag pans.</span></section>\n\
          <section id=\"cases\"><h2>Cases</h2>\n{sections}</section>",
         n = sorted.len(),
