@@ -31,6 +31,8 @@ pub struct Config {
     pub root: Option<OsString>,
     /// `VISTA_FAULT`: fault-injection plan for the write-path tests.
     pub fault: Option<String>,
+    /// `GITHUB_ACTIONS=true`: check also prints `::error` annotations.
+    pub github_actions: bool,
 }
 
 /// The command-line flags that override the environment.
@@ -98,6 +100,7 @@ impl Config {
             allow_no_gpu: truthy("VISTA_ALLOW_NO_GPU", text("VISTA_ALLOW_NO_GPU"))?,
             font: get("VISTA_FONT").filter(|v| !v.is_empty()).map(PathBuf::from),
             root: get("VISTA_ROOT").filter(|v| !v.is_empty()),
+            github_actions: text("GITHUB_ACTIONS").is_some_and(|v| v.eq_ignore_ascii_case("true")),
             fault: text("VISTA_FAULT"),
         })
     }

@@ -108,6 +108,24 @@ enum Command {
         /// Every case on lavapipe, swiftshader and browser: one case x backend table.
         #[arg(long)]
         matrix: bool,
+        /// Also write JUnit XML here: one testcase per case, the failure text
+        /// being the block printed for it.
+        #[arg(long, value_name = "FILE")]
+        junit: Option<PathBuf>,
+        /// Also write the results as JSON here: per case the verdict,
+        /// metrics, thresholds, problems, report anchor and golden used.
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+        /// Only the cases whose params or any reached WGSL file changed
+        /// since their bless (or that have no manifest entry).
+        #[arg(long)]
+        changed: bool,
+        /// Only the cases that failed in the last report (its results.json).
+        #[arg(long)]
+        failed: bool,
+        /// Only partition K of N (1-based), split stably by case id.
+        #[arg(long, value_name = "K/N")]
+        partition: Option<String>,
     },
     /// Re-render cases and write their goldens (refused under CI=true without --force).
     Bless {
@@ -383,10 +401,22 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             }
             Ok(0)
         }
-        Command::Check { case, report_dir, matrix: true } => {
+        Command::Check { matrix: true, junit: Some(_), .. } | Command::Check { matrix: true, json: Some(_), .. } => {
+            Err(bad(
+                "--junit and --json are written by a check on one backend; drop --matrix (or run check per backend)",
+            ))
+        }
+        Command::Check { matrix: true, changed, failed, partition, .. } if changed || failed || partition.is_some() => {
+            Err(bad("--changed, --failed and --partition select cases of a check on one backend; drop --matrix"))
+        }
+        Command::Check { case, report_dir, matrix: true, .. } => {
             matrix::matrix(project, config, case.as_deref(), report_dir)
         }
-        Command::Check { case, report_dir, matrix: false } => check(project, config, case.as_deref(), report_dir),
+        Command::Check { case, report_dir, matrix: false, junit, json, changed, failed, partition } => {
+            let partition = partition.as_deref().map(vista_golden::selection::parse_partition).transpose()?;
+            let pick = Pick { glob: case, changed, failed, partition };
+            check(project, config, &pick, report_dir, Results { junit, json })
+        }
         Command::Bless { case, force, prune } => {
             let store = Store::of_project(project, "vista bless")?;
             let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
@@ -476,21 +506,81 @@ fn probe_writable(dir: &Path) -> Result<(), GoldenError> {
     Ok(())
 }
 
+/// Which cases a check runs: `--case`, then `--changed`, `--failed`,
+/// `--partition` (each narrows the one before).
+struct Pick {
+    glob: Option<String>,
+    changed: bool,
+    failed: bool,
+    partition: Option<(u64, u64)>,
+}
+
+/// Machine-readable results a check also writes.
+struct Results {
+    junit: Option<PathBuf>,
+    json: Option<PathBuf>,
+}
+
+/// A results file's directory must exist and be writable, before any GPU work.
+fn check_results_path(flag: &str, path: &Path) -> Result<(), GoldenError> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if path.is_dir() {
+        return Err(bad(format!("{flag} {} is a directory; expected a file path", path.display())));
+    }
+    if !dir.is_dir() {
+        return Err(bad(format!("{flag} {}: directory {} does not exist", path.display(), dir.display())));
+    }
+    probe_writable(&dir)
+}
+
 fn check(
     project: &Project,
     config: &Config,
-    glob: Option<&str>,
+    pick: &Pick,
     report_dir: Option<PathBuf>,
+    results: Results,
 ) -> Result<i32, GoldenError> {
+    if let Some(p) = &results.junit {
+        check_results_path("--junit", p)?;
+    }
+    if let Some(p) = &results.json {
+        check_results_path("--json", p)?;
+    }
     let store = Store::of_project(project, "vista check")?;
     let cases = store.load_cases()?;
-    let picked = vista_golden::select(&cases, glob)?;
+    let mut picked = vista_golden::select(&cases, pick.glob.as_deref())?;
     let manifest = store.manifest()?;
-    let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
     let report_dir = match report_dir {
         Some(d) => d,
         None => project.report_dir().expect("a store implies a root"),
     };
+    // Selection needs no device: hashes from the project's WGSL, the last report.
+    let all = picked.len();
+    let mut why: Vec<String> = Vec::new();
+    if pick.changed {
+        let shaders = vista_render::shader_set(project)?;
+        picked.retain(|c| {
+            let files = shaders.file_hashes(c.kernel.shader()).map(|f| f.into_iter().collect()).unwrap_or_default();
+            vista_golden::selection::change(c, &manifest, &files).is_some()
+        });
+        why.push("--changed".into());
+    }
+    if pick.failed {
+        let failures = vista_golden::selection::last_failures(&report_dir)?;
+        picked.retain(|c| failures.contains(&c.id));
+        why.push("--failed".into());
+    }
+    if let Some(part) = pick.partition {
+        picked.retain(|c| vista_golden::selection::in_partition(&c.id, part));
+        why.push(format!("--partition {}/{}", part.0, part.1));
+    }
+    if !why.is_empty() {
+        println!("selected {} of {all} cases ({})", picked.len(), why.join(", "));
+    }
+    let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
     vista_report::clear_case_folders(&report_dir)?;
     let opts = CheckOptions { twice: false };
     let mut outcomes = Vec::new();
@@ -516,6 +606,27 @@ fn check(
         adapter: ctx.adapter_description(),
     };
     let index = vista_report::write_report(&report_dir, &run, &outcomes)?;
+    // results.json beside the report: what `check --failed` reads next time.
+    let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
+    vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;
+    if let Some(p) = &results.junit {
+        vista_image::atomic_write(p, vista_report::junit_xml(&run, &outcomes, &report_dir)?.as_bytes())?;
+    }
+    if let Some(p) = &results.json {
+        vista_image::atomic_write(p, json_text.as_bytes())?;
+    }
+    if config.github_actions {
+        // Paths relative to the working directory, where the workflow runs.
+        let cases = store.cases_path();
+        let shown = std::env::current_dir()
+            .ok()
+            .and_then(|cwd| cases.strip_prefix(&cwd).ok().map(Path::to_path_buf))
+            .unwrap_or_else(|| cases.clone());
+        let text = std::fs::read_to_string(&cases).unwrap_or_default();
+        for line in vista_report::github_annotations(&outcomes, &shown.display().to_string(), &text) {
+            println!("{line}");
+        }
+    }
     let failing: Vec<&str> = outcomes.iter().filter(|o| !o.passed()).map(|o| o.id.as_str()).collect();
     let failed = failing.len();
     println!("{} passed, {} failed", outcomes.len() - failed, failed);

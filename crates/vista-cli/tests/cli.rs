@@ -1444,6 +1444,130 @@ fn readme_newcomer_commands_run_as_shown() {
     assert!(dir.join("golden/rings/rings-dense.png").exists() && dir.join("target/vista-report/index.html").exists());
 }
 
+/// `check --junit/--json` write what CI systems read, and under
+/// GITHUB_ACTIONS=true each failing case is annotated at its `[[case]]`
+/// line: a pass, a changed render, a missing golden and an expected
+/// failure, each reported as such.
+fn check_writes_junit_json_and_github_annotations() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    // b renders differently now; c's golden is gone; d is expected to fail.
+    let cases = CASES.replace("set = { basis = \"value\" }", "set = { basis = \"value\", seed = 9 }")
+        + "\n[[case]]\nid = \"d\"\nkernel = \"fbm\"\nsize = \"16x16\"\n\
+           expect_fail = [{ backend = \"lavapipe\", reason = \"no golden on purpose\" }]\n";
+    std::fs::write(cases_path(d.path()), &cases).unwrap();
+    std::fs::remove_file(d.path().join("golden/ridged/c.png")).unwrap();
+    let (junit, json) = (d.path().join("out/j.xml"), d.path().join("r.json"));
+    let args = ["check", "--junit", junit.to_str().unwrap(), "--json", json.to_str().unwrap()];
+    assert_rejected(&vista_in(Some(d.path()), &[], &args), 2, &["--junit", "does not exist"]);
+    std::fs::create_dir(d.path().join("out")).unwrap();
+    let r = vista_in(Some(d.path()), &[("GITHUB_ACTIONS", "true")], &args);
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    // JUnit: parsed back by quick-junit's reader, counts and texts per case.
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    let report = quick_junit::Report::deserialize_from_str(&xml).unwrap_or_else(|e| panic!("{e}: {xml}"));
+    assert_eq!((report.tests, report.failures, report.errors), (4, 1, 1), "{xml}");
+    let suite = &report.test_suites[0];
+    let status = |name: &str| &suite.test_cases.iter().find(|c| c.name.as_str() == name).unwrap().status;
+    assert!(matches!(status("golden::fbm::a"), quick_junit::TestCaseStatus::Success { .. }));
+    match status("golden::fbm::b") {
+        quick_junit::TestCaseStatus::NonSuccess { kind: quick_junit::NonSuccessKind::Failure, description, .. } => {
+            let text = description.as_ref().unwrap().as_str();
+            assert!(text.contains("PSNR") && text.contains("vista bless --case 'b'"), "{text}");
+        }
+        other => panic!("b: {other:?}"),
+    }
+    assert!(matches!(
+        status("golden::ridged::c"),
+        quick_junit::TestCaseStatus::NonSuccess { kind: quick_junit::NonSuccessKind::Error, .. }
+    ));
+    assert!(matches!(status("golden::fbm::d"), quick_junit::TestCaseStatus::Skipped { .. }));
+    // JSON: verdicts, thresholds, anchors, the golden used.
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let case = |id: &str| v["cases"].as_array().unwrap().iter().find(|c| c["id"] == id).unwrap().clone();
+    assert_eq!((v["passed"].as_u64(), v["failed"].as_u64()), (Some(2), Some(2)));
+    assert_eq!(case("a")["verdict"], "pass");
+    assert_eq!(case("a")["metrics"]["psnr"], "inf");
+    assert_eq!(case("b")["verdict"], "fail");
+    assert!(case("b")["metrics"]["psnr"].as_f64().unwrap() < 60.0);
+    assert_eq!(case("b")["thresholds"]["psnr"], 60.0);
+    assert_eq!(case("b")["report_anchor"], "index.html#case-b");
+    assert_eq!(case("b")["golden"]["backend"], "lavapipe");
+    assert_eq!(case("c")["verdict"], "missing");
+    assert_eq!(case("d")["verdict"], "expected_fail");
+    // GitHub: one annotation per failing case, at its [[case]] line.
+    let annotations: Vec<&str> = r.stdout.lines().filter(|l| l.starts_with("::error ")).collect();
+    let line_of = |id: &str| {
+        let lines: Vec<&str> = cases.lines().collect();
+        let at = lines.iter().position(|l| *l == format!("id = \"{id}\"")).unwrap();
+        (0..at).rev().find(|&i| lines[i] == "[[case]]").unwrap() + 1
+    };
+    assert_eq!(annotations.len(), 2, "{}", r.stdout);
+    for id in ["b", "c"] {
+        let want = format!("::error file=golden/cases.toml,line={},title=vista {id}::case {id}: ", line_of(id));
+        assert!(annotations.iter().any(|a| a.starts_with(&want)), "{want} in {annotations:?}");
+    }
+    let quiet = vista_in(Some(d.path()), &[], &["check"]);
+    assert!(!quiet.stdout.contains("::error"), "annotations only under GITHUB_ACTIONS=true");
+}
+
+/// Selection: `--changed` runs exactly the cases whose params or reached
+/// files changed since the bless (an imported module's edit selects the
+/// kernel that reaches it, no other); `--failed` reruns the last report's
+/// failures; `--partition K/N` splits the cases, each in one partition.
+fn check_selects_changed_failed_and_partitions() {
+    let module = "#define_import_path mylib::tone\n\nfn tone(x: f32) -> f32 {\n    return x * x;\n}\n";
+    let shader = gradient_shader("main", "8, 8", "params.height")
+        .replace("struct Params", "#import mylib::tone::{tone}\n\nstruct Params")
+        .replace("params.gain * u * v", "tone(params.gain * u * v)");
+    let d = kernel_project(K_MANIFEST, &shader);
+    std::fs::create_dir_all(d.path().join("shaders/mylib")).unwrap();
+    std::fs::write(d.path().join("shaders/mylib/tone.wgsl"), module).unwrap();
+    std::fs::write(d.path().join("kernels/plain.toml"), K_MANIFEST).unwrap();
+    std::fs::write(d.path().join("shaders/plain.wgsl"), gradient_shader("main", "8, 8", "params.height")).unwrap();
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    let cases = "[[case]]\nid = \"k-a\"\nkernel = \"k\"\nsize = \"16x16\"\n\n\
+                 [[case]]\nid = \"k-b\"\nkernel = \"k\"\nsize = \"16x16\"\nset = { gain = 0.9 }\n\n\
+                 [[case]]\nid = \"plain-a\"\nkernel = \"plain\"\nsize = \"16x16\"\n\n\
+                 [[case]]\nid = \"plain-b\"\nkernel = \"plain\"\nsize = \"8x8\"\n";
+    std::fs::write(cases_path(d.path()), cases).unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let check = |args: &[&str]| {
+        let mut all = vec!["check"];
+        all.extend_from_slice(args);
+        vista_in(Some(d.path()), &[], &all)
+    };
+    let ran = |r: &Run| -> Vec<String> {
+        r.stdout
+            .lines()
+            .filter(|l| l.starts_with("ok ") || l.starts_with("FAIL "))
+            .map(|l| l.split_whitespace().nth(1).unwrap().to_string())
+            .collect()
+    };
+    let r = check(&["--changed"]);
+    assert!(r.code == 0 && r.stdout.contains("selected 0 of 4 cases (--changed)"), "{}", r.stdout);
+    // An edit to the imported module reaches k's cases only.
+    std::fs::write(d.path().join("shaders/mylib/tone.wgsl"), module.replace("x * x", "x * x * x")).unwrap();
+    let r = check(&["--changed"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert_eq!(ran(&r), ["k-a", "k-b"], "{}", r.stdout);
+    // A case's params changed: that case too.
+    std::fs::write(cases_path(d.path()), cases.replace("size = \"8x8\"", "size = \"8x8\"\nset = { gain = 0.25 }"))
+        .unwrap();
+    assert_eq!(ran(&check(&["--changed"])), ["k-a", "k-b", "plain-b"]);
+    // The last report's failures, and nothing else.
+    let r = check(&["--failed"]);
+    assert!(r.stdout.contains("selected 3 of 4 cases (--failed)"), "{}", r.stdout);
+    assert_eq!(ran(&r), ["k-a", "k-b", "plain-b"]);
+    // Partitions: every case in exactly one.
+    let mut seen: Vec<String> = (1..=3).flat_map(|k| ran(&check(&["--partition", &format!("{k}/3")]))).collect();
+    seen.sort();
+    assert_eq!(seen, ["k-a", "k-b", "plain-a", "plain-b"]);
+    assert_rejected(&check(&["--partition", "4/3"]), 2, &["--partition 4/3", "1 <= K <= N"]);
+    std::fs::remove_file(d.path().join("target/vista-report/results.json")).unwrap();
+    assert_rejected(&check(&["--failed"]), 2, &["results.json", "run vista check once first"]);
+}
+
 /// The manifest names the entry point; an unknown one lists the shader's.
 fn the_manifest_names_the_entry_point() {
     let manifest = format!("{K_MANIFEST}[[pass]]\nentry = \"height\"\n");
@@ -2639,6 +2763,8 @@ fn main() {
         (Gpu, "a_broken_manifest_breaks_only_its_kernel", a_broken_manifest_breaks_only_its_kernel),
         (Cpu, "adapter_is_a_hidden_alias_of_backend", adapter_is_a_hidden_alias_of_backend),
         (Cpu, "readme_schemas_match_the_parsers", readme_schemas_match_the_parsers),
+        (Gpu, "check_selects_changed_failed_and_partitions", check_selects_changed_failed_and_partitions),
+        (Gpu, "check_writes_junit_json_and_github_annotations", check_writes_junit_json_and_github_annotations),
         (Gpu, "readme_newcomer_commands_run_as_shown", readme_newcomer_commands_run_as_shown),
         (Gpu, "init_writes_a_project_that_blesses_and_checks", init_writes_a_project_that_blesses_and_checks),
         (

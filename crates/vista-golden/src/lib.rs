@@ -12,6 +12,7 @@ pub mod bless;
 pub mod cases;
 pub mod check;
 pub mod run;
+pub mod selection;
 pub mod store;
 
 pub use agreement::{Agreement, agreement};
@@ -22,7 +23,7 @@ pub use check::{
     unwritten_problem,
 };
 pub use run::{CheckOptions, Checked, check_case, run_info};
-pub use store::{Manifest, ManifestEntry, Store};
+pub use store::{Manifest, ManifestEntry, Store, params_hash};
 
 use vista_gpu::GpuError;
 use vista_image::ImageError;

@@ -10,10 +10,12 @@
 mod matrix;
 mod mutation;
 mod report;
+mod results;
 
 pub use matrix::{MatrixColumn, cell as matrix_cell, matrix_page};
 pub use mutation::mutation_page;
 pub use report::{CASE_MARKER, RunSummary, clear_case_folders, file_case, view_js, write_case_files, write_report};
+pub use results::{case_line, github_annotations, json_results, junit_xml, verdict_name};
 
 /// The stylesheet every page carries inline (a copied report folder opens
 /// offline, and a page from `file://` may not load another origin's CSS).

@@ -161,7 +161,7 @@ fn severity(o: &Outcome) -> (u8, i64) {
     (rank, psnr)
 }
 
-fn anchor(id: &str) -> String {
+pub(crate) fn anchor(id: &str) -> String {
     format!("case-{}", html_escape(id))
 }
 

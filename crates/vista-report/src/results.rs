@@ -1,0 +1,166 @@
+//! Results CI systems read (SPEC 15): JUnit XML (one testcase per case,
+//! the failure text being the terminal block), JSON (per case: metrics,
+//! thresholds, verdict, report anchor, golden used) and GitHub Actions
+//! `::error` annotations pointing at each failing case in
+//! `golden/cases.toml`.
+
+use std::path::Path;
+use std::time::Duration;
+
+use quick_junit::{NonSuccessKind, Property, Report, TestCase, TestCaseStatus, TestSuite};
+use vista_golden::{GoldenError, Outcome, Verdict};
+
+use crate::report::RunSummary;
+
+/// The JUnit XML of a check: suite `vista`, one testcase per case named
+/// `golden::<kernel>::<case>` (classname `golden::<kernel>`); a failure's
+/// text is the block `vista check` prints; a missing golden or an error is
+/// an error; an expected failure is skipped with its reason.
+pub fn junit_xml(run: &RunSummary, outcomes: &[Outcome], report_dir: &Path) -> Result<String, GoldenError> {
+    let mut suite = TestSuite::new("vista");
+    suite.add_properties([
+        Property::new("backend", run.backend.as_str()),
+        Property::new("adapter", run.adapter.as_str()),
+        Property::new("command", run.command.as_str()),
+    ]);
+    for o in outcomes {
+        let block = o.explain(report_dir);
+        let first = o.problems.first().cloned().unwrap_or_default();
+        let status = match o.verdict {
+            Verdict::Pass => TestCaseStatus::success(),
+            Verdict::ExpectedFail => {
+                let mut s = TestCaseStatus::skipped();
+                s.set_type("expected failure").set_message(o.notes.join("; "));
+                s
+            }
+            Verdict::Fail => {
+                let mut s = TestCaseStatus::non_success(NonSuccessKind::Failure);
+                s.set_type("golden mismatch").set_message(first).set_description(block);
+                s
+            }
+            Verdict::Missing | Verdict::Error => {
+                let mut s = TestCaseStatus::non_success(NonSuccessKind::Error);
+                let ty = if o.verdict == Verdict::Missing { "missing golden" } else { "error" };
+                s.set_type(ty).set_message(first).set_description(block);
+                s
+            }
+        };
+        let mut case = TestCase::new(format!("golden::{}::{}", o.kernel, o.id), status);
+        case.set_classname(format!("golden::{}", o.kernel)).set_time(Duration::from_secs_f64(o.gpu_ms / 1e3));
+        suite.add_test_case(case);
+    }
+    let mut report = Report::new("vista check");
+    report.add_test_suite(suite);
+    report.to_string().map_err(|e| GoldenError::Io { path: "junit".into(), message: e.to_string() })
+}
+
+/// The word a verdict is reported as.
+pub fn verdict_name(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Pass => "pass",
+        Verdict::Fail => "fail",
+        Verdict::Missing => "missing",
+        Verdict::Error => "error",
+        Verdict::ExpectedFail => "expected_fail",
+    }
+}
+
+/// The JSON of a check: the run, then per case its verdict, metrics,
+/// thresholds, problems and notes, report anchor, golden used and bless
+/// command.
+pub fn json_results(run: &RunSummary, outcomes: &[Outcome]) -> serde_json::Value {
+    let num = |v: f64| if v.is_finite() { serde_json::json!(v) } else { serde_json::json!(v.to_string()) };
+    let cases: Vec<serde_json::Value> = outcomes
+        .iter()
+        .map(|o| {
+            serde_json::json!({
+                "id": o.id,
+                "kernel": o.kernel,
+                "verdict": verdict_name(o.verdict),
+                "passed": o.passed(),
+                "metrics": o.metrics.map(|m| serde_json::json!({
+                    "psnr": num(m.psnr),
+                    "ssim": num(m.ssim),
+                    "flip_mean": m.flip_mean,
+                    "max_abs": num(m.max_abs),
+                    "bad_pixels": m.bad_pixels,
+                    "nan": m.nan,
+                })),
+                "thresholds": {
+                    "psnr": o.psnr_threshold,
+                    "same_driver": o.same_driver,
+                    "min_ssim": o.min_ssim,
+                    "max_flip": o.max_flip,
+                },
+                "problems": o.problems,
+                "notes": o.notes,
+                "changed_files": o.changed_files,
+                "report_anchor": format!("index.html#{}", crate::report::anchor(&o.id)),
+                "golden": o.golden.as_ref().map(|g| serde_json::json!({
+                    "path": o.files.expected.as_ref().map(|_| format!("golden/{}/{}.png", o.kernel, o.id)),
+                    "backend": g.backend,
+                    "adapter": g.adapter,
+                    "date": g.date,
+                })),
+                "gpu_ms": o.gpu_ms,
+                "size": [o.width, o.height],
+                "bless_command": o.bless_command,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "backend": run.backend,
+        "adapter": run.adapter,
+        "command": run.command,
+        "passed": outcomes.iter().filter(|o| o.passed()).count(),
+        "failed": outcomes.iter().filter(|o| !o.passed()).count(),
+        "cases": cases,
+    })
+}
+
+/// GitHub Actions annotations, one per failing case, at the line of its
+/// `[[case]]` header in `cases_text` (`cases_file` as the repository
+/// names it).
+pub fn github_annotations(outcomes: &[Outcome], cases_file: &str, cases_text: &str) -> Vec<String> {
+    outcomes
+        .iter()
+        .filter(|o| !o.passed())
+        .map(|o| {
+            let line = case_line(cases_text, &o.id).map(|l| format!(",line={l}")).unwrap_or_default();
+            let what = o.problems.first().map(String::as_str).unwrap_or("failed");
+            // Annotation text: newlines and '%' are escaped as GitHub reads them.
+            let text = format!("case {}: {what}", o.id).replace('%', "%25").replace('\r', "%0D").replace('\n', "%0A");
+            format!("::error file={cases_file}{line},title=vista {}::{text}", o.id)
+        })
+        .collect()
+}
+
+/// The 1-based line of the `[[case]]` header of case `id`.
+pub fn case_line(text: &str, id: &str) -> Option<usize> {
+    let mut header = None;
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim();
+        if t.starts_with("[[case]]") {
+            header = Some(i + 1);
+        } else if let Some(rest) = t.strip_prefix("id")
+            && let Some(value) = rest.trim_start().strip_prefix('=')
+            && value.trim().trim_matches('"') == id
+        {
+            return header;
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn case_line_is_the_header_of_the_case() {
+        let text = "# cases\n[[case]]\nid = \"a\"\nkernel = \"k\"\n\n[[case]]\nkernel = \"k\"\nid = \"b\"\n";
+        assert_eq!(case_line(text, "a"), Some(2));
+        assert_eq!(case_line(text, "b"), Some(6));
+        assert_eq!(case_line(text, "c"), None);
+    }
+}
