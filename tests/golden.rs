@@ -77,6 +77,7 @@ fn main() {
             },
             adapter: r.map(|c| c.adapter_description()).unwrap_or_default(),
             backend,
+            ..Default::default()
         };
         match vista_report::write_report(&report_dir, &run, &outcomes) {
             Ok(index) => eprintln!("vista report: {}", index.display()),

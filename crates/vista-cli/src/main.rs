@@ -138,6 +138,12 @@ enum Command {
         /// Delete golden images that no case refers to.
         #[arg(long)]
         prune: bool,
+        /// Accept exactly the renders a check left in this report folder
+        /// (its pending.toml: failing and missing cases), without
+        /// rendering, after checking this checkout's params and WGSL still
+        /// hash as they did there.
+        #[arg(long, value_name = "DIR", conflicts_with = "prune")]
+        from_report: Option<PathBuf>,
     },
     /// Sweep a parameter (or a grid of two) against a high-quality reference:
     /// curve.csv, curve.svg, curve.png and a table naming the cheapest setting
@@ -417,7 +423,33 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             let pick = Pick { glob: case, changed, failed, partition };
             check(project, config, &pick, report_dir, Results { junit, json })
         }
-        Command::Bless { case, force, prune } => {
+        Command::Bless { case, force, from_report: Some(dir), .. } => {
+            let store = Store::of_project(project, "vista bless")?;
+            if config.in_ci && !force {
+                return Err(GoldenError::Refused(
+                    "CI=true: refusing to bless goldens in CI; bless locally from the CI report, or pass --force"
+                        .into(),
+                ));
+            }
+            let shaders = vista_render::shader_set(project)?;
+            let files_now = |shader: &str| -> Result<std::collections::BTreeMap<String, String>, String> {
+                shaders.file_hashes(shader).map(|f| f.into_iter().collect()).map_err(|e| e.to_string())
+            };
+            let summary = vista_golden::pending::bless_from_report(&store, &dir, case.as_deref(), &files_now)?;
+            println!("{:<40} {:<10} PSNR against the golden it replaces", "case", "status");
+            for r in &summary.rows {
+                println!("{:<40} {:<10} {}", r.id, r.status, r.psnr_vs_previous);
+            }
+            let n = summary.rows.len();
+            println!(
+                "accepted {n} render{} from {} as golden{}",
+                if n == 1 { "" } else { "s" },
+                dir.display(),
+                if n == 1 { "" } else { "s" }
+            );
+            Ok(0)
+        }
+        Command::Bless { case, force, prune, .. } => {
             let store = Store::of_project(project, "vista bless")?;
             let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
             let opts = BlessOptions { glob: case, force, prune, in_ci: config.in_ci };
@@ -584,8 +616,19 @@ fn check(
     vista_report::clear_case_folders(&report_dir)?;
     let opts = CheckOptions { twice: false };
     let mut outcomes = Vec::new();
+    let mut pending = std::collections::BTreeMap::new();
     for case in picked {
-        let o = vista_report::file_case(&report_dir, vista_golden::check_case(ctx, &store, &manifest, case, &opts));
+        let mut checked = vista_golden::check_case(ctx, &store, &manifest, case, &opts);
+        let entry = checked.pending.take();
+        let o = vista_report::file_case(&report_dir, checked);
+        // A failing or missing case's render, as bless --from-report may take it.
+        if let Some(mut entry) = entry
+            && matches!(o.verdict, vista_golden::Verdict::Fail | vista_golden::Verdict::Missing)
+            && let Ok(bytes) = std::fs::read(vista_golden::pending::pending_png(&report_dir, &o.id))
+        {
+            entry.golden_hash = vista_golden::short_hash_bytes(&bytes);
+            pending.insert(o.id.clone(), entry);
+        }
         let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
         let label = match o.verdict {
             vista_golden::Verdict::Pass => "ok",
@@ -604,8 +647,12 @@ fn check(
         command: command_line(),
         backend: ctx.backend().to_string(),
         adapter: ctx.adapter_description(),
+        pending: pending.keys().cloned().collect(),
+        accept_from: report_dir.display().to_string(),
     };
     let index = vista_report::write_report(&report_dir, &run, &outcomes)?;
+    let accept = (!pending.is_empty()).then(|| format!("vista bless --from-report {}", report_dir.display()));
+    vista_golden::pending::write_pending(&report_dir, pending)?;
     // results.json beside the report: what `check --failed` reads next time.
     let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
     vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;
@@ -633,6 +680,11 @@ fn check(
     if let Some(cmd) = vista_golden::bless_all_command(&failing) {
         println!("failed: {}", failing.join(", "));
         println!("if every change is intended, after reviewing the report: {cmd}");
+        if let Some(accept) = &accept {
+            println!(
+                "or accept exactly what this run rendered (on another machine too, from this report folder): {accept}"
+            );
+        }
     }
     println!("report: {}", index.display());
     Ok(if failed == 0 { 0 } else { 1 })

@@ -1568,6 +1568,57 @@ fn check_selects_changed_failed_and_partitions() {
     assert_rejected(&check(&["--failed"]), 2, &["results.json", "run vista check once first"]);
 }
 
+/// Goldens from CI's own output: a check in one clone keeps its failing and
+/// missing renders with pending.toml; another clone with the same sources
+/// accepts exactly those files (no render) and then checks clean; after an
+/// edit there, the same report is refused, naming the file, writing nothing.
+fn bless_from_report_accepts_what_another_clone_rendered() {
+    let shader = gradient_shader("main", "8, 8", "params.height");
+    let ci = kernel_project(K_MANIFEST, &shader);
+    std::fs::create_dir(ci.path().join("golden")).unwrap();
+    std::fs::write(
+        cases_path(ci.path()),
+        "[[case]]\nid = \"a\"\nkernel = \"k\"\nsize = \"16x16\"\n\n[[case]]\nid = \"b\"\nkernel = \"k\"\nsize = \"8x8\"\n",
+    )
+    .unwrap();
+    assert_eq!(vista_in(Some(ci.path()), &[], &["bless"]).code, 0);
+    let dev = tmp();
+    copy_tree(ci.path(), dev.path());
+    // The change under review, in both clones; CI also has a new case.
+    let edited = shader.replace("params.gain * u * v", "params.gain * u");
+    for root in [ci.path(), dev.path()] {
+        std::fs::write(root.join("shaders/k.wgsl"), &edited).unwrap();
+        let cases = std::fs::read_to_string(cases_path(root)).unwrap();
+        std::fs::write(cases_path(root), cases + "\n[[case]]\nid = \"c\"\nkernel = \"k\"\nsize = \"12x4\"\n").unwrap();
+    }
+    let report = ci.path().join("target/vista-report");
+    let r = vista_in(Some(ci.path()), &[], &["check"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(r.stdout.contains(&format!("vista bless --from-report {}", report.display())), "{}", r.stdout);
+    let page = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(
+        page.contains("accept this very render") && page.contains("Or accept exactly what this run rendered (3 cases)")
+    );
+    // The developer's clone accepts exactly CI's files, without rendering.
+    let a = vista_in(Some(dev.path()), &[], &["bless", "--from-report", report.to_str().unwrap()]);
+    assert_eq!(a.code, 0, "{}{}", a.stdout, a.stderr);
+    assert!(a.stdout.contains("accepted 3 renders"), "{}", a.stdout);
+    for id in ["a", "b", "c"] {
+        let ours = std::fs::read(dev.path().join(format!("golden/k/{id}.png"))).unwrap();
+        assert_eq!(ours, std::fs::read(report.join(format!("{id}/actual.png"))).unwrap(), "{id}: CI's very file");
+    }
+    let c = vista_in(Some(dev.path()), &[], &["check"]);
+    assert!(c.code == 0 && c.stdout.contains("3 passed, 0 failed"), "{}", c.stdout);
+    // Another edit in the developer's clone: the report is stale now.
+    let before = std::fs::read(dev.path().join("golden/k/a.png")).unwrap();
+    std::fs::write(dev.path().join("shaders/k.wgsl"), edited.replace("params.gain * u", "params.gain * v")).unwrap();
+    let stale = vista_in(Some(dev.path()), &[], &["bless", "--from-report", report.to_str().unwrap(), "--case", "a"]);
+    assert_rejected(&stale, 2, &["case a", "is stale", "WGSL changed since the check: k.wgsl"]);
+    assert_eq!(std::fs::read(dev.path().join("golden/k/a.png")).unwrap(), before, "a stale bless wrote");
+    let none = vista_in(Some(dev.path()), &[], &["bless", "--from-report", dev.path().to_str().unwrap()]);
+    assert_rejected(&none, 2, &["pending.toml", "vista check"]);
+}
+
 /// The manifest names the entry point; an unknown one lists the shader's.
 fn the_manifest_names_the_entry_point() {
     let manifest = format!("{K_MANIFEST}[[pass]]\nentry = \"height\"\n");
@@ -2764,6 +2815,11 @@ fn main() {
         (Cpu, "adapter_is_a_hidden_alias_of_backend", adapter_is_a_hidden_alias_of_backend),
         (Cpu, "readme_schemas_match_the_parsers", readme_schemas_match_the_parsers),
         (Gpu, "check_selects_changed_failed_and_partitions", check_selects_changed_failed_and_partitions),
+        (
+            Gpu,
+            "bless_from_report_accepts_what_another_clone_rendered",
+            bless_from_report_accepts_what_another_clone_rendered,
+        ),
         (Gpu, "check_writes_junit_json_and_github_annotations", check_writes_junit_json_and_github_annotations),
         (Gpu, "readme_newcomer_commands_run_as_shown", readme_newcomer_commands_run_as_shown),
         (Gpu, "init_writes_a_project_that_blesses_and_checks", init_writes_a_project_that_blesses_and_checks),

@@ -25,6 +25,10 @@ pub struct Checked {
     pub actual: Option<Image>,
     /// The golden's values, when it could be read.
     pub expected: Option<Image>,
+    /// The manifest entry a bless of this very render would write (its
+    /// `golden_hash` is set once the PNG is written): what the report's
+    /// `pending.toml` keeps for `vista bless --from-report`.
+    pub pending: Option<crate::ManifestEntry>,
 }
 
 /// This run's side of `case`'s provenance: backend, adapter, params hash
@@ -47,7 +51,9 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     let rendered = render(ctx, case.kernel, &case.params, case.width, case.height).map_err(|e| e.to_string());
     let r = match rendered {
         Ok(r) => r,
-        Err(e) => return Checked { outcome: judge(case, entry, run, Err(e)), actual: None, expected: None },
+        Err(e) => {
+            return Checked { outcome: judge(case, entry, run, Err(e)), actual: None, expected: None, pending: None };
+        }
     };
     let actual = quantize16(r.display());
     let gathered = (|| -> Result<_, String> {
@@ -96,9 +102,29 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         }
     };
     out.gpu_ms = r.stats.gpu_wall.as_secs_f64() * 1e3;
+    let pending = match &gathered {
+        Ok((_, files, _, _)) => Some(crate::ManifestEntry {
+            kernel: case.kernel.name().to_string(),
+            size: format!("{}x{}", case.width, case.height),
+            params_hash: out.run.params_hash.clone(),
+            shader_hash: out.run.shader_hash.clone(),
+            shader_files: files.clone(),
+            adapter: out.run.adapter.clone(),
+            backend: out.run.backend.clone(),
+            date: crate::now_utc(),
+            raw_hash: r.raw.content_hash(),
+            psnr_vs_previous: out
+                .metrics
+                .map(|m| vista_image::metrics::format_psnr(m.psnr))
+                .unwrap_or_else(|| "new".into()),
+            golden_hash: String::new(),
+            replacing: None,
+        }),
+        Err(_) => None,
+    };
     let expected = match gathered {
         Ok((_, _, _, Some((_, Ok(image))))) => Some(image),
         _ => None,
     };
-    Checked { outcome: out, actual: Some(actual), expected }
+    Checked { outcome: out, actual: Some(actual), expected, pending }
 }

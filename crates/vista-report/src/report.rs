@@ -42,7 +42,7 @@ pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
 /// A checked case with its images written into `dir`: the outcome with
 /// `files` filled in (a failure to write them makes the case an error).
 pub fn file_case(dir: &Path, checked: vista_golden::Checked) -> Outcome {
-    let vista_golden::Checked { mut outcome, actual, expected } = checked;
+    let vista_golden::Checked { mut outcome, actual, expected, .. } = checked;
     if let Some(actual) = &actual
         && let Err(e) = write_case_files(dir, &mut outcome, actual, expected.as_ref())
     {
@@ -111,6 +111,10 @@ pub struct RunSummary {
     pub backend: String,
     /// The adapter's description (name | driver | backend | type).
     pub adapter: String,
+    /// Cases whose render the report keeps for `vista bless --from-report`.
+    pub pending: Vec<String>,
+    /// The report folder as that command names it.
+    pub accept_from: String,
 }
 
 /// The viewer's data for one case: both images' 16-bit display values
@@ -258,7 +262,7 @@ fn metric_cells(o: &Outcome) -> (String, String) {
     }
 }
 
-fn case_section(o: &Outcome) -> String {
+fn case_section(o: &Outcome, run: &RunSummary) -> String {
     let (psnr, metrics) = metric_cells(o);
     let failing = !o.passed();
     let msgs: String = o
@@ -291,7 +295,7 @@ fn case_section(o: &Outcome) -> String {
          <span class=\"psnr\">PSNR {psnr}</span> <span class=\"ms\">{gpu:.1} ms</span> \
          <span class=\"thumbs\">{e}{a}{d}</span></summary>\
          <div class=\"body\"><div class=\"cols\"><div>{metrics}{first_bad}{msgs}\
-         <p>bless this case: <code class=\"cmd\">{bless}</code></p></div><div>{prov}</div></div>{viewer}</div></details>\n",
+         <p>bless this case: <code class=\"cmd\">{bless}</code></p>{accept}</div><div>{prov}</div></div>{viewer}</div></details>\n",
         cls = if failing { "fail" } else { "pass" },
         anchor = anchor(&o.id),
         open = if failing { " open" } else { "" },
@@ -303,6 +307,15 @@ fn case_section(o: &Outcome) -> String {
         a = thumb(&o.files.actual8, &o.files.actual, "actual"),
         d = thumb(&o.files.diff8, &o.files.diff, "heat map"),
         bless = html_escape(&o.bless_command),
+        accept = match run.pending.contains(&o.id) {
+            true => format!(
+                "<p>or accept this very render (on any machine with this checkout): <code class=\"cmd\">vista bless \
+                 --from-report {} --case '{}'</code></p>",
+                html_escape(&run.accept_from),
+                html_escape(&o.id)
+            ),
+            false => String::new(),
+        },
         prov = provenance(o),
     )
 }
@@ -347,6 +360,16 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
                 html_escape(&cmd)
             );
         }
+        if !run.pending.is_empty() {
+            let _ = write!(
+                summary,
+                "<p>Or accept exactly what this run rendered ({} case{}), on any machine with this checkout: \
+                 <code class=\"cmd\">vista bless --from-report {}</code></p>",
+                run.pending.len(),
+                if run.pending.len() == 1 { "" } else { "s" },
+                html_escape(&run.accept_from)
+            );
+        }
     }
     let expectations: String = sorted
         .iter()
@@ -372,7 +395,7 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
         .map(|(f, what)| format!(" <a href=\"{f}\">{what}</a>"))
         .collect();
     let stops = serde_json::to_string(&vista_image::HEATMAP_STOPS).expect("stops serialise");
-    let sections: String = sorted.iter().map(|o| case_section(o)).collect();
+    let sections: String = sorted.iter().map(|o| case_section(o, run)).collect();
     let body = format!(
         "<header><h1>vista report</h1>\
          <p class=\"counts\"><b>{n}</b> cases: <b class=\"{fcls}\">{nfail} failing</b>, {passed} passed, {xfail} expected failures.</p>\
