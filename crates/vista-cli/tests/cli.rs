@@ -1412,6 +1412,23 @@ fn readme_schemas_match_the_parsers() {
         &["check"],
     ));
     assert_eq!(table_keys(&readme, "### Cases"), cases, "README's case table");
+    // Every subcommand `vista --help` lists has its row in the CLI table.
+    let help = vista(&["--help"]).stdout;
+    let commands: Vec<&str> = help
+        .split("Commands:")
+        .nth(1)
+        .unwrap()
+        .split("\n\n")
+        .next()
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    assert!(commands.len() >= 9, "{help}");
+    for c in commands {
+        assert!(readme.contains(&format!("| `vista {c}")), "README's CLI table lacks vista {c}");
+    }
     let vista_toml = expected_fields(&err(K_MANIFEST, "vista.toml", "zzz = 1\n", &["list"]));
     let layout_row = readme.lines().find(|l| l.starts_with("| `vista.toml` |")).unwrap();
     assert!(vista_toml.iter().all(|k| layout_row.contains(&format!("`{k}`"))), "{layout_row} lacks {vista_toml:?}");

@@ -169,6 +169,21 @@ impl Expr {
         }
     }
 
+    /// One entry of a manifest's `workgroups` or `size` list: a number
+    /// >= 1, a param name or an expression (in a string).
+    pub fn parse_entry(v: &toml::Value, params: &[ParamSpec]) -> Result<Expr, String> {
+        let text = match v {
+            toml::Value::Integer(n) if *n >= 1 => n.to_string(),
+            toml::Value::String(s) => s.clone(),
+            other => {
+                return Err(format!(
+                    "entry {other} is not valid; expected a number >= 1, a param name or an expression"
+                ));
+            }
+        };
+        Expr::parse(&text, params).map_err(|e| format!("entry \"{text}\": {e}"))
+    }
+
     pub fn parse(text: &str, params: &[ParamSpec]) -> Result<Expr, String> {
         let mut p = Parser { toks: lex(text)?, at: 0, params };
         let e = p.sum()?;

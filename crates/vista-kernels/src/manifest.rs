@@ -448,18 +448,9 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         Some(list) if list.len() == 3 => {
             let mut out = Vec::new();
             for v in list {
-                let text = match v {
-                    toml::Value::Integer(n) if *n >= 1 => n.to_string(),
-                    toml::Value::String(s) => s.clone(),
-                    other => {
-                        return Err(kfail(format!(
-                            "[[pass]] workgroups entry {other} is not valid; expected a count >= 1, a param name or an expression"
-                        )));
-                    }
-                };
-                let e = crate::expr::Expr::parse(&text, params)
-                    .map_err(|e| kfail(format!("[[pass]] workgroups entry \"{text}\": {e}")))?;
-                out.push(e);
+                out.push(
+                    crate::expr::Expr::parse_entry(v, params).map_err(|e| kfail(format!("[[pass]] workgroups {e}")))?,
+                );
             }
             let [x, y, z]: [crate::expr::Expr; 3] = out.try_into().expect("three entries");
             Some([x, y, z])

@@ -171,16 +171,7 @@ pub(crate) fn parse(
                 }
                 let mut exprs = Vec::new();
                 for v in list {
-                    let text = match v {
-                        toml::Value::Integer(n) if *n >= 1 => n.to_string(),
-                        toml::Value::String(s) => s.clone(),
-                        other => {
-                            return Err(at(format!(
-                                "size entry {other} is not valid; expected a number >= 1, a param name or an expression"
-                            )));
-                        }
-                    };
-                    exprs.push(Expr::parse(&text, params).map_err(|e| at(format!("size entry \"{text}\": {e}")))?);
+                    exprs.push(Expr::parse_entry(v, params).map_err(|e| at(format!("size {e}")))?);
                 }
                 Some(exprs)
             }
