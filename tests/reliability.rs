@@ -35,6 +35,8 @@ fn nan_case() -> Case {
         psnr_other_driver: 35.0,
         min_ssim: None,
         max_flip: None,
+        max_bad_pixels: None,
+        max_bad_ratio: None,
         expect_fail: vec![],
         doc: String::new(),
     }

@@ -126,6 +126,10 @@ enum Command {
         /// Only partition K of N (1-based), split stably by case id.
         #[arg(long, value_name = "K/N")]
         partition: Option<String>,
+        /// Report golden images that no case refers to as a warning
+        /// instead of failing the check.
+        #[arg(long)]
+        allow_orphans: bool,
     },
     /// Re-render cases and write their goldens (refused under CI=true without --force).
     Bless {
@@ -418,9 +422,9 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
         Command::Check { case, report_dir, matrix: true, .. } => {
             matrix::matrix(project, config, case.as_deref(), report_dir)
         }
-        Command::Check { case, report_dir, matrix: false, junit, json, changed, failed, partition } => {
+        Command::Check { case, report_dir, matrix: false, junit, json, changed, failed, partition, allow_orphans } => {
             let partition = partition.as_deref().map(vista_golden::selection::parse_partition).transpose()?;
-            let pick = Pick { glob: case, changed, failed, partition };
+            let pick = Pick { glob: case, changed, failed, partition, allow_orphans };
             check(project, config, &pick, report_dir, Results { junit, json })
         }
         Command::Bless { case, force, from_report: Some(dir), .. } => {
@@ -545,6 +549,8 @@ struct Pick {
     changed: bool,
     failed: bool,
     partition: Option<(u64, u64)>,
+    /// Orphaned goldens warn instead of failing.
+    allow_orphans: bool,
 }
 
 /// Machine-readable results a check also writes.
@@ -677,6 +683,23 @@ fn check(
     let failing: Vec<&str> = outcomes.iter().filter(|o| !o.passed()).map(|o| o.id.as_str()).collect();
     let failed = failing.len();
     println!("{} passed, {} failed", outcomes.len() - failed, failed);
+    // Goldens no case refers to: a renamed or deleted case left them behind.
+    let orphans = store.orphans(&cases);
+    for o in &orphans {
+        println!(
+            "{}: golden with no case: {} (delete it, or vista bless --prune)",
+            if pick.allow_orphans { "warning" } else { "FAIL" },
+            o.display()
+        );
+    }
+    let orphans_fail = !orphans.is_empty() && !pick.allow_orphans;
+    if orphans_fail {
+        println!(
+            "{} orphaned golden{} fail the check (--allow-orphans makes them a warning)",
+            orphans.len(),
+            if orphans.len() == 1 { "" } else { "s" }
+        );
+    }
     if let Some(cmd) = vista_golden::bless_all_command(&failing) {
         println!("failed: {}", failing.join(", "));
         println!("if every change is intended, after reviewing the report: {cmd}");
@@ -687,7 +710,7 @@ fn check(
         }
     }
     println!("report: {}", index.display());
-    Ok(if failed == 0 { 0 } else { 1 })
+    Ok(if failed == 0 && !orphans_fail { 0 } else { 1 })
 }
 
 /// This process's command line as a user would type it again (`vista` and

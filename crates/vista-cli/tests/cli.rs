@@ -1636,6 +1636,48 @@ fn bless_from_report_accepts_what_another_clone_rendered() {
     assert_rejected(&none, 2, &["pending.toml", "vista check"]);
 }
 
+/// Hygiene and budgets: an orphaned golden fails check unless
+/// --allow-orphans; a Git LFS pointer where a golden should be says "git lfs
+/// pull"; a case with a bad-pixel budget is judged by it instead of PSNR.
+fn orphans_lfs_pointers_and_bad_pixel_budgets() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    std::fs::copy(d.path().join("golden/fbm/a.png"), d.path().join("golden/fbm/old-name.png")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(r.stdout.contains("3 passed, 0 failed") && r.stdout.contains("golden with no case:"), "{}", r.stdout);
+    assert!(r.stdout.contains("fbm/old-name.png") && r.stdout.contains("--allow-orphans"), "{}", r.stdout);
+    let r = vista_in(Some(d.path()), &[], &["check", "--allow-orphans"]);
+    assert!(r.code == 0 && r.stdout.contains("warning: golden with no case"), "{}", r.stdout);
+    std::fs::remove_file(d.path().join("golden/fbm/old-name.png")).unwrap();
+    // A Git LFS pointer instead of the PNG.
+    let pointer = "version https://git-lfs.github.com/spec/v1\noid sha256:0123\nsize 12345\n";
+    std::fs::write(d.path().join("golden/fbm/a.png"), pointer).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "a"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(r.stdout.contains("is a Git LFS pointer, not a PNG: run `git lfs pull`"), "{}", r.stdout);
+    // b renders 32 x 32 with another seed: every pixel moves. A budget of
+    // all of them passes it whatever the PSNR; one pixel fewer fails it.
+    let moved = CASES.replace("set = { basis = \"value\" }", "set = { basis = \"value\", seed = 9 }");
+    let budget = |extra: &str| moved.replace("seed = 9 }\n", &format!("seed = 9 }}\n{extra}\n"));
+    std::fs::write(cases_path(d.path()), budget("")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert!(r.code == 1 && r.stdout.contains("below the threshold"), "{}", r.stdout);
+    let bad: u64 = r.stdout.split("bad pixels ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+    assert!(bad > 0);
+    std::fs::write(cases_path(d.path()), budget(&format!("max_bad_pixels = {bad}"))).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert_eq!(r.code, 0, "{}", r.stdout);
+    std::fs::write(cases_path(d.path()), budget(&format!("max_bad_pixels = {}", bad - 1))).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert!(r.code == 1 && r.stdout.contains("above max_bad_pixels"), "{}", r.stdout);
+    std::fs::write(cases_path(d.path()), budget("max_bad_ratio = 0.0001")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert!(r.code == 1 && r.stdout.contains("above max_bad_ratio 0.0001"), "{}", r.stdout);
+    std::fs::write(cases_path(d.path()), budget("max_bad_ratio = 2")).unwrap();
+    assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["max_bad_ratio=2 is out of range"]);
+}
+
 /// The manifest names the entry point; an unknown one lists the shader's.
 fn the_manifest_names_the_entry_point() {
     let manifest = format!("{K_MANIFEST}[[pass]]\nentry = \"height\"\n");
@@ -2832,6 +2874,7 @@ fn main() {
         (Cpu, "adapter_is_a_hidden_alias_of_backend", adapter_is_a_hidden_alias_of_backend),
         (Cpu, "readme_schemas_match_the_parsers", readme_schemas_match_the_parsers),
         (Gpu, "check_selects_changed_failed_and_partitions", check_selects_changed_failed_and_partitions),
+        (Gpu, "orphans_lfs_pointers_and_bad_pixel_budgets", orphans_lfs_pointers_and_bad_pixel_budgets),
         (
             Gpu,
             "bless_from_report_accepts_what_another_clone_rendered",

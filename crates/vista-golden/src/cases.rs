@@ -11,6 +11,8 @@
 //! psnr_other_driver = 35.0
 //! min_ssim = 0.99                # optional
 //! max_flip = 0.01                # optional: mean LDR-FLIP error, in [0, 1]
+//! max_bad_pixels = 25            # optional: pixels a channel of which differs by > 1/255
+//! max_bad_ratio = 0.001          # optional: the same as a share of the pixels, in [0, 1]
 //! ```
 
 use std::collections::BTreeMap;
@@ -45,6 +47,8 @@ struct RawCase {
     psnr_other_driver: Option<f64>,
     min_ssim: Option<f64>,
     max_flip: Option<f64>,
+    max_bad_pixels: Option<u64>,
+    max_bad_ratio: Option<f64>,
     #[serde(default)]
     expect_fail: Vec<Expectation>,
     #[serde(default)]
@@ -92,6 +96,11 @@ pub struct Case {
     pub min_ssim: Option<f64>,
     /// Largest mean LDR-FLIP error allowed (display values), if any.
     pub max_flip: Option<f64>,
+    /// Most bad pixels allowed (a channel differs by more than 1/255), as a
+    /// count and as a share of the pixels, if any; a case with either is
+    /// judged by them instead of its PSNR threshold.
+    pub max_bad_pixels: Option<u64>,
+    pub max_bad_ratio: Option<f64>,
     /// Where this case is expected to fail, and why.
     pub expect_fail: Vec<Expectation>,
     pub doc: String,
@@ -153,6 +162,11 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         {
             return Err(bad(format!("max_flip={f} is out of range; allowed: [0, 1] (mean FLIP error)")));
         }
+        if let Some(r) = raw.max_bad_ratio
+            && !(0.0..=1.0).contains(&r)
+        {
+            return Err(bad(format!("max_bad_ratio={r} is out of range; allowed: [0, 1] (a share of the pixels)")));
+        }
         for x in &raw.expect_fail {
             if !EXPECTATION_BACKENDS.contains(&x.backend.as_str()) {
                 return Err(bad(format!(
@@ -177,6 +191,8 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             psnr_other_driver,
             min_ssim: raw.min_ssim,
             max_flip: raw.max_flip,
+            max_bad_pixels: raw.max_bad_pixels,
+            max_bad_ratio: raw.max_bad_ratio,
             expect_fail: raw.expect_fail,
             doc: raw.doc,
         });

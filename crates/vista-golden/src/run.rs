@@ -75,7 +75,16 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
                 let bytes = std::fs::read(&path)
                     .map_err(|source| vista_image::ImageError::Io { path: path.clone(), source }.to_string())?;
                 let hash = crate::short_hash_bytes(&bytes);
-                Some((hash, vista_image::decode_png16(&path, &bytes).map_err(|e| e.to_string())))
+                let image = match bytes.starts_with(b"version https://git-lfs.github.com/spec/") {
+                    // A Git LFS pointer where the PNG should be: the clone lacks the file.
+                    true => Err(format!(
+                        "{} is a Git LFS pointer, not a PNG: run `git lfs pull` (and `git lfs install` once) to fetch \
+                         the goldens",
+                        path.display()
+                    )),
+                    false => vista_image::decode_png16(&path, &bytes).map_err(|e| e.to_string()),
+                };
+                Some((hash, image))
             }
         };
         Ok((repeat_identical, files, path, golden))
