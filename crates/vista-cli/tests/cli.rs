@@ -1636,6 +1636,33 @@ fn bless_from_report_accepts_what_another_clone_rendered() {
     assert_rejected(&none, 2, &["pending.toml", "vista check"]);
 }
 
+/// One process runs a read_write kernel, then a write-only kernel of the same
+/// size and format that leaves a row unwritten: the second must still be
+/// caught (the read_write run's zero-filled output must not stand in for
+/// the sentinel fill).
+fn a_read_write_run_does_not_hide_the_next_runs_unwritten_texels() {
+    let rw = "@group(0) @binding(1) var map: texture_storage_2d<rgba32float, read_write>;
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let d = textureDimensions(map);
+    if any(id.xy >= d) { return; }
+    textureStore(map, id.xy, textureLoad(map, id.xy) + vec4(0.25, 0.5, 0.75, 1.0));
+}
+";
+    let d = kernel_project("summary = \"accumulate\"\n", rw);
+    std::fs::write(d.path().join("kernels/cut.toml"), K_MANIFEST).unwrap();
+    std::fs::write(d.path().join("shaders/cut.wgsl"), gradient_shader("main", "8, 8", "params.height - 1u")).unwrap();
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    std::fs::write(
+        cases_path(d.path()),
+        "[[case]]\nid = \"rw\"\nkernel = \"k\"\nsize = \"16x8\"\n\n[[case]]\nid = \"cut\"\nkernel = \"cut\"\nsize = \"16x8\"\n",
+    )
+    .unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(r.stdout.contains("16 of 128 texels never written"), "{}", r.stdout);
+}
+
 /// Hygiene and budgets: an orphaned golden fails check unless
 /// --allow-orphans; a Git LFS pointer where a golden should be says "git lfs
 /// pull"; a case with a bad-pixel budget is judged by it instead of PSNR.
@@ -2875,6 +2902,11 @@ fn main() {
         (Cpu, "readme_schemas_match_the_parsers", readme_schemas_match_the_parsers),
         (Gpu, "check_selects_changed_failed_and_partitions", check_selects_changed_failed_and_partitions),
         (Gpu, "orphans_lfs_pointers_and_bad_pixel_budgets", orphans_lfs_pointers_and_bad_pixel_budgets),
+        (
+            Gpu,
+            "a_read_write_run_does_not_hide_the_next_runs_unwritten_texels",
+            a_read_write_run_does_not_hide_the_next_runs_unwritten_texels,
+        ),
         (
             Gpu,
             "bless_from_report_accepts_what_another_clone_rendered",

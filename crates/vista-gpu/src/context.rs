@@ -333,6 +333,9 @@ struct Scratch {
     layers: u32,
     dimension: Dimension,
     format: wgpu::TextureFormat,
+    /// A read_write run's fill buffer holds zeros, not the sentinel: only
+    /// another read_write run may take it.
+    read_write: bool,
     texture: wgpu::Texture,
     readback: wgpu::Buffer,
     /// The output's size of sentinel-0 texels, copied over the texture
@@ -748,26 +751,21 @@ impl Context {
         // Buffer rows must be 256-byte aligned; unpadded again after mapping.
         let row_bytes = job.width * format.texel_bytes() as u32;
         let padded_row = row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        // A read_write output starts as zeros (see `Dispatch::read_write`).
-        let fill_texel = |which: usize| match job.read_write {
-            true => vec![0u8; format.texel_bytes()],
-            false => format.sentinel(which),
-        };
         let fill = |which: usize| {
             let texels = (padded_row as usize / format.texel_bytes()) * rows as usize;
             d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("unwritten sentinel"),
-                contents: &fill_texel(which).repeat(texels + 1),
+                contents: &initial_texel(job, format, which).repeat(texels + 1),
                 usage: wgpu::BufferUsages::COPY_SRC,
             })
         };
-        let shape = (job.width, job.height, job.layers, job.dimension, format.wgpu);
+        let shape = (job.width, job.height, job.layers, job.dimension, format.wgpu, job.read_write);
         let kept = w
             .scratch
             .lock()
             .expect("scratch")
             .take()
-            .filter(|s| (s.width, s.height, s.layers, s.dimension, s.format) == shape && !job.read_write);
+            .filter(|s| (s.width, s.height, s.layers, s.dimension, s.format, s.read_write) == shape);
         let Scratch { texture, readback, sentinel, .. } = match kept {
             Some(s) => s,
             None => Scratch {
@@ -776,6 +774,7 @@ impl Context {
                 layers: job.layers,
                 dimension: job.dimension,
                 format: format.wgpu,
+                read_write: job.read_write,
                 texture: d.create_texture(&wgpu::TextureDescriptor {
                     label: Some("output"),
                     size: extent,
@@ -892,6 +891,7 @@ impl Context {
             layers: job.layers,
             dimension: job.dimension,
             format: format.wgpu,
+            read_write: job.read_write,
             texture,
             readback,
             sentinel,
@@ -920,9 +920,6 @@ impl Context {
     ) -> Result<(Texels, RunStats), GpuError> {
         // Override values are baked into the page's WGSL (see `wgsl_source`).
         let key = format!("{}#{}@{}{:?}", job.shader, job.shaders.source_hash(job.shader)?, job.entry, job.constants);
-        // The page's pipeline cache keys on this with the slots and format;
-        // dimension and access change the bind group layout too.
-        let key = format!("{key}{:?}{}", job.dimension, job.read_write);
         let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
         let wgsl = match cached {
             Some(w) => w,
@@ -964,10 +961,7 @@ impl Context {
                 layers: job.layers,
                 read_write: job.read_write,
                 texel_bytes: format.texel_bytes() as u32,
-                fill: &match job.read_write {
-                    true => vec![0u8; format.texel_bytes()],
-                    false => format.sentinel(which),
-                },
+                fill: &initial_texel(job, format, which),
                 uniforms: job.uniforms,
                 table: job.table,
                 width: job.width,
@@ -1002,6 +996,16 @@ impl Context {
                 }
                 other => GpuError::Validation { what: what.to_string(), message: other.to_string() },
             })
+    }
+}
+
+/// What every output texel holds before the kernel runs: sentinel `which`,
+/// or zeros for a read_write output (a resource's default contents, which
+/// the kernel may read; see `Dispatch::read_write`).
+fn initial_texel(job: &Dispatch<'_>, format: &OutputFormat, which: usize) -> Vec<u8> {
+    match job.read_write {
+        true => vec![0u8; format.texel_bytes()],
+        false => format.sentinel(which),
     }
 }
 
