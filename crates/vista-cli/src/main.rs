@@ -437,7 +437,7 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             }
             let shaders = vista_render::shader_set(project)?;
             let files_now = |shader: &str| -> Result<std::collections::BTreeMap<String, String>, String> {
-                shaders.file_hashes(shader).map(|f| f.into_iter().collect()).map_err(|e| e.to_string())
+                shaders.file_hashes(shader).map_err(|e| e.to_string())
             };
             let summary = vista_golden::pending::bless_from_report(&store, &dir, case.as_deref(), &files_now)?;
             println!("{:<40} {:<10} PSNR against the golden it replaces", "case", "status");
@@ -513,7 +513,12 @@ fn check_output_path(out: &Path) -> Result<(), GoldenError> {
     if !ext_ok {
         return Err(bad(format!("output {} must end in .png or .exr", out.display())));
     }
-    let dir = match out.parent() {
+    check_parent_writable(out)
+}
+
+/// The directory a file will be written into exists, is one, and is writable.
+fn check_parent_writable(file: &Path) -> Result<(), GoldenError> {
+    let dir = match file.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
@@ -561,17 +566,10 @@ struct Results {
 
 /// A results file's directory must exist and be writable, before any GPU work.
 fn check_results_path(flag: &str, path: &Path) -> Result<(), GoldenError> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
     if path.is_dir() {
         return Err(bad(format!("{flag} {} is a directory; expected a file path", path.display())));
     }
-    if !dir.is_dir() {
-        return Err(bad(format!("{flag} {}: directory {} does not exist", path.display(), dir.display())));
-    }
-    probe_writable(&dir)
+    check_parent_writable(path).map_err(|e| bad(format!("{flag} {}: {e}", path.display())))
 }
 
 fn check(
@@ -601,7 +599,7 @@ fn check(
     if pick.changed {
         let shaders = vista_render::shader_set(project)?;
         picked.retain(|c| {
-            let files = shaders.file_hashes(c.kernel.shader()).map(|f| f.into_iter().collect()).unwrap_or_default();
+            let files = shaders.file_hashes(c.kernel.shader()).unwrap_or_default();
             vista_golden::selection::change(c, &manifest, &files).is_some()
         });
         why.push("--changed".into());

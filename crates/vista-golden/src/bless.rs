@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use vista_image::metrics;
 
 use crate::store::{ManifestEntry, Store, params_hash};
-use crate::{GoldenError, now_utc, select};
+use crate::{GoldenError, select};
 use vista_render::{Rendered, Renderer, quantize16, render};
 
 #[derive(Debug, Clone, Default)]
@@ -105,20 +105,15 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         let bytes = vista_image::encode_png16(&path, &new)?;
         let new_hash = crate::short_hash_bytes(&bytes);
         let old_hash = old_bytes.as_deref().map(crate::short_hash_bytes);
-        let mut entry = ManifestEntry {
-            kernel: case.kernel.name().to_string(),
-            size: format!("{}x{}", case.width, case.height),
+        let run = crate::RunInfo {
+            backend: ctx.backend().to_string(),
+            adapter: adapter.clone(),
             params_hash: params_hash(case),
             shader_hash: ctx.shader_hash(case.kernel.shader())?,
-            shader_files: ctx.shader_file_hashes(case.kernel.shader())?,
-            adapter: adapter.clone(),
-            backend: ctx.backend().to_string(),
-            date: now_utc(),
-            raw_hash: r.raw.content_hash(),
-            psnr_vs_previous: psnr.clone(),
-            golden_hash: new_hash.clone(),
-            replacing: None,
         };
+        let files = ctx.shader_file_hashes(case.kernel.shader())?;
+        let mut entry =
+            ManifestEntry::of_render(case, &run, files, r.raw.content_hash(), psnr.clone(), new_hash.clone());
         let same_render = |e: &ManifestEntry| {
             (&e.params_hash, &e.shader_hash, &e.adapter, &e.raw_hash)
                 == (&entry.params_hash, &entry.shader_hash, &entry.adapter, &entry.raw_hash)

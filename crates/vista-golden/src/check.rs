@@ -434,7 +434,7 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
 
 /// Files whose hash differs between bless time and now, or that only one
 /// side has, by path.
-fn changed_files(then: &BTreeMap<String, String>, now: &BTreeMap<String, String>) -> Vec<String> {
+pub fn changed_files(then: &BTreeMap<String, String>, now: &BTreeMap<String, String>) -> Vec<String> {
     let mut changed: Vec<String> = now
         .iter()
         .filter(|(f, h)| then.get(*f) != Some(h))

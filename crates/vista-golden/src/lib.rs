@@ -20,7 +20,7 @@ pub use agreement::{Agreement, agreement};
 pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, bless_all_command, load_cases, parse_cases, select};
 pub use check::{
-    BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, first_out_of_range, guards, judge,
+    BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, changed_files, first_out_of_range, guards, judge,
     unwritten_problem,
 };
 pub use run::{CheckOptions, Checked, check_case, run_info};

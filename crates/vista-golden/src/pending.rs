@@ -101,13 +101,7 @@ pub fn bless_from_report(
             return Err(stale(id, "its params (preset, set or size) changed since the check".into()));
         }
         let now = files_now(case.kernel.shader()).map_err(|e| stale(id, e))?;
-        let mut changed: Vec<&str> = now
-            .iter()
-            .filter(|(f, h)| entry.shader_files.get(*f) != Some(*h))
-            .map(|(f, _)| f.as_str())
-            .chain(entry.shader_files.keys().filter(|f| !now.contains_key(*f)).map(String::as_str))
-            .collect();
-        changed.dedup();
+        let changed = crate::changed_files(&entry.shader_files, &now);
         if !changed.is_empty() {
             return Err(stale(id, format!("WGSL changed since the check: {}", changed.join(", "))));
         }

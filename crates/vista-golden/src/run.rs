@@ -112,23 +112,15 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     };
     out.gpu_ms = r.stats.gpu_wall.as_secs_f64() * 1e3;
     let pending = match &gathered {
-        Ok((_, files, _, _)) => Some(crate::ManifestEntry {
-            kernel: case.kernel.name().to_string(),
-            size: format!("{}x{}", case.width, case.height),
-            params_hash: out.run.params_hash.clone(),
-            shader_hash: out.run.shader_hash.clone(),
-            shader_files: files.clone(),
-            adapter: out.run.adapter.clone(),
-            backend: out.run.backend.clone(),
-            date: crate::now_utc(),
-            raw_hash: r.raw.content_hash(),
-            psnr_vs_previous: out
-                .metrics
-                .map(|m| vista_image::metrics::format_psnr(m.psnr))
-                .unwrap_or_else(|| "new".into()),
-            golden_hash: String::new(),
-            replacing: None,
-        }),
+        // golden_hash is set once the report has written the PNG.
+        Ok((_, files, _, _)) => Some(crate::ManifestEntry::of_render(
+            case,
+            &out.run,
+            files.clone(),
+            r.raw.content_hash(),
+            out.metrics.map(|m| vista_image::metrics::format_psnr(m.psnr)).unwrap_or_else(|| "new".into()),
+            String::new(),
+        )),
         Err(_) => None,
     };
     let expected = match gathered {

@@ -39,12 +39,7 @@ pub fn change(case: &Case, manifest: &Manifest, files: &BTreeMap<String, String>
     if e.shader_files.is_empty() {
         return Some("the manifest predates per-file hashes".into());
     }
-    let edited: Vec<&str> = files
-        .iter()
-        .filter(|(f, h)| e.shader_files.get(*f) != Some(*h))
-        .map(|(f, _)| f.as_str())
-        .chain(e.shader_files.keys().filter(|f| !files.contains_key(*f)).map(String::as_str))
-        .collect();
+    let edited = crate::changed_files(&e.shader_files, files);
     (!edited.is_empty()).then(|| format!("changed: {}", edited.join(", ")))
 }
 

@@ -43,6 +43,36 @@ pub struct ManifestEntry {
     pub replacing: Option<String>,
 }
 
+impl ManifestEntry {
+    /// The entry a bless of one render of `case` writes, dated now: this
+    /// run's provenance, the hash of each WGSL file the kernel reaches, the
+    /// raw output's hash, the PSNR against the golden it replaces and the
+    /// hash of the PNG's bytes.
+    pub fn of_render(
+        case: &Case,
+        run: &crate::RunInfo,
+        shader_files: BTreeMap<String, String>,
+        raw_hash: String,
+        psnr_vs_previous: String,
+        golden_hash: String,
+    ) -> ManifestEntry {
+        ManifestEntry {
+            kernel: case.kernel.name().to_string(),
+            size: format!("{}x{}", case.width, case.height),
+            params_hash: run.params_hash.clone(),
+            shader_hash: run.shader_hash.clone(),
+            shader_files,
+            adapter: run.adapter.clone(),
+            backend: run.backend.clone(),
+            date: crate::now_utc(),
+            raw_hash,
+            psnr_vs_previous,
+            golden_hash,
+            replacing: None,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 pub struct Manifest {
     #[serde(default)]

@@ -162,7 +162,7 @@ impl ShaderSet {
 
     /// Each file of [`ShaderSet::import_closure`] with the hash of its text:
     /// recorded at bless time so that a check can name the files that changed.
-    pub fn file_hashes(&self, name: &str) -> Result<Vec<(String, String)>, GpuError> {
+    pub fn file_hashes(&self, name: &str) -> Result<std::collections::BTreeMap<String, String>, GpuError> {
         let (source, _) = self.kernel_source(name)?;
         let hash = |text: &str| blake3::hash(text.as_bytes()).to_hex()[..16].to_string();
         Ok(std::iter::once((name.to_string(), hash(source)))

@@ -106,6 +106,18 @@ pub fn undecorate(name: &str) -> (String, Option<String>) {
     }
 }
 
+/// The storage texture a pass writes, as [`reflect`] found it (it refuses
+/// a pass without one).
+pub fn output(bindings: &[Binding]) -> (&Binding, crate::resources::Storage) {
+    bindings
+        .iter()
+        .find_map(|b| match b.feed {
+            Feed::Output(storage) => Some((b, storage)),
+            _ => None,
+        })
+        .expect("bindings::reflect refuses a pass without an output")
+}
+
 /// A WGSL spelling of a global's type, for messages.
 pub fn wgsl_type(module: &naga::Module, var: &naga::GlobalVariable) -> String {
     let ty = &module.types[var.ty];

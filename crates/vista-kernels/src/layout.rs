@@ -130,15 +130,8 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
         }
         blocks.push(Block { group: uniform.group, binding: uniform.binding, var: name, size });
     }
-    let output = bindings
-        .iter()
-        .find_map(|b| match b.feed {
-            crate::bindings::Feed::Output(storage) => {
-                Some(crate::resources::Target { var: b.name.clone(), storage, resource: None })
-            }
-            _ => None,
-        })
-        .expect("bindings::reflect refuses a pass without an output");
+    let (out, storage) = crate::bindings::output(&bindings);
+    let output = crate::resources::Target { var: out.name.clone(), storage, resource: None };
     Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module), output })
 }
 
@@ -263,10 +256,9 @@ fn leaf_type(module: &naga::Module, inner: &TypeInner) -> Result<FieldType, &'st
     }
 }
 
-/// Params that vista consumes on the host, so the shader may leave them out:
-/// `exposure` of an HDR kernel (the PNG tone map).
-/// Whether param `name` feeds something other than a uniform leaf or an
-/// override: the hdr view's exposure, a `workgroups` or `size` expression.
+/// Whether param `name` feeds something on the host rather than a uniform
+/// leaf or an override, so the shader may leave it out: the hdr view's
+/// `exposure`, or a name a `workgroups` or `size` expression reads.
 fn host_only(kernel: &Kernel, name: &str) -> bool {
     let m = &kernel.manifest;
     (kernel.output() == crate::Output::Hdr && name == "exposure")

@@ -542,7 +542,7 @@ pub struct Registry {
 
 impl Registry {
     /// Parses every manifest (`<name>.toml` files; the name is the stem).
-    pub fn from_files(files: &[vista_project::SourceFile]) -> Result<Registry, ParamError> {
+    pub fn from_files(files: &[vista_project::SourceFile]) -> Registry {
         let (mut kernels, mut broken) = (Vec::new(), Vec::new());
         for f in files {
             let Some(name) = f.rel.strip_suffix(".toml") else { continue };
@@ -554,7 +554,7 @@ impl Registry {
                 Err(e) => broken.push((name.to_string(), e)),
             }
         }
-        Ok(Registry { kernels, broken })
+        Registry { kernels, broken }
     }
 
     /// Kernels whose manifest does not parse, with the error.
@@ -567,7 +567,7 @@ impl Registry {
         let files = project
             .kernel_files()
             .map_err(|e| ParamError::Manifest { file: "kernels/".into(), message: e.to_string() })?;
-        Registry::from_files(&files)
+        Ok(Registry::from_files(&files))
     }
 
     /// The built-in kernels from the manifests embedded in the binary.

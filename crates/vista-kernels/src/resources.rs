@@ -268,11 +268,7 @@ pub(crate) fn resolve(
         }
         resource = Some(r.clone());
     }
-    let out = bindings
-        .iter()
-        .find(|b| matches!(b.feed, Feed::Output(_)))
-        .expect("bindings::reflect refuses a pass without an output");
-    let Feed::Output(storage) = out.feed else { unreachable!() };
+    let (out, storage) = crate::bindings::output(bindings);
     if let Some(named) = kernel.output_resource {
         let fits = resource.as_ref().map(|r| r.name == named).unwrap_or(named == out.name);
         if !fits {

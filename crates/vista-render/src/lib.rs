@@ -159,7 +159,7 @@ impl<'a> Renderer<'a> {
 
     /// Hash of each file of the kernel's import closure, by path.
     pub fn shader_file_hashes(&self, shader: &str) -> Result<std::collections::BTreeMap<String, String>, RenderError> {
-        Ok(self.shaders.file_hashes(shader)?.into_iter().collect())
+        Ok(self.shaders.file_hashes(shader)?)
     }
 }
 
