@@ -38,6 +38,7 @@ fn nan_case() -> Case {
         max_bad_pixels: None,
         max_bad_ratio: None,
         expect_fail: vec![],
+        inputs: vec![],
         doc: String::new(),
     }
 }

@@ -131,6 +131,23 @@ pub struct Output {
     pub total: Duration,
 }
 
+/// Standard base64, as the page's `fromBase64` reads it (for callers that
+/// build a graph job's JSON).
+pub fn base64(bytes: &[u8]) -> String {
+    B64.encode(bytes)
+}
+
+/// A pass graph's outputs as the page read them back (each output's bytes:
+/// a texture's texels row-major and unpadded, a buffer whole) and timings.
+#[derive(Debug, Clone)]
+pub struct GraphOutput {
+    pub outputs: Vec<Vec<u8>>,
+    /// Wall time of each pass in the page, all its repeats.
+    pub passes: Vec<Duration>,
+    pub readback: Duration,
+    pub total: Duration,
+}
+
 struct Session {
     chromium: Chromium,
     _page_dir: tempfile::TempDir,
@@ -202,6 +219,68 @@ impl Browser {
         }
     }
 
+    /// Runs a pass graph (`runner.js`'s `vistaRunGraph`, whose comment
+    /// gives the job's shape) and reads every output back. As [`Browser::run`],
+    /// a failure drops the browser.
+    pub fn run_graph(&self, label: &str, job: &serde_json::Value) -> Result<GraphOutput, BrowserError> {
+        let start = Instant::now();
+        let mut guard = self.session.lock().unwrap_or_else(|p| p.into_inner());
+        if guard.is_none() {
+            let (session, _) = Session::start(&self.path, self.timeout)?;
+            *guard = Some(session);
+        }
+        let session = guard.as_ref().expect("session just set");
+        let result = (|| {
+            let reply = session.call(label, &format!("vistaRunGraph({job})"), self.timeout)?;
+            #[derive(Deserialize)]
+            struct Ran {
+                pass_ms: Vec<f64>,
+                readback_ms: f64,
+                lengths: Vec<usize>,
+                bytes: usize,
+            }
+            let ran: Ran = parse_ok(&reply).map_err(|message| BrowserError::Page { case: label.into(), message })?;
+            let bytes = self.fetch(session, label, ran.bytes)?;
+            let mut outputs = Vec::new();
+            let mut at = 0;
+            for n in ran.lengths {
+                outputs.push(bytes[at..at + n].to_vec());
+                at += n;
+            }
+            let ms = |v: f64| Duration::from_secs_f64(v.max(0.0) / 1e3);
+            Ok(GraphOutput {
+                outputs,
+                passes: ran.pass_ms.into_iter().map(ms).collect(),
+                readback: ms(ran.readback_ms),
+                total: start.elapsed(),
+            })
+        })();
+        if result.is_err() {
+            *guard = None;
+        }
+        result
+    }
+
+    /// The page's last output (`expected` bytes), in chunks.
+    fn fetch(&self, s: &Session, label: &str, expected: usize) -> Result<Vec<u8>, BrowserError> {
+        let mut bytes = Vec::with_capacity(expected);
+        for offset in (0..expected).step_by(CHUNK) {
+            let chunk = s.call(label, &format!("vistaChunk({offset}, {CHUNK})"), self.timeout)?;
+            let decoded = B64.decode(chunk.as_bytes()).map_err(|e| BrowserError::Page {
+                case: label.into(),
+                message: format!("output chunk at byte {offset} is not base64: {e}"),
+            })?;
+            bytes.extend_from_slice(&decoded);
+        }
+        if bytes.len() != expected {
+            return Err(BrowserError::Page {
+                case: label.into(),
+                message: format!("received {} output bytes, expected {expected}", bytes.len()),
+            });
+        }
+        Ok(bytes)
+    }
+
     fn run_on(&self, s: &Session, job: &Job<'_>, start: Instant) -> Result<Output, BrowserError> {
         let table: Vec<u8> = job.table.iter().flat_map(|w| w.to_le_bytes()).collect();
         let args = serde_json::json!({
@@ -237,21 +316,7 @@ impl Browser {
                 message: format!("the page read back {} bytes, expected {expected}", ran.bytes),
             });
         }
-        let mut bytes = Vec::with_capacity(expected);
-        for offset in (0..expected).step_by(CHUNK) {
-            let chunk = s.call(job.label, &format!("vistaChunk({offset}, {CHUNK})"), self.timeout)?;
-            let decoded = B64.decode(chunk.as_bytes()).map_err(|e| BrowserError::Page {
-                case: job.label.into(),
-                message: format!("output chunk at byte {offset} is not base64: {e}"),
-            })?;
-            bytes.extend_from_slice(&decoded);
-        }
-        if bytes.len() != expected {
-            return Err(BrowserError::Page {
-                case: job.label.into(),
-                message: format!("received {} output bytes, expected {expected}", bytes.len()),
-            });
-        }
+        let bytes = self.fetch(s, job.label, expected)?;
         Ok(Output {
             bytes,
             kernel: Duration::from_secs_f64(ran.kernel_ms.max(0.0) / 1e3),

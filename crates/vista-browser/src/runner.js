@@ -194,3 +194,183 @@ async function vistaRun(job) {
 function vistaChunk(offset, length) {
   return toBase64(vista.out.subarray(offset, offset + length));
 }
+
+// A pass graph (SPEC 14): job = { resources: [texture | buffer | sampler], passes: [{ key, wgsl, entry,
+// workgroups, repeat, swap: [[a, b]], slots: [{ group, binding, layout, owned (base64) | resource }] }],
+// outputs: [resource index] }. A texture: { kind, format, dimension, width, height, layers, texel_bytes,
+// contents (base64 or null: zeros) }; a buffer: { kind, contents (base64) }; a sampler: { kind, filter,
+// address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
+// binding and visibility); a texture slot's view dimension is its layout's. Outputs are read back one
+// after another into vista.out: textures unpadded, layers stacked; buffers whole.
+async function graphPipeline(pass) {
+  const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout]))}`;
+  const cached = vista.pipelines.get(key);
+  if (cached) return cached;
+  const d = vista.device;
+  d.pushErrorScope("validation");
+  const module = d.createShaderModule({ code: pass.wgsl, label: pass.key });
+  const info = await module.getCompilationInfo();
+  const errors = info.messages.filter((m) => m.type === "error");
+  if (errors.length) {
+    await d.popErrorScope();
+    const lines = errors.map((m) => `line ${m.lineNum}:${m.linePos}: ${m.message}`);
+    throw new Error(`Tint rejected the WGSL of ${pass.key}: ${lines.join("; ")}`);
+  }
+  const count = pass.slots.reduce((m, s) => Math.max(m, s.group + 1), 0);
+  const groups = [];
+  for (let g = 0; g < count; g++) {
+    const entries = pass.slots
+      .filter((s) => s.group === g)
+      .map((s) => Object.assign({ binding: s.binding, visibility: GPUShaderStage.COMPUTE }, s.layout));
+    groups.push(d.createBindGroupLayout({ entries }));
+  }
+  let p;
+  try {
+    const layout = d.createPipelineLayout({ bindGroupLayouts: groups });
+    p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: pass.entry } });
+  } finally {
+    const e = await d.popErrorScope();
+    if (e) throw new Error(`pipeline of ${pass.key}: ${e.message}`);
+  }
+  const compiled = { pipeline: p, groups };
+  vista.pipelines.set(key, compiled);
+  return compiled;
+}
+
+async function vistaRunGraph(job) {
+  const made = [];
+  const scratch = [];
+  try {
+    const d = vista.device;
+    if (!d) throw new Error(`the WebGPU device is gone (${vista.lost || "never created"})`);
+    const compiled = [];
+    for (const pass of job.passes) compiled.push(await graphPipeline(pass));
+    const start = performance.now();
+    d.pushErrorScope("out-of-memory");
+    d.pushErrorScope("validation");
+    const B = GPUBufferUsage;
+    const T = GPUTextureUsage;
+    for (const r of job.resources) {
+      if (r.kind === "texture") {
+        const size = { width: r.width, height: r.height, depthOrArrayLayers: r.layers };
+        const usage = T.STORAGE_BINDING | T.TEXTURE_BINDING | T.COPY_SRC | T.COPY_DST;
+        const texture = d.createTexture({ size, dimension: r.dimension, format: r.format, usage });
+        if (r.contents) {
+          const rowBytes = r.width * r.texel_bytes;
+          d.queue.writeTexture({ texture }, fromBase64(r.contents), { bytesPerRow: rowBytes, rowsPerImage: r.height }, size);
+        }
+        made.push(texture);
+      } else if (r.kind === "buffer") {
+        const bytes = fromBase64(r.contents);
+        const buffer = d.createBuffer({ size: Math.max(4, Math.ceil(bytes.length / 4) * 4), usage: B.STORAGE | B.UNIFORM | B.COPY_SRC | B.COPY_DST, mappedAtCreation: true });
+        new Uint8Array(buffer.getMappedRange()).set(bytes);
+        buffer.unmap();
+        made.push(buffer);
+      } else {
+        const desc = { addressModeU: r.address[0], addressModeV: r.address[1], addressModeW: r.address[2], magFilter: r.filter, minFilter: r.filter, mipmapFilter: r.filter };
+        if (r.compare) desc.compare = r.compare;
+        made.push(d.createSampler(desc));
+      }
+    }
+    const current = job.resources.map((_, i) => i);
+    const owned = job.passes.map((pass) =>
+      pass.slots.map((s) => {
+        if (s.owned === undefined || s.owned === null) return null;
+        const bytes = fromBase64(s.owned);
+        const usage = s.layout.buffer.type === "uniform" ? B.UNIFORM : B.STORAGE;
+        const buffer = d.createBuffer({ size: Math.max(16, Math.ceil(bytes.length / 16) * 16), usage, mappedAtCreation: true });
+        new Uint8Array(buffer.getMappedRange()).set(bytes);
+        buffer.unmap();
+        scratch.push(buffer);
+        return buffer;
+      }),
+    );
+    const setup = await d.popErrorScope();
+    const setupOom = await d.popErrorScope();
+    if (setup) throw new Error(`WebGPU validation (resources): ${setup.message}`);
+    if (setupOom) throw new Error(`WebGPU out of memory (resources): ${setupOom.message}`);
+    await d.queue.onSubmittedWorkDone();
+    const passMs = [];
+    for (let p = 0; p < job.passes.length; p++) {
+      const pass = job.passes[p];
+      const passStart = performance.now();
+      for (let run = 0; run < pass.repeat; run++) {
+        d.pushErrorScope("validation");
+        const resource = (s, i) => {
+          if (owned[p][i]) return { buffer: owned[p][i] };
+          const r = made[current[s.resource]];
+          if (s.layout.buffer) return { buffer: r };
+          if (s.layout.sampler) return r;
+          const dim = (s.layout.texture || s.layout.storageTexture).viewDimension;
+          return r.createView({ dimension: dim });
+        };
+        const bindGroups = compiled[p].groups.map((layout, g) =>
+          d.createBindGroup({
+            layout,
+            entries: pass.slots.map((s, i) => [s, i]).filter(([s]) => s.group === g).map(([s, i]) => ({ binding: s.binding, resource: resource(s, i) })),
+          }),
+        );
+        const encoder = d.createCommandEncoder();
+        const cp = encoder.beginComputePass();
+        cp.setPipeline(compiled[p].pipeline);
+        bindGroups.forEach((group, g) => cp.setBindGroup(g, group));
+        cp.dispatchWorkgroups(pass.workgroups[0], pass.workgroups[1], pass.workgroups[2]);
+        cp.end();
+        const e = await d.popErrorScope();
+        if (e) throw new Error(`WebGPU validation (${pass.label}): ${e.message}`);
+        d.queue.submit([encoder.finish()]);
+        await d.queue.onSubmittedWorkDone();
+        for (const [a, b] of pass.swap) [current[a], current[b]] = [current[b], current[a]];
+      }
+      passMs.push(performance.now() - passStart);
+    }
+    const copyStart = performance.now();
+    const parts = [];
+    for (const o of job.outputs) {
+      const r = job.resources[o];
+      const physical = made[current[o]];
+      const encoder = d.createCommandEncoder();
+      let readback;
+      let unpad = null;
+      if (r.kind === "texture") {
+        const rowBytes = r.width * r.texel_bytes;
+        const paddedRow = Math.ceil(rowBytes / 256) * 256;
+        const rows = r.height * r.layers;
+        readback = d.createBuffer({ size: paddedRow * rows, usage: B.COPY_DST | B.MAP_READ });
+        const size = { width: r.width, height: r.height, depthOrArrayLayers: r.layers };
+        encoder.copyTextureToBuffer({ texture: physical }, { buffer: readback, bytesPerRow: paddedRow, rowsPerImage: r.height }, size);
+        unpad = { rowBytes, paddedRow, rows };
+      } else {
+        const size = Math.max(4, Math.ceil(r.size / 4) * 4);
+        readback = d.createBuffer({ size, usage: B.COPY_DST | B.MAP_READ });
+        encoder.copyBufferToBuffer(physical, 0, readback, 0, size);
+      }
+      scratch.push(readback);
+      d.queue.submit([encoder.finish()]);
+      await readback.mapAsync(GPUMapMode.READ);
+      const mapped = new Uint8Array(readback.getMappedRange());
+      if (unpad) {
+        const out = new Uint8Array(unpad.rowBytes * unpad.rows);
+        for (let y = 0; y < unpad.rows; y++) out.set(mapped.subarray(y * unpad.paddedRow, y * unpad.paddedRow + unpad.rowBytes), y * unpad.rowBytes);
+        parts.push(out);
+      } else {
+        parts.push(mapped.slice(0, r.size));
+      }
+      readback.unmap();
+    }
+    const total = parts.reduce((n, p) => n + p.length, 0);
+    const out = new Uint8Array(total);
+    let at = 0;
+    for (const p of parts) {
+      out.set(p, at);
+      at += p.length;
+    }
+    if (!vista.device) throw new Error(`the WebGPU device was lost during the run (${vista.lost})`);
+    vista.out = out;
+    return JSON.stringify({ ok: true, pass_ms: passMs, readback_ms: performance.now() - copyStart, total_ms: performance.now() - start, lengths: parts.map((p) => p.length), bytes: total });
+  } catch (e) {
+    return fail(e);
+  } finally {
+    for (const x of [...made, ...scratch]) if (x && x.destroy) x.destroy();
+  }
+}

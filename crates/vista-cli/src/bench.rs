@@ -27,18 +27,46 @@ pub fn bench(
     let p = k.resolve(preset, &parse_sets(set)?).map_err(bad)?;
     let (w, h) = vista_kernels::parse_size(size).map_err(bad)?;
     let shaders = vista_render::shader_set(project)?;
-    vista_render::plan(&shaders, k, &p, w, h, &config.limits)?;
+    // Every check that needs no device, before it is made.
+    let graph_passes = match k.graph() {
+        Some(_) => {
+            vista_render::check_request(k, &p, w, h, &config.limits)?;
+            let plan = vista_render::plan_graph(&shaders, project.root(), k, &p, &[], w, h)?;
+            plan.passes.iter().map(|p| p.label.clone()).collect()
+        }
+        None => {
+            vista_render::plan(&shaders, k, &p, w, h, &config.limits)?;
+            Vec::new()
+        }
+    };
     if cpu && !k.has_reference() {
         return Err(bad(format!("--cpu: kernel {kernel} has no CPU reference (only built-in kernels have one)")));
     }
-    let ctx = &Renderer { ctx: Context::shared(&config.gpu)?, shaders, limits: config.limits };
+    let ctx = &Renderer {
+        ctx: Context::shared(&config.gpu)?,
+        shaders,
+        limits: config.limits,
+        root: project.root().map(Into::into),
+    };
     // Warm-up: compiles the pipeline and touches every allocation path once.
     // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
     let first = vista_render::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
     let mut stats = Vec::new();
+    let mut pass_times: Vec<Vec<std::time::Duration>> = vec![Vec::new(); graph_passes.len()];
     for _ in 0..runs {
-        stats.push(vista_render::render(ctx, k, &p, w, h)?.stats);
+        let r = vista_render::render(ctx, k, &p, w, h)?;
+        for (all, t) in pass_times.iter_mut().zip(&r.pass_times) {
+            all.push(*t);
+        }
+        stats.push(r.stats);
     }
+    // A pass graph's passes, each by its median wall time (submit to done,
+    // all its repeats; the adapter's timestamps are not read).
+    let passes: Vec<PassTime> = graph_passes
+        .into_iter()
+        .zip(pass_times)
+        .map(|(pass, times)| PassTime { pass, median_ms: vista_render::median(times).as_secs_f64() * 1e3 })
+        .collect();
     let med = |f: fn(&vista_gpu::RunStats) -> std::time::Duration| {
         vista_render::median(stats.iter().map(f).collect()).as_secs_f64()
     };
@@ -68,6 +96,7 @@ pub fn bench(
         cpu_f32_ms: cpu_ms,
         cpu_threads: cpu_ms.map(|_| rayon::current_num_threads()),
         cpu_over_gpu: cpu_ms.map(|ms| ms / (median * 1e3)),
+        passes,
     };
     if json {
         println!("{}", serde_json::to_string(&result).map_err(|e| bad(format!("JSON encode: {e}")))?);
@@ -85,11 +114,21 @@ pub fn bench(
             "device creation {:.1} ms, first call (compose + pipeline compile + dispatch + readback) {:.1} ms",
             r.device_creation_ms, r.first_dispatch_ms
         );
+        for p in &r.passes {
+            println!("  {}: median {:.2} ms", p.pass, p.median_ms);
+        }
         if let (Some(ms), Some(threads), Some(ratio)) = (r.cpu_f32_ms, r.cpu_threads, r.cpu_over_gpu) {
             println!("f32 CPU reference on {threads} threads: {ms:.2} ms = {ratio:.2}x the GPU time");
         }
     }
     Ok(0)
+}
+
+/// One pass of a graph and its median wall time.
+#[derive(Debug, serde::Serialize)]
+struct PassTime {
+    pass: String,
+    median_ms: f64,
 }
 
 /// What `vista bench` measured: printed as text, or serialised whole by `--json`.
@@ -113,6 +152,9 @@ struct BenchResult {
     cpu_f32_ms: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     cpu_threads: Option<usize>,
+    /// A pass graph's passes (empty for a one-pass kernel).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    passes: Vec<PassTime>,
     #[serde(skip_serializing_if = "Option::is_none")]
     cpu_over_gpu: Option<f64>,
 }

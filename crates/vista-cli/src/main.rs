@@ -13,6 +13,7 @@ use vista_project::Project;
 use vista_render::Renderer;
 
 mod bench;
+mod graph_render;
 mod init;
 mod matrix;
 mod mutate;
@@ -335,12 +336,33 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             if !(1..=16).contains(&zoom) {
                 return Err(bad(format!("--zoom {zoom} is out of range; allowed: 1 to 16")));
             }
+            if k.graph().is_some() {
+                if crop.is_some() || zoom > 1 {
+                    return Err(bad(
+                        "--crop and --zoom apply to one-pass kernels; a pass graph writes every output whole",
+                    ));
+                }
+                check_parent_writable(&out)?;
+                let shaders = vista_render::shader_set(project)?;
+                let ctx = &Renderer {
+                    ctx: Context::shared(&config.gpu)?,
+                    shaders,
+                    limits: config.limits,
+                    root: project.root().map(Into::into),
+                };
+                return graph_render::render(ctx, k, &p, w, h, &out);
+            }
             check_output_path(&out)?;
             let shaders = vista_render::shader_set(project)?;
             let plan = vista_render::plan(&shaders, k, &p, w, h, &config.limits)?;
             // Layers and slices are stacked top to bottom: crop that image.
             let rect = crop.as_deref().map(|c| parse_crop(c, plan.width, plan.height * plan.layers)).transpose()?;
-            let ctx = &Renderer { ctx: Context::shared(&config.gpu)?, shaders, limits: config.limits };
+            let ctx = &Renderer {
+                ctx: Context::shared(&config.gpu)?,
+                shaders,
+                limits: config.limits,
+                root: project.root().map(Into::into),
+            };
             let r = vista_render::run(ctx, &plan)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
             let mut img = if is_exr { r.raw.clone() } else { r.display().clone() };

@@ -37,7 +37,12 @@ pub fn matrix(
                 continue;
             }
         };
-        let gpu = Renderer { ctx: &ctx, shaders: shaders.clone(), limits: config.limits };
+        let gpu = Renderer {
+            ctx: &ctx,
+            shaders: shaders.clone(),
+            limits: config.limits,
+            root: project.root().map(Into::into),
+        };
         let (dir, opts) = (report_dir.join(b), CheckOptions { twice: false });
         let outcomes: Vec<Outcome> = picked
             .iter()

@@ -11,7 +11,7 @@ use vista_image::metrics;
 
 use crate::store::{ManifestEntry, Store, params_hash};
 use crate::{GoldenError, select};
-use vista_render::{Rendered, Renderer, quantize16, render};
+use vista_render::{Rendered, Renderer, quantize16};
 
 #[derive(Debug, Clone, Default)]
 pub struct BlessOptions {
@@ -59,11 +59,15 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
 
     let mut rendered: Vec<(&crate::Case, Rendered)> = Vec::new();
     for case in &picked {
-        let r = render(ctx, case.kernel, &case.params, case.width, case.height)?;
+        let r = crate::run::render_case(ctx, case)?;
         // The checks of `vista check` that need no golden, with the same
         // words: a golden is never blessed from output check would fail.
-        let again = render(ctx, case.kernel, &case.params, case.width, case.height)?;
-        let (problems, _) = crate::guards(case, &r.raw, r.format, r.unwritten, Some(again.raw.bit_identical(&r.raw)));
+        let identical = match case.kernel.graph().is_none_or(|g| g.deterministic) {
+            true => Some(crate::run::same_render(&crate::run::render_case(ctx, case)?, &r)),
+            false => None,
+        };
+        let (mut problems, _) = crate::guards(case, &r.raw, r.format, r.unwritten, identical);
+        problems.extend(crate::outputs::output_guards(&r.outputs));
         if !problems.is_empty() {
             return Err(GoldenError::Rejected(format!(
                 "case {}: {}; refusing to bless it (vista check would fail it); nothing was written",
@@ -84,6 +88,47 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
     let mut rows = Vec::new();
     for (case, r) in rendered {
         let path = store.golden_path(case);
+        // A pass graph's other files first: each atomic, named in the entry.
+        let extra = crate::outputs::golden_bytes(&store.dir, case, &r.outputs)?;
+        let mut extra_hashes = std::collections::BTreeMap::new();
+        let mut extra_changed = false;
+        for (file, bytes) in &extra {
+            if let Some(parent) = file.parent() {
+                std::fs::create_dir_all(parent)
+                    .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+            }
+            let hash = crate::short_hash_bytes(bytes);
+            if std::fs::read(file).ok().map(|b| crate::short_hash_bytes(&b)).as_deref() != Some(hash.as_str()) {
+                extra_changed = true;
+                vista_image::atomic_write(file, bytes)?;
+            }
+            let name = file.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+            extra_hashes.insert(name, hash);
+        }
+        if r.raw.width == 0 {
+            // No main image (a graph whose first output is a buffer).
+            let run = crate::RunInfo {
+                backend: ctx.backend().to_string(),
+                adapter: adapter.clone(),
+                params_hash: params_hash(case),
+                shader_hash: ctx.kernel_shader_hash(case.kernel)?,
+            };
+            let files = ctx.kernel_file_hashes(case.kernel)?;
+            let previous = manifest.case.get(&case.id);
+            let status = match previous {
+                None => "new",
+                Some(p) if p.outputs == extra_hashes && !extra_changed => "unchanged",
+                Some(_) => "changed",
+            };
+            let mut entry =
+                ManifestEntry::of_render(case, &run, files, r.raw.content_hash(), status.into(), String::new());
+            entry.outputs = extra_hashes;
+            manifest.case.insert(case.id.clone(), entry);
+            store.write_manifest(&manifest)?;
+            let shown = extra.first().map(|(p, _)| p.clone()).unwrap_or(path);
+            rows.push(BlessRow { id: case.id.clone(), status, psnr_vs_previous: status.into(), path: shown });
+            continue;
+        }
         let new = quantize16(r.display());
         // Read once: decoded for the PSNR against the new golden, hashed below.
         let old_bytes = std::fs::read(&path).ok();
@@ -109,11 +154,13 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             backend: ctx.backend().to_string(),
             adapter: adapter.clone(),
             params_hash: params_hash(case),
-            shader_hash: ctx.shader_hash(case.kernel.shader())?,
+            shader_hash: ctx.kernel_shader_hash(case.kernel)?,
         };
-        let files = ctx.shader_file_hashes(case.kernel.shader())?;
+        let files = ctx.kernel_file_hashes(case.kernel)?;
         let mut entry =
             ManifestEntry::of_render(case, &run, files, r.raw.content_hash(), psnr.clone(), new_hash.clone());
+        entry.outputs = extra_hashes;
+        let status = if status == "unchanged" && extra_changed { "changed" } else { status };
         let same_render = |e: &ManifestEntry| {
             (&e.params_hash, &e.shader_hash, &e.adapter, &e.raw_hash)
                 == (&entry.params_hash, &entry.shader_hash, &entry.adapter, &entry.raw_hash)
@@ -130,6 +177,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
                 replacing: None,
                 shader_files,
                 backend,
+                outputs: entry.outputs.clone(),
                 ..previous.clone()
             };
         } else if old_hash.as_deref() != Some(new_hash.as_str()) {

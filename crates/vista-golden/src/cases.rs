@@ -13,6 +13,7 @@
 //! max_flip = 0.01                # optional: mean LDR-FLIP error, in [0, 1]
 //! max_bad_pixels = 25            # optional: pixels a channel of which differs by > 1/255
 //! max_bad_ratio = 0.001          # optional: the same as a share of the pixels, in [0, 1]
+//! inputs = { photo = "inputs/other.png" }  # optional: a pass graph's resource files replaced
 //! ```
 
 use std::collections::BTreeMap;
@@ -51,6 +52,8 @@ struct RawCase {
     max_bad_ratio: Option<f64>,
     #[serde(default)]
     expect_fail: Vec<Expectation>,
+    #[serde(default)]
+    inputs: BTreeMap<String, String>,
     #[serde(default)]
     doc: String,
 }
@@ -103,6 +106,9 @@ pub struct Case {
     pub max_bad_ratio: Option<f64>,
     /// Where this case is expected to fail, and why.
     pub expect_fail: Vec<Expectation>,
+    /// A pass graph's resource files this case replaces: (resource, file
+    /// under the project root).
+    pub inputs: Vec<(String, String)>,
     pub doc: String,
 }
 
@@ -167,6 +173,35 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         {
             return Err(bad(format!("max_bad_ratio={r} is out of range; allowed: [0, 1] (a share of the pixels)")));
         }
+        if !raw.inputs.is_empty() {
+            let Some(g) = kernel.graph() else {
+                return Err(bad(format!(
+                    "inputs: kernel {} has no [[resource]] files to replace (a pass graph's inputs)",
+                    kernel.name()
+                )));
+            };
+            for (name, file) in &raw.inputs {
+                let Some(r) = g.resources.iter().find(|r| &r.name == name) else {
+                    let names: Vec<&str> = g.resources.iter().map(|r| r.name.as_str()).collect();
+                    return Err(bad(format!("inputs: {name} names no resource; resources: {}", names.join(", "))));
+                };
+                let want: &[&str] = match r.kind_name() {
+                    "texture" => &[".png", ".exr"],
+                    "buffer" => &[".npy", ".bin"],
+                    _ => &[],
+                };
+                if file.starts_with('/') || file.split(['/', '\\']).any(|c| c == "..") {
+                    return Err(bad(format!("inputs: {name} = \"{file}\" must be a path under the project root")));
+                }
+                if !want.iter().any(|e| file.ends_with(e)) {
+                    return Err(bad(format!(
+                        "inputs: {name} = \"{file}\" is not valid for a {}; expected a {} file",
+                        r.kind_name(),
+                        if want.is_empty() { "(none: a sampler has no file)".to_string() } else { want.join(" or ") }
+                    )));
+                }
+            }
+        }
         for x in &raw.expect_fail {
             if !EXPECTATION_BACKENDS.contains(&x.backend.as_str()) {
                 return Err(bad(format!(
@@ -194,6 +229,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             max_bad_pixels: raw.max_bad_pixels,
             max_bad_ratio: raw.max_bad_ratio,
             expect_fail: raw.expect_fail,
+            inputs: raw.inputs.into_iter().collect(),
             doc: raw.doc,
         });
     }

@@ -146,6 +146,9 @@ pub enum GoldenRead<'a> {
     /// The file, the short hash of its bytes and its decoded values, or
     /// why they could not be decoded.
     Present { path: &'a Path, hash: &'a str, image: Result<&'a Image, &'a str> },
+    /// The case has no main image: a pass graph whose first output is a
+    /// buffer, judged by its outputs alone.
+    NoImage,
 }
 
 /// What a check observed of one case, gathered by the caller.
@@ -165,6 +168,12 @@ pub struct Observed<'a> {
     /// Hash of each WGSL file the kernel reaches now, by path.
     pub shader_files: &'a BTreeMap<String, String>,
     pub golden: GoldenRead<'a>,
+    /// A pass graph's outputs as compared with their goldens
+    /// (`outputs::compare_output`); empty for a one-pass kernel.
+    pub outputs: &'a [crate::outputs::OutputVerdict],
+    /// False for a kernel whose manifest says `deterministic = false`: no
+    /// bit-identity with the bless-time render is asked.
+    pub deterministic: bool,
 }
 
 /// The checks that need no golden, and so also gate `vista bless`: every
@@ -320,7 +329,11 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
                 ));
             } else if e.params_hash != run.params_hash {
                 out.notes.push("case parameters changed since the last bless".into());
-            } else if out.same_driver && e.shader_hash == run.shader_hash && e.raw_hash != obs.raw.content_hash() {
+            } else if obs.deterministic
+                && out.same_driver
+                && e.shader_hash == run.shader_hash
+                && e.raw_hash != obs.raw.content_hash()
+            {
                 out.problems.push(format!(
                     "not bit-identical with the bless-time render on the same adapter, shader and params \
                      (raw hash {} vs manifest {})",
@@ -331,7 +344,9 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
         }
         None => out.notes.push("no manifest entry for this case".into()),
     }
+    outputs_verdict(case, obs.outputs, out);
     let (path, hash, expected) = match obs.golden {
+        GoldenRead::NoImage => return,
         GoldenRead::Missing { path } => {
             out.verdict = Verdict::Missing;
             out.problems.push(format!(
@@ -430,6 +445,31 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
         ));
     }
     out.metrics = Some(m);
+}
+
+/// Folds a graph's output verdicts into the case's: a missing golden file
+/// makes the case missing, an unreadable one an error, a difference a
+/// failure; each output's summary is a note.
+fn outputs_verdict(case: &Case, outputs: &[crate::outputs::OutputVerdict], out: &mut Outcome) {
+    for o in outputs {
+        for path in &o.missing {
+            out.verdict = Verdict::Missing;
+            out.problems.push(format!(
+                "golden {} (output {}) does not exist; render and review it, then create it with: {}",
+                path.display(),
+                o.name,
+                case.bless_command()
+            ));
+        }
+        if !o.errors.is_empty() {
+            out.verdict = Verdict::Error;
+            out.problems.extend(o.errors.iter().cloned());
+        }
+        out.problems.extend(o.problems.iter().cloned());
+        if o.problems.is_empty() && !o.summary.is_empty() {
+            out.notes.push(o.summary.clone());
+        }
+    }
 }
 
 /// Files whose hash differs between bless time and now, or that only one

@@ -11,6 +11,7 @@ pub mod agreement;
 pub mod bless;
 pub mod cases;
 pub mod check;
+pub mod outputs;
 pub mod pending;
 pub mod run;
 pub mod selection;

@@ -3,7 +3,7 @@
 //! outcome, for the caller to hand to `vista-report`.
 
 use vista_image::Image;
-use vista_render::{Renderer, quantize16, render};
+use vista_render::{Rendered, Renderer, quantize16, render_with};
 
 use crate::Case;
 use crate::check::{GoldenRead, Observed, Outcome, RunInfo, judge};
@@ -38,35 +38,31 @@ pub fn run_info(ctx: &Renderer, case: &Case) -> RunInfo {
         backend: ctx.backend().to_string(),
         adapter: ctx.adapter_description(),
         params_hash: params_hash(case),
-        shader_hash: ctx.shader_hash(case.kernel.shader()).unwrap_or_else(|e| format!("unavailable: {e}")),
+        shader_hash: ctx.kernel_shader_hash(case.kernel).unwrap_or_else(|e| format!("unavailable: {e}")),
     }
 }
 
 /// Renders `case` and judges it against its golden and manifest entry
 /// (errors become `Verdict::Error`).
 pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Case, opts: &CheckOptions) -> Checked {
-    let shader = case.kernel.shader();
     let run = run_info(ctx, case);
     let entry = manifest.case.get(&case.id);
-    let rendered = render(ctx, case.kernel, &case.params, case.width, case.height).map_err(|e| e.to_string());
+    let rendered = render_case(ctx, case).map_err(|e| e.to_string());
     let r = match rendered {
         Ok(r) => r,
         Err(e) => {
             return Checked { outcome: judge(case, entry, run, Err(e)), actual: None, expected: None, pending: None };
         }
     };
+    let has_image = r.raw.width > 0;
     let actual = quantize16(r.display());
+    let deterministic = case.kernel.graph().is_none_or(|g| g.deterministic);
     let gathered = (|| -> Result<_, String> {
-        let repeat_identical = match opts.twice {
-            true => Some(
-                render(ctx, case.kernel, &case.params, case.width, case.height)
-                    .map_err(|e| e.to_string())?
-                    .raw
-                    .bit_identical(&r.raw),
-            ),
+        let repeat_identical = match opts.twice && deterministic {
+            true => Some(same_render(&render_case(ctx, case).map_err(|e| e.to_string())?, &r)),
             false => None,
         };
-        let files = ctx.shader_file_hashes(shader).map_err(|e| e.to_string())?;
+        let files = ctx.kernel_file_hashes(case.kernel).map_err(|e| e.to_string())?;
         let path = store.golden_path(case);
         let golden = match path.exists() {
             false => None,
@@ -93,11 +89,20 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         Err(e) => judge(case, entry, run, Err(e.clone())),
         Ok((repeat_identical, files, path, golden)) => {
             let golden_read = match golden {
+                _ if !has_image => GoldenRead::NoImage,
                 None => GoldenRead::Missing { path },
                 Some((hash, image)) => {
                     GoldenRead::Present { path, hash, image: image.as_ref().map_err(|e| e.as_str()) }
                 }
             };
+            let same_driver = entry.is_none_or(|e| e.adapter == run.adapter);
+            let threshold = if same_driver { case.psnr_same_driver } else { case.psnr_other_driver };
+            let outputs: Vec<crate::outputs::OutputVerdict> = r
+                .outputs
+                .iter()
+                .enumerate()
+                .map(|(i, o)| crate::outputs::compare_output(case, &store.dir, i, o, threshold))
+                .collect();
             let observed = Observed {
                 unwritten: r.unwritten,
                 format: r.format,
@@ -106,6 +111,8 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
                 repeat_identical: *repeat_identical,
                 shader_files: files,
                 golden: golden_read,
+                outputs: &outputs,
+                deterministic,
             };
             judge(case, entry, run, Ok(observed))
         }
@@ -127,5 +134,26 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         Ok((_, _, _, Some((_, Ok(image))))) => Some(image),
         _ => None,
     };
-    Checked { outcome: out, actual: Some(actual), expected, pending }
+    Checked { outcome: out, actual: has_image.then_some(actual), expected, pending }
+}
+
+/// Renders a case: its kernel, params, size and replacement inputs.
+pub fn render_case(ctx: &Renderer, case: &Case) -> Result<Rendered, vista_render::RenderError> {
+    render_with(ctx, case.kernel, &case.params, &case.inputs, case.width, case.height)
+}
+
+/// Whether two renders are bit-identical in every output.
+pub fn same_render(a: &Rendered, b: &Rendered) -> bool {
+    a.raw.bit_identical(&b.raw)
+        && a.outputs.len() == b.outputs.len()
+        && a.outputs.iter().zip(&b.outputs).all(|(x, y)| match (&x.value, &y.value) {
+            (vista_render::OutputValue::Texture { raw: p, .. }, vista_render::OutputValue::Texture { raw: q, .. }) => {
+                p.bit_identical(q)
+            }
+            (
+                vista_render::OutputValue::Buffer { bytes: p, .. },
+                vista_render::OutputValue::Buffer { bytes: q, .. },
+            ) => p == q,
+            _ => false,
+        })
 }

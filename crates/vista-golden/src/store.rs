@@ -41,6 +41,11 @@ pub struct ManifestEntry {
     /// cleared after it, so the file on disk always matches the entry.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub replacing: Option<String>,
+    /// A pass graph's other golden files (`<case>.<output>.png`, `.exr`,
+    /// `.npy`; a first output's `.exr` or `.npy`), by file name, with the
+    /// hash of their bytes.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub outputs: BTreeMap<String, String>,
 }
 
 impl ManifestEntry {
@@ -69,6 +74,7 @@ impl ManifestEntry {
             psnr_vs_previous,
             golden_hash,
             replacing: None,
+            outputs: BTreeMap::new(),
         }
     }
 }
@@ -133,9 +139,13 @@ impl Store {
         Ok(())
     }
 
-    /// Golden PNGs on disk that no case refers to.
+    /// Golden files on disk (PNG, EXR, NumPy) that no case refers to: a
+    /// file of `golden/<kernel>/` belongs to a case of that kernel when its
+    /// name is the case id up to the first '.' (ids have none), so a pass
+    /// graph's `<case>.<output>.npy` belongs to its case.
     pub fn orphans(&self, cases: &[Case]) -> Vec<PathBuf> {
-        let known: std::collections::HashSet<PathBuf> = cases.iter().map(|c| self.golden_path(c)).collect();
+        let known: std::collections::HashSet<(String, String)> =
+            cases.iter().map(|c| (c.kernel.name().to_string(), c.id.clone())).collect();
         let mut out = Vec::new();
         let Ok(kernels) = std::fs::read_dir(&self.dir) else {
             return out;
@@ -146,7 +156,10 @@ impl Store {
             };
             for f in files.flatten() {
                 let p = f.path();
-                if p.extension().is_some_and(|e| e == "png") && !known.contains(&p) {
+                let kernel = k.file_name().to_string_lossy().to_string();
+                let id = f.file_name().to_string_lossy().split('.').next().unwrap_or_default().to_string();
+                let golden_kind = p.extension().is_some_and(|e| e == "png" || e == "npy" || e == "exr");
+                if golden_kind && !known.contains(&(kernel, id)) {
                     out.push(p);
                 }
             }

@@ -218,7 +218,7 @@ pub enum Dimension {
 }
 
 impl Dimension {
-    fn texture(self) -> wgpu::TextureDimension {
+    pub(crate) fn texture(self) -> wgpu::TextureDimension {
         match self {
             Dimension::D1 => wgpu::TextureDimension::D1,
             Dimension::D2 | Dimension::D2Array => wgpu::TextureDimension::D2,
@@ -226,7 +226,7 @@ impl Dimension {
         }
     }
 
-    fn view(self) -> wgpu::TextureViewDimension {
+    pub(crate) fn view(self) -> wgpu::TextureViewDimension {
         match self {
             Dimension::D1 => wgpu::TextureViewDimension::D1,
             Dimension::D2 => wgpu::TextureViewDimension::D2,
@@ -238,6 +238,11 @@ impl Dimension {
     /// The manifest's name (and WebGPU's view dimension).
     pub fn name(self) -> &'static str {
         self.web().1
+    }
+
+    /// WebGPU's names: the texture's dimension and its view's.
+    pub(crate) fn web_names(self) -> (&'static str, &'static str) {
+        self.web()
     }
 
     /// WebGPU's names: the texture's dimension and its view's.
@@ -288,28 +293,28 @@ pub struct Readback {
 /// Headless state shared by everything in one process: a wgpu device, or
 /// the browser.
 pub struct Context {
-    engine: Engine,
+    pub(crate) engine: Engine,
     info: wgpu::AdapterInfo,
     backend: &'static str,
-    timeout: Duration,
+    pub(crate) timeout: Duration,
     /// Serialises submissions so a timeout is attributed to the right job.
-    submit_lock: Mutex<()>,
+    pub(crate) submit_lock: Mutex<()>,
     pub creation_time: Duration,
     /// Whether the Khronos validation layer is on.
-    validate: bool,
+    pub(crate) validate: bool,
 }
 
-enum Engine {
+pub(crate) enum Engine {
     Wgpu(Box<WgpuEngine>),
     Browser(Box<BrowserEngine>),
 }
 
-struct WgpuEngine {
-    device: wgpu::Device,
-    queue: wgpu::Queue,
+pub(crate) struct WgpuEngine {
+    pub(crate) device: wgpu::Device,
+    pub(crate) queue: wgpu::Queue,
     /// Pipelines with their bind group layouts (one per group up to the
     /// highest the kernel binds), by shader hash, entry, slots and format.
-    pipelines: Mutex<HashMap<String, Arc<Compiled>>>,
+    pub(crate) pipelines: Mutex<HashMap<String, Arc<Compiled>>>,
     /// The last run's output texture, readback and sentinel buffers, which
     /// the next run of the same size takes instead of allocating its own:
     /// fresh ones cost a page fault per 4 KiB as they are first written
@@ -322,9 +327,9 @@ struct WgpuEngine {
     read_write: Vec<&'static str>,
 }
 
-struct Compiled {
-    pipeline: wgpu::ComputePipeline,
-    groups: Vec<wgpu::BindGroupLayout>,
+pub(crate) struct Compiled {
+    pub(crate) pipeline: wgpu::ComputePipeline,
+    pub(crate) groups: Vec<wgpu::BindGroupLayout>,
 }
 
 struct Scratch {
@@ -343,12 +348,12 @@ struct Scratch {
     sentinel: wgpu::Buffer,
 }
 
-struct BrowserEngine {
-    browser: vista_browser::Browser,
+pub(crate) struct BrowserEngine {
+    pub(crate) browser: vista_browser::Browser,
     /// The WebGPU device's features (requested: every one the adapter has).
-    features: Vec<String>,
+    pub(crate) features: Vec<String>,
     /// naga's WGSL of each composed kernel, by source hash.
-    sources: Mutex<HashMap<String, Arc<String>>>,
+    pub(crate) sources: Mutex<HashMap<String, Arc<String>>>,
 }
 
 /// Where Debian's vulkan-validationlayers puts the layer's manifest.
@@ -427,12 +432,15 @@ impl Context {
         // Adapter-specific format features: read_write storage beyond the
         // core r32 formats, where the driver has it.
         let specific = wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
-        let required_features = adapter.features() & specific;
+        // Linear sampling of r32float/rg32float/rgba32float inputs, where
+        // the driver has it (SPEC 14, features and limits).
+        let wanted = specific | wgpu::Features::FLOAT32_FILTERABLE;
+        let required_features = adapter.features() & wanted;
         let read_write = crate::format::format_names()
             .into_iter()
             .filter(|name| {
                 CORE_READ_WRITE.contains(name)
-                    || (!required_features.is_empty()
+                    || (required_features.contains(specific)
                         && OutputFormat::parse(name).is_ok_and(|f| {
                             adapter
                                 .get_texture_format_features(f.wgpu)
@@ -577,17 +585,10 @@ impl Context {
         if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
         }
-        let module = job.shaders.compose(job.shader)?;
-        let scope = w.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let sm = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(job.shader),
-            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned((*module).clone())),
-        });
         let last = job.slots.iter().map(|s| s.group).max();
-        let groups: Vec<wgpu::BindGroupLayout> = (0..last.map_or(0, |g| g + 1))
+        let layouts: Vec<Vec<wgpu::BindGroupLayoutEntry>> = (0..last.map_or(0, |g| g + 1))
             .map(|g| {
-                let entries: Vec<wgpu::BindGroupLayoutEntry> = job
-                    .slots
+                job.slots
                     .iter()
                     .filter(|s| s.group == g)
                     .map(|s| {
@@ -618,36 +619,59 @@ impl Context {
                             count: None,
                         }
                     })
-                    .collect();
-                w.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("vista group"),
-                    entries: &entries,
-                })
+                    .collect()
             })
             .collect();
-        let layouts: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(Some).collect();
+        let compiled = self.compile(w, job.shaders, job.shader, job.entry, job.constants, &layouts)?;
+        w.pipelines.lock().expect("pipeline cache").insert(key, compiled.clone());
+        Ok(compiled)
+    }
+
+    /// Compiles a kernel file's entry point with one bind group layout per
+    /// group (entries given per group, groups 0..n).
+    pub(crate) fn compile(
+        &self,
+        w: &WgpuEngine,
+        shaders: &ShaderSet,
+        shader: &str,
+        entry: &str,
+        constants: &[(String, f64)],
+        layouts: &[Vec<wgpu::BindGroupLayoutEntry>],
+    ) -> Result<Arc<Compiled>, GpuError> {
+        let module = shaders.compose(shader)?;
+        let scope = w.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let sm = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(shader),
+            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned((*module).clone())),
+        });
+        let groups: Vec<wgpu::BindGroupLayout> = layouts
+            .iter()
+            .map(|entries| {
+                w.device
+                    .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("vista group"), entries })
+            })
+            .collect();
+        let layout_refs: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(Some).collect();
         let pipeline_layout = w.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(job.shader),
-            bind_group_layouts: &layouts,
+            label: Some(shader),
+            bind_group_layouts: &layout_refs,
             immediate_size: 0,
         });
         let pipeline = w.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(job.shader),
+            label: Some(shader),
             layout: Some(&pipeline_layout),
             module: &sm,
-            entry_point: Some(job.entry),
+            entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &job.constants.iter().map(|(k, v)| (k.as_str(), *v)).collect::<Vec<_>>(),
+                constants: &constants.iter().map(|(k, v)| (k.as_str(), *v)).collect::<Vec<_>>(),
                 ..Default::default()
             },
             cache: None,
         });
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Validation { what: job.shader.to_string(), message: e.to_string() });
+            return Err(GpuError::Validation { what: shader.to_string(), message: e.to_string() });
         }
-        let compiled = Arc::new(Compiled { pipeline, groups });
-        w.pipelines.lock().expect("pipeline cache").insert(key, compiled.clone());
-        Ok(compiled)
+        Ok(Arc::new(Compiled { pipeline, groups }))
     }
 
     /// Runs one dispatch and reads the output texture back, counting the
@@ -664,23 +688,13 @@ impl Context {
             )));
         }
         let format = OutputFormat::parse(job.format)?;
-        if job.read_write && !CORE_READ_WRITE.contains(&format.name) {
-            let (supported, feature) = match &self.engine {
-                Engine::Wgpu(w) => (
-                    w.read_write.contains(&format.name),
-                    "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES with STORAGE_READ_WRITE for this format",
-                ),
-                Engine::Browser(b) => {
-                    (b.features.iter().any(|f| f == "texture-formats-tier2"), "texture-formats-tier2")
-                }
-            };
-            if !supported {
-                return Err(GpuError::Unsupported {
-                    adapter: self.adapter_description(),
-                    what: format!("a read_write {} storage texture", format.name),
-                    feature: feature.to_string(),
-                });
-            }
+        if job.read_write && !self.binds_read_write(&format) {
+            let feature = self.read_write_feature();
+            return Err(GpuError::Unsupported {
+                adapter: self.adapter_description(),
+                what: format!("a read_write {} storage texture", format.name),
+                feature: feature.to_string(),
+            });
         }
         let start = Instant::now();
         let (Texels { mut image, holding_sentinel: suspects }, mut stats) = self.run_over(job, &format, 0)?;
@@ -699,6 +713,25 @@ impl Context {
         }
         stats.total = start.elapsed();
         Ok(Readback { image, stats, unwritten: unwritten.len() as u64 })
+    }
+
+    /// Whether this device binds `format` as a read_write (or read-only)
+    /// storage texture: the core r32 formats everywhere, others where the
+    /// adapter's format features (or Dawn's `texture-formats-tier2`) say so.
+    pub(crate) fn binds_read_write(&self, format: &OutputFormat) -> bool {
+        CORE_READ_WRITE.contains(&format.name)
+            || match &self.engine {
+                Engine::Wgpu(w) => w.read_write.contains(&format.name),
+                Engine::Browser(b) => b.features.iter().any(|f| f == "texture-formats-tier2"),
+            }
+    }
+
+    /// The feature that [`Context::binds_read_write`] depends on here.
+    pub(crate) fn read_write_feature(&self) -> &'static str {
+        match &self.engine {
+            Engine::Wgpu(_) => "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES with STORAGE_READ_WRITE for this format",
+            Engine::Browser(_) => "texture-formats-tier2",
+        }
     }
 
     /// One run over sentinel `which`: the output decoded, and the texels
@@ -986,7 +1019,7 @@ impl Context {
     }
 
     /// Blocks until `index` completes, or fails after the watchdog timeout.
-    fn wait(&self, w: &WgpuEngine, index: wgpu::SubmissionIndex, what: &str) -> Result<(), GpuError> {
+    pub(crate) fn wait(&self, w: &WgpuEngine, index: wgpu::SubmissionIndex, what: &str) -> Result<(), GpuError> {
         w.device
             .poll(wgpu::PollType::Wait { submission_index: Some(index), timeout: Some(self.timeout) })
             .map(|_| ())
@@ -1015,15 +1048,22 @@ fn words_to_bytes(words: &[u32]) -> Vec<u8> {
 
 /// One run's output: decoded, and the indices (ascending) of the texels
 /// whose bytes are the run's sentinel texel.
-struct Texels {
-    image: Image,
-    holding_sentinel: Vec<usize>,
+pub(crate) struct Texels {
+    pub(crate) image: Image,
+    pub(crate) holding_sentinel: Vec<usize>,
 }
 
 /// Decodes `height` rows of `width` texels of `format`, rows `stride` bytes
 /// apart (a readback buffer pads them to 256 bytes), into f32 RGBA, noting
 /// the texels that hold `sentinel`: one pass over the mapped memory.
-fn read_texels(bytes: &[u8], stride: usize, format: &OutputFormat, width: u32, height: u32, sentinel: &[u8]) -> Texels {
+pub(crate) fn read_texels(
+    bytes: &[u8],
+    stride: usize,
+    format: &OutputFormat,
+    width: u32,
+    height: u32,
+    sentinel: &[u8],
+) -> Texels {
     let (w, tb) = (width as usize, format.texel_bytes());
     let mut data = vec![[0.0f32; 4]; w * height as usize];
     let mut holding_sentinel = Vec::new();

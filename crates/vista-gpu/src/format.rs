@@ -60,6 +60,27 @@ impl Channel {
     }
 }
 
+impl Channel {
+    /// One channel of a texel from an f32 value, as a texture upload
+    /// stores it: normalized formats clamp and round, integers round and
+    /// saturate, half floats round to nearest.
+    fn encode(self, v: f32) -> Vec<u8> {
+        let int = |lo: f64, hi: f64| (v as f64).round().clamp(lo, hi);
+        match self {
+            Channel::Unorm8 => vec![(v.clamp(0.0, 1.0) * 255.0).round() as u8],
+            Channel::Snorm8 => vec![((v.clamp(-1.0, 1.0) * 127.0).round() as i8) as u8],
+            Channel::Uint8 => vec![int(0.0, 255.0) as u8],
+            Channel::Sint8 => vec![(int(-128.0, 127.0) as i8) as u8],
+            Channel::Float16 => half::f16::from_f32(v).to_le_bytes().to_vec(),
+            Channel::Uint16 => (int(0.0, 65535.0) as u16).to_le_bytes().to_vec(),
+            Channel::Sint16 => (int(-32768.0, 32767.0) as i16).to_le_bytes().to_vec(),
+            Channel::Float32 => v.to_le_bytes().to_vec(),
+            Channel::Uint32 => (int(0.0, u32::MAX as f64) as u32).to_le_bytes().to_vec(),
+            Channel::Sint32 => (int(i32::MIN as f64, i32::MAX as f64) as i32).to_le_bytes().to_vec(),
+        }
+    }
+}
+
 /// Half-precision bits to f32 (IEEE 754 binary16).
 fn f16_to_f32(h: u16) -> f32 {
     let sign = ((h >> 15) as u32) << 31;
@@ -76,6 +97,14 @@ fn f16_to_f32(h: u16) -> f32 {
         (e, f) => sign | ((e + 127 - 15) << 23) | (f << 13),
     };
     f32::from_bits(bits)
+}
+
+/// What a sampled texture of a format returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampleKind {
+    Float,
+    Uint,
+    Sint,
 }
 
 /// A storage format an output may have.
@@ -142,6 +171,32 @@ impl OutputFormat {
         self.channels.iter().flat_map(|c| c.sentinel(which)).collect()
     }
 
+    /// One texel from f32 RGBA (channels the format lacks are dropped).
+    pub fn encode(&self, rgba: [f32; 4]) -> Vec<u8> {
+        self.channels.iter().zip(rgba).flat_map(|(c, v)| c.encode(v)).collect()
+    }
+
+    /// Whether the channels are 32-bit floats (filterable only with the
+    /// float32-filterable feature).
+    pub fn is_float32(&self) -> bool {
+        self.channels[0] == Channel::Float32
+    }
+
+    /// Whether the channels are unsigned or signed integers (sampled as
+    /// `texture_2d<u32>` / `<i32>`), else floats (normalized ones included).
+    pub fn sample_kind(&self) -> SampleKind {
+        match self.channels[0] {
+            Channel::Uint8 | Channel::Uint16 | Channel::Uint32 => SampleKind::Uint,
+            Channel::Sint8 | Channel::Sint16 | Channel::Sint32 => SampleKind::Sint,
+            _ => SampleKind::Float,
+        }
+    }
+
+    /// Channels per texel.
+    pub fn channels(&self) -> usize {
+        self.channels.len()
+    }
+
     /// One texel as f32 RGBA.
     pub fn decode(&self, texel: &[u8]) -> [f32; 4] {
         let mut out = [0.0, 0.0, 0.0, 1.0];
@@ -172,6 +227,15 @@ mod tests {
         assert!(f16_to_f32(0x7E5A).is_nan() && f16_to_f32(0x7C00).is_infinite());
         assert_eq!(f("rgba16float").texel_bytes(), 8);
         assert_ne!(f("rgba8uint").sentinel(0), f("rgba8uint").sentinel(1));
+        for name in format_names() {
+            let fmt = f(name);
+            let texel = [0.5, -2.0, 3.0, 1.0];
+            let back = fmt.decode(&fmt.encode(texel));
+            assert_eq!(fmt.encode(texel).len(), fmt.texel_bytes(), "{name}");
+            assert_eq!(fmt.encode(back), fmt.encode(texel), "{name}: encode . decode . encode");
+        }
+        assert_eq!(f("rgba8unorm").encode([0.5, -1.0, 2.0, 1.0]), [128, 0, 255, 255]);
+        assert_eq!(f("r32sint").encode([-3.4, 0.0, 0.0, 0.0]), (-3i32).to_le_bytes());
         let e = OutputFormat::parse("bgra8unorm").unwrap_err().to_string();
         assert!(e.contains("bgra8unorm is not supported") && e.contains("rgba16float"), "{e}");
     }

@@ -9,6 +9,7 @@
 
 mod context;
 mod format;
+mod graph;
 mod shaders;
 pub mod validation;
 
@@ -16,7 +17,11 @@ pub use context::{
     AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dimension, Dispatch, GpuConfig, Readback,
     RunStats, SWIFTSHADER_HINT, Slot, SlotKind, UNWRITTEN, VALIDATION_LAYER_JSON,
 };
-pub use format::{OutputFormat, format_names};
+pub use format::{OutputFormat, SampleKind, format_names};
+pub use graph::{
+    Access, Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphReadback, GraphSlot, OutputData, Resource,
+    SamplerDesc, TextureDesc,
+};
 pub use shaders::{ShaderSet, resolve_overrides, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.

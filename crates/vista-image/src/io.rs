@@ -54,6 +54,11 @@ pub fn decode_png16(path: &Path, bytes: &[u8]) -> Result<Image, ImageError> {
 /// Writes `img` as a ZIP-compressed f32 RGBA OpenEXR file; values (including
 /// NaN, Inf and negatives) are stored bit-exactly.
 pub fn write_exr(path: &Path, img: &Image) -> Result<(), ImageError> {
+    atomic_write(path, &encode_exr(path, img)?)
+}
+
+/// The bytes [`write_exr`] writes (`path` names the file in errors).
+pub fn encode_exr(path: &Path, img: &Image) -> Result<Vec<u8>, ImageError> {
     use exr::prelude::{Encoding, SpecificChannels, WritableImage};
 
     // The exr crate panics (instead of erroring) on an empty image.
@@ -69,7 +74,7 @@ pub fn write_exr(path: &Path, img: &Image) -> Result<(), ImageError> {
     let exr_image = exr::image::Image::from_encoded_channels((w, h), Encoding::SMALL_LOSSLESS, channels);
     let mut bytes = Cursor::new(Vec::new());
     exr_image.write().non_parallel().to_buffered(&mut bytes).map_err(|e| encode_error(path, "EXR", e))?;
-    atomic_write(path, bytes.get_ref())
+    Ok(bytes.into_inner())
 }
 
 /// Reads an OpenEXR file with R, G, B (and optionally A) channels as f32

@@ -20,6 +20,14 @@ pub enum Feed {
     Table,
     /// The output: a write or read_write storage texture.
     Output(crate::resources::Storage),
+    /// A read-only storage texture (pass graphs only).
+    StorageRead(crate::resources::Storage),
+    /// A storage buffer other than the table (pass graphs only).
+    Buffer { read_only: bool },
+    /// A sampled texture (pass graphs only).
+    Sampled { dim: crate::graph::SampledDim, kind: crate::graph::SampledKind },
+    /// A sampler (pass graphs only).
+    Sampler { comparison: bool },
 }
 
 /// One binding the entry point reaches.
@@ -215,10 +223,10 @@ fn reached(module: &naga::Module, entry: &naga::Function) -> Vec<Handle<naga::Gl
     globals
 }
 
-/// Every binding `entry` of `module` reaches, each with what feeds it; a
-/// reached global nothing feeds, a second uniform or output, or an unknown
-/// entry point is refused.
-pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<Vec<Binding>, ParamError> {
+/// Every binding `entry` of `module` reaches, each with what feeds it
+/// (any kind SPEC 14 names); only a type no resource can feed, or an
+/// unknown entry point, is refused.
+pub fn reflect_all(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<Vec<Binding>, ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
     let ep = module.entry_points.iter().find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute).ok_or_else(
         || {
@@ -244,13 +252,13 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
         let name = undecorate(var.name.as_deref().unwrap_or_default()).0;
         let unfed = |feed: &str| {
             bad(format!(
-                "pass {entry}: {name} (@group({}) @binding({}), {}) is fed by nothing; it needs {feed}, which vista \
-                 does not feed yet",
+                "pass {entry}: {name} (@group({}) @binding({}), {}) cannot be fed; it would need {feed}",
                 rb.group,
                 rb.binding,
                 wgsl_type(module, var)
             ))
         };
+        use crate::graph::{SampledDim, SampledKind};
         let feed = match (&var.space, &module.types[var.ty].inner) {
             (AddressSpace::Uniform, _) => Feed::Uniform,
             (AddressSpace::Storage { access }, TypeInner::Array { base, .. })
@@ -259,12 +267,8 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
             {
                 Feed::Table
             }
-            (AddressSpace::Storage { .. }, _) => {
-                return Err(unfed("a buffer resource ([[resource]] kind = \"buffer\")"));
-            }
-            (_, TypeInner::Image { dim, arrayed, class: ImageClass::Storage { format, access } })
-                if access.contains(StorageAccess::STORE) =>
-            {
+            (AddressSpace::Storage { access }, _) => Feed::Buffer { read_only: !access.contains(StorageAccess::STORE) },
+            (_, TypeInner::Image { dim, arrayed, class: ImageClass::Storage { format, access } }) => {
                 use crate::resources::{Access, Dimension};
                 let dimension = match (dim, arrayed) {
                     (ImageDimension::D1, _) => Dimension::D1,
@@ -273,37 +277,83 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
                     (ImageDimension::D3, _) => Dimension::D3,
                     _ => return Err(unfed("a storage texture of dimension 1d, 2d, 2d-array or 3d")),
                 };
-                let access = if access.contains(StorageAccess::LOAD) { Access::ReadWrite } else { Access::Write };
-                match format_name(*format) {
-                    Some(format) => Feed::Output(crate::resources::Storage { format, dimension, access }),
-                    None => {
-                        return Err(unfed("an output texture of a supported format (not bgra8unorm or a packed one)"));
+                let access = match (access.contains(StorageAccess::LOAD), access.contains(StorageAccess::STORE)) {
+                    (true, true) => Access::ReadWrite,
+                    (false, _) => Access::Write,
+                    (true, false) => Access::Read,
+                };
+                let Some(format) = format_name(*format) else {
+                    return Err(unfed("a storage texture of a supported format (not bgra8unorm or a packed one)"));
+                };
+                let storage = crate::resources::Storage { format, dimension, access };
+                if access == Access::Read { Feed::StorageRead(storage) } else { Feed::Output(storage) }
+            }
+            (_, TypeInner::Image { dim, arrayed, class }) => {
+                let dim = match (dim, arrayed) {
+                    (ImageDimension::D1, false) => SampledDim::D1,
+                    (ImageDimension::D2, false) => SampledDim::D2,
+                    (ImageDimension::D2, true) => SampledDim::D2Array,
+                    (ImageDimension::D3, false) => SampledDim::D3,
+                    (ImageDimension::Cube, false) => SampledDim::Cube,
+                    _ => return Err(unfed("a texture of dimension 1d, 2d, 2d-array, 3d or cube")),
+                };
+                let kind = match class {
+                    ImageClass::Sampled { multi: true, .. } | ImageClass::Depth { multi: true } => {
+                        return Err(unfed("a multisampled texture, which compute passes cannot make"));
                     }
-                }
+                    ImageClass::Sampled { kind: ScalarKind::Uint, .. } => SampledKind::Uint,
+                    ImageClass::Sampled { kind: ScalarKind::Sint, .. } => SampledKind::Sint,
+                    ImageClass::Sampled { .. } => SampledKind::Float,
+                    ImageClass::Depth { .. } => SampledKind::Depth,
+                    _ => return Err(unfed("an external texture, which compute passes cannot bind")),
+                };
+                Feed::Sampled { dim, kind }
             }
-            (_, TypeInner::Image { .. }) => return Err(unfed("a texture resource ([[resource]] kind = \"texture\")")),
-            (_, TypeInner::Sampler { .. }) => {
-                return Err(unfed("a sampler resource ([[resource]] kind = \"sampler\")"));
-            }
+            (_, TypeInner::Sampler { comparison }) => Feed::Sampler { comparison: *comparison },
             _ => return Err(unfed("a resource")),
         };
-        if let Feed::Output(_) = feed
-            && let Some(first) = out.iter().find(|b| matches!(b.feed, Feed::Output(_)))
-        {
-            return Err(bad(format!(
-                "pass {entry}: {name} (@group({}) @binding({})) is a second output texture after {}; one is \
-                 supported so far",
-                rb.group, rb.binding, first.name
-            )));
-        }
         out.push(Binding { group: rb.group, binding: rb.binding, name, feed, global: g });
     }
-    if !out.iter().any(|b| matches!(b.feed, Feed::Output(_))) {
+    out.sort_by_key(|b| (b.group, b.binding));
+    Ok(out)
+}
+
+/// Every binding `entry` of `module` reaches on the one-pass path (SPEC
+/// 10): uniforms, the table and one written storage texture; any other
+/// reached global, a second output or none is refused, naming what would
+/// feed it.
+pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<Vec<Binding>, ParamError> {
+    let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
+    let out = reflect_all(kernel, shader, entry, module)?;
+    for b in &out {
+        let var = &module.global_variables[b.global];
+        let needs = match b.feed {
+            Feed::Uniform | Feed::Table | Feed::Output(_) => continue,
+            Feed::Buffer { .. } => "a buffer resource ([[resource]] kind = \"buffer\")",
+            Feed::StorageRead(_) | Feed::Sampled { .. } => "a texture resource ([[resource]] kind = \"texture\")",
+            Feed::Sampler { .. } => "a sampler resource ([[resource]] kind = \"sampler\")",
+        };
+        return Err(bad(format!(
+            "pass {entry}: {} (@group({}) @binding({}), {}) is fed by nothing; it needs {needs}, named in the pass's bind",
+            b.name,
+            b.group,
+            b.binding,
+            wgsl_type(module, var)
+        )));
+    }
+    let outputs: Vec<&Binding> = out.iter().filter(|b| matches!(b.feed, Feed::Output(_))).collect();
+    if let [first, second, ..] = outputs[..] {
+        return Err(bad(format!(
+            "pass {entry}: {} (@group({}) @binding({})) is a second output texture after {}; list both as \
+             [[output]] tables (a pass graph)",
+            second.name, second.group, second.binding, first.name
+        )));
+    }
+    if outputs.is_empty() {
         return Err(bad(format!(
             "pass {entry} of {shader} writes no storage texture (texture_storage_{{1d,2d,2d_array,3d}} with write or \
              read_write access)"
         )));
     }
-    out.sort_by_key(|b| (b.group, b.binding));
     Ok(out)
 }

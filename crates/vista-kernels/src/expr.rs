@@ -169,6 +169,18 @@ impl Expr {
         }
     }
 
+    /// Every param (or size) name the expression reads, added to `out`.
+    pub fn names(&self, out: &mut Vec<&'static str>) {
+        match self {
+            Expr::Num(_) => {}
+            Expr::Name(n) => out.push(n),
+            Expr::Bin(_, a, b) | Expr::CeilDiv(a, b) => {
+                a.names(out);
+                b.names(out);
+            }
+        }
+    }
+
     /// One entry of a manifest's `workgroups` or `size` list: a number
     /// >= 1, a param name or an expression (in a string).
     pub fn parse_entry(v: &toml::Value, params: &[ParamSpec]) -> Result<Expr, String> {

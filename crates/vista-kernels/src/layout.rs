@@ -78,14 +78,29 @@ pub struct UniformLayout {
     /// The module's `override` constants by name (a param may feed one).
     pub overrides: Vec<String>,
     /// The storage texture the pass writes, and its resource
-    /// ([`Kernel::layout`] applies the manifest's `bind`).
-    pub output: crate::resources::Target,
+    /// ([`Kernel::layout`] applies the manifest's `bind`); none for a pass
+    /// of a graph (its resources are resolved by `graph::resolve`).
+    pub output: Option<crate::resources::Target>,
 }
 
 /// Reflects the uniform block of `module` for `kernel` (named in errors).
 pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<UniformLayout, ParamError> {
-    let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
     let bindings = crate::bindings::reflect(kernel, shader, entry, module)?;
+    let mut l = blocks_of(kernel, shader, module, bindings)?;
+    let (out, storage) = crate::bindings::output(&l.bindings);
+    l.output = Some(crate::resources::Target { var: out.name.clone(), storage, resource: None });
+    Ok(l)
+}
+
+/// The uniform blocks among `bindings` (those fed by params), walked into
+/// leaves; no output target.
+pub fn blocks_of(
+    kernel: &str,
+    shader: &str,
+    module: &naga::Module,
+    bindings: Vec<crate::bindings::Binding>,
+) -> Result<UniformLayout, ParamError> {
+    let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
     let uses_table = bindings.iter().any(|b| b.feed == crate::bindings::Feed::Table);
     let (mut blocks, mut fields) = (Vec::new(), Vec::new());
     for uniform in bindings.iter().filter(|b| b.feed == crate::bindings::Feed::Uniform) {
@@ -130,9 +145,7 @@ pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -
         }
         blocks.push(Block { group: uniform.group, binding: uniform.binding, var: name, size });
     }
-    let (out, storage) = crate::bindings::output(&bindings);
-    let output = crate::resources::Target { var: out.name.clone(), storage, resource: None };
-    Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module), output })
+    Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module), output: None })
 }
 
 fn override_names(module: &naga::Module) -> Vec<String> {
@@ -261,9 +274,12 @@ fn leaf_type(module: &naga::Module, inner: &TypeInner) -> Result<FieldType, &'st
 /// `exposure`, or a name a `workgroups` or `size` expression reads.
 fn host_only(kernel: &Kernel, name: &str) -> bool {
     let m = &kernel.manifest;
-    (kernel.output() == crate::Output::Hdr && name == "exposure")
+    let hdr = kernel.output() == crate::Output::Hdr
+        || m.graph.as_ref().is_some_and(|g| g.outputs.iter().any(|o| o.view == Some(crate::Output::Hdr)));
+    (hdr && name == "exposure")
         || m.workgroups.iter().flatten().any(|e| e.mentions(name))
         || m.resources.iter().filter_map(|r| r.size.as_ref()).flatten().any(|e| e.mentions(name))
+        || m.graph.as_ref().is_some_and(|g| crate::graph::host_params(g).contains(&name))
 }
 
 /// The param feeding `f`, if any: one named by its `variable.path`, else
@@ -281,6 +297,12 @@ fn param_of<'k>(kernel: &'k Kernel, f: &Field) -> Option<&'k crate::ParamSpec> {
 /// param, a param with no field, a bare param name that leaves of two
 /// uniforms share, or a type mismatch.
 pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> {
+    check_fields(kernel, layout)?;
+    check_params(kernel, &[layout])
+}
+
+/// Every leaf of `layout` has a param of its type (or is padding).
+pub fn check_fields(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.name().to_string(), message };
     for f in &layout.fields {
         if f.name == "width" || f.name == "height" {
@@ -317,6 +339,30 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
             )));
         }
     }
+    Ok(())
+}
+
+/// Every param feeds something in one of `layouts` (a graph's passes), a
+/// host-side expression or an override, and names no two leaves at once.
+pub fn check_params(kernel: &Kernel, layouts: &[&UniformLayout]) -> Result<(), ParamError> {
+    let mut fed: Vec<&str> = Vec::new();
+    for layout in layouts {
+        for spec in kernel.params() {
+            if layout.fields.iter().any(|f| f.qualified == spec.name || f.key == spec.name || f.name == spec.name)
+                || layout.overrides.iter().any(|o| o == spec.name)
+            {
+                fed.push(spec.name);
+            }
+        }
+    }
+    for layout in layouts {
+        check_names(kernel, layout, &fed, layouts.len() > 1)?;
+    }
+    Ok(())
+}
+
+fn check_names(kernel: &Kernel, layout: &UniformLayout, fed_elsewhere: &[&str], graph: bool) -> Result<(), ParamError> {
+    let bad = |message: String| ParamError::Layout { kernel: kernel.name().to_string(), message };
     for spec in kernel.params() {
         let by_qualified = layout.fields.iter().any(|f| f.qualified == spec.name);
         let by_key: Vec<&Field> = layout.fields.iter().filter(|f| f.key == spec.name).collect();
@@ -340,12 +386,17 @@ pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> 
             )));
         }
         let feeds_override = layout.overrides.iter().any(|o| o == spec.name);
-        if by_key.is_empty() && by_name.is_empty() && !host_only(kernel, spec.name) && !feeds_override {
+        if by_key.is_empty()
+            && by_name.is_empty()
+            && !host_only(kernel, spec.name)
+            && !feeds_override
+            && !(graph && fed_elsewhere.contains(&spec.name))
+        {
             return Err(bad(format!(
                 "param {} ({}) has no field in the Params struct of {}; add `{}: {}` to it",
                 spec.name,
                 spec.ty.name(),
-                kernel.shader(),
+                kernel.shader_files().join(" or "),
                 spec.name,
                 spec.ty.wgsl()
             )));

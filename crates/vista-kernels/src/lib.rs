@@ -69,6 +69,7 @@ pub mod cloudmap;
 pub mod clouds;
 pub mod expr;
 pub mod fbm;
+pub mod graph;
 pub mod heightfield;
 pub mod landscape;
 pub mod layout;
@@ -178,6 +179,11 @@ pub struct DisplayMap {
 }
 
 impl DisplayMap {
+    /// Display values are the raw values.
+    pub fn identity() -> DisplayMap {
+        DisplayMap { exposure: None, opaque: false, normalize: false }
+    }
+
     /// The display values of `raw`, or None where they are `raw` itself (a
     /// display kernel that keeps its alpha), so callers need not copy it.
     pub fn apply(&self, raw: &Image) -> Option<Image> {
@@ -268,7 +274,10 @@ impl Kernel {
     }
     /// Whether texels the kernel leaves unwritten are allowed (`[[output]] partial`).
     pub fn partial(&self) -> bool {
-        self.manifest.partial
+        match self.graph() {
+            Some(g) => g.outputs.first().is_some_and(|o| o.partial),
+            None => self.manifest.partial,
+        }
     }
     /// The manifest's explicit workgroup count for these params and size
     /// (`[[pass]] workgroups`), or `None`: cover the output with the
@@ -328,7 +337,11 @@ impl Kernel {
 
     /// The display map of an output of `format` (see [`Kernel::view`]).
     pub fn display_map_of(&self, p: &ParamSet, format: &str) -> DisplayMap {
-        let view = self.view(format);
+        self.display_map_with(p, self.view(format))
+    }
+
+    /// The display map of `view` (a graph output's own `view`).
+    pub fn display_map_with(&self, p: &ParamSet, view: Output) -> DisplayMap {
         DisplayMap {
             exposure: (view == Output::Hdr).then(|| p.f32("exposure")),
             opaque: self.manifest.opaque_display,
@@ -359,7 +372,15 @@ impl Kernel {
         if let Some(b) = self.cpu.and_then(|c| c.output_bounds(p)) {
             return b;
         }
-        match (self.manifest.output_range, self.view(format)) {
+        self.output_bounds_with(p, self.view(format))
+    }
+
+    /// The bounds of an output shown with `view` (a graph output's own).
+    pub fn output_bounds_with(&self, p: &ParamSet, view: Output) -> (f32, f32) {
+        if let Some(b) = self.cpu.and_then(|c| c.output_bounds(p)) {
+            return b;
+        }
+        match (self.manifest.output_range, view) {
             (Some((lo, hi)), _) => (lo as f32, hi as f32),
             (None, Output::Display) => (0.0, 1.0),
             (None, Output::Hdr) => (0.0, f32::INFINITY),
@@ -418,6 +439,11 @@ impl Kernel {
     /// `fbm.wgsl?VISTA_HASH_PLANE&BASIS_IS_PERLIN`. Each distinct name is
     /// composed, cached and compiled as its own pipeline.
     pub fn shader_for(&self, p: &ParamSet) -> String {
+        self.with_defs(self.shader(), p)
+    }
+
+    /// `file` with the defs of [`Kernel::shader_for`].
+    fn with_defs(&self, file: &str, p: &ParamSet) -> String {
         let mut defs: Vec<String> = self.manifest.defs.clone();
         if self.hash_plane(p).is_some() {
             defs.push("VISTA_HASH_PLANE".into());
@@ -428,9 +454,75 @@ impl Kernel {
             }
         }
         match defs.is_empty() {
-            true => self.shader().to_string(),
-            false => format!("{}?{}", self.shader(), defs.join("&")),
+            true => file.to_string(),
+            false => format!("{file}?{}", defs.join("&")),
         }
+    }
+
+    /// Every kernel file the kernel's passes use (without defs), the
+    /// manifest's first.
+    pub fn shader_files(&self) -> Vec<&str> {
+        let Some(g) = self.graph() else { return vec![self.shader()] };
+        let mut out: Vec<&str> = Vec::new();
+        for p in &g.passes {
+            let s = p.shader.as_deref().unwrap_or(self.shader());
+            if !out.contains(&s) {
+                out.push(s);
+            }
+        }
+        out
+    }
+
+    /// The manifest's `overrides` values, by name.
+    pub fn manifest_overrides(&self) -> &[(&'static str, f64)] {
+        &self.manifest.overrides
+    }
+
+    /// The pass graph, for a manifest that has one (SPEC 14 part 2).
+    pub fn graph(&self) -> Option<&graph::GraphSpec> {
+        self.manifest.graph.as_ref()
+    }
+
+    /// The file of graph pass `i` as composed for `p`: its `shader` (else
+    /// the manifest's) with the defs of [`Kernel::shader_for`].
+    pub fn pass_shader_for(&self, i: usize, p: &ParamSet) -> String {
+        let file = self.graph().and_then(|g| g.passes[i].shader.as_deref()).unwrap_or(self.shader());
+        self.with_defs(file, p)
+    }
+
+    /// Reflects every pass of the graph (`modules[i]`: pass i's composed
+    /// file name and module), resolves what feeds each binding, and checks
+    /// each pass's uniform blocks against the params: a leaf with no param,
+    /// or a param that feeds nothing in any pass, is refused.
+    pub fn graph_layouts(
+        &self,
+        modules: &[(&str, &naga::Module)],
+    ) -> Result<(graph::Resolved, Vec<UniformLayout>), ParamError> {
+        let g = self.graph().expect("a graph kernel");
+        let mut reflected = Vec::new();
+        for ((shader, module), pass) in modules.iter().zip(&g.passes) {
+            reflected.push(bindings::reflect_all(self.name(), shader, &pass.entry, module)?);
+        }
+        let passes: Vec<(&str, &[bindings::Binding], &naga::Module)> =
+            modules.iter().zip(&reflected).map(|((s, m), b)| (*s, b.as_slice(), *m)).collect();
+        let resolved = graph::resolve(self.name(), g, &passes)?;
+        let mut layouts = Vec::new();
+        for (((shader, module), bindings), pass) in modules.iter().zip(reflected).zip(&g.passes) {
+            // Params feed the uniforms no `bind` names, and the table.
+            let fed: Vec<bindings::Binding> = bindings
+                .into_iter()
+                .filter(|b| {
+                    matches!(b.feed, bindings::Feed::Uniform | bindings::Feed::Table)
+                        && !pass.bind.iter().any(|(v, _)| *v == b.name)
+                        && !g.resources.iter().any(|r| r.name == b.name)
+                })
+                .collect();
+            let l = layout::blocks_of(self.name(), shader, module, fed)?;
+            layout::check_fields(self, &l)?;
+            layouts.push(l);
+        }
+        layout::check_params(self, &layouts.iter().collect::<Vec<_>>())?;
+        Ok((resolved, layouts))
     }
 
     /// The value of every `override` constant of `module` for `p`: a param
@@ -438,10 +530,21 @@ impl Kernel {
     /// (`None` in the list: naga takes the default). An override with
     /// neither, or a manifest value naming no override, is refused.
     pub fn overrides(&self, module: &naga::Module, p: &ParamSet) -> Result<Vec<(String, f64)>, ParamError> {
+        self.overrides_in(module, p, true)
+    }
+
+    /// [`Kernel::overrides`]; with `strict` false a manifest value naming
+    /// no override of this module is left for another pass's.
+    pub fn overrides_in(
+        &self,
+        module: &naga::Module,
+        p: &ParamSet,
+        strict: bool,
+    ) -> Result<Vec<(String, f64)>, ParamError> {
         let bad = |message: String| ParamError::Layout { kernel: self.name().to_string(), message };
         let names: Vec<&str> = module.overrides.iter().filter_map(|(_, o)| o.name.as_deref()).collect();
         for (k, _) in &self.manifest.overrides {
-            if !names.contains(k) {
+            if strict && !names.contains(k) {
                 return Err(bad(format!(
                     "overrides: {k} is not an override of {}; its overrides: {}",
                     self.shader(),
@@ -484,7 +587,7 @@ impl Kernel {
     pub fn layout(&self, module: &naga::Module) -> Result<UniformLayout, ParamError> {
         let mut l = layout::reflect(self.name(), self.shader(), self.entry(), module)?;
         layout::check(self, &l)?;
-        l.output = resources::resolve(&self.manifest, &l.bindings, module)?;
+        l.output = Some(resources::resolve(&self.manifest, &l.bindings, module)?);
         Ok(l)
     }
 

@@ -61,6 +61,8 @@ struct RawManifest {
     /// `[[resource]]` tables (SPEC 14): so far the output texture.
     #[serde(default, rename = "resource")]
     resources: Vec<toml::Value>,
+    /// `false`: no render-twice check; every output needs a tolerance.
+    deterministic: Option<bool>,
     /// naga_oil shader defs: bool or integer values.
     #[serde(default)]
     defs: toml::Table,
@@ -83,24 +85,34 @@ struct RawManifest {
     preset: toml::Table,
 }
 
-/// A `[[pass]]` table: so far one pass, its entry point and workgroup count.
+/// A `[[pass]]` table. One pass with `entry`, `workgroups` and `bind`
+/// only is the one-pass path; the other keys make a graph (`graph.rs`,
+/// which checks their values).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[allow(dead_code)] // the graph keys are read by graph.rs from the TOML
 struct RawPass {
     entry: Option<String>,
     workgroups: Option<Vec<toml::Value>>,
     /// WGSL variable name -> resource name.
     bind: Option<toml::Table>,
+    shader: Option<toml::Value>,
+    dispatch: Option<toml::Value>,
+    set: Option<toml::Value>,
+    repeat: Option<toml::Value>,
+    swap: Option<toml::Value>,
 }
 
-/// An `[[output]]` table: so far the kernel's one storage-texture output.
+/// An `[[output]]` table.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[allow(dead_code)] // tolerance is read by graph.rs
 struct RawOutput {
     resource: Option<String>,
     view: Option<String>,
     #[serde(default)]
     partial: bool,
+    tolerance: Option<toml::Value>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -158,6 +170,10 @@ pub struct Manifest {
     pub bind: Vec<(String, String)>,
     /// `[[output]] resource`: a resource's name or the WGSL variable.
     pub output_resource: Option<&'static str>,
+    /// A pass graph (SPEC 14 part 2), where the manifest has one; then
+    /// `entry`, `workgroups`, `resources`, `bind` and `output_resource`
+    /// are unused (the first pass's entry is kept for messages).
+    pub graph: Option<crate::graph::GraphSpec>,
     /// naga_oil shader defs (`defs = { MAX_LIGHTS = 10, FIRST_PASS = true }`),
     /// as `NAME=value` in declaration order.
     pub defs: Vec<String>,
@@ -203,6 +219,11 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     }
     let raw: RawManifest = toml::from_str(text).map_err(|e| fail(vista_project::one_line_toml_error(text, &e)))?;
     let kfail = |message: String| fail(format!("kernel {name}: {message}"));
+    // The graph parser reads the tables as TOML (their keys were checked above).
+    let doc: toml::Table = toml::from_str(text).map_err(|e| fail(vista_project::one_line_toml_error(text, &e)))?;
+    let tables = |k: &str| doc.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
+    let (pass_tables, output_tables) = (tables("pass"), tables("output"));
+    let is_graph = crate::graph::is_graph(&raw.resources, &pass_tables, &output_tables, raw.deterministic);
 
     let view = |v: &str| match v {
         "display" => Ok(Output::Display),
@@ -213,6 +234,12 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let (output, partial, output_resource) = match &raw.output {
         None => (None, false, None),
         Some(toml::Value::String(s)) => (Some(view(s)?), false, None),
+        Some(toml::Value::Array(tables)) if is_graph => {
+            for t in tables {
+                RawOutput::deserialize(t.clone()).map_err(|e| kfail(format!("[[output]]: {e}")))?;
+            }
+            (None, false, None)
+        }
         Some(toml::Value::Array(tables)) => {
             if tables.len() != 1 {
                 return Err(kfail(format!(
@@ -435,11 +462,23 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             _ => return Err(kfail(format!("specialize = [\"{n}\"]: \"{n}\" must name an enum param"))),
         }
     }
-    if raw.passes.len() > 1 {
-        return Err(kfail(format!("{} [[pass]] tables: one pass is supported so far", raw.passes.len())));
-    }
-    let pass = raw.passes.first();
-    let entry = pass.and_then(|p| p.entry.clone()).unwrap_or_else(|| "main".into());
+    let graph = match is_graph {
+        true => Some(crate::graph::parse(
+            &raw.resources,
+            &pass_tables,
+            &output_tables,
+            raw.deterministic,
+            output,
+            params,
+            &kfail,
+        )?),
+        false => None,
+    };
+    let pass = if is_graph { None } else { raw.passes.first() };
+    let entry = match &graph {
+        Some(g) => g.passes[0].entry.clone(),
+        None => pass.and_then(|p| p.entry.clone()).unwrap_or_else(|| "main".into()),
+    };
     if entry.is_empty() || !entry.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
         return Err(kfail(format!("[[pass]] entry = \"{entry}\" is not a WGSL function name")));
     }
@@ -459,8 +498,10 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             return Err(kfail(format!("[[pass]] workgroups has {} entries; expected [x, y, z]", list.len())));
         }
     };
-    let (resources, bind) =
-        crate::resources::parse(&raw.resources, pass.and_then(|p| p.bind.as_ref()), params, &kfail)?;
+    let (resources, bind) = match is_graph {
+        true => (Vec::new(), Vec::new()),
+        false => crate::resources::parse(&raw.resources, pass.and_then(|p| p.bind.as_ref()), params, &kfail)?,
+    };
     if let Some(named) = output_resource
         && !resources.is_empty()
         && !resources.iter().any(|r| r.name == named)
@@ -513,6 +554,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         resources,
         bind,
         output_resource,
+        graph,
         defs,
         overrides,
         work,

@@ -47,6 +47,8 @@ impl Dimension {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Access {
     Write,
+    /// Read-only (an input of a pass graph).
+    Read,
     ReadWrite,
 }
 

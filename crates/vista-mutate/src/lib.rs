@@ -321,9 +321,12 @@ pub fn plan(
 /// golden (hash and image) and the unmutated raw output's hash.
 struct CaseBaseline<'a> {
     case: &'a Case,
-    golden_hash: String,
-    golden: Image,
+    /// The main golden PNG's hash and values (none for a pass graph whose
+    /// first output is a buffer).
+    golden: Option<(String, Image)>,
     raw_hash: String,
+    /// The golden directory, where a graph's other outputs' goldens lie.
+    golden_dir: std::path::PathBuf,
 }
 
 /// What an unmutated kernel looks like to its detectors: its golden cases
@@ -348,23 +351,23 @@ fn baseline<'a>(
     let mut out = Vec::new();
     for c in cases.iter().filter(|c| c.kernel.name() == kernel.name()) {
         let path = store.golden_path(c);
-        let bytes = std::fs::read(&path).map_err(|e| {
-            GoldenError::BadInput(format!(
-                "case {}: golden {} cannot be read ({e}); mutation testing judges every case like vista check, \
-                 so bless it first: {}",
-                c.id,
-                path.display(),
-                c.bless_command()
-            ))
-        })?;
-        let golden = vista_image::decode_png16(&path, &bytes)?;
-        let r = vista_render::render(gpu, kernel, &c.params, c.width, c.height)?;
-        let b = CaseBaseline {
-            case: c,
-            golden_hash: vista_golden::short_hash_bytes(&bytes),
-            golden,
-            raw_hash: r.raw.content_hash(),
+        let r = vista_golden::run::render_case(gpu, c)?;
+        let golden = match r.raw.width > 0 {
+            false => None,
+            true => {
+                let bytes = std::fs::read(&path).map_err(|e| {
+                    GoldenError::BadInput(format!(
+                        "case {}: golden {} cannot be read ({e}); mutation testing judges every case like vista \
+                         check, so bless it first: {}",
+                        c.id,
+                        path.display(),
+                        c.bless_command()
+                    ))
+                })?;
+                Some((vista_golden::short_hash_bytes(&bytes), vista_image::decode_png16(&path, &bytes)?))
+            }
         };
+        let b = CaseBaseline { case: c, golden, raw_hash: r.raw.content_hash(), golden_dir: store.dir.clone() };
         let o = judge_case(gpu, manifest, &b, &r);
         if !o.passed() {
             return Err(GoldenError::BadInput(format!(
@@ -402,8 +405,20 @@ fn judge_case(
 ) -> vista_golden::Outcome {
     let actual = vista_render::quantize16(r.display());
     let run = vista_golden::run_info(gpu, b.case);
-    let files = gpu.shader_file_hashes(b.case.kernel.shader()).unwrap_or_default();
+    let files = gpu.kernel_file_hashes(b.case.kernel).unwrap_or_default();
     let path = std::path::PathBuf::from(b.case.golden_rel_path());
+    let entry = manifest.case.get(&b.case.id);
+    let threshold = match entry.is_none_or(|e| e.adapter == run.adapter) {
+        true => b.case.psnr_same_driver,
+        false => b.case.psnr_other_driver,
+    };
+    // Any output's verdict kills a mutant of a pass graph.
+    let outputs: Vec<vista_golden::outputs::OutputVerdict> = r
+        .outputs
+        .iter()
+        .enumerate()
+        .map(|(i, o)| vista_golden::outputs::compare_output(b.case, &b.golden_dir, i, o, threshold))
+        .collect();
     let observed = Observed {
         raw: &r.raw,
         unwritten: r.unwritten,
@@ -411,7 +426,12 @@ fn judge_case(
         actual: &actual,
         repeat_identical: None,
         shader_files: &files,
-        golden: GoldenRead::Present { path: &path, hash: &b.golden_hash, image: Ok(&b.golden) },
+        golden: match &b.golden {
+            Some((hash, image)) => GoldenRead::Present { path: &path, hash, image: Ok(image) },
+            None => GoldenRead::NoImage,
+        },
+        outputs: &outputs,
+        deterministic: b.case.kernel.graph().is_none_or(|g| g.deterministic),
     };
     vista_golden::judge(b.case, manifest.case.get(&b.case.id), run, Ok(observed))
 }
@@ -438,7 +458,7 @@ fn judge(gpu: &Renderer, manifest: &Manifest, kernel: &Kernel, base: &Baseline, 
     let mut identical = true;
     for (n, b) in base.cases.iter().enumerate() {
         let c = b.case;
-        let r = match vista_render::render(gpu, kernel, &c.params, c.width, c.height) {
+        let r = match vista_golden::run::render_case(gpu, c) {
             Ok(r) => r,
             Err(e) => return report(failed(&e), None, false, n + 1),
         };
@@ -496,7 +516,7 @@ pub fn run(
         )
     };
     let manifest = store.manifest()?;
-    let original = Renderer { ctx, shaders: set(None), limits };
+    let original = Renderer { ctx, shaders: set(None), limits, root: project.root().map(Into::into) };
     let mut baselines = BTreeMap::new();
     for p in planned {
         if !baselines.contains_key(p.kernel.name()) {
@@ -512,7 +532,8 @@ pub fn run(
                 loop {
                     let i = next.fetch_add(1, Ordering::SeqCst);
                     let Some(p) = planned.get(i) else { break };
-                    let gpu = Renderer { ctx, shaders: set(Some(&p.mutant)), limits };
+                    let gpu =
+                        Renderer { ctx, shaders: set(Some(&p.mutant)), limits, root: project.root().map(Into::into) };
                     let r = judge(&gpu, &manifest, p.kernel, &baselines[p.kernel.name()], &p.mutant);
                     results.lock().expect("results")[i] = Some(r);
                     progress(done.fetch_add(1, Ordering::SeqCst) + 1, planned.len());

@@ -10,6 +10,8 @@
 //! writes), or knowing any kernel's meaning (`vista-kernels`).
 #![deny(missing_docs)]
 
+pub mod graph;
+pub use graph::{GraphPlan, Inputs, PlannedKind, PlannedOutput, plan_graph};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
@@ -85,6 +87,12 @@ pub struct Rendered {
     pub unwritten: u64,
     /// The output's storage format (an integer one compares exactly).
     pub format: &'static str,
+    /// A pass graph's outputs, the first (the main image) included; empty
+    /// for a one-pass kernel. A graph whose first output is a buffer has
+    /// an empty `raw` (0 x 0): its outputs say everything.
+    pub outputs: Vec<OutputRender>,
+    /// Wall time of each graph pass (all its repeats).
+    pub pass_times: Vec<std::time::Duration>,
     to_display: DisplayMap,
     /// Display values, made on first use unless they are `raw` itself: a
     /// benchmark or a raw-only caller never pays for a second image.
@@ -132,6 +140,8 @@ pub struct Renderer<'a> {
     pub shaders: ShaderSet,
     /// Bounds every render is held to.
     pub limits: RenderLimits,
+    /// The project root, under which a graph's input files lie.
+    pub root: Option<std::path::PathBuf>,
 }
 
 impl std::ops::Deref for Renderer<'_> {
@@ -149,12 +159,35 @@ impl<'a> Renderer<'a> {
         project: &vista_project::Project,
         limits: RenderLimits,
     ) -> Result<Renderer<'a>, RenderError> {
-        Ok(Renderer { ctx, shaders: shader_set(project)?, limits })
+        Ok(Renderer { ctx, shaders: shader_set(project)?, limits, root: project.root().map(Into::into) })
     }
 
     /// Provenance hash of a kernel file and its imports.
     pub fn shader_hash(&self, shader: &str) -> Result<String, RenderError> {
         Ok(self.shaders.source_hash(shader)?)
+    }
+
+    /// Provenance hash of every file a kernel's passes reach (one file:
+    /// [`Renderer::shader_hash`] of it).
+    pub fn kernel_shader_hash(&self, kernel: &Kernel) -> Result<String, RenderError> {
+        let files = kernel.shader_files();
+        if let [one] = files[..] {
+            return self.shader_hash(one);
+        }
+        let hashes: Vec<String> = files.iter().map(|f| self.shader_hash(f)).collect::<Result<_, _>>()?;
+        Ok(blake3::hash(hashes.join("|").as_bytes()).to_hex()[..16].to_string())
+    }
+
+    /// Hash of each file any of a kernel's passes reaches, by path.
+    pub fn kernel_file_hashes(
+        &self,
+        kernel: &Kernel,
+    ) -> Result<std::collections::BTreeMap<String, String>, RenderError> {
+        let mut out = std::collections::BTreeMap::new();
+        for f in kernel.shader_files() {
+            out.extend(self.shader_file_hashes(f)?);
+        }
+        Ok(out)
     }
 
     /// Hash of each file of the kernel's import closure, by path.
@@ -259,10 +292,11 @@ pub fn plan(
                 ),
                 Feed::Table => vista_gpu::SlotKind::Table,
                 Feed::Output(_) => vista_gpu::SlotKind::Output,
+                _ => unreachable!("bindings::reflect refuses the graph feeds"),
             },
         })
         .collect();
-    let target = &layout.output;
+    let target = layout.output.as_ref().expect("Kernel::layout resolves the output");
     let format = target.storage.format;
     let extent = target.extent(kernel.name(), p, width, height).map_err(|e| RenderError::BadInput(e.to_string()))?;
     use vista_kernels::resources::{Access, Dimension};
@@ -304,7 +338,11 @@ pub fn plan(
 
 /// The entry point's workgroup size; where it names `override`s, their
 /// values are substituted first.
-fn workgroup_size(module: &naga::Module, entry: &str, constants: &[(String, f64)]) -> Result<[u32; 3], String> {
+pub(crate) fn workgroup_size(
+    module: &naga::Module,
+    entry: &str,
+    constants: &[(String, f64)],
+) -> Result<[u32; 3], String> {
     let find = |m: &naga::Module| {
         m.entry_points
             .iter()
@@ -346,14 +384,151 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         stats: out.stats,
         unwritten: out.unwritten,
         format: plan.format,
+        outputs: Vec::new(),
+        pass_times: Vec::new(),
         to_display: plan.display,
         display: OnceLock::new(),
     })
 }
 
-/// Renders `kernel` with `p` at `width` x `height`: [`plan`], then [`run`].
+/// One output of a pass graph as read back.
+#[derive(Debug, Clone)]
+pub struct OutputRender {
+    /// The resource's name (golden files add it after the case id).
+    pub name: String,
+    /// The manifest's tolerance, if any.
+    pub tolerance: Option<vista_kernels::graph::Tolerance>,
+    /// Texels left unwritten are allowed.
+    pub partial: bool,
+    /// What the passes left in it.
+    pub value: OutputValue,
+}
+
+/// A graph output's values.
+#[derive(Debug, Clone)]
+pub enum OutputValue {
+    /// A texture: raw f32 RGBA (layers stacked top to bottom).
+    Texture {
+        /// What the passes wrote.
+        raw: Image,
+        /// Its storage format.
+        format: &'static str,
+        /// Its PNG view.
+        view: vista_kernels::Output,
+        /// Texels of a sentinel-filled output no pass wrote.
+        unwritten: u64,
+        /// Raw values to display values.
+        display: DisplayMap,
+    },
+    /// A buffer: its bytes and element layout.
+    Buffer {
+        /// Every byte, a struct's fixed header included.
+        bytes: Vec<u8>,
+        /// The element its binding declares.
+        element: vista_kernels::graph::Element,
+        /// Elements after the header.
+        count: u64,
+    },
+}
+
+impl OutputRender {
+    /// A texture output's display values (a buffer has none).
+    pub fn display(&self) -> Option<Image> {
+        match &self.value {
+            OutputValue::Texture { raw, display, .. } => Some(display.apply(raw).unwrap_or_else(|| raw.clone())),
+            OutputValue::Buffer { .. } => None,
+        }
+    }
+
+    /// A buffer's dtype and shape as NumPy writes them.
+    pub fn npy(&self) -> Option<(String, Vec<u64>)> {
+        match &self.value {
+            OutputValue::Buffer { element, count, .. } => {
+                let (descr, tail) = graph::npy_dtype(element);
+                Some((descr, std::iter::once(*count).chain(tail).collect()))
+            }
+            OutputValue::Texture { .. } => None,
+        }
+    }
+
+    /// A buffer's bytes without its fixed header (what its `.npy` holds).
+    pub fn buffer_body(&self) -> Option<&[u8]> {
+        match &self.value {
+            OutputValue::Buffer { bytes, element, .. } => Some(&bytes[element.header as usize..]),
+            OutputValue::Texture { .. } => None,
+        }
+    }
+}
+
+/// Runs a graph plan.
+pub fn run_graph(gpu: &Renderer, plan: &GraphPlan) -> Result<Rendered, RenderError> {
+    let out = gpu.ctx.run_graph(&vista_gpu::Graph {
+        shaders: &gpu.shaders,
+        resources: plan.resources.clone(),
+        passes: plan.passes.clone(),
+        outputs: plan.output_ids.clone(),
+    })?;
+    let outputs: Vec<OutputRender> = plan
+        .outputs
+        .iter()
+        .zip(out.outputs)
+        .map(|(o, data)| OutputRender {
+            name: o.name.clone(),
+            tolerance: o.tolerance,
+            partial: o.partial,
+            value: match (&o.kind, data) {
+                (
+                    PlannedKind::Texture { format, view, display },
+                    vista_gpu::OutputData::Texture { image, unwritten },
+                ) => OutputValue::Texture { raw: image, format, view: *view, unwritten, display: *display },
+                (PlannedKind::Buffer { element, count }, vista_gpu::OutputData::Buffer(bytes)) => {
+                    OutputValue::Buffer { bytes, element: element.clone(), count: *count }
+                }
+                _ => unreachable!("outputs come back as planned"),
+            },
+        })
+        .collect();
+    let (raw, format, unwritten, display) = match outputs.first().map(|o| &o.value) {
+        Some(OutputValue::Texture { raw, format, unwritten, display, .. }) => {
+            (raw.clone(), *format, *unwritten, *display)
+        }
+        _ => (Image::new(0, 0), "rgba32float", 0, DisplayMap::identity()),
+    };
+    Ok(Rendered {
+        raw,
+        stats: out.stats,
+        unwritten,
+        format,
+        outputs,
+        pass_times: out.pass_times,
+        to_display: display,
+        display: OnceLock::new(),
+    })
+}
+
+/// Renders `kernel` with `p` at `width` x `height`: [`plan`], then [`run`]
+/// (a pass graph: [`plan_graph`], then [`run_graph`]).
 pub fn render(gpu: &Renderer, kernel: &Kernel, p: &ParamSet, width: u32, height: u32) -> Result<Rendered, RenderError> {
-    run(gpu, &plan(&gpu.shaders, kernel, p, width, height, &gpu.limits)?)
+    render_with(gpu, kernel, p, &[], width, height)
+}
+
+/// [`render`] with a case's replacement input files (`inputs`).
+pub fn render_with(
+    gpu: &Renderer,
+    kernel: &Kernel,
+    p: &ParamSet,
+    inputs: &Inputs,
+    width: u32,
+    height: u32,
+) -> Result<Rendered, RenderError> {
+    match kernel.graph() {
+        Some(_) => {
+            check_request(kernel, p, width, height, &gpu.limits)?;
+            let plan = plan_graph(&gpu.shaders, gpu.root.as_deref(), kernel, p, inputs, width, height)?;
+            run_graph(gpu, &plan)
+        }
+        None => run(gpu, &plan(&gpu.shaders, kernel, p, width, height, &gpu.limits)?),
+    }
 }
 
 /// Renders `runs` (at least 1) times; returns the first render and the

@@ -1,0 +1,87 @@
+//! `vista render` of a pass graph (SPEC 14 part 2): every output written,
+//! the first to `-o`, the others beside it as `<stem>.<output>.<ext>`
+//! (textures: the PNG view or, for `-o x.exr`, raw EXR; buffers: `.npy`).
+
+use std::path::{Path, PathBuf};
+
+use vista_golden::GoldenError;
+use vista_kernels::{Kernel, ParamSet};
+use vista_render::{OutputValue, Renderer};
+
+use crate::bad;
+
+/// The file output `name` goes to, given `-o out` (the first output: `out`).
+pub fn output_path(out: &Path, first: bool, name: &str, buffer: bool) -> PathBuf {
+    let ext = match buffer {
+        true => "npy".to_string(),
+        false => out.extension().and_then(|e| e.to_str()).unwrap_or("png").to_string(),
+    };
+    if first {
+        return out.to_path_buf();
+    }
+    let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
+    out.with_file_name(format!("{stem}.{name}.{ext}"))
+}
+
+/// Renders a graph kernel and writes its outputs; exit 1 on NaN or
+/// unwritten texels in any output, as for one-pass kernels.
+pub fn render(ctx: &Renderer, k: &Kernel, p: &ParamSet, w: u32, h: u32, out: &Path) -> Result<i32, GoldenError> {
+    let r = vista_render::render(ctx, k, p, w, h)?;
+    let first_is_buffer = matches!(r.outputs.first().map(|o| &o.value), Some(OutputValue::Buffer { .. }));
+    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+    let want: &[&str] = if first_is_buffer { &["npy"] } else { &["png", "exr"] };
+    if !want.contains(&ext.as_str()) {
+        return Err(bad(format!(
+            "output {} must end in .{} (kernel {}'s first output, {}, is a {})",
+            out.display(),
+            want.join(" or ."),
+            k.name(),
+            r.outputs[0].name,
+            if first_is_buffer { "buffer" } else { "texture" }
+        )));
+    }
+    let mut code = 0;
+    for (i, o) in r.outputs.iter().enumerate() {
+        let is_buffer = matches!(o.value, OutputValue::Buffer { .. });
+        let path = output_path(out, i == 0, &o.name, is_buffer);
+        match &o.value {
+            OutputValue::Texture { raw, unwritten, .. } => {
+                let img = if ext == "exr" { raw.clone() } else { o.display().expect("a texture") };
+                vista_image::save(&path, &img)?;
+                if let Some((x, y)) = raw.first_nonfinite() {
+                    eprintln!(
+                        "error: output {} has {} NaN/Inf texels, first at ({x}, {y})",
+                        o.name,
+                        raw.nonfinite_count()
+                    );
+                    code = 1;
+                }
+                if *unwritten > 0 && !o.partial {
+                    eprintln!(
+                        "error: kernel {}: output {}: {}",
+                        k.name(),
+                        o.name,
+                        vista_golden::unwritten_problem(*unwritten, raw)
+                    );
+                    code = 1;
+                }
+            }
+            OutputValue::Buffer { .. } => {
+                let (descr, shape) = o.npy().expect("a buffer");
+                vista_image::npy::write_npy(&path, &descr, &shape, o.buffer_body().expect("a buffer"))?;
+            }
+        }
+        eprintln!("  output {} -> {}", o.name, path.display());
+    }
+    let passes: Vec<String> = r.pass_times.iter().map(|t| format!("{:.1}", t.as_secs_f64() * 1e3)).collect();
+    eprintln!(
+        "rendered {} ({} passes: {} ms) on {} in {:.1} ms -> {}",
+        k.name(),
+        r.pass_times.len(),
+        passes.join(" + "),
+        ctx.adapter_description(),
+        r.stats.gpu_wall.as_secs_f64() * 1e3,
+        out.display()
+    );
+    Ok(code)
+}

@@ -1,0 +1,405 @@
+//! A pass graph's outputs against their goldens (SPEC 14): the first
+//! output keeps the case's names (`<case>.png`, raw `<case>.exr`, a buffer
+//! `<case>.npy`), the others add their name (`<case>.<output>.png`, ...).
+//! Textures keep their PNG view (what the report shows) and, beside it, raw
+//! values in EXR where a tolerance or an integer format needs them; buffers
+//! are NumPy files. Each output is judged by its tolerance: exact (the
+//! default for integer formats and buffers), max_abs, max_rel, max_ulp,
+//! rmse or histogram_emd; a float texture without one by the case's PSNR
+//! thresholds on its view.
+
+use std::path::{Path, PathBuf};
+
+use vista_image::Image;
+use vista_kernels::graph::Tolerance;
+use vista_render::{OutputRender, OutputValue, quantize16};
+
+use crate::Case;
+
+/// The golden files of one output.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct OutputFiles {
+    /// The PNG view (textures).
+    pub png: Option<PathBuf>,
+    /// Raw values (textures judged by a tolerance or exactly).
+    pub exr: Option<PathBuf>,
+    /// A buffer's values.
+    pub npy: Option<PathBuf>,
+}
+
+impl OutputFiles {
+    /// Every file, in png, exr, npy order.
+    pub fn all(&self) -> Vec<&PathBuf> {
+        [&self.png, &self.exr, &self.npy].into_iter().flatten().collect()
+    }
+}
+
+/// How an output is judged: its tolerance, else exact for an integer
+/// texture or a buffer, else `None` (a float texture: PSNR of its view).
+pub fn effective_tolerance(out: &OutputRender) -> Option<Tolerance> {
+    match (&out.value, out.tolerance) {
+        (_, Some(t)) => Some(t),
+        (OutputValue::Buffer { .. }, None) => Some(Tolerance::Exact),
+        (OutputValue::Texture { format, .. }, None) if vista_kernels::is_integer_format(format) => {
+            Some(Tolerance::Exact)
+        }
+        _ => None,
+    }
+}
+
+/// The golden files of output `index` of `case` under `golden_dir`.
+pub fn output_files(golden_dir: &Path, case: &Case, index: usize, out: &OutputRender) -> OutputFiles {
+    let stem = match index {
+        0 => case.id.clone(),
+        _ => format!("{}.{}", case.id, out.name),
+    };
+    let at = |ext: &str| golden_dir.join(case.kernel.name()).join(format!("{stem}.{ext}"));
+    match &out.value {
+        OutputValue::Buffer { .. } => OutputFiles { npy: Some(at("npy")), ..Default::default() },
+        OutputValue::Texture { .. } => {
+            OutputFiles { png: Some(at("png")), exr: effective_tolerance(out).map(|_| at("exr")), npy: None }
+        }
+    }
+}
+
+/// One output's verdict.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct OutputVerdict {
+    pub name: String,
+    /// Golden files that do not exist.
+    pub missing: Vec<PathBuf>,
+    /// Golden files that exist but cannot be read.
+    pub errors: Vec<String>,
+    pub problems: Vec<String>,
+    /// One line: what was compared and how it came out.
+    pub summary: String,
+}
+
+/// Compares output `index` with its goldens. The first texture output's PNG
+/// is the case's main image, judged by `check::judge` itself; here it only
+/// gets its raw comparison, if it has one.
+pub fn compare_output(
+    case: &Case,
+    golden_dir: &Path,
+    index: usize,
+    out: &OutputRender,
+    psnr_threshold: f64,
+) -> OutputVerdict {
+    let files = output_files(golden_dir, case, index, out);
+    let mut v = OutputVerdict { name: out.name.clone(), ..Default::default() };
+    let tolerance = effective_tolerance(out);
+    v.problems = guard_one(index, out);
+    match &out.value {
+        OutputValue::Buffer { .. } => {
+            let path = files.npy.expect("a buffer's npy");
+            if !path.exists() {
+                v.missing.push(path);
+                return v;
+            }
+            let golden = match vista_image::npy::read_npy(&path) {
+                Ok(n) => n,
+                Err(e) => {
+                    v.errors.push(e.to_string());
+                    return v;
+                }
+            };
+            let (descr, shape) = out.npy().expect("a buffer");
+            if golden.descr != descr || golden.shape != shape {
+                v.problems.push(format!(
+                    "output {}: golden {} has dtype {} shape {:?}, the render {} shape {:?}; re-bless if intended",
+                    out.name,
+                    path.display(),
+                    golden.descr,
+                    golden.shape,
+                    descr,
+                    shape
+                ));
+                return v;
+            }
+            let OutputValue::Buffer { element, .. } = &out.value else { unreachable!("a buffer") };
+            let expected = vista_render::graph::leaf_values(&golden.data, element);
+            let actual = vista_render::graph::leaf_values(out.buffer_body().expect("a buffer"), element);
+            judge_values(&mut v, &out.name, tolerance.expect("buffers have one"), &expected, &actual, is_f32(element));
+        }
+        OutputValue::Texture { raw, .. } => {
+            if let Some(exr) = &files.exr {
+                match exr.exists() {
+                    false => v.missing.push(exr.clone()),
+                    true => match vista_image::read_exr(exr) {
+                        Err(e) => v.errors.push(e.to_string()),
+                        Ok(g) if (g.width, g.height) != (raw.width, raw.height) => v.problems.push(format!(
+                            "output {}: golden {} is {}x{} but the render is {}x{}",
+                            out.name,
+                            exr.display(),
+                            g.width,
+                            g.height,
+                            raw.width,
+                            raw.height
+                        )),
+                        Ok(g) => judge_values(
+                            &mut v,
+                            &out.name,
+                            tolerance.expect("an exr goes with a tolerance"),
+                            &flat(&g),
+                            &flat(raw),
+                            true,
+                        ),
+                    },
+                }
+            }
+            let png = files.png.expect("a texture's png");
+            if index > 0 && tolerance.is_none() {
+                // A float texture without a tolerance: its view by PSNR.
+                match png.exists() {
+                    false => v.missing.push(png),
+                    true => match vista_image::read_png16(&png) {
+                        Err(e) => v.errors.push(e.to_string()),
+                        Ok(g) => {
+                            let actual = quantize16(&out.display().expect("a texture"));
+                            match vista_image::metrics::compare(&g, &actual) {
+                                Err(e) => v.problems.push(format!("output {}: {e}", out.name)),
+                                Ok(m) => {
+                                    v.summary = format!(
+                                        "output {}: PSNR {} (>= {psnr_threshold:.1} dB)",
+                                        out.name,
+                                        vista_image::metrics::format_psnr(m.psnr)
+                                    );
+                                    if m.psnr < psnr_threshold {
+                                        v.problems.push(format!(
+                                            "output {}: PSNR {} is below the threshold {psnr_threshold:.1} dB",
+                                            out.name,
+                                            vista_image::metrics::format_psnr(m.psnr)
+                                        ));
+                                    }
+                                }
+                            }
+                        }
+                    },
+                }
+            } else if index > 0 && !png.exists() {
+                v.missing.push(png);
+            }
+        }
+    }
+    v
+}
+
+/// The checks of a graph's outputs that need no golden (the main image's
+/// are `check::guards`): every texel of each other texture written unless
+/// it is `partial`, finite textures and float buffers.
+pub fn output_guards(outputs: &[OutputRender]) -> Vec<String> {
+    outputs.iter().enumerate().flat_map(|(i, o)| guard_one(i, o)).collect()
+}
+
+/// [`output_guards`] of output `i`.
+fn guard_one(i: usize, o: &OutputRender) -> Vec<String> {
+    let mut problems = Vec::new();
+    {
+        match &o.value {
+            OutputValue::Texture { raw, unwritten, .. } if i > 0 => {
+                if *unwritten > 0 && !o.partial {
+                    problems.push(format!("output {}: {}", o.name, crate::check::unwritten_problem(*unwritten, raw)));
+                }
+                if let Some((x, y)) = raw.first_nonfinite() {
+                    problems.push(format!(
+                        "output {}: {} texels contain NaN/Inf; first at ({x}, {y})",
+                        o.name,
+                        raw.nonfinite_count()
+                    ));
+                }
+            }
+            OutputValue::Buffer { element, .. } => {
+                let values = vista_render::graph::leaf_values(o.buffer_body().expect("a buffer"), element);
+                if let Some(at) = values.iter().position(|v| !v.is_finite()) {
+                    let n = values.iter().filter(|v| !v.is_finite()).count();
+                    problems.push(format!("output {}: {n} values are NaN/Inf; first at value {at}", o.name));
+                }
+            }
+            _ => {}
+        }
+    }
+    problems
+}
+
+/// The bytes of every golden file of a graph's outputs except the first
+/// output's PNG (the case's main golden, which bless writes itself):
+/// (path, bytes).
+pub fn golden_bytes(
+    golden_dir: &Path,
+    case: &Case,
+    outputs: &[OutputRender],
+) -> Result<Vec<(PathBuf, Vec<u8>)>, vista_image::ImageError> {
+    let mut out = Vec::new();
+    for (i, o) in outputs.iter().enumerate() {
+        let files = output_files(golden_dir, case, i, o);
+        if let (Some(png), true) = (&files.png, i > 0) {
+            out.push((png.clone(), vista_image::encode_png16(png, &quantize16(&o.display().expect("a texture")))?));
+        }
+        if let (Some(exr), OutputValue::Texture { raw, .. }) = (&files.exr, &o.value) {
+            out.push((exr.clone(), vista_image::encode_exr(exr, raw)?));
+        }
+        if let Some(npy) = &files.npy {
+            let (descr, shape) = o.npy().expect("a buffer");
+            out.push((npy.clone(), vista_image::npy::encode_npy(&descr, &shape, o.buffer_body().expect("a buffer"))));
+        }
+    }
+    Ok(out)
+}
+
+fn is_f32(e: &vista_kernels::graph::Element) -> bool {
+    e.leaves.iter().all(|l| l.1 == 'f')
+}
+
+fn flat(img: &Image) -> Vec<f64> {
+    img.data.iter().flat_map(|p| p.iter().map(|c| *c as f64)).collect()
+}
+
+/// Judges `actual` against `expected` by `t`, with the worst values named.
+fn judge_values(v: &mut OutputVerdict, name: &str, t: Tolerance, expected: &[f64], actual: &[f64], floats: bool) {
+    match within(t, expected, actual, floats) {
+        Ok(summary) => v.summary = format!("output {name}: {summary}"),
+        Err(problem) => {
+            v.summary = format!("output {name}: {problem}");
+            v.problems.push(format!("output {name}: {problem}"));
+        }
+    }
+}
+
+/// Whether `actual` is within `t` of `expected`: Ok with the measured
+/// figure, or Err naming it, the bound and the worst elements.
+pub fn within(t: Tolerance, expected: &[f64], actual: &[f64], floats: bool) -> Result<String, String> {
+    if expected.len() != actual.len() {
+        return Err(format!("{} values against {} in the golden", actual.len(), expected.len()));
+    }
+    let nonfinite = actual.iter().filter(|v| !v.is_finite()).count();
+    if nonfinite > 0 && t != Tolerance::Exact {
+        return Err(format!("{nonfinite} values are NaN/Inf"));
+    }
+    let diff = |i: usize| (actual[i] - expected[i]).abs();
+    let worst = |score: &dyn Fn(usize) -> f64| -> String {
+        let mut idx: Vec<usize> = (0..actual.len()).filter(|i| score(*i) > 0.0 || score(*i).is_nan()).collect();
+        idx.sort_by(|a, b| score(*b).total_cmp(&score(*a)));
+        let shown: Vec<String> =
+            idx.iter().take(5).map(|i| format!("[{i}] {} vs golden {}", actual[*i], expected[*i])).collect();
+        format!("{} differ; worst: {}", idx.len(), shown.join(", "))
+    };
+    match t {
+        Tolerance::Exact => {
+            let differ = (0..actual.len()).filter(|i| actual[*i].to_bits() != expected[*i].to_bits()).count();
+            match differ {
+                0 => Ok(format!("{} values, exact", actual.len())),
+                _ => Err(format!(
+                    "not exact: {}",
+                    worst(&|i| if actual[i].to_bits() != expected[i].to_bits() {
+                        diff(i).max(f64::MIN_POSITIVE)
+                    } else {
+                        0.0
+                    })
+                )),
+            }
+        }
+        Tolerance::MaxAbs(bound) => {
+            let m = (0..actual.len()).map(diff).fold(0.0, f64::max);
+            match m <= bound {
+                true => Ok(format!("max_abs {m:.3e} (<= {bound:.3e})")),
+                false => Err(format!("max_abs {m:.3e} is above {bound:.3e}: {}", worst(&diff))),
+            }
+        }
+        Tolerance::MaxRel(bound) => {
+            let rel = |i: usize| diff(i) / expected[i].abs().max(f64::MIN_POSITIVE);
+            let m = (0..actual.len()).map(rel).fold(0.0, f64::max);
+            match m <= bound {
+                true => Ok(format!("max_rel {m:.3e} (<= {bound:.3e})")),
+                false => Err(format!("max_rel {m:.3e} is above {bound:.3e}: {}", worst(&rel))),
+            }
+        }
+        Tolerance::MaxUlp(bound) => {
+            if !floats {
+                return Err("max_ulp applies to f32 values; this output holds integers (use exact or max_abs)".into());
+            }
+            let ulp = |i: usize| {
+                let key = |v: f64| {
+                    let b = (v as f32).to_bits() as i64;
+                    if b < 0x8000_0000 { b } else { 0x8000_0000 - b }
+                };
+                (key(actual[i]) - key(expected[i])).unsigned_abs() as f64
+            };
+            let m = (0..actual.len()).map(ulp).fold(0.0, f64::max);
+            match m <= bound as f64 {
+                true => Ok(format!("max_ulp {m} (<= {bound})")),
+                false => Err(format!("max_ulp {m} is above {bound}: {}", worst(&ulp))),
+            }
+        }
+        Tolerance::Rmse(bound) => {
+            let n = actual.len().max(1) as f64;
+            let r = ((0..actual.len()).map(|i| diff(i) * diff(i)).sum::<f64>() / n).sqrt();
+            match r <= bound {
+                true => Ok(format!("rmse {r:.3e} (<= {bound:.3e})")),
+                false => Err(format!("rmse {r:.3e} is above {bound:.3e}: {}", worst(&diff))),
+            }
+        }
+        Tolerance::HistogramEmd { max, bins } => {
+            let emd = histogram_emd(expected, actual, bins);
+            match emd <= max {
+                true => Ok(format!("histogram EMD {emd:.3e} over {bins} bins (<= {max:.3e})")),
+                false => Err(format!("histogram EMD {emd:.3e} over {bins} bins is above {max:.3e}")),
+            }
+        }
+    }
+}
+
+/// Earth mover's distance between the value histograms of `a` and `b`,
+/// `bins` bins over the range of both, in units of that range (0: same
+/// distribution, 1: all mass moved across the whole range).
+pub fn histogram_emd(a: &[f64], b: &[f64], bins: u32) -> f64 {
+    let (lo, hi) = a.iter().chain(b).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) || a.is_empty() || b.is_empty() {
+        return 0.0;
+    }
+    let hist = |v: &[f64]| {
+        let mut h = vec![0.0; bins as usize];
+        for x in v {
+            let i = (((x - lo) / (hi - lo)) * bins as f64).floor().clamp(0.0, bins as f64 - 1.0) as usize;
+            h[i] += 1.0 / v.len() as f64;
+        }
+        h
+    };
+    let (ha, hb) = (hist(a), hist(b));
+    let (mut ca, mut cb, mut emd) = (0.0, 0.0, 0.0);
+    for i in 0..bins as usize {
+        ca += ha[i];
+        cb += hb[i];
+        emd += (ca - cb).abs();
+    }
+    emd / bins as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tolerances_measure_and_name_the_worst_values() {
+        let g = [1.0, 2.0, 3.0, 4.0];
+        assert!(within(Tolerance::Exact, &g, &g, true).unwrap().contains("exact"));
+        let e = within(Tolerance::Exact, &g, &[1.0, 2.0, 3.5, 4.0], true).unwrap_err();
+        assert!(e.contains("1 differ") && e.contains("[2] 3.5 vs golden 3"), "{e}");
+        assert!(within(Tolerance::MaxAbs(0.5), &g, &[1.0, 2.0, 3.5, 4.0], true).is_ok());
+        assert!(within(Tolerance::MaxAbs(0.4), &g, &[1.0, 2.0, 3.5, 4.0], true).unwrap_err().contains("above"));
+        assert!(within(Tolerance::MaxRel(0.2), &g, &[1.1, 2.0, 3.0, 4.0], true).is_ok());
+        assert!(within(Tolerance::MaxRel(0.05), &g, &[1.1, 2.0, 3.0, 4.0], true).is_err());
+        let next = f32::from_bits(3.0f32.to_bits() + 2) as f64;
+        assert!(within(Tolerance::MaxUlp(2), &g, &[1.0, 2.0, next, 4.0], true).is_ok());
+        assert!(within(Tolerance::MaxUlp(1), &g, &[1.0, 2.0, next, 4.0], true).is_err());
+        assert!(within(Tolerance::MaxUlp(1), &g, &g, false).unwrap_err().contains("integers"));
+        assert!(within(Tolerance::Rmse(0.25), &g, &[1.0, 2.0, 3.0, 4.5], true).is_ok());
+        assert!(within(Tolerance::Rmse(0.24), &g, &[1.0, 2.0, 3.0, 4.5], true).is_err());
+        // The same values in another order: no mass moves.
+        assert_eq!(histogram_emd(&g, &[4.0, 3.0, 2.0, 1.0], 8), 0.0);
+        let moved = histogram_emd(&[0.0, 0.0], &[1.0, 1.0], 10);
+        assert!((moved - 0.9).abs() < 1e-12, "{moved}");
+        let t = Tolerance::HistogramEmd { max: 0.1, bins: 10 };
+        assert!(within(t, &[0.0, 0.0], &[1.0, 1.0], true).is_err());
+        assert!(within(Tolerance::MaxAbs(1.0), &g, &[1.0, f64::NAN, 3.0, 4.0], true).unwrap_err().contains("NaN"));
+    }
+}

@@ -1,0 +1,182 @@
+//! NumPy `.npy` files (format version 1.0) for buffer goldens and inputs:
+//! a dtype (`<f4`, `<u4`, `<i4`, or a structured dtype for a WGSL struct,
+//! padding as void fields), a C-order shape, and the raw little-endian
+//! bytes. Written by hand rather than with npyz: vista's buffers are bytes
+//! whose dtype comes from naga's reflection at run time, which a typed
+//! reader/writer would have to re-derive.
+
+use std::path::Path;
+
+use crate::ImageError;
+
+const MAGIC: &[u8] = b"\x93NUMPY";
+
+/// A decoded `.npy` file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Npy {
+    /// The dtype as the header spells it (`<f4`, or a list for a struct).
+    pub descr: String,
+    pub shape: Vec<u64>,
+    /// Bytes of one element (of the dtype).
+    pub item_bytes: u64,
+    /// The raw data, C order.
+    pub data: Vec<u8>,
+}
+
+impl Npy {
+    /// Elements along the first axis times the rest: the total count of
+    /// dtype items.
+    pub fn items(&self) -> u64 {
+        self.shape.iter().product()
+    }
+}
+
+/// The `.npy` bytes of `data` with this dtype and shape.
+pub fn encode_npy(descr: &str, shape: &[u64], data: &[u8]) -> Vec<u8> {
+    let shape_text = match shape {
+        [n] => format!("({n},)"),
+        _ => format!("({})", shape.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ")),
+    };
+    let descr_text = if descr.starts_with('[') { descr.to_string() } else { format!("'{descr}'") };
+    let mut header = format!("{{'descr': {descr_text}, 'fortran_order': False, 'shape': {shape_text}, }}");
+    // Magic (6) + version (2) + length (2) + header, padded to 64 bytes.
+    let total = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(total.next_multiple_of(64) - total));
+    header.push('\n');
+    let mut out = Vec::with_capacity(10 + header.len() + data.len());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&[1, 0]);
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    out.extend_from_slice(data);
+    out
+}
+
+/// Writes a `.npy` atomically.
+pub fn write_npy(path: &Path, descr: &str, shape: &[u64], data: &[u8]) -> Result<(), ImageError> {
+    crate::atomic_write(path, &encode_npy(descr, shape, data))
+}
+
+/// Reads a `.npy` file.
+pub fn read_npy(path: &Path) -> Result<Npy, ImageError> {
+    let bytes = std::fs::read(path).map_err(|source| ImageError::Io { path: path.to_path_buf(), source })?;
+    decode_npy(path, &bytes)
+}
+
+/// Decodes `.npy` bytes (`path` names the file in errors): version 1 or 2,
+/// little-endian or byte-sized dtypes, C order.
+pub fn decode_npy(path: &Path, bytes: &[u8]) -> Result<Npy, ImageError> {
+    let bad = |msg: String| ImageError::Decode { path: path.to_path_buf(), format: "NumPy .npy", msg };
+    if !bytes.starts_with(MAGIC) || bytes.len() < 10 {
+        return Err(bad("no \\x93NUMPY magic at the start".into()));
+    }
+    let (len, start) = match bytes[6] {
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
+        2 | 3 if bytes.len() >= 12 => (u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize, 12),
+        v => return Err(bad(format!("format version {v} is not supported; expected 1, 2 or 3"))),
+    };
+    let header = bytes.get(start..start + len).ok_or_else(|| bad("the header is cut short".into()))?;
+    let header = std::str::from_utf8(header).map_err(|_| bad("the header is not text".into()))?;
+    let value = |key: &str| -> Result<&str, ImageError> {
+        let at = header.find(&format!("'{key}':")).ok_or_else(|| bad(format!("the header has no '{key}'")))?;
+        Ok(header[at + key.len() + 3..].trim_start())
+    };
+    let descr_at = value("descr")?;
+    let descr = if descr_at.starts_with('[') {
+        let mut depth = 0;
+        let end = descr_at
+            .char_indices()
+            .find(|&(_, c)| {
+                depth += match c {
+                    '[' | '(' => 1,
+                    ']' | ')' => -1,
+                    _ => 0,
+                };
+                depth == 0
+            })
+            .map(|(i, _)| i)
+            .ok_or_else(|| bad("the structured descr is not closed".into()))?;
+        descr_at[..=end].to_string()
+    } else {
+        let q = descr_at.chars().next().unwrap_or('\'');
+        descr_at[1..].split(q).next().unwrap_or_default().to_string()
+    };
+    if value("fortran_order")?.starts_with("True") {
+        return Err(bad("fortran_order = True is not supported; save it in C order".into()));
+    }
+    let shape_at = value("shape")?;
+    let shape_text = shape_at
+        .strip_prefix('(')
+        .and_then(|s| s.split(')').next())
+        .ok_or_else(|| bad("the shape is not a tuple".into()))?;
+    let shape: Vec<u64> = shape_text
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| s.trim_end_matches('L').parse::<u64>().map_err(|_| bad(format!("shape entry {s} is not a number"))))
+        .collect::<Result<_, _>>()?;
+    let item_bytes = dtype_bytes(&descr).map_err(bad)?;
+    let data = bytes[start + len..].to_vec();
+    let want = shape.iter().product::<u64>() * item_bytes;
+    if data.len() as u64 != want {
+        return Err(bad(format!("{} data bytes for shape {shape:?} of {descr} ({want} expected)", data.len())));
+    }
+    Ok(Npy { descr, shape, item_bytes, data })
+}
+
+/// Bytes of one item of a dtype: a simple one (`<f4`, `|u1`, `|V4`) or a
+/// structured list (`[('a', '<f4'), ('b', '<u4', (3,))]`).
+pub fn dtype_bytes(descr: &str) -> Result<u64, String> {
+    if !descr.starts_with('[') {
+        let (order, rest) = descr.split_at(descr.len().min(1));
+        let little = ["<", "|", "="].contains(&order) || (order == ">" && rest.ends_with('1'));
+        if !little {
+            return Err(format!("dtype {descr} is not little-endian; save it as little-endian ('<')"));
+        }
+        return rest
+            .get(1..)
+            .and_then(|n| n.parse::<u64>().ok())
+            .ok_or_else(|| format!("dtype {descr} is not a fixed-size number type"));
+    }
+    let mut total = 0;
+    // Each field: ('name', 'type') or ('name', 'type', (dims)).
+    for field in descr[1..descr.len() - 1].split("),").map(|f| f.trim().trim_start_matches('(').trim_end_matches(')')) {
+        if field.trim().is_empty() {
+            continue;
+        }
+        let parts: Vec<&str> = field.splitn(3, ',').map(str::trim).collect();
+        let ty = parts.get(1).ok_or_else(|| format!("structured field {field} has no type"))?;
+        let ty = ty.trim_matches(|c| c == '\'' || c == '"');
+        let mut n = dtype_bytes(ty)?;
+        if let Some(dims) = parts.get(2) {
+            for d in dims.trim_matches(|c| c == '(' || c == ')').split(',').map(str::trim).filter(|d| !d.is_empty()) {
+                n *= d.parse::<u64>().map_err(|_| format!("structured field {field} has a bad shape"))?;
+            }
+        }
+        total += n;
+    }
+    Ok(total)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_round_trips_simple_and_structured_dtypes() {
+        let p = Path::new("x.npy");
+        let data: Vec<u8> = [1.5f32, -2.0, 3.25].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let bytes = encode_npy("<f4", &[3], &data);
+        assert_eq!((10 + u16::from_le_bytes([bytes[8], bytes[9]]) as usize) % 64, 0, "header padded to 64");
+        let n = decode_npy(p, &bytes).unwrap();
+        assert_eq!((n.descr.as_str(), n.shape.as_slice(), n.item_bytes, &n.data), ("<f4", &[3u64][..], 4, &data));
+        let s = "[('pos', '<f4', (2,)), ('id', '<u4'), ('_pad', '|V4')]";
+        let n = decode_npy(p, &encode_npy(s, &[2, 1], &[0u8; 32])).unwrap();
+        assert_eq!((n.descr.as_str(), n.item_bytes, n.items()), (s, 16, 2));
+        // Real NumPy headers: version 1, double quotes absent, a trailing comma.
+        let e = decode_npy(p, &encode_npy("<f4", &[4], &data)).unwrap_err().to_string();
+        assert!(e.contains("12 data bytes for shape [4]"), "{e}");
+        assert!(decode_npy(p, &encode_npy(">f4", &[3], &data)).unwrap_err().to_string().contains("little-endian"));
+        assert!(decode_npy(p, b"PK\x03\x04").unwrap_err().to_string().contains("magic"));
+    }
+}

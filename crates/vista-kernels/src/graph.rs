@@ -1,0 +1,1125 @@
+//! SPEC 14's pass graphs: `[[resource]]` textures, buffers and samplers
+//! (with their files, inline data, fill and length), `[[pass]]` tables
+//! (entry, shader, bind, dispatch or workgroups, set, repeat, swap) and
+//! `[[output]]` tables (any texture or buffer a pass writes, with a view,
+//! `partial` and a tolerance). A manifest that uses any of these beyond a
+//! single pass writing one storage texture is a graph; the others keep the
+//! one-pass path of [`crate::resources`] (SPEC 14: "for today's kernels that
+//! equals section 10").
+//!
+//! Parsing checks everything that needs no shader; [`resolve`] then checks
+//! each pass against naga's reflection of its composed module and says what
+//! feeds every binding.
+
+use crate::bindings::{Binding, Feed};
+use crate::expr::Expr;
+use crate::params::ParamSpec;
+use crate::resources::{Access, Dimension, Storage};
+use crate::{Output, ParamError};
+
+/// A sampled texture's dimension (cube only for sampling).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampledDim {
+    D1,
+    D2,
+    D2Array,
+    D3,
+    Cube,
+}
+
+/// What a sampled texture binding returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampledKind {
+    Float,
+    Uint,
+    Sint,
+    Depth,
+}
+
+/// The sampler address modes a manifest may name.
+pub const ADDRESS_MODES: [&str; 3] = ["clamp-to-edge", "repeat", "mirror-repeat"];
+/// The comparison functions a comparison sampler may name (WebGPU's).
+pub const COMPARE_FUNCTIONS: [&str; 8] =
+    ["never", "less", "equal", "less-equal", "greater", "not-equal", "greater-equal", "always"];
+
+/// What a resource is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ResourceKind {
+    Texture {
+        format: Option<&'static str>,
+        /// 1d | 2d | 2d-array | 3d (storage and sampled) or cube (sampled).
+        dimension: Option<SampledDim>,
+        size: Option<Vec<Expr>>,
+        file: Option<String>,
+    },
+    Buffer {
+        file: Option<String>,
+        data: Option<Vec<f64>>,
+        fill: Option<f64>,
+        length: Option<Expr>,
+    },
+    Sampler {
+        linear: bool,
+        address: [&'static str; 3],
+        compare: Option<&'static str>,
+    },
+}
+
+/// One `[[resource]]` table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResourceSpec {
+    pub name: String,
+    pub kind: ResourceKind,
+}
+
+impl ResourceSpec {
+    pub fn kind_name(&self) -> &'static str {
+        match self.kind {
+            ResourceKind::Texture { .. } => "texture",
+            ResourceKind::Buffer { .. } => "buffer",
+            ResourceKind::Sampler { .. } => "sampler",
+        }
+    }
+}
+
+/// How often a pass runs.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Repeat {
+    Count(u32),
+    Param(&'static str),
+}
+
+/// One `[[pass]]` table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassSpec {
+    pub entry: String,
+    /// Default: the manifest's shader.
+    pub shader: Option<String>,
+    /// WGSL variable name -> resource name.
+    pub bind: Vec<(String, String)>,
+    /// Cover this resource with the reflected workgroup size.
+    pub dispatch: Option<String>,
+    pub workgroups: Option<[Expr; 3]>,
+    /// Params overridden for this pass's uniforms: (param, value text).
+    pub set: Vec<(&'static str, String)>,
+    pub repeat: Repeat,
+    /// Resource pairs exchanged after every run of the pass.
+    pub swap: Vec<(String, String)>,
+}
+
+/// How an output is compared with its golden.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    Exact,
+    MaxAbs(f64),
+    MaxRel(f64),
+    MaxUlp(u64),
+    Rmse(f64),
+    /// Earth mover's distance between the value histograms (`bins` bins
+    /// over the golden's range), in units of that range.
+    HistogramEmd {
+        max: f64,
+        bins: u32,
+    },
+}
+
+impl Tolerance {
+    /// The keys a tolerance table may have.
+    pub const KEYS: [&'static str; 7] = ["exact", "max_abs", "max_rel", "max_ulp", "rmse", "histogram_emd", "bins"];
+
+    pub fn describe(&self) -> String {
+        match self {
+            Tolerance::Exact => "exact".into(),
+            Tolerance::MaxAbs(v) => format!("max_abs {v}"),
+            Tolerance::MaxRel(v) => format!("max_rel {v}"),
+            Tolerance::MaxUlp(v) => format!("max_ulp {v}"),
+            Tolerance::Rmse(v) => format!("rmse {v}"),
+            Tolerance::HistogramEmd { max, bins } => format!("histogram_emd {max} over {bins} bins"),
+        }
+    }
+}
+
+/// One `[[output]]` table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputSpec {
+    pub resource: String,
+    pub view: Option<Output>,
+    pub partial: bool,
+    pub tolerance: Option<Tolerance>,
+}
+
+/// A kernel's pass graph.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GraphSpec {
+    pub resources: Vec<ResourceSpec>,
+    pub passes: Vec<PassSpec>,
+    pub outputs: Vec<OutputSpec>,
+    /// False: no render-twice check; every output needs a tolerance.
+    pub deterministic: bool,
+}
+
+/// Resource keys by kind, for messages and the README's table.
+pub const RESOURCE_KEYS: [&str; 12] =
+    ["name", "kind", "format", "dimension", "size", "file", "data", "fill", "length", "filter", "address", "compare"];
+/// The keys of a `[[pass]]` table.
+pub const PASS_KEYS: [&str; 8] = ["entry", "shader", "bind", "dispatch", "workgroups", "set", "repeat", "swap"];
+/// The keys of an `[[output]]` table.
+pub const OUTPUT_KEYS: [&str; 4] = ["resource", "view", "partial", "tolerance"];
+
+/// Whether these tables need the graph path: more than one pass or output,
+/// a buffer or sampler, an input file or contents, or any part-2 key of a
+/// pass or output.
+pub(crate) fn is_graph(
+    resources: &[toml::Value],
+    passes: &[toml::Value],
+    outputs: &[toml::Value],
+    deterministic: Option<bool>,
+) -> bool {
+    let has = |t: &toml::Value, keys: &[&str]| t.as_table().is_some_and(|t| keys.iter().any(|k| t.contains_key(*k)));
+    passes.len() > 1
+        || outputs.len() > 1
+        || deterministic == Some(false)
+        || resources.iter().any(|r| {
+            has(r, &["file", "data", "fill", "length", "filter", "address", "compare"])
+                || r.get("kind").and_then(|k| k.as_str()).is_some_and(|k| k != "texture")
+                || r.get("dimension").and_then(|k| k.as_str()) == Some("cube")
+        })
+        || passes.iter().any(|p| has(p, &["shader", "dispatch", "set", "repeat", "swap"]))
+        || outputs.iter().any(|o| has(o, &["tolerance"]))
+}
+
+fn valid_name(name: &str) -> bool {
+    !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+/// Parses a graph manifest's tables; `fail` prefixes file and kernel.
+pub(crate) fn parse(
+    resources: &[toml::Value],
+    passes: &[toml::Value],
+    outputs: &[toml::Value],
+    deterministic: Option<bool>,
+    default_view: Option<Output>,
+    params: &'static [ParamSpec],
+    fail: &dyn Fn(String) -> ParamError,
+) -> Result<GraphSpec, ParamError> {
+    let mut res: Vec<ResourceSpec> = Vec::new();
+    for t in resources {
+        let Some(t) = t.as_table() else { return Err(fail("[[resource]] must be a table".into())) };
+        let name = match t.get("name") {
+            Some(toml::Value::String(s)) => s.clone(),
+            _ => return Err(fail("[[resource]] needs name = \"...\"".into())),
+        };
+        if !valid_name(&name) {
+            return Err(fail(format!("[[resource]] name \"{name}\" must use only letters, digits, '-' and '_'")));
+        }
+        if res.iter().any(|r| r.name == name) {
+            return Err(fail(format!("[[resource]] name \"{name}\" is used twice")));
+        }
+        let at = |m: String| fail(format!("[[resource]] {name}: {m}"));
+        let text = |k: &str| -> Result<Option<String>, ParamError> {
+            match t.get(k) {
+                None => Ok(None),
+                Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+                Some(other) => Err(at(format!("{k} = {other} is not valid; expected a string"))),
+            }
+        };
+        let kind = text("kind")?.ok_or_else(|| at("needs kind = \"texture\", \"buffer\" or \"sampler\"".into()))?;
+        let allowed: &[&str] = match kind.as_str() {
+            "texture" => &["name", "kind", "format", "dimension", "size", "file"],
+            "buffer" => &["name", "kind", "file", "data", "fill", "length"],
+            "sampler" => &["name", "kind", "filter", "address", "compare"],
+            other => return Err(at(format!("kind = \"{other}\" is not valid; expected texture|buffer|sampler"))),
+        };
+        for k in t.keys() {
+            if !allowed.contains(&k.as_str()) {
+                return Err(at(format!("key {k} does not apply to a {kind}; allowed: {}", allowed.join(", "))));
+            }
+        }
+        let file = text("file")?;
+        if let Some(f) = &file
+            && (f.starts_with('/') || f.split(['/', '\\']).any(|c| c == ".."))
+        {
+            return Err(at(format!("file = \"{f}\" must be a path under the project root (no '/' start, no '..')")));
+        }
+        let kind = match kind.as_str() {
+            "texture" => {
+                let format = match text("format")? {
+                    None => None,
+                    Some(f) => {
+                        Some(crate::bindings::STORAGE_FORMATS.iter().copied().find(|n| *n == f).ok_or_else(|| {
+                            at(format!(
+                                "format = \"{f}\" is not valid; expected one of {}",
+                                crate::bindings::STORAGE_FORMATS.join(", ")
+                            ))
+                        })?)
+                    }
+                };
+                let dimension = match text("dimension")? {
+                    None => None,
+                    Some(d) => Some(match d.as_str() {
+                        "1d" => SampledDim::D1,
+                        "2d" => SampledDim::D2,
+                        "2d-array" => SampledDim::D2Array,
+                        "3d" => SampledDim::D3,
+                        "cube" => SampledDim::Cube,
+                        other => {
+                            return Err(at(format!(
+                                "dimension = \"{other}\" is not valid; expected 1d|2d|2d-array|3d|cube"
+                            )));
+                        }
+                    }),
+                };
+                if let Some(f) = &file
+                    && !(f.ends_with(".png") || f.ends_with(".exr"))
+                {
+                    return Err(at(format!("file = \"{f}\" is not valid for a texture; expected a .png or .exr file")));
+                }
+                let size = match t.get("size") {
+                    None => None,
+                    Some(toml::Value::Array(list)) => {
+                        let want = match dimension.unwrap_or(SampledDim::D2) {
+                            SampledDim::D1 => 1,
+                            SampledDim::D2 => 2,
+                            SampledDim::Cube => 1,
+                            _ => 3,
+                        };
+                        if list.len() != want {
+                            return Err(at(format!("size has {} entries; this texture takes {want}", list.len())));
+                        }
+                        let mut exprs = Vec::new();
+                        for v in list {
+                            exprs.push(Expr::parse_entry(v, params).map_err(|e| at(format!("size {e}")))?);
+                        }
+                        Some(exprs)
+                    }
+                    Some(other) => return Err(at(format!("size = {other} is not valid; expected a list"))),
+                };
+                ResourceKind::Texture { format, dimension, size, file }
+            }
+            "buffer" => {
+                let number = |v: &toml::Value| match v {
+                    toml::Value::Integer(i) => Some(*i as f64),
+                    toml::Value::Float(f) => Some(*f),
+                    toml::Value::Boolean(b) => Some(*b as u8 as f64),
+                    _ => None,
+                };
+                let data = match t.get("data") {
+                    None => None,
+                    Some(toml::Value::Array(list)) => {
+                        let mut out = Vec::new();
+                        fn flatten(v: &toml::Value, out: &mut Vec<toml::Value>) {
+                            match v {
+                                toml::Value::Array(l) => l.iter().for_each(|x| flatten(x, out)),
+                                other => out.push(other.clone()),
+                            }
+                        }
+                        let mut flat = Vec::new();
+                        list.iter().for_each(|v| flatten(v, &mut flat));
+                        for v in &flat {
+                            out.push(number(v).ok_or_else(|| at(format!("data entry {v} is not a number")))?);
+                        }
+                        Some(out)
+                    }
+                    Some(other) => return Err(at(format!("data = {other} is not valid; expected a list of numbers"))),
+                };
+                let fill = match t.get("fill") {
+                    None => None,
+                    Some(v) => {
+                        Some(number(v).ok_or_else(|| at(format!("fill = {v} is not valid; expected a number")))?)
+                    }
+                };
+                let length = match t.get("length") {
+                    None => None,
+                    Some(v) => Some(Expr::parse_entry(v, params).map_err(|e| at(format!("length {e}")))?),
+                };
+                if let Some(f) = &file
+                    && !(f.ends_with(".npy") || f.ends_with(".bin"))
+                {
+                    return Err(at(format!("file = \"{f}\" is not valid for a buffer; expected a .npy or .bin file")));
+                }
+                let sources = [file.is_some(), data.is_some(), fill.is_some()].iter().filter(|b| **b).count();
+                if sources > 1 {
+                    return Err(at("file, data and fill are exclusive; give one".into()));
+                }
+                if length.is_some() && (file.is_some() || data.is_some()) {
+                    return Err(at("length goes with fill or nothing; a file or data gives its own length".into()));
+                }
+                ResourceKind::Buffer { file, data, fill, length }
+            }
+            _ => {
+                let linear = match text("filter")?.as_deref() {
+                    None | Some("nearest") => false,
+                    Some("linear") => true,
+                    Some(other) => {
+                        return Err(at(format!("filter = \"{other}\" is not valid; expected nearest|linear")));
+                    }
+                };
+                let mode = |s: &str| {
+                    ADDRESS_MODES.iter().copied().find(|m| *m == s).ok_or_else(|| {
+                        at(format!("address \"{s}\" is not valid; expected {}", ADDRESS_MODES.join("|")))
+                    })
+                };
+                let address = match t.get("address") {
+                    None => ["clamp-to-edge"; 3],
+                    Some(toml::Value::String(s)) => [mode(s)?; 3],
+                    Some(toml::Value::Array(l)) if (1..=3).contains(&l.len()) => {
+                        let mut out = ["clamp-to-edge"; 3];
+                        for (i, v) in l.iter().enumerate() {
+                            out[i] = mode(v.as_str().ok_or_else(|| at(format!("address entry {v} is not a string")))?)?;
+                        }
+                        out
+                    }
+                    Some(other) => {
+                        return Err(at(format!("address = {other} is not valid; expected a mode or [u, v, w]")));
+                    }
+                };
+                let compare = match text("compare")? {
+                    None => None,
+                    Some(c) => Some(COMPARE_FUNCTIONS.iter().copied().find(|f| *f == c).ok_or_else(|| {
+                        at(format!("compare = \"{c}\" is not valid; expected {}", COMPARE_FUNCTIONS.join("|")))
+                    })?),
+                };
+                ResourceKind::Sampler { linear, address, compare }
+            }
+        };
+        res.push(ResourceSpec { name, kind });
+    }
+    let named = |r: &str| res.iter().any(|x| x.name == r);
+    let names = || {
+        let n: Vec<&str> = res.iter().map(|r| r.name.as_str()).collect();
+        if n.is_empty() { "none".to_string() } else { n.join(", ") }
+    };
+    let mut out_passes = Vec::new();
+    let raw_passes: Vec<toml::Value> =
+        if passes.is_empty() { vec![toml::Value::Table(Default::default())] } else { passes.to_vec() };
+    for (i, t) in raw_passes.iter().enumerate() {
+        let Some(t) = t.as_table() else { return Err(fail("[[pass]] must be a table".into())) };
+        let at = |m: String| fail(format!("[[pass]] {}: {m}", i + 1));
+        for k in t.keys() {
+            if !PASS_KEYS.contains(&k.as_str()) {
+                return Err(at(format!("unknown key {k}; allowed: {}", PASS_KEYS.join(", "))));
+            }
+        }
+        let text = |k: &str| -> Result<Option<String>, ParamError> {
+            match t.get(k) {
+                None => Ok(None),
+                Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+                Some(other) => Err(at(format!("{k} = {other} is not valid; expected a string"))),
+            }
+        };
+        let entry = text("entry")?.unwrap_or_else(|| "main".into());
+        if entry.is_empty() || !entry.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(at(format!("entry = \"{entry}\" is not a WGSL function name")));
+        }
+        let shader = text("shader")?;
+        let mut bind = Vec::new();
+        match t.get("bind") {
+            None => {}
+            Some(toml::Value::Table(b)) => {
+                for (var, r) in b {
+                    let Some(r) = r.as_str() else {
+                        return Err(at(format!("bind: {var} = {r} is not valid; expected a resource name")));
+                    };
+                    if !named(r) {
+                        return Err(at(format!("bind: {var} = \"{r}\" names no resource; resources: {}", names())));
+                    }
+                    bind.push((var.clone(), r.to_string()));
+                }
+            }
+            Some(other) => return Err(at(format!("bind = {other} is not valid; expected a table"))),
+        }
+        let dispatch = text("dispatch")?;
+        if let Some(d) = &dispatch
+            && !named(d)
+        {
+            return Err(at(format!("dispatch = \"{d}\" names no resource; resources: {}", names())));
+        }
+        let workgroups = match t.get("workgroups") {
+            None => None,
+            Some(toml::Value::Array(list)) if list.len() == 3 => {
+                let mut e = Vec::new();
+                for v in list {
+                    e.push(Expr::parse_entry(v, params).map_err(|m| at(format!("workgroups {m}")))?);
+                }
+                let [x, y, z]: [Expr; 3] = e.try_into().expect("three entries");
+                Some([x, y, z])
+            }
+            Some(other) => return Err(at(format!("workgroups = {other} is not valid; expected [x, y, z]"))),
+        };
+        if workgroups.is_some() && dispatch.is_some() {
+            return Err(at("dispatch and workgroups are exclusive; give one".into()));
+        }
+        let mut set = Vec::new();
+        match t.get("set") {
+            None => {}
+            Some(toml::Value::Table(s)) => {
+                for (k, v) in s {
+                    let Some(spec) = params.iter().find(|p| p.name == k) else {
+                        let all: Vec<&str> = params.iter().map(|p| p.name).collect();
+                        return Err(at(format!("set: {k} is not a param; params: {}", all.join(", "))));
+                    };
+                    let text = crate::manifest::value_text(v);
+                    crate::params::parse_value(spec, &text).map_err(|e| at(format!("set: {e}")))?;
+                    set.push((spec.name, text));
+                }
+            }
+            Some(other) => return Err(at(format!("set = {other} is not valid; expected a table of params"))),
+        }
+        let repeat = match t.get("repeat") {
+            None => Repeat::Count(1),
+            Some(toml::Value::Integer(n)) if (1..=100_000).contains(n) => Repeat::Count(*n as u32),
+            Some(toml::Value::String(s)) => match params.iter().find(|p| p.name == s) {
+                Some(p) if p.ty == crate::params::ParamType::U32 || p.ty == crate::params::ParamType::I32 => {
+                    Repeat::Param(p.name)
+                }
+                _ => return Err(at(format!("repeat = \"{s}\" must name an integer param"))),
+            },
+            Some(other) => {
+                return Err(at(format!("repeat = {other} is not valid; expected a number in [1, 100000] or a param")));
+            }
+        };
+        let mut swap = Vec::new();
+        match t.get("swap") {
+            None => {}
+            Some(toml::Value::Array(pairs)) => {
+                for p in pairs {
+                    let pair: Option<Vec<&str>> = p.as_array().map(|l| l.iter().filter_map(|v| v.as_str()).collect());
+                    match pair.as_deref() {
+                        Some([a, b]) if named(a) && named(b) && a != b => swap.push((a.to_string(), b.to_string())),
+                        _ => {
+                            return Err(at(format!(
+                                "swap entry {p} is not valid; expected [\"a\", \"b\"], two different resources of {}",
+                                names()
+                            )));
+                        }
+                    }
+                }
+            }
+            Some(other) => return Err(at(format!("swap = {other} is not valid; expected [[\"a\", \"b\"], ..]"))),
+        }
+        out_passes.push(PassSpec { entry, shader, bind, dispatch, workgroups, set, repeat, swap });
+    }
+    let mut outs = Vec::new();
+    for t in outputs {
+        let Some(t) = t.as_table() else { return Err(fail("[[output]] must be a table".into())) };
+        for k in t.keys() {
+            if !OUTPUT_KEYS.contains(&k.as_str()) {
+                return Err(fail(format!("[[output]]: unknown key {k}; allowed: {}", OUTPUT_KEYS.join(", "))));
+            }
+        }
+        let Some(resource) = t.get("resource").and_then(|v| v.as_str()) else {
+            return Err(fail("[[output]] needs resource = \"...\" (a texture or buffer a pass writes)".into()));
+        };
+        let at = |m: String| fail(format!("[[output]] {resource}: {m}"));
+        let view = match t.get("view") {
+            None => default_view,
+            Some(toml::Value::String(v)) => Some(match v.as_str() {
+                "display" => Output::Display,
+                "hdr" => Output::Hdr,
+                "normalize" => Output::Normalize,
+                other => return Err(at(format!("view = \"{other}\" is not valid; expected display|hdr|normalize"))),
+            }),
+            Some(other) => return Err(at(format!("view = {other} is not valid; expected a string"))),
+        };
+        let partial = match t.get("partial") {
+            None => false,
+            Some(toml::Value::Boolean(b)) => *b,
+            Some(other) => return Err(at(format!("partial = {other} is not valid; expected true or false"))),
+        };
+        let tolerance = match t.get("tolerance") {
+            None => None,
+            Some(toml::Value::String(s)) if s == "exact" => Some(Tolerance::Exact),
+            Some(toml::Value::Table(tt)) => Some(tolerance(tt).map_err(at)?),
+            Some(other) => {
+                return Err(at(format!(
+                    "tolerance = {other} is not valid; expected \"exact\" or a table with one of {}",
+                    Tolerance::KEYS.join(", ")
+                )));
+            }
+        };
+        if outs.iter().any(|o: &OutputSpec| o.resource == resource) {
+            return Err(at("is listed twice".into()));
+        }
+        outs.push(OutputSpec { resource: resource.to_string(), view, partial, tolerance });
+    }
+    if outs.iter().any(|o| o.view == Some(Output::Hdr))
+        && !params.iter().any(|p| p.name == "exposure" && p.ty == crate::params::ParamType::F32)
+    {
+        return Err(fail(
+            "an [[output]] with view = \"hdr\" needs an f32 param named exposure (the PNG tone map)".into(),
+        ));
+    }
+    let deterministic = deterministic.unwrap_or(true);
+    if !deterministic {
+        if outs.is_empty() {
+            return Err(fail("deterministic = false needs [[output]] tables, each with a tolerance".into()));
+        }
+        if let Some(o) = outs.iter().find(|o| o.tolerance.is_none()) {
+            return Err(fail(format!(
+                "[[output]] {}: deterministic = false needs a tolerance on every output ({})",
+                o.resource,
+                Tolerance::KEYS[1..6].join(", ")
+            )));
+        }
+    }
+    Ok(GraphSpec { resources: res, passes: out_passes, outputs: outs, deterministic })
+}
+
+fn tolerance(t: &toml::Table) -> Result<Tolerance, String> {
+    for k in t.keys() {
+        if !Tolerance::KEYS.contains(&k.as_str()) {
+            return Err(format!("tolerance: unknown key {k}; allowed: {}", Tolerance::KEYS.join(", ")));
+        }
+    }
+    let num = |k: &str| -> Result<Option<f64>, String> {
+        match t.get(k) {
+            None => Ok(None),
+            Some(toml::Value::Integer(i)) if *i >= 0 => Ok(Some(*i as f64)),
+            Some(toml::Value::Float(f)) if f.is_finite() && *f >= 0.0 => Ok(Some(*f)),
+            Some(other) => Err(format!("tolerance {k} = {other} is not valid; expected a number >= 0")),
+        }
+    };
+    let given: Vec<&str> = Tolerance::KEYS[..6].iter().copied().filter(|k| t.contains_key(*k)).collect();
+    if given.len() != 1 {
+        return Err(format!(
+            "tolerance needs exactly one of {} (found {})",
+            Tolerance::KEYS[..6].join(", "),
+            if given.is_empty() { "none".into() } else { given.join(", ") }
+        ));
+    }
+    if t.contains_key("bins") && given[0] != "histogram_emd" {
+        return Err("tolerance bins goes with histogram_emd".into());
+    }
+    Ok(match given[0] {
+        "exact" => match t.get("exact") {
+            Some(toml::Value::Boolean(true)) => Tolerance::Exact,
+            other => return Err(format!("tolerance exact = {} is not valid; expected true", other.expect("given"))),
+        },
+        "max_abs" => Tolerance::MaxAbs(num("max_abs")?.expect("given")),
+        "max_rel" => Tolerance::MaxRel(num("max_rel")?.expect("given")),
+        "max_ulp" => Tolerance::MaxUlp(num("max_ulp")?.expect("given") as u64),
+        "rmse" => Tolerance::Rmse(num("rmse")?.expect("given")),
+        _ => {
+            let bins = num("bins")?.unwrap_or(64.0);
+            if !(2.0..=4096.0).contains(&bins) {
+                return Err(format!("tolerance bins = {bins} is not valid; expected [2, 4096]"));
+            }
+            Tolerance::HistogramEmd { max: num("histogram_emd")?.expect("given"), bins: bins as u32 }
+        }
+    })
+}
+
+/// How a pass uses a resource it binds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Usage {
+    StorageBuffer { read_only: bool },
+    UniformBuffer,
+    StorageTexture(Storage),
+    Sampled { dim: SampledDim, kind: SampledKind },
+    Sampler { comparison: bool },
+}
+
+/// What feeds one binding of a pass.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SlotFeed {
+    /// Params, packed into uniform block `n` of the pass's layout.
+    Uniform(usize),
+    /// The noise permutation table.
+    Table,
+    /// Resource `n` of [`Resolved::resources`].
+    Resource(usize, Usage),
+}
+
+/// One binding of a pass and what feeds it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassSlot {
+    pub group: u32,
+    pub binding: u32,
+    pub var: String,
+    pub feed: SlotFeed,
+    /// For a storage buffer: its element layout (stride, fixed header
+    /// bytes before a runtime-sized array, leaf scalars of one element).
+    pub element: Option<Element>,
+}
+
+/// A buffer binding's element: what one entry of its runtime-sized array
+/// (or the whole binding, when fixed-size) holds.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Element {
+    /// Bytes from one element to the next.
+    pub stride: u32,
+    /// Bytes before the runtime-sized array (0 for a bare array).
+    pub header: u32,
+    /// Elements of a fixed-size binding (`None`: runtime-sized).
+    pub fixed: Option<u32>,
+    /// Every leaf scalar of one element: byte offset, kind ('f' 'u' 'i'),
+    /// and its field path (for NumPy's structured dtype).
+    pub leaves: Vec<(u32, char, String)>,
+    /// The WGSL type, for messages.
+    pub wgsl: String,
+}
+
+/// The graph's resources after reflection: the manifest's, then one
+/// implicit texture per write-only storage texture no `bind` names.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Resolved {
+    pub resources: Vec<ResolvedResource>,
+    /// Per pass, its slots (sorted by group and binding).
+    pub slots: Vec<Vec<PassSlot>>,
+}
+
+/// One resource with what reflection adds to its table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResolvedResource {
+    pub spec: ResourceSpec,
+    /// A texture's format: its own, else a storage binding's, else its
+    /// file's (decided when the file is read: `None` here).
+    pub format: Option<&'static str>,
+    /// A texture's dimension: its own, else its bindings'.
+    pub dimension: Option<SampledDim>,
+    /// A buffer's element (from its first storage or uniform binding).
+    pub element: Option<Element>,
+    /// Some pass writes it (a write or read_write storage binding).
+    pub written: bool,
+    /// Some pass reads it (sampled, read, read_write, storage read).
+    pub read: bool,
+}
+
+fn storage_dim(d: Dimension) -> SampledDim {
+    match d {
+        Dimension::D1 => SampledDim::D1,
+        Dimension::D2 => SampledDim::D2,
+        Dimension::D2Array => SampledDim::D2Array,
+        Dimension::D3 => SampledDim::D3,
+    }
+}
+
+pub fn dim_name(d: SampledDim) -> &'static str {
+    match d {
+        SampledDim::D1 => "1d",
+        SampledDim::D2 => "2d",
+        SampledDim::D2Array => "2d-array",
+        SampledDim::D3 => "3d",
+        SampledDim::Cube => "cube",
+    }
+}
+
+/// Checks every pass's reflected bindings against the graph and says what
+/// feeds each. `passes[i]` is pass i's bindings and module.
+pub fn resolve(
+    kernel: &str,
+    graph: &GraphSpec,
+    passes: &[(&str, &[Binding], &naga::Module)],
+) -> Result<Resolved, ParamError> {
+    let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
+    let mut resources: Vec<ResolvedResource> = graph
+        .resources
+        .iter()
+        .map(|spec| {
+            let (format, dimension) = match &spec.kind {
+                ResourceKind::Texture { format, dimension, .. } => (*format, *dimension),
+                _ => (None, None),
+            };
+            ResolvedResource { spec: spec.clone(), format, dimension, element: None, written: false, read: false }
+        })
+        .collect();
+    let mut all_slots = Vec::new();
+    for (i, ((shader, bindings, module), pass)) in passes.iter().zip(&graph.passes).enumerate() {
+        let label = format!("pass {} ({})", i + 1, pass.entry);
+        let describe = |b: &Binding| {
+            format!(
+                "{} (@group({}) @binding({}), {})",
+                b.name,
+                b.group,
+                b.binding,
+                crate::bindings::wgsl_type(module, &module.global_variables[b.global])
+            )
+        };
+        // A bind may name a global this entry point does not reach (one
+        // bind table for several entry points of a file), not one the
+        // module lacks.
+        for (var, _) in &pass.bind {
+            let declared = module
+                .global_variables
+                .iter()
+                .any(|(_, g)| g.name.as_deref().map(|n| crate::bindings::undecorate(n).0).as_deref() == Some(var));
+            if !declared {
+                let reached: Vec<&str> = bindings.iter().map(|b| b.name.as_str()).collect();
+                return Err(bad(format!(
+                    "{label}: bind names {var}, which {shader} does not declare; {} reaches: {}",
+                    pass.entry,
+                    reached.join(", ")
+                )));
+            }
+        }
+        let mut slots = Vec::new();
+        let mut blocks = 0usize;
+        for b in bindings.iter() {
+            // Bound by the pass's bind, else to the resource of its own name.
+            let bound = pass
+                .bind
+                .iter()
+                .find(|(v, _)| *v == b.name)
+                .map(|(_, r)| r.clone())
+                .or_else(|| graph.resources.iter().find(|r| r.name == b.name).map(|r| r.name.clone()));
+            let bound = bound.as_deref();
+            let feed = match (b.feed, bound) {
+                (Feed::Uniform, None) => {
+                    blocks += 1;
+                    SlotFeed::Uniform(blocks - 1)
+                }
+                (Feed::Uniform, Some(r)) => {
+                    let ri = find(&resources, r);
+                    if kind_of(&resources, ri) != "buffer" {
+                        return Err(bad(format!(
+                            "{label}: {} is bound to {r}, a {}; it needs a buffer",
+                            describe(b),
+                            kind_of(&resources, ri)
+                        )));
+                    }
+                    SlotFeed::Resource(ri, Usage::UniformBuffer)
+                }
+                (Feed::Table, None) => SlotFeed::Table,
+                (Feed::Table | Feed::Buffer { .. }, Some(r)) => {
+                    let ri = find(&resources, r);
+                    if kind_of(&resources, ri) != "buffer" {
+                        return Err(bad(format!(
+                            "{label}: {} is bound to {r}, a {}; it needs a buffer",
+                            describe(b),
+                            kind_of(&resources, ri)
+                        )));
+                    }
+                    let read_only = match b.feed {
+                        Feed::Buffer { read_only } => read_only,
+                        _ => true,
+                    };
+                    SlotFeed::Resource(ri, Usage::StorageBuffer { read_only })
+                }
+                (Feed::Buffer { .. }, None) => {
+                    return Err(bad(format!(
+                        "{label}: {} is fed by nothing; it needs a buffer resource ([[resource]] kind = \"buffer\", named in this pass's bind)",
+                        describe(b)
+                    )));
+                }
+                (Feed::Output(storage) | Feed::StorageRead(storage), bound) => {
+                    let ri = match bound {
+                        Some(r) => find(&resources, r),
+                        None if storage.access == Access::Write => {
+                            // Implicit: one resource per unbound written variable.
+                            match resources.iter().position(|r| r.spec.name == b.name) {
+                                Some(ri) => ri,
+                                None => {
+                                    resources.push(ResolvedResource {
+                                        spec: ResourceSpec {
+                                            name: b.name.clone(),
+                                            kind: ResourceKind::Texture {
+                                                format: None,
+                                                dimension: None,
+                                                size: None,
+                                                file: None,
+                                            },
+                                        },
+                                        format: None,
+                                        dimension: None,
+                                        element: None,
+                                        written: false,
+                                        read: false,
+                                    });
+                                    resources.len() - 1
+                                }
+                            }
+                        }
+                        None => {
+                            return Err(bad(format!(
+                                "{label}: {} is fed by nothing; it needs a texture resource ([[resource]] kind = \"texture\", named in this pass's bind)",
+                                describe(b)
+                            )));
+                        }
+                    };
+                    if kind_of(&resources, ri) != "texture" {
+                        return Err(bad(format!(
+                            "{label}: {} is bound to {}, a {}; it needs a texture",
+                            describe(b),
+                            resources[ri].spec.name,
+                            kind_of(&resources, ri)
+                        )));
+                    }
+                    let r = &mut resources[ri];
+                    match r.format {
+                        Some(f) if f != storage.format => {
+                            return Err(bad(format!(
+                                "{label}: resource {} has format {f} but is bound to {}; would fit: format = \"{}\"",
+                                r.spec.name,
+                                describe(b),
+                                storage.format
+                            )));
+                        }
+                        _ => r.format = Some(storage.format),
+                    }
+                    let dim = storage_dim(storage.dimension);
+                    match r.dimension {
+                        Some(d) if d != dim => {
+                            return Err(bad(format!(
+                                "{label}: resource {} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
+                                r.spec.name,
+                                dim_name(d),
+                                describe(b),
+                                dim_name(dim)
+                            )));
+                        }
+                        _ => r.dimension = Some(dim),
+                    }
+                    match storage.access {
+                        Access::Write => r.written = true,
+                        Access::Read => r.read = true,
+                        Access::ReadWrite => {
+                            r.written = true;
+                            r.read = true;
+                        }
+                    }
+                    SlotFeed::Resource(ri, Usage::StorageTexture(storage))
+                }
+                (Feed::Sampled { dim, kind }, bound) => {
+                    let Some(rn) = bound else {
+                        return Err(bad(format!(
+                            "{label}: {} is fed by nothing; it needs a texture resource ([[resource]] kind = \"texture\" with a file or written by an earlier pass, named in this pass's bind)",
+                            describe(b)
+                        )));
+                    };
+                    let ri = find(&resources, rn);
+                    if kind_of(&resources, ri) != "texture" {
+                        return Err(bad(format!(
+                            "{label}: {} is bound to {rn}, a {}; it needs a texture",
+                            describe(b),
+                            kind_of(&resources, ri)
+                        )));
+                    }
+                    let r = &mut resources[ri];
+                    match r.dimension {
+                        Some(d) if d != dim && !(d == SampledDim::D2Array && dim == SampledDim::Cube) => {
+                            return Err(bad(format!(
+                                "{label}: resource {rn} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
+                                dim_name(d),
+                                describe(b),
+                                dim_name(dim)
+                            )));
+                        }
+                        _ => r.dimension = Some(dim),
+                    }
+                    r.read = true;
+                    SlotFeed::Resource(ri, Usage::Sampled { dim, kind })
+                }
+                (Feed::Sampler { comparison }, bound) => {
+                    let Some(rn) = bound else {
+                        return Err(bad(format!(
+                            "{label}: {} is fed by nothing; it needs a sampler resource ([[resource]] kind = \"sampler\", named in this pass's bind)",
+                            describe(b)
+                        )));
+                    };
+                    let ri = find(&resources, rn);
+                    match &resources[ri].spec.kind {
+                        ResourceKind::Sampler { compare, .. } if compare.is_some() == comparison => {}
+                        ResourceKind::Sampler { .. } => {
+                            return Err(bad(format!(
+                                "{label}: resource {rn} is {} but is bound to {}",
+                                if comparison { "a filtering sampler" } else { "a comparison sampler" },
+                                describe(b)
+                            )));
+                        }
+                        _ => {
+                            return Err(bad(format!(
+                                "{label}: {} is bound to {rn}, a {}; it needs a sampler",
+                                describe(b),
+                                kind_of(&resources, ri)
+                            )));
+                        }
+                    }
+                    SlotFeed::Resource(ri, Usage::Sampler { comparison })
+                }
+            };
+            let element = match feed {
+                SlotFeed::Resource(ri, Usage::StorageBuffer { read_only }) => {
+                    let e = element(module, &module.global_variables[b.global])
+                        .map_err(|m| bad(format!("{label}: {}: {m}", describe(b))))?;
+                    let r = &mut resources[ri];
+                    if let Some(prev) = &r.element
+                        && (prev.stride != e.stride || prev.header != e.header)
+                    {
+                        return Err(bad(format!(
+                            "{label}: resource {} is bound as {} here but as {} elsewhere",
+                            r.spec.name, e.wgsl, prev.wgsl
+                        )));
+                    }
+                    r.element.get_or_insert(e.clone());
+                    if read_only {
+                        r.read = true;
+                    } else {
+                        r.written = true;
+                        r.read = true;
+                    }
+                    Some(e)
+                }
+                SlotFeed::Resource(ri, Usage::UniformBuffer) => {
+                    let e = element(module, &module.global_variables[b.global])
+                        .map_err(|m| bad(format!("{label}: {}: {m}", describe(b))))?;
+                    resources[ri].element.get_or_insert(e.clone());
+                    resources[ri].read = true;
+                    Some(e)
+                }
+                _ => None,
+            };
+            slots.push(PassSlot { group: b.group, binding: b.binding, var: b.name.clone(), feed, element });
+        }
+        all_slots.push(slots);
+    }
+    for (i, pass) in graph.passes.iter().enumerate() {
+        for (a, b) in &pass.swap {
+            let (ra, rb) = (
+                resources.iter().find(|r| &r.spec.name == a).expect("parsed"),
+                resources.iter().find(|r| &r.spec.name == b).expect("parsed"),
+            );
+            if ra.spec.kind_name() != rb.spec.kind_name() || ra.format != rb.format || ra.dimension != rb.dimension {
+                return Err(bad(format!(
+                    "pass {} ({}): swap [\"{a}\", \"{b}\"] pairs resources of different kinds, formats or dimensions",
+                    i + 1,
+                    pass.entry
+                )));
+            }
+        }
+    }
+    for o in &graph.outputs {
+        let Some(r) = resources.iter().find(|r| r.spec.name == o.resource) else {
+            let n: Vec<&str> = resources.iter().map(|r| r.spec.name.as_str()).collect();
+            return Err(bad(format!(
+                "[[output]] resource = \"{}\" names no resource; resources: {}",
+                o.resource,
+                n.join(", ")
+            )));
+        };
+        let swapped = graph.passes.iter().any(|p| p.swap.iter().any(|(a, b)| *a == o.resource || *b == o.resource));
+        if r.spec.kind_name() == "sampler" || !(r.written || swapped) {
+            return Err(bad(format!(
+                "[[output]] resource = \"{}\" is not written by any pass (a {}); an output is a texture or buffer a pass writes",
+                o.resource,
+                r.spec.kind_name()
+            )));
+        }
+    }
+    Ok(Resolved { resources, slots: all_slots })
+}
+
+fn find(resources: &[ResolvedResource], name: &str) -> usize {
+    resources.iter().position(|r| r.spec.name == name).expect("parse checks bind")
+}
+
+fn kind_of(resources: &[ResolvedResource], r: usize) -> &'static str {
+    resources[r].spec.kind_name()
+}
+
+/// The element layout of a buffer binding's type.
+fn element(module: &naga::Module, var: &naga::GlobalVariable) -> Result<Element, String> {
+    use naga::TypeInner as T;
+    let ty = &module.types[var.ty].inner;
+    let gctx = module.to_ctx();
+    let (header, base, stride, fixed) = match ty {
+        T::Array { base, size, stride } => (
+            0,
+            *base,
+            *stride,
+            match size {
+                naga::ArraySize::Constant(n) => Some(n.get()),
+                _ => None,
+            },
+        ),
+        T::Struct { members, span } => match members.last().map(|m| (m, &module.types[m.ty].inner)) {
+            Some((m, T::Array { base, size: naga::ArraySize::Dynamic, stride })) => (m.offset, *base, *stride, None),
+            _ => (0, var.ty, *span, Some(1)),
+        },
+        _ => (0, var.ty, ty.size(gctx), Some(1)),
+    };
+    let mut leaves = Vec::new();
+    leaves_of(module, base, 0, "", &mut leaves)?;
+    Ok(Element { stride, header, fixed, leaves, wgsl: crate::bindings::wgsl_type(module, var) })
+}
+
+fn leaves_of(
+    module: &naga::Module,
+    ty: naga::Handle<naga::Type>,
+    offset: u32,
+    path: &str,
+    out: &mut Vec<(u32, char, String)>,
+) -> Result<(), String> {
+    use naga::TypeInner as T;
+    let kind = |s: &naga::Scalar| match (s.kind, s.width) {
+        (naga::ScalarKind::Float, 4) => Ok('f'),
+        (naga::ScalarKind::Uint, 4) => Ok('u'),
+        (naga::ScalarKind::Sint, 4) => Ok('i'),
+        _ => Err(format!(
+            "element scalar {:?}{} is not supported; allowed: f32, u32, i32 (and atomics of them)",
+            s.kind,
+            s.width * 8
+        )),
+    };
+    let name = |suffix: String| {
+        if path.is_empty() {
+            suffix
+        } else if suffix.is_empty() {
+            path.to_string()
+        } else {
+            format!("{path}.{suffix}")
+        }
+    };
+    match &module.types[ty].inner {
+        T::Scalar(s) | T::Atomic(s) => out.push((offset, kind(s)?, name(String::new()))),
+        T::Vector { size, scalar } => {
+            for c in 0..*size as u32 {
+                out.push((offset + 4 * c, kind(scalar)?, name(["x", "y", "z", "w"][c as usize].into())));
+            }
+        }
+        T::Matrix { columns, rows, scalar } => {
+            let col_stride = if *rows as u32 == 2 { 8 } else { 16 };
+            for c in 0..*columns as u32 {
+                for r in 0..*rows as u32 {
+                    out.push((offset + c * col_stride + 4 * r, kind(scalar)?, name(format!("c{c}r{r}"))));
+                }
+            }
+        }
+        T::Array { base, size: naga::ArraySize::Constant(n), stride } => {
+            for i in 0..n.get() {
+                leaves_of(module, *base, offset + i * stride, &name(format!("{i}")), out)?;
+            }
+        }
+        T::Struct { members, .. } => {
+            for m in members {
+                let n = m.name.clone().unwrap_or_default();
+                leaves_of(module, m.ty, offset + m.offset, &name(n), out)?;
+            }
+        }
+        other => return Err(format!("element type {other:?} is not supported in a buffer")),
+    }
+    Ok(())
+}
+
+/// Every param a graph consumes outside uniforms and overrides: repeat
+/// counts, sizes, lengths and workgroup expressions.
+pub fn host_params(graph: &GraphSpec) -> Vec<&'static str> {
+    let mut names: Vec<&'static str> = Vec::new();
+    let mut exprs: Vec<&Expr> = Vec::new();
+    for r in &graph.resources {
+        match &r.kind {
+            ResourceKind::Texture { size: Some(s), .. } => exprs.extend(s.iter()),
+            ResourceKind::Buffer { length: Some(l), .. } => exprs.push(l),
+            _ => {}
+        }
+    }
+    for p in &graph.passes {
+        if let Repeat::Param(n) = p.repeat {
+            names.push(n);
+        }
+        exprs.extend(p.workgroups.iter().flatten());
+    }
+    for e in exprs {
+        e.names(&mut names);
+    }
+    names
+}

@@ -1,0 +1,553 @@
+//! Planning a pass graph (SPEC 14 part 2): every pass composed and
+//! reflected, every binding resolved to a param block, the table or a
+//! resource, every input file read and checked, and every resource, pass
+//! and output laid out for `vista_gpu::Context::run_graph`. All of it
+//! before any GPU work: a bad file, size, element type or binding is bad
+//! input, one line naming the resource, the file and what was expected.
+
+use std::path::{Path, PathBuf};
+
+use vista_gpu::{Bind, Contents, GraphSlot};
+use vista_image::Image;
+use vista_kernels::graph::{Element, ResourceKind, SampledDim, SlotFeed, Tolerance, Usage};
+use vista_kernels::{DisplayMap, Kernel, ParamSet};
+
+use crate::RenderError;
+
+/// One output as planned.
+#[derive(Debug, Clone)]
+pub struct PlannedOutput {
+    /// The resource's name.
+    pub name: String,
+    /// The manifest's tolerance.
+    pub tolerance: Option<Tolerance>,
+    /// Texels left unwritten are allowed.
+    pub partial: bool,
+    /// Texture or buffer.
+    pub kind: PlannedKind,
+}
+
+/// What an output is.
+#[derive(Debug, Clone)]
+pub enum PlannedKind {
+    /// A texture of this format, shown with this view.
+    Texture {
+        /// Its storage format.
+        format: &'static str,
+        /// Its PNG view.
+        view: vista_kernels::Output,
+        /// Raw to display values.
+        display: DisplayMap,
+    },
+    /// A buffer of `count` elements.
+    Buffer {
+        /// The element its binding declares.
+        element: Element,
+        /// Elements after the fixed header.
+        count: u64,
+    },
+}
+
+/// A planned graph: what `run_graph` takes, and how to read its outputs.
+#[derive(Debug, Clone)]
+pub struct GraphPlan {
+    /// The kernel's name.
+    pub kernel: String,
+    /// Every resource with its initial contents.
+    pub resources: Vec<vista_gpu::Resource>,
+    /// The passes in order.
+    pub passes: Vec<vista_gpu::GraphPass>,
+    /// Resource index of each output, in `outputs` order.
+    pub output_ids: Vec<usize>,
+    /// The outputs, the main one first.
+    pub outputs: Vec<PlannedOutput>,
+    /// Whether the kernel is deterministic (render-twice check).
+    pub deterministic: bool,
+    /// Every composed file the passes use (for hashes), in pass order.
+    pub shaders: Vec<String>,
+}
+
+/// Case-level replacements of resource files (`inputs = { name = "file" }`).
+pub type Inputs = [(String, String)];
+
+/// Plans `kernel`'s graph for `p` at `width` x `height` (the case size
+/// that resources without a `size` take), reading input files under
+/// `root` (or the case's `inputs` instead).
+pub fn plan_graph(
+    shaders: &vista_gpu::ShaderSet,
+    root: Option<&Path>,
+    kernel: &Kernel,
+    p: &ParamSet,
+    inputs: &Inputs,
+    width: u32,
+    height: u32,
+) -> Result<GraphPlan, RenderError> {
+    let g = kernel.graph().expect("a graph kernel");
+    let bad = |m: String| RenderError::BadInput(format!("kernel {}: {m}", kernel.name()));
+    let mut files = Vec::new();
+    let mut modules = Vec::new();
+    for i in 0..g.passes.len() {
+        let file = kernel.pass_shader_for(i, p);
+        let module = shaders.compose(&file).map_err(|e| match e {
+            vista_gpu::GpuError::Shader(m) => bad(m),
+            other => RenderError::Gpu(other),
+        })?;
+        files.push(file);
+        modules.push(module);
+    }
+    let pairs: Vec<(&str, &naga::Module)> =
+        files.iter().map(|f| f.as_str()).zip(modules.iter().map(|m| &**m)).collect();
+    let (resolved, layouts) = kernel.graph_layouts(&pairs).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    for (k, _) in kernel.manifest_overrides() {
+        if !modules.iter().any(|m| m.overrides.iter().any(|(_, o)| o.name.as_deref() == Some(k))) {
+            return Err(bad(format!("overrides: {k} is an override of no pass's shader")));
+        }
+    }
+    for (name, _) in inputs {
+        if !g.resources.iter().any(|r| &r.name == name) {
+            let names: Vec<&str> = g.resources.iter().map(|r| r.name.as_str()).collect();
+            return Err(bad(format!("case inputs: {name} names no resource; resources: {}", names.join(", "))));
+        }
+    }
+    let outputs_named: Vec<String> = match g.outputs.is_empty() {
+        false => g.outputs.iter().map(|o| o.resource.clone()).collect(),
+        // No [[output]] tables: the first texture some pass writes.
+        true => resolved
+            .resources
+            .iter()
+            .find(|r| r.written && r.spec.kind_name() == "texture")
+            .map(|r| vec![r.spec.name.clone()])
+            .ok_or_else(|| bad("no pass writes a texture; name the outputs in [[output]] tables".into()))?,
+    };
+    let mut resources = Vec::new();
+    for r in &resolved.resources {
+        let is_output = outputs_named.contains(&r.spec.name);
+        resources.push(match &r.spec.kind {
+            ResourceKind::Texture { size, file, .. } => {
+                let file = inputs.iter().find(|(n, _)| *n == r.spec.name).map(|(_, f)| f.clone()).or(file.clone());
+                let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
+                let dim = r.dimension.unwrap_or(SampledDim::D2);
+                let dimension = match dim {
+                    SampledDim::D1 => vista_gpu::Dimension::D1,
+                    SampledDim::D2 => vista_gpu::Dimension::D2,
+                    SampledDim::D2Array => vista_gpu::Dimension::D2Array,
+                    SampledDim::D3 => vista_gpu::Dimension::D3,
+                    SampledDim::Cube => {
+                        return Err(at("cube textures are not supported yet; use a 2d-array of 6 layers".into()));
+                    }
+                };
+                let mut extent = match size {
+                    Some(exprs) => {
+                        let mut v = [1u32; 3];
+                        for (i, e) in exprs.iter().enumerate() {
+                            let n = e.eval(p, width, height).map_err(|m| at(format!("size[{i}] {m}")))?;
+                            v[i] = u32::try_from(n)
+                                .ok()
+                                .filter(|n| (1..=16384).contains(n))
+                                .ok_or_else(|| at(format!("size[{i}] is {n} for these params; allowed: [1, 16384]")))?;
+                        }
+                        Some(v)
+                    }
+                    None => None,
+                };
+                let (format, contents) = match &file {
+                    Some(f) => {
+                        let (natural, image) = read_texture(root, f).map_err(at)?;
+                        let layers = extent.map(|e| e[2]).unwrap_or(1);
+                        let want_h = extent.map(|e| e[1] * layers);
+                        if let Some(e) = extent
+                            && (image.width != e[0] || Some(image.height) != want_h)
+                        {
+                            return Err(at(format!(
+                                "file {f} is {}x{} but size says {}x{}{}",
+                                image.width,
+                                image.height,
+                                e[0],
+                                e[1],
+                                if layers > 1 {
+                                    format!(" x {layers} layers stacked ({}x{})", e[0], e[1] * layers)
+                                } else {
+                                    String::new()
+                                }
+                            )));
+                        }
+                        extent.get_or_insert([image.width, image.height, 1]);
+                        if let Some((x, y)) = image.first_nonfinite() {
+                            return Err(at(format!("file {f} holds NaN/Inf at ({x}, {y}); inputs must be finite")));
+                        }
+                        let format = r.format.unwrap_or(natural);
+                        let out = vista_gpu::OutputFormat::parse(format).map_err(|e| at(e.to_string()))?;
+                        let bytes: Vec<u8> = image.data.iter().flat_map(|px| out.encode(*px)).collect();
+                        (format, Contents::Bytes(bytes))
+                    }
+                    None => {
+                        let format = r.format.ok_or_else(|| {
+                            at("needs format = \"...\" (no file gives one and no storage binding declares one)".into())
+                        })?;
+                        let contents = if is_output && !r.read { Contents::Sentinel } else { Contents::Zeros };
+                        (format, contents)
+                    }
+                };
+                let [w, h, l] = extent.unwrap_or(match dim {
+                    SampledDim::D1 => [width, 1, 1],
+                    _ => [width, height, 1],
+                });
+                vista_gpu::Resource::Texture(vista_gpu::TextureDesc {
+                    format,
+                    dimension,
+                    width: w,
+                    height: h,
+                    layers: l,
+                    contents,
+                })
+            }
+            ResourceKind::Buffer { file, data, fill, length } => {
+                let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
+                let Some(e) = &r.element else {
+                    return Err(at("no pass binds this buffer".into()));
+                };
+                let file = inputs.iter().find(|(n, _)| *n == r.spec.name).map(|(_, f)| f.clone()).or(file.clone());
+                let count = |n: i64| -> Result<u64, RenderError> {
+                    u64::try_from(n)
+                        .ok()
+                        .filter(|n| (1..=1 << 28).contains(n))
+                        .ok_or_else(|| at(format!("length is {n}; allowed: [1, 268435456]")))
+                };
+                let body = match (&file, data, fill, length) {
+                    (Some(f), ..) => read_buffer(root, f, e).map_err(at)?,
+                    (None, Some(values), ..) => encode_values(values, e).map_err(at)?,
+                    (None, None, fill, len) => {
+                        let n = match (len, e.fixed) {
+                            (Some(l), _) => count(l.eval(p, width, height).map_err(|m| at(format!("length {m}")))?)?,
+                            (None, Some(n)) => n as u64,
+                            (None, None) => {
+                                return Err(at(format!(
+                                    "{} is runtime-sized: give it length = N (with fill), data or a file",
+                                    e.wgsl
+                                )));
+                            }
+                        };
+                        let v = fill.unwrap_or(0.0);
+                        encode_values(&vec![v; (n * e.leaves.len() as u64) as usize], e).map_err(at)?
+                    }
+                };
+                let mut bytes = vec![0u8; e.header as usize];
+                bytes.extend(body);
+                if let Some(n) = e.fixed {
+                    let want = e.header as u64 + n as u64 * e.stride as u64;
+                    if bytes.len() as u64 != want {
+                        return Err(at(format!(
+                            "holds {} elements but {} is fixed at {n}",
+                            (bytes.len() as u64 - e.header as u64) / e.stride as u64,
+                            e.wgsl
+                        )));
+                    }
+                }
+                vista_gpu::Resource::Buffer(bytes)
+            }
+            ResourceKind::Sampler { linear, address, compare } => {
+                let a = |s: &str| vista_gpu::Address::parse(s).expect("manifest checks address modes");
+                vista_gpu::Resource::Sampler(vista_gpu::SamplerDesc {
+                    linear: *linear,
+                    address: [a(address[0]), a(address[1]), a(address[2])],
+                    compare: *compare,
+                })
+            }
+        });
+    }
+    let index = |name: &str| resolved.resources.iter().position(|r| r.spec.name == name).expect("resolved");
+    let mut passes = Vec::new();
+    for (i, ((pass, slots), layout)) in g.passes.iter().zip(&resolved.slots).zip(&layouts).enumerate() {
+        let label = format!("pass {} ({}, {})", i + 1, pass.entry, files[i]);
+        let mut pp = p.clone();
+        for (k, v) in &pass.set {
+            pp = pp.with(kernel.params(), k, v).map_err(|e| bad(format!("{label}: set: {e}")))?;
+        }
+        let module = &modules[i];
+        let constants = kernel.overrides_in(module, &pp, false).map_err(|e| RenderError::BadInput(e.to_string()))?;
+        let size = crate::workgroup_size(module, &pass.entry, &constants).map_err(|e| bad(format!("{label}: {e}")))?;
+        let blocks = kernel.uniforms(layout, &pp, width, height);
+        let table = kernel.table(layout, &pp);
+        let mut gslots = Vec::new();
+        for s in slots {
+            let bind = match &s.feed {
+                SlotFeed::Uniform(n) => Bind::Uniform(blocks[*n].clone()),
+                SlotFeed::Table => Bind::Table(table.clone()),
+                SlotFeed::Resource(r, usage) => match usage {
+                    Usage::UniformBuffer => Bind::UniformBuffer(*r),
+                    Usage::StorageBuffer { read_only } => Bind::Storage { resource: *r, read_only: *read_only },
+                    Usage::StorageTexture(st) => Bind::StorageTexture {
+                        resource: *r,
+                        access: match st.access {
+                            vista_kernels::resources::Access::Write => vista_gpu::Access::Write,
+                            vista_kernels::resources::Access::Read => vista_gpu::Access::Read,
+                            vista_kernels::resources::Access::ReadWrite => vista_gpu::Access::ReadWrite,
+                        },
+                    },
+                    Usage::Sampled { kind, .. } => {
+                        Bind::Sampled { resource: *r, depth: *kind == vista_kernels::graph::SampledKind::Depth }
+                    }
+                    Usage::Sampler { .. } => Bind::Sampler(*r),
+                },
+            };
+            gslots.push(GraphSlot { group: s.group, binding: s.binding, bind });
+        }
+        let cover = |r: usize| -> [u32; 3] {
+            match &resources[r] {
+                vista_gpu::Resource::Texture(t) => [t.width, t.height, t.layers],
+                vista_gpu::Resource::Buffer(b) => {
+                    let e = resolved.resources[r].element.as_ref().expect("a bound buffer");
+                    [((b.len() as u32 - e.header) / e.stride.max(1)).max(1), 1, 1]
+                }
+                vista_gpu::Resource::Sampler(_) => [width, height, 1],
+            }
+        };
+        let workgroups = match (&pass.workgroups, &pass.dispatch) {
+            (Some(exprs), _) => {
+                let mut out = [1u32; 3];
+                for (k, e) in exprs.iter().enumerate() {
+                    let v = e.eval(&pp, width, height).map_err(|m| bad(format!("{label}: workgroups[{k}] {m}")))?;
+                    out[k] = u32::try_from(v).ok().filter(|v| (1..=65535).contains(v)).ok_or_else(|| {
+                        bad(format!("{label}: workgroups[{k}] is {v} for these params; allowed: [1, 65535]"))
+                    })?;
+                }
+                out
+            }
+            (None, target) => {
+                let extent = match target {
+                    Some(name) => cover(index(name)),
+                    None => {
+                        let written: Vec<usize> = slots
+                            .iter()
+                            .filter_map(|s| match s.feed {
+                                SlotFeed::Resource(r, Usage::StorageTexture(st))
+                                    if st.access != vista_kernels::resources::Access::Read =>
+                                {
+                                    Some(r)
+                                }
+                                _ => None,
+                            })
+                            .collect();
+                        match written[..] {
+                            [one] => cover(one),
+                            _ => [width, height, 1],
+                        }
+                    }
+                };
+                let wg = [extent[0].div_ceil(size[0]), extent[1].div_ceil(size[1]), extent[2].div_ceil(size[2])];
+                if let Some(k) = wg.iter().position(|v| *v > 65535) {
+                    return Err(bad(format!("{label}: {} workgroups along axis {k}; allowed: at most 65535", wg[k])));
+                }
+                wg
+            }
+        };
+        let repeat = match pass.repeat {
+            vista_kernels::graph::Repeat::Count(n) => n,
+            vista_kernels::graph::Repeat::Param(name) => {
+                let n = pp.int(name);
+                u32::try_from(n)
+                    .ok()
+                    .filter(|n| (1..=100_000).contains(n))
+                    .ok_or_else(|| bad(format!("{label}: repeat = {name} is {n}; allowed: [1, 100000]")))?
+            }
+        };
+        let swap = pass.swap.iter().map(|(a, b)| (index(a), index(b))).collect();
+        passes.push(vista_gpu::GraphPass {
+            label,
+            shader: files[i].clone(),
+            entry: pass.entry.clone(),
+            constants,
+            workgroups,
+            slots: gslots,
+            repeat,
+            swap,
+        });
+    }
+    let mut outputs = Vec::new();
+    let mut output_ids = Vec::new();
+    for name in &outputs_named {
+        let r = index(name);
+        let spec = g.outputs.iter().find(|o| &o.resource == name);
+        let kind = match &resources[r] {
+            vista_gpu::Resource::Texture(t) => {
+                let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.view(t.format));
+                PlannedKind::Texture { format: t.format, view, display: kernel.display_map_with(p, view) }
+            }
+            vista_gpu::Resource::Buffer(b) => {
+                let e = resolved.resources[r].element.clone().expect("a bound buffer");
+                let count = (b.len() as u64 - e.header as u64) / e.stride.max(1) as u64;
+                PlannedKind::Buffer { element: e, count }
+            }
+            vista_gpu::Resource::Sampler(_) => unreachable!("resolve refuses a sampler output"),
+        };
+        outputs.push(PlannedOutput {
+            name: name.clone(),
+            tolerance: spec.and_then(|o| o.tolerance),
+            partial: spec.is_some_and(|o| o.partial),
+            kind,
+        });
+        output_ids.push(r);
+    }
+    Ok(GraphPlan {
+        kernel: kernel.name().to_string(),
+        resources,
+        passes,
+        output_ids,
+        outputs,
+        deterministic: g.deterministic,
+        shaders: files,
+    })
+}
+
+/// A texture file under the project root: its natural format (8-bit PNG:
+/// rgba8unorm; 16-bit PNG and EXR: rgba32float) and its values.
+fn read_texture(root: Option<&Path>, file: &str) -> Result<(&'static str, Image), String> {
+    let path = under(root, file)?;
+    let bytes = std::fs::read(&path).map_err(|e| format!("file {file} cannot be read ({}): {e}", path.display()))?;
+    if file.ends_with(".exr") {
+        let image = vista_image::read_exr(&path).map_err(|e| format!("file {file}: {e}"))?;
+        return Ok(("rgba32float", image));
+    }
+    // PNG: bit depth is byte 24 of the IHDR chunk.
+    if !bytes.starts_with(b"\x89PNG") || bytes.len() < 25 {
+        return Err(format!("file {file} is not a PNG"));
+    }
+    let image = vista_image::decode_png16(&path, &bytes).map_err(|e| format!("file {file}: {e}"))?;
+    Ok((if bytes[24] == 16 { "rgba32float" } else { "rgba8unorm" }, image))
+}
+
+fn under(root: Option<&Path>, file: &str) -> Result<PathBuf, String> {
+    let root = root.ok_or_else(|| format!("file {file} needs a project root (vista.toml) to be found under"))?;
+    Ok(root.join(file))
+}
+
+/// A buffer file: `.npy` (dtype checked against the element) or `.bin`
+/// (raw little-endian bytes, a whole number of elements).
+fn read_buffer(root: Option<&Path>, file: &str, e: &Element) -> Result<Vec<u8>, String> {
+    let path = under(root, file)?;
+    let bytes =
+        std::fs::read(&path).map_err(|err| format!("file {file} cannot be read ({}): {err}", path.display()))?;
+    let data = match file.ends_with(".npy") {
+        true => {
+            let n = vista_image::npy::decode_npy(&path, &bytes).map_err(|err| format!("file {file}: {err}"))?;
+            let (descr, _) = npy_dtype(e);
+            let scalar_of = |d: &str| d.chars().nth(1);
+            let leaf_kind = e.leaves.first().map(|l| l.1);
+            let simple_ok = !n.descr.starts_with('[')
+                && scalar_of(&n.descr) == leaf_kind
+                && n.descr.ends_with('4')
+                && e.leaves.iter().all(|l| Some(l.1) == leaf_kind);
+            if !(simple_ok || (n.descr.starts_with('[') && n.item_bytes == e.stride as u64)) {
+                return Err(format!(
+                    "file {file} has dtype {} but {} needs {descr} (or any dtype of {} bytes per element)",
+                    n.descr, e.wgsl, e.stride
+                ));
+            }
+            n.data
+        }
+        false => bytes,
+    };
+    // A simple dtype of a padded element (vec3 at 16-byte stride) is packed:
+    // spread it over the stride.
+    let packed = e.leaves.len() as u32 * 4;
+    let data = if packed != e.stride
+        && data.len().is_multiple_of(packed as usize)
+        && !data.len().is_multiple_of(e.stride as usize)
+    {
+        let mut out = Vec::new();
+        for chunk in data.chunks(packed as usize) {
+            let mut el = vec![0u8; e.stride as usize];
+            for (leaf, v) in e.leaves.iter().zip(chunk.chunks(4)) {
+                el[leaf.0 as usize..leaf.0 as usize + 4].copy_from_slice(v);
+            }
+            out.extend(el);
+        }
+        out
+    } else {
+        data
+    };
+    if data.is_empty() || !data.len().is_multiple_of(e.stride as usize) {
+        return Err(format!(
+            "file {file} holds {} bytes, not a whole number of {}-byte elements of {}",
+            data.len(),
+            e.stride,
+            e.wgsl
+        ));
+    }
+    if let Some((i, v)) = leaf_values(&data, e).iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(format!("file {file} holds {v} at value {i}; inputs must be finite"));
+    }
+    Ok(data)
+}
+
+/// Numbers converted to the element's leaves in order (a whole number of
+/// elements).
+fn encode_values(values: &[f64], e: &Element) -> Result<Vec<u8>, String> {
+    let per = e.leaves.len();
+    if per == 0 || values.is_empty() || !values.len().is_multiple_of(per) {
+        return Err(format!(
+            "{} numbers are not a whole number of elements of {} ({per} numbers each)",
+            values.len(),
+            e.wgsl
+        ));
+    }
+    let mut out = Vec::new();
+    for chunk in values.chunks(per) {
+        let mut el = vec![0u8; e.stride as usize];
+        for ((offset, kind, path), v) in e.leaves.iter().zip(chunk) {
+            let word = match kind {
+                'f' => (*v as f32).to_le_bytes(),
+                'u' if *v >= 0.0 && *v <= u32::MAX as f64 && v.fract() == 0.0 => (*v as u32).to_le_bytes(),
+                'i' if *v >= i32::MIN as f64 && *v <= i32::MAX as f64 && v.fract() == 0.0 => (*v as i32).to_le_bytes(),
+                _ => return Err(format!("{v} does not fit {path} ({kind}32) of {}", e.wgsl)),
+            };
+            el[*offset as usize..*offset as usize + 4].copy_from_slice(&word);
+        }
+        out.extend(el);
+    }
+    Ok(out)
+}
+
+/// Every leaf value of every element, as f64, in order.
+pub fn leaf_values(bytes: &[u8], e: &Element) -> Vec<f64> {
+    let mut out = Vec::new();
+    for el in bytes.chunks_exact(e.stride.max(1) as usize) {
+        for (offset, kind, _) in &e.leaves {
+            let b = &el[*offset as usize..*offset as usize + 4];
+            let w = [b[0], b[1], b[2], b[3]];
+            out.push(match kind {
+                'f' => f32::from_le_bytes(w) as f64,
+                'u' => u32::from_le_bytes(w) as f64,
+                _ => i32::from_le_bytes(w) as f64,
+            });
+        }
+    }
+    out
+}
+
+/// The NumPy dtype of an element and the shape of one element: a simple
+/// dtype when its leaves are one scalar kind packed without padding
+/// (`<u4` shape `()`, `<f4` shape `(4,)`), else a structured dtype with
+/// padding as void fields.
+pub fn npy_dtype(e: &Element) -> (String, Vec<u64>) {
+    let kind = e.leaves.first().map(|l| l.1).unwrap_or('u');
+    let packed = e.leaves.iter().enumerate().all(|(i, l)| l.0 == 4 * i as u32 && l.1 == kind);
+    if packed && e.stride == 4 * e.leaves.len() as u32 {
+        let tail = if e.leaves.len() == 1 { vec![] } else { vec![e.leaves.len() as u64] };
+        return (format!("<{kind}4"), tail);
+    }
+    let mut fields = Vec::new();
+    let mut at = 0;
+    for (offset, kind, path) in &e.leaves {
+        if *offset > at {
+            fields.push(format!("('_pad{at}', '|V{}')", offset - at));
+        }
+        let name = if path.is_empty() { "value".to_string() } else { path.clone() };
+        fields.push(format!("('{name}', '<{kind}4')"));
+        at = offset + 4;
+    }
+    if e.stride > at {
+        fields.push(format!("('_pad{at}', '|V{}')", e.stride - at));
+    }
+    (format!("[{}]", fields.join(", ")), vec![])
+}
