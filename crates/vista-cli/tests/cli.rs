@@ -2535,6 +2535,17 @@ fn the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu() {
         .collect();
     assert_eq!(values.len(), 1 << 16);
     assert!(npy_u32(&root.join("scan.npy")) == cpu, "the GPU's prefix sum differs from the CPU's");
+    // `vista compare` reads two buffers: the golden against itself, then
+    // against another count (the first 1000 prefixes agree).
+    let golden = root.join("golden/scan/scan.npy");
+    let same = run(&["compare", golden.to_str().unwrap(), "scan.npy", "--json"]);
+    assert!(same.code == 0 && same.stdout.contains("\"differ\":0"), "{}{}", same.stdout, same.stderr);
+    let other = root.join("golden/scan/scan-partial.npy");
+    assert_rejected(
+        &run(&["compare", golden.to_str().unwrap(), other.to_str().unwrap()]),
+        2,
+        &["<u4 [1000]", "one dtype and shape"],
+    );
     // Separable Gaussian: the f64 blur of the input with clamped edges. The
     // GPU stores the input and both passes in rgba16float (3 roundings of at
     // most 2^-12 relative, values <= 1): measured 9.2e-4, bound 2e-3.

@@ -39,6 +39,9 @@ pub struct ReportFiles {
     pub diff8: Option<String>,
     /// `view.js`: both images' 16-bit values for the viewer's readout.
     pub view: Option<String>,
+    /// A pass graph's other texture outputs: (name, expected 8-bit, actual
+    /// 8-bit).
+    pub outputs: Vec<(String, Option<String>, Option<String>)>,
 }
 
 /// The run's side of the provenance, beside the golden's manifest entry.
@@ -81,6 +84,8 @@ pub struct Outcome {
     pub changed_files: Vec<String>,
     /// The first NaN/Inf or out-of-range raw pixel, and what it holds.
     pub first_bad: Option<(u32, u32, String)>,
+    /// A pass graph's outputs as judged (empty for a one-pass kernel).
+    pub outputs: Vec<crate::outputs::OutputVerdict>,
 }
 
 /// A pixel is "bad" when a display channel differs by more than this.
@@ -246,6 +251,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
         run,
         changed_files: Vec::new(),
         first_bad: None,
+        outputs: Vec::new(),
     };
     match observed {
         Err(e) => {
@@ -318,7 +324,11 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
                     out.changed_files = changed_files(&e.shader_files, obs.shader_files);
                 }
             }
-            if vista_kernels::is_integer_format(obs.format) && e.raw_hash != obs.raw.content_hash() {
+            // A graph's outputs are judged by `outputs` (integers exactly there).
+            if obs.outputs.is_empty()
+                && vista_kernels::is_integer_format(obs.format)
+                && e.raw_hash != obs.raw.content_hash()
+            {
                 // Integers compare exactly, on any driver and after any edit.
                 out.problems.push(format!(
                     "raw values differ from the blessed ones: a {} output compares exactly (raw hash {} vs \
@@ -406,6 +416,14 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
         }
     };
     m.nan = obs.raw.nonfinite_count();
+    // A graph's main image with a tolerance (its own, or exact for an
+    // integer format) is judged by it alone, in `outputs`; the metrics stay
+    // for the reader.
+    if obs.outputs.first().is_some_and(|o| o.by_tolerance) {
+        out.notes.push("the main image is judged by its output's tolerance instead of PSNR".into());
+        out.metrics = Some(m);
+        return;
+    }
     // A case with a bad-pixel budget is judged by it instead of PSNR: a few
     // pixels that flip far (a crest across drivers) pass, more do not.
     let by_bad_pixels = case.max_bad_pixels.is_some() || case.max_bad_ratio.is_some();
@@ -451,6 +469,7 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
 /// makes the case missing, an unreadable one an error, a difference a
 /// failure; each output's summary is a note.
 fn outputs_verdict(case: &Case, outputs: &[crate::outputs::OutputVerdict], out: &mut Outcome) {
+    out.outputs = outputs.to_vec();
     for o in outputs {
         for path in &o.missing {
             out.verdict = Verdict::Missing;

@@ -66,6 +66,15 @@ pub fn output_files(golden_dir: &Path, case: &Case, index: usize, out: &OutputRe
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct OutputVerdict {
     pub name: String,
+    /// What it is: `texture rgba16float 64x32`, `buffer <u4 [65536]`.
+    pub kind: String,
+    /// How it is judged: its tolerance, or the case's PSNR threshold.
+    pub judged_by: String,
+    /// Its golden files' names.
+    pub files: Vec<String>,
+    /// Judged by a tolerance (its own, or exact by default): for the main
+    /// image, instead of the case's PSNR thresholds.
+    pub by_tolerance: bool,
     /// Golden files that do not exist.
     pub missing: Vec<PathBuf>,
     /// Golden files that exist but cannot be read.
@@ -86,8 +95,25 @@ pub fn compare_output(
     psnr_threshold: f64,
 ) -> OutputVerdict {
     let files = output_files(golden_dir, case, index, out);
-    let mut v = OutputVerdict { name: out.name.clone(), ..Default::default() };
     let tolerance = effective_tolerance(out);
+    let mut v = OutputVerdict {
+        name: out.name.clone(),
+        kind: match &out.value {
+            OutputValue::Texture { raw, format, .. } => format!("texture {format} {}x{}", raw.width, raw.height),
+            OutputValue::Buffer { .. } => {
+                let (descr, shape) = out.npy().expect("a buffer");
+                format!("buffer {descr} {shape:?}")
+            }
+        },
+        judged_by: match (tolerance, index) {
+            (Some(t), _) => t.describe(),
+            (None, 0) => "the case's thresholds (the main image)".into(),
+            (None, _) => format!("PSNR >= {psnr_threshold:.1} dB of its view"),
+        },
+        by_tolerance: tolerance.is_some(),
+        files: files.all().iter().filter_map(|p| p.file_name().map(|n| n.to_string_lossy().to_string())).collect(),
+        ..Default::default()
+    };
     v.problems = guard_one(index, out);
     match &out.value {
         OutputValue::Buffer { .. } => {
@@ -122,6 +148,9 @@ pub fn compare_output(
             judge_values(&mut v, &out.name, tolerance.expect("buffers have one"), &expected, &actual, is_f32(element));
         }
         OutputValue::Texture { raw, .. } => {
+            if index == 0 && tolerance.is_none() {
+                v.summary = format!("output {}: the main image (metrics above)", out.name);
+            }
             if let Some(exr) = &files.exr {
                 match exr.exists() {
                     false => v.missing.push(exr.clone()),

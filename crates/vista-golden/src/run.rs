@@ -29,6 +29,9 @@ pub struct Checked {
     /// `golden_hash` is set once the PNG is written): what the report's
     /// `pending.toml` keeps for `vista bless --from-report`.
     pub pending: Option<crate::ManifestEntry>,
+    /// A pass graph's other texture outputs for the report: (name, display
+    /// values as a 16-bit PNG holds them, its golden PNG when readable).
+    pub output_images: Vec<(String, Image, Option<Image>)>,
 }
 
 /// This run's side of `case`'s provenance: backend, adapter, params hash
@@ -51,7 +54,13 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     let r = match rendered {
         Ok(r) => r,
         Err(e) => {
-            return Checked { outcome: judge(case, entry, run, Err(e)), actual: None, expected: None, pending: None };
+            return Checked {
+                outcome: judge(case, entry, run, Err(e)),
+                actual: None,
+                expected: None,
+                pending: None,
+                output_images: Vec::new(),
+            };
         }
     };
     let has_image = r.raw.width > 0;
@@ -134,7 +143,19 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         Ok((_, _, _, Some((_, Ok(image))))) => Some(image),
         _ => None,
     };
-    Checked { outcome: out, actual: has_image.then_some(actual), expected, pending }
+    let output_images = r
+        .outputs
+        .iter()
+        .enumerate()
+        .skip(1)
+        .filter_map(|(i, o)| {
+            let shown = quantize16(&o.display()?);
+            let files = crate::outputs::output_files(&store.dir, case, i, o);
+            let golden = files.png.and_then(|p| vista_image::read_png16(&p).ok());
+            Some((o.name.clone(), shown, golden))
+        })
+        .collect();
+    Checked { outcome: out, actual: has_image.then_some(actual), expected, pending, output_images }
 }
 
 /// Renders a case: its kernel, params, size and replacement inputs.

@@ -158,6 +158,67 @@ pub fn dtype_bytes(descr: &str) -> Result<u64, String> {
     Ok(total)
 }
 
+/// Every number of one item of a dtype, in order: (byte offset, kind
+/// `f` `u` `i`, bytes). Void (padding) fields are skipped.
+pub fn dtype_numbers(descr: &str) -> Result<Vec<(u64, char, u64)>, String> {
+    let simple = |ty: &str| -> Result<(char, u64), String> {
+        let kind = ty.chars().nth(1).ok_or_else(|| format!("dtype {ty} is not valid"))?;
+        Ok((kind, dtype_bytes(ty)?))
+    };
+    if !descr.starts_with('[') {
+        let (kind, n) = simple(descr)?;
+        return Ok(vec![(0, kind, n)]);
+    }
+    let mut out = Vec::new();
+    let mut at = 0;
+    for field in descr[1..descr.len() - 1].split("),").map(|f| f.trim().trim_start_matches('(').trim_end_matches(')')) {
+        if field.trim().is_empty() {
+            continue;
+        }
+        let parts: Vec<&str> = field.splitn(3, ',').map(str::trim).collect();
+        let ty = parts.get(1).ok_or_else(|| format!("structured field {field} has no type"))?;
+        let ty = ty.trim_matches(|c| c == '\'' || c == '"');
+        let (kind, n) = simple(ty)?;
+        let mut count = 1;
+        if let Some(dims) = parts.get(2) {
+            for d in dims.trim_matches(|c| c == '(' || c == ')').split(',').map(str::trim).filter(|d| !d.is_empty()) {
+                count *= d.parse::<u64>().map_err(|_| format!("structured field {field} has a bad shape"))?;
+            }
+        }
+        for i in 0..count {
+            if kind != 'V' {
+                out.push((at + i * n, kind, n));
+            }
+        }
+        at += count * n;
+    }
+    Ok(out)
+}
+
+/// Every number of `n`'s data as f64, item after item.
+pub fn values(n: &Npy) -> Result<Vec<f64>, String> {
+    let numbers = dtype_numbers(&n.descr)?;
+    let mut out = Vec::new();
+    for item in n.data.chunks_exact(n.item_bytes.max(1) as usize) {
+        for &(offset, kind, size) in &numbers {
+            let b = &item[offset as usize..(offset + size) as usize];
+            out.push(match (kind, size) {
+                ('f', 4) => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                ('f', 8) => f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]),
+                ('u', 1) => b[0] as f64,
+                ('u', 2) => u16::from_le_bytes([b[0], b[1]]) as f64,
+                ('u', 4) => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                ('i', 1) => b[0] as i8 as f64,
+                ('i', 2) => i16::from_le_bytes([b[0], b[1]]) as f64,
+                ('i', 4) => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                ('b', 1) => b[0] as f64,
+                _ => return Err(format!("dtype {} holds a {kind}{size} number, which vista cannot read", n.descr)),
+            });
+        }
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -178,5 +239,12 @@ mod tests {
         assert!(e.contains("12 data bytes for shape [4]"), "{e}");
         assert!(decode_npy(p, &encode_npy(">f4", &[3], &data)).unwrap_err().to_string().contains("little-endian"));
         assert!(decode_npy(p, b"PK\x03\x04").unwrap_err().to_string().contains("magic"));
+        let mut item = Vec::new();
+        item.extend(1.5f32.to_le_bytes());
+        item.extend(2.5f32.to_le_bytes());
+        item.extend(7u32.to_le_bytes());
+        item.extend([0xFF; 4]);
+        let n = decode_npy(p, &encode_npy(s, &[1], &item)).unwrap();
+        assert_eq!(values(&n).unwrap(), [1.5, 2.5, 7.0], "padding skipped");
     }
 }

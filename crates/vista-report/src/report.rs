@@ -42,14 +42,97 @@ pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
 /// A checked case with its images written into `dir`: the outcome with
 /// `files` filled in (a failure to write them makes the case an error).
 pub fn file_case(dir: &Path, checked: vista_golden::Checked) -> Outcome {
-    let vista_golden::Checked { mut outcome, actual, expected, .. } = checked;
+    let vista_golden::Checked { mut outcome, actual, expected, output_images, .. } = checked;
     if let Some(actual) = &actual
         && let Err(e) = write_case_files(dir, &mut outcome, actual, expected.as_ref())
     {
         outcome.verdict = Verdict::Error;
         outcome.problems.push(e.to_string());
     }
+    if let Err(e) = write_output_images(dir, &mut outcome, &output_images) {
+        outcome.verdict = Verdict::Error;
+        outcome.problems.push(e.to_string());
+    }
     outcome
+}
+
+/// Writes a pass graph's other texture outputs (8-bit, the render's and
+/// the golden's) into `<dir>/<id>/` for the outputs table.
+fn write_output_images(
+    dir: &Path,
+    out: &mut Outcome,
+    images: &[(String, Image, Option<Image>)],
+) -> Result<(), GoldenError> {
+    if images.is_empty() {
+        return Ok(());
+    }
+    let id = out.id.clone();
+    let case_dir = dir.join(&id);
+    std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
+        path: case_dir.display().to_string(),
+        message: format!("cannot create report dir: {e}"),
+    })?;
+    let marker = case_dir.join(CASE_MARKER);
+    if !marker.exists() {
+        std::fs::write(&marker, b"")
+            .map_err(|e| GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
+    }
+    for (name, actual, expected) in images {
+        let write = |which: &str, img: &Image| -> Result<String, GoldenError> {
+            let file = format!("{name}.{which}8.png");
+            vista_image::write_png8(&case_dir.join(&file), img)?;
+            Ok(format!("{id}/{file}"))
+        };
+        let e = expected.as_ref().map(|img| write("expected", img)).transpose()?;
+        let a = Some(write("actual", actual)?);
+        out.files.outputs.push((name.clone(), e, a));
+    }
+    Ok(())
+}
+
+/// A pass graph's outputs: what each is, how it is judged, its result (or
+/// problems) and, for textures other than the main image, both images.
+fn outputs_table(o: &Outcome) -> String {
+    if o.outputs.is_empty() {
+        return String::new();
+    }
+    let mut t = String::from(
+        "<table class=\"outputs\"><tr><th>output</th><th>what</th><th>judged by</th><th>result</th><th>golden</th>\
+         <th>this run</th></tr>",
+    );
+    for v in &o.outputs {
+        let images = o.files.outputs.iter().find(|(n, _, _)| *n == v.name);
+        let img = |p: Option<&String>| match p {
+            Some(p) => format!(
+                "<a href=\"{0}\"><img class=\"thumb\" src=\"{0}\" alt=\"{1}\"></a>",
+                html_escape(p),
+                html_escape(&v.name)
+            ),
+            None => String::new(),
+        };
+        let mut result: Vec<String> =
+            v.problems.iter().map(|p| format!("<div class=\"problem\">{}</div>", html_escape(p))).collect();
+        result.extend(
+            v.missing
+                .iter()
+                .map(|m| format!("<div class=\"problem\">missing {}</div>", html_escape(&m.display().to_string()))),
+        );
+        result.extend(v.errors.iter().map(|m| format!("<div class=\"problem\">{}</div>", html_escape(m))));
+        if result.is_empty() {
+            result.push(html_escape(&v.summary));
+        }
+        t += &format!(
+            "<tr><td><b>{}</b><br><small>{}</small></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            html_escape(&v.name),
+            html_escape(&v.files.join(", ")),
+            html_escape(&v.kind),
+            html_escape(&v.judged_by),
+            result.join(""),
+            img(images.and_then(|i| i.1.as_ref())),
+            img(images.and_then(|i| i.2.as_ref())),
+        );
+    }
+    t + "</table>"
 }
 
 /// Writes one case's report images into `<dir>/<id>/` and records their
@@ -293,8 +376,8 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
         "<details class=\"case {cls}\" id=\"{anchor}\" data-failing=\"{failing}\"{open}>\
          <summary><span class=\"verdict\">{verdict}</span> <b class=\"id\">{id}</b> <span class=\"kernel\">{kernel}</span> \
          <span class=\"psnr\">PSNR {psnr}</span> <span class=\"ms\">{gpu:.1} ms</span> \
-         <span class=\"thumbs\">{e}{a}{d}</span></summary>\
-         <div class=\"body\"><div class=\"cols\"><div>{metrics}{first_bad}{msgs}\
+         <span class=\"thumbs\">{thumbs}</span></summary>\
+         <div class=\"body\"><div class=\"cols\"><div>{metrics}{outputs}{first_bad}{msgs}\
          <p>bless this case: <code class=\"cmd\">{bless}</code></p>{accept}</div><div>{prov}</div></div>{viewer}</div></details>\n",
         cls = if failing { "fail" } else { "pass" },
         anchor = anchor(&o.id),
@@ -303,9 +386,20 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
         id = html_escape(&o.id),
         kernel = html_escape(&o.kernel),
         gpu = o.gpu_ms,
-        e = thumb(&o.files.expected8, &o.files.expected, "expected"),
-        a = thumb(&o.files.actual8, &o.files.actual, "actual"),
-        d = thumb(&o.files.diff8, &o.files.diff, "heat map"),
+        thumbs = match (&o.files.actual, o.outputs.is_empty()) {
+            // A graph whose first output is a buffer has no main image.
+            (None, false) => format!(
+                "<span class=\"none\">outputs: {}</span>",
+                html_escape(&o.outputs.iter().map(|v| v.name.as_str()).collect::<Vec<_>>().join(", "))
+            ),
+            _ => format!(
+                "{} {} {}",
+                thumb(&o.files.expected8, &o.files.expected, "expected"),
+                thumb(&o.files.actual8, &o.files.actual, "actual"),
+                thumb(&o.files.diff8, &o.files.diff, "heat map")
+            ),
+        },
+        outputs = outputs_table(o),
         bless = html_escape(&o.bless_command),
         accept = match run.pending.contains(&o.id) {
             true => format!(
