@@ -2762,6 +2762,14 @@ fn every_output_of_a_graph_is_judged() {
     assert!(root.join("golden/scan/scan.npy").exists());
     let manifest = std::fs::read_to_string(root.join("golden/manifest.toml")).unwrap();
     assert!(manifest.contains("\"scan.npy\" = "), "{manifest}");
+    // A golden file changed outside vista bless is named, as the main one is.
+    let horizontal = root.join("golden/blur/blur.horizontal.png");
+    let mut img = vista_image::load(&horizontal).unwrap();
+    img.data[0] = [0.0, 0.0, 0.0, 1.0];
+    vista_image::write_png16(&horizontal, &img).unwrap();
+    let c = run(&["check", "--case", "blur"]);
+    assert!(c.code == 1 && c.stdout.contains("blur.horizontal.png (hash"), "{}", c.stdout);
+    assert!(c.stdout.contains("is not the file its manifest entry describes"), "{}", c.stdout);
     // Outputs of other cases' files are not orphans; a stray one is.
     assert_eq!(run(&["check", "--case", "scan"]).code, 0);
     std::fs::write(root.join("golden/scan/gone.npy"), b"x").unwrap();

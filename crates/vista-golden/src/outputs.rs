@@ -93,6 +93,7 @@ pub fn compare_output(
     index: usize,
     out: &OutputRender,
     psnr_threshold: f64,
+    blessed: Option<&crate::ManifestEntry>,
 ) -> OutputVerdict {
     let files = output_files(golden_dir, case, index, out);
     let tolerance = effective_tolerance(out);
@@ -115,6 +116,23 @@ pub fn compare_output(
         ..Default::default()
     };
     v.problems = guard_one(index, out);
+    // Each file is the one its manifest entry describes: a file changed
+    // outside vista bless, or left by an interrupted one, is named.
+    if let Some(entry) = blessed {
+        for path in files.all() {
+            let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+            let (Some(want), Ok(bytes)) = (entry.outputs.get(&name), std::fs::read(path)) else { continue };
+            let hash = crate::short_hash_bytes(&bytes);
+            if &hash != want {
+                v.problems.push(format!(
+                    "golden {} (hash {hash}) is not the file its manifest entry describes ({want}): it was changed \
+                     outside vista bless or by an interrupted one; review it and re-bless: {}",
+                    path.display(),
+                    case.bless_command()
+                ));
+            }
+        }
+    }
     match &out.value {
         OutputValue::Buffer { .. } => {
             let path = files.npy.expect("a buffer's npy");

@@ -110,7 +110,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
                 .outputs
                 .iter()
                 .enumerate()
-                .map(|(i, o)| crate::outputs::compare_output(case, &store.dir, i, o, threshold))
+                .map(|(i, o)| crate::outputs::compare_output(case, &store.dir, i, o, threshold, entry))
                 .collect();
             let observed = Observed {
                 unwritten: r.unwritten,

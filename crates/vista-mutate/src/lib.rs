@@ -417,7 +417,7 @@ fn judge_case(
         .outputs
         .iter()
         .enumerate()
-        .map(|(i, o)| vista_golden::outputs::compare_output(b.case, &b.golden_dir, i, o, threshold))
+        .map(|(i, o)| vista_golden::outputs::compare_output(b.case, &b.golden_dir, i, o, threshold, entry))
         .collect();
     let observed = Observed {
         raw: &r.raw,
