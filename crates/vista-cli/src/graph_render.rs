@@ -12,9 +12,11 @@ use crate::bad;
 
 /// The file output `name` goes to, given `-o out` (the first output: `out`).
 pub fn output_path(out: &Path, first: bool, name: &str, buffer: bool) -> PathBuf {
-    let ext = match buffer {
-        true => "npy".to_string(),
-        false => out.extension().and_then(|e| e.to_str()).unwrap_or("png").to_string(),
+    let ext = match (buffer, out.extension().and_then(|e| e.to_str())) {
+        (true, _) => "npy".to_string(),
+        // Beside a buffer's `-o x.npy`, a texture gets its PNG view.
+        (false, Some(e)) if e.eq_ignore_ascii_case("npy") => "png".to_string(),
+        (false, e) => e.unwrap_or("png").to_string(),
     };
     if first {
         return out.to_path_buf();
@@ -46,7 +48,8 @@ pub fn render(ctx: &Renderer, k: &Kernel, p: &ParamSet, w: u32, h: u32, out: &Pa
         let path = output_path(out, i == 0, &o.name, is_buffer);
         match &o.value {
             OutputValue::Texture { raw, unwritten, .. } => {
-                let img = if ext == "exr" { raw.clone() } else { o.display().expect("a texture") };
+                let raw_values = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+                let img = if raw_values { raw.clone() } else { o.display().expect("a texture") };
                 vista_image::save(&path, &img)?;
                 if let Some((x, y)) = raw.first_nonfinite() {
                     eprintln!(

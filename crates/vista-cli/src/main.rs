@@ -673,7 +673,11 @@ fn check(
     if pick.changed {
         let shaders = vista_render::shader_set(project)?;
         picked.retain(|c| {
-            let files = shaders.file_hashes(c.kernel.shader()).unwrap_or_default();
+            // Every file any pass reaches, as the manifest records them.
+            let mut files = std::collections::BTreeMap::new();
+            for f in c.kernel.shader_files() {
+                files.extend(shaders.file_hashes(f).unwrap_or_default());
+            }
             vista_golden::selection::change(c, &manifest, &files).is_some()
         });
         why.push("--changed".into());

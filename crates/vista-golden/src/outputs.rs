@@ -163,7 +163,20 @@ pub fn compare_output(
             let OutputValue::Buffer { element, .. } = &out.value else { unreachable!("a buffer") };
             let expected = vista_render::graph::leaf_values(&golden.data, element);
             let actual = vista_render::graph::leaf_values(out.buffer_body().expect("a buffer"), element);
-            judge_values(&mut v, &out.name, tolerance.expect("buffers have one"), &expected, &actual, is_f32(element));
+            let per = element.leaves.len().max(1);
+            let locate = |i: usize| {
+                let leaf = &element.leaves[i % per].2;
+                if leaf.is_empty() { format!("[{}]", i / per) } else { format!("[{}].{leaf}", i / per) }
+            };
+            judge_values(
+                &mut v,
+                &out.name,
+                tolerance.expect("buffers have one"),
+                &expected,
+                &actual,
+                is_f32(element),
+                &locate,
+            );
         }
         OutputValue::Texture { raw, .. } => {
             if index == 0 && tolerance.is_none() {
@@ -183,14 +196,22 @@ pub fn compare_output(
                             raw.width,
                             raw.height
                         )),
-                        Ok(g) => judge_values(
-                            &mut v,
-                            &out.name,
-                            tolerance.expect("an exr goes with a tolerance"),
-                            &flat(&g),
-                            &flat(raw),
-                            true,
-                        ),
+                        Ok(g) => {
+                            let w = raw.width as usize;
+                            let locate = |i: usize| {
+                                let t = i / 4;
+                                format!("({}, {}).{}", t % w, t / w, ["r", "g", "b", "a"][i % 4])
+                            };
+                            judge_values(
+                                &mut v,
+                                &out.name,
+                                tolerance.expect("an exr goes with a tolerance"),
+                                &flat(&g),
+                                &flat(raw),
+                                true,
+                                &locate,
+                            )
+                        }
                     },
                 }
             }
@@ -302,8 +323,16 @@ fn flat(img: &Image) -> Vec<f64> {
 }
 
 /// Judges `actual` against `expected` by `t`, with the worst values named.
-fn judge_values(v: &mut OutputVerdict, name: &str, t: Tolerance, expected: &[f64], actual: &[f64], floats: bool) {
-    match within(t, expected, actual, floats) {
+fn judge_values(
+    v: &mut OutputVerdict,
+    name: &str,
+    t: Tolerance,
+    expected: &[f64],
+    actual: &[f64],
+    floats: bool,
+    locate: &dyn Fn(usize) -> String,
+) {
+    match within_at(t, expected, actual, floats, locate) {
         Ok(summary) => v.summary = format!("output {name}: {summary}"),
         Err(problem) => {
             v.summary = format!("output {name}: {problem}");
@@ -315,6 +344,18 @@ fn judge_values(v: &mut OutputVerdict, name: &str, t: Tolerance, expected: &[f64
 /// Whether `actual` is within `t` of `expected`: Ok with the measured
 /// figure, or Err naming it, the bound and the worst elements.
 pub fn within(t: Tolerance, expected: &[f64], actual: &[f64], floats: bool) -> Result<String, String> {
+    within_at(t, expected, actual, floats, &|i| format!("[{i}]"))
+}
+
+/// [`within`], each value named by `locate` (a texel and channel, or an
+/// element and field).
+pub fn within_at(
+    t: Tolerance,
+    expected: &[f64],
+    actual: &[f64],
+    floats: bool,
+    locate: &dyn Fn(usize) -> String,
+) -> Result<String, String> {
     if expected.len() != actual.len() {
         return Err(format!("{} values against {} in the golden", actual.len(), expected.len()));
     }
@@ -327,7 +368,7 @@ pub fn within(t: Tolerance, expected: &[f64], actual: &[f64], floats: bool) -> R
         let mut idx: Vec<usize> = (0..actual.len()).filter(|i| score(*i) > 0.0 || score(*i).is_nan()).collect();
         idx.sort_by(|a, b| score(*b).total_cmp(&score(*a)));
         let shown: Vec<String> =
-            idx.iter().take(5).map(|i| format!("[{i}] {} vs golden {}", actual[*i], expected[*i])).collect();
+            idx.iter().take(5).map(|i| format!("{} {} vs golden {}", locate(*i), actual[*i], expected[*i])).collect();
         format!("{} differ; worst: {}", idx.len(), shown.join(", "))
     };
     match t {

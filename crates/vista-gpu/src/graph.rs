@@ -443,7 +443,7 @@ impl Context {
                     Bind::StorageTexture { resource, access } => {
                         let t = texture(*resource)?;
                         let format = OutputFormat::parse(t.format)?;
-                        if *access != Access::Write && !self.binds_read_write(&format) {
+                        if *access == Access::ReadWrite && !self.binds_read_write(&format) {
                             return Err(GpuError::Unsupported {
                                 adapter: self.adapter_description(),
                                 what: format!("{}: a {} {} storage texture", pass.label, access.name(), t.format),
@@ -662,7 +662,9 @@ impl Context {
                         )));
                     };
                     let format = OutputFormat::parse(t.format)?;
-                    if access != Access::Write && !self.binds_read_write(&format) {
+                    // Read-only storage is core for every storage format;
+                    // read_write beyond the r32 formats needs a feature.
+                    if access == Access::ReadWrite && !self.binds_read_write(&format) {
                         return Err(GpuError::Unsupported {
                             adapter: self.adapter_description(),
                             what: format!("{}: a {} {} storage texture", pass.label, access.name(), t.format),

@@ -176,12 +176,16 @@ pub struct DisplayMap {
     exposure: Option<f32>,
     opaque: bool,
     normalize: bool,
+    /// Channels the output's format has (1 for r32*, 2 for rg32*, else 3
+    /// counted): a normalised view spans only those, a single channel shown
+    /// grey.
+    channels: u8,
 }
 
 impl DisplayMap {
     /// Display values are the raw values.
     pub fn identity() -> DisplayMap {
-        DisplayMap { exposure: None, opaque: false, normalize: false }
+        DisplayMap { exposure: None, opaque: false, normalize: false, channels: 3 }
     }
 
     /// The display values of `raw`, or None where they are `raw` itself (a
@@ -189,7 +193,7 @@ impl DisplayMap {
     pub fn apply(&self, raw: &Image) -> Option<Image> {
         let mut out = match self.exposure {
             Some(e) => vista_image::tonemap(raw, e),
-            None if self.normalize => normalized(raw),
+            None if self.normalize => normalized(raw, self.channels),
             None if self.opaque => raw.clone(),
             None => return None,
         };
@@ -202,14 +206,24 @@ impl DisplayMap {
     }
 }
 
-/// `raw` mapped to [0, 1] by the min and max of its finite RGB values (a
-/// constant image maps to 0), alpha 1; non-finite values map to 0.
-fn normalized(raw: &Image) -> Image {
-    let finite = raw.data.iter().flat_map(|p| p[..3].iter().copied()).filter(|v| v.is_finite());
+/// `raw` mapped to [0, 1] by the min and max of the finite values of its
+/// first `channels` of R, G, B (a constant image maps to 0), alpha 1;
+/// non-finite values map to 0. A single channel is shown grey.
+fn normalized(raw: &Image, channels: u8) -> Image {
+    let n = channels.clamp(1, 3) as usize;
+    let finite = raw.data.iter().flat_map(|p| p[..n].iter().copied()).filter(|v| v.is_finite());
     let (lo, hi) = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
     let span = if hi > lo { (hi as f64 - lo as f64) as f32 } else { f32::INFINITY };
     let map = |v: f32| if v.is_finite() { ((v - lo) / span).clamp(0.0, 1.0) } else { 0.0 };
-    let data = raw.data.iter().map(|p| [map(p[0]), map(p[1]), map(p[2]), 1.0]).collect();
+    let data = raw
+        .data
+        .iter()
+        .map(|p| match n {
+            1 => [map(p[0]), map(p[0]), map(p[0]), 1.0],
+            2 => [map(p[0]), map(p[1]), 0.0, 1.0],
+            _ => [map(p[0]), map(p[1]), map(p[2]), 1.0],
+        })
+        .collect();
     Image::from_raw(raw.width, raw.height, data).expect("same size")
 }
 
@@ -305,6 +319,16 @@ impl Kernel {
     /// The PNG view of an output of `format`: the manifest's, else
     /// normalize for an integer format and display otherwise.
     pub fn view(&self, format: &str) -> Output {
+        // A graph's first output may say its own view.
+        match self.graph().and_then(|g| g.outputs.first()).and_then(|o| o.view) {
+            Some(v) => v,
+            None => self.default_view(format),
+        }
+    }
+
+    /// The view of an output of `format` that says none: the manifest's
+    /// `output`, else normalize for an integer format and display otherwise.
+    pub fn default_view(&self, format: &str) -> Output {
         match self.manifest.output {
             Some(v) => v,
             None if is_integer_format(format) => Output::Normalize,
@@ -337,12 +361,19 @@ impl Kernel {
 
     /// The display map of an output of `format` (see [`Kernel::view`]).
     pub fn display_map_of(&self, p: &ParamSet, format: &str) -> DisplayMap {
-        self.display_map_with(p, self.view(format))
+        self.display_map_with(p, self.view(format), format)
     }
 
-    /// The display map of `view` (a graph output's own `view`).
-    pub fn display_map_with(&self, p: &ParamSet, view: Output) -> DisplayMap {
+    /// The display map of an output of `format` shown with `view` (a graph
+    /// output's own `view`).
+    pub fn display_map_with(&self, p: &ParamSet, view: Output, format: &str) -> DisplayMap {
+        let channels = match format {
+            f if f.starts_with("rg32") => 2,
+            f if f.starts_with("r32") => 1,
+            _ => 3,
+        };
         DisplayMap {
+            channels,
             exposure: (view == Output::Hdr).then(|| p.f32("exposure")),
             opaque: self.manifest.opaque_display,
             normalize: view == Output::Normalize,

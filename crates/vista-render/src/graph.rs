@@ -370,8 +370,8 @@ pub fn plan_graph(
         let spec = g.outputs.iter().find(|o| &o.resource == name);
         let kind = match &resources[r] {
             vista_gpu::Resource::Texture(t) => {
-                let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.view(t.format));
-                PlannedKind::Texture { format: t.format, view, display: kernel.display_map_with(p, view) }
+                let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.default_view(t.format));
+                PlannedKind::Texture { format: t.format, view, display: kernel.display_map_with(p, view, t.format) }
             }
             vista_gpu::Resource::Buffer(b) => {
                 let e = resolved.resources[r].element.clone().expect("a bound buffer");
