@@ -35,6 +35,8 @@ demo: lavapipe build
 test: lavapipe swiftshader validation browser
 	mkdir -p target
 	set -o pipefail; CARGO=$(CARGO) bash ci/test-parallel.sh 2>&1 | tee target/test.log
+	@echo "---- examples/harness-crate: another crate's cargo test running its golden cases through vista::harness::main()"
+	set -o pipefail; CARGO=$(CARGO) bash ci/harness-example.sh 2>&1 | tee -a target/test.log
 	@echo "---- every golden case again on SwiftShader (other-driver thresholds, expectations from golden/cases.toml)"
 	set -o pipefail; VISTA_BACKEND=swiftshader $(CARGO) test --test golden 2>&1 | tee -a target/test.log
 	@echo "---- every golden case again in headless Chromium's WebGPU (naga's WGSL through Tint and Dawn)"

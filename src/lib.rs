@@ -4,6 +4,7 @@
 //! golden harness and the kernel test suites, `benches/` the benchmarks.
 
 pub mod config;
+pub mod harness;
 
 pub use config::{Config, Flags};
 pub use vista_golden as golden;

@@ -1,0 +1,166 @@
+//! vista inside another crate's `cargo test` (SPEC 15): the whole `main`
+//! of a `[[test]] harness = false` target.
+//!
+//! ```toml
+//! # Cargo.toml of the crate whose kernels vista checks
+//! [dev-dependencies]
+//! vista = { path = "..." }
+//!
+//! [[test]]
+//! name = "golden"
+//! harness = false
+//! ```
+//!
+//! ```text
+//! // tests/golden.rs
+//! fn main() {
+//!     vista::harness::main()
+//! }
+//! ```
+//!
+//! The project is found at run time: `VISTA_ROOT`, else the nearest
+//! `vista.toml` at or above the crate's directory (`CARGO_MANIFEST_DIR`,
+//! which cargo sets for its tests), else above the current directory. Each
+//! case of `golden/cases.toml` is one test named `golden::<kernel>::<case>`,
+//! so libtest's arguments work as in any `cargo test` (a filter, `--exact`,
+//! `--list`, `--ignored`, `--skip`) and nextest lists and partitions them.
+//! After the run the report is written (`target/vista-report/` of the
+//! project, `target/vista-report-<backend>/` for another `VISTA_BACKEND`).
+//! Without an adapter every case fails naming the install command, unless
+//! `VISTA_ALLOW_NO_GPU=1`: then each is reported ignored and a loud line
+//! names them.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use libtest_mimic::{Arguments, Failed, Trial};
+use vista_golden::{CheckOptions, Store};
+use vista_project::Project;
+use vista_render::Renderer;
+
+/// Runs the project's golden cases as libtest tests and exits.
+pub fn main() -> ! {
+    let args = Arguments::from_args();
+    let cwd = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
+    let start = std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or(cwd);
+    let project = Project::discover(None, std::env::var_os("VISTA_ROOT"), &start)
+        .unwrap_or_else(|e| fail(&format!("vista harness: {e}")));
+    if project.root().is_none() {
+        fail(&format!(
+            "vista harness: no vista.toml at or above {} (the crate's directory); add one at the project root or set \
+             VISTA_ROOT",
+            start.display()
+        ));
+    }
+    run(&args, &project, &command_name())
+}
+
+/// `cargo test --test <name>`: this binary's test target, from its file name
+/// (`golden-<hash>`).
+fn command_name() -> String {
+    let exe = std::env::args().next().unwrap_or_default();
+    let stem = Path::new(&exe).file_stem().and_then(|s| s.to_str()).unwrap_or("golden").to_string();
+    let name = match stem.rsplit_once('-') {
+        Some((name, hash)) if hash.len() == 16 && hash.chars().all(|c| c.is_ascii_hexdigit()) => name.to_string(),
+        _ => stem,
+    };
+    format!("cargo test --test {name}")
+}
+
+fn fail(message: &str) -> ! {
+    eprintln!("error: {message}");
+    std::process::exit(2)
+}
+
+/// The harness over `project`'s cases with libtest's `args`; `command`
+/// names the run in the report.
+pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
+    let config = crate::Config::from_env(&crate::Flags::default()).unwrap_or_else(|e| fail(&e.to_string()));
+    let store = Store::of_project(project, "the golden tests").unwrap_or_else(|e| fail(&e.to_string()));
+    let cases = store.load_cases().unwrap_or_else(|e| fail(&format!("cannot load golden cases: {e}")));
+    let manifest = Arc::new(store.manifest().unwrap_or_else(|e| fail(&format!("cannot load the manifest: {e}"))));
+    let root = project.root().expect("a store has a root");
+    // One report per implementation (VISTA_BACKEND), so runs do not overwrite each other.
+    let backend = config.gpu.adapter.backend_name();
+    let report_dir = match backend {
+        "lavapipe" => project.report_dir().expect("a root"),
+        b => root.join(format!("target/vista-report-{b}")),
+    };
+    let outcomes = Arc::new(Mutex::new(Vec::new()));
+    // Listing needs no device (nextest lists before it runs). One renderer
+    // per process, shared by every case.
+    static RENDERER: std::sync::OnceLock<Result<Renderer<'static>, String>> = std::sync::OnceLock::new();
+    let renderer: Option<Result<&'static Renderer<'static>, String>> = (!args.list).then(|| {
+        RENDERER
+            .get_or_init(|| {
+                let ctx = vista_gpu::Context::shared(&config.gpu).map_err(|e| e.to_string())?;
+                Renderer::new(ctx, project, config.limits).map_err(|e| e.to_string())
+            })
+            .as_ref()
+            .map_err(Clone::clone)
+    });
+    let missing = renderer.as_ref().and_then(|r| r.as_ref().err().cloned());
+    // A run that will render clears the last report's case folders; one that
+    // skips (no adapter) leaves the last report whole.
+    if renderer.as_ref().is_some_and(|r| r.is_ok()) {
+        vista_report::clear_case_folders(&report_dir)
+            .unwrap_or_else(|e| fail(&format!("cannot clear the report: {e}")));
+    }
+    let skip = missing.is_some() && config.allow_no_gpu;
+    if let Some(e) = &missing
+        && config.allow_no_gpu
+    {
+        eprintln!("\n!!! VISTA_ALLOW_NO_GPU=1 and no adapter: {e}");
+        eprintln!(
+            "!!! SKIPPING all {} golden cases: {}\n",
+            cases.len(),
+            cases.iter().map(|c| c.id.as_str()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    let trials: Vec<Trial> = cases
+        .iter()
+        .map(|case| {
+            let (case, store, manifest, outcomes, report_dir, renderer) =
+                (case.clone(), store.clone(), manifest.clone(), outcomes.clone(), report_dir.clone(), renderer.clone());
+            let name = format!("golden::{}::{}", case.kernel.name(), case.id);
+            Trial::test(name, move || {
+                let ctx = match renderer {
+                    Some(Ok(ctx)) => ctx,
+                    Some(Err(e)) => return Err(Failed::from(format!("no GPU adapter: {e}"))),
+                    None => return Err(Failed::from("listed, not run")),
+                };
+                // The in-process determinism check (two renders, bit-identical)
+                // runs on the bless-time driver; other backends render once.
+                let opts = CheckOptions { twice: ctx.backend() == "lavapipe" };
+                let o = vista_report::file_case(
+                    &report_dir,
+                    vista_golden::check_case(ctx, &store, &manifest, &case, &opts),
+                );
+                let result = if o.passed() { Ok(()) } else { Err(Failed::from(o.explain(&report_dir))) };
+                outcomes.lock().expect("outcomes").push(o);
+                result
+            })
+            .with_ignored_flag(skip)
+        })
+        .collect();
+    let conclusion = libtest_mimic::run(args, trials);
+    let outcomes = outcomes.lock().expect("outcomes");
+    if !outcomes.is_empty()
+        && let Some(Ok(ctx)) = &renderer
+    {
+        let run = vista_report::RunSummary {
+            command: match ctx.backend() {
+                "lavapipe" => command.to_string(),
+                b => format!("VISTA_BACKEND={b} {command}"),
+            },
+            adapter: ctx.adapter_description(),
+            backend: ctx.backend().to_string(),
+            ..Default::default()
+        };
+        match vista_report::write_report(&report_dir, &run, &outcomes) {
+            Ok(index) => eprintln!("vista report: {}", index.display()),
+            Err(e) => eprintln!("could not write the vista report: {e}"),
+        }
+    }
+    conclusion.exit()
+}
