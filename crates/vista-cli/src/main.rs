@@ -150,6 +150,11 @@ enum Command {
         /// hash as they did there.
         #[arg(long, value_name = "DIR", conflicts_with = "prune")]
         from_report: Option<PathBuf>,
+        /// Write golden/<kernel>/<case>@<backend>.png for this run's backend
+        /// (--backend): from then on that backend is judged against it, at the
+        /// same-driver threshold, and every other backend against the case's own.
+        #[arg(long, conflicts_with = "from_report")]
+        per_backend: bool,
     },
     /// Sweep a parameter (or a grid of two) against a high-quality reference:
     /// curve.csv, curve.svg, curve.png and a table naming the cheapest setting
@@ -480,10 +485,10 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             );
             Ok(0)
         }
-        Command::Bless { case, force, prune, .. } => {
+        Command::Bless { case, force, prune, per_backend, .. } => {
             let store = Store::of_project(project, "vista bless")?;
             let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
-            let opts = BlessOptions { glob: case, force, prune, in_ci: config.in_ci };
+            let opts = BlessOptions { glob: case, force, prune, in_ci: config.in_ci, per_backend };
             let summary = vista_golden::bless(ctx, &store, &opts)?;
             println!("{:<40} {:<10} PSNR new vs old", "case", "status");
             for r in &summary.rows {
@@ -717,7 +722,12 @@ fn check(
             vista_golden::Verdict::ExpectedFail => "xfail",
             _ => "FAIL",
         };
-        println!("{label:<6} {:<40} PSNR {:<12} {:>8.1} ms", o.id, psnr, o.gpu_ms);
+        // A per-backend golden is named on the case's line.
+        let per_backend = match o.golden_file.rsplit_once('@') {
+            Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
+            None => String::new(),
+        };
+        println!("{label:<6} {:<40} PSNR {:<12} {:>8.1} ms{per_backend}", o.id, psnr, o.gpu_ms);
         if !o.passed() {
             print!("{}", o.explain(&report_dir));
         } else if o.verdict == vista_golden::Verdict::ExpectedFail {

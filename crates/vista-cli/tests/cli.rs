@@ -2777,6 +2777,48 @@ fn every_output_of_a_graph_is_judged() {
     assert!(c.code == 1 && c.stdout.contains("gone.npy"), "{}{}", c.stdout, c.stderr);
 }
 
+/// Per-backend goldens (SPEC 15): `bless --backend B --per-backend` writes
+/// `<case>@<B>.png`, which B is judged against from then on (at the
+/// same-driver threshold, named on the case's line, in the matrix and in
+/// the JSON); other backends keep the case's own golden; prune keeps it.
+fn per_backend_goldens_are_used_on_their_backend() {
+    let t = tmp();
+    let root = t.path().join("real");
+    copy_tree(&repo().join("examples/real-kernels"), &root);
+    let run = |args: &[&str]| vista_in(Some(&root), &[], args);
+    let b = run(&["bless", "--backend", "swiftshader", "--per-backend", "--case", "sky-noon"]);
+    assert_eq!(b.code, 0, "{}{}", b.stdout, b.stderr);
+    assert!(root.join("golden/sky/sky-noon@swiftshader.png").is_file());
+    let manifest = std::fs::read_to_string(root.join("golden/manifest.toml")).unwrap();
+    assert!(manifest.contains("[case.\"sky-noon@swiftshader\"]") && manifest.contains("[case.sky-noon]"), "{manifest}");
+    let c = run(&["check", "--backend", "swiftshader", "--case", "sky-noon", "--json", "r.json"]);
+    assert_eq!(c.code, 0, "{}{}", c.stdout, c.stderr);
+    assert!(c.stdout.contains("PSNR identical") && c.stdout.contains("[golden @swiftshader]"), "{}", c.stdout);
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(root.join("r.json")).unwrap()).unwrap();
+    let case = &json["cases"][0];
+    assert_eq!(case["golden"]["path"], "golden/sky/sky-noon@swiftshader.png", "{json}");
+    assert_eq!(case["thresholds"]["same_driver"], true, "{json}");
+    // lavapipe keeps the case's own golden.
+    let c = run(&["check", "--case", "sky-noon"]);
+    assert!(c.code == 0 && !c.stdout.contains("[golden @"), "{}", c.stdout);
+    let m = run(&["check", "--matrix", "--case", "sky-noon"]);
+    let page = std::fs::read_to_string(root.join("target/vista-report/matrix.html")).unwrap();
+    assert!(m.code == 0 && page.contains("(golden @swiftshader)"), "{}{page}", m.stdout);
+    // A change on that backend fails it there, with the per-backend bless command.
+    std::fs::write(
+        root.join("golden/sky/sky-noon@swiftshader.png"),
+        std::fs::read(root.join("golden/sky/sky-noon.png")).unwrap(),
+    )
+    .unwrap();
+    let c = run(&["check", "--backend", "swiftshader", "--case", "sky-noon"]);
+    assert!(c.code == 1 && c.stdout.contains("--backend swiftshader --per-backend"), "{}", c.stdout);
+    // Not an orphan, and pruning keeps its entry.
+    let p = run(&["bless", "--prune", "--case", "poster"]);
+    assert!(p.code == 0 && !p.stdout.contains("sky-noon@"), "{}", p.stdout);
+    let manifest = std::fs::read_to_string(root.join("golden/manifest.toml")).unwrap();
+    assert!(manifest.contains("[case.\"sky-noon@swiftshader\"]"), "{manifest}");
+}
+
 // ---- examples/project: a project outside the built-ins ---------------------
 
 fn copy_tree(from: &Path, to: &Path) {
@@ -3248,6 +3290,7 @@ fn main() {
         ),
         (Gpu, "graph_inputs_are_checked_before_gpu_work", graph_inputs_are_checked_before_gpu_work),
         (Gpu, "every_output_of_a_graph_is_judged", every_output_of_a_graph_is_judged),
+        (Gpu, "per_backend_goldens_are_used_on_their_backend", per_backend_goldens_are_used_on_their_backend),
         (
             Gpu,
             "matrices_integer_vectors_arrays_and_padding_are_packed",

@@ -23,6 +23,9 @@ pub struct BlessOptions {
     pub in_ci: bool,
     /// Delete golden PNGs that no case refers to (otherwise only listed).
     pub prune: bool,
+    /// Write `<case>@<backend>.png` (entry `<case>@<backend>`), the golden
+    /// this backend is judged against from now on, instead of the case's own.
+    pub per_backend: bool,
 }
 
 /// One blessed case, for the summary table.
@@ -56,6 +59,15 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
     let picked = select(&cases, opts.glob.as_deref())?;
     let mut manifest = store.manifest()?;
     let adapter = ctx.adapter_description();
+    if opts.per_backend
+        && let Some(c) = picked.iter().find(|c| c.kernel.graph().is_some())
+    {
+        return Err(GoldenError::BadInput(format!(
+            "--per-backend: case {} is a pass graph; per-backend goldens cover one-pass kernels so far (its other \
+             outputs have one golden each)",
+            c.id
+        )));
+    }
 
     let mut rendered: Vec<(&crate::Case, Rendered)> = Vec::new();
     for case in &picked {
@@ -87,7 +99,10 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
     }
     let mut rows = Vec::new();
     for (case, r) in rendered {
-        let path = store.golden_path(case);
+        let (path, key) = match opts.per_backend {
+            true => (store.backend_golden_path(case, ctx.backend()), format!("{}@{}", case.id, ctx.backend())),
+            false => (store.golden_path(case), case.id.clone()),
+        };
         // A pass graph's other files first: each atomic, named in the entry.
         let extra = crate::outputs::golden_bytes(&store.dir, case, &r.outputs)?;
         let mut extra_hashes = std::collections::BTreeMap::new();
@@ -114,7 +129,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
                 shader_hash: ctx.kernel_shader_hash(case.kernel)?,
             };
             let files = ctx.kernel_file_hashes(case.kernel)?;
-            let previous = manifest.case.get(&case.id);
+            let previous = manifest.case.get(&key);
             let status = match previous {
                 None => "new",
                 Some(p) if p.outputs == extra_hashes && !extra_changed => "unchanged",
@@ -123,7 +138,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             let mut entry =
                 ManifestEntry::of_render(case, &run, files, r.raw.content_hash(), status.into(), String::new());
             entry.outputs = extra_hashes;
-            manifest.case.insert(case.id.clone(), entry);
+            manifest.case.insert(key.clone(), entry);
             store.write_manifest(&manifest)?;
             let shown = extra.first().map(|(p, _)| p.clone()).unwrap_or(path);
             rows.push(BlessRow { id: case.id.clone(), status, psnr_vs_previous: status.into(), path: shown });
@@ -166,7 +181,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
                 == (&entry.params_hash, &entry.shader_hash, &entry.adapter, &entry.raw_hash)
         };
         if old_hash.as_deref() == Some(new_hash.as_str())
-            && let Some(previous) = manifest.case.get(&case.id).filter(|e| same_render(e))
+            && let Some(previous) = manifest.case.get(&key).filter(|e| same_render(e))
         {
             // Nothing changed: keep the entry's date and PSNR-vs-previous (the
             // provenance of the last real change), only completing its hashes
@@ -185,12 +200,12 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             // the golden is replaced, then the manifest names only the new one.
             // A stop anywhere leaves a golden that its entry describes.
             entry.replacing = Some(old_hash.unwrap_or_else(|| "none".into()));
-            manifest.case.insert(case.id.clone(), entry.clone());
+            manifest.case.insert(key.clone(), entry.clone());
             store.write_manifest(&manifest)?;
             vista_image::atomic_write(&path, &bytes)?;
             entry.replacing = None;
         }
-        manifest.case.insert(case.id.clone(), entry);
+        manifest.case.insert(key.clone(), entry);
         store.write_manifest(&manifest)?;
         rows.push(BlessRow { id: case.id.clone(), status, psnr_vs_previous: psnr, path });
     }
@@ -202,7 +217,8 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
                 .map_err(|e| GoldenError::Io { path: o.display().to_string(), message: e.to_string() })?;
         }
         let live: std::collections::HashSet<&str> = cases.iter().map(|c| c.id.as_str()).collect();
-        manifest.case.retain(|id, _| live.contains(id.as_str()));
+        // Per-backend entries (`<case>@<backend>`) live with their case.
+        manifest.case.retain(|key, _| live.contains(key.split('@').next().unwrap_or_default()));
         store.write_manifest(&manifest)?;
     }
     Ok(BlessSummary { rows, orphans, pruned: opts.prune })

@@ -86,6 +86,9 @@ pub struct Outcome {
     pub first_bad: Option<(u32, u32, String)>,
     /// A pass graph's outputs as judged (empty for a one-pass kernel).
     pub outputs: Vec<crate::outputs::OutputVerdict>,
+    /// The golden judged against, relative to `golden/`
+    /// (`<kernel>/<case>.png`, or a per-backend `<kernel>/<case>@<backend>.png`).
+    pub golden_file: String,
 }
 
 /// A pixel is "bad" when a display channel differs by more than this.
@@ -252,6 +255,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
         changed_files: Vec::new(),
         first_bad: None,
         outputs: Vec::new(),
+        golden_file: case.golden_rel_path(),
     };
     match observed {
         Err(e) => {

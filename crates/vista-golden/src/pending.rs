@@ -97,6 +97,14 @@ pub fn bless_from_report(
             .iter()
             .find(|c| &c.id == id)
             .ok_or_else(|| stale(id, "it is no longer in golden/cases.toml".into()))?;
+        if case.kernel.graph().is_some() {
+            return Err(GoldenError::BadInput(format!(
+                "case {id}: kernel {} is a pass graph, whose other outputs the report does not keep; bless it by \
+                 rendering: {}",
+                case.kernel.name(),
+                case.bless_command()
+            )));
+        }
         if params_hash(case) != entry.params_hash {
             return Err(stale(id, "its params (preset, set or size) changed since the check".into()));
         }

@@ -113,6 +113,22 @@ impl Store {
         self.dir.join(case.golden_rel_path())
     }
 
+    /// `golden/<kernel>/<case>@<backend>.png`: a per-backend golden.
+    pub fn backend_golden_path(&self, case: &Case, backend: &str) -> PathBuf {
+        self.dir.join(case.kernel.name()).join(format!("{}@{backend}.png", case.id))
+    }
+
+    /// The golden a run on `backend` is judged against, and the manifest key
+    /// of its entry: the per-backend golden `<case>@<backend>.png` where one
+    /// exists (key `<case>@<backend>`), else the case's own.
+    pub fn golden_for(&self, case: &Case, backend: &str) -> (PathBuf, String) {
+        let own = self.backend_golden_path(case, backend);
+        match own.is_file() {
+            true => (own, format!("{}@{backend}", case.id)),
+            false => (self.golden_path(case), case.id.clone()),
+        }
+    }
+
     pub fn load_cases(&self) -> Result<Vec<Case>, GoldenError> {
         crate::load_cases(&self.cases_path(), &self.kernels)
     }
@@ -157,7 +173,8 @@ impl Store {
             for f in files.flatten() {
                 let p = f.path();
                 let kernel = k.file_name().to_string_lossy().to_string();
-                let id = f.file_name().to_string_lossy().split('.').next().unwrap_or_default().to_string();
+                // `<id>.<output>.npy`, `<id>@<backend>.png`: the id ends at the first '.' or '@'.
+                let id = f.file_name().to_string_lossy().split(['.', '@']).next().unwrap_or_default().to_string();
                 let golden_kind = p.extension().is_some_and(|e| e == "png" || e == "npy" || e == "exr");
                 if golden_kind && !known.contains(&(kernel, id)) {
                     out.push(p);

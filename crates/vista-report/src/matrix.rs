@@ -12,6 +12,11 @@ pub type MatrixColumn = (String, Result<(String, Vec<Outcome>), String>);
 /// A cell's text: the PSNR, and the verdict where it is not a pass.
 pub fn cell(o: &Outcome) -> String {
     let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
+    // Judged against a per-backend golden: say which.
+    let psnr = match o.golden_file.rsplit_once('@') {
+        Some((_, b)) => format!("{psnr} (golden @{})", b.trim_end_matches(".png")),
+        None => psnr,
+    };
     match o.verdict {
         Verdict::Pass => psnr,
         Verdict::ExpectedFail => format!("{psnr} xfail"),

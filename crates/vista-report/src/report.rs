@@ -265,7 +265,10 @@ fn thumb(path: &Option<String>, full: &Option<String>, alt: &str) -> String {
 
 /// The golden's manifest entry beside this run, mismatches marked.
 fn provenance(o: &Outcome) -> String {
-    let mut t = String::from("<table class=\"prov\"><tr><th></th><th>golden (manifest)</th><th>this run</th></tr>");
+    let mut t = format!(
+        "<table class=\"prov\"><tr><th></th><th>golden (manifest): <code>{}</code></th><th>this run</th></tr>",
+        html_escape(&o.golden_file)
+    );
     let golden = o.golden.as_ref();
     fn split(a: &str, i: usize) -> String {
         a.split(" | ").nth(i).unwrap_or("").to_string()
