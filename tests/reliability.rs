@@ -37,6 +37,7 @@ fn nan_case() -> Case {
         max_flip: None,
         max_bad_pixels: None,
         max_bad_ratio: None,
+        ignore: vec![],
         expect_fail: vec![],
         inputs: vec![],
         doc: String::new(),

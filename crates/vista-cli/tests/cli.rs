@@ -1713,6 +1713,20 @@ fn orphans_lfs_pointers_and_bad_pixel_budgets() {
     assert!(r.code == 1 && r.stdout.contains("above max_bad_ratio 0.0001"), "{}", r.stdout);
     std::fs::write(cases_path(d.path()), budget("max_bad_ratio = 2")).unwrap();
     assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["max_bad_ratio=2 is out of range"]);
+    // Ignore rectangles leave parts of the image out of the comparison: all
+    // of it passes the moved render, all but its last row does not.
+    std::fs::write(cases_path(d.path()), budget("ignore = [[0, 0, 32, 32]]")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert_eq!(r.code, 0, "{}", r.stdout);
+    std::fs::write(cases_path(d.path()), budget("ignore = [[0, 0, 32, 31]]")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "b"]);
+    assert!(r.code == 1 && r.stdout.contains("992 pixels in 1 ignore rectangles left out"), "{}", r.stdout);
+    std::fs::write(cases_path(d.path()), budget("ignore = [[30, 0, 4, 4]]")).unwrap();
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["check"]),
+        2,
+        &["ignore = [30, 0, 4, 4] is not valid", "x + w <= 32"],
+    );
 }
 
 /// The manifest names the entry point; an unknown one lists the shader's.

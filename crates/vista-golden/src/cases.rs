@@ -13,6 +13,7 @@
 //! max_flip = 0.01                # optional: mean LDR-FLIP error, in [0, 1]
 //! max_bad_pixels = 25            # optional: pixels a channel of which differs by > 1/255
 //! max_bad_ratio = 0.001          # optional: the same as a share of the pixels, in [0, 1]
+//! ignore = [[0, 0, 16, 8]]       # optional: rectangles [x, y, w, h] the comparison leaves out
 //! inputs = { photo = "inputs/other.png" }  # optional: a pass graph's resource files replaced
 //! ```
 
@@ -50,6 +51,8 @@ struct RawCase {
     max_flip: Option<f64>,
     max_bad_pixels: Option<u64>,
     max_bad_ratio: Option<f64>,
+    #[serde(default)]
+    ignore: Vec<[u32; 4]>,
     #[serde(default)]
     expect_fail: Vec<Expectation>,
     #[serde(default)]
@@ -104,6 +107,9 @@ pub struct Case {
     /// judged by them instead of its PSNR threshold.
     pub max_bad_pixels: Option<u64>,
     pub max_bad_ratio: Option<f64>,
+    /// Rectangles `[x, y, w, h]` of the image the golden comparison leaves
+    /// out (a watermark, a frame counter, a crest that flips across drivers).
+    pub ignore: Vec<[u32; 4]>,
     /// Where this case is expected to fail, and why.
     pub expect_fail: Vec<Expectation>,
     /// A pass graph's resource files this case replaces: (resource, file
@@ -173,6 +179,16 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         {
             return Err(bad(format!("max_bad_ratio={r} is out of range; allowed: [0, 1] (a share of the pixels)")));
         }
+        for r in &raw.ignore {
+            let [x, y, w, h] = *r;
+            let (iw, ih) = (width, height);
+            if w == 0 || h == 0 || x.saturating_add(w) > iw || y.saturating_add(h) > ih {
+                return Err(bad(format!(
+                    "ignore = [{x}, {y}, {w}, {h}] is not valid; expected [x, y, w, h] with w, h >= 1 inside the \
+                     {iw}x{ih} image (x + w <= {iw}, y + h <= {ih})"
+                )));
+            }
+        }
         if !raw.inputs.is_empty() {
             let Some(g) = kernel.graph() else {
                 return Err(bad(format!(
@@ -228,6 +244,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             max_flip: raw.max_flip,
             max_bad_pixels: raw.max_bad_pixels,
             max_bad_ratio: raw.max_bad_ratio,
+            ignore: raw.ignore,
             expect_fail: raw.expect_fail,
             inputs: raw.inputs.into_iter().collect(),
             doc: raw.doc,

@@ -86,6 +86,8 @@ pub struct Outcome {
     pub first_bad: Option<(u32, u32, String)>,
     /// A pass graph's outputs as judged (empty for a one-pass kernel).
     pub outputs: Vec<crate::outputs::OutputVerdict>,
+    /// The case's ignore rectangles `[x, y, w, h]` (drawn in the report).
+    pub ignore: Vec<[u32; 4]>,
     /// The golden judged against, relative to `golden/`
     /// (`<kernel>/<case>.png`, or a per-backend `<kernel>/<case>@<backend>.png`).
     pub golden_file: String,
@@ -256,6 +258,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
         first_bad: None,
         outputs: Vec::new(),
         golden_file: case.golden_rel_path(),
+        ignore: case.ignore.clone(),
     };
     match observed {
         Err(e) => {
@@ -411,6 +414,27 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
         ));
         return;
     }
+    // Ignored rectangles hold the golden's values on both sides, so they
+    // count as equal in every metric.
+    let masked;
+    let actual = match case.ignore.is_empty() {
+        true => actual,
+        false => {
+            let mut a = actual.clone();
+            let mut n = 0u64;
+            for &[x, y, w, h] in &case.ignore {
+                for yy in y..(y + h).min(a.height) {
+                    for xx in x..(x + w).min(a.width) {
+                        a.set(xx, yy, expected.get(xx, yy));
+                        n += 1;
+                    }
+                }
+            }
+            out.notes.push(format!("{n} pixels in {} ignore rectangles left out of the comparison", case.ignore.len()));
+            masked = a;
+            &masked
+        }
+    };
     let mut m = match metrics::compare(expected, actual) {
         Ok(m) => m,
         Err(e) => {

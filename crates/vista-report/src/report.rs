@@ -175,7 +175,24 @@ pub fn write_case_files(
     // golden, a size change) it shows the render alone, at full size.
     let comparable = expected.filter(|e| (e.width, e.height) == (actual.width, actual.height));
     if let Some(expected) = comparable {
-        let heat = vista_image::diff_heatmap_log(expected, actual);
+        let mut heat = vista_image::diff_heatmap_log(expected, actual);
+        // Ignored rectangles outlined in cyan on the heat map.
+        for &[x, y, w, h] in &out.ignore {
+            for i in 0..w {
+                for yy in [y, y + h - 1] {
+                    if x + i < heat.width && yy < heat.height {
+                        heat.set(x + i, yy, [0.0, 1.0, 1.0, 1.0]);
+                    }
+                }
+            }
+            for j in 0..h {
+                for xx in [x, x + w - 1] {
+                    if xx < heat.width && y + j < heat.height {
+                        heat.set(xx, y + j, [0.0, 1.0, 1.0, 1.0]);
+                    }
+                }
+            }
+        }
         out.files.diff = write("diff.png", &heat, true)?;
         out.files.diff8 = write("diff8.png", &heat, false)?;
     }
