@@ -19,8 +19,8 @@
 //! ```
 //!
 //! The project is found at run time: `VISTA_ROOT`, else the nearest
-//! `vista.toml` at or above the crate's directory (`CARGO_MANIFEST_DIR`,
-//! which cargo sets for its tests), else above the current directory. Each
+//! `vista.toml` at or above the crate's directory (which cargo gives its
+//! test processes in a variable), else above the current directory. Each
 //! case of `golden/cases.toml` is one test named `golden::<kernel>::<case>`,
 //! so libtest's arguments work as in any `cargo test` (a filter, `--exact`,
 //! `--list`, `--ignored`, `--skip`) and nextest lists and partitions them.

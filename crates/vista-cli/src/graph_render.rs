@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use vista_golden::GoldenError;
-use vista_kernels::{Kernel, ParamSet};
-use vista_render::{OutputValue, Renderer};
+use vista_kernels::Kernel;
+use vista_render::{GraphPlan, OutputValue, Renderer};
 
 use crate::bad;
 
@@ -27,9 +27,9 @@ pub fn output_path(out: &Path, first: bool, name: &str, buffer: bool) -> PathBuf
 
 /// Renders a graph kernel and writes its outputs; exit 1 on NaN or
 /// unwritten texels in any output, as for one-pass kernels.
-pub fn render(ctx: &Renderer, k: &Kernel, p: &ParamSet, w: u32, h: u32, out: &Path) -> Result<i32, GoldenError> {
-    let r = vista_render::render(ctx, k, p, w, h)?;
-    let first_is_buffer = matches!(r.outputs.first().map(|o| &o.value), Some(OutputValue::Buffer { .. }));
+pub fn render(ctx: &Renderer, k: &Kernel, plan: &GraphPlan, out: &Path) -> Result<i32, GoldenError> {
+    let first_is_buffer =
+        matches!(plan.outputs.first().map(|o| &o.kind), Some(vista_render::PlannedKind::Buffer { .. }));
     let ext = out.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     let want: &[&str] = if first_is_buffer { &["npy"] } else { &["png", "exr"] };
     if !want.contains(&ext.as_str()) {
@@ -38,10 +38,11 @@ pub fn render(ctx: &Renderer, k: &Kernel, p: &ParamSet, w: u32, h: u32, out: &Pa
             out.display(),
             want.join(" or ."),
             k.name(),
-            r.outputs[0].name,
+            plan.outputs[0].name,
             if first_is_buffer { "buffer" } else { "texture" }
         )));
     }
+    let r = vista_render::run_graph(ctx, plan)?;
     let mut code = 0;
     for (i, o) in r.outputs.iter().enumerate() {
         let is_buffer = matches!(o.value, OutputValue::Buffer { .. });

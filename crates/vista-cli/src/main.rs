@@ -18,6 +18,7 @@ mod init;
 mod matrix;
 mod mutate;
 mod sweep;
+mod watch;
 
 #[derive(Parser)]
 #[command(name = "vista", version, about = "Headless GPU compute validation for procedural WGSL kernels")]
@@ -98,6 +99,19 @@ enum Command {
         /// Compare only this rectangle of both images: X,Y,W,H in pixels.
         #[arg(long, value_name = "X,Y,W,H")]
         crop: Option<String>,
+    },
+    /// Check the cases, then re-check the ones a saved file reaches (WGSL,
+    /// kernel manifests, golden/) and rewrite the report, until interrupted.
+    Watch {
+        /// Only the cases whose id matches this glob.
+        #[arg(long = "case", value_name = "GLOB")]
+        case: Option<String>,
+        /// How often the files are looked at, in milliseconds (50-60000).
+        #[arg(long, default_value_t = 500)]
+        interval: u64,
+        /// Stop after this many seconds (default: never; for scripts and tests).
+        #[arg(long, value_name = "SECONDS")]
+        timeout: Option<f64>,
     },
     /// Render golden cases and compare them with their goldens.
     Check {
@@ -316,6 +330,15 @@ fn bad(e: impl std::fmt::Display) -> GoldenError {
 fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenError> {
     match cmd {
         Command::Init { .. } => unreachable!("init runs before a project is found"),
+        Command::Watch { case, interval, timeout } => {
+            let timeout = match timeout {
+                Some(t) if !(t > 0.0 && t <= 86400.0) => {
+                    return Err(bad(format!("--timeout {t} is out of range; allowed: (0, 86400] seconds")));
+                }
+                t => t.map(std::time::Duration::from_secs_f64),
+            };
+            watch::watch(project, config, case.as_deref(), watch::interval(interval)?, timeout)
+        }
         Command::List { names } => {
             let kernels = registry(project)?;
             if names {
@@ -350,13 +373,16 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
                 }
                 check_parent_writable(&out)?;
                 let shaders = vista_render::shader_set(project)?;
+                // Every check that needs no device (bindings, input files) before one is made.
+                vista_render::check_request(k, &p, w, h, &config.limits)?;
+                let plan = vista_render::plan_graph(&shaders, project.root(), k, &p, &[], w, h)?;
                 let ctx = &Renderer {
                     ctx: Context::shared(&config.gpu)?,
                     shaders,
                     limits: config.limits,
                     root: project.root().map(Into::into),
                 };
-                return graph_render::render(ctx, k, &p, w, h, &out);
+                return graph_render::render(ctx, k, &plan, &out);
             }
             check_output_path(&out)?;
             let shaders = vista_render::shader_set(project)?;
