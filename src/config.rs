@@ -29,6 +29,9 @@ pub struct Config {
     pub font: Option<PathBuf>,
     /// `VISTA_ROOT`: the project root, after `--root`.
     pub root: Option<OsString>,
+    /// The crate directory cargo gives a test process (at run time, never
+    /// at build time): where `vista::harness` looks for the project.
+    pub crate_dir: Option<PathBuf>,
     /// `VISTA_FAULT`: fault-injection plan for the write-path tests.
     pub fault: Option<String>,
     /// `GITHUB_ACTIONS=true`: check also prints `::error` annotations.
@@ -100,6 +103,7 @@ impl Config {
             allow_no_gpu: truthy("VISTA_ALLOW_NO_GPU", text("VISTA_ALLOW_NO_GPU"))?,
             font: get("VISTA_FONT").filter(|v| !v.is_empty()).map(PathBuf::from),
             root: get("VISTA_ROOT").filter(|v| !v.is_empty()),
+            crate_dir: get("CARGO_MANIFEST_DIR").filter(|v| !v.is_empty()).map(PathBuf::from),
             github_actions: text("GITHUB_ACTIONS").is_some_and(|v| v.eq_ignore_ascii_case("true")),
             fault: text("VISTA_FAULT"),
         })

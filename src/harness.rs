@@ -41,10 +41,11 @@ use vista_render::Renderer;
 /// Runs the project's golden cases as libtest tests and exits.
 pub fn main() -> ! {
     let args = Arguments::from_args();
+    let config = crate::Config::from_env(&crate::Flags::default()).unwrap_or_else(|e| fail(&e.to_string()));
     let cwd = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
-    let start = std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or(cwd);
-    let project = Project::discover(None, std::env::var_os("VISTA_ROOT"), &start)
-        .unwrap_or_else(|e| fail(&format!("vista harness: {e}")));
+    let start = config.crate_dir.clone().unwrap_or(cwd);
+    let project =
+        Project::discover(None, config.root.clone(), &start).unwrap_or_else(|e| fail(&format!("vista harness: {e}")));
     if project.root().is_none() {
         fail(&format!(
             "vista harness: no vista.toml at or above {} (the crate's directory); add one at the project root or set \

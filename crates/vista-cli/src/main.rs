@@ -520,6 +520,9 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             for r in &summary.rows {
                 println!("{:<40} {:<10} {}", r.id, r.status, r.psnr_vs_previous);
             }
+            for w in &summary.warnings {
+                println!("warning: {w}");
+            }
             for o in &summary.orphans {
                 println!(
                     "{} golden with no case: {}",

@@ -883,9 +883,10 @@ fn no_build_time_paths_in_non_test_code() {
                 let text = std::fs::read_to_string(&p).unwrap();
                 // Unit-test modules sit at the end of a file, after `#[cfg(test)]`.
                 let code = text.split("#[cfg(test)]").next().unwrap();
-                // vista::harness reads the variable cargo sets for a test
-                // process at run time (the crate under test), never at build time.
-                let code = code.replace("std::env::var_os(\"CARGO_MANIFEST_DIR\")", "");
+                // The configuration reads the variable cargo sets for a test
+                // process at run time (the crate under test, for
+                // vista::harness), never at build time.
+                let code = code.replace("get(\"CARGO_MANIFEST_DIR\")", "");
                 for needle in ["CARGO_MANIFEST_DIR", "env!(", "option_env!(", "VISTA_SHADERS", "VISTA_GOLDEN_DIR"] {
                     if code.contains(needle) {
                         offenders.push(format!("{}: {needle}", p.display()));
@@ -2880,6 +2881,55 @@ fn watch_rechecks_what_a_saved_file_reaches() {
     assert!(index.contains("1 failing"), "the report is rewritten");
 }
 
+/// The README's CI recipe, run as written where it can be: every `vista`
+/// line of the GitHub and GitLab jobs in a copy of examples/project after an
+/// intended change (the check fails and writes JUnit XML, GitHub
+/// annotations under GITHUB_ACTIONS=true), then the developer's bless from
+/// the report as CI would upload it, after which the check passes. The
+/// clone, install and cargo install lines are the README's install steps.
+fn the_ci_recipe_runs_as_written() {
+    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let section = readme.split("## Use vista in your CI").nth(1).unwrap().split("\n## ").next().unwrap();
+    let lines: Vec<String> = section
+        .lines()
+        .map(|l| l.trim().trim_start_matches("- run: ").trim_start_matches("- ").to_string())
+        .filter(|l| l.starts_with("vista "))
+        .map(|l| l.split(" #").next().unwrap().trim().to_string())
+        .collect();
+    assert_eq!(lines.len(), 3, "{lines:?}");
+    let t = tmp();
+    let (bin, root) = (t.path().join("vista"), t.path().join("project"));
+    std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
+    copy_tree(&repo().join("examples/project"), &root);
+    // The intended change: sharper veins.
+    let shader = root.join("shaders/marble.wgsl");
+    let text = std::fs::read_to_string(&shader).unwrap();
+    std::fs::write(&shader, text.replace("0.5 + 0.5 * sin(", "0.5 + 0.45 * sin(")).unwrap();
+    for (i, line) in lines.iter().enumerate() {
+        let args: Vec<&str> = line.split_whitespace().skip(1).collect();
+        let env: &[(&str, &str)] = if i == 0 { &[("GITHUB_ACTIONS", "true")] } else { &[] };
+        if args[0] == "bless" {
+            // The artifact as CI uploads it: the report folder.
+            copy_tree(&root.join("target/vista-report"), &root.join("vista-report"));
+        }
+        let r = run_in(&bin, &root, env, &args);
+        match args[0] {
+            "check" => {
+                assert_eq!(r.code, 1, "{line}: {}{}", r.stdout, r.stderr);
+                let junit = root.join(args[2]);
+                let xml = std::fs::read_to_string(&junit).unwrap_or_else(|e| panic!("{line}: {e}"));
+                assert!(xml.contains("<testsuites") && xml.contains("golden::marble::marble-default"), "{xml}");
+                if i == 0 {
+                    assert!(r.stdout.contains("::error file=golden/cases.toml,line="), "{}", r.stdout);
+                }
+            }
+            _ => assert_eq!(r.code, 0, "{line}: {}{}", r.stdout, r.stderr),
+        }
+    }
+    let after = run_in(&bin, &root, &[], &["check"]);
+    assert_eq!(after.code, 0, "after blessing what CI rendered: {}", after.stdout);
+}
+
 // ---- examples/project: a project outside the built-ins ---------------------
 
 fn copy_tree(from: &Path, to: &Path) {
@@ -3353,6 +3403,7 @@ fn main() {
         (Gpu, "every_output_of_a_graph_is_judged", every_output_of_a_graph_is_judged),
         (Gpu, "per_backend_goldens_are_used_on_their_backend", per_backend_goldens_are_used_on_their_backend),
         (Gpu, "watch_rechecks_what_a_saved_file_reaches", watch_rechecks_what_a_saved_file_reaches),
+        (Gpu, "the_ci_recipe_runs_as_written", the_ci_recipe_runs_as_written),
         (
             Gpu,
             "matrices_integer_vectors_arrays_and_padding_are_packed",

@@ -43,9 +43,14 @@ pub struct BlessRow {
 #[derive(Debug, Clone, Default)]
 pub struct BlessSummary {
     pub rows: Vec<BlessRow>,
+    /// Goldens over 1 MiB, one line each.
+    pub warnings: Vec<String>,
     pub orphans: Vec<PathBuf>,
     pub pruned: bool,
 }
+
+/// A golden larger than this is named when blessed.
+pub const GOLDEN_WARN_BYTES: usize = 1 << 20;
 
 pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<BlessSummary, GoldenError> {
     if opts.in_ci && !opts.force {
@@ -98,6 +103,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         }
     }
     let mut rows = Vec::new();
+    let mut warnings = Vec::new();
     for (case, r) in rendered {
         let (path, key) = match opts.per_backend {
             true => (store.backend_golden_path(case, ctx.backend()), format!("{}@{}", case.id, ctx.backend())),
@@ -162,7 +168,15 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             std::fs::create_dir_all(parent)
                 .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
         }
-        let bytes = vista_image::encode_png16(&path, &new)?;
+        // Goldens live in a repository: the smallest lossless encoding.
+        let bytes = vista_image::encode_png16_small(&path, &new)?;
+        if bytes.len() > GOLDEN_WARN_BYTES {
+            warnings.push(format!(
+                "golden {} is {:.1} MiB (over 1 MiB): a smaller case size, or Git LFS for golden/ (see the README)",
+                path.display(),
+                bytes.len() as f64 / (1 << 20) as f64
+            ));
+        }
         let new_hash = crate::short_hash_bytes(&bytes);
         let old_hash = old_bytes.as_deref().map(crate::short_hash_bytes);
         let run = crate::RunInfo {
@@ -221,5 +235,5 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         manifest.case.retain(|key, _| live.contains(key.split('@').next().unwrap_or_default()));
         store.write_manifest(&manifest)?;
     }
-    Ok(BlessSummary { rows, orphans, pruned: opts.prune })
+    Ok(BlessSummary { rows, orphans, pruned: opts.prune, warnings })
 }

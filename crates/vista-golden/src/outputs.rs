@@ -301,7 +301,10 @@ pub fn golden_bytes(
     for (i, o) in outputs.iter().enumerate() {
         let files = output_files(golden_dir, case, i, o);
         if let (Some(png), true) = (&files.png, i > 0) {
-            out.push((png.clone(), vista_image::encode_png16(png, &quantize16(&o.display().expect("a texture")))?));
+            out.push((
+                png.clone(),
+                vista_image::encode_png16_small(png, &quantize16(&o.display().expect("a texture")))?,
+            ));
         }
         if let (Some(exr), OutputValue::Texture { raw, .. }) = (&files.exr, &o.value) {
             out.push((exr.clone(), vista_image::encode_exr(exr, raw)?));

@@ -146,5 +146,5 @@ pub fn bless_from_report(
             path: golden,
         });
     }
-    Ok(BlessSummary { rows, orphans: Vec::new(), pruned: false })
+    Ok(BlessSummary { rows, orphans: Vec::new(), pruned: false, warnings: Vec::new() })
 }

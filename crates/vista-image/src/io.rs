@@ -26,6 +26,26 @@ pub fn encode_png16(path: &Path, img: &Image) -> Result<Vec<u8>, ImageError> {
     Ok(bytes.into_inner())
 }
 
+/// The smallest lossless 16-bit PNG of `img` the encoder makes, for
+/// goldens that live in a repository: best deflate with adaptive row
+/// filters, and RGB without the alpha channel where every alpha is 1
+/// (a reader takes missing alpha as 1). The same values as
+/// [`encode_png16`], in fewer bytes; slower to write, so bless uses it and
+/// reports do not.
+pub fn encode_png16_small(path: &Path, img: &Image) -> Result<Vec<u8>, ImageError> {
+    use image::ImageEncoder;
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let opaque = img.data.iter().all(|p| quantize16(p[3]) == u16::MAX);
+    let channels = if opaque { 3 } else { 4 };
+    let samples: Vec<u8> =
+        img.data.iter().flat_map(|p| p[..channels].iter().flat_map(|&v| quantize16(v).to_ne_bytes())).collect();
+    let mut bytes = Vec::new();
+    let encoder = PngEncoder::new_with_quality(&mut bytes, CompressionType::Best, FilterType::Adaptive);
+    let color = if opaque { image::ExtendedColorType::Rgb16 } else { image::ExtendedColorType::Rgba16 };
+    encoder.write_image(&samples, img.width, img.height, color).map_err(|e| encode_error(path, "PNG", e))?;
+    Ok(bytes)
+}
+
 /// Writes `img` as an 8-bit RGBA PNG (clamped to `[0, 1]`, NaN as 0): the
 /// light display copy reports load, beside the 16-bit file.
 pub fn write_png8(path: &Path, img: &Image) -> Result<(), ImageError> {

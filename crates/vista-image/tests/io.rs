@@ -236,3 +236,22 @@ fn encoding_an_empty_image_is_an_error_not_a_panic() {
     assert!(matches!(err, ImageError::Encode { format: "EXR", .. }), "{err:?}");
     assert!(dir_entries(dir.path()).is_empty());
 }
+
+/// The goldens' encoding keeps every 16-bit value: RGB where alpha is 1
+/// everywhere, RGBA otherwise, and fewer bytes than the report's encoding.
+#[test]
+fn small_png16_is_lossless_and_smaller() {
+    let p = std::path::Path::new("g.png");
+    let img = Image::from_fn(64, 48, |x, y| [x as f32 / 63.0, y as f32 / 47.0, ((x * y) % 7) as f32 / 6.0, 1.0]);
+    let small = vista_image::encode_png16_small(p, &img).unwrap();
+    let plain = vista_image::encode_png16(p, &img).unwrap();
+    assert!(small.len() < plain.len(), "{} vs {} bytes", small.len(), plain.len());
+    let back = vista_image::decode_png16(p, &small).unwrap();
+    let again = vista_image::decode_png16(p, &plain).unwrap();
+    assert!(back.bit_identical(&again), "the same values as the plain encoding");
+    // A translucent pixel keeps the alpha channel.
+    let mut t = img.clone();
+    t.set(3, 4, [0.5, 0.5, 0.5, 0.25]);
+    let back = vista_image::decode_png16(p, &vista_image::encode_png16_small(p, &t).unwrap()).unwrap();
+    assert_eq!(back.get(3, 4)[3], vista_image::quantize16(0.25) as f32 / 65535.0);
+}
