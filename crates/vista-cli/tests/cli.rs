@@ -2513,6 +2513,23 @@ fn the_report_works_in_a_real_browser() {
 
 // ---- examples/graphs: pass graphs (SPEC 14 part 2) -------------------------
 
+/// A copy of examples/graphs in a temporary directory (kept while the
+/// first value lives).
+fn graphs_copy() -> (tempfile::TempDir, PathBuf) {
+    let t = tmp();
+    let root = t.path().join("graphs");
+    copy_tree(&repo().join("examples/graphs"), &root);
+    (t, root)
+}
+
+/// Replaces `from` (which must be there) with `to` in `root/file`.
+fn edit_file(root: &Path, file: &str, from: &str, to: &str) {
+    let path = root.join(file);
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains(from), "{file} lacks {from}");
+    std::fs::write(&path, text.replace(from, to)).unwrap();
+}
+
 /// Reads a `.npy` of u32 as the example's tests need it.
 fn npy_u32(path: &Path) -> Vec<u32> {
     let n = vista_image::npy::read_npy(path).unwrap();
@@ -2676,16 +2693,9 @@ fn the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu() {
 /// naming no resource; each exit 2 with one line naming the resource, the
 /// file and what was expected. A case's replacement file is used.
 fn graph_inputs_are_checked_before_gpu_work() {
-    let t = tmp();
-    let root = t.path().join("graphs");
-    copy_tree(&repo().join("examples/graphs"), &root);
+    let (_t, root) = graphs_copy();
     let run = |args: &[&str]| vista_in(Some(&root), &[], args);
-    let edit = |file: &str, from: &str, to: &str| {
-        let path = root.join(file);
-        let text = std::fs::read_to_string(&path).unwrap();
-        assert!(text.contains(from), "{file} lacks {from}");
-        std::fs::write(&path, text.replace(from, to)).unwrap();
-    };
+    let edit = |file: &str, from: &str, to: &str| edit_file(&root, file, from, to);
     edit("kernels/blur.toml", "file = \"inputs/photo.png\"", "file = \"inputs/nope.png\"");
     assert_rejected(
         &run(&["render", "blur", "-o", "b.png"]),
@@ -2751,16 +2761,9 @@ fn graph_inputs_are_checked_before_gpu_work() {
 /// where the final image hides it, naming the output; a changed buffer
 /// names its worst elements.
 fn every_output_of_a_graph_is_judged() {
-    let t = tmp();
-    let root = t.path().join("graphs");
-    copy_tree(&repo().join("examples/graphs"), &root);
+    let (_t, root) = graphs_copy();
     let run = |args: &[&str]| vista_in(Some(&root), &[], args);
-    let edit = |file: &str, from: &str, to: &str| {
-        let path = root.join(file);
-        let text = std::fs::read_to_string(&path).unwrap();
-        assert!(text.contains(from), "{file} lacks {from}");
-        std::fs::write(&path, text.replace(from, to)).unwrap();
-    };
+    let edit = |file: &str, from: &str, to: &str| edit_file(&root, file, from, to);
     // Blurring along y first: the final image barely changes, the
     // intermediate does.
     edit("shaders/blur/gaussian.wgsl", "flip.value == 1u", "flip.value == 0u");

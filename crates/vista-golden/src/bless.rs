@@ -126,15 +126,15 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             let name = file.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
             extra_hashes.insert(name, hash);
         }
+        let run = crate::RunInfo {
+            backend: ctx.backend().to_string(),
+            adapter: adapter.clone(),
+            params_hash: params_hash(case),
+            shader_hash: ctx.kernel_shader_hash(case.kernel)?,
+        };
+        let files = ctx.kernel_file_hashes(case.kernel)?;
         if r.raw.width == 0 {
             // No main image (a graph whose first output is a buffer).
-            let run = crate::RunInfo {
-                backend: ctx.backend().to_string(),
-                adapter: adapter.clone(),
-                params_hash: params_hash(case),
-                shader_hash: ctx.kernel_shader_hash(case.kernel)?,
-            };
-            let files = ctx.kernel_file_hashes(case.kernel)?;
             let previous = manifest.case.get(&key);
             let status = match previous {
                 None => "new",
@@ -179,13 +179,6 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         }
         let new_hash = crate::short_hash_bytes(&bytes);
         let old_hash = old_bytes.as_deref().map(crate::short_hash_bytes);
-        let run = crate::RunInfo {
-            backend: ctx.backend().to_string(),
-            adapter: adapter.clone(),
-            params_hash: params_hash(case),
-            shader_hash: ctx.kernel_shader_hash(case.kernel)?,
-        };
-        let files = ctx.kernel_file_hashes(case.kernel)?;
         let mut entry =
             ManifestEntry::of_render(case, &run, files, r.raw.content_hash(), psnr.clone(), new_hash.clone());
         entry.outputs = extra_hashes;

@@ -867,15 +867,7 @@ impl Context {
             extent,
         );
         let mut compute = d.create_command_encoder(&Default::default());
-        {
-            let mut pass = compute.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&compiled.pipeline);
-            for (g, group) in groups.iter().enumerate() {
-                pass.set_bind_group(g as u32, group, &[]);
-            }
-            let [x, y, z] = job.workgroups;
-            pass.dispatch_workgroups(x, y, z);
-        }
+        encode_dispatch(&mut compute, &compiled, &groups, job.workgroups);
         let mut encoder = d.create_command_encoder(&Default::default());
         encoder.copy_texture_to_buffer(
             texture.as_image_copy(),
@@ -1030,6 +1022,22 @@ impl Context {
                 other => GpuError::Validation { what: what.to_string(), message: other.to_string() },
             })
     }
+}
+
+/// One compute pass: the pipeline, its bind groups in order, the dispatch.
+pub(crate) fn encode_dispatch(
+    encoder: &mut wgpu::CommandEncoder,
+    compiled: &Compiled,
+    groups: &[wgpu::BindGroup],
+    workgroups: [u32; 3],
+) {
+    let mut pass = encoder.begin_compute_pass(&Default::default());
+    pass.set_pipeline(&compiled.pipeline);
+    for (g, group) in groups.iter().enumerate() {
+        pass.set_bind_group(g as u32, group, &[]);
+    }
+    let [x, y, z] = workgroups;
+    pass.dispatch_workgroups(x, y, z);
 }
 
 /// What every output texel holds before the kernel runs: sentinel `which`,

@@ -327,15 +327,7 @@ impl Context {
                     })
                     .collect();
                 let mut encoder = d.create_command_encoder(&Default::default());
-                {
-                    let mut cp = encoder.begin_compute_pass(&Default::default());
-                    cp.set_pipeline(&compiled.pipeline);
-                    for (gi, group) in groups.iter().enumerate() {
-                        cp.set_bind_group(gi as u32, group, &[]);
-                    }
-                    let [x, y, z] = pass.workgroups;
-                    cp.dispatch_workgroups(x, y, z);
-                }
+                crate::context::encode_dispatch(&mut encoder, compiled, &groups, pass.workgroups);
                 if let Some(e) = pollster::block_on(scope.pop()) {
                     return Err(GpuError::Validation { what: pass.label.clone(), message: e.to_string() });
                 }

@@ -56,6 +56,22 @@ pub fn file_case(dir: &Path, checked: vista_golden::Checked) -> Outcome {
     outcome
 }
 
+/// `<dir>/<id>/`, created and marked as vista's (so a later run may clear
+/// it and nothing else).
+fn case_folder(dir: &Path, id: &str) -> Result<std::path::PathBuf, GoldenError> {
+    let case_dir = dir.join(id);
+    std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
+        path: case_dir.display().to_string(),
+        message: format!("cannot create report dir: {e}"),
+    })?;
+    let marker = case_dir.join(CASE_MARKER);
+    if !marker.exists() {
+        std::fs::write(&marker, b"")
+            .map_err(|e| GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
+    }
+    Ok(case_dir)
+}
+
 /// Writes a pass graph's other texture outputs (8-bit, the render's and
 /// the golden's) into `<dir>/<id>/` for the outputs table.
 fn write_output_images(
@@ -67,16 +83,7 @@ fn write_output_images(
         return Ok(());
     }
     let id = out.id.clone();
-    let case_dir = dir.join(&id);
-    std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
-        path: case_dir.display().to_string(),
-        message: format!("cannot create report dir: {e}"),
-    })?;
-    let marker = case_dir.join(CASE_MARKER);
-    if !marker.exists() {
-        std::fs::write(&marker, b"")
-            .map_err(|e| GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
-    }
+    let case_dir = case_folder(dir, &id)?;
     for (name, actual, expected) in images {
         let write = |which: &str, img: &Image| -> Result<String, GoldenError> {
             let file = format!("{name}.{which}8.png");
@@ -146,17 +153,7 @@ pub fn write_case_files(
     expected: Option<&Image>,
 ) -> Result<(), GoldenError> {
     let id = out.id.clone();
-    let case_dir = dir.join(&id);
-    std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
-        path: case_dir.display().to_string(),
-        message: format!("cannot create report dir: {e}"),
-    })?;
-    // Marks the folder as vista's, so a later run may clear it and nothing else.
-    let marker = case_dir.join(CASE_MARKER);
-    if !marker.exists() {
-        std::fs::write(&marker, b"")
-            .map_err(|e| GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
-    }
+    let case_dir = case_folder(dir, &id)?;
     let write = |name: &str, img: &Image, bits16: bool| -> Result<Option<String>, GoldenError> {
         if bits16 {
             vista_image::write_png16(&case_dir.join(name), img)?;
