@@ -128,17 +128,31 @@ pub fn decode_npy(path: &Path, bytes: &[u8]) -> Result<Npy, ImageError> {
 /// structured list (`[('a', '<f4'), ('b', '<u4', (3,))]`).
 pub fn dtype_bytes(descr: &str) -> Result<u64, String> {
     if !descr.starts_with('[') {
-        let (order, rest) = descr.split_at(descr.len().min(1));
-        let little = ["<", "|", "="].contains(&order) || (order == ">" && rest.ends_with('1'));
-        if !little {
-            return Err(format!("dtype {descr} is not little-endian; save it as little-endian ('<')"));
-        }
-        return rest
-            .get(1..)
-            .and_then(|n| n.parse::<u64>().ok())
-            .ok_or_else(|| format!("dtype {descr} is not a fixed-size number type"));
+        return simple_bytes(descr);
     }
     let mut total = 0;
+    for (ty, count) in structured_fields(descr)? {
+        total += simple_bytes(&ty)? * count;
+    }
+    Ok(total)
+}
+
+/// Bytes of a simple little-endian (or byte-sized) dtype.
+fn simple_bytes(descr: &str) -> Result<u64, String> {
+    let (order, rest) = descr.split_at(descr.len().min(1));
+    let little = ["<", "|", "="].contains(&order) || (order == ">" && rest.ends_with('1'));
+    if !little {
+        return Err(format!("dtype {descr} is not little-endian; save it as little-endian ('<')"));
+    }
+    rest.get(1..)
+        .and_then(|n| n.parse::<u64>().ok())
+        .ok_or_else(|| format!("dtype {descr} is not a fixed-size number type"))
+}
+
+/// The fields of a structured dtype, in order: each one's simple type and
+/// how many of it (the product of its subarray shape, 1 without one).
+fn structured_fields(descr: &str) -> Result<Vec<(String, u64)>, String> {
+    let mut out = Vec::new();
     // Each field: ('name', 'type') or ('name', 'type', (dims)).
     for field in descr[1..descr.len() - 1].split("),").map(|f| f.trim().trim_start_matches('(').trim_end_matches(')')) {
         if field.trim().is_empty() {
@@ -146,16 +160,15 @@ pub fn dtype_bytes(descr: &str) -> Result<u64, String> {
         }
         let parts: Vec<&str> = field.splitn(3, ',').map(str::trim).collect();
         let ty = parts.get(1).ok_or_else(|| format!("structured field {field} has no type"))?;
-        let ty = ty.trim_matches(|c| c == '\'' || c == '"');
-        let mut n = dtype_bytes(ty)?;
+        let mut count = 1;
         if let Some(dims) = parts.get(2) {
             for d in dims.trim_matches(|c| c == '(' || c == ')').split(',').map(str::trim).filter(|d| !d.is_empty()) {
-                n *= d.parse::<u64>().map_err(|_| format!("structured field {field} has a bad shape"))?;
+                count *= d.parse::<u64>().map_err(|_| format!("structured field {field} has a bad shape"))?;
             }
         }
-        total += n;
+        out.push((ty.trim_matches(|c| c == '\'' || c == '"').to_string(), count));
     }
-    Ok(total)
+    Ok(out)
 }
 
 /// Every number of one item of a dtype, in order: (byte offset, kind
@@ -163,7 +176,7 @@ pub fn dtype_bytes(descr: &str) -> Result<u64, String> {
 pub fn dtype_numbers(descr: &str) -> Result<Vec<(u64, char, u64)>, String> {
     let simple = |ty: &str| -> Result<(char, u64), String> {
         let kind = ty.chars().nth(1).ok_or_else(|| format!("dtype {ty} is not valid"))?;
-        Ok((kind, dtype_bytes(ty)?))
+        Ok((kind, simple_bytes(ty)?))
     };
     if !descr.starts_with('[') {
         let (kind, n) = simple(descr)?;
@@ -171,20 +184,8 @@ pub fn dtype_numbers(descr: &str) -> Result<Vec<(u64, char, u64)>, String> {
     }
     let mut out = Vec::new();
     let mut at = 0;
-    for field in descr[1..descr.len() - 1].split("),").map(|f| f.trim().trim_start_matches('(').trim_end_matches(')')) {
-        if field.trim().is_empty() {
-            continue;
-        }
-        let parts: Vec<&str> = field.splitn(3, ',').map(str::trim).collect();
-        let ty = parts.get(1).ok_or_else(|| format!("structured field {field} has no type"))?;
-        let ty = ty.trim_matches(|c| c == '\'' || c == '"');
-        let (kind, n) = simple(ty)?;
-        let mut count = 1;
-        if let Some(dims) = parts.get(2) {
-            for d in dims.trim_matches(|c| c == '(' || c == ')').split(',').map(str::trim).filter(|d| !d.is_empty()) {
-                count *= d.parse::<u64>().map_err(|_| format!("structured field {field} has a bad shape"))?;
-            }
-        }
+    for (ty, count) in structured_fields(descr)? {
+        let (kind, n) = simple(&ty)?;
         for i in 0..count {
             if kind != 'V' {
                 out.push((at + i * n, kind, n));

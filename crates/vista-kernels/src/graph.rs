@@ -763,6 +763,15 @@ pub fn resolve(
                 .map(|(_, r)| r.clone())
                 .or_else(|| graph.resources.iter().find(|r| r.name == b.name).map(|r| r.name.clone()));
             let bound = bound.as_deref();
+            // The resource bound here must be of `kind`.
+            let needs = |resources: &[ResolvedResource], ri: usize, kind: &str| match kind_of(resources, ri) {
+                k if k == kind => Ok(()),
+                k => Err(bad(format!(
+                    "{label}: {} is bound to {}, a {k}; it needs a {kind}",
+                    describe(b),
+                    resources[ri].spec.name
+                ))),
+            };
             let feed = match (b.feed, bound) {
                 (Feed::Uniform, None) => {
                     blocks += 1;
@@ -770,25 +779,13 @@ pub fn resolve(
                 }
                 (Feed::Uniform, Some(r)) => {
                     let ri = find(&resources, r);
-                    if kind_of(&resources, ri) != "buffer" {
-                        return Err(bad(format!(
-                            "{label}: {} is bound to {r}, a {}; it needs a buffer",
-                            describe(b),
-                            kind_of(&resources, ri)
-                        )));
-                    }
+                    needs(&resources, ri, "buffer")?;
                     SlotFeed::Resource(ri, Usage::UniformBuffer)
                 }
                 (Feed::Table, None) => SlotFeed::Table,
                 (Feed::Table | Feed::Buffer { .. }, Some(r)) => {
                     let ri = find(&resources, r);
-                    if kind_of(&resources, ri) != "buffer" {
-                        return Err(bad(format!(
-                            "{label}: {} is bound to {r}, a {}; it needs a buffer",
-                            describe(b),
-                            kind_of(&resources, ri)
-                        )));
-                    }
+                    needs(&resources, ri, "buffer")?;
                     let read_only = match b.feed {
                         Feed::Buffer { read_only } => read_only,
                         _ => true,
@@ -836,14 +833,7 @@ pub fn resolve(
                             )));
                         }
                     };
-                    if kind_of(&resources, ri) != "texture" {
-                        return Err(bad(format!(
-                            "{label}: {} is bound to {}, a {}; it needs a texture",
-                            describe(b),
-                            resources[ri].spec.name,
-                            kind_of(&resources, ri)
-                        )));
-                    }
+                    needs(&resources, ri, "texture")?;
                     let r = &mut resources[ri];
                     match r.format {
                         Some(f) if f != storage.format => {
@@ -887,13 +877,7 @@ pub fn resolve(
                         )));
                     };
                     let ri = find(&resources, rn);
-                    if kind_of(&resources, ri) != "texture" {
-                        return Err(bad(format!(
-                            "{label}: {} is bound to {rn}, a {}; it needs a texture",
-                            describe(b),
-                            kind_of(&resources, ri)
-                        )));
-                    }
+                    needs(&resources, ri, "texture")?;
                     let r = &mut resources[ri];
                     match r.dimension {
                         Some(d) if d != dim && !(d == SampledDim::D2Array && dim == SampledDim::Cube) => {
@@ -917,22 +901,15 @@ pub fn resolve(
                         )));
                     };
                     let ri = find(&resources, rn);
-                    match &resources[ri].spec.kind {
-                        ResourceKind::Sampler { compare, .. } if compare.is_some() == comparison => {}
-                        ResourceKind::Sampler { .. } => {
-                            return Err(bad(format!(
-                                "{label}: resource {rn} is {} but is bound to {}",
-                                if comparison { "a filtering sampler" } else { "a comparison sampler" },
-                                describe(b)
-                            )));
-                        }
-                        _ => {
-                            return Err(bad(format!(
-                                "{label}: {} is bound to {rn}, a {}; it needs a sampler",
-                                describe(b),
-                                kind_of(&resources, ri)
-                            )));
-                        }
+                    needs(&resources, ri, "sampler")?;
+                    if let ResourceKind::Sampler { compare, .. } = &resources[ri].spec.kind
+                        && compare.is_some() != comparison
+                    {
+                        return Err(bad(format!(
+                            "{label}: resource {rn} is {} but is bound to {}",
+                            if comparison { "a filtering sampler" } else { "a comparison sampler" },
+                            describe(b)
+                        )));
                     }
                     SlotFeed::Resource(ri, Usage::Sampler { comparison })
                 }
