@@ -54,11 +54,16 @@ golden: lavapipe build
 curves: lavapipe build
 	bash ci/curves.sh $(VISTA) docs/curves
 
-# The seed's clouds quality study on the whole landscape frame into
-# docs/seed-study (480x270 on lavapipe; SIZE=1920x1080 on a hardware GPU with
+# The seed's clouds quality study on the whole landscape frame, on two
+# scenes: vista's seed frame (a flat slab) into docs/seed-study/slab, the
+# source material's (a cloud shell, preset seed-scene) into
+# docs/seed-study/shell, side by side in docs/seed-study/README.md (480x270
+# on lavapipe; SIZE=1920x1080 on a hardware GPU with
 # VISTA_STUDY_ARGS="--backend gpu" and VISTA_MAX_WORK raised). Not part of make test.
 seed-study: lavapipe build
-	bash ci/seed-study.sh $(VISTA) docs/seed-study $(or $(SIZE),480x270)
+	bash ci/seed-study.sh $(VISTA) docs/seed-study/slab $(or $(SIZE),480x270) seed
+	bash ci/seed-study.sh $(VISTA) docs/seed-study/shell $(or $(SIZE),480x270) seed-scene
+	bash ci/seed-study-index.sh docs/seed-study
 
 # Mutation score of every kernel's suite into docs/mutants (not part of make test).
 mutants: lavapipe build

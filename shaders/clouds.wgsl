@@ -1,8 +1,8 @@
-// clouds kernel (SPEC 3.6): a cloud slab between cloud_base and cloud_top
-// (km, y up), ray marched with a light march toward the sun at each sample.
+// clouds kernel (SPEC 3.6): a cloud layer between cloud_base and cloud_top
+// (km, y up; a flat slab or a shell around the planet), ray marched with a light march toward the sun at each sample.
 // rgb = L_cloud + T * background (linear radiance), alpha = 1 - T.
 // The f64 reference, written from the same formulas, is crates/vista-kernels/src/cpu/clouds.rs.
-#import vista::cloud_slab::{CloudParams, CloudSlab, cloud_march, cloud_slab, jitter_offset, slab_segment}
+#import vista::cloud_slab::{CloudParams, CloudSlab, cloud_march, cloud_slab, jitter_offset, layer_segment}
 #import vista::geometry::{direction, pinhole_looking, pinhole_ray}
 
 // Packed by name from kernels/clouds.toml (exposure is the host's tone map).
@@ -56,6 +56,8 @@ struct Params {
     step_spread: f32,
     jitter_steps: u32,
     step_km: f32,
+    layer: u32,
+    basis: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -82,7 +84,8 @@ fn slab() -> CloudSlab {
         params.absorption, params.profile, params.profile_bottom, params.profile_top, params.noise_scale,
         params.noise_stretch, params.wind_offset, params.octaves, params.lacunarity, params.gain, params.seed,
         params.max_distance_km, params.steps, params.light_steps, params.light_spread, params.step_spread, params.step_km, params.jitter_steps, params.integrator, params.g1,
-        params.g2, params.phase_blend, params.powder, params.ambient, params.ambient_bottom));
+        params.g2, params.phase_blend, params.powder, params.ambient, params.ambient_bottom, params.layer, params.basis),
+        params.camera_pos);
 }
 
 @compute @workgroup_size(8, 8)
@@ -102,8 +105,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let horizon = params.sky_horizon;
     let background = horizon + (zenith - horizon) * clamp(d.y, 0.0, 1.0);
 
-    // Segment of the ray inside the slab and within max_distance.
-    let seg = slab_segment(slab, o, d);
+    // Segment of the ray inside the layer and within max_distance.
+    let seg = layer_segment(slab, o, d);
     var cloud = vec4(0.0, 0.0, 0.0, 1.0);
     if seg.y > seg.x {
         let s = direction(radians(params.sun_azimuth_deg), radians(params.sun_elevation_deg));

@@ -21,7 +21,7 @@
 // slab's, by the clouds' light march: cloud shadows) and the ground_ambient
 // sky light. The cloud's sun is E_sun T_sun at the middle of its segment. Without a cloud segment (or
 // with coverage or density 0) the ray is one atmosphere segment.
-#import vista::cloud_slab::{CloudParams, CloudSlab, cloud_march, cloud_slab, jitter_offset, slab_segment, sun_optical_depth}
+#import vista::cloud_slab::{CloudParams, CloudSlab, cloud_march, cloud_slab, jitter_offset, layer_segment, sun_optical_depth}
 #import vista::geometry::{direction, latlong_direction, pinhole_looking, pinhole_ray}
 #import vista::sky::{Atmosphere, sky_segment, sun_transmittance_along, view_segment}
 #import vista::terrain::{Light, March, Shadow, Terrain, TerrainParams, march, surface_point, surface_radiance, terrain_of}
@@ -93,6 +93,8 @@ struct Params {
     powder: f32,
     cloud_ambient: vec3<f32>,
     ambient_bottom: f32,
+    cloud_layer: u32,
+    cloud_basis: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -117,7 +119,7 @@ fn slab() -> CloudSlab {
         params.noise_stretch, params.wind_offset, params.cloud_octaves, params.cloud_lacunarity, params.cloud_gain,
         params.seed, params.cloud_max_distance_km, params.cloud_steps, params.cloud_light_steps, params.light_spread,
         1.0, 0.0, 0u, params.cloud_integrator, params.cloud_g1, params.cloud_g2, params.cloud_phase_blend, params.powder,
-        params.cloud_ambient, params.ambient_bottom));
+        params.cloud_ambient, params.ambient_bottom, params.cloud_layer, params.cloud_basis), params.camera_pos);
 }
 
 @compute @workgroup_size(8, 8)
@@ -166,8 +168,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                                    Light(sun_dir, sun, params.ground_ambient));
     }
 
-    // The slab's part of the ray in front of the far end.
-    let seg = slab_segment(slab, o, d);
+    // The layer's part of the ray in front of the far end.
+    let seg = layer_segment(slab, o, d);
     let c0 = seg.x;
     var c1 = seg.y;
     if hit.hit {

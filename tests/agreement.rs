@@ -84,6 +84,14 @@ const FAULTS: &[Fault] = &[
         "let g = 0.5 + 0.5 * sum * s.inv_amplitude;",
         "let g = 0.5 + 0.525 * sum * s.inv_amplitude;",
     ),
+    // Issue 32's cloud shell: its altitude and its sphere crossings.
+    ("clouds", "lib/cloud_slab.wgsl", "p.y * (p.y + 2.0 * PLANET_RADIUS_KM);", "p.y * (p.y + 2.1 * PLANET_RADIUS_KM);"),
+    (
+        "clouds",
+        "lib/cloud_slab.wgsl",
+        "(o.y - h) * (o.y + h + 2.0 * PLANET_RADIUS_KM);",
+        "(o.y - h) * (o.y + h + 2.1 * PLANET_RADIUS_KM);",
+    ),
     ("landscape", "landscape.wgsl", "params.sun_intensity / PI", "params.sun_intensity / (1.05 * PI)"),
     ("landscape", "landscape.wgsl", "KM * 0.5 * (c0 + c1)", "KM * 0.525 * (c0 + c1)"),
     (

@@ -1,6 +1,7 @@
-// A cloud slab between two altitudes (SPEC 3.6), y up, lengths in km: the
-// density field, the light march toward the sun, the primary march with its
-// two integrators, and the per-pixel jitter. Shared by the clouds and
+// A cloud layer between two altitudes (SPEC 3.6), y up, lengths in km: a
+// flat slab, or a shell between two spheres around the atmosphere's planet
+// (`layer`); the density field, the light march toward the sun, the primary
+// march with its two integrators, and the per-pixel jitter. Shared by the clouds and
 // landscape kernels; each builds the settings from its own params, with the
 // derived values (noise frequency, fBm normaliser, light-step layout)
 // computed in WGSL by `cloud_slab` below.
@@ -10,6 +11,8 @@
 #import vista::hash::{pcg3d, unit_from_hash}
 #import vista::phase::dual_hg_phase
 #import vista::fractal::fbm_amplitude
+#import vista::geometry::ray_sphere_bc
+#import vista::sky::R_GROUND
 
 const INTEGRATOR_ANALYTIC: u32 = 1u;
 const JITTER_WHITE: u32 = 1u;
@@ -19,6 +22,9 @@ const JITTER_STEPS_GOLDEN: u32 = 1u;
 const INV_PHI: f32 = 0.6180339887498949;
 const PROFILE_CUMULIFORM: u32 = 1u;
 const PROFILE_ANVIL: u32 = 2u;
+const LAYER_SHELL: u32 = 1u;
+// The atmosphere's ground radius in km: the shell's planet is the sky's.
+const PLANET_RADIUS_KM: f32 = R_GROUND / 1000.0;
 // Same cutoffs as the reference (T_CUTOFF, TAU_SUN_CUTOFF).
 const T_CUTOFF: f32 = 1e-4;
 const TAU_SUN_CUTOFF: f32 = 16.0;
@@ -56,6 +62,8 @@ struct CloudParams {
     powder: f32,
     ambient: vec3<f32>,
     ambient_bottom: f32,
+    layer: u32,
+    basis: u32,
 }
 
 // CloudParams plus what is derived from them once per invocation.
@@ -66,6 +74,9 @@ struct CloudSlab {
     frequency: vec3<f32>, // noise_scale * noise_stretch
     light_first: f32, // first light step, fraction of the path
     light_growth: f32, // ratio of consecutive light steps
+    // The shell's centre is (centre_xz.x, -R, centre_xz.y): under the
+    // camera, as the atmosphere places its planet.
+    centre_xz: vec2<f32>,
 }
 
 // e^x - 1 without the cancellation of exp(x) - 1 near 0.
@@ -86,14 +97,59 @@ fn light_step_layout(n: u32, spread: f32) -> vec2<f32> {
     return vec2(expm1(log_r) / expm1(f32(n) * log_r), exp(log_r));
 }
 
-fn cloud_slab(c: CloudParams) -> CloudSlab {
+fn cloud_slab(c: CloudParams, camera: vec3<f32>) -> CloudSlab {
     let a = fbm_amplitude(c.octaves, c.gain);
     let light = light_step_layout(c.light_steps, c.light_spread);
-    return CloudSlab(c, a, 1.0 / a, c.noise_scale * c.noise_stretch, light.x, light.y);
+    return CloudSlab(c, a, 1.0 / a, c.noise_scale * c.noise_stretch, light.x, light.y, camera.xz);
+}
+
+// The point's altitude: y for the slab; for the shell |q| - R with
+// q = p - centre, as (|q|^2 - R^2) / (|q| + R) where |q|^2 - R^2 =
+// dx^2 + dz^2 + y (y + 2R) is formed without the cancellation of squares
+// near 6360^2 (an f32 ulp there is 4 km^2).
+fn altitude(s: CloudSlab, p: vec3<f32>) -> f32 {
+    if s.c.layer != LAYER_SHELL {
+        return p.y;
+    }
+    let dx = p.x - s.centre_xz.x;
+    let dz = p.z - s.centre_xz.y;
+    let k = dx * dx + dz * dz + p.y * (p.y + 2.0 * PLANET_RADIUS_KM);
+    let len = sqrt(dx * dx + dz * dz + (p.y + PLANET_RADIUS_KM) * (p.y + PLANET_RADIUS_KM));
+    return k / (len + PLANET_RADIUS_KM);
 }
 
 fn height01(s: CloudSlab, y: f32) -> f32 {
     return (y - s.c.base_km) / (s.c.top_km - s.c.base_km);
+}
+
+// Where the ray o + t d (unit d) meets the sphere of radius R + h around the
+// shell's centre: ray_sphere_bc with b = q . d and c = |q|^2 - (R + h)^2 =
+// dx^2 + dz^2 + (y - h)(y + h + 2R), q = o - centre (no cancellation).
+fn shell_sphere(s: CloudSlab, o: vec3<f32>, d: vec3<f32>, h: f32) -> vec2<f32> {
+    let q = vec3(o.x - s.centre_xz.x, o.y + PLANET_RADIUS_KM, o.z - s.centre_xz.y);
+    let c = q.x * q.x + q.z * q.z + (o.y - h) * (o.y + h + 2.0 * PLANET_RADIUS_KM);
+    return ray_sphere_bc(dot(q, d), c);
+}
+
+// The first part (t0, t1) of t >= 0 inside the outer sphere and outside the
+// inner one; t1 <= t0 when there is none. A ray that crosses the inner
+// sphere and comes out of it again (from above the layer, past the limb)
+// keeps only its first crossing.
+fn shell_segment(s: CloudSlab, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
+    let outer = shell_sphere(s, o, d, s.c.top_km);
+    if outer.y <= 0.0 {
+        return vec2(0.0, 0.0);
+    }
+    let inner = shell_sphere(s, o, d, s.c.base_km);
+    var t0 = max(outer.x, 0.0);
+    var t1 = outer.y;
+    let crosses_inner = inner.y > 0.0;
+    if crosses_inner && inner.x <= t0 {
+        t0 = max(t0, inner.y);
+    } else if crosses_inner {
+        t1 = min(t1, inner.x);
+    }
+    return vec2(t0, min(t1, s.c.max_distance_km));
 }
 
 // Plateau smoothstep(0, bottom, h) * smoothstep(0, top, 1 - h) times the genus shape.
@@ -116,7 +172,7 @@ fn height_profile(s: CloudSlab, h: f32) -> f32 {
 // sum runs in the same order as a full evaluation) while most empty samples
 // cost one or two octaves instead of all of them.
 fn cloud_density(s: CloudSlab, p: vec3<f32>) -> f32 {
-    let h = height01(s, p.y);
+    let h = height01(s, altitude(s, p));
     if h < 0.0 || h > 1.0 || s.c.coverage <= 0.0 {
         return 0.0;
     }
@@ -131,7 +187,7 @@ fn cloud_density(s: CloudSlab, p: vec3<f32>) -> f32 {
     var left = s.amplitude_sum;
     var sum = 0.0;
     for (var i = 0u; i < s.c.octaves; i++) {
-        sum += amplitude * basis_noise(0u, s.c.seed, q);
+        sum += amplitude * basis_noise(s.c.basis, s.c.seed, q);
         left = max(0.0, left - amplitude);
         let g_max = 0.5 + 0.5 * (sum + PERLIN_MAX_ABS * left) * s.inv_amplitude;
         if g_max < threshold - SKIP_MARGIN {
@@ -147,14 +203,21 @@ fn cloud_density(s: CloudSlab, p: vec3<f32>) -> f32 {
 }
 
 // Optical depth toward the sun (unit sun_dir, above the horizon) through
-// the slab from p: midpoint rule on steps growing geometrically (first =
+// the layer from p: midpoint rule on steps growing geometrically (first =
 // light_first of the path, ratio light_growth) from where the sun ray is
-// first inside the slab (p itself for a point in the slab; the base for a
+// first inside the layer (p itself for a point in it; the base for a
 // point below it, so a cloud shadow on the ground spends no step in the
 // empty air under the layer) up to its top, cut at max_distance from there.
 fn sun_optical_depth(s: CloudSlab, p_from: vec3<f32>, sun_dir: vec3<f32>) -> f32 {
-    let p = p_from + sun_dir * max(0.0, (s.c.base_km - p_from.y) / sun_dir.y);
-    let len = clamp((s.c.top_km - p.y) / sun_dir.y, 0.0, s.c.max_distance_km);
+    var p = p_from + sun_dir * max(0.0, (s.c.base_km - p_from.y) / sun_dir.y);
+    var len = clamp((s.c.top_km - p.y) / sun_dir.y, 0.0, s.c.max_distance_km);
+    if s.c.layer == LAYER_SHELL {
+        // Below the base p_from is inside the inner sphere: start where the sun ray leaves it.
+        let inner = shell_sphere(s, p_from, sun_dir, s.c.base_km);
+        let start = select(0.0, inner.y, inner.x <= 0.0 && inner.y > 0.0);
+        p = p_from + sun_dir * start;
+        len = clamp(shell_sphere(s, p_from, sun_dir, s.c.top_km).y - start, 0.0, s.c.max_distance_km);
+    }
     let ext = 1.0 + s.c.absorption;
     var dt = len * s.light_first;
     var t = 0.0;
@@ -193,9 +256,12 @@ fn jitter_offset(jitter: u32, seed: u32, pixel: vec2<u32>) -> f32 {
     return 0.5;
 }
 
-// The part (t0, t1) of the ray o + t d inside the slab and within
+// The part (t0, t1) of the ray o + t d inside the layer and within
 // max_distance; t1 <= t0 when there is none. The camera may be inside.
-fn slab_segment(s: CloudSlab, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
+fn layer_segment(s: CloudSlab, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
+    if s.c.layer == LAYER_SHELL {
+        return shell_segment(s, o, d);
+    }
     var t0 = 0.0;
     var t1 = 0.0;
     if abs(d.y) < 1e-6 {
@@ -255,7 +321,7 @@ fn cloud_march(s: CloudSlab, o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, xi: f
         if sigma_s > 0.0 {
             let tau_sun = sun_optical_depth(s, p, sun_dir);
             let sun_vis = exp(-tau_sun) * (1.0 - s.c.powder * exp(-2.0 * tau_sun));
-            let amb = s.c.ambient_bottom + (1.0 - s.c.ambient_bottom) * clamp(height01(s, p.y), 0.0, 1.0);
+            let amb = s.c.ambient_bottom + (1.0 - s.c.ambient_bottom) * clamp(height01(s, altitude(s, p)), 0.0, 1.0);
             let l_in = sun * (phase * sun_vis) + s.c.ambient * amb;
             let x = sigma_s * ext * dt;
             var w = dt;

@@ -750,6 +750,63 @@ fn closed_stdout_pipe_is_not_a_panic() {
 // ---- projects found at run time --------------------------------------------
 
 /// The checkout these tests were built from (test code only).
+/// A small version of `make seed-study` on the shell scene (the generator
+/// must not rot): ci/seed-study.sh at 64 x 36 on the grid points its
+/// findings read, then ci/seed-study-index.sh over it and a copy of it. The
+/// README must carry both tables, all four findings with a verdict, the
+/// crops and the sweep; figures.csv every number the index reads.
+fn the_seed_study_generator_runs_on_the_shell_scene() {
+    let t = tmp();
+    let out = t.path().join("study");
+    let r = Command::new("bash")
+        .arg(repo().join("ci/seed-study.sh"))
+        .arg(env!("CARGO_BIN_EXE_vista"))
+        .arg(out.join("shell"))
+        .args(["64x36", "seed-scene"])
+        .current_dir(repo())
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .env("STUDY_STEPS", "32,64,128,512")
+        .env("STUDY_LIGHTS", "6,12,24,32")
+        .env("STUDY_RUNS", "1")
+        .env_remove("CI")
+        .output()
+        .unwrap();
+    let log = format!("{}{}", String::from_utf8_lossy(&r.stdout), String::from_utf8_lossy(&r.stderr));
+    assert!(r.status.success(), "ci/seed-study.sh failed:\n{log}");
+    let readme = std::fs::read_to_string(out.join("shell/README.md")).unwrap();
+    assert!(readme.starts_with("# The seed's clouds study on the source material's scene: a cloud shell"), "{readme}");
+    for want in ["| 512 | ", "| 32 | ", "## GPU time", "(rows 0-18)", "a ray 5 deg up enters the layer"] {
+        assert!(readme.contains(want), "README lacks {want:?}:\n{readme}");
+    }
+    let verdicts = readme.matches("**holds**").count() + readme.matches("**does not hold**").count();
+    assert_eq!(verdicts, 4, "four findings, each with a verdict:\n{readme}");
+    for f in [
+        "crop-reference.png",
+        "crop-64x12.png",
+        "crop-32x12.png",
+        "crop-32x12-jitter.png",
+        "frame.png",
+        "sweep/curve.csv",
+    ] {
+        assert!(out.join("shell").join(f).is_file(), "{f} missing");
+    }
+    let figures = std::fs::read_to_string(out.join("shell/figures.csv")).unwrap();
+    for key in ["psnr_64x12", "psnr_32x12", "ms_64x12", "ms_512x32", "cost_ratio"] {
+        let v = figures
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("{key},")))
+            .unwrap_or_else(|| panic!("{key}: {figures}"));
+        assert!(v.parse::<f64>().is_ok(), "{key} = {v:?} is not a number");
+    }
+    copy_tree(&out.join("shell"), &out.join("slab"));
+    let r = Command::new("bash").arg(repo().join("ci/seed-study-index.sh")).arg(&out).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let index = std::fs::read_to_string(out.join("README.md")).unwrap();
+    let psnr = figures.lines().find_map(|l| l.strip_prefix("psnr_64x12,")).unwrap();
+    assert!(index.contains(&format!("| 64 x 12 | {psnr} | {psnr} |")), "{index}");
+    assert_eq!(index.matches("| holds |").count() + index.matches("| does not hold |").count(), 4, "{index}");
+}
+
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).unwrap().to_path_buf()
 }
@@ -3411,6 +3468,7 @@ fn main() {
         (Gpu, "per_backend_goldens_are_used_on_their_backend", per_backend_goldens_are_used_on_their_backend),
         (Gpu, "watch_rechecks_what_a_saved_file_reaches", watch_rechecks_what_a_saved_file_reaches),
         (Gpu, "the_ci_recipe_runs_as_written", the_ci_recipe_runs_as_written),
+        (Gpu, "the_seed_study_generator_runs_on_the_shell_scene", the_seed_study_generator_runs_on_the_shell_scene),
         (
             Gpu,
             "matrices_integer_vectors_arrays_and_padding_are_packed",

@@ -1,7 +1,11 @@
 //! `clouds`: a volumetric cloud layer, ray marched (SPEC 3.6).
 //!
-//! Geometry: a flat-earth slab between `cloud_base_km` and `cloud_top_km`,
-//! y up, all lengths in kilometres (extinction in 1/km). A pinhole camera
+//! Geometry (`layer`): a flat-earth slab between `cloud_base_km` and
+//! `cloud_top_km`, y up, or a shell between the spheres of radius R + base
+//! and R + top around the atmosphere's planet (R = 6360 km, centred under
+//! the camera: the camera stands at the planet's top as in the sky), where a
+//! point's height in the layer is its altitude |p - centre| - R; all
+//! lengths in kilometres (extinction in 1/km). A pinhole camera
 //! (SPEC 3.4 conventions: forward from yaw/pitch, vertical fov) looks into a
 //! sky gradient (horizon + (zenith - horizon) clamp(d.y, 0, 1)); every ray
 //! that meets the slab is marched in `steps` equal steps of length dt over
@@ -20,8 +24,8 @@
 //!
 //! Density d(p) = density_scale * height_profile(h) *
 //! max(0, remap(G(q), 1 - coverage, 1, 0, 1)), q = p * noise_scale *
-//! noise_stretch + wind_offset, G = 0.5 + 0.5 fbm3(q) / A: the 3D perlin
-//! fBm normalised by its amplitude sum A and mapped to [0, 1] exactly like
+//! noise_stretch + wind_offset, G = 0.5 + 0.5 fbm3(q) / A: the 3D fBm of
+//! `basis` (perlin or value noise) normalised by its amplitude sum A and mapped to [0, 1] exactly like
 //! the `fbm` kernel's output, so `coverage` means the same at every octave
 //! count and reads as a cloud fraction (0.5: about half of the volume is
 //! cloud, 1: all of it, 0: none). sigma_s = d, sigma_t = (1 + absorption) d.
@@ -67,11 +71,40 @@ pub enum JitterSteps {
     Golden,
 }
 
+/// The cloud layer's geometry: a flat slab between the altitudes base and
+/// top (y), or a shell between the spheres of radius R + base and R + top
+/// around the atmosphere's planet (R = 6360 km, centre (camera x, -R,
+/// camera z): the camera stands at the planet's top, as in the sky).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layer {
+    Slab,
+    Shell,
+}
+
+impl Layer {
+    /// The layer named by an enum param's value; `None` for any other name.
+    pub fn from_name(name: &str) -> Option<Layer> {
+        match name {
+            "slab" => Some(Layer::Slab),
+            "shell" => Some(Layer::Shell),
+            _ => None,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Profile {
     Stratiform,
     Cumuliform,
     Anvil,
+}
+
+/// The [`Layer`] an enum param names, or the error naming its value and
+/// the allowed ones.
+pub fn layer_of(p: &ParamSet, param: &str) -> Result<Layer, ParamError> {
+    let name = p.choice(param);
+    Layer::from_name(name)
+        .ok_or_else(|| ParamError::Invalid(format!("{param}={name} is not a cloud layer; allowed: slab, shell")))
 }
 
 /// The built-in `clouds` kernel (derefs to its [`Kernel`](crate::Kernel);
@@ -99,7 +132,7 @@ impl CpuReference for CloudsKernel {
         if top <= base {
             return Err(ParamError::Invalid(format!("clouds: cloud_top_km={top} must be above cloud_base_km={base}")));
         }
-        Ok(())
+        layer_of(p, "layer").map(|_| ())
     }
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
         crate::cpu64::clouds::render(p, width, height)

@@ -57,7 +57,7 @@ impl CpuReference for LandscapeKernel {
                 "landscape: cloud_top_km={top} must be above cloud_base_km={base}"
             )));
         }
-        Ok(())
+        crate::clouds::layer_of(p, "cloud_layer").map(|_| ())
     }
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image {
         crate::cpu64::landscape::render(p, width, height, HitSearch::BruteForce)

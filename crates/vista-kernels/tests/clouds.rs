@@ -353,13 +353,20 @@ fn density_evaluations_follow_steps_times_one_plus_light_steps() {
 /// from the slab boundary behind the camera does not match.
 #[test]
 fn with_the_camera_inside_the_layer_the_march_starts_at_the_camera() {
-    let c = Clouds::from_params(&params("flythrough", &[("steps", "1024"), ("max_distance_km", "6")]));
+    for layer in ["slab", "shell"] {
+        march_starts_at_the_camera(layer);
+    }
+}
+
+fn march_starts_at_the_camera(layer: &str) {
+    let c =
+        Clouds::from_params(&params("flythrough", &[("steps", "1024"), ("max_distance_km", "6"), ("layer", layer)]));
     let o = c.view.pos;
-    assert!(o[1] > c.base && o[1] < c.top, "the flythrough camera must be inside the slab");
+    assert!(o[1] > c.base && o[1] < c.top, "the flythrough camera must be inside the layer");
     let (mut checked, mut distinct) = (0, 0);
     for (x, y, o, d) in rays(&c, 8) {
-        let (t0, t1) = c.slab_segment(o, d).expect("inside the slab every ray has a segment");
-        assert_eq!(t0, 0.0, "pixel ({x}, {y}): the segment starts at {t0}, not at the camera");
+        let (t0, t1) = c.layer_segment(o, d).expect("inside the layer every ray has a segment");
+        assert_eq!(t0, 0.0, "{layer} pixel ({x}, {y}): the segment starts at {t0}, not at the camera");
         let r = c.march(o, d, 0.5, false);
         if r.transmittance <= T_CUTOFF {
             continue;
@@ -374,23 +381,112 @@ fn with_the_camera_inside_the_layer_the_march_starts_at_the_camera() {
         let t = r.transmittance;
         assert!(
             (t - (-from_camera).exp()).abs() <= 2e-3,
-            "pixel ({x}, {y}): T = {t}, exp(-tau from the camera) = {}",
+            "{layer} pixel ({x}, {y}): T = {t}, exp(-tau from the camera) = {}",
             (-from_camera).exp()
         );
-        // The part of the line behind the camera, inside the slab.
-        let back =
-            if d[1].abs() < 1e-6 { c.max_distance } else { ((if d[1] > 0.0 { c.base } else { c.top }) - o[1]) / d[1] };
-        let behind = tau(back.min(0.0).max(-c.max_distance), 0.0);
+        // The part of the line behind the camera, inside the layer.
+        let back = c.layer_segment(o, d.map(|v| -v)).map_or(0.0, |(_, t)| t);
+        let behind = tau(-back, 0.0);
         if behind > 0.05 {
             distinct += 1;
             assert!(
                 (t - (-(from_camera + behind)).exp()).abs() > 1e-3,
-                "pixel ({x}, {y}): the part behind the camera counted"
+                "{layer} pixel ({x}, {y}): the part behind the camera counted"
             );
         }
         checked += 1;
     }
-    assert!(checked >= 20 && distinct >= 5, "only {checked} rays checked, {distinct} with cloud behind the camera");
+    assert!(
+        checked >= 20 && distinct >= 5,
+        "{layer}: only {checked} rays checked, {distinct} with cloud behind the camera"
+    );
+}
+
+/// The shell's planet: the atmosphere's ground radius (km).
+const R: f64 = 6360.0;
+
+/// A horizontal ray from a camera under the shell is tangent to the sphere
+/// through the camera (the centre lies straight below it), so it enters the
+/// layer and leaves it where the closed-form chords sqrt((R + h)^2 - (R +
+/// a)^2) of the base and top spheres end.
+#[test]
+fn a_tangent_ray_crosses_the_shell_along_the_closed_form_chord() {
+    for (a, base, top) in [(0.0, 1.0, 3.0), (1.5, 2.5, 4.5), (0.3, 8.0, 12.0)] {
+        let (pos, base_s, top_s) = (format!("0.4,{a},-0.7"), base.to_string(), top.to_string());
+        let at = |layer| {
+            let set = [
+                ("layer", layer),
+                ("camera_pos", pos.as_str()),
+                ("cloud_base_km", base_s.as_str()),
+                ("cloud_top_km", top_s.as_str()),
+                ("max_distance_km", "1000"),
+            ];
+            Clouds::from_params(&params("cumulus", &set))
+        };
+        let (c, slab) = (at("shell"), at("slab"));
+        for az in [0.0f64, 1.0, 2.5] {
+            let d = [az.sin(), 0.0, az.cos()];
+            let (t0, t1) = c.layer_segment(c.view.pos, d).expect("a tangent ray reaches the shell");
+            let chord = |h: f64| ((R + h) * (R + h) - (R + a) * (R + a)).sqrt();
+            for (t, want, what) in [(t0, chord(base), "enters"), (t1, chord(top), "leaves")] {
+                assert!(
+                    (t - want).abs() <= 1e-9 * want,
+                    "camera at {a} km, layer {base}-{top} km, azimuth {az}: the ray {what} at {t} km, chord {want} km"
+                );
+            }
+            // The flat slab is never reached by a horizontal ray from under it.
+            assert!(slab.layer_segment(slab.view.pos, d).is_none());
+        }
+    }
+}
+
+/// Near the zenith a shell whose base and top lie far below R is the slab.
+/// From a camera at radius rho = R + a, a ray at zenith angle theta reaches
+/// the height h' = h - a above the camera at s = h' / cos(theta) in the slab
+/// and at t = sqrt((rho cos(theta) + s)^2 - s^2 sin^2(theta)) - rho
+/// cos(theta) in the shell; since sqrt(X^2 - Y) >= X - Y / X,
+/// 0 <= s - t <= s^2 sin^2(theta) / (rho cos(theta) + s), which is where the
+/// two segments' ends must lie. The bound is about twice the true gap
+/// (sqrt(X^2 - Y) ~ X - Y / 2X), so the test also sees it is no looser.
+/// The altitude of a point at horizontal distance r from the axis likewise
+/// exceeds its y by between 0 and r^2 / (2 (R + y)).
+#[test]
+fn near_the_zenith_a_thin_shell_agrees_with_the_slab_within_the_derived_bound() {
+    for a in [0.0, 1.0] {
+        let set = |layer: &str| {
+            Clouds::from_params(&params(
+                "cumulus",
+                &[("layer", layer), ("camera_pos", &format!("2.0,{a},3.0")), ("max_distance_km", "1000")],
+            ))
+        };
+        let (shell, slab) = (set("shell"), set("slab"));
+        let o = shell.view.pos;
+        for theta_deg in [0.0f64, 2.0, 5.0, 10.0, 20.0] {
+            let th = theta_deg.to_radians();
+            let d = [th.sin() * 0.6, th.cos(), th.sin() * 0.8];
+            let (s0, s1) = slab.layer_segment(o, d).unwrap();
+            let (t0, t1) = shell.layer_segment(o, d).unwrap();
+            for (s, t) in [(s0, t0), (s1, t1)] {
+                let bound = s * s * th.sin().powi(2) / ((R + a) * th.cos() + s);
+                let gap = s - t;
+                assert!(
+                    gap >= -1e-9 && gap <= bound + 1e-9,
+                    "a = {a} km, theta = {theta_deg} deg: slab {s} km, shell {t} km, gap {gap} outside [0, {bound}]"
+                );
+                if theta_deg >= 5.0 {
+                    assert!(gap >= 0.4 * bound, "theta = {theta_deg}: gap {gap} far under the bound {bound}");
+                }
+            }
+        }
+        for r in [0.0f64, 1.0, 10.0, 50.0] {
+            let y = 2.0;
+            let p = [o[0] + 0.6 * r, y, o[2] + 0.8 * r];
+            let rise = shell.altitude(p) - y;
+            let bound = r * r / (2.0 * (R + y));
+            assert!(rise >= -1e-12 && rise <= bound + 1e-12, "r = {r} km: altitude - y = {rise}, bound {bound}");
+            assert_eq!(slab.altitude(p), y);
+        }
+    }
 }
 
 /// Seeds the okta calibration averages over, and the others the test below
@@ -516,7 +612,7 @@ fn step_km_gives_each_ray_the_steps_its_segment_needs() {
     let c = Clouds::from_params(&params("cumulus", &[("steps", "128"), ("light_steps", "4"), ("step_km", "0.14")]));
     let (mut sum, mut n, mut capped, mut short) = (0.0, 0, 0, 0);
     for (x, y, o, d) in rays(&c, 4) {
-        let (t0, t1) = c.slab_segment(o, d).expect("cumulus: every ray meets the slab");
+        let (t0, t1) = c.layer_segment(o, d).expect("cumulus: every ray meets the slab");
         let steps = c.primary_steps(t0, t1);
         let expected = ((t1 - t0) / 0.14).ceil().min(128.0) as u32;
         assert_eq!(steps, expected, "({x},{y}): {steps} steps over {:.3} km", t1 - t0);

@@ -43,13 +43,13 @@ fn with_the_camera_inside_the_layer_the_clouds_start_at_the_camera() {
         for x in 0..w {
             let (o, d) = l.ray(x, y, w, h);
             assert!(o[1] > l.clouds.base && o[1] < l.clouds.top, "the flythrough camera must be inside the slab");
-            let (t0, _) = l.clouds.slab_segment(o, d).expect("inside the slab every ray has a segment");
+            let (t0, _) = l.clouds.layer_segment(o, d).expect("inside the slab every ray has a segment");
             assert_eq!(t0, 0.0, "pixel ({x}, {y}): the cloud segment starts at {t0}, not at the camera");
             if d[1] <= 0.0 {
                 continue; // toward the terrain
             }
             let px = l.pixel(x, y, w, h, HitSearch::BruteForce);
-            let (t0, t1) = l.clouds.slab_segment(o, d).unwrap();
+            let (t0, t1) = l.clouds.layer_segment(o, d).unwrap();
             let sun = [l.sun_intensity; 3];
             let m = l.clouds.march_segment(o, d, t0, t1, l.clouds.jitter_offset(x, y), sun, false);
             for (c, (a, b)) in px.iter().zip(&m.radiance).enumerate() {

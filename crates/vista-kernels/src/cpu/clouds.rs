@@ -1,12 +1,12 @@
 //! The `clouds` kernel's reference (SPEC 3.6), written from the formulas in
 //! `crate::clouds`; built in f64 (the oracle) and f32.
 
-use super::geometry::{Camera, V3, add, direction, dot, scale, smoothstep};
+use super::geometry::{Camera, V3, add, direction, dot, scale, smoothstep, sub};
 use super::noise::{Fbm, Noise};
 use super::phase::dual_hg;
 use super::{Real, pixel_uv, real, real3, render_cpu};
 use crate::ParamSet;
-use crate::clouds::{Integrator, Jitter, JitterSteps, Profile};
+use crate::clouds::{Integrator, Jitter, JitterSteps, Layer, Profile, layer_of};
 use crate::noise::{Basis, pcg3d};
 use vista_image::Image;
 
@@ -20,6 +20,8 @@ pub const TAU_SUN_CUTOFF: Real = 16.0;
 /// A sky direction counts as cloudy when its optical depth exceeds this
 /// (transmittance below 0.905: visibly cloud, SPEC's oktas calibration).
 pub const OKTA_TAU: Real = 0.1;
+/// The planet's radius (km) under a shell layer: the atmosphere's ground.
+pub const PLANET_RADIUS_KM: Real = super::atmosphere::R_GROUND / 1000.0;
 /// 1 / golden ratio, (sqrt 5 - 1) / 2: the golden-ratio step offsets.
 const INV_PHI: f64 = 0.618_033_988_749_894_9;
 /// Midpoint samples per sky direction in [`Clouds::sky_cover`].
@@ -118,6 +120,20 @@ impl StepLayout {
     }
 }
 
+/// The roots t0 <= t1 of t^2 + 2 b t + c = 0, where the unit ray q + t d
+/// meets a sphere around the origin (b = q . d, c = |q|^2 - r^2); `None`
+/// when it misses. The root of larger magnitude comes first, the other from
+/// t0 t1 = c, so neither is a difference of near-equal numbers.
+pub fn sphere_roots(b: Real, c: Real) -> Option<(Real, Real)> {
+    let disc = b * b - c;
+    if disc < 0.0 {
+        return None;
+    }
+    let far = -b - if b >= 0.0 { disc.sqrt() } else { -disc.sqrt() };
+    let near = if far == 0.0 { 0.0 } else { c / far };
+    Some((far.min(near), far.max(near)))
+}
+
 /// One marched ray.
 #[derive(Debug, Clone)]
 pub struct RayResult {
@@ -134,6 +150,10 @@ pub struct RayResult {
 /// Everything the march needs, resolved from a parameter set in Real.
 #[derive(Debug, Clone)]
 pub struct Clouds {
+    pub layer: Layer,
+    /// x and z of the shell's centre (the camera's): it lies at
+    /// (x, -[`PLANET_RADIUS_KM`], z).
+    pub centre_xz: [Real; 2],
     pub base: Real,
     pub top: Real,
     pub coverage: Real,
@@ -184,7 +204,10 @@ impl Clouds {
         // pitch is within +-89 deg, so forward is never vertical.
         let forward = direction(real(p, "yaw_deg").to_radians(), real(p, "pitch_deg").to_radians());
         let sun_color = real3(p, "sun_color");
+        let camera = real3(p, "camera_pos");
         Clouds {
+            layer: layer_of(p, "layer").expect("CloudsKernel::check refuses other layers"),
+            centre_xz: [camera[0], camera[2]],
             base: real(p, "cloud_base_km"),
             top: real(p, "cloud_top_km"),
             coverage: coverage_of(p),
@@ -200,9 +223,9 @@ impl Clouds {
             frequency: stretch.map(|s| s * ns),
             wind: real3(p, "wind_offset"),
             fbm,
-            noise: Noise::new(Basis::Perlin, p.u32("seed")),
+            noise: Noise::new(Basis::from_name(p.choice("basis")), p.u32("seed")),
             inv_amplitude: 1.0 / fbm.amplitude_sum(),
-            view: Camera::looking(real3(p, "camera_pos"), forward, real(p, "fov_deg"), 1.0),
+            view: Camera::looking(camera, forward, real(p, "fov_deg"), 1.0),
             max_distance: real(p, "max_distance_km"),
             sun_dir: direction(real(p, "sun_azimuth_deg").to_radians(), real(p, "sun_elevation_deg").to_radians()),
             sun: sun_color.map(|c| c * real(p, "sun_intensity")),
@@ -230,14 +253,40 @@ impl Clouds {
         }
     }
 
-    /// Normalised height in the slab (unclamped).
+    /// Normalised height in the layer of the altitude y (unclamped).
     pub fn height01(&self, y: Real) -> Real {
         (y - self.base) / (self.top - self.base)
     }
 
+    /// The altitude that places p in the layer: p.y for the slab; for the
+    /// shell |q| - R, q = p - centre, written (|q|^2 - R^2) / (|q| + R) with
+    /// |q|^2 - R^2 = x^2 + z^2 + y (y + 2R) so the f32 build does not lose
+    /// it to the cancellation of two squares near R^2.
+    pub fn altitude(&self, p: V3) -> Real {
+        match self.layer {
+            Layer::Slab => p[1],
+            Layer::Shell => {
+                let (x, z) = (p[0] - self.centre_xz[0], p[2] - self.centre_xz[1]);
+                let r = PLANET_RADIUS_KM;
+                let above = x * x + z * z + p[1] * (p[1] + 2.0 * r);
+                above / ((x * x + z * z + (p[1] + r) * (p[1] + r)).sqrt() + r)
+            }
+        }
+    }
+
+    /// Where the ray o + t d (unit d) meets the sphere of altitude h around
+    /// the shell's centre (radius R + h), as [`sphere_roots`].
+    pub fn sphere_hits(&self, o: V3, d: V3, h: Real) -> Option<(Real, Real)> {
+        let r = PLANET_RADIUS_KM;
+        let q = sub(o, [self.centre_xz[0], -r, self.centre_xz[1]]);
+        // |q|^2 - (R + h)^2 with the large terms factored out.
+        let c = q[0] * q[0] + q[2] * q[2] + (o[1] - h) * (o[1] + h + 2.0 * r);
+        sphere_roots(dot(q, d), c)
+    }
+
     /// The density d(p) (1/km), i.e. sigma_s.
     pub fn density(&self, p: V3) -> Real {
-        let h = self.height01(p[1]);
+        let h = self.height01(self.altitude(p));
         if !(0.0..=1.0).contains(&h) {
             return 0.0;
         }
@@ -264,9 +313,25 @@ impl Clouds {
         [0, 1, 2].map(|i| self.sky_horizon[i] + (self.sky_zenith[i] - self.sky_horizon[i]) * t)
     }
 
-    /// Part [t0, t1] of the ray o + t d inside the slab and within
-    /// max_distance, or None.
-    pub fn slab_segment(&self, o: V3, d: V3) -> Option<(Real, Real)> {
+    /// Part [t0, t1] of the ray o + t d inside the layer and within
+    /// max_distance, or None. For the shell, the first such part: a ray
+    /// from above the layer that dips into the inner sphere and leaves it
+    /// again (past the limb) keeps only its first crossing.
+    pub fn layer_segment(&self, o: V3, d: V3) -> Option<(Real, Real)> {
+        if self.layer == Layer::Shell {
+            let (out0, out1) = self.sphere_hits(o, d, self.top).filter(|&(_, t1)| t1 > 0.0)?;
+            let (mut t0, mut t1) = (out0.max(0.0), out1);
+            if let Some((in0, in1)) = self.sphere_hits(o, d, self.base).filter(|&(_, t1)| t1 > 0.0) {
+                if in0 <= t0 {
+                    // Starting inside the inner sphere: the layer begins where the ray leaves it.
+                    t0 = t0.max(in1);
+                } else {
+                    t1 = t1.min(in0);
+                }
+            }
+            let t1 = t1.min(self.max_distance);
+            return (t1 > t0).then_some((t0, t1));
+        }
         let (t0, t1) = if d[1].abs() < 1e-6 {
             if o[1] < self.base || o[1] > self.top {
                 return None;
@@ -302,9 +367,23 @@ impl Clouds {
     /// (optical depth toward the sun, density evaluations spent).
     fn sun_march(&self, p: V3) -> (Real, u32) {
         let s = self.sun_dir;
-        // From where the sun ray enters the slab (p itself inside it).
-        let p = add(p, scale(s, ((self.base - p[1]) / s[1]).max(0.0)));
-        let len = ((self.top - p[1]) / s[1]).clamp(0.0, self.max_distance);
+        // From where the sun ray enters the layer (p itself inside it) to its top.
+        let (p, len) = match self.layer {
+            Layer::Slab => {
+                let p = add(p, scale(s, ((self.base - p[1]) / s[1]).max(0.0)));
+                (p, (self.top - p[1]) / s[1])
+            }
+            Layer::Shell => {
+                // Below the base p is inside the inner sphere, which the sun ray leaves at its far root.
+                let start = match self.sphere_hits(p, s, self.base) {
+                    Some((t0, t1)) if t0 <= 0.0 && t1 > 0.0 => t1,
+                    _ => 0.0,
+                };
+                let exit = self.sphere_hits(p, s, self.top).map_or(0.0, |(_, t1)| t1);
+                (add(p, scale(s, start)), exit - start)
+            }
+        };
+        let len = len.clamp(0.0, self.max_distance);
         let (first, growth) = self.light_step_layout();
         let mut dt = len * first;
         let mut t = 0.0;
@@ -340,7 +419,7 @@ impl Clouds {
     /// Marches the ray o + t d with first-sample offset `xi` (in steps).
     /// With `trace`, records the transmittance after every step.
     pub fn march(&self, o: V3, d: V3, xi: Real, trace: bool) -> RayResult {
-        match self.slab_segment(o, d) {
+        match self.layer_segment(o, d) {
             Some((t0, t1)) => self.march_segment(o, d, t0, t1, xi, self.sun, trace),
             None => RayResult { radiance: [0.0; 3], transmittance: 1.0, trace: Vec::new(), density_evals: 0 },
         }
@@ -364,7 +443,7 @@ impl Clouds {
         for y in 0..height {
             for x in 0..width {
                 let (o, d) = self.ray(x, y, width, height);
-                if let Some((t0, t1)) = self.slab_segment(o, d) {
+                if let Some((t0, t1)) = self.layer_segment(o, d) {
                     sum += self.primary_steps(t0, t1) as Real;
                 }
             }
@@ -406,7 +485,8 @@ impl Clouds {
                 let (tau_sun, evals) = self.sun_march(p);
                 out.density_evals += evals;
                 let sun_vis = (-tau_sun).exp() * (1.0 - self.powder * (-2.0 * tau_sun).exp());
-                let amb = self.ambient_bottom + (1.0 - self.ambient_bottom) * self.height01(p[1]).clamp(0.0, 1.0);
+                let amb =
+                    self.ambient_bottom + (1.0 - self.ambient_bottom) * self.height01(self.altitude(p)).clamp(0.0, 1.0);
                 let x = sigma_s * ext * dt;
                 // Riemann: S dt; analytic: S (1 - exp(-x)) / sigma_t.
                 let w = match self.integrator {
@@ -433,8 +513,8 @@ impl Clouds {
         out
     }
 
-    /// Optical depth (extinction) of the ray o + t d through the slab, by the
-    /// midpoint rule with `samples` steps over its slab segment.
+    /// Optical depth (extinction) of the ray o + t d through the layer, by
+    /// the midpoint rule with `samples` steps over its layer segment.
     pub fn optical_depth(&self, o: V3, d: V3, samples: u32) -> Real {
         let Some((ext, dt, densities)) = self.depth_samples(o, d, samples) else { return 0.0 };
         densities.sum::<Real>() * ext * dt
@@ -443,7 +523,7 @@ impl Clouds {
     /// (1 + absorption, dt, the densities at the `samples` midpoints of the
     /// ray's slab segment in order); `None` off the slab.
     fn depth_samples(&self, o: V3, d: V3, samples: u32) -> Option<(Real, Real, impl Iterator<Item = Real> + '_)> {
-        let (t0, t1) = self.slab_segment(o, d)?;
+        let (t0, t1) = self.layer_segment(o, d)?;
         let dt = (t1 - t0) / samples as Real;
         let densities = (0..samples).map(move |k| self.density(add(o, scale(d, t0 + (k as Real + 0.5) * dt))));
         Some((1.0 + self.absorption, dt, densities))
@@ -483,7 +563,7 @@ impl Clouds {
                 for j in 0..n {
                     let az = 2.0 * super::consts::PI * (j as Real + 0.5) / n as Real;
                     let d = [cos_e * az.sin(), sin_e, cos_e * az.cos()];
-                    if self.slab_segment(o, d).is_none() {
+                    if self.layer_segment(o, d).is_none() {
                         continue;
                     }
                     sky += 1;

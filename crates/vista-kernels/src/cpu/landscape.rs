@@ -74,6 +74,8 @@ impl Landscape {
         };
         let ns = real(p, "noise_scale");
         let clouds = Clouds {
+            layer: crate::clouds::layer_of(p, "cloud_layer").expect("LandscapeKernel::check refuses other layers"),
+            centre_xz: [pos[0], pos[2]],
             base: real(p, "cloud_base_km"),
             top: real(p, "cloud_top_km"),
             coverage: real(p, "coverage"),
@@ -85,7 +87,7 @@ impl Landscape {
             frequency: real3(p, "noise_stretch").map(|s| s * ns),
             wind: real3(p, "wind_offset"),
             fbm,
-            noise: Noise::new(Basis::Perlin, p.u32("seed")),
+            noise: Noise::new(Basis::from_name(p.choice("cloud_basis")), p.u32("seed")),
             inv_amplitude: 1.0 / fbm.amplitude_sum(),
             view,
             max_distance: real(p, "cloud_max_distance_km"),
@@ -160,7 +162,7 @@ impl Landscape {
 
     /// The terrain's radiance at the hit at distance t (km) along o + t d:
     /// the heightfield shading (albedo / pi x irradiance) under the sun seen
-    /// through the air and the slab, plus the ground ambient.
+    /// through the air and the cloud layer, plus the ground ambient.
     pub fn surface(&self, o: V3, d: V3, t: Real) -> V3 {
         let t_sun = self.sky.sun_transmittance(self.air_point(d, t));
         let mut cloud = 1.0;
@@ -200,7 +202,7 @@ impl Landscape {
             Some(t) => (KM * t, self.surface(o, d, t)),
             None => (exit.max(start), [0.0; 3]),
         };
-        let cloud_seg = self.clouds.slab_segment(o, d).map(|(c0, c1)| (c0, hit.map_or(c1, |t| c1.min(t))));
+        let cloud_seg = self.clouds.layer_segment(o, d).map(|(c0, c1)| (c0, hit.map_or(c1, |t| c1.min(t))));
         let rgb: V3 = match cloud_seg {
             Some((c0, c1)) if self.has_clouds() && c1 > c0 => {
                 let (front_l, front_t) = self.sky.segment(dir, start, (KM * c0).max(start));
