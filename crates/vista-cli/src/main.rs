@@ -740,10 +740,18 @@ fn check(
         // A failing or missing case's render, as bless --from-report may take it.
         if let Some(mut entry) = entry
             && matches!(o.verdict, vista_golden::Verdict::Fail | vista_golden::Verdict::Missing)
-            && let Ok(bytes) = std::fs::read(vista_golden::pending::pending_png(&report_dir, &o.id))
         {
-            entry.golden_hash = vista_golden::short_hash_bytes(&bytes);
-            pending.insert(o.id.clone(), entry);
+            // A graph whose first output is a buffer has no main PNG.
+            let png = match o.files.actual {
+                Some(_) => std::fs::read(vista_golden::pending::pending_png(&report_dir, &o.id))
+                    .ok()
+                    .map(|bytes| vista_golden::short_hash_bytes(&bytes)),
+                None => Some(String::new()),
+            };
+            if let Some(hash) = png {
+                entry.golden_hash = hash;
+                pending.insert(o.id.clone(), entry);
+            }
         }
         let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
         let label = match o.verdict {

@@ -1322,7 +1322,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     let c = vista_in(Some(d.path()), &[], &["check"]);
     assert_eq!(c.code, 1, "{}", c.stdout);
     assert!(
-        c.stdout.contains("raw values differ from the blessed ones: a r32uint output compares exactly"),
+        c.stdout.contains("output image: not exact: 1 differ; worst: (3, 4).r 4010 vs golden 4009"),
         "{}",
         c.stdout
     );
@@ -1705,6 +1705,77 @@ fn bless_from_report_accepts_what_another_clone_rendered() {
     assert_eq!(std::fs::read(dev.path().join("golden/k/a.png")).unwrap(), before, "a stale bless wrote");
     let none = vista_in(Some(dev.path()), &[], &["bless", "--from-report", dev.path().to_str().unwrap()]);
     assert_rejected(&none, 2, &["pending.toml", "vista check"]);
+}
+
+/// A float output other than the seed's rgba32float display image keeps
+/// its raw values in an EXR beside its PNG view, and check judges those:
+/// an edit that changes only values the view clamps away fails the case.
+/// bless --from-report takes the EXR with the PNG; the seed's contract
+/// keeps its PNG alone.
+fn float_outputs_keep_raw_values_beside_their_view() {
+    let hdr = |slope: &str| {
+        format!(
+            "@group(0) @binding(0) var radiance: texture_storage_2d<rgba16float, write>;
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
+    let d = textureDimensions(radiance);
+    if any(id.xy >= d) {{ return; }}
+    let u = f32(id.x) / f32(d.x);
+    textureStore(radiance, id.xy, vec4(2.0 + {slope} * u, 0.25, 0.5, 1.0));
+}}
+"
+        )
+    };
+    let ci = kernel_project(K_MANIFEST, K_SHADER);
+    std::fs::write(ci.path().join("kernels/hdr.toml"), "summary = \"radiance above 1\"\noutput_range = [0, 16]\n")
+        .unwrap();
+    std::fs::write(ci.path().join("shaders/hdr.wgsl"), hdr("4.0")).unwrap();
+    std::fs::create_dir(ci.path().join("golden")).unwrap();
+    std::fs::write(
+        cases_path(ci.path()),
+        "[[case]]\nid = \"sky\"\nkernel = \"hdr\"\nsize = \"16x8\"\n\n[[case]]\nid = \"grey\"\nkernel = \"k\"\nsize = \"8x8\"\n",
+    )
+    .unwrap();
+    let b = vista_in(Some(ci.path()), &[], &["bless"]);
+    assert_eq!(b.code, 0, "{}{}", b.stdout, b.stderr);
+    let exr = ci.path().join("golden/hdr/sky.exr");
+    let raw = vista_image::read_exr(&exr).expect("bless wrote the raw values");
+    assert!(raw.get(15, 0)[0] > 5.0, "raw values above the view's 1: {:?}", raw.get(15, 0));
+    assert!(!ci.path().join("golden/k/grey.exr").exists(), "the seed's contract keeps its PNG alone");
+    let manifest = std::fs::read_to_string(ci.path().join("golden/manifest.toml")).unwrap();
+    assert!(manifest.contains("\"sky.exr\""), "the manifest records the EXR's hash: {manifest}");
+    let ok = vista_in(Some(ci.path()), &[], &["check"]);
+    assert!(ok.code == 0 && ok.stdout.contains("2 passed, 0 failed"), "{}", ok.stdout);
+    // Every value the view shows is 1 before and after: only the EXR sees it.
+    let png_before = vista_image::read_png16(&golden(ci.path(), "hdr", "sky")).unwrap();
+    std::fs::write(ci.path().join("shaders/hdr.wgsl"), hdr("3.0")).unwrap();
+    let r = vista_in(Some(ci.path()), &[], &["check"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(r.stdout.contains("raw PSNR") && r.stdout.contains("is below the threshold"), "{}", r.stdout);
+    assert!(
+        r.stdout.contains("PSNR 25.15 dB of raw values") && r.stdout.contains("max-abs 0.000e0 | bad pixels 0"),
+        "the view alone would pass: {}",
+        r.stdout
+    );
+    // Another clone accepts CI's render whole: the PNG and the EXR.
+    let dev = tmp();
+    copy_tree(ci.path(), dev.path());
+    let report = ci.path().join("target/vista-report");
+    let a = vista_in(Some(dev.path()), &[], &["bless", "--from-report", report.to_str().unwrap()]);
+    assert_eq!(a.code, 0, "{}{}", a.stdout, a.stderr);
+    assert_eq!(
+        std::fs::read(dev.path().join("golden/hdr/sky.exr")).unwrap(),
+        std::fs::read(report.join("sky/golden/sky.exr")).unwrap(),
+        "CI's very EXR"
+    );
+    let png_after = vista_image::read_png16(&golden(dev.path(), "hdr", "sky")).unwrap();
+    assert!(png_after.bit_identical(&png_before), "the view did not change");
+    let c = vista_in(Some(dev.path()), &[], &["check"]);
+    assert!(c.code == 0 && c.stdout.contains("2 passed, 0 failed"), "{}", c.stdout);
+    // An EXR edited after the check makes the report stale; nothing is written.
+    std::fs::write(report.join("sky/golden/sky.exr"), b"not the check's file").unwrap();
+    let stale = vista_in(Some(dev.path()), &[], &["bless", "--from-report", report.to_str().unwrap()]);
+    assert_rejected(&stale, 2, &["case sky", "is stale", "sky.exr is not the file the check wrote"]);
 }
 
 /// One process runs a read_write kernel, then a write-only kernel of the same
@@ -2901,6 +2972,45 @@ fn per_backend_goldens_are_used_on_their_backend() {
     assert!(manifest.contains("[case.\"sky-noon@swiftshader\"]"), "{manifest}");
 }
 
+/// A pass graph's per-backend golden covers every output: `bless
+/// --per-backend` writes `<case>@<B>` files for the main image, its raw
+/// values and the other outputs, and B is judged against all of them; a
+/// graph whose first output is a buffer is refused, writing nothing.
+fn per_backend_goldens_cover_every_output_of_a_graph() {
+    let (_t, root) = graphs_copy();
+    let run = |args: &[&str]| vista_in(Some(&root), &[], args);
+    let b = run(&["bless", "--backend", "swiftshader", "--per-backend", "--case", "blur"]);
+    assert_eq!(b.code, 0, "{}{}", b.stdout, b.stderr);
+    for f in [
+        "blur@swiftshader.png",
+        "blur@swiftshader.exr",
+        "blur@swiftshader.horizontal.png",
+        "blur@swiftshader.horizontal.exr",
+    ] {
+        assert!(root.join("golden/blur").join(f).is_file(), "{f}");
+    }
+    let c = run(&["check", "--backend", "swiftshader", "--case", "blur"]);
+    assert!(
+        c.code == 0 && c.stdout.contains("PSNR identical") && c.stdout.contains("[golden @swiftshader]"),
+        "{}",
+        c.stdout
+    );
+    // The per-backend intermediate is judged: a copy of lavapipe's fails it.
+    std::fs::copy(
+        root.join("golden/blur/blur.horizontal.exr"),
+        root.join("golden/blur/blur@swiftshader.horizontal.exr"),
+    )
+    .unwrap();
+    let c = run(&["check", "--backend", "swiftshader", "--case", "blur"]);
+    assert!(c.code == 1 && c.stdout.contains("blur@swiftshader.horizontal.exr (hash"), "{}", c.stdout);
+    // lavapipe keeps the case's own files.
+    assert_eq!(run(&["check", "--case", "blur"]).code, 0);
+    let before = std::fs::read_dir(root.join("golden/scan")).unwrap().count();
+    let s = run(&["bless", "--backend", "swiftshader", "--per-backend", "--case", "scan"]);
+    assert_rejected(&s, 2, &["--per-backend", "case scan", "first output is a buffer", "nothing was written"]);
+    assert_eq!(std::fs::read_dir(root.join("golden/scan")).unwrap().count(), before);
+}
+
 /// `vista watch` checks the cases, then re-checks exactly the cases a saved
 /// WGSL file reaches and rewrites the report, until its --timeout.
 fn watch_rechecks_what_a_saved_file_reaches() {
@@ -3418,6 +3528,8 @@ fn main() {
             "a_read_write_run_does_not_hide_the_next_runs_unwritten_texels",
             a_read_write_run_does_not_hide_the_next_runs_unwritten_texels,
         ),
+        (Gpu, "float_outputs_keep_raw_values_beside_their_view", float_outputs_keep_raw_values_beside_their_view),
+        (Gpu, "per_backend_goldens_cover_every_output_of_a_graph", per_backend_goldens_cover_every_output_of_a_graph),
         (
             Gpu,
             "bless_from_report_accepts_what_another_clone_rendered",

@@ -64,19 +64,16 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
     let picked = select(&cases, opts.glob.as_deref())?;
     let mut manifest = store.manifest()?;
     let adapter = ctx.adapter_description();
-    if opts.per_backend
-        && let Some(c) = picked.iter().find(|c| c.kernel.graph().is_some())
-    {
-        return Err(GoldenError::BadInput(format!(
-            "--per-backend: case {} is a pass graph; per-backend goldens cover one-pass kernels so far (its other \
-             outputs have one golden each)",
-            c.id
-        )));
-    }
-
     let mut rendered: Vec<(&crate::Case, Rendered)> = Vec::new();
     for case in &picked {
         let r = crate::run::render_case(ctx, case)?;
+        if opts.per_backend && r.raw.width == 0 {
+            return Err(GoldenError::BadInput(format!(
+                "--per-backend: case {}'s first output is a buffer; a per-backend golden is found by its main PNG \
+                 (<case>@<backend>.png), so its first output must be a texture; nothing was written",
+                case.id
+            )));
+        }
         // The checks of `vista check` that need no golden, with the same
         // words: a golden is never blessed from output check would fail.
         let identical = match case.kernel.graph().is_none_or(|g| g.deterministic) {
@@ -110,7 +107,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             false => (store.golden_path(case), case.id.clone()),
         };
         // A pass graph's other files first: each atomic, named in the entry.
-        let extra = crate::outputs::golden_bytes(&store.dir, case, &r.outputs)?;
+        let extra = crate::outputs::golden_bytes(&store.dir, case, &key, &crate::outputs::outputs_of(case, &r))?;
         let mut extra_hashes = std::collections::BTreeMap::new();
         let mut extra_changed = false;
         for (file, bytes) in &extra {
@@ -168,8 +165,13 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             std::fs::create_dir_all(parent)
                 .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
         }
-        // Goldens live in a repository: the smallest lossless encoding.
-        let bytes = vista_image::encode_png16_small(&path, &new)?;
+        // Goldens live in a repository: the smallest lossless encoding, and
+        // a golden whose pixels did not change keeps its bytes (another
+        // encoder version must not churn the history).
+        let bytes = match (status, &old_bytes) {
+            ("unchanged", Some(old)) => old.clone(),
+            _ => vista_image::encode_png16_small(&path, &new)?,
+        };
         if bytes.len() > GOLDEN_WARN_BYTES {
             warnings.push(format!(
                 "golden {} is {:.1} MiB (over 1 MiB): a smaller case size, or Git LFS for golden/ (see the README)",

@@ -61,6 +61,9 @@ pub struct Outcome {
     pub kernel: String,
     pub verdict: Verdict,
     pub metrics: Option<Metrics>,
+    /// `metrics.psnr` is of the main image's raw values (its EXR golden),
+    /// the rest of the metrics of its view.
+    pub psnr_of_raw: bool,
     /// The PSNR threshold that applied, and whether the adapter matched the
     /// manifest's (60 dB same driver, 35 dB other driver by default).
     pub psnr_threshold: f64,
@@ -117,9 +120,10 @@ impl Outcome {
         // A missing golden or an error explains itself in its problem line.
         if let Some(m) = &self.metrics {
             s += &format!(
-                "  PSNR {} (>= {:.1} dB, {} driver) | SSIM {:.5}{} | FLIP {} | max-abs {:.3e} | bad pixels {} \
+                "  PSNR {}{} (>= {:.1} dB, {} driver) | SSIM {:.5}{} | FLIP {} | max-abs {:.3e} | bad pixels {} \
                      ({:.3}%, > {BAD_PIXEL_LIMIT}) | NaN/Inf {}\n",
                 metrics::format_psnr(m.psnr),
+                if self.psnr_of_raw { " of raw values" } else { "" },
                 self.psnr_threshold,
                 if self.same_driver { "same" } else { "other" },
                 m.ssim,
@@ -241,6 +245,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
         kernel: case.kernel.name().to_string(),
         verdict: Verdict::Pass,
         metrics: None,
+        psnr_of_raw: false,
         psnr_threshold: case.psnr_same_driver,
         same_driver: true,
         min_ssim: case.min_ssim,
@@ -331,20 +336,8 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
                     out.changed_files = changed_files(&e.shader_files, obs.shader_files);
                 }
             }
-            // A graph's outputs are judged by `outputs` (integers exactly there).
-            if obs.outputs.is_empty()
-                && vista_kernels::is_integer_format(obs.format)
-                && e.raw_hash != obs.raw.content_hash()
-            {
-                // Integers compare exactly, on any driver and after any edit.
-                out.problems.push(format!(
-                    "raw values differ from the blessed ones: a {} output compares exactly (raw hash {} vs \
-                     manifest {})",
-                    obs.format,
-                    obs.raw.content_hash(),
-                    e.raw_hash
-                ));
-            } else if e.params_hash != run.params_hash {
+            // Integer outputs compare exactly in `outputs` (their EXR golden).
+            if e.params_hash != run.params_hash {
                 out.notes.push("case parameters changed since the last bless".into());
             } else if obs.deterministic
                 && out.same_driver
@@ -457,6 +450,11 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
     let by_bad_pixels = case.max_bad_pixels.is_some() || case.max_bad_ratio.is_some();
     if by_bad_pixels {
         out.notes.push("judged by its bad-pixel budget (max_bad_pixels / max_bad_ratio) instead of PSNR".into());
+    } else if let Some(raw) = obs.outputs.first().filter(|o| o.by_raw).and_then(|o| o.raw_psnr) {
+        // Its raw values (the EXR golden) carry the PSNR verdict (a failure
+        // is the output's problem); the view's other metrics stay.
+        m.psnr = raw;
+        out.psnr_of_raw = true;
     } else if m.psnr < out.psnr_threshold {
         out.problems.push(format!(
             "PSNR {} is below the threshold {:.1} dB",

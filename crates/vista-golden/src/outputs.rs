@@ -1,18 +1,21 @@
-//! A pass graph's outputs against their goldens (SPEC 14): the first
-//! output keeps the case's names (`<case>.png`, raw `<case>.exr`, a buffer
+//! A kernel's outputs against their goldens (SPEC 14): the first output
+//! keeps the case's names (`<case>.png`, raw `<case>.exr`, a buffer
 //! `<case>.npy`), the others add their name (`<case>.<output>.png`, ...).
 //! Textures keep their PNG view (what the report shows) and, beside it, raw
-//! values in EXR where a tolerance or an integer format needs them; buffers
-//! are NumPy files. Each output is judged by its tolerance: exact (the
-//! default for integer formats and buffers), max_abs, max_rel, max_ulp,
-//! rmse or histogram_emd; a float texture without one by the case's PSNR
-//! thresholds on its view.
+//! values in EXR ([`keeps_raw`]); buffers are NumPy files. Each output is
+//! judged by its tolerance: exact (the default for integer formats and
+//! buffers), max_abs, max_rel, max_ulp, rmse or histogram_emd; a float
+//! texture without one by the case's PSNR thresholds on its raw values
+//! (on its view where it keeps no EXR). A one-pass kernel that keeps raw
+//! goldens is treated as a graph of one output ([`outputs_of`]).
 
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 use vista_image::Image;
+use vista_kernels::Kernel;
 use vista_kernels::graph::Tolerance;
-use vista_render::{OutputRender, OutputValue, quantize16};
+use vista_render::{OutputRender, OutputValue, Rendered, quantize16};
 
 use crate::Case;
 
@@ -47,18 +50,45 @@ pub fn effective_tolerance(out: &OutputRender) -> Option<Tolerance> {
     }
 }
 
-/// The golden files of output `index` of `case` under `golden_dir`.
-pub fn output_files(golden_dir: &Path, case: &Case, index: usize, out: &OutputRender) -> OutputFiles {
+/// Whether a texture output of `format` keeps its raw values in an EXR
+/// golden beside its PNG view (SPEC 14): every output of a kernel that
+/// describes its own resources, passes or outputs, and any output in
+/// another format than the seed's. The seed's contract (one rgba32float
+/// image whose display values are the golden, SPEC 3-4: the built-ins and
+/// kernels written like them) keeps its PNG and the manifest's raw hash.
+pub fn keeps_raw(kernel: &Kernel, format: &str) -> bool {
+    kernel.describes_resources() || format != "rgba32float"
+}
+
+/// The name a one-pass kernel's image has as an output.
+pub const MAIN_OUTPUT: &str = "image";
+
+/// A render's outputs as goldens see them: a graph's own, or a one-pass
+/// kernel's image as its one output where it keeps raw goldens; empty for
+/// the seed's contract (judged by its PNG alone).
+pub fn outputs_of<'a>(case: &Case, r: &'a Rendered) -> Cow<'a, [OutputRender]> {
+    match r.outputs.is_empty() && keeps_raw(case.kernel, r.format) {
+        true => Cow::Owned(r.main_output(case.kernel, MAIN_OUTPUT).into_iter().collect()),
+        false => Cow::Borrowed(&r.outputs),
+    }
+}
+
+/// The golden files of output `index` of `case` under `golden_dir`, for
+/// golden `key` (the case's id, or `<id>@<backend>` for a per-backend
+/// golden).
+pub fn output_files(golden_dir: &Path, case: &Case, key: &str, index: usize, out: &OutputRender) -> OutputFiles {
     let stem = match index {
-        0 => case.id.clone(),
-        _ => format!("{}.{}", case.id, out.name),
+        0 => key.to_string(),
+        _ => format!("{key}.{}", out.name),
     };
     let at = |ext: &str| golden_dir.join(case.kernel.name()).join(format!("{stem}.{ext}"));
     match &out.value {
         OutputValue::Buffer { .. } => OutputFiles { npy: Some(at("npy")), ..Default::default() },
-        OutputValue::Texture { .. } => {
-            OutputFiles { png: Some(at("png")), exr: effective_tolerance(out).map(|_| at("exr")), npy: None }
-        }
+        OutputValue::Texture { format, .. } => OutputFiles {
+            png: Some(at("png")),
+            exr: (effective_tolerance(out).is_some() || keeps_raw(case.kernel, format)).then(|| at("exr")),
+            npy: None,
+        },
     }
 }
 
@@ -75,6 +105,11 @@ pub struct OutputVerdict {
     /// Judged by a tolerance (its own, or exact by default): for the main
     /// image, instead of the case's PSNR thresholds.
     pub by_tolerance: bool,
+    /// Judged by the case's PSNR threshold on its raw values (its EXR): for
+    /// the main image, instead of the PSNR of its view.
+    pub by_raw: bool,
+    /// That PSNR (dB), where it was measured.
+    pub raw_psnr: Option<f64>,
     /// Golden files that do not exist.
     pub missing: Vec<PathBuf>,
     /// Golden files that exist but cannot be read.
@@ -90,12 +125,13 @@ pub struct OutputVerdict {
 pub fn compare_output(
     case: &Case,
     golden_dir: &Path,
+    key: &str,
     index: usize,
     out: &OutputRender,
     psnr_threshold: f64,
     blessed: Option<&crate::ManifestEntry>,
 ) -> OutputVerdict {
-    let files = output_files(golden_dir, case, index, out);
+    let files = output_files(golden_dir, case, key, index, out);
     let tolerance = effective_tolerance(out);
     let mut v = OutputVerdict {
         name: out.name.clone(),
@@ -106,10 +142,11 @@ pub fn compare_output(
                 format!("buffer {descr} {shape:?}")
             }
         },
-        judged_by: match (tolerance, index) {
-            (Some(t), _) => t.describe(),
-            (None, 0) => "the case's thresholds (the main image)".into(),
-            (None, _) => format!("PSNR >= {psnr_threshold:.1} dB of its view"),
+        judged_by: match (tolerance, &files.exr, index) {
+            (Some(t), _, _) => t.describe(),
+            (None, Some(_), _) => format!("PSNR >= {psnr_threshold:.1} dB of its raw values"),
+            (None, None, 0) => "the case's thresholds (the main image)".into(),
+            (None, None, _) => format!("PSNR >= {psnr_threshold:.1} dB of its view"),
         },
         by_tolerance: tolerance.is_some(),
         files: files.all().iter().filter_map(|p| p.file_name().map(|n| n.to_string_lossy().to_string())).collect(),
@@ -178,8 +215,8 @@ pub fn compare_output(
                 &locate,
             );
         }
-        OutputValue::Texture { raw, .. } => {
-            if index == 0 && tolerance.is_none() {
+        OutputValue::Texture { raw, format, .. } => {
+            if index == 0 && tolerance.is_none() && files.exr.is_none() {
                 v.summary = format!("output {}: the main image (metrics above)", out.name);
             }
             if let Some(exr) = &files.exr {
@@ -196,28 +233,23 @@ pub fn compare_output(
                             raw.width,
                             raw.height
                         )),
-                        Ok(g) => {
-                            let w = raw.width as usize;
-                            let locate = |i: usize| {
-                                let t = i / 4;
-                                format!("({}, {}).{}", t % w, t / w, ["r", "g", "b", "a"][i % 4])
-                            };
-                            judge_values(
-                                &mut v,
-                                &out.name,
-                                tolerance.expect("an exr goes with a tolerance"),
-                                &flat(&g),
-                                &flat(raw),
-                                true,
-                                &locate,
-                            )
-                        }
+                        Ok(g) => match tolerance {
+                            Some(t) => {
+                                let w = raw.width as usize;
+                                let locate = |i: usize| {
+                                    let t = i / 4;
+                                    format!("({}, {}).{}", t % w, t / w, ["r", "g", "b", "a"][i % 4])
+                                };
+                                judge_values(&mut v, &out.name, t, &flat(&g), &flat(raw), true, &locate)
+                            }
+                            None => judge_raw(&mut v, case, index, format, &g, raw, psnr_threshold),
+                        },
                     },
                 }
             }
             let png = files.png.expect("a texture's png");
-            if index > 0 && tolerance.is_none() {
-                // A float texture without a tolerance: its view by PSNR.
+            if index > 0 && tolerance.is_none() && files.exr.is_none() {
+                // A float texture without a tolerance or raw golden: its view by PSNR.
                 match png.exists() {
                     false => v.missing.push(png),
                     true => match vista_image::read_png16(&png) {
@@ -289,17 +321,18 @@ fn guard_one(i: usize, o: &OutputRender) -> Vec<String> {
     problems
 }
 
-/// The bytes of every golden file of a graph's outputs except the first
-/// output's PNG (the case's main golden, which bless writes itself):
-/// (path, bytes).
+/// The bytes of every golden file of a kernel's outputs (for golden `key`)
+/// except the first output's PNG (the case's main golden, which bless
+/// writes itself): (path, bytes).
 pub fn golden_bytes(
     golden_dir: &Path,
     case: &Case,
+    key: &str,
     outputs: &[OutputRender],
 ) -> Result<Vec<(PathBuf, Vec<u8>)>, vista_image::ImageError> {
     let mut out = Vec::new();
     for (i, o) in outputs.iter().enumerate() {
-        let files = output_files(golden_dir, case, i, o);
+        let files = output_files(golden_dir, case, key, i, o);
         if let (Some(png), true) = (&files.png, i > 0) {
             out.push((
                 png.clone(),
@@ -315,6 +348,95 @@ pub fn golden_bytes(
         }
     }
     Ok(out)
+}
+
+/// Judges a float texture's raw values against its EXR golden by PSNR over
+/// the format's colour channels (peak: the golden's largest value for a
+/// float format, 1 for unorm and snorm; SPEC 5) against the case's
+/// threshold, with max-abs and the worst texel beside it. The main image's
+/// ignore rectangles are left out; a main image with a bad-pixel budget is
+/// judged by that budget on its view, so here it is only measured.
+fn judge_raw(
+    v: &mut OutputVerdict,
+    case: &Case,
+    index: usize,
+    format: &str,
+    golden: &Image,
+    actual: &Image,
+    threshold: f64,
+) {
+    let n = colour_channels(format);
+    let ignored = |x: u32, y: u32| {
+        index == 0 && case.ignore.iter().any(|&[rx, ry, w, h]| x >= rx && x < rx + w && y >= ry && y < ry + h)
+    };
+    let (mut sum, mut count, mut worst) = (0.0f64, 0u64, (0.0f64, 0u32, 0u32, 0usize));
+    let mut peak = f64::NEG_INFINITY;
+    for y in 0..golden.height {
+        for x in 0..golden.width {
+            if ignored(x, y) {
+                continue;
+            }
+            let (g, a) = (golden.get(x, y), actual.get(x, y));
+            for c in 0..n {
+                let (g, a) = (g[c] as f64, a[c] as f64);
+                if g.is_finite() {
+                    peak = peak.max(g);
+                }
+                let d = (a - g).abs();
+                sum += d * d;
+                count += 1;
+                if d > worst.0 || d.is_nan() {
+                    worst = (d, x, y, c);
+                }
+            }
+        }
+    }
+    let peak = match format.ends_with("float") && peak > 0.0 {
+        true => peak,
+        false => 1.0,
+    };
+    let mse = if count == 0 { 0.0 } else { sum / count as f64 };
+    let psnr = if mse == 0.0 { f64::INFINITY } else { 10.0 * (peak * peak / mse).log10() };
+    let shown = vista_image::metrics::format_psnr(psnr);
+    let worst_at = match worst.0 > 0.0 {
+        true => format!(
+            ", worst ({}, {}).{} {} vs golden {}",
+            worst.1,
+            worst.2,
+            ["r", "g", "b"][worst.3],
+            actual.get(worst.1, worst.2)[worst.3],
+            golden.get(worst.1, worst.2)[worst.3]
+        ),
+        false => String::new(),
+    };
+    let budget = index == 0 && (case.max_bad_pixels.is_some() || case.max_bad_ratio.is_some());
+    v.by_raw = !budget;
+    v.raw_psnr = Some(psnr);
+    v.summary = match budget {
+        true => format!(
+            "output {}: raw PSNR {shown} (peak {peak:.4}), max_abs {:.3e}; judged by the bad-pixel budget",
+            v.name, worst.0
+        ),
+        false => format!(
+            "output {}: raw PSNR {shown} (peak {peak:.4}, >= {threshold:.1} dB), max_abs {:.3e}",
+            v.name, worst.0
+        ),
+    };
+    if !budget && psnr < threshold {
+        v.problems.push(format!(
+            "output {}: raw PSNR {shown} (peak {peak:.4}) is below the threshold {threshold:.1} dB; max_abs {:.3e}{worst_at}",
+            v.name, worst.0
+        ));
+    }
+}
+
+/// Colour channels a storage format holds (alpha is left out of PSNR).
+fn colour_channels(format: &str) -> usize {
+    match format {
+        f if f.starts_with("rgba") || f.starts_with("bgra") => 3,
+        f if f.starts_with("rg") => 2,
+        _ => 1,
+    }
 }
 
 fn is_f32(e: &vista_kernels::graph::Element) -> bool {

@@ -1,6 +1,7 @@
 //! Goldens from the CI driver (SPEC 15): `vista check` keeps, in the report,
-//! each failing or missing case's render (`<id>/actual.png`) and the
-//! manifest entry a bless of it would write (`pending.toml`); `vista bless
+//! each failing or missing case's render (`<id>/actual.png`, its other
+//! golden files under `<id>/golden/`) and the manifest entry a bless of it
+//! would write (`pending.toml`); `vista bless
 //! --from-report DIR` accepts exactly those files, after checking that this
 //! checkout's params and WGSL still hash as they did, so a developer on
 //! another machine blesses what CI's driver rendered without re-rendering.
@@ -40,6 +41,12 @@ pub type FileHashes<'a> = &'a dyn Fn(&str) -> Result<BTreeMap<String, String>, S
 /// The rendered PNG of case `id` in a report folder.
 pub fn pending_png(report_dir: &Path, id: &str) -> PathBuf {
     report_dir.join(id).join("actual.png")
+}
+
+/// Where the report keeps a pending render's other golden file `name`
+/// (a raw EXR, another output, a buffer).
+pub fn pending_file(report_dir: &Path, id: &str, name: &str) -> PathBuf {
+    report_dir.join(id).join("golden").join(name)
 }
 
 /// Accepts the report's pending renders (those matching `glob`) as goldens.
@@ -97,38 +104,64 @@ pub fn bless_from_report(
             .iter()
             .find(|c| &c.id == id)
             .ok_or_else(|| stale(id, "it is no longer in golden/cases.toml".into()))?;
-        if case.kernel.graph().is_some() {
-            return Err(GoldenError::BadInput(format!(
-                "case {id}: kernel {} is a pass graph, whose other outputs the report does not keep; bless it by \
-                 rendering: {}",
-                case.kernel.name(),
-                case.bless_command()
-            )));
-        }
         if params_hash(case) != entry.params_hash {
             return Err(stale(id, "its params (preset, set or size) changed since the check".into()));
         }
-        let now = files_now(case.kernel.shader()).map_err(|e| stale(id, e))?;
+        let mut now = BTreeMap::new();
+        for f in case.kernel.shader_files() {
+            now.extend(files_now(f).map_err(|e| stale(id, e))?);
+        }
         let changed = crate::changed_files(&entry.shader_files, &now);
         if !changed.is_empty() {
             return Err(stale(id, format!("WGSL changed since the check: {}", changed.join(", "))));
         }
-        let png = pending_png(report_dir, id);
-        let bytes = std::fs::read(&png)
-            .map_err(|e| GoldenError::Io { path: png.display().to_string(), message: e.to_string() })?;
-        if crate::short_hash_bytes(&bytes) != entry.golden_hash {
-            return Err(stale(id, format!("{} is not the file the check wrote", png.display())));
+        let read_checked = |path: PathBuf, want: &str| -> Result<Vec<u8>, GoldenError> {
+            let bytes = std::fs::read(&path)
+                .map_err(|e| GoldenError::Io { path: path.display().to_string(), message: e.to_string() })?;
+            match crate::short_hash_bytes(&bytes) == want {
+                true => Ok(bytes),
+                false => Err(stale(id, format!("{} is not the file the check wrote", path.display()))),
+            }
+        };
+        // A graph whose first output is a buffer has no main PNG.
+        let png = match entry.golden_hash.is_empty() {
+            true => None,
+            false => Some(read_checked(pending_png(report_dir, id), &entry.golden_hash)?),
+        };
+        let mut others = Vec::new();
+        for (name, hash) in &entry.outputs {
+            // Only the case's own golden files, in its kernel's folder.
+            let own = name.starts_with(&format!("{id}."))
+                && !name.contains(['/', '\\'])
+                && [".png", ".exr", ".npy"].iter().any(|e| name.ends_with(e));
+            if !own {
+                return Err(stale(id, format!("it names {name}, which is not one of the case's golden files")));
+            }
+            let bytes = read_checked(pending_file(report_dir, id, name), hash)?;
+            others.push((store.dir.join(case.kernel.name()).join(name), bytes));
         }
-        accepted.push((case, entry.clone(), bytes));
+        accepted.push((case, entry.clone(), png, others));
     }
     let mut manifest = store.manifest()?;
     let mut rows = Vec::new();
-    for (case, entry, bytes) in accepted {
+    for (case, entry, png, others) in accepted {
         let golden = store.golden_path(case);
         if let Some(parent) = golden.parent() {
             std::fs::create_dir_all(parent)
                 .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
         }
+        // The other files first, each atomic and named in the entry (as
+        // bless writes them).
+        for (path, bytes) in &others {
+            vista_image::atomic_write(path, bytes)?;
+        }
+        let Some(bytes) = png else {
+            manifest.case.insert(case.id.clone(), entry.clone());
+            store.write_manifest(&manifest)?;
+            let path = others.first().map(|(p, _)| p.clone()).unwrap_or(golden);
+            rows.push(BlessRow { id: case.id.clone(), status: "changed", psnr_vs_previous: "-".into(), path });
+            continue;
+        };
         let old = std::fs::read(&golden).ok().map(|b| crate::short_hash_bytes(&b));
         // Two-phase, as bless: the manifest accepts both files, the golden
         // is replaced, then the manifest names only the new one.

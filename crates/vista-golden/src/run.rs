@@ -29,6 +29,10 @@ pub struct Checked {
     /// `golden_hash` is set once the PNG is written): what the report's
     /// `pending.toml` keeps for `vista bless --from-report`.
     pub pending: Option<crate::ManifestEntry>,
+    /// With `pending`, for a failing or missing case: the golden files a
+    /// bless would write besides the main PNG (file name, bytes), which the
+    /// report keeps under `<id>/golden/`.
+    pub pending_files: Vec<(String, Vec<u8>)>,
     /// A pass graph's other texture outputs for the report: (name, display
     /// values as a 16-bit PNG holds them, its golden PNG when readable).
     pub output_images: Vec<(String, Image, Option<Image>)>,
@@ -61,6 +65,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
                 actual: None,
                 expected: None,
                 pending: None,
+                pending_files: Vec::new(),
                 output_images: Vec::new(),
             };
         }
@@ -108,11 +113,10 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
             };
             let same_driver = entry.is_none_or(|e| e.adapter == run.adapter);
             let threshold = if same_driver { case.psnr_same_driver } else { case.psnr_other_driver };
-            let outputs: Vec<crate::outputs::OutputVerdict> = r
-                .outputs
+            let outputs: Vec<crate::outputs::OutputVerdict> = crate::outputs::outputs_of(case, &r)
                 .iter()
                 .enumerate()
-                .map(|(i, o)| crate::outputs::compare_output(case, &store.dir, i, o, threshold, entry))
+                .map(|(i, o)| crate::outputs::compare_output(case, &store.dir, &golden_key, i, o, threshold, entry))
                 .collect();
             let observed = Observed {
                 unwritten: r.unwritten,
@@ -135,9 +139,6 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         out.bless_command = format!("{} --backend {} --per-backend", out.bless_command, ctx.backend());
     }
     let pending = match &gathered {
-        // A pass graph's other outputs are not kept in the report (yet):
-        // bless --from-report does not offer what it could not accept whole.
-        _ if case.kernel.graph().is_some() => None,
         // golden_hash is set once the report has written the PNG.
         Ok((_, files, _, _)) => Some(crate::ManifestEntry::of_render(
             case,
@@ -148,6 +149,26 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
             String::new(),
         )),
         Err(_) => None,
+    };
+    // A failing or missing case's other golden files (raw EXR, other
+    // outputs, buffers), kept in the report with their hashes in the entry,
+    // so bless --from-report accepts the render whole.
+    let (pending, pending_files) = match pending {
+        Some(mut e) if matches!(out.verdict, crate::Verdict::Fail | crate::Verdict::Missing) => {
+            // Accepted as the case's own golden (bless --from-report writes no per-backend one).
+            match crate::outputs::golden_bytes(&store.dir, case, &case.id, &crate::outputs::outputs_of(case, &r)) {
+                Ok(files) => {
+                    let named: Vec<(String, Vec<u8>)> = files
+                        .into_iter()
+                        .map(|(p, b)| (p.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default(), b))
+                        .collect();
+                    e.outputs = named.iter().map(|(n, b)| (n.clone(), crate::short_hash_bytes(b))).collect();
+                    (Some(e), named)
+                }
+                Err(_) => (None, Vec::new()),
+            }
+        }
+        p => (p, Vec::new()),
     };
     let expected = match gathered {
         Ok((_, _, _, Some((_, Ok(image))))) => Some(image),
@@ -160,12 +181,12 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         .skip(1)
         .filter_map(|(i, o)| {
             let shown = quantize16(&o.display()?);
-            let files = crate::outputs::output_files(&store.dir, case, i, o);
+            let files = crate::outputs::output_files(&store.dir, case, &golden_key, i, o);
             let golden = files.png.and_then(|p| vista_image::read_png16(&p).ok());
             Some((o.name.clone(), shown, golden))
         })
         .collect();
-    Checked { outcome: out, actual: has_image.then_some(actual), expected, pending, output_images }
+    Checked { outcome: out, actual: has_image.then_some(actual), expected, pending, pending_files, output_images }
 }
 
 /// Renders a case: its kernel, params, size and replacement inputs.

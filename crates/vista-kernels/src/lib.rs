@@ -514,6 +514,13 @@ impl Kernel {
         self.manifest.graph.as_ref()
     }
 
+    /// Whether the manifest describes its own resources, passes or outputs
+    /// (`[[pass]]`, `[[resource]]`, `[[output]]`: SPEC 14) instead of
+    /// following the seed's contract (SPEC 3-4).
+    pub fn describes_resources(&self) -> bool {
+        self.manifest.describes_resources
+    }
+
     /// The file of graph pass `i` as composed for `p`: its `shader` (else
     /// the manifest's) with the defs of [`Kernel::shader_for`].
     pub fn pass_shader_for(&self, i: usize, p: &ParamSet) -> String {

@@ -174,6 +174,10 @@ pub struct Manifest {
     /// `entry`, `workgroups`, `resources`, `bind` and `output_resource`
     /// are unused (the first pass's entry is kept for messages).
     pub graph: Option<crate::graph::GraphSpec>,
+    /// The manifest has `[[pass]]`, `[[resource]]` or `[[output]]` tables
+    /// (SPEC 14): it describes its own resources instead of following the
+    /// seed's contract.
+    pub describes_resources: bool,
     /// naga_oil shader defs (`defs = { MAX_LIGHTS = 10, FIRST_PASS = true }`),
     /// as `NAME=value` in declaration order.
     pub defs: Vec<String>,
@@ -224,6 +228,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let tables = |k: &str| doc.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
     let (pass_tables, output_tables) = (tables("pass"), tables("output"));
     let is_graph = crate::graph::is_graph(&raw.resources, &pass_tables, &output_tables, raw.deterministic);
+    let describes_resources = !pass_tables.is_empty() || !raw.resources.is_empty() || !output_tables.is_empty();
 
     let view = |v: &str| match v {
         "display" => Ok(Output::Display),
@@ -555,6 +560,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         bind,
         output_resource,
         graph,
+        describes_resources,
         defs,
         overrides,
         work,

@@ -412,12 +412,11 @@ fn judge_case(
         true => b.case.psnr_same_driver,
         false => b.case.psnr_other_driver,
     };
-    // Any output's verdict kills a mutant of a pass graph.
-    let outputs: Vec<vista_golden::outputs::OutputVerdict> = r
-        .outputs
+    // Any output's verdict kills a mutant (a graph's, or a raw golden's).
+    let outputs: Vec<vista_golden::outputs::OutputVerdict> = vista_golden::outputs::outputs_of(b.case, r)
         .iter()
         .enumerate()
-        .map(|(i, o)| vista_golden::outputs::compare_output(b.case, &b.golden_dir, i, o, threshold, entry))
+        .map(|(i, o)| vista_golden::outputs::compare_output(b.case, &b.golden_dir, &b.case.id, i, o, threshold, entry))
         .collect();
     let observed = Observed {
         raw: &r.raw,

@@ -105,6 +105,24 @@ impl Rendered {
     pub fn display(&self) -> &Image {
         self.display.get_or_init(|| self.to_display.apply(&self.raw)).as_ref().unwrap_or(&self.raw)
     }
+
+    /// A one-pass render's image as an output named `name` (what a graph's
+    /// first output would be), so goldens treat both paths alike; `None`
+    /// when there is no image.
+    pub fn main_output(&self, kernel: &Kernel, name: &str) -> Option<OutputRender> {
+        (self.raw.width > 0).then(|| OutputRender {
+            name: name.to_string(),
+            tolerance: None,
+            partial: kernel.partial(),
+            value: OutputValue::Texture {
+                raw: self.raw.clone(),
+                format: self.format,
+                view: kernel.view(self.format),
+                unwritten: self.unwritten,
+                display: self.to_display,
+            },
+        })
+    }
 }
 
 /// Checks size and work bounds before any GPU work.

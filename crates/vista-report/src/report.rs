@@ -42,7 +42,24 @@ pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
 /// A checked case with its images written into `dir`: the outcome with
 /// `files` filled in (a failure to write them makes the case an error).
 pub fn file_case(dir: &Path, checked: vista_golden::Checked) -> Outcome {
-    let vista_golden::Checked { mut outcome, actual, expected, output_images, .. } = checked;
+    let vista_golden::Checked { mut outcome, actual, expected, output_images, pending_files, .. } = checked;
+    // What bless --from-report accepts besides the main PNG.
+    let kept = (|| -> Result<(), GoldenError> {
+        for (name, bytes) in &pending_files {
+            let path = vista_golden::pending::pending_file(dir, &outcome.id, name);
+            case_folder(dir, &outcome.id)?;
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent)
+                    .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+            }
+            vista_image::atomic_write(&path, bytes)?;
+        }
+        Ok(())
+    })();
+    if let Err(e) = kept {
+        outcome.verdict = Verdict::Error;
+        outcome.problems.push(e.to_string());
+    }
     if let Some(actual) = &actual
         && let Err(e) = write_case_files(dir, &mut outcome, actual, expected.as_ref())
     {
@@ -334,12 +351,13 @@ fn metric_cells(o: &Outcome) -> (String, String) {
             let flip_bad = m.flip_mean.zip(o.max_flip).is_some_and(|(f, t)| f > t);
             let cls = |bad: bool| if bad { " class=\"bad\"" } else { "" };
             let table = format!(
-                "<table class=\"metrics\"><tr><th>PSNR</th><td{}>{}</td><td>&ge; {:.1} dB ({} driver)</td></tr>\
+                "<table class=\"metrics\"><tr><th>PSNR{}</th><td{}>{}</td><td>&ge; {:.1} dB ({} driver)</td></tr>\
                  <tr><th>SSIM</th><td{}>{:.5}</td><td>{}</td></tr>\
                  <tr><th>FLIP mean</th><td{}>{}</td><td>{}</td></tr>\
                  <tr><th>max abs</th><td>{:.3e}</td><td></td></tr>\
                  <tr><th>bad pixels</th><td>{} ({:.3}%)</td><td>a channel differs by &gt; {BAD_PIXEL_LIMIT}</td></tr>\
                  <tr><th>NaN/Inf</th><td{}>{}</td><td>none allowed</td></tr></table>",
+                if o.psnr_of_raw { " (raw values)" } else { "" },
                 cls(psnr_bad),
                 format_psnr(m.psnr),
                 o.psnr_threshold,
