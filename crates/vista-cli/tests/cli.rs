@@ -1778,6 +1778,81 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     assert_rejected(&stale, 2, &["case sky", "is stale", "sky.exr is not the file the check wrote"]);
 }
 
+/// A `dimension = "cube"` resource: six square layers written through a
+/// 2d-array storage view, then sampled through a `texture_cube` view. Each
+/// axis direction finds its face (WebGPU's order +X, -X, +Y, -Y, +Z, -Z)
+/// and an off-axis one the right place in it, on every backend.
+fn cube_textures_are_written_as_layers_and_sampled_as_cubes() {
+    let manifest = r#"summary = "a cube written face by face, then sampled along its axes"
+[[resource]]
+name = "env"
+kind = "texture"
+format = "rgba16float"
+dimension = "cube"
+size = [16]
+[[resource]]
+name = "nearest"
+kind = "sampler"
+filter = "nearest"
+[[resource]]
+name = "probe"
+kind = "texture"
+format = "rgba16float"
+size = [8, 1]
+[[pass]]
+entry = "bake"
+bind = { faces = "env" }
+[[pass]]
+entry = "look"
+bind = { env_cube = "env", probe_out = "probe", nearest = "nearest" }
+[[output]]
+resource = "probe"
+"#;
+    let shader = "@group(0) @binding(0) var faces: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(1) var env_cube: texture_cube<f32>;
+@group(0) @binding(2) var nearest: sampler;
+@group(1) @binding(0) var probe_out: texture_storage_2d<rgba16float, write>;
+
+@compute @workgroup_size(8, 8, 1)
+fn bake(@builtin(global_invocation_id) id: vec3<u32>) {
+    let d = textureDimensions(faces);
+    if any(id.xy >= d) || id.z >= textureNumLayers(faces) { return; }
+    let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(d);
+    textureStore(faces, id.xy, id.z, vec4(f32(id.z + 1u) / 8.0, uv.x, uv.y, 1.0));
+}
+
+@compute @workgroup_size(8, 1, 1)
+fn look(@builtin(global_invocation_id) id: vec3<u32>) {
+    var dirs = array<vec3<f32>, 8>(vec3(1.0, 0.0, 0.0), vec3(-1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0),
+        vec3(0.0, -1.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0), vec3(0.5, 0.0, 1.0), vec3(0.0, 0.5, 1.0));
+    if id.x >= 8u { return; }
+    textureStore(probe_out, vec2(id.x, 0u), textureSampleLevel(env_cube, nearest, dirs[id.x], 0.0));
+}
+";
+    let d = kernel_project(manifest, shader);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("probe-{backend}.exr"));
+        let r = vista_in(
+            Some(d.path()),
+            &[],
+            &["render", "k", "--size", "16x16", "--backend", backend, "-o", out.to_str().unwrap()],
+        );
+        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
+        let probe = vista_image::load(&out).unwrap();
+        let faces: Vec<f32> = (0..6).map(|x| probe.get(x, 0)[0] * 8.0 - 1.0).collect();
+        assert_eq!(faces, [0.0, 1.0, 2.0, 3.0, 4.0, 5.0], "{backend}: the face each axis finds");
+        // +Z: u grows with x, v with -y (WebGPU's cube coordinates).
+        let (right, up) = (probe.get(6, 0), probe.get(7, 0));
+        assert_eq!((right[0], up[0]), (5.0 / 8.0, 5.0 / 8.0), "{backend}: both on +Z");
+        assert!((right[1] - 0.75).abs() <= 1.0 / 16.0, "{backend}: u at (0.5, 0, 1) is {}", right[1]);
+        assert!((up[2] - 0.25).abs() <= 1.0 / 16.0, "{backend}: v at (0, 0.5, 1) is {}", up[2]);
+    }
+    // A cube's faces are square.
+    std::fs::write(d.path().join("kernels/k.toml"), manifest.replace("size = [16]\n", "")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "16x8", "-o", "x.exr"]);
+    assert_rejected(&r, 2, &["resource env", "a cube's faces are square but the case is 16x8", "size = [N]"]);
+}
+
 /// One process runs a read_write kernel, then a write-only kernel of the same
 /// size and format that leaves a row unwritten: the second must still be
 /// caught (the read_write run's zero-filled output must not stand in for
@@ -3529,6 +3604,11 @@ fn main() {
             a_read_write_run_does_not_hide_the_next_runs_unwritten_texels,
         ),
         (Gpu, "float_outputs_keep_raw_values_beside_their_view", float_outputs_keep_raw_values_beside_their_view),
+        (
+            Gpu,
+            "cube_textures_are_written_as_layers_and_sampled_as_cubes",
+            cube_textures_are_written_as_layers_and_sampled_as_cubes,
+        ),
         (Gpu, "per_backend_goldens_cover_every_output_of_a_graph", per_backend_goldens_cover_every_output_of_a_graph),
         (
             Gpu,

@@ -126,8 +126,8 @@ pub enum Bind {
     /// A texture resource bound as a storage texture.
     StorageTexture { resource: usize, access: Access },
     /// A texture resource bound for sampling or loads; `depth` for
-    /// `texture_depth_2d`.
-    Sampled { resource: usize, depth: bool },
+    /// `texture_depth_2d`, `cube` for `texture_cube` over six layers.
+    Sampled { resource: usize, depth: bool, cube: bool },
     /// A sampler resource.
     Sampler(usize),
 }
@@ -285,8 +285,12 @@ impl Context {
                     .map(|s| match s.bind {
                         Bind::StorageTexture { resource, .. } | Bind::Sampled { resource, .. } => {
                             let Resource::Texture(t) = &g.resources[resource] else { return None };
+                            let cube = matches!(s.bind, Bind::Sampled { cube: true, .. });
                             Some(made.textures[&current[resource]].create_view(&wgpu::TextureViewDescriptor {
-                                dimension: Some(t.dimension.view()),
+                                dimension: Some(match cube {
+                                    true => wgpu::TextureViewDimension::Cube,
+                                    false => t.dimension.view(),
+                                }),
                                 ..Default::default()
                             }))
                         }
@@ -452,7 +456,7 @@ impl Context {
                             json!({ "resource": resource }),
                         )
                     }
-                    Bind::Sampled { resource, depth } => {
+                    Bind::Sampled { resource, depth, cube } => {
                         let t = texture(*resource)?;
                         let format = OutputFormat::parse(t.format)?;
                         let sample = match (depth, format.sample_kind()) {
@@ -463,7 +467,10 @@ impl Context {
                             (_, SampleKind::Float) => "float",
                         };
                         (
-                            json!({ "texture": { "sampleType": sample, "viewDimension": t.dimension.web_names().1 } }),
+                            json!({ "texture": { "sampleType": sample, "viewDimension": match cube {
+                                true => "cube",
+                                false => t.dimension.web_names().1,
+                            } } }),
                             json!({ "resource": resource }),
                         )
                     }
@@ -673,7 +680,7 @@ impl Context {
                         view_dimension: t.dimension.view(),
                     }
                 }
-                Bind::Sampled { resource, depth } => {
+                Bind::Sampled { resource, depth, cube } => {
                     let Resource::Texture(t) = &g.resources[resource] else {
                         return Err(GpuError::Request(format!("{}: a texture bound to a non-texture", pass.label)));
                     };
@@ -687,7 +694,10 @@ impl Context {
                                 wgpu::TextureSampleType::Float { filterable: !format.is_float32() || filterable32 }
                             }
                         },
-                        view_dimension: t.dimension.view(),
+                        view_dimension: match cube {
+                            true => wgpu::TextureViewDimension::Cube,
+                            false => t.dimension.view(),
+                        },
                         multisampled: false,
                     }
                 }

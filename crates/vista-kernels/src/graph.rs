@@ -848,6 +848,8 @@ pub fn resolve(
                     }
                     let dim = storage_dim(storage.dimension);
                     match r.dimension {
+                        // A cube's six faces are written through a 2d-array view.
+                        Some(SampledDim::Cube) if dim == SampledDim::D2Array => {}
                         Some(d) if d != dim => {
                             return Err(bad(format!(
                                 "{label}: resource {} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
@@ -880,6 +882,8 @@ pub fn resolve(
                     needs(&resources, ri, "texture")?;
                     let r = &mut resources[ri];
                     match r.dimension {
+                        // Six layers sampled as a cube, or a cube read as its 2d-array of faces.
+                        Some(SampledDim::Cube) if dim == SampledDim::D2Array => {}
                         Some(d) if d != dim && !(d == SampledDim::D2Array && dim == SampledDim::Cube) => {
                             return Err(bad(format!(
                                 "{label}: resource {rn} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",

@@ -132,10 +132,10 @@ pub fn plan_graph(
                     SampledDim::D2 => vista_gpu::Dimension::D2,
                     SampledDim::D2Array => vista_gpu::Dimension::D2Array,
                     SampledDim::D3 => vista_gpu::Dimension::D3,
-                    SampledDim::Cube => {
-                        return Err(at("cube textures are not supported yet; use a 2d-array of 6 layers".into()));
-                    }
+                    // Six square layers: written through a 2d-array view, sampled through a cube view.
+                    SampledDim::Cube => vista_gpu::Dimension::D2Array,
                 };
+                let cube = dim == SampledDim::Cube;
                 let mut extent = match size {
                     Some(exprs) => {
                         let mut v = [1u32; 3];
@@ -146,7 +146,8 @@ pub fn plan_graph(
                                 .filter(|n| (1..=16384).contains(n))
                                 .ok_or_else(|| at(format!("size[{i}] is {n} for these params; allowed: [1, 16384]")))?;
                         }
-                        Some(v)
+                        // A cube's size is its face's edge.
+                        Some(if cube { [v[0], v[0], 6] } else { v })
                     }
                     None => None,
                 };
@@ -171,6 +172,15 @@ pub fn plan_graph(
                                 }
                             )));
                         }
+                        if cube && extent.is_none() {
+                            if image.height != 6 * image.width {
+                                return Err(at(format!(
+                                    "file {f} is {}x{}; a cube's six square faces stack to W x 6W (or give size = [W])",
+                                    image.width, image.height
+                                )));
+                            }
+                            extent = Some([image.width, image.width, 6]);
+                        }
                         extent.get_or_insert([image.width, image.height, 1]);
                         if let Some((x, y)) = image.first_nonfinite() {
                             return Err(at(format!("file {f} holds NaN/Inf at ({x}, {y}); inputs must be finite")));
@@ -188,10 +198,17 @@ pub fn plan_graph(
                         (format, contents)
                     }
                 };
-                let [w, h, l] = extent.unwrap_or(match dim {
-                    SampledDim::D1 => [width, 1, 1],
-                    _ => [width, height, 1],
-                });
+                let [w, h, l] = match (extent, dim) {
+                    (Some(e), _) => e,
+                    (None, SampledDim::D1) => [width, 1, 1],
+                    (None, SampledDim::Cube) if width == height => [width, width, 6],
+                    (None, SampledDim::Cube) => {
+                        return Err(at(format!(
+                            "a cube's faces are square but the case is {width}x{height}; give size = [N]"
+                        )));
+                    }
+                    (None, _) => [width, height, 1],
+                };
                 vista_gpu::Resource::Texture(vista_gpu::TextureDesc {
                     format,
                     dimension,
@@ -284,9 +301,11 @@ pub fn plan_graph(
                             vista_kernels::resources::Access::ReadWrite => vista_gpu::Access::ReadWrite,
                         },
                     },
-                    Usage::Sampled { kind, .. } => {
-                        Bind::Sampled { resource: *r, depth: *kind == vista_kernels::graph::SampledKind::Depth }
-                    }
+                    Usage::Sampled { kind, dim } => Bind::Sampled {
+                        resource: *r,
+                        depth: *kind == vista_kernels::graph::SampledKind::Depth,
+                        cube: *dim == SampledDim::Cube,
+                    },
                     Usage::Sampler { .. } => Bind::Sampler(*r),
                 },
             };
