@@ -277,16 +277,26 @@ pub fn plan(
     kernels.sort_by_key(|k| k.name());
     let mut all = Vec::new();
     for k in kernels {
-        let closure: Vec<&SourceFile> = shaders
-            .import_closure(k.shader())?
-            .iter()
-            .map(|rel| files.iter().find(|f| &f.rel == rel).expect("the closure names files of the set"))
-            .collect();
+        // Every file any pass reaches, and every pass's entry point as a root.
+        let mut closure: Vec<&SourceFile> = Vec::new();
+        for shader in k.shader_files() {
+            for rel in shaders.import_closure(shader)? {
+                let f = files.iter().find(|f| f.rel == rel).expect("the closure names files of the set");
+                if !closure.iter().any(|c| c.rel == f.rel) {
+                    closure.push(f);
+                }
+            }
+        }
+        let roots: Vec<(&str, &str)> = match k.graph() {
+            Some(g) => g.passes.iter().map(|p| (p.shader.as_deref().unwrap_or(k.shader()), p.entry.as_str())).collect(),
+            None => vec![(k.shader(), k.entry())],
+        };
         let fns: Vec<(&str, mutants::Function)> = closure
             .iter()
             .flat_map(|f| mutants::functions(&f.text).into_iter().map(move |g| (f.rel.as_str(), g)))
             .collect();
-        let mut reached: Vec<bool> = fns.iter().map(|(rel, g)| *rel == k.shader() && g.name == k.entry()).collect();
+        let mut reached: Vec<bool> =
+            fns.iter().map(|(rel, g)| roots.iter().any(|(file, entry)| rel == file && g.name == *entry)).collect();
         let mut work: Vec<String> =
             fns.iter().zip(&reached).filter(|(_, r)| **r).flat_map(|((_, g), _)| g.calls.clone()).collect();
         while let Some(name) = work.pop() {
