@@ -193,7 +193,7 @@ function vistaChunk(offset, length) {
 }
 
 // A pass graph (SPEC 14): job = { resources: [texture | buffer | sampler], passes: [{ key, wgsl, entry,
-// workgroups, repeat, swap: [[a, b]], slots: [{ group, binding, layout, owned (base64) | resource }] }],
+// workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding, layout, owned (base64) | resource }] }],
 // outputs: [resource index] }. A texture: { kind, format, dimension, width, height, layers, texel_bytes,
 // contents (base64 or null: zeros) }; a buffer: { kind, contents (base64) }; a sampler: { kind, filter,
 // address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
@@ -287,11 +287,19 @@ async function vistaRunGraph(job) {
     if (setup) throw new Error(`WebGPU validation (resources): ${setup.message}`);
     if (setupOom) throw new Error(`WebGPU out of memory (resources): ${setupOom.message}`);
     await d.queue.onSubmittedWorkDone();
-    const passMs = [];
-    for (let p = 0; p < job.passes.length; p++) {
+    // Each group (a pass with span n and the n - 1 after it) runs `repeat`
+    // times over; a pass alone (span 1) `repeat` times in a row.
+    const order = [];
+    for (let first = 0; first < job.passes.length; ) {
+      const span = Math.min(Math.max(1, job.passes[first].span), job.passes.length - first);
+      for (let run = 0; run < job.passes[first].repeat; run++) for (let p = first; p < first + span; p++) order.push(p);
+      first += span;
+    }
+    const passMs = job.passes.map(() => 0);
+    for (const p of order) {
       const pass = job.passes[p];
       const passStart = performance.now();
-      for (let run = 0; run < pass.repeat; run++) {
+      {
         d.pushErrorScope("validation");
         const resource = (s, i) => {
           if (owned[p][i]) return { buffer: owned[p][i] };
@@ -319,7 +327,7 @@ async function vistaRunGraph(job) {
         await d.queue.onSubmittedWorkDone();
         for (const [a, b] of pass.swap) [current[a], current[b]] = [current[b], current[a]];
       }
-      passMs.push(performance.now() - passStart);
+      passMs[p] += performance.now() - passStart;
     }
     const copyStart = performance.now();
     const parts = [];

@@ -1853,6 +1853,93 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_rejected(&r, 2, &["resource env", "a cube's faces are square but the case is 16x8", "size = [N]"]);
 }
 
+/// Passes of one `group` repeat together: a counter pass and a pass that
+/// appends the counter's digit run in turn, so 3 steps give 123 (one pass
+/// repeated after the other would give 333), on every backend; a group
+/// split by another pass, or a repeat on its later pass, is refused.
+fn a_group_of_passes_repeats_as_one_step() {
+    let manifest = r#"summary = "two passes repeated as one step"
+[[resource]]
+name = "x_a"
+kind = "texture"
+format = "r32float"
+[[resource]]
+name = "x_b"
+kind = "texture"
+format = "r32float"
+[[resource]]
+name = "y_a"
+kind = "texture"
+format = "r32float"
+[[resource]]
+name = "y_b"
+kind = "texture"
+format = "r32float"
+[[pass]]
+entry = "count"
+group = "step"
+bind = { x_in = "x_a", x_out = "x_b" }
+repeat = "steps"
+swap = [["x_a", "x_b"]]
+[[pass]]
+entry = "append"
+group = "step"
+bind = { x_in = "x_a", y_in = "y_a", y_out = "y_b" }
+swap = [["y_a", "y_b"]]
+[[output]]
+resource = "y_a"
+[[param]]
+name = "steps"
+type = "u32"
+range = [1, 6]
+default = 3
+"#;
+    let shader = "@group(0) @binding(0) var x_in: texture_storage_2d<r32float, read>;
+@group(0) @binding(1) var x_out: texture_storage_2d<r32float, write>;
+@group(0) @binding(2) var y_in: texture_storage_2d<r32float, read>;
+@group(0) @binding(3) var y_out: texture_storage_2d<r32float, write>;
+
+@compute @workgroup_size(4, 4)
+fn count(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(x_out)) { return; }
+    textureStore(x_out, id.xy, vec4(textureLoad(x_in, id.xy).x + 1.0, 0.0, 0.0, 1.0));
+}
+
+@compute @workgroup_size(4, 4)
+fn append(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(y_out)) { return; }
+    textureStore(y_out, id.xy, vec4(textureLoad(y_in, id.xy).x * 10.0 + textureLoad(x_in, id.xy).x, 0.0, 0.0, 1.0));
+}
+";
+    let d = kernel_project(manifest, shader);
+    let render = |backend: &str, set: &str| {
+        let out = d.path().join(format!("y-{backend}.exr"));
+        let r = vista_in(
+            Some(d.path()),
+            &[],
+            &["render", "k", "--size", "5x3", "--backend", backend, "--set", set, "-o", out.to_str().unwrap()],
+        );
+        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
+        vista_image::load(&out).unwrap().get(4, 2)[0]
+    };
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        assert_eq!(render(backend, "steps=3"), 123.0, "{backend}");
+    }
+    assert_eq!(render("lavapipe", "steps=5"), 12345.0);
+    let refused = |m: &str, words: &[&str]| {
+        std::fs::write(d.path().join("kernels/k.toml"), m).unwrap();
+        let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "5x3", "-o", "y.exr"]);
+        assert_rejected(&r, 2, words);
+    };
+    let later_repeat = manifest.replace("bind = { x_in = \"x_a\", y_in", "repeat = 2\nbind = { x_in = \"x_a\", y_in");
+    refused(&later_repeat, &["[[pass]] 2", "repeat goes on the first pass of group \"step\" (pass 1)"]);
+    let split = manifest.replace(
+        "[[pass]]\nentry = \"append\"",
+        "[[pass]]\nentry = \"count\"\nbind = { x_in = \"x_a\", x_out = \"x_b\" }\n[[pass]]\nentry = \"append\"",
+    );
+    refused(&split, &["[[pass]] 3", "group \"step\" must be consecutive passes; pass 1 starts it"]);
+}
+
 /// One process runs a read_write kernel, then a write-only kernel of the same
 /// size and format that leaves a row unwritten: the second must still be
 /// caught (the read_write run's zero-filled output must not stand in for
@@ -2878,6 +2965,14 @@ fn the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu() {
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(root.join("m.json")).unwrap()).unwrap();
     assert!(report["kernels"]["scan"]["killed"].as_u64().unwrap() > 0, "{report}");
+    // Mutants come from every pass's entry point and file, not the first's.
+    let mutate = run(&["mutate", "--kernel", "erosion", "--sample", "12", "--json", "e.json"]);
+    assert_eq!(mutate.code, 0, "{}", mutate.stderr);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root.join("e.json")).unwrap()).unwrap();
+    let files: std::collections::BTreeSet<&str> =
+        report["mutants"].as_array().unwrap().iter().filter_map(|m| m["file"].as_str()).collect();
+    assert!(files.contains("erosion/seed.wgsl") && files.contains("erosion/pipes.wgsl"), "{files:?}");
     let sweep = run(&[
         "sweep", "blur", "--param", "radius", "--values", "1,2,4", "--size", "64x64", "--runs", "1", "--out", "sw",
     ]);
@@ -3609,6 +3704,7 @@ fn main() {
             "cube_textures_are_written_as_layers_and_sampled_as_cubes",
             cube_textures_are_written_as_layers_and_sampled_as_cubes,
         ),
+        (Gpu, "a_group_of_passes_repeats_as_one_step", a_group_of_passes_repeats_as_one_step),
         (Gpu, "per_backend_goldens_cover_every_output_of_a_graph", per_backend_goldens_cover_every_output_of_a_graph),
         (
             Gpu,

@@ -154,8 +154,11 @@ pub struct GraphSlot {
     pub bind: Bind,
 }
 
-/// One pass: a dispatch of an entry point, run `repeat` times; after every
-/// run the `swap` pairs exchange which resource each name binds.
+/// One pass: a dispatch of an entry point; after every run the `swap`
+/// pairs exchange which resource each name binds. A pass with `span` n
+/// runs itself and the n - 1 passes after it, in order, `repeat` times (a
+/// group; its later passes have span 0 and are run by it); span 1 is a
+/// pass alone.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GraphPass {
     /// Names the pass in errors and timings (e.g. `flux (pass 2)`).
@@ -168,6 +171,7 @@ pub struct GraphPass {
     pub slots: Vec<GraphSlot>,
     pub repeat: u32,
     pub swap: Vec<(usize, usize)>,
+    pub span: u32,
 }
 
 /// A whole graph.
@@ -179,6 +183,21 @@ pub struct Graph<'a> {
     /// Resources read back after the last pass (after its swaps: a swapped
     /// name reads the resource it binds then).
     pub outputs: Vec<usize>,
+}
+
+/// The order passes run in: each group (a pass with span n and the n - 1
+/// after it) `repeat` times over, a pass alone `repeat` times in a row.
+pub fn run_order(passes: &[GraphPass]) -> Vec<usize> {
+    let mut order = Vec::new();
+    let mut i = 0;
+    while i < passes.len() {
+        let span = (passes[i].span.max(1) as usize).min(passes.len() - i);
+        for _ in 0..passes[i].repeat {
+            order.extend(i..i + span);
+        }
+        i += span;
+    }
+    order
 }
 
 /// One output as read back.
@@ -256,11 +275,11 @@ impl Context {
         }
         // Which physical resource each name binds now (swaps exchange them).
         let mut current: Vec<usize> = (0..g.resources.len()).collect();
-        let mut pass_times = Vec::new();
+        let mut pass_times = vec![Duration::ZERO; g.passes.len()];
         let _serial = self.submit_lock.lock().expect("submit lock");
-        for (pass, compiled) in g.passes.iter().zip(&pipelines) {
+        for (pi, pass, compiled) in run_order(&g.passes).into_iter().map(|i| (i, &g.passes[i], &pipelines[i])) {
             let pass_start = Instant::now();
-            for _ in 0..pass.repeat {
+            {
                 let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
                 let owned: Vec<Option<wgpu::Buffer>> = pass
                     .slots
@@ -341,7 +360,7 @@ impl Context {
                     current.swap(a, b);
                 }
             }
-            pass_times.push(pass_start.elapsed());
+            pass_times[pi] += pass_start.elapsed();
         }
         let kernel: Duration = pass_times.iter().sum();
         let copy_start = Instant::now();
@@ -492,7 +511,7 @@ impl Context {
             }
             passes.push(json!({
                 "key": key, "label": pass.label, "wgsl": *wgsl, "entry": pass.entry,
-                "workgroups": pass.workgroups, "repeat": pass.repeat,
+                "workgroups": pass.workgroups, "repeat": pass.repeat, "span": pass.span,
                 "swap": pass.swap.iter().map(|(a, b)| [a, b]).collect::<Vec<_>>(),
                 "slots": slots,
             }));

@@ -105,6 +105,22 @@ pub struct PassSpec {
     pub repeat: Repeat,
     /// Resource pairs exchanged after every run of the pass.
     pub swap: Vec<(String, String)>,
+    /// Consecutive passes with one `group` run together, in order, the
+    /// group's `repeat` times (given on its first pass).
+    pub group: Option<String>,
+}
+
+impl GraphSpec {
+    /// How many passes, pass `i` first, run together (its group's length
+    /// when `i` starts a group, 1 for a pass alone); 0 for a later pass of
+    /// a group, which its first pass runs.
+    pub fn span(&self, i: usize) -> usize {
+        let Some(g) = self.passes[i].group.as_deref() else { return 1 };
+        if i > 0 && self.passes[i - 1].group.as_deref() == Some(g) {
+            return 0;
+        }
+        self.passes[i..].iter().take_while(|p| p.group.as_deref() == Some(g)).count()
+    }
 }
 
 /// How an output is compared with its golden.
@@ -162,7 +178,8 @@ pub struct GraphSpec {
 pub const RESOURCE_KEYS: [&str; 12] =
     ["name", "kind", "format", "dimension", "size", "file", "data", "fill", "length", "filter", "address", "compare"];
 /// The keys of a `[[pass]]` table.
-pub const PASS_KEYS: [&str; 8] = ["entry", "shader", "bind", "dispatch", "workgroups", "set", "repeat", "swap"];
+pub const PASS_KEYS: [&str; 9] =
+    ["entry", "shader", "bind", "dispatch", "workgroups", "set", "repeat", "swap", "group"];
 /// The keys of an `[[output]]` table.
 pub const OUTPUT_KEYS: [&str; 4] = ["resource", "view", "partial", "tolerance"];
 
@@ -184,7 +201,7 @@ pub(crate) fn is_graph(
                 || r.get("kind").and_then(|k| k.as_str()).is_some_and(|k| k != "texture")
                 || r.get("dimension").and_then(|k| k.as_str()) == Some("cube")
         })
-        || passes.iter().any(|p| has(p, &["shader", "dispatch", "set", "repeat", "swap"]))
+        || passes.iter().any(|p| has(p, &["shader", "dispatch", "set", "repeat", "swap", "group"]))
         || outputs.iter().any(|o| has(o, &["tolerance"]))
 }
 
@@ -497,7 +514,29 @@ pub(crate) fn parse(
             }
             Some(other) => return Err(at(format!("swap = {other} is not valid; expected [[\"a\", \"b\"], ..]"))),
         }
-        out_passes.push(PassSpec { entry, shader, bind, dispatch, workgroups, set, repeat, swap });
+        let group = text("group")?;
+        if let Some(g) = &group {
+            if !valid_name(g) {
+                return Err(at(format!("group = \"{g}\" must use only letters, digits, '-' and '_'")));
+            }
+            let first = out_passes.iter().position(|q: &PassSpec| q.group.as_deref() == Some(g));
+            match first {
+                Some(f) if out_passes.last().and_then(|q| q.group.as_deref()) != Some(g.as_str()) => {
+                    return Err(at(format!(
+                        "group \"{g}\" must be consecutive passes; pass {} starts it and another pass comes between",
+                        f + 1
+                    )));
+                }
+                Some(f) if repeat != Repeat::Count(1) => {
+                    return Err(at(format!(
+                        "repeat goes on the first pass of group \"{g}\" (pass {}), which repeats the whole group",
+                        f + 1
+                    )));
+                }
+                _ => {}
+            }
+        }
+        out_passes.push(PassSpec { entry, shader, bind, dispatch, workgroups, set, repeat, swap, group });
     }
     let mut outs = Vec::new();
     for t in outputs {

@@ -101,6 +101,7 @@ struct RawPass {
     set: Option<toml::Value>,
     repeat: Option<toml::Value>,
     swap: Option<toml::Value>,
+    group: Option<toml::Value>,
 }
 
 /// An `[[output]]` table.

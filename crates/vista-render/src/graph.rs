@@ -380,6 +380,7 @@ pub fn plan_graph(
             slots: gslots,
             repeat,
             swap,
+            span: g.span(i) as u32,
         });
     }
     let mut outputs = Vec::new();

@@ -2,14 +2,11 @@
 // edge neighbours), after Mei, Decaudin and Hu 2007, "Fast Hydraulic
 // Erosion Simulation and Visualization on GPU".
 //
-// One dispatch is one whole time step, so that a single pass can be
-// repeated: rain, outflow through the pipes, the water update, velocity,
-// sediment transport, erosion or deposition, evaporation. The paper runs
-// the outflow and the water update as separate passes; here the water
-// update of a cell needs the *new* outflow of its four neighbours, and
-// each of those needs its own neighbours' surfaces, so every invocation
-// recomputes the outflow of its 4-neighbourhood (five evaluations) and
-// stores its own cell's for the next step. Suspended sediment moves
+// A time step is two passes, run together as one repeated group: the
+// outflow pass (rain, then each cell's outflow through its pipes from the
+// last step's) and the update pass (the water that arrives and leaves,
+// velocity, sediment transport, erosion or deposition, evaporation), which
+// reads the outflow the first pass wrote. Suspended sediment moves
 // through the pipes with the water (a conservative upwind scheme) rather
 // than by the paper's semi-Lagrangian back-trace.
 //
@@ -17,8 +14,9 @@
 // the next step's); the fluid texel holds x water depth d, y suspended
 // sediment s, zw the flow velocity; the flux texel holds the outflow
 // towards -x, +x, -y, +y (left, right, top, bottom), volume per unit
-// time. Fluid and flux are read as sampled textures with textureLoad.
-// Lengths in cells of `cell_size`.
+// time. Fluid and flux are read as sampled textures with textureLoad: in
+// the outflow pass flux_in is the last step's outflow, in the update pass
+// (after the swap) this step's. Lengths in cells of `cell_size`.
 
 struct PipeModel {
     gravity: f32,
@@ -76,9 +74,10 @@ fn surface(p: vec2<i32>) -> f32 {
 }
 
 // This step's outflow from cell p (inside the grid) towards its left,
-// right, top and bottom neighbours. Each pipe accelerates with the
-// surface difference; no pipe leaves the grid; the total is scaled down
-// so that a cell never ships more water than it holds.
+// right, top and bottom neighbours, from the last step's (flux_in in the
+// outflow pass). Each pipe accelerates with the surface difference; no
+// pipe leaves the grid; the total is scaled down so that a cell never
+// ships more water than it holds.
 fn outflow(p: vec2<i32>) -> vec4<f32> {
     let n = grid();
     let here = state_at(p);
@@ -113,7 +112,23 @@ fn leaving(p: vec2<i32>, f: f32) -> f32 {
 }
 
 @compute @workgroup_size(8, 8)
-fn simulate_step(@builtin(global_invocation_id) id: vec3<u32>) {
+fn outflow_step(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = grid();
+    let p = vec2<i32>(id.xy);
+    if (p.x >= n.x || p.y >= n.y) {
+        return;
+    }
+    textureStore(flux_out, id.xy, outflow(p));
+}
+
+// This step's outflow of cell p, as the outflow pass wrote it (flux_in in
+// the update pass).
+fn shipped_by(p: vec2<i32>) -> vec4<f32> {
+    return textureLoad(flux_in, p, 0);
+}
+
+@compute @workgroup_size(8, 8)
+fn update_step(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = grid();
     let p = vec2<i32>(id.xy);
     if (p.x >= n.x || p.y >= n.y) {
@@ -121,7 +136,7 @@ fn simulate_step(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let here = state_at(p);
     let depth = rained(here);
-    let out_here = outflow(p);
+    let out_here = shipped_by(p);
 
     // What the neighbours ship towards p this step, and the sediment
     // suspended in it (it rides with the water, mixed evenly).
@@ -132,22 +147,22 @@ fn simulate_step(@builtin(global_invocation_id) id: vec3<u32>) {
     var sediment_in = 0.0;
     if (p.x > 0) {
         let q = p + vec2<i32>(-1, 0);
-        from_left = outflow(q).y;
+        from_left = shipped_by(q).y;
         sediment_in = sediment_in + state_at(q).z * leaving(q, from_left);
     }
     if (p.x < n.x - 1) {
         let q = p + vec2<i32>(1, 0);
-        from_right = outflow(q).x;
+        from_right = shipped_by(q).x;
         sediment_in = sediment_in + state_at(q).z * leaving(q, from_right);
     }
     if (p.y > 0) {
         let q = p + vec2<i32>(0, -1);
-        from_top = outflow(q).w;
+        from_top = shipped_by(q).w;
         sediment_in = sediment_in + state_at(q).z * leaving(q, from_top);
     }
     if (p.y < n.y - 1) {
         let q = p + vec2<i32>(0, 1);
-        from_bottom = outflow(q).z;
+        from_bottom = shipped_by(q).z;
         sediment_in = sediment_in + state_at(q).z * leaving(q, from_bottom);
     }
     let area = pipes.cell_size * pipes.cell_size;
@@ -198,5 +213,4 @@ fn simulate_step(@builtin(global_invocation_id) id: vec3<u32>) {
     let remaining = new_depth * max(0.0, 1.0 - evaporation_rate * time_step);
     textureStore(terrain_out, id.xy, vec4<f32>(terrain, 0.0, 0.0, 1.0));
     textureStore(fluid_out, id.xy, vec4<f32>(remaining, suspended, velocity));
-    textureStore(flux_out, id.xy, out_here);
 }
