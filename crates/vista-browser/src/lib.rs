@@ -69,6 +69,10 @@ pub struct AdapterInfo {
     /// The device's features (the page requests every one the adapter has).
     #[serde(default)]
     pub features: Vec<String>,
+    /// The device's limits by WebGPU's names (the page requests the
+    /// adapter's).
+    #[serde(default)]
+    pub limits: std::collections::BTreeMap<String, f64>,
     /// "Chrome/156.0.8078.114" from `Browser.getVersion`.
     #[serde(skip)]
     pub product: String,

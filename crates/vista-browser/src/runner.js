@@ -54,6 +54,7 @@ async function vistaInit() {
       user_agent: navigator.userAgent,
       max_dimension: device.limits.maxTextureDimension2D,
       features: [...device.features],
+      limits: Object.fromEntries(Object.keys(requiredLimits).map((k) => [k, device.limits[k]])),
     });
   } catch (e) {
     return fail(e);

@@ -1940,6 +1940,46 @@ fn append(@builtin(global_invocation_id) id: vec3<u32>) {
     refused(&split, &["[[pass]] 3", "group \"step\" must be consecutive passes; pass 1 starts it"]);
 }
 
+/// A kernel that needs more of a limit than a backend grants is reported
+/// unsupported there, naming the limit and both values, before any GPU
+/// work (here 32 x 32 invocations: lavapipe allows 1024, SwiftShader 256),
+/// and `expect_fail` with `unsupported` names it.
+fn limits_are_reported_unsupported_by_name() {
+    let shader = "@group(0) @binding(0) var out_tex: texture_storage_2d<rgba8unorm, write>;
+@compute @workgroup_size(32, 32)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(out_tex)) { return; }
+    textureStore(out_tex, id.xy, vec4(vec2<f32>(id.xy) / 40.0, 0.5, 1.0));
+}
+";
+    let d = kernel_project("summary = \"wide workgroups\"\n", shader);
+    let render = |backend: &str| {
+        vista_in(Some(d.path()), &[], &["render", "k", "--size", "40x40", "--backend", backend, "-o", "w.png"])
+    };
+    assert_eq!(render("lavapipe").code, 0);
+    for backend in ["swiftshader", "browser"] {
+        assert_rejected(
+            &render(backend),
+            1,
+            &[
+                "unsupported on",
+                "main (k.wgsl): @workgroup_size(32, 32, 1): 1024 invocations per workgroup",
+                "needs maxComputeInvocationsPerWorkgroup >= 1024 (this device has 256)",
+            ],
+        );
+    }
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    std::fs::write(
+        cases_path(d.path()),
+        "[[case]]\nid = \"wide\"\nkernel = \"k\"\nsize = \"40x40\"\nexpect_fail = [{ backend = \"swiftshader\", \
+         unsupported = \"maxComputeInvocationsPerWorkgroup\", reason = \"256 invocations per workgroup\" }]\n",
+    )
+    .unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let c = vista_in(Some(d.path()), &[], &["check", "--backend", "swiftshader"]);
+    assert!(c.code == 0 && c.stdout.contains("xfail"), "{}", c.stdout);
+}
+
 /// One process runs a read_write kernel, then a write-only kernel of the same
 /// size and format that leaves a row unwritten: the second must still be
 /// caught (the read_write run's zero-filled output must not stand in for
@@ -3705,6 +3745,7 @@ fn main() {
             cube_textures_are_written_as_layers_and_sampled_as_cubes,
         ),
         (Gpu, "a_group_of_passes_repeats_as_one_step", a_group_of_passes_repeats_as_one_step),
+        (Gpu, "limits_are_reported_unsupported_by_name", limits_are_reported_unsupported_by_name),
         (Gpu, "per_backend_goldens_cover_every_output_of_a_graph", per_backend_goldens_cover_every_output_of_a_graph),
         (
             Gpu,

@@ -166,6 +166,9 @@ pub struct Dispatch<'a> {
     /// Workgroups dispatched along x, y and z (the plan derives them from
     /// the entry point's reflected workgroup size; nothing here assumes 8 x 8).
     pub workgroups: [u32; 3],
+    /// The entry point's reflected workgroup size (checked against the
+    /// device's limits before any work).
+    pub workgroup_size: [u32; 3],
     /// Every binding the entry point uses, and what feeds it.
     pub slots: &'a [Slot],
     /// The output's storage format (its WGSL name).
@@ -687,6 +690,16 @@ impl Context {
                 job.width, job.height
             )));
         }
+        let needs = crate::Needs {
+            workgroup_size: job.workgroup_size,
+            workgroups: job.workgroups,
+            bind_groups: job.slots.iter().map(|s| s.group + 1).max().unwrap_or(0),
+            uniform_buffers: job.slots.iter().filter(|s| matches!(s.kind, SlotKind::Uniform(_))).count() as u32,
+            storage_buffers: job.slots.iter().filter(|s| matches!(s.kind, SlotKind::Table)).count() as u32,
+            storage_textures: job.slots.iter().filter(|s| matches!(s.kind, SlotKind::Output)).count() as u32,
+            ..Default::default()
+        };
+        self.require_needs(&format!("{} ({})", job.entry, job.shader), &needs)?;
         let format = OutputFormat::parse(job.format)?;
         if job.read_write && !self.binds_read_write(&format) {
             let feature = self.read_write_feature();

@@ -172,6 +172,31 @@ pub struct GraphPass {
     pub repeat: u32,
     pub swap: Vec<(usize, usize)>,
     pub span: u32,
+    /// The entry point's reflected workgroup size (checked against the
+    /// device's limits before any work).
+    pub workgroup_size: [u32; 3],
+}
+
+impl GraphPass {
+    /// What this pass needs of the device's limits.
+    pub fn needs(&self) -> crate::Needs {
+        let mut n = crate::Needs {
+            workgroup_size: self.workgroup_size,
+            workgroups: self.workgroups,
+            bind_groups: self.slots.iter().map(|s| s.group + 1).max().unwrap_or(0),
+            ..Default::default()
+        };
+        for s in &self.slots {
+            match s.bind {
+                Bind::Uniform(_) | Bind::UniformBuffer(_) => n.uniform_buffers += 1,
+                Bind::Table(_) | Bind::Storage { .. } => n.storage_buffers += 1,
+                Bind::StorageTexture { .. } => n.storage_textures += 1,
+                Bind::Sampled { .. } => n.sampled_textures += 1,
+                Bind::Sampler(_) => n.samplers += 1,
+            }
+        }
+        n
+    }
 }
 
 /// A whole graph.
@@ -231,6 +256,9 @@ impl Context {
     /// textures that still hold sentinel 0 somewhere are run again over
     /// sentinel 1: a texel holding each run's sentinel was never written.
     pub fn run_graph(&self, g: &Graph<'_>) -> Result<GraphReadback, GpuError> {
+        for pass in &g.passes {
+            self.require_needs(&pass.label, &pass.needs())?;
+        }
         let start = Instant::now();
         let once = |which: usize| match &self.engine {
             Engine::Wgpu(w) => self.graph_once(w, g, which),

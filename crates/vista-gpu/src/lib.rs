@@ -10,6 +10,7 @@
 mod context;
 mod format;
 mod graph;
+mod limits;
 mod shaders;
 pub mod validation;
 
@@ -22,6 +23,7 @@ pub use graph::{
     Access, Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphReadback, GraphSlot, OutputData, Resource,
     SamplerDesc, TextureDesc,
 };
+pub use limits::Needs;
 pub use shaders::{ShaderSet, resolve_overrides, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.

@@ -381,6 +381,7 @@ pub fn plan_graph(
             repeat,
             swap,
             span: g.span(i) as u32,
+            workgroup_size: size,
         });
     }
     let mut outputs = Vec::new();

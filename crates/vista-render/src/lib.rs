@@ -385,6 +385,7 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         shader: &plan.shader,
         entry: &plan.entry,
         workgroups: plan.workgroups,
+        workgroup_size: plan.workgroup_size,
         slots: &plan.slots,
         format: plan.format,
         dimension: plan.dimension,

@@ -1,0 +1,114 @@
+//! The device's limits by WebGPU's names (`maxStorageTexturesPerShaderStage`),
+//! so that a kernel needing more than a backend grants is reported
+//! *unsupported*, naming the limit (SPEC 14, "Features and limits"), before
+//! any GPU work, instead of failing as a driver validation error.
+
+use crate::GpuError;
+use crate::context::{Context, Engine};
+
+/// What one dispatch needs of the device.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Needs {
+    pub workgroup_size: [u32; 3],
+    pub workgroups: [u32; 3],
+    pub bind_groups: u32,
+    pub uniform_buffers: u32,
+    pub storage_buffers: u32,
+    pub storage_textures: u32,
+    pub sampled_textures: u32,
+    pub samplers: u32,
+}
+
+/// Reads one limit from wgpu's.
+type Read = fn(&wgpu::Limits) -> u64;
+
+/// The limits vista checks, by WebGPU's name, read from wgpu's.
+const WGPU_LIMITS: [(&str, Read); 17] = [
+    ("maxComputeWorkgroupSizeX", |l| l.max_compute_workgroup_size_x as u64),
+    ("maxComputeWorkgroupSizeY", |l| l.max_compute_workgroup_size_y as u64),
+    ("maxComputeWorkgroupSizeZ", |l| l.max_compute_workgroup_size_z as u64),
+    ("maxComputeInvocationsPerWorkgroup", |l| l.max_compute_invocations_per_workgroup as u64),
+    ("maxComputeWorkgroupsPerDimension", |l| l.max_compute_workgroups_per_dimension as u64),
+    ("maxComputeWorkgroupStorageSize", |l| l.max_compute_workgroup_storage_size as u64),
+    ("maxBindGroups", |l| l.max_bind_groups as u64),
+    ("maxUniformBuffersPerShaderStage", |l| l.max_uniform_buffers_per_shader_stage as u64),
+    ("maxStorageBuffersPerShaderStage", |l| l.max_storage_buffers_per_shader_stage as u64),
+    ("maxStorageTexturesPerShaderStage", |l| l.max_storage_textures_per_shader_stage as u64),
+    ("maxSampledTexturesPerShaderStage", |l| l.max_sampled_textures_per_shader_stage as u64),
+    ("maxSamplersPerShaderStage", |l| l.max_samplers_per_shader_stage as u64),
+    ("maxTextureDimension1D", |l| l.max_texture_dimension_1d as u64),
+    ("maxTextureDimension2D", |l| l.max_texture_dimension_2d as u64),
+    ("maxTextureDimension3D", |l| l.max_texture_dimension_3d as u64),
+    ("maxTextureArrayLayers", |l| l.max_texture_array_layers as u64),
+    ("maxStorageBufferBindingSize", |l| l.max_storage_buffer_binding_size),
+];
+
+impl Context {
+    /// The device's limit `name` (WebGPU's spelling), where the backend
+    /// reports it.
+    pub fn limit(&self, name: &str) -> Option<u64> {
+        match &self.engine {
+            Engine::Wgpu(w) => WGPU_LIMITS.iter().find(|(n, _)| *n == name).map(|(_, f)| f(&w.device.limits())),
+            Engine::Browser(b) => b.browser.info().limits.get(name).map(|v| *v as u64),
+        }
+    }
+
+    /// Refuses `what` as unsupported when it needs more of limit `name`
+    /// than this device has.
+    pub fn require(&self, what: &str, name: &str, needed: u64) -> Result<(), GpuError> {
+        match self.limit(name) {
+            Some(have) if needed > have => Err(GpuError::Unsupported {
+                adapter: self.adapter_description(),
+                what: what.to_string(),
+                feature: format!("{name} >= {needed} (this device has {have})"),
+            }),
+            _ => Ok(()),
+        }
+    }
+
+    /// Checks a dispatch's workgroup size and count and its bindings
+    /// against the device's limits; `what` names it (a pass, a kernel).
+    pub fn require_needs(&self, what: &str, n: &Needs) -> Result<(), GpuError> {
+        let [x, y, z] = n.workgroup_size;
+        let invocations = x as u64 * y as u64 * z as u64;
+        let size = format!("@workgroup_size({x}, {y}, {z})");
+        let most = n.workgroups.iter().copied().max().unwrap_or(0) as u64;
+        let checks: Vec<(String, &str, u64)> = vec![
+            (
+                format!("{size}: {invocations} invocations per workgroup"),
+                "maxComputeInvocationsPerWorkgroup",
+                invocations,
+            ),
+            (size.clone(), "maxComputeWorkgroupSizeX", x as u64),
+            (size.clone(), "maxComputeWorkgroupSizeY", y as u64),
+            (size, "maxComputeWorkgroupSizeZ", z as u64),
+            (format!("{most} workgroups along one axis"), "maxComputeWorkgroupsPerDimension", most),
+            (format!("bind group {}", n.bind_groups.saturating_sub(1)), "maxBindGroups", n.bind_groups as u64),
+            (
+                format!("{} uniform buffers", n.uniform_buffers),
+                "maxUniformBuffersPerShaderStage",
+                n.uniform_buffers as u64,
+            ),
+            (
+                format!("{} storage buffers", n.storage_buffers),
+                "maxStorageBuffersPerShaderStage",
+                n.storage_buffers as u64,
+            ),
+            (
+                format!("{} storage textures", n.storage_textures),
+                "maxStorageTexturesPerShaderStage",
+                n.storage_textures as u64,
+            ),
+            (
+                format!("{} sampled textures", n.sampled_textures),
+                "maxSampledTexturesPerShaderStage",
+                n.sampled_textures as u64,
+            ),
+            (format!("{} samplers", n.samplers), "maxSamplersPerShaderStage", n.samplers as u64),
+        ];
+        for (need, name, value) in &checks {
+            self.require(&format!("{what}: {need}"), name, *value)?;
+        }
+        Ok(())
+    }
+}
