@@ -3117,6 +3117,17 @@ fn every_output_of_a_graph_is_judged() {
     let c = run(&["check", "--case", "scan"]);
     assert_eq!(c.code, 1, "{}", c.stdout);
     assert!(c.stdout.contains("FAIL: output prefix: not exact: 65") && c.stdout.contains("vs golden"), "{}", c.stdout);
+    // The report shows the inputs, and a buffer's worst elements and its
+    // histogram of differences.
+    let page = std::fs::read_to_string(root.join("target/vista-report/index.html")).unwrap();
+    assert!(page.contains("buffer from inputs/values.npy (dtype &lt;u4, shape [65536])"), "inputs table");
+    assert!(page.contains("<table class=\"histogram\">") && page.contains("<td>&gt; 1</td>"), "histogram");
+    assert!(page.contains("<table class=\"worst\">") && page.contains("<td>[532]</td>"), "worst elements");
+    let c = run(&["check", "--case", "blur"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    let page = std::fs::read_to_string(root.join("target/vista-report/index.html")).unwrap();
+    assert!(page.contains("texture from inputs/photo.png") && page.contains("blur/input.photo8.png"), "input image");
+    assert!(root.join("target/vista-report/blur/input.photo8.png").is_file());
     // A missing buffer golden is a missing case, and bless writes it.
     std::fs::remove_file(root.join("golden/scan/scan.npy")).unwrap();
     let c = run(&["check", "--case", "scan"]);

@@ -42,6 +42,8 @@ pub struct ReportFiles {
     /// A pass graph's other texture outputs: (name, expected 8-bit, actual
     /// 8-bit).
     pub outputs: Vec<(String, Option<String>, Option<String>)>,
+    /// A pass graph's inputs: (resource, where from, an 8-bit image).
+    pub inputs: Vec<(String, String, Option<String>)>,
 }
 
 /// The run's side of the provenance, beside the golden's manifest entry.

@@ -110,6 +110,11 @@ pub struct OutputVerdict {
     pub by_raw: bool,
     /// That PSNR (dB), where it was measured.
     pub raw_psnr: Option<f64>,
+    /// Where values were compared one by one (a tolerance): the elements
+    /// or texel channels that differ most, (where, this run, golden).
+    pub worst: Vec<(String, f64, f64)>,
+    /// And how far they differ: (|difference| range, values in it).
+    pub histogram: Vec<(String, u64)>,
     /// Golden files that do not exist.
     pub missing: Vec<PathBuf>,
     /// Golden files that exist but cannot be read.
@@ -447,6 +452,39 @@ fn flat(img: &Image) -> Vec<f64> {
     img.data.iter().flat_map(|p| p.iter().map(|c| *c as f64)).collect()
 }
 
+/// The values that differ most, (where, this run, golden), and a
+/// histogram of |difference|, (range, values in it).
+pub type Differences = (Vec<(String, f64, f64)>, Vec<(String, u64)>);
+
+/// The |difference| ranges of [`difference_profile`]'s histogram.
+pub const DIFFERENCE_BINS: [&str; 7] = ["0", "<= 1e-6", "<= 1e-4", "<= 1e-2", "<= 1", "> 1", "NaN/Inf"];
+
+/// The `n` values of `actual` that differ most from `expected` (where,
+/// this run, golden) and a histogram of |difference| by decade.
+pub fn difference_profile(expected: &[f64], actual: &[f64], locate: &dyn Fn(usize) -> String, n: usize) -> Differences {
+    let mut counts = [0u64; DIFFERENCE_BINS.len()];
+    let mut differing: Vec<(usize, f64)> = Vec::new();
+    for (i, (a, e)) in actual.iter().zip(expected).enumerate() {
+        let d = (a - e).abs();
+        let bin = match d {
+            _ if a.to_bits() == e.to_bits() => 0,
+            d if !d.is_finite() => 6,
+            d if d <= 1e-6 => 1,
+            d if d <= 1e-4 => 2,
+            d if d <= 1e-2 => 3,
+            d if d <= 1.0 => 4,
+            _ => 5,
+        };
+        counts[bin] += 1;
+        if bin > 0 {
+            differing.push((i, if d.is_finite() { d } else { f64::INFINITY }));
+        }
+    }
+    differing.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let worst = differing.iter().take(n).map(|&(i, _)| (locate(i), actual[i], expected[i])).collect();
+    (worst, DIFFERENCE_BINS.iter().zip(counts).map(|(b, c)| (b.to_string(), c)).collect())
+}
+
 /// Judges `actual` against `expected` by `t`, with the worst values named.
 fn judge_values(
     v: &mut OutputVerdict,
@@ -457,6 +495,9 @@ fn judge_values(
     floats: bool,
     locate: &dyn Fn(usize) -> String,
 ) {
+    if expected.len() == actual.len() {
+        (v.worst, v.histogram) = difference_profile(expected, actual, locate, 8);
+    }
     match within_at(t, expected, actual, floats, locate) {
         Ok(summary) => v.summary = format!("output {name}: {summary}"),
         Err(problem) => {

@@ -36,6 +36,74 @@ pub struct Checked {
     /// A pass graph's other texture outputs for the report: (name, display
     /// values as a 16-bit PNG holds them, its golden PNG when readable).
     pub output_images: Vec<(String, Image, Option<Image>)>,
+    /// A pass graph's inputs for the report: (resource, where it comes
+    /// from, a texture's values as shown).
+    pub inputs: Vec<(String, String, Option<Image>)>,
+}
+
+/// A pass graph's resources that start from a file or inline data (a
+/// case's `inputs` replacing the manifest's file), for the report: (name,
+/// what and where from, a texture's values in [0, 1] (normalized when
+/// they leave it)). Files are read relative to `root`; one that cannot be
+/// read says so (the render refuses it before this is asked).
+pub fn inputs_of(case: &Case, root: Option<&std::path::Path>) -> Vec<(String, String, Option<Image>)> {
+    use vista_kernels::graph::ResourceKind;
+    let Some(g) = case.kernel.graph() else { return Vec::new() };
+    let mut out = Vec::new();
+    for r in &g.resources {
+        let replaced = case.inputs.iter().find(|(n, _)| *n == r.name).map(|(_, f)| f.clone());
+        let at = |f: &str| root.map(|r| r.join(f)).unwrap_or_else(|| f.into());
+        match &r.kind {
+            ResourceKind::Texture { file, .. } => {
+                let Some(f) = replaced.or(file.clone()) else { continue };
+                match vista_image::load(&at(&f)) {
+                    Ok(img) => out.push((
+                        r.name.clone(),
+                        format!("texture from {f} ({}x{})", img.width, img.height),
+                        Some(shown(&img)),
+                    )),
+                    Err(e) => out.push((r.name.clone(), format!("texture from {f}: {e}"), None)),
+                }
+            }
+            ResourceKind::Buffer { file, data, .. } => {
+                let what = match (replaced.or(file.clone()), data) {
+                    (Some(f), _) if f.ends_with(".npy") => match vista_image::npy::read_npy(&at(&f)) {
+                        Ok(n) => format!("buffer from {f} (dtype {}, shape {:?})", n.descr, n.shape),
+                        Err(e) => format!("buffer from {f}: {e}"),
+                    },
+                    (Some(f), _) => match std::fs::metadata(at(&f)) {
+                        Ok(m) => format!("buffer from {f} ({} bytes)", m.len()),
+                        Err(e) => format!("buffer from {f}: {e}"),
+                    },
+                    (None, Some(values)) => format!("buffer from inline data ({} values)", values.len()),
+                    (None, None) => continue,
+                };
+                out.push((r.name.clone(), what, None));
+            }
+            ResourceKind::Sampler { .. } => {}
+        }
+    }
+    out
+}
+
+/// An input texture as the report shows it: as is when its RGB values lie
+/// in [0, 1], else mapped from their min..max; alpha 1.
+fn shown(img: &Image) -> Image {
+    let values = img.data.iter().flat_map(|p| p[..3].iter().copied()).filter(|v| v.is_finite());
+    let (lo, hi) = values.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let (lo, span) = match lo >= 0.0 && hi <= 1.0 {
+        true => (0.0, 1.0),
+        false => (lo, (hi - lo).max(f32::MIN_POSITIVE)),
+    };
+    let data = img
+        .data
+        .iter()
+        .map(|p| {
+            let f = |v: f32| if v.is_finite() { ((v - lo) / span).clamp(0.0, 1.0) } else { 0.0 };
+            [f(p[0]), f(p[1]), f(p[2]), 1.0]
+        })
+        .collect();
+    Image::from_raw(img.width, img.height, data).expect("same size")
 }
 
 /// This run's side of `case`'s provenance: backend, adapter, params hash
@@ -67,6 +135,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
                 pending: None,
                 pending_files: Vec::new(),
                 output_images: Vec::new(),
+                inputs: inputs_of(case, ctx.root.as_deref()),
             };
         }
     };
@@ -186,7 +255,16 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
             Some((o.name.clone(), shown, golden))
         })
         .collect();
-    Checked { outcome: out, actual: has_image.then_some(actual), expected, pending, pending_files, output_images }
+    let inputs = inputs_of(case, ctx.root.as_deref());
+    Checked {
+        outcome: out,
+        actual: has_image.then_some(actual),
+        expected,
+        pending,
+        pending_files,
+        output_images,
+        inputs,
+    }
 }
 
 /// Renders a case: its kernel, params, size and replacement inputs.

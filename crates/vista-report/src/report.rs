@@ -42,7 +42,11 @@ pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
 /// A checked case with its images written into `dir`: the outcome with
 /// `files` filled in (a failure to write them makes the case an error).
 pub fn file_case(dir: &Path, checked: vista_golden::Checked) -> Outcome {
-    let vista_golden::Checked { mut outcome, actual, expected, output_images, pending_files, .. } = checked;
+    let vista_golden::Checked { mut outcome, actual, expected, output_images, pending_files, inputs, .. } = checked;
+    if let Err(e) = write_inputs(dir, &mut outcome, &inputs) {
+        outcome.verdict = Verdict::Error;
+        outcome.problems.push(e.to_string());
+    }
     // What bless --from-report accepts besides the main PNG.
     let kept = (|| -> Result<(), GoldenError> {
         for (name, bytes) in &pending_files {
@@ -114,6 +118,73 @@ fn write_output_images(
     Ok(())
 }
 
+/// Records a pass graph's inputs in `out.files.inputs`, writing each
+/// texture's values as `<dir>/<id>/input.<name>8.png`.
+fn write_inputs(dir: &Path, out: &mut Outcome, inputs: &[(String, String, Option<Image>)]) -> Result<(), GoldenError> {
+    for (name, what, image) in inputs {
+        let path = match image {
+            Some(img) => {
+                let file = format!("input.{name}8.png");
+                vista_image::write_png8(&case_folder(dir, &out.id)?.join(&file), img)?;
+                Some(format!("{}/{file}", out.id))
+            }
+            None => None,
+        };
+        out.files.inputs.push((name.clone(), what.clone(), path));
+    }
+    Ok(())
+}
+
+/// A pass graph's inputs: each resource that starts from a file or inline
+/// data, where from, and a texture's image.
+fn inputs_table(o: &Outcome) -> String {
+    if o.files.inputs.is_empty() {
+        return String::new();
+    }
+    let mut t = String::from("<table class=\"outputs inputs\"><tr><th>input</th><th>from</th><th>image</th></tr>");
+    for (name, what, path) in &o.files.inputs {
+        let img = path
+            .as_ref()
+            .map(|p| {
+                format!(
+                    "<a href=\"{0}\"><img class=\"thumb\" src=\"{0}\" alt=\"{1}\"></a>",
+                    html_escape(p),
+                    html_escape(name)
+                )
+            })
+            .unwrap_or_default();
+        t += &format!("<tr><td><b>{}</b></td><td>{}</td><td>{img}</td></tr>", html_escape(name), html_escape(what));
+    }
+    t + "</table>"
+}
+
+/// Where values were compared one by one: the worst of them and a
+/// histogram of |difference| (bars scaled to the largest bin).
+fn differences(v: &vista_golden::outputs::OutputVerdict) -> String {
+    if v.histogram.iter().all(|(_, n)| *n == 0) {
+        return String::new();
+    }
+    let most = v.histogram.iter().map(|(_, n)| *n).max().unwrap_or(1).max(1);
+    let mut h = String::from("<table class=\"histogram\"><tr><th>|difference|</th><th>values</th><th></th></tr>");
+    for (bin, n) in &v.histogram {
+        let width = (120.0 * *n as f64 / most as f64).round() as u32;
+        h += &format!(
+            "<tr><td>{}</td><td>{n}</td><td><span class=\"bar\" style=\"width:{width}px\"></span></td></tr>",
+            html_escape(bin)
+        );
+    }
+    h += "</table>";
+    if !v.worst.is_empty() {
+        h += "<table class=\"worst\"><tr><th>where</th><th>this run</th><th>golden</th><th>|difference|</th></tr>";
+        for (at, a, e) in &v.worst {
+            h +=
+                &format!("<tr><td>{}</td><td>{a}</td><td>{e}</td><td>{:.3e}</td></tr>", html_escape(at), (a - e).abs());
+        }
+        h += "</table>";
+    }
+    h
+}
+
 /// A pass graph's outputs: what each is, how it is judged, its result (or
 /// problems) and, for textures other than the main image, both images.
 fn outputs_table(o: &Outcome) -> String {
@@ -145,6 +216,7 @@ fn outputs_table(o: &Outcome) -> String {
         if result.is_empty() {
             result.push(html_escape(&v.summary));
         }
+        result.push(differences(v));
         t += &format!(
             "<tr><td><b>{}</b><br><small>{}</small></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             html_escape(&v.name),
@@ -434,7 +506,7 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
                 thumb(&o.files.diff8, &o.files.diff, "heat map")
             ),
         },
-        outputs = outputs_table(o),
+        outputs = outputs_table(o) + &inputs_table(o),
         bless = html_escape(&o.bless_command),
         accept = match run.pending.contains(&o.id) {
             true => format!(
