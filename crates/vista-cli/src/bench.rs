@@ -53,19 +53,29 @@ pub fn bench(
     let first = vista_render::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
     let mut stats = Vec::new();
     let mut pass_times: Vec<Vec<std::time::Duration>> = vec![Vec::new(); graph_passes.len()];
+    let mut gpu_times: Vec<Vec<std::time::Duration>> = vec![Vec::new(); graph_passes.len()];
     for _ in 0..runs {
         let r = vista_render::render(ctx, k, &p, w, h)?;
         for (all, t) in pass_times.iter_mut().zip(&r.pass_times) {
             all.push(*t);
         }
+        for (all, t) in gpu_times.iter_mut().zip(&r.pass_gpu_times) {
+            all.extend(*t);
+        }
         stats.push(r.stats);
     }
     // A pass graph's passes, each by its median wall time (submit to done,
-    // all its repeats; the adapter's timestamps are not read).
+    // all its repeats) and, where the device has timestamps, its median
+    // GPU time between them.
     let passes: Vec<PassTime> = graph_passes
         .into_iter()
         .zip(pass_times)
-        .map(|(pass, times)| PassTime { pass, median_ms: vista_render::median(times).as_secs_f64() * 1e3 })
+        .zip(gpu_times)
+        .map(|((pass, times), gpu)| PassTime {
+            pass,
+            median_ms: vista_render::median(times).as_secs_f64() * 1e3,
+            gpu_median_ms: (!gpu.is_empty()).then(|| vista_render::median(gpu).as_secs_f64() * 1e3),
+        })
         .collect();
     let med = |f: fn(&vista_gpu::RunStats) -> std::time::Duration| {
         vista_render::median(stats.iter().map(f).collect()).as_secs_f64()
@@ -115,7 +125,12 @@ pub fn bench(
             r.device_creation_ms, r.first_dispatch_ms
         );
         for p in &r.passes {
-            println!("  {}: median {:.2} ms", p.pass, p.median_ms);
+            match p.gpu_median_ms {
+                Some(gpu) => {
+                    println!("  {}: median {:.2} ms ({:.3} ms on the GPU's timestamps)", p.pass, p.median_ms, gpu)
+                }
+                None => println!("  {}: median {:.2} ms (no GPU timestamps on this backend)", p.pass, p.median_ms),
+            }
         }
         if let (Some(ms), Some(threads), Some(ratio)) = (r.cpu_f32_ms, r.cpu_threads, r.cpu_over_gpu) {
             println!("f32 CPU reference on {threads} threads: {ms:.2} ms = {ratio:.2}x the GPU time");
@@ -129,6 +144,9 @@ pub fn bench(
 struct PassTime {
     pass: String,
     median_ms: f64,
+    /// From the device's timestamps; absent where it has none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gpu_median_ms: Option<f64>,
 }
 
 /// What `vista bench` measured: printed as text, or serialised whole by `--json`.

@@ -3019,7 +3019,9 @@ fn the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu() {
     assert_eq!(sweep.code, 0, "{}", sweep.stderr);
     let bench = run(&["bench", "sky_luts", "--size", "64x32", "--runs", "2", "--json"]);
     assert!(
-        bench.code == 0 && bench.stdout.contains("\"pass\":\"pass 2 (render_multiscattering_lut"),
+        bench.code == 0
+            && bench.stdout.contains("\"pass\":\"pass 2 (render_multiscattering_lut")
+            && bench.stdout.contains("\"gpu_median_ms\":"),
         "{}{}",
         bench.stdout,
         bench.stderr

@@ -437,7 +437,8 @@ impl Context {
         let specific = wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
         // Linear sampling of r32float/rg32float/rgba32float inputs, where
         // the driver has it (SPEC 14, features and limits).
-        let wanted = specific | wgpu::Features::FLOAT32_FILTERABLE;
+        // GPU timestamps around each graph pass, where the driver has them.
+        let wanted = specific | wgpu::Features::FLOAT32_FILTERABLE | wgpu::Features::TIMESTAMP_QUERY;
         let required_features = adapter.features() & wanted;
         let read_write = crate::format::format_names()
             .into_iter()
@@ -880,7 +881,7 @@ impl Context {
             extent,
         );
         let mut compute = d.create_command_encoder(&Default::default());
-        encode_dispatch(&mut compute, &compiled, &groups, job.workgroups);
+        encode_dispatch(&mut compute, &compiled, &groups, job.workgroups, None);
         let mut encoder = d.create_command_encoder(&Default::default());
         encoder.copy_texture_to_buffer(
             texture.as_image_copy(),
@@ -1043,8 +1044,17 @@ pub(crate) fn encode_dispatch(
     compiled: &Compiled,
     groups: &[wgpu::BindGroup],
     workgroups: [u32; 3],
+    stamps: Option<&wgpu::QuerySet>,
 ) {
-    let mut pass = encoder.begin_compute_pass(&Default::default());
+    // Timestamps 0 and 1 at the pass's beginning and end, where asked.
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: None,
+        timestamp_writes: stamps.map(|query_set| wgpu::ComputePassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: Some(0),
+            end_of_pass_write_index: Some(1),
+        }),
+    });
     pass.set_pipeline(&compiled.pipeline);
     for (g, group) in groups.iter().enumerate() {
         pass.set_bind_group(g as u32, group, &[]);

@@ -243,6 +243,75 @@ pub struct GraphReadback {
     pub stats: RunStats,
     /// Wall time of each pass, all its repeats together.
     pub pass_times: Vec<Duration>,
+    /// GPU time of each pass from the device's timestamps, all its repeats
+    /// together; `None` where the backend has no timestamps.
+    pub pass_gpu_times: Vec<Option<Duration>>,
+}
+
+/// Two GPU timestamps around one pass run, resolved and read back.
+struct Stamps {
+    set: wgpu::QuerySet,
+    resolved: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    /// Nanoseconds per timestamp tick.
+    period: f64,
+}
+
+impl Stamps {
+    fn new(w: &WgpuEngine) -> Stamps {
+        let d = &w.device;
+        let buffer = |usage| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps"),
+                size: 16,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Stamps {
+            set: d.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            }),
+            resolved: buffer(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
+            staging: buffer(wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ),
+            period: w.queue.get_timestamp_period() as f64,
+        }
+    }
+
+    fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.resolve_query_set(&self.set, 0..2, &self.resolved, 0);
+        encoder.copy_buffer_to_buffer(&self.resolved, 0, &self.staging, 0, 16);
+    }
+
+    /// The pass's GPU time, once its submission is done.
+    fn read(&self, ctx: &Context, w: &WgpuEngine, what: &str) -> Result<Duration, GpuError> {
+        let (tx, rx) = mpsc::channel();
+        self.staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        w.device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(ctx.timeout) })
+            .map_err(|e| GpuError::Validation { what: format!("{what}: timestamps"), message: e.to_string() })?;
+        match rx.recv_timeout(ctx.timeout) {
+            Ok(Ok(())) => {}
+            _ => {
+                return Err(GpuError::Validation { what: format!("{what}: timestamps"), message: "map failed".into() });
+            }
+        }
+        let ticks = {
+            let mapped = self
+                .staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Validation { what: format!("{what}: timestamps"), message: e.to_string() })?;
+            let at = |i: usize| u64::from_le_bytes(mapped[i * 8..i * 8 + 8].try_into().expect("8 bytes"));
+            at(1).saturating_sub(at(0))
+        };
+        self.staging.unmap();
+        Ok(Duration::from_nanos((ticks as f64 * self.period) as u64))
+    }
 }
 
 struct Made {
@@ -304,6 +373,8 @@ impl Context {
         // Which physical resource each name binds now (swaps exchange them).
         let mut current: Vec<usize> = (0..g.resources.len()).collect();
         let mut pass_times = vec![Duration::ZERO; g.passes.len()];
+        let stamps = w.device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Stamps::new(w));
+        let mut gpu_times = vec![Duration::ZERO; g.passes.len()];
         let _serial = self.submit_lock.lock().expect("submit lock");
         for (pi, pass, compiled) in run_order(&g.passes).into_iter().map(|i| (i, &g.passes[i], &pipelines[i])) {
             let pass_start = Instant::now();
@@ -378,7 +449,16 @@ impl Context {
                     })
                     .collect();
                 let mut encoder = d.create_command_encoder(&Default::default());
-                crate::context::encode_dispatch(&mut encoder, compiled, &groups, pass.workgroups);
+                crate::context::encode_dispatch(
+                    &mut encoder,
+                    compiled,
+                    &groups,
+                    pass.workgroups,
+                    stamps.as_ref().map(|s| &s.set),
+                );
+                if let Some(s) = &stamps {
+                    s.resolve(&mut encoder);
+                }
                 if let Some(e) = pollster::block_on(scope.pop()) {
                     return Err(GpuError::Validation { what: pass.label.clone(), message: e.to_string() });
                 }
@@ -389,6 +469,10 @@ impl Context {
                 }
             }
             pass_times[pi] += pass_start.elapsed();
+            // Read after the wall time stops: the map is not the pass's.
+            if let Some(s) = &stamps {
+                gpu_times[pi] += s.read(self, w, &pass.label)?;
+            }
         }
         let kernel: Duration = pass_times.iter().sum();
         let copy_start = Instant::now();
@@ -410,7 +494,8 @@ impl Context {
             }
         }
         let stats = RunStats { gpu_wall: kernel + readback, kernel, readback, total: start.elapsed() };
-        Ok((GraphReadback { outputs, stats, pass_times }, sentinels))
+        let pass_gpu_times = gpu_times.into_iter().map(|t| stamps.as_ref().map(|_| t)).collect();
+        Ok((GraphReadback { outputs, stats, pass_times, pass_gpu_times }, sentinels))
     }
 
     /// The same graph in headless Chromium: naga's WGSL of each pass, the
@@ -577,7 +662,8 @@ impl Context {
         }
         let kernel: Duration = out.passes.iter().sum();
         let stats = RunStats { gpu_wall: kernel + out.readback, kernel, readback: out.readback, total: out.total };
-        Ok((GraphReadback { outputs, stats, pass_times: out.passes }, sentinels))
+        let pass_gpu_times = vec![None; out.passes.len()];
+        Ok((GraphReadback { outputs, stats, pass_times: out.passes, pass_gpu_times }, sentinels))
     }
 
     /// Creates every resource with its initial contents (`which` picks the

@@ -93,6 +93,9 @@ pub struct Rendered {
     pub outputs: Vec<OutputRender>,
     /// Wall time of each graph pass (all its repeats).
     pub pass_times: Vec<std::time::Duration>,
+    /// GPU time of each graph pass from the device's timestamps (all its
+    /// repeats), where the backend has them.
+    pub pass_gpu_times: Vec<Option<std::time::Duration>>,
     to_display: DisplayMap,
     /// Display values, made on first use unless they are `raw` itself: a
     /// benchmark or a raw-only caller never pays for a second image.
@@ -405,6 +408,7 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         format: plan.format,
         outputs: Vec::new(),
         pass_times: Vec::new(),
+        pass_gpu_times: Vec::new(),
         to_display: plan.display,
         display: OnceLock::new(),
     })
@@ -520,6 +524,7 @@ pub fn run_graph(gpu: &Renderer, plan: &GraphPlan) -> Result<Rendered, RenderErr
         format,
         outputs,
         pass_times: out.pass_times,
+        pass_gpu_times: out.pass_gpu_times,
         to_display: display,
         display: OnceLock::new(),
     })
