@@ -6,7 +6,7 @@
 mod common;
 
 use vista_image::Image;
-use vista_image::metrics::{compare_hdr, hdr_peak, psnr_with_peak};
+use vista_image::metrics::{hdr_peak, psnr_with_peak};
 use vista_kernels::ParamSet;
 use vista_kernels::atmosphere::AtmosphereKernel;
 
@@ -23,29 +23,6 @@ fn gpu(ctx: &vista_render::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
 
 fn samples(view: u32, light: u32) -> [(&'static str, String); 2] {
     [("view_samples", view.to_string()), ("light_samples", light.to_string())]
-}
-
-/// Same discrete scheme on both sides: only f32 vs f64 (and the GPU's
-/// camera-relative altitude formula vs the CPU's |p| - R_ground) differ.
-fn gpu_matches_cpu_at_the_same_settings(ctx: &vista_render::Renderer) {
-    for preset in ["noon", "afternoon", "sunset", "twilight", "high_altitude"] {
-        let p = params(Some(preset), &[]);
-        let (cpu, gpu) = (K.reference(&p, 48, 24), gpu(ctx, &p, 48, 24));
-        let m = compare_hdr(&cpu, &gpu).unwrap();
-        eprintln!(
-            "{preset} (32 x 8): GPU vs CPU {:.2} dB, max abs {:.3e}, peak {:.3}",
-            m.psnr,
-            m.max_abs,
-            hdr_peak(&cpu)
-        );
-        assert_eq!(m.nan, 0);
-        // Lavapipe gives ~140 dB; 90 leaves room for other drivers' exp/sin.
-        assert!(m.psnr >= 90.0, "{preset}: GPU vs CPU at the same settings {:.2} dB < 90", m.psnr);
-    }
-    let p = params(Some("noon"), &[("projection", "fisheye".into())]);
-    let m = compare_hdr(&K.reference(&p, 32, 32), &gpu(ctx, &p, 32, 32)).unwrap();
-    eprintln!("noon fisheye: GPU vs CPU {:.2} dB", m.psnr);
-    assert!(m.psnr >= 90.0, "fisheye: GPU vs CPU {:.2} dB < 90", m.psnr);
 }
 
 /// GPU at 256 x 64 steps against the converged CPU reference. The reference
@@ -197,7 +174,6 @@ fn exr_round_trip_is_bit_identical(ctx: &vista_render::Renderer) {
 
 fn main() {
     common::run_gpu_tests(&[
-        ("gpu_matches_cpu_at_the_same_settings", gpu_matches_cpu_at_the_same_settings),
         ("gpu_high_quality_matches_converged_cpu", gpu_high_quality_matches_converged_cpu),
         ("gpu_sky_invariants", gpu_sky_invariants),
         ("gpu_finite_over_the_parameter_grid", gpu_finite_over_the_parameter_grid),

@@ -4,7 +4,7 @@
 mod common;
 
 use vista_image::Image;
-use vista_image::metrics::{compare_hdr, hdr_peak, psnr_with_peak};
+use vista_image::metrics::{hdr_peak, psnr_with_peak};
 use vista_kernels::ParamSet;
 use vista_kernels::clouds::CloudsKernel;
 use vista_render::render;
@@ -120,10 +120,8 @@ fn seed_experiment_on_the_gpu(ctx: &vista_render::Renderer) {
         "clouds seed experiment on the GPU ({w}x{h}): riemann/none 64x12 {pb:.2} dB, analytic/ign 32x6 {pf:.2} dB"
     );
     assert!(pf >= pb, "GPU analytic/ign 32x6 ({pf:.2} dB) less close than riemann/none 64x12 ({pb:.2} dB)");
-    // The GPU candidate is the CPU candidate up to f32 rounding.
-    let cpu_fast = CloudsKernel.reference(&fast_p, w, h);
-    let agree = compare_hdr(&cpu_fast, &fast).unwrap().psnr;
-    assert!(agree >= 50.0, "GPU vs CPU analytic/ign 32x6: {agree:.1} dB");
+    // That the GPU candidate is the CPU candidate up to f32 rounding is
+    // tests/agreement.rs's (the same setting, 120.5 dB against 110).
 }
 
 /// On the GPU coverage_oktas = n is exactly the preset's table entry for n

@@ -86,6 +86,9 @@ struct BoundRow {
     kernel: String,
     preset: Option<String>,
     backend: Option<String>,
+    /// Overrides a setting must have (all of them) for the row to apply.
+    #[serde(default)]
+    set: std::collections::BTreeMap<String, String>,
     min_psnr: f64,
     max_abs: f64,
 }
@@ -111,8 +114,24 @@ pub fn settings() -> &'static [Setting] {
     &table().setting
 }
 
-/// The bound of a kernel's setting on a backend: the first row that matches.
+/// The bound of a kernel's preset on a backend, without overrides: the
+/// first row that matches.
 pub fn bound(kernel: &str, preset: &str, backend: &str) -> Option<Bound> {
+    bound_with(kernel, preset, &Default::default(), backend)
+}
+
+/// The bound of setting `s` on a backend: the first row whose kernel,
+/// preset, backend and `set` overrides (all of them) match.
+pub fn bound_of(s: &Setting, backend: &str) -> Option<Bound> {
+    bound_with(&s.kernel, &s.preset, &s.set, backend)
+}
+
+fn bound_with(
+    kernel: &str,
+    preset: &str,
+    set: &std::collections::BTreeMap<String, String>,
+    backend: &str,
+) -> Option<Bound> {
     table()
         .bound
         .iter()
@@ -120,6 +139,7 @@ pub fn bound(kernel: &str, preset: &str, backend: &str) -> Option<Bound> {
             b.kernel == kernel
                 && b.preset.as_deref().is_none_or(|p| p == preset)
                 && b.backend.as_deref().is_none_or(|x| x == backend)
+                && b.set.iter().all(|(k, v)| set.get(k) == Some(v))
         })
         .map(|b| Bound { min_psnr: b.min_psnr, max_abs: b.max_abs })
 }
@@ -198,7 +218,7 @@ pub fn judge_setting(gpu: &Renderer, s: &Setting) -> Result<Judged, SettingError
         _ => reference(k, &p, w, h),
     };
     let a = agreement(k, &g, &c);
-    let bound = bound(&s.kernel, &s.preset, gpu.backend()).ok_or_else(|| {
+    let bound = bound_of(s, gpu.backend()).ok_or_else(|| {
         SettingError::Unjudgeable(format!("agreement.toml has no bound for {} on {}", s.label(), gpu.backend()))
     })?;
     let broken = (a.psnr < bound.min_psnr || a.max_abs > bound.max_abs)
@@ -282,12 +302,16 @@ mod tests {
             let k = vista_kernels::find(&s.kernel).unwrap();
             s.params(k, &[]).unwrap();
             for b in ["lavapipe", "swiftshader", "browser", "gpu"] {
-                assert!(bound(&s.kernel, &s.preset, b).is_some(), "{} on {b}", s.label());
+                assert!(bound_of(s, b).is_some(), "{} on {b}", s.label());
             }
         }
         // First match wins: the flythrough's own row off lavapipe only.
         assert_eq!(bound("clouds", "flythrough", "lavapipe").unwrap().min_psnr, 110.0);
         assert_eq!(bound("clouds", "flythrough", "swiftshader").unwrap().min_psnr, 65.0);
         assert_eq!(bound("clouds", "cumulus", "swiftshader").unwrap().min_psnr, 75.0);
+        // A row's overrides must all be the setting's.
+        let low = settings().iter().find(|s| s.set.get("pitch_deg").is_some_and(|p| p == "5")).expect("a low view");
+        assert_eq!(bound_of(low, "swiftshader").unwrap().min_psnr, 65.0);
+        assert_eq!(bound_of(low, "lavapipe").unwrap().min_psnr, 110.0);
     }
 }
