@@ -48,12 +48,7 @@ pub struct Flags {
 }
 
 fn truthy(name: &str, v: Option<String>) -> Result<bool, GoldenError> {
-    match v.as_deref() {
-        None | Some("") | Some("0") => Ok(false),
-        Some(v) if v.eq_ignore_ascii_case("false") => Ok(false),
-        Some(v) if v == "1" || v.eq_ignore_ascii_case("true") => Ok(true),
-        Some(v) => Err(GoldenError::BadInput(format!("{name}={v} is not valid; expected 1|0|true|false"))),
-    }
+    vista_project::truthy(name, v.as_deref()).map_err(GoldenError::BadInput)
 }
 
 impl Config {

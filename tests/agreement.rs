@@ -1,7 +1,7 @@
 //! GPU against the f64 CPU reference, every kernel, with bounds set from the
 //! measured agreement (README "GPU vs CPU bounds"), all four channels
 //! compared. Then the proof that those bounds can fail: a 5% change of a
-//! physical or shading constant in a temporary copy of the shaders, three
+//! physical or shading constant in the shaders, composed in memory, three
 //! per kernel, must break at least one setting's bound; and dropping the
 //! heightfield hit refinement must break its depth agreement.
 
@@ -122,7 +122,7 @@ const FAULTS: &[Fault] = &[
 fn a_five_percent_constant_change_fails_an_agreement_bound(gpu: &Renderer<'static>) {
     let mut survived = Vec::new();
     for (kernel, file, from, to) in FAULTS {
-        let (_dir, edited) = common::with_edit(gpu, file, from, to);
+        let edited = common::with_edit(gpu, file, from, to);
         let v = violations(&edited, kernel);
         eprintln!("fault {kernel} {file}: '{from}' -> '{to}': {} settings out of bounds {v:?}", v.len());
         if v.is_empty() {
@@ -167,7 +167,7 @@ fn heightfield_depth_agrees_over_pixels_where_either_side_hits(gpu: &Renderer) {
 
 fn dropping_the_hit_refinement_fails_the_depth_agreement(gpu: &Renderer<'static>) {
     let refined = "return Hit(true, refine(s, m.eps, o, d, prev, vec2(t, dh)), k);";
-    let (_dir, edited) = common::with_edit(gpu, "lib/terrain.wgsl", refined, "return Hit(true, t, k);");
+    let edited = common::with_edit(gpu, "lib/terrain.wgsl", refined, "return Hit(true, t, k);");
     for (preset, min_pct) in DEPTH_AGREEMENT_PCT {
         let (ok, n) = depth_agreement(&edited, preset);
         let pct = 100.0 * ok as f64 / n as f64;
@@ -177,22 +177,10 @@ fn dropping_the_hit_refinement_fails_the_depth_agreement(gpu: &Renderer<'static>
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        (
-            "gpu_agrees_with_the_f64_reference_within_measured_bounds",
-            gpu_agrees_with_the_f64_reference_within_measured_bounds,
-        ),
-        (
-            "a_five_percent_constant_change_fails_an_agreement_bound",
-            a_five_percent_constant_change_fails_an_agreement_bound,
-        ),
-        (
-            "heightfield_depth_agrees_over_pixels_where_either_side_hits",
-            heightfield_depth_agrees_over_pixels_where_either_side_hits,
-        ),
-        (
-            "dropping_the_hit_refinement_fails_the_depth_agreement",
-            dropping_the_hit_refinement_fails_the_depth_agreement,
-        ),
-    ]);
+    common::gpu_tests![
+        gpu_agrees_with_the_f64_reference_within_measured_bounds,
+        a_five_percent_constant_change_fails_an_agreement_bound,
+        heightfield_depth_agrees_over_pixels_where_either_side_hits,
+        dropping_the_hit_refinement_fails_the_depth_agreement,
+    ];
 }

@@ -173,10 +173,10 @@ fn exr_round_trip_is_bit_identical(ctx: &vista_render::Renderer) {
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        ("gpu_high_quality_matches_converged_cpu", gpu_high_quality_matches_converged_cpu),
-        ("gpu_sky_invariants", gpu_sky_invariants),
-        ("gpu_finite_over_the_parameter_grid", gpu_finite_over_the_parameter_grid),
-        ("exr_round_trip_is_bit_identical", exr_round_trip_is_bit_identical),
-    ]);
+    common::gpu_tests![
+        gpu_high_quality_matches_converged_cpu,
+        gpu_sky_invariants,
+        gpu_finite_over_the_parameter_grid,
+        exr_round_trip_is_bit_identical,
+    ];
 }

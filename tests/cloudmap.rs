@@ -51,8 +51,5 @@ fn gpu_invariants_cover_and_frames(ctx: &vista_render::Renderer) {
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        ("gpu_matches_f64_reference_on_every_preset", gpu_matches_f64_reference_on_every_preset),
-        ("gpu_invariants_cover_and_frames", gpu_invariants_cover_and_frames),
-    ]);
+    common::gpu_tests![gpu_matches_f64_reference_on_every_preset, gpu_invariants_cover_and_frames,];
 }

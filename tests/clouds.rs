@@ -140,18 +140,12 @@ fn coverage_oktas_reads_the_presets_table_on_the_gpu(ctx: &vista_render::Rendere
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        ("coverage_oktas_reads_the_presets_table_on_the_gpu", coverage_oktas_reads_the_presets_table_on_the_gpu),
-        ("zero_coverage_is_exactly_the_background", zero_coverage_is_exactly_the_background),
-        ("doubling_density_never_raises_transmittance", doubling_density_never_raises_transmittance),
-        (
-            "dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind",
-            dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind,
-        ),
-        (
-            "renders_are_deterministic_and_jitter_follows_its_seed",
-            renders_are_deterministic_and_jitter_follows_its_seed,
-        ),
-        ("seed_experiment_on_the_gpu", seed_experiment_on_the_gpu),
-    ]);
+    common::gpu_tests![
+        coverage_oktas_reads_the_presets_table_on_the_gpu,
+        zero_coverage_is_exactly_the_background,
+        doubling_density_never_raises_transmittance,
+        dual_lobe_hg_is_brighter_than_single_lobe_with_the_sun_behind,
+        renders_are_deterministic_and_jitter_follows_its_seed,
+        seed_experiment_on_the_gpu,
+    ];
 }

@@ -252,14 +252,14 @@ fn cpu_f32_relax_march_matches_the_gpu(ctx: &vista_render::Renderer) {
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        ("no_hit_lies_behind_the_brute_force_reference", no_hit_lies_behind_the_brute_force_reference),
-        ("refined_hits_satisfy_eps_rule", refined_hits_satisfy_eps_rule),
-        ("raising_max_steps_never_removes_hits", raising_max_steps_never_removes_hits),
-        ("relax_one_oversteps_on_grazing_where_half_does_not", relax_one_oversteps_on_grazing_where_half_does_not),
-        ("analytic_plane_depth_and_ramp_normals", analytic_plane_depth_and_ramp_normals),
-        ("sine_terrain_matches_bisection_and_normals_face_up", sine_terrain_matches_bisection_and_normals_face_up),
-        ("steps_match_reference", steps_match_reference),
-        ("cpu_f32_relax_march_matches_the_gpu", cpu_f32_relax_march_matches_the_gpu),
-    ]);
+    common::gpu_tests![
+        no_hit_lies_behind_the_brute_force_reference,
+        refined_hits_satisfy_eps_rule,
+        raising_max_steps_never_removes_hits,
+        relax_one_oversteps_on_grazing_where_half_does_not,
+        analytic_plane_depth_and_ramp_normals,
+        sine_terrain_matches_bisection_and_normals_face_up,
+        steps_match_reference,
+        cpu_f32_relax_march_matches_the_gpu,
+    ];
 }

@@ -177,16 +177,10 @@ fn clouds_in_front_hide_the_terrain(ctx: &Renderer) {
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        (
-            "without_air_or_clouds_it_is_the_heightfield_shading_under_a_white_sun",
-            without_air_or_clouds_it_is_the_heightfield_shading_under_a_white_sun,
-        ),
-        (
-            "flat_ground_gives_the_atmosphere_kernels_sky_above_the_horizon",
-            flat_ground_gives_the_atmosphere_kernels_sky_above_the_horizon,
-        ),
-        ("radiance_is_finite_and_non_negative_in_every_preset", radiance_is_finite_and_non_negative_in_every_preset),
-        ("clouds_in_front_hide_the_terrain", clouds_in_front_hide_the_terrain),
-    ]);
+    common::gpu_tests![
+        without_air_or_clouds_it_is_the_heightfield_shading_under_a_white_sun,
+        flat_ground_gives_the_atmosphere_kernels_sky_above_the_horizon,
+        radiance_is_finite_and_non_negative_in_every_preset,
+        clouds_in_front_hide_the_terrain,
+    ];
 }

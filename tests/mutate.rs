@@ -66,9 +66,9 @@ fn only_functions_the_kernel_reaches_are_mutated(_gpu: &Renderer) {
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        ("a_known_bad_mutant_is_killed_by_a_golden_case", a_known_bad_mutant_is_killed_by_a_golden_case),
-        ("a_change_the_shader_never_reads_is_equivalent", a_change_the_shader_never_reads_is_equivalent),
-        ("only_functions_the_kernel_reaches_are_mutated", only_functions_the_kernel_reaches_are_mutated),
-    ]);
+    common::gpu_tests![
+        a_known_bad_mutant_is_killed_by_a_golden_case,
+        a_change_the_shader_never_reads_is_equivalent,
+        only_functions_the_kernel_reaches_are_mutated,
+    ];
 }

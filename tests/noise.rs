@@ -108,7 +108,7 @@ fn one_octave_fbm_equals_the_basis_on_gpu(ctx: &vista_render::Renderer) {
 /// exactly 0): every 2D perlin kernel must render bit-identical raw output
 /// with and without that shortcut.
 fn the_integer_z_shortcut_is_bit_identical_to_the_full_formula(gpu: &vista_render::Renderer<'static>) {
-    let (_dir, full) = common::with_edit(gpu, "lib/noise.wgsl", "if f.z == 0.0 {", "if false {");
+    let full = common::with_edit(gpu, "lib/noise.wgsl", "if f.z == 0.0 {", "if false {");
     for (name, preset, size) in [
         ("fbm", "default", (128, 96)),
         ("fbm", "rough", (128, 96)),
@@ -149,8 +149,8 @@ fn bit_identical_to_reference(
     wrong: (&str, &str),
     cases: &[Equivalence],
 ) {
-    let (_dir, reference) = common::with_edit(gpu, file, reference.0, reference.1);
-    let (_dir2, broken) = common::with_edit(gpu, file, wrong.0, wrong.1);
+    let reference = common::with_edit(gpu, file, reference.0, reference.1);
+    let broken = common::with_edit(gpu, file, wrong.0, wrong.1);
     for &(name, preset, set, def, shows) in cases {
         let k = vista_kernels::find(name).unwrap();
         let p = common::params(k, Some(preset), set);
@@ -274,34 +274,16 @@ fn the_specialized_terrain_is_bit_identical_to_the_run_time_branch(gpu: &vista_r
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        (
-            "the_hash_plane_is_bit_identical_to_the_permutation_chain",
-            the_hash_plane_is_bit_identical_to_the_permutation_chain,
-        ),
-        ("the_packed_chain_is_bit_identical_to_perlins_chain", the_packed_chain_is_bit_identical_to_perlins_chain),
-        (
-            "the_specialized_basis_is_bit_identical_to_the_run_time_branch",
-            the_specialized_basis_is_bit_identical_to_the_run_time_branch,
-        ),
-        (
-            "the_specialized_terrain_is_bit_identical_to_the_run_time_branch",
-            the_specialized_terrain_is_bit_identical_to_the_run_time_branch,
-        ),
-        (
-            "the_integer_z_shortcut_is_bit_identical_to_the_full_formula",
-            the_integer_z_shortcut_is_bit_identical_to_the_full_formula,
-        ),
-        (
-            "fbm_f32_error_follows_the_coordinate_precision_estimate",
-            fbm_f32_error_follows_the_coordinate_precision_estimate,
-        ),
-        (
-            "value_noise_is_bit_identical_to_cpu_at_lattice_points",
-            value_noise_is_bit_identical_to_cpu_at_lattice_points,
-        ),
-        ("perlin_is_zero_at_lattice_points_on_gpu", perlin_is_zero_at_lattice_points_on_gpu),
-        ("seed_changes_the_gpu_image", seed_changes_the_gpu_image),
-        ("one_octave_fbm_equals_the_basis_on_gpu", one_octave_fbm_equals_the_basis_on_gpu),
-    ]);
+    common::gpu_tests![
+        the_hash_plane_is_bit_identical_to_the_permutation_chain,
+        the_packed_chain_is_bit_identical_to_perlins_chain,
+        the_specialized_basis_is_bit_identical_to_the_run_time_branch,
+        the_specialized_terrain_is_bit_identical_to_the_run_time_branch,
+        the_integer_z_shortcut_is_bit_identical_to_the_full_formula,
+        fbm_f32_error_follows_the_coordinate_precision_estimate,
+        value_noise_is_bit_identical_to_cpu_at_lattice_points,
+        perlin_is_zero_at_lattice_points_on_gpu,
+        seed_changes_the_gpu_image,
+        one_octave_fbm_equals_the_basis_on_gpu,
+    ];
 }

@@ -233,20 +233,11 @@ fn a_validation_message_fails_the_dispatch(_shared: &vista_render::Renderer) {
 }
 
 fn main() {
-    common::run_gpu_tests(&[
-        ("a_validation_message_fails_the_dispatch", a_validation_message_fails_the_dispatch),
-        (
-            "injected_nan_fails_the_case_naming_count_and_first_pixel",
-            injected_nan_fails_the_case_naming_count_and_first_pixel,
-        ),
-        ("render_path_reports_nan_from_the_gpu_bit_exactly", render_path_reports_nan_from_the_gpu_bit_exactly),
-        (
-            "an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it",
-            an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it,
-        ),
-        (
-            "random_in_range_params_give_finite_output_within_documented_bounds",
-            random_in_range_params_give_finite_output_within_documented_bounds,
-        ),
-    ]);
+    common::gpu_tests![
+        a_validation_message_fails_the_dispatch,
+        injected_nan_fails_the_case_naming_count_and_first_pixel,
+        render_path_reports_nan_from_the_gpu_bit_exactly,
+        an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it,
+        random_in_range_params_give_finite_output_within_documented_bounds,
+    ];
 }

@@ -79,25 +79,30 @@ pub fn run_gpu_tests(tests: &[GpuTest]) -> ! {
     libtest_mimic::run(&args, trials).exit()
 }
 
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap().flatten() {
-        let (src, dst) = (e.path(), to.join(e.file_name()));
-        if src.is_dir() { copy_tree(&src, &dst) } else { std::fs::copy(&src, &dst).map(|_| ()).unwrap() }
-    }
+/// A renderer over this checkout's shaders with one edit (`from`, which
+/// must occur exactly once in `file`, replaced by `to`), composed in memory
+/// as `vista mutate` composes its mutants: nothing is written anywhere.
+pub fn with_edit(gpu: &Renderer<'static>, file: &str, from: &str, to: &str) -> Renderer<'static> {
+    let files = project().shader_files().expect("the checkout's shaders");
+    let target = files.iter().find(|f| f.rel == file).unwrap_or_else(|| panic!("no shader {file}"));
+    assert_eq!(target.text.matches(from).count(), 1, "{file}: '{from}' must occur exactly once (shader changed?)");
+    let shaders = vista_gpu::ShaderSet::from_files(
+        "edited",
+        files.into_iter().map(|f| {
+            let text = if f.rel == file { f.text.replace(from, to) } else { f.text };
+            (f.rel, text, f.origin)
+        }),
+    );
+    Renderer { ctx: gpu.ctx, shaders, limits: gpu.limits, root: gpu.root.clone() }
 }
 
-/// A renderer over a temporary copy of this checkout's shaders with one
-/// edit (`from`, which must occur exactly once, replaced by `to`): the
-/// checkout itself is never written. Keep the TempDir alive while rendering.
-pub fn with_edit(gpu: &Renderer<'static>, file: &str, from: &str, to: &str) -> (tempfile::TempDir, Renderer<'static>) {
-    let t = tempfile::tempdir().unwrap();
-    std::fs::write(t.path().join("vista.toml"), "").unwrap();
-    copy_tree(&project().root().unwrap().join("shaders"), &t.path().join("shaders"));
-    let path = t.path().join("shaders").join(file);
-    let text = std::fs::read_to_string(&path).unwrap();
-    assert_eq!(text.matches(from).count(), 1, "{file}: '{from}' must occur exactly once (shader changed?)");
-    std::fs::write(&path, text.replace(from, to)).unwrap();
-    let project = vista_project::Project::at(t.path()).unwrap();
-    (t, Renderer::new(gpu.ctx, &project, gpu.limits).unwrap())
+/// Runs a file's GPU test functions, each named by itself (see
+/// [`run_gpu_tests`]).
+#[allow(unused_macros)] // files without GPU tests include this module too
+macro_rules! gpu_tests {
+    ($($f:ident),* $(,)?) => {
+        common::run_gpu_tests(&[$((stringify!($f), $f as fn(&vista_render::Renderer<'static>))),*])
+    };
 }
+#[allow(unused_imports)]
+pub(crate) use gpu_tests;

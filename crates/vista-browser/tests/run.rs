@@ -30,14 +30,20 @@ fn browser() -> Browser {
 fn main() {
     let args = libtest_mimic::Arguments::from_args();
     let missing = vista_browser::find_chromium(&config()).err();
-    let skip = missing.filter(|_| std::env::var("VISTA_ALLOW_NO_GPU").as_deref() == Ok("1"));
-    let tests: [(&str, fn()); 3] = [
-        ("a_kernel_runs_and_reads_back_every_texel", a_kernel_runs_and_reads_back_every_texel),
-        ("tint_errors_name_the_case_and_the_next_run_works", tint_errors_name_the_case_and_the_next_run_works),
-        (
-            "a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named",
-            a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named,
-        ),
+    // The one parser of VISTA_ALLOW_NO_GPU (1|0|true|false), as every GPU suite reads it.
+    let allow = vista_project::truthy("VISTA_ALLOW_NO_GPU", std::env::var("VISTA_ALLOW_NO_GPU").ok().as_deref())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let skip = missing.filter(|_| allow);
+    // Each test's name is its function's name, written once.
+    macro_rules! tests {
+        ($($f:ident),* $(,)?) => {
+            [$((stringify!($f), $f as fn())),*]
+        };
+    }
+    let tests = tests![
+        a_kernel_runs_and_reads_back_every_texel,
+        tint_errors_name_the_case_and_the_next_run_works,
+        a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named,
     ];
     if let Some(e) = &skip {
         eprintln!(

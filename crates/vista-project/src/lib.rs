@@ -256,6 +256,20 @@ fn files_with_ext(dir: &Path, ext: &str) -> Result<Vec<PathBuf>, ProjectError> {
     Ok(out)
 }
 
+/// A yes/no setting's value (`VISTA_ALLOW_NO_GPU`, `VISTA_VALIDATION`, ...):
+/// unset, empty, `0` or `false` is no, `1` or `true` yes (either case);
+/// anything else is an error naming the setting and what is allowed. The
+/// one parser for every edge that reads such a setting (the binary's
+/// configuration, the test harnesses).
+pub fn truthy(name: &str, value: Option<&str>) -> Result<bool, String> {
+    match value {
+        None | Some("") | Some("0") => Ok(false),
+        Some(v) if v.eq_ignore_ascii_case("false") => Ok(false),
+        Some(v) if v == "1" || v.eq_ignore_ascii_case("true") => Ok(true),
+        Some(v) => Err(format!("{name}={v} is not valid; expected 1|0|true|false")),
+    }
+}
+
 /// A TOML parse error as one line: message, line and column.
 pub fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
     let msg = e.message().trim().replace('\n', " ");
