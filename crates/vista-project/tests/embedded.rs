@@ -1,6 +1,7 @@
 //! The embedded built-ins are exactly the repository's files: nothing in
-//! `shaders/` or `kernels/` is left out of the binary, and nothing embedded
-//! is stale.
+//! `shaders/` or `kernels/` is left out of the binary's list, and the list
+//! names no file that is gone. (Their text cannot be stale: `include_str!`
+//! reads the very file at build time, so comparing it would prove nothing.)
 
 use std::path::{Path, PathBuf};
 
@@ -35,9 +36,6 @@ fn same_set(embedded: &[(&str, &str)], dir: &Path, ext: &str, skip: &[&str]) {
     let mut names: Vec<String> = embedded.iter().map(|(r, _)| r.to_string()).collect();
     names.sort();
     assert_eq!(names, files(dir, ext, skip), "embedded list vs {}", dir.display());
-    for (rel, text) in embedded {
-        assert_eq!(*text, std::fs::read_to_string(dir.join(rel)).unwrap(), "{rel} is stale");
-    }
 }
 
 #[test]
@@ -49,4 +47,12 @@ fn every_builtin_shader_is_embedded() {
 #[test]
 fn every_builtin_manifest_is_embedded() {
     same_set(KERNELS, &repo().join("kernels"), "toml", &[]);
+}
+
+/// The check fails when a file is left out of the list (a new shader that
+/// builtin.rs does not name).
+#[test]
+#[should_panic(expected = "embedded list vs")]
+fn a_shader_left_out_of_the_list_fails() {
+    same_set(&SHADERS[1..], &repo().join("shaders"), "wgsl", &["test/"]);
 }
