@@ -1,3 +1,4 @@
+#![deny(missing_docs)]
 //! vista: headless GPU compute validation for procedural WGSL kernels.
 //!
 //! This root package re-exports the workspace crates; its `tests/` hold the

@@ -1,3 +1,4 @@
+#![deny(missing_docs)]
 //! Runs one WGSL compute kernel in headless Chromium's WebGPU: Tint
 //! compiles it and Dawn runs it on Chromium's SwiftShader adapter. The
 //! browser is driven over the DevTools protocol through
@@ -39,32 +40,74 @@ const RUNNER: &str = include_str!("runner.js");
 /// each chunk is whole base64 quads and whole texels).
 const CHUNK: usize = 3 << 20;
 
+/// Why finding, launching or running the browser failed.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum BrowserError {
+    /// No Chromium binary was found, or `VISTA_CHROMIUM` names no file.
     #[error("no Chromium found ({looked}); {hint}")]
-    NotInstalled { looked: String, hint: &'static str },
+    NotInstalled {
+        /// Where the search looked.
+        looked: String,
+        /// How to install Chromium ([`INSTALL_HINT`]).
+        hint: &'static str,
+    },
+    /// Chromium could not be started, the runner page could not be written
+    /// or loaded, or the call to the page's WebGPU init failed.
     #[error("Chromium ({path}) did not start: {message}")]
-    Launch { path: String, message: String },
+    Launch {
+        /// The Chromium binary.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// The page's WebGPU init reported an error (e.g. no adapter, or device
+    /// creation failed) or an unreadable reply; holds the message.
     #[error("Chromium has no usable WebGPU adapter: {0}")]
     NoWebGpu(String),
+    /// The page reported an error (e.g. Tint rejected the WGSL, a WebGPU
+    /// validation error), a DevTools call failed, or the reply or its output
+    /// bytes were malformed.
     #[error("{case}: in the browser: {message}")]
-    Page { case: String, message: String },
+    Page {
+        /// The run's label.
+        case: String,
+        /// The page's or protocol's error message.
+        message: String,
+    },
+    /// A DevTools call got no answer within the watchdog timeout.
     #[error(
         "{case}: the browser did not answer within {seconds} s (watchdog; raise VISTA_GPU_TIMEOUT_S); Chromium was killed"
     )]
-    Timeout { case: String, seconds: f64 },
+    Timeout {
+        /// The run's label.
+        case: String,
+        /// The watchdog timeout, in seconds.
+        seconds: f64,
+    },
+    /// Chromium or its page's renderer exited, or the DevTools pipe closed.
     #[error("{case}: Chromium died or closed the DevTools connection: {message}")]
-    Died { case: String, message: String },
+    Died {
+        /// The run's label.
+        case: String,
+        /// Why the browser or connection is gone.
+        message: String,
+    },
 }
 
 /// What the page's WebGPU adapter and the browser say about themselves.
 #[derive(Debug, Clone, Default, Deserialize)]
 pub struct AdapterInfo {
+    /// The adapter's `GPUAdapterInfo.vendor`.
     pub vendor: String,
+    /// The adapter's `GPUAdapterInfo.architecture`.
     pub architecture: String,
+    /// The adapter's `GPUAdapterInfo.device`.
     pub device: String,
+    /// The adapter's `GPUAdapterInfo.description`.
     pub description: String,
+    /// The page's `navigator.userAgent`.
     pub user_agent: String,
+    /// The device's `maxTextureDimension2D` limit, in texels.
     pub max_dimension: u32,
     /// The device's features (the page requests every one the adapter has).
     #[serde(default)]
@@ -85,6 +128,7 @@ pub struct Job<'a> {
     pub label: &'a str,
     /// Pipeline cache key: equal keys must mean equal WGSL.
     pub key: &'a str,
+    /// The WGSL module source, compiled in the page by Tint.
     pub wgsl: &'a str,
     /// The compute entry point.
     pub entry: &'a str,
@@ -106,8 +150,11 @@ pub struct Job<'a> {
     pub fill: &'a [u8],
     /// The bytes of each uniform block.
     pub uniforms: &'a [Vec<u8>],
+    /// The words of the read-only `array<u32>` table buffer.
     pub table: &'a [u32],
+    /// Output texture width in texels.
     pub width: u32,
+    /// Output texture height in texels (of one layer).
     pub height: u32,
 }
 
@@ -115,8 +162,11 @@ pub struct Job<'a> {
 /// (`uniform`, `table` or `output`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct Slot {
+    /// The WGSL `@group` index.
     pub group: u32,
+    /// The WGSL `@binding` number within the group.
     pub binding: u32,
+    /// `"uniform"`, `"table"` or `"output"`.
     pub kind: &'static str,
     /// Which of the job's uniform blocks a `uniform` slot takes.
     pub index: u32,
@@ -126,6 +176,7 @@ pub struct Slot {
 /// unpadded) and the page's timings.
 #[derive(Debug, Clone)]
 pub struct Output {
+    /// The output texels, row-major and unpadded, layers stacked in order.
     pub bytes: Vec<u8>,
     /// Submit to `onSubmittedWorkDone` of the compute pass.
     pub kernel: Duration,
@@ -145,10 +196,14 @@ pub fn base64(bytes: &[u8]) -> String {
 /// a texture's texels row-major and unpadded, a buffer whole) and timings.
 #[derive(Debug, Clone)]
 pub struct GraphOutput {
+    /// Each output's bytes, in the order of the job's `outputs`.
     pub outputs: Vec<Vec<u8>>,
     /// Wall time of each pass in the page, all its repeats.
     pub passes: Vec<Duration>,
+    /// Copy, map and unpad of every output in the page (not the DevTools
+    /// transfer).
     pub readback: Duration,
+    /// The whole call from Rust, transfer included.
     pub total: Duration,
 }
 
@@ -182,6 +237,7 @@ impl Browser {
         self.timeout = timeout;
     }
 
+    /// What the adapter and browser reported at launch.
     pub fn info(&self) -> &AdapterInfo {
         &self.info
     }

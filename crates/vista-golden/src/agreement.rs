@@ -48,10 +48,14 @@ pub fn agreement(kernel: &Kernel, gpu: &Image, reference: &Image) -> Agreement {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Setting {
+    /// Name of the built-in kernel rendered.
     pub kernel: String,
+    /// The kernel preset the setting starts from.
     pub preset: String,
+    /// Parameter overrides on top of the preset, by name (values as text).
     #[serde(default)]
     pub set: std::collections::BTreeMap<String, String>,
+    /// Render size `[width, height]` in pixels.
     pub size: [u32; 2],
 }
 
@@ -76,7 +80,9 @@ impl Setting {
 /// The least agreement a setting must reach.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 pub struct Bound {
+    /// Least PSNR (dB) of the GPU render against the f64 reference.
     pub min_psnr: f64,
+    /// Largest absolute difference allowed between GPU and reference values.
     pub max_abs: f64,
 }
 
@@ -176,7 +182,9 @@ pub fn reference(k: &Kernel, p: &ParamSet, w: u32, h: u32) -> Image {
 /// One setting judged: its agreement, its bound, and why it breaks it.
 #[derive(Debug, Clone)]
 pub struct Judged {
+    /// The GPU render's agreement with the f64 reference.
     pub agreement: Agreement,
+    /// The bound from `agreement.toml` it is held to on this backend.
     pub bound: Bound,
     /// The figures, when the agreement is outside the bound.
     pub broken: Option<String>,
@@ -189,7 +197,13 @@ pub struct Judged {
 pub enum SettingError {
     /// A render failed (a GPU timeout among them).
     #[error("{setting}: {source}")]
-    Render { setting: String, source: vista_render::RenderError },
+    Render {
+        /// The setting's label ([`Setting::label`]; with ` depth` appended for
+        /// its depth-view render).
+        setting: String,
+        /// Why the render failed.
+        source: vista_render::RenderError,
+    },
     /// The setting is not judgeable: no bound, bad params, or terrain hits
     /// too far from the oracle's for shading to be compared.
     #[error("{0}")]

@@ -13,6 +13,7 @@ use crate::store::{ManifestEntry, Store, params_hash};
 use crate::{GoldenError, select};
 use vista_render::{Rendered, Renderer, quantize16};
 
+/// What `vista bless` blesses, and how.
 #[derive(Debug, Clone, Default)]
 pub struct BlessOptions {
     /// Glob over case ids; all cases when `None`.
@@ -31,27 +32,36 @@ pub struct BlessOptions {
 /// One blessed case, for the summary table.
 #[derive(Debug, Clone)]
 pub struct BlessRow {
+    /// The case id.
     pub id: String,
     /// "new", "changed" or "unchanged".
     pub status: &'static str,
     /// PSNR of the new golden against the old one.
     pub psnr_vs_previous: String,
+    /// The golden file written (for a case without a main image, its first other golden file).
     pub path: PathBuf,
 }
 
 /// Result of a bless: the rows, and orphaned goldens (deleted if pruned).
 #[derive(Debug, Clone, Default)]
 pub struct BlessSummary {
+    /// One row per blessed case, in selection order.
     pub rows: Vec<BlessRow>,
     /// Goldens over 1 MiB, one line each.
     pub warnings: Vec<String>,
+    /// Golden files on disk that no case refers to (`Store::orphans`).
     pub orphans: Vec<PathBuf>,
+    /// Whether the orphans were deleted (`BlessOptions::prune`).
     pub pruned: bool,
 }
 
 /// A golden larger than this is named when blessed.
 pub const GOLDEN_WARN_BYTES: usize = 1 << 20;
 
+/// Renders every selected case and, only if all succeed and pass the guards
+/// `vista check` applies, writes each golden and its manifest entry
+/// (atomically, case by case); lists orphaned goldens and deletes them with
+/// `prune`. Refused when `in_ci` is set without `force`.
 pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<BlessSummary, GoldenError> {
     if opts.in_ci && !opts.force {
         return Err(GoldenError::Refused(

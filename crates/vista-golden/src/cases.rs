@@ -25,8 +25,11 @@ use vista_kernels::ParamSet;
 
 use crate::GoldenError;
 
+/// Image size (width, height) in pixels of a case without `size`.
 pub const DEFAULT_SIZE: (u32, u32) = (256, 256);
+/// `psnr_same_driver` (dB) of a case that does not set it.
 pub const DEFAULT_PSNR_SAME_DRIVER: f64 = 60.0;
+/// `psnr_other_driver` (dB) of a case that does not set it.
 pub const DEFAULT_PSNR_OTHER_DRIVER: f64 = 35.0;
 
 #[derive(Debug, Deserialize)]
@@ -70,15 +73,21 @@ struct RawCase {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Expectation {
+    /// The backend it fails on: one of `EXPECTATION_BACKENDS`.
     pub backend: String,
+    /// Substring of the adapter description it fails on; empty matches any.
     #[serde(default)]
     pub driver: String,
+    /// Why it fails there (required, non-empty).
     pub reason: String,
+    /// A feature whose lack is the expected failure; empty for any failure.
     #[serde(default)]
     pub unsupported: String,
 }
 
 impl Expectation {
+    /// Whether this expectation applies to a run on `backend` whose adapter
+    /// description is `adapter`.
     pub fn matches(&self, backend: &str, adapter: &str) -> bool {
         self.backend == backend && adapter.contains(&self.driver)
     }
@@ -90,15 +99,26 @@ pub const EXPECTATION_BACKENDS: &[&str] = &["lavapipe", "swiftshader", "browser"
 /// One validated golden case.
 #[derive(Debug, Clone)]
 pub struct Case {
+    /// Unique id: the test name and the golden's file stem.
     pub id: String,
+    /// The kernel the case renders.
     pub kernel: &'static vista_kernels::Kernel,
+    /// The kernel preset the case names, if any.
     pub preset: Option<String>,
+    /// The case's `set` overrides as (name, value text), in name order.
     pub overrides: Vec<(String, String)>,
+    /// The resolved parameters: kernel defaults, then the preset, then the overrides.
     pub params: ParamSet,
+    /// Image width in pixels (256 unless `size` says otherwise).
     pub width: u32,
+    /// Image height in pixels (256 unless `size` says otherwise).
     pub height: u32,
+    /// Least PSNR (dB) against the golden when this run's adapter is the one it
+    /// was blessed on.
     pub psnr_same_driver: f64,
+    /// Least PSNR (dB) against the golden on any other adapter.
     pub psnr_other_driver: f64,
+    /// Least SSIM against the golden, if any.
     pub min_ssim: Option<f64>,
     /// Largest mean LDR-FLIP error allowed (display values), if any.
     pub max_flip: Option<f64>,
@@ -106,6 +126,7 @@ pub struct Case {
     /// count and as a share of the pixels, if any; a case with either is
     /// judged by them instead of its PSNR threshold.
     pub max_bad_pixels: Option<u64>,
+    /// Most bad pixels allowed as a share of the image's pixels, in [0, 1], if any.
     pub max_bad_ratio: Option<f64>,
     /// Rectangles `[x, y, w, h]` of the image the golden comparison leaves
     /// out (a watermark, a frame counter, a crest that flips across drivers).
@@ -115,6 +136,7 @@ pub struct Case {
     /// A pass graph's resource files this case replaces: (resource, file
     /// under the project root).
     pub inputs: Vec<(String, String)>,
+    /// What the case covers, in a few words (`doc` in cases.toml).
     pub doc: String,
 }
 
@@ -264,6 +286,7 @@ pub fn bless_all_command(failed: &[&str]) -> Option<String> {
 
 pub use vista_project::one_line_toml_error;
 
+/// Reads the case file at `path` and validates it (see [`parse_cases`]).
 pub fn load_cases(path: &Path, kernels: &vista_kernels::Registry) -> Result<Vec<Case>, GoldenError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| GoldenError::Cases { path: path.display().to_string(), message: format!("cannot read: {e}") })?;

@@ -13,8 +13,10 @@ use vista_image::metrics::{self, Metrics};
 use crate::Case;
 use crate::store::ManifestEntry;
 
+/// How a case came out of [`judge`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
+    /// No problem: every guard, provenance check and threshold holds.
     Pass,
     /// Rendered, but a metric or invariant is outside its threshold.
     Fail,
@@ -30,12 +32,18 @@ pub enum Verdict {
 /// 16-bit files, their 8-bit display copies, and the viewer's data.
 #[derive(Debug, Clone, Default)]
 pub struct ReportFiles {
+    /// The golden's values as a 16-bit PNG (`<id>/expected.png`), when the
+    /// golden could be read.
     pub expected: Option<String>,
+    /// The render's display values as a 16-bit PNG (`<id>/actual.png`).
     pub actual: Option<String>,
     /// Heat map on the fixed log scale (`vista_image::log_position`).
     pub diff: Option<String>,
+    /// 8-bit display copy of `expected`.
     pub expected8: Option<String>,
+    /// 8-bit display copy of `actual`.
     pub actual8: Option<String>,
+    /// 8-bit display copy of `diff`.
     pub diff8: Option<String>,
     /// `view.js`: both images' 16-bit values for the viewer's readout.
     pub view: Option<String>,
@@ -49,9 +57,16 @@ pub struct ReportFiles {
 /// The run's side of the provenance, beside the golden's manifest entry.
 #[derive(Debug, Clone, Default)]
 pub struct RunInfo {
+    /// The backend name this run renders on, as reports and manifests name it
+    /// (`lavapipe`, `swiftshader`, `gpu`, ...).
     pub backend: String,
+    /// The adapter description (`name | driver driver_info | backend | device
+    /// type`), compared with the golden's to pick the PSNR threshold.
     pub adapter: String,
+    /// Hash of the case's kernel, size and resolved parameters ([`params_hash`](crate::params_hash)).
     pub params_hash: String,
+    /// Hash of the WGSL the kernel reaches now (`unavailable: ...` when it
+    /// cannot be computed).
     pub shader_hash: String,
 }
 
@@ -59,9 +74,14 @@ pub struct RunInfo {
 #[must_use]
 #[derive(Debug, Clone)]
 pub struct Outcome {
+    /// The case id.
     pub id: String,
+    /// The name of the case's kernel.
     pub kernel: String,
+    /// How the case came out.
     pub verdict: Verdict,
+    /// Metrics of the render against the golden; `None` when no comparison was
+    /// made.
     pub metrics: Option<Metrics>,
     /// `metrics.psnr` is of the main image's raw values (its EXR golden),
     /// the rest of the metrics of its view.
@@ -69,19 +89,33 @@ pub struct Outcome {
     /// The PSNR threshold that applied, and whether the adapter matched the
     /// manifest's (60 dB same driver, 35 dB other driver by default).
     pub psnr_threshold: f64,
+    /// Whether this run's adapter is the one the golden was blessed on (true
+    /// without a manifest entry).
     pub same_driver: bool,
+    /// The least SSIM the case allows (`min_ssim`), if any.
     pub min_ssim: Option<f64>,
+    /// The largest mean FLIP error the case allows (`max_flip`), if any.
     pub max_flip: Option<f64>,
     /// One line per problem or note (shader changed since bless, ...).
     pub problems: Vec<String>,
+    /// Remarks that do not fail the case (another adapter, parameters changed
+    /// since bless, an expected failure).
     pub notes: Vec<String>,
+    /// The report's images of the case; filled in by the caller (`vista-report`).
     pub files: ReportFiles,
+    /// GPU wall time of the render in milliseconds; filled in by the caller.
     pub gpu_ms: f64,
+    /// The `vista bless` command that re-blesses this case's golden.
     pub bless_command: String,
+    /// Width in pixels of the rendered image (the case's size when nothing was
+    /// rendered).
     pub width: u32,
+    /// Height in pixels of the rendered image, layers and slices stacked top to
+    /// bottom (the case's size when nothing was rendered).
     pub height: u32,
     /// The golden's manifest entry at check time, and this run's side.
     pub golden: Option<crate::ManifestEntry>,
+    /// This run's side of the provenance.
     pub run: RunInfo,
     /// WGSL files (relative to `shaders/`) whose hash differs from the one
     /// recorded at bless time, or that were added to or dropped from the
@@ -158,10 +192,21 @@ impl Outcome {
 #[derive(Debug, Clone, Copy)]
 pub enum GoldenRead<'a> {
     /// No file at `path`.
-    Missing { path: &'a Path },
+    Missing {
+        /// Where the golden was looked for.
+        path: &'a Path,
+    },
     /// The file, the short hash of its bytes and its decoded values, or
     /// why they could not be decoded.
-    Present { path: &'a Path, hash: &'a str, image: Result<&'a Image, &'a str> },
+    Present {
+        /// The golden file.
+        path: &'a Path,
+        /// Short hash of its bytes ([`short_hash_bytes`](crate::short_hash_bytes)).
+        hash: &'a str,
+        /// Its decoded values, or why they could not be decoded (a Git LFS
+        /// pointer, a bad PNG).
+        image: Result<&'a Image, &'a str>,
+    },
     /// The case has no main image: a pass graph whose first output is a
     /// buffer, judged by its outputs alone.
     NoImage,
@@ -183,6 +228,7 @@ pub struct Observed<'a> {
     pub repeat_identical: Option<bool>,
     /// Hash of each WGSL file the kernel reaches now, by path.
     pub shader_files: &'a BTreeMap<String, String>,
+    /// The case's golden as the caller read it.
     pub golden: GoldenRead<'a>,
     /// A pass graph's outputs as compared with their goldens
     /// (`outputs::compare_output`); empty for a one-pass kernel.

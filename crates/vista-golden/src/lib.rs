@@ -1,3 +1,4 @@
+#![deny(missing_docs)]
 //! vista's golden cases: the case file, the golden store and its manifest,
 //! the verdict (`check::judge`, pure), and bless. Reports are written from
 //! its outcomes by `vista-report`.
@@ -30,27 +31,50 @@ pub use store::{Manifest, ManifestEntry, Store, params_hash};
 use vista_gpu::GpuError;
 use vista_image::ImageError;
 
+/// Errors of the golden workflow; [`GoldenError::exit_code`] maps each to the
+/// process exit code.
 #[derive(Debug, thiserror::Error)]
 pub enum GoldenError {
+    /// The case file, the golden manifest or a report's pending file cannot be
+    /// read or parsed, or a case in it is invalid.
     #[error("{path}: {message}")]
-    Cases { path: String, message: String },
+    Cases {
+        /// The file.
+        path: String,
+        /// What is wrong with it (for TOML syntax, with the line).
+        message: String,
+    },
+    /// A command-line value, environment variable or input the user can fix is
+    /// not valid (a glob that matches no case, a stale pending render, ...).
     #[error("{0}")]
     BadInput(String),
+    /// `vista bless` refused to run in CI (`CI=true`) without `--force`.
     #[error("{0}")]
     Refused(String),
     /// A render that a check would fail (exit 1, like the failed check).
     #[error("{0}")]
     Rejected(String),
+    /// A GPU error (`vista-gpu`): no adapter, a device failure, a timeout, an
+    /// unsupported feature, ...
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    /// A render failed or its request was refused (`vista-render`).
     #[error(transparent)]
     Render(#[from] vista_render::RenderError),
+    /// The project could not be found or its configuration read (`vista-project`).
     #[error(transparent)]
     Project(#[from] vista_project::ProjectError),
+    /// An image file could not be read, decoded, encoded or written (`vista-image`).
     #[error(transparent)]
     Image(#[from] ImageError),
+    /// A file or directory could not be read, created, written or removed.
     #[error("{path}: {message}")]
-    Io { path: String, message: String },
+    Io {
+        /// The path.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 impl GoldenError {

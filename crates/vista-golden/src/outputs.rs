@@ -95,6 +95,7 @@ pub fn output_files(golden_dir: &Path, case: &Case, key: &str, index: usize, out
 /// One output's verdict.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct OutputVerdict {
+    /// The output's name (`image` for a one-pass kernel's main image).
     pub name: String,
     /// What it is: `texture rgba16float 64x32`, `buffer <u4 [65536]`.
     pub kind: String,
@@ -119,6 +120,8 @@ pub struct OutputVerdict {
     pub missing: Vec<PathBuf>,
     /// Golden files that exist but cannot be read.
     pub errors: Vec<String>,
+    /// Why the output fails, one line each (a guard, a golden changed outside
+    /// bless, a difference beyond its threshold).
     pub problems: Vec<String>,
     /// One line: what was compared and how it came out.
     pub summary: String,

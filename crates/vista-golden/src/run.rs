@@ -20,6 +20,7 @@ pub struct CheckOptions {
 #[must_use]
 #[derive(Debug, Clone)]
 pub struct Checked {
+    /// The verdict on the case and everything it was judged on.
     pub outcome: Outcome,
     /// The render's display values as a 16-bit PNG holds them (none when it failed).
     pub actual: Option<Image>,

@@ -11,7 +11,9 @@ use crate::{Case, GoldenError};
 /// Provenance of one golden at bless time.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct ManifestEntry {
+    /// The case's kernel name.
     pub kernel: String,
+    /// Image size as `<width>x<height>` in pixels.
     pub size: String,
     /// Hash of the case's canonical resolved parameters.
     pub params_hash: String,
@@ -27,6 +29,7 @@ pub struct ManifestEntry {
     /// lavapipe | swiftshader | browser | gpu ("" in entries that predate it).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub backend: String,
+    /// When the golden was blessed: UTC, RFC 3339 to the second.
     pub date: String,
     /// Hash of the raw f32 output bits: a later render on the same adapter
     /// and shader must reproduce it exactly (determinism across processes).
@@ -79,8 +82,10 @@ impl ManifestEntry {
     }
 }
 
+/// `golden/manifest.toml`: the provenance of every golden.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 pub struct Manifest {
+    /// Entries by case id, or `<case>@<backend>` for a per-backend golden.
     #[serde(default)]
     pub case: BTreeMap<String, ManifestEntry>,
 }
@@ -88,7 +93,9 @@ pub struct Manifest {
 /// A golden directory and the kernels its cases may name.
 #[derive(Debug, Clone)]
 pub struct Store {
+    /// The golden directory (`golden/` under the project root).
     pub dir: PathBuf,
+    /// The project's kernels, which the case file's kernel names resolve against.
     pub kernels: vista_kernels::Registry,
 }
 
@@ -101,14 +108,17 @@ impl Store {
         Ok(Store { dir, kernels })
     }
 
+    /// `golden/cases.toml`: the case file.
     pub fn cases_path(&self) -> PathBuf {
         self.dir.join("cases.toml")
     }
 
+    /// `golden/manifest.toml`: the manifest.
     pub fn manifest_path(&self) -> PathBuf {
         self.dir.join("manifest.toml")
     }
 
+    /// `golden/<kernel>/<case>.png`: the case's own golden.
     pub fn golden_path(&self, case: &Case) -> PathBuf {
         self.dir.join(case.golden_rel_path())
     }
@@ -129,6 +139,7 @@ impl Store {
         }
     }
 
+    /// Reads and validates `golden/cases.toml` against the store's kernels.
     pub fn load_cases(&self) -> Result<Vec<Case>, GoldenError> {
         crate::load_cases(&self.cases_path(), &self.kernels)
     }
@@ -146,6 +157,7 @@ impl Store {
         }
     }
 
+    /// Writes the manifest atomically, under a do-not-edit header.
     pub fn write_manifest(&self, m: &Manifest) -> Result<(), GoldenError> {
         let text = format!(
             "# Written by `vista bless`: provenance of every golden. Do not edit by hand.\n\n{}",

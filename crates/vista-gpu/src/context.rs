@@ -36,10 +36,15 @@ pub const BACKENDS: &[&str] = &["lavapipe", "swiftshader", "browser", "gpu"];
 /// them from its flags and the environment, once.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct AdapterSettings {
+    /// The `--backend` flag's value.
     pub backend_flag: Option<String>,
+    /// The `--adapter` flag's value.
     pub adapter_flag: Option<String>,
+    /// `WGPU_ADAPTER_NAME`.
     pub wgpu_adapter_name: Option<String>,
+    /// `VISTA_BACKEND`.
     pub backend_env: Option<String>,
+    /// `VISTA_ADAPTER`.
     pub adapter_env: Option<String>,
 }
 
@@ -47,6 +52,7 @@ pub struct AdapterSettings {
 /// edge and passed in: this crate reads no environment.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GpuConfig {
+    /// The adapter to use (see [`AdapterChoice::from_settings`]).
     pub adapter: AdapterChoice,
     /// The Khronos validation layer (`VISTA_VALIDATION=1`): every message fails the run.
     pub validate: bool,
@@ -176,6 +182,7 @@ pub struct Dispatch<'a> {
     /// The output's dimension; its layers (2d-array) or depth (3d) are
     /// read back stacked top to bottom, one `height`-row image each.
     pub dimension: Dimension,
+    /// Array layers (2d-array) or depth (3d) of the output; 1 otherwise.
     pub layers: u32,
     /// The output is `read_write`: it starts as zeros (a resource's
     /// default contents), since the kernel may read a texel before writing
@@ -187,7 +194,9 @@ pub struct Dispatch<'a> {
     pub uniforms: &'a [Vec<u8>],
     /// Read-only u32 table for binding 2.
     pub table: &'a [u32],
+    /// Output width in texels.
     pub width: u32,
+    /// Output height in texels (of one layer).
     pub height: u32,
 }
 
@@ -214,9 +223,13 @@ pub const UNWRITTEN: u32 = 0x7FC0_DEAD;
 /// An output texture's dimension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Dimension {
+    /// A 1d texture (WebGPU `1d`).
     D1,
+    /// A 2d texture (WebGPU `2d`).
     D2,
+    /// A 2d texture of array layers, viewed as `2d-array`.
     D2Array,
+    /// A 3d texture (WebGPU `3d`).
     D3,
 }
 
@@ -277,8 +290,11 @@ pub enum SlotKind {
 /// One binding of a dispatch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Slot {
+    /// The WGSL `@group` index.
     pub group: u32,
+    /// The WGSL `@binding` number within the group.
     pub binding: u32,
+    /// What feeds the binding.
     pub kind: SlotKind,
 }
 
@@ -288,6 +304,8 @@ pub struct Slot {
 pub struct Readback {
     /// What the kernel wrote (unwritten texels read 0).
     pub image: Image,
+    /// The first run's timing; `total` covers both runs when unwritten
+    /// texels needed a second.
     pub stats: RunStats,
     /// Texels still holding [`UNWRITTEN`] after the run.
     pub unwritten: u64,
@@ -302,6 +320,8 @@ pub struct Context {
     pub(crate) timeout: Duration,
     /// Serialises submissions so a timeout is attributed to the right job.
     pub(crate) submit_lock: Mutex<()>,
+    /// How long creating the context took (adapter and device, or the
+    /// browser's launch).
     pub creation_time: Duration,
     /// Whether the Khronos validation layer is on.
     pub(crate) validate: bool,
@@ -528,6 +548,8 @@ impl Context {
         self.backend
     }
 
+    /// wgpu's info on the adapter in use; for the browser backend, filled in
+    /// from the page's WebGPU adapter and Chromium's version.
     pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
         &self.info
     }

@@ -102,8 +102,11 @@ fn f16_to_f32(h: u16) -> f32 {
 /// What a sampled texture of a format returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SampleKind {
+    /// Floats, normalized formats included (`texture_2d<f32>`).
     Float,
+    /// Unsigned integers (`texture_2d<u32>`).
     Uint,
+    /// Signed integers (`texture_2d<i32>`).
     Sint,
 }
 
@@ -112,6 +115,7 @@ pub enum SampleKind {
 pub struct OutputFormat {
     /// The WGSL (and WebGPU) name.
     pub name: &'static str,
+    /// The matching wgpu texture format.
     pub wgpu: wgpu::TextureFormat,
     channels: &'static [Channel],
 }

@@ -33,20 +33,28 @@ pub enum Contents {
 /// A texture resource.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TextureDesc {
+    /// The storage format's WGSL name (one of [`crate::format_names`]).
     pub format: &'static str,
+    /// The texture's dimension.
     pub dimension: Dimension,
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels (of one layer).
     pub height: u32,
     /// Array layers or depth (1 for 1d and 2d).
     pub layers: u32,
+    /// What the texture holds before the first pass.
     pub contents: Contents,
 }
 
 /// A sampler's address mode along one axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Address {
+    /// Coordinates outside [0, 1] clamp to the edge texel (`clamp-to-edge`).
     ClampToEdge,
+    /// The texture tiles (`repeat`).
     Repeat,
+    /// The texture tiles, mirrored every other tile (`mirror-repeat`).
     MirrorRepeat,
 }
 
@@ -54,6 +62,8 @@ impl Address {
     /// The manifest's names, in order.
     pub const NAMES: [&'static str; 3] = ["clamp-to-edge", "repeat", "mirror-repeat"];
 
+    /// The address mode of a manifest name, or `None` if it is not one of
+    /// [`Address::NAMES`].
     pub fn parse(name: &str) -> Option<Address> {
         Address::NAMES
             .iter()
@@ -90,6 +100,7 @@ pub struct SamplerDesc {
     /// Linear filtering (else nearest), for magnification, minification
     /// and mips alike.
     pub linear: bool,
+    /// Address modes along u, v and w.
     pub address: [Address; 3],
     /// A comparison sampler's function (one of [`COMPARE_NAMES`]).
     pub compare: Option<&'static str>,
@@ -98,17 +109,23 @@ pub struct SamplerDesc {
 /// A resource of the graph.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Resource {
+    /// A texture.
     Texture(TextureDesc),
     /// A buffer's initial bytes (its size; a multiple of 4).
     Buffer(Vec<u8>),
+    /// A sampler.
     Sampler(SamplerDesc),
 }
 
 /// How a storage texture is bound.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Access {
+    /// WGSL `write` (WebGPU `write-only`).
     Write,
+    /// WGSL `read` (WebGPU `read-only`).
     Read,
+    /// WGSL `read_write` (WebGPU `read-write`); beyond the r32 formats it
+    /// needs an adapter feature.
     ReadWrite,
 }
 
@@ -122,12 +139,29 @@ pub enum Bind {
     /// A buffer resource bound as a uniform (its bytes).
     UniformBuffer(usize),
     /// A buffer resource bound as storage.
-    Storage { resource: usize, read_only: bool },
+    Storage {
+        /// Index of the buffer in [`Graph::resources`].
+        resource: usize,
+        /// Bound `read-only-storage` rather than `storage`.
+        read_only: bool,
+    },
     /// A texture resource bound as a storage texture.
-    StorageTexture { resource: usize, access: Access },
+    StorageTexture {
+        /// Index of the texture in [`Graph::resources`].
+        resource: usize,
+        /// The storage texture's access mode.
+        access: Access,
+    },
     /// A texture resource bound for sampling or loads; `depth` for
     /// `texture_depth_2d`, `cube` for `texture_cube` over six layers.
-    Sampled { resource: usize, depth: bool, cube: bool },
+    Sampled {
+        /// Index of the texture in [`Graph::resources`].
+        resource: usize,
+        /// Bound with a depth sample type.
+        depth: bool,
+        /// Viewed as a cube rather than by its own dimension.
+        cube: bool,
+    },
     /// A sampler resource.
     Sampler(usize),
 }
@@ -149,8 +183,11 @@ impl Bind {
 /// One binding of a pass.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GraphSlot {
+    /// The WGSL `@group` index.
     pub group: u32,
+    /// The WGSL `@binding` number within the group.
     pub binding: u32,
+    /// What feeds the binding.
     pub bind: Bind,
 }
 
@@ -165,12 +202,21 @@ pub struct GraphPass {
     pub label: String,
     /// The kernel file (relative to `shaders/`), with defs after `?`.
     pub shader: String,
+    /// The compute entry point.
     pub entry: String,
+    /// Values of the module's pipeline-overridable constants, by name.
     pub constants: Vec<(String, f64)>,
+    /// Workgroups dispatched along x, y and z.
     pub workgroups: [u32; 3],
+    /// Every binding the entry point uses.
     pub slots: Vec<GraphSlot>,
+    /// How many times the pass (or the group it starts) runs.
     pub repeat: u32,
+    /// Pairs of resource indices whose bindings are exchanged after every
+    /// run of the pass (ping-pong).
     pub swap: Vec<(usize, usize)>,
+    /// Passes in the group this pass starts (itself included); 1 alone, 0
+    /// for a later member of a group.
     pub span: u32,
     /// The entry point's reflected workgroup size (checked against the
     /// device's limits before any work).
@@ -202,8 +248,11 @@ impl GraphPass {
 /// A whole graph.
 #[derive(Debug, Clone)]
 pub struct Graph<'a> {
+    /// The project's WGSL sources.
     pub shaders: &'a ShaderSet,
+    /// Every resource; bindings, swaps and outputs name them by index.
     pub resources: Vec<Resource>,
+    /// The passes, in order.
     pub passes: Vec<GraphPass>,
     /// Resources read back after the last pass (after its swaps: a swapped
     /// name reads the resource it binds then).
@@ -230,7 +279,12 @@ pub fn run_order(passes: &[GraphPass]) -> Vec<usize> {
 pub enum OutputData {
     /// A texture decoded to f32 RGBA (layers stacked top to bottom), and
     /// how many texels of a sentinel-filled output no pass wrote.
-    Texture { image: Image, unwritten: u64 },
+    Texture {
+        /// The texels as f32 RGBA; never-written texels read 0.
+        image: Image,
+        /// Texels no pass wrote (0 unless the texture was sentinel-filled).
+        unwritten: u64,
+    },
     /// A buffer's bytes.
     Buffer(Vec<u8>),
 }
@@ -238,6 +292,7 @@ pub enum OutputData {
 /// A graph's outputs and timings.
 #[derive(Debug, Clone)]
 pub struct GraphReadback {
+    /// One per [`Graph::outputs`], in that order.
     pub outputs: Vec<OutputData>,
     /// `kernel` sums every pass; `readback` is the copies and maps.
     pub stats: RunStats,

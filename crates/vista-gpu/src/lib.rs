@@ -1,3 +1,4 @@
+#![deny(missing_docs)]
 //! Headless wgpu compute for vista: one shared context per process (instance,
 //! adapter choice, device, queue), WGSL composition of a [`ShaderSet`], dispatch
 //! of a compute entry point over a W x H image, and readback into an f32 RGBA
@@ -30,24 +31,71 @@ pub use shaders::{ShaderSet, resolve_overrides, validate};
 pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \
 (or `sudo apt-get install mesa-vulkan-drivers libvulkan1`); set VISTA_ALLOW_NO_GPU=1 to skip GPU tests loudly";
 
+/// Everything that can go wrong creating the context or running a dispatch
+/// or pass graph on it.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum GpuError {
+    /// No enumerated adapter matches the [`AdapterChoice`], or, for the
+    /// browser backend, no Chromium was found.
     #[error("no {wanted} found (seen: {seen}); {hint}")]
-    NoAdapter { wanted: String, seen: String, hint: &'static str },
+    NoAdapter {
+        /// The adapter asked for, in words.
+        wanted: String,
+        /// The adapters enumerated (`name [device type, backend]`), or where
+        /// Chromium was looked for.
+        seen: String,
+        /// How to install the missing driver or browser.
+        hint: &'static str,
+    },
+    /// wgpu's device request failed, or headless Chromium failed to launch,
+    /// died or had no WebGPU device.
     #[error("device request failed on {adapter}: {message}")]
-    Device { adapter: String, message: String },
+    Device {
+        /// The adapter's name or description.
+        adapter: String,
+        /// What failed.
+        message: String,
+    },
+    /// A kernel file was not found, or its WGSL failed to parse, compose,
+    /// pass naga's validation, resolve its overrides or be written back as
+    /// WGSL; holds the message.
     #[error("{0}")]
     Shader(String),
+    /// wgpu reported a validation error (error scope, device poll or buffer
+    /// map), the Khronos validation layer reported messages, or the browser
+    /// page reported an error.
     #[error("GPU validation error in {what}: {message}")]
-    Validation { what: String, message: String },
+    Validation {
+        /// The shader, pass or step the error arose in.
+        what: String,
+        /// The error or the joined validation messages.
+        message: String,
+    },
+    /// A GPU wait or readback map took longer than the context's watchdog.
     #[error(
         "GPU wait exceeded {seconds} s ({what}); the dispatch is too heavy for this device or the driver hung; lower the size or step counts, or raise VISTA_GPU_TIMEOUT_S"
     )]
-    Timeout { what: String, seconds: f64 },
+    Timeout {
+        /// The shader, pass or step that was waited on.
+        what: String,
+        /// The watchdog timeout, in seconds.
+        seconds: f64,
+    },
+    /// The request cannot be carried out as made, e.g. an unknown backend,
+    /// adapter or output format name, a size outside the device's range, a
+    /// resource bound as the wrong kind, or a second configuration for the
+    /// process's shared context.
     #[error("{0}")]
     Request(String),
     /// The kernel needs a feature or limit this backend lacks (SPEC 14,
     /// "Features and limits"): the case is unsupported here, not broken.
     #[error("unsupported on {adapter}: {what} needs {feature}, which this backend lacks")]
-    Unsupported { adapter: String, what: String, feature: String },
+    Unsupported {
+        /// [`Context::adapter_description`] of the device.
+        adapter: String,
+        /// The kernel or pass, and what of it needs the feature or limit.
+        what: String,
+        /// The missing feature, or the limit with the value needed and had.
+        feature: String,
+    },
 }

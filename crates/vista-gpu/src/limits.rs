@@ -9,13 +9,21 @@ use crate::context::{Context, Engine};
 /// What one dispatch needs of the device.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Needs {
+    /// The entry point's `@workgroup_size` (x, y, z).
     pub workgroup_size: [u32; 3],
+    /// Workgroups dispatched along x, y and z.
     pub workgroups: [u32; 3],
+    /// Bind groups used: the highest `@group` index plus one.
     pub bind_groups: u32,
+    /// Uniform buffer bindings (`maxUniformBuffersPerShaderStage`).
     pub uniform_buffers: u32,
+    /// Storage buffer bindings (`maxStorageBuffersPerShaderStage`).
     pub storage_buffers: u32,
+    /// Storage texture bindings (`maxStorageTexturesPerShaderStage`).
     pub storage_textures: u32,
+    /// Sampled texture bindings (`maxSampledTexturesPerShaderStage`).
     pub sampled_textures: u32,
+    /// Sampler bindings (`maxSamplersPerShaderStage`).
     pub samplers: u32,
 }
 

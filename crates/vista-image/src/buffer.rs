@@ -8,7 +8,9 @@ use crate::ImageError;
 /// the type can hold both LDR output and raw HDR kernel results.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Image {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels (number of rows).
     pub height: u32,
     /// `width * height` pixels; pixel `(x, y)` is at `y * width + x`.
     pub data: Vec<[f32; 4]>,

@@ -8,21 +8,30 @@ use std::path::PathBuf;
 pub enum ImageError {
     /// The file could not be read, created, written or renamed into place.
     #[error("I/O error on {}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
-    /// The file exists but is not a decodable image of the expected format.
+    Io {
+        /// The file the operation was on.
+        path: PathBuf,
+        /// The underlying I/O error.
+        source: std::io::Error,
+    },
+    /// The file exists but is not a decodable image (or `.npy` array) of the expected format.
     #[error("{} is not a valid {format}: {msg}", path.display())]
     Decode {
+        /// The file that failed to decode.
         path: PathBuf,
-        /// `"PNG"` or `"EXR"`.
+        /// `"PNG"`, `"EXR"` or `"NumPy .npy"`.
         format: &'static str,
+        /// What was wrong with the contents.
         msg: String,
     },
     /// The encoder rejected the image (e.g. a zero-sized image).
     #[error("could not encode {} as {format}: {msg}", path.display())]
     Encode {
+        /// The file that was being written.
         path: PathBuf,
         /// `"PNG"` or `"EXR"`.
         format: &'static str,
+        /// Why the encoder refused.
         msg: String,
     },
     /// Two images that must have the same size do not.
@@ -30,14 +39,31 @@ pub enum ImageError {
         "image size mismatch: expected {}x{}, got {}x{}",
         expected.0, expected.1, actual.0, actual.1
     )]
-    SizeMismatch { expected: (u32, u32), actual: (u32, u32) },
+    SizeMismatch {
+        /// `(width, height)` of the reference image.
+        expected: (u32, u32),
+        /// `(width, height)` of the image compared against it.
+        actual: (u32, u32),
+    },
     /// [`crate::save`] / [`crate::load`] only know `.png` and `.exr`.
     #[error(
         "{}: unsupported image extension (expected .png or .exr)",
         path.display()
     )]
-    UnsupportedExtension { path: PathBuf },
+    UnsupportedExtension {
+        /// The path whose extension is neither `.png` nor `.exr`.
+        path: PathBuf,
+    },
     /// A pixel buffer whose length does not match `width * height`.
     #[error("bad image dimensions {width}x{height}: expected {expected} pixels, got {len}")]
-    BadDimensions { width: u32, height: u32, expected: u64, len: usize },
+    BadDimensions {
+        /// Requested width in pixels.
+        width: u32,
+        /// Requested height in pixels.
+        height: u32,
+        /// `width * height`, the pixel count the buffer should have.
+        expected: u64,
+        /// The pixel count the buffer actually has.
+        len: usize,
+    },
 }

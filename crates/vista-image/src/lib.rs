@@ -1,3 +1,4 @@
+#![deny(missing_docs)]
 //! Image handling for vista.
 //!
 //! This crate owns the [`Image`] type (row-major f32 RGBA, `y = 0` is the top

@@ -35,14 +35,18 @@ pub struct Metrics {
     /// dB; `+inf` when the images are identical.
     #[serde(with = "float_repr")]
     pub psnr: f64,
+    /// Mean SSIM of the luma, in [-1, 1]; 1 when identical (see [`ssim`]).
     #[serde(with = "float_repr")]
     pub ssim: f64,
+    /// Largest absolute RGB channel difference; `+inf` if a differing pair is
+    /// non-finite.
     #[serde(with = "float_repr")]
     pub max_abs: f64,
     /// Pixels where any RGB channel differs by more than 1/255.
     pub bad_pixels: u64,
     /// Pixels of the actual image with a NaN/Inf in any channel (RGBA).
     pub nan: u64,
+    /// Mean squared RGB error, a non-finite difference counting as 1.
     #[serde(with = "float_repr")]
     pub mse: f64,
     /// Mean LDR-FLIP error in [0, 1] (NVIDIA's FLIP at

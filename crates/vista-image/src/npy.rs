@@ -16,6 +16,7 @@ const MAGIC: &[u8] = b"\x93NUMPY";
 pub struct Npy {
     /// The dtype as the header spells it (`<f4`, or a list for a struct).
     pub descr: String,
+    /// The array shape in C order, in elements of the dtype.
     pub shape: Vec<u64>,
     /// Bytes of one element (of the dtype).
     pub item_bytes: u64,

@@ -23,20 +23,34 @@ pub enum Feed {
     /// A read-only storage texture (pass graphs only).
     StorageRead(crate::resources::Storage),
     /// A storage buffer other than the table (pass graphs only).
-    Buffer { read_only: bool },
+    Buffer {
+        /// `var<storage, read>` (else `read_write`).
+        read_only: bool,
+    },
     /// A sampled texture (pass graphs only).
-    Sampled { dim: crate::graph::SampledDim, kind: crate::graph::SampledKind },
+    Sampled {
+        /// The texture's dimension.
+        dim: crate::graph::SampledDim,
+        /// What sampling it returns.
+        kind: crate::graph::SampledKind,
+    },
     /// A sampler (pass graphs only).
-    Sampler { comparison: bool },
+    Sampler {
+        /// A `sampler_comparison` (else a filtering `sampler`).
+        comparison: bool,
+    },
 }
 
 /// One binding the entry point reaches.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Binding {
+    /// The binding's `@group`.
     pub group: u32,
+    /// The binding's `@binding` within its group.
     pub binding: u32,
     /// The WGSL variable name.
     pub name: String,
+    /// What feeds it.
     pub feed: Feed,
     pub(crate) global: Handle<naga::GlobalVariable>,
 }

@@ -50,16 +50,24 @@ pub use crate::cpu64::geometry::direction;
 use crate::{CpuReference, ParamError, ParamSet};
 use vista_image::Image;
 
+/// How a primary step's in-scattering is integrated (`integrator`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Integrator {
+    /// T sigma_s Lin dt per step.
     Riemann,
+    /// T sigma_s Lin (1 - exp(-sigma_t dt)) / sigma_t per step (Hillaire 2016):
+    /// exact when density and Lin are constant over the step.
     Analytic,
 }
 
+/// The first-sample offset xi of a pixel's ray, in steps (`jitter`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Jitter {
+    /// xi = 0.5 for every pixel: the midpoint rule.
     None,
+    /// White noise in [0, 1): pcg3d of (x, y, jitter_seed).
     White,
+    /// Interleaved gradient noise (Jimenez 2014), shifted by jitter_seed.
     Ign,
 }
 
@@ -67,7 +75,9 @@ pub enum Jitter {
 /// step, or fract(xi + k / phi) for step k (golden-ratio offsets).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum JitterSteps {
+    /// Every step's sample at xi.
     Shared,
+    /// Step k's sample at fract(xi + k / phi).
     Golden,
 }
 
@@ -77,7 +87,9 @@ pub enum JitterSteps {
 /// camera z): the camera stands at the planet's top, as in the sky).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Layer {
+    /// Flat, between the altitudes base and top (y).
     Slab,
+    /// Between the spheres of radius R + base and R + top.
     Shell,
 }
 
@@ -92,10 +104,15 @@ impl Layer {
     }
 }
 
+/// The cloud's height profile (`profile`): a rounded plateau over the
+/// normalised height h in the layer, shaped as [`height_profile`] says.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Profile {
+    /// The plateau alone.
     Stratiform,
+    /// The plateau times (1 - 0.5 h): dense base, thinner top.
     Cumuliform,
+    /// The plateau times 0.45 + 0.55 smoothstep(0.5, 0.7, h): a dense upper band.
     Anvil,
 }
 

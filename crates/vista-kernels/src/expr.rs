@@ -8,10 +8,14 @@ use crate::params::{Kind, ParamSet, ParamSpec};
 /// A parsed expression.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Expr {
+    /// An integer literal.
     Num(i64),
     /// A param, `width` or `height`.
     Name(&'static str),
+    /// `a op b`, op one of `+ - * /` (`+ - *` saturate; `/` is Euclidean
+    /// division, an error by zero).
     Bin(char, Box<Expr>, Box<Expr>),
+    /// `ceil_div(a, b)`: a / b rounded up (b must be positive).
     CeilDiv(Box<Expr>, Box<Expr>),
 }
 
@@ -159,7 +163,6 @@ fn describe(t: Option<&Tok>) -> String {
 }
 
 impl Expr {
-    /// Parses `text` over `params`.
     /// Whether the expression reads param (or size) `name`.
     pub fn mentions(&self, name: &str) -> bool {
         match self {
@@ -196,6 +199,8 @@ impl Expr {
         Expr::parse(&text, params).map_err(|e| format!("entry \"{text}\": {e}"))
     }
 
+    /// Parses `text` over `params`: each name must be an integer param,
+    /// `width` or `height`.
     pub fn parse(text: &str, params: &[ParamSpec]) -> Result<Expr, String> {
         let mut p = Parser { toks: lex(text)?, at: 0, params };
         let e = p.sum()?;

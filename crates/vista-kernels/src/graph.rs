@@ -20,19 +20,28 @@ use crate::{Output, ParamError};
 /// A sampled texture's dimension (cube only for sampling).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SampledDim {
+    /// `1d`.
     D1,
+    /// `2d`.
     D2,
+    /// `2d-array`.
     D2Array,
+    /// `3d`.
     D3,
+    /// `cube`: six square layers, sampled as a cube (written as their 2d-array).
     Cube,
 }
 
 /// What a sampled texture binding returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SampledKind {
+    /// `texture_*<f32>`: sampling returns floats.
     Float,
+    /// `texture_*<u32>`: sampling returns unsigned integers.
     Uint,
+    /// `texture_*<i32>`: sampling returns signed integers.
     Sint,
+    /// `texture_depth_*`: a depth texture.
     Depth,
 }
 
@@ -45,22 +54,39 @@ pub const COMPARE_FUNCTIONS: [&str; 8] =
 /// What a resource is.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ResourceKind {
+    /// A texture (`kind = "texture"`): written as a storage texture, sampled, or both.
     Texture {
+        /// Its storage format (one of [`crate::bindings::STORAGE_FORMATS`]); `None`:
+        /// a storage binding's, else its file's.
         format: Option<&'static str>,
         /// 1d | 2d | 2d-array | 3d (storage and sampled) or cube (sampled).
         dimension: Option<SampledDim>,
+        /// Its size as expressions of the params and the case size: one entry for
+        /// 1d or a cube (the face edge), two for 2d, three for 2d-array and 3d;
+        /// `None`: its file's size, else the case's.
         size: Option<Vec<Expr>>,
+        /// A `.png` or `.exr` file under the project root holding its contents.
         file: Option<String>,
     },
+    /// A storage or uniform buffer (`kind = "buffer"`).
     Buffer {
+        /// A `.npy` or `.bin` file under the project root holding its contents.
         file: Option<String>,
+        /// Inline contents, one number per scalar (nested lists flattened, booleans as 0 or 1).
         data: Option<Vec<f64>>,
+        /// The value every scalar starts at (`file`, `data` and `fill` are exclusive).
         fill: Option<f64>,
+        /// Its element count as an expression of the params and the case size, with
+        /// `fill` or alone (a runtime-sized array needs one).
         length: Option<Expr>,
     },
+    /// A sampler (`kind = "sampler"`).
     Sampler {
+        /// `filter = "linear"`; false: nearest.
         linear: bool,
+        /// The address mode per axis (u, v, w), each one of [`ADDRESS_MODES`] (default clamp-to-edge).
         address: [&'static str; 3],
+        /// The comparison function (one of [`COMPARE_FUNCTIONS`]); `None`: a filtering sampler.
         compare: Option<&'static str>,
     },
 }
@@ -68,11 +94,15 @@ pub enum ResourceKind {
 /// One `[[resource]]` table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResourceSpec {
+    /// Its name, which `bind`, `dispatch`, `swap` and `[[output]]` refer to (a
+    /// binding of the same variable name is bound to it).
     pub name: String,
+    /// What it is, with the settings of its kind.
     pub kind: ResourceKind,
 }
 
 impl ResourceSpec {
+    /// The manifest's `kind`: `texture`, `buffer` or `sampler`.
     pub fn kind_name(&self) -> &'static str {
         match self.kind {
             ResourceKind::Texture { .. } => "texture",
@@ -85,13 +115,16 @@ impl ResourceSpec {
 /// How often a pass runs.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Repeat {
+    /// A fixed number of runs, in [1, 100000].
     Count(u32),
+    /// The value of this integer param.
     Param(&'static str),
 }
 
 /// One `[[pass]]` table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PassSpec {
+    /// The compute entry point (default `main`).
     pub entry: String,
     /// Default: the manifest's shader.
     pub shader: Option<String>,
@@ -99,9 +132,12 @@ pub struct PassSpec {
     pub bind: Vec<(String, String)>,
     /// Cover this resource with the reflected workgroup size.
     pub dispatch: Option<String>,
+    /// Explicit workgroup counts `[x, y, z]` as expressions of the params and the
+    /// case size (exclusive with `dispatch`).
     pub workgroups: Option<[Expr; 3]>,
     /// Params overridden for this pass's uniforms: (param, value text).
     pub set: Vec<(&'static str, String)>,
+    /// How many times the pass runs (on a group's first pass: the whole group's runs).
     pub repeat: Repeat,
     /// Resource pairs exchanged after every run of the pass.
     pub swap: Vec<(String, String)>,
@@ -126,15 +162,22 @@ impl GraphSpec {
 /// How an output is compared with its golden.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Tolerance {
+    /// Every value equal to the golden's, bit for bit.
     Exact,
+    /// The largest absolute difference from the golden is at most this.
     MaxAbs(f64),
+    /// The largest difference relative to the golden's magnitude is at most this.
     MaxRel(f64),
+    /// The largest difference in f32 units in the last place is at most this (float outputs only).
     MaxUlp(u64),
+    /// The root-mean-square difference from the golden is at most this.
     Rmse(f64),
     /// Earth mover's distance between the value histograms (`bins` bins
     /// over the golden's range), in units of that range.
     HistogramEmd {
+        /// The largest distance allowed (`histogram_emd`).
         max: f64,
+        /// The number of bins (`bins`; default 64, in [2, 4096]).
         bins: u32,
     },
 }
@@ -143,6 +186,7 @@ impl Tolerance {
     /// The keys a tolerance table may have.
     pub const KEYS: [&'static str; 7] = ["exact", "max_abs", "max_rel", "max_ulp", "rmse", "histogram_emd", "bins"];
 
+    /// The tolerance in one phrase for messages, e.g. `max_abs 0.001`.
     pub fn describe(&self) -> String {
         match self {
             Tolerance::Exact => "exact".into(),
@@ -158,17 +202,25 @@ impl Tolerance {
 /// One `[[output]]` table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputSpec {
+    /// The texture or buffer resource (one a pass writes) compared with its golden.
     pub resource: String,
+    /// The PNG view of a texture (`view`; default: the manifest's `output`).
     pub view: Option<Output>,
+    /// Whether texels no pass writes are allowed.
     pub partial: bool,
+    /// How it is compared with its golden; `None`: `vista-golden`'s default (exact
+    /// for a buffer or integer texture, PSNR of the view otherwise).
     pub tolerance: Option<Tolerance>,
 }
 
 /// A kernel's pass graph.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GraphSpec {
+    /// The `[[resource]]` tables, in manifest order.
     pub resources: Vec<ResourceSpec>,
+    /// The `[[pass]]` tables in run order (one default pass when the manifest has none).
     pub passes: Vec<PassSpec>,
+    /// The `[[output]]` tables; empty: the first texture a pass writes is the output.
     pub outputs: Vec<OutputSpec>,
     /// False: no render-twice check; every output needs a tolerance.
     pub deterministic: bool,
@@ -651,11 +703,27 @@ fn tolerance(t: &toml::Table) -> Result<Tolerance, String> {
 /// How a pass uses a resource it binds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Usage {
-    StorageBuffer { read_only: bool },
+    /// A storage buffer (`var<storage>`).
+    StorageBuffer {
+        /// `var<storage, read>` (else `read_write`).
+        read_only: bool,
+    },
+    /// A uniform buffer (`var<uniform>` bound to a buffer resource).
     UniformBuffer,
+    /// A storage texture of this format, dimension and access.
     StorageTexture(Storage),
-    Sampled { dim: SampledDim, kind: SampledKind },
-    Sampler { comparison: bool },
+    /// A sampled texture.
+    Sampled {
+        /// The binding's dimension.
+        dim: SampledDim,
+        /// What sampling it returns.
+        kind: SampledKind,
+    },
+    /// A sampler.
+    Sampler {
+        /// A `sampler_comparison` (else a filtering `sampler`).
+        comparison: bool,
+    },
 }
 
 /// What feeds one binding of a pass.
@@ -672,9 +740,13 @@ pub enum SlotFeed {
 /// One binding of a pass and what feeds it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PassSlot {
+    /// The binding's `@group`.
     pub group: u32,
+    /// The binding's `@binding` within its group.
     pub binding: u32,
+    /// The WGSL variable name.
     pub var: String,
+    /// What feeds the binding.
     pub feed: SlotFeed,
     /// For a storage buffer: its element layout (stride, fixed header
     /// bytes before a runtime-sized array, leaf scalars of one element).
@@ -702,6 +774,8 @@ pub struct Element {
 /// implicit texture per write-only storage texture no `bind` names.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Resolved {
+    /// The manifest's resources, then the implicit textures; [`SlotFeed::Resource`]
+    /// indexes this list.
     pub resources: Vec<ResolvedResource>,
     /// Per pass, its slots (sorted by group and binding).
     pub slots: Vec<Vec<PassSlot>>,
@@ -710,6 +784,7 @@ pub struct Resolved {
 /// One resource with what reflection adds to its table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResolvedResource {
+    /// Its `[[resource]]` table (an implicit texture's: only its variable's name).
     pub spec: ResourceSpec,
     /// A texture's format: its own, else a storage binding's, else its
     /// file's (decided when the file is read: `None` here).
@@ -733,6 +808,7 @@ fn storage_dim(d: Dimension) -> SampledDim {
     }
 }
 
+/// The manifest's name of a dimension: `1d`, `2d`, `2d-array`, `3d` or `cube`.
 pub fn dim_name(d: SampledDim) -> &'static str {
     match d {
         SampledDim::D1 => "1d",

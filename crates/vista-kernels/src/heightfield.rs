@@ -56,11 +56,16 @@ pub const BRUTE_STEPS: u32 = 4096;
 pub const REFINE_ITERS: u32 = 16;
 // ---------------------------------------------------------------- terrain
 
+/// The terrain's height function T (`terrain`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TerrainKind {
+    /// fBm / A, A the amplitude sum: about [-1, 1].
     Fbm,
+    /// Ridged multifractal / its analytic maximum: [0, 1].
     Ridged,
+    /// The analytic plane h = amplitude + s x + r z (an invariant-test terrain).
     Plane,
+    /// The analytic h = amplitude sin(x scale) cos(z scale) (an invariant-test terrain).
     Sine,
 }
 

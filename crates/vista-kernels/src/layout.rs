@@ -17,12 +17,16 @@ use crate::{Kernel, ParamError, ParamSet};
 /// strides).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FieldType {
+    /// The scalar of every component.
     pub scalar: Scalar,
+    /// The normalised WGSL name, e.g. `vec3<f32>`.
     pub name: String,
+    /// The byte offset of each component from the field's offset.
     pub components: Vec<u32>,
 }
 
 impl FieldType {
+    /// The normalised WGSL name (a copy of `name`), for messages.
     pub fn wgsl(&self) -> String {
         self.name.clone()
     }
@@ -36,9 +40,12 @@ impl FieldType {
 /// leaves are matched by their own name), type and absolute byte offset.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Field {
+    /// The leaf's own name: a param of that name feeds it when none is named
+    /// by its `qualified` or `key` name.
     pub name: String,
     /// `outer.inner` for a field inside a nested struct, for messages.
     pub path: String,
+    /// Its WGSL type.
     pub ty: FieldType,
     /// Byte offset within its block.
     pub offset: u32,
@@ -56,7 +63,9 @@ pub struct Field {
 /// One uniform global.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Block {
+    /// The uniform's `@group`.
     pub group: u32,
+    /// The uniform's `@binding` within its group.
     pub binding: u32,
     /// The WGSL variable name.
     pub var: String,

@@ -1,3 +1,4 @@
+#![deny(missing_docs)]
 //! vista's kernels: each described as data by its manifest
 //! (`kernels/<name>.toml`, [`manifest`]) with its WGSL; the uniform block
 //! packed from naga's reflection of the composed module ([`layout`]); and,
@@ -94,20 +95,75 @@ use vista_image::Image;
 /// what is allowed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
+    /// No kernel has the name asked for.
     #[error("unknown kernel '{name}'; valid kernels: {valid}")]
-    UnknownKernel { name: String, valid: String },
+    UnknownKernel {
+        /// The name asked for.
+        name: String,
+        /// The known kernel names, comma-separated.
+        valid: String,
+    },
+    /// The kernel has no preset of the name asked for.
     #[error("kernel {kernel} has no preset '{name}'; valid presets: {valid}")]
-    UnknownPreset { kernel: String, name: String, valid: String },
+    UnknownPreset {
+        /// The kernel's name.
+        kernel: String,
+        /// The preset name asked for.
+        name: String,
+        /// The kernel's preset names, comma-separated.
+        valid: String,
+    },
+    /// The kernel has no parameter of the name given.
     #[error("kernel {kernel} has no parameter '{name}'; valid parameters: {valid}")]
-    UnknownParam { kernel: String, name: String, valid: String },
+    UnknownParam {
+        /// The kernel's name.
+        kernel: String,
+        /// The parameter name given.
+        name: String,
+        /// The kernel's parameter names, comma-separated.
+        valid: String,
+    },
+    /// A value that parses but lies outside its allowed range (also an
+    /// image width or height outside [1, [`MAX_DIMENSION`]]).
     #[error("{param}={value} is out of range; allowed: {range}")]
-    OutOfRange { param: String, value: String, range: String },
+    OutOfRange {
+        /// The parameter (or `width` / `height`).
+        param: String,
+        /// The value as given.
+        value: String,
+        /// The allowed range, as users read it (see [`Kind::range_text`]).
+        range: String,
+    },
+    /// A value that does not parse as what its parameter takes.
     #[error("{param}={value} is not valid; expected {expected}")]
-    BadValue { param: String, value: String, expected: String },
+    BadValue {
+        /// The parameter (or `size`).
+        param: String,
+        /// The text as given.
+        value: String,
+        /// What would have been accepted.
+        expected: String,
+    },
+    /// A manifest that is invalid or cannot be read.
     #[error("{file}: {message}")]
-    Manifest { file: String, message: String },
+    Manifest {
+        /// Where the manifest came from: its path or `<built-in>/kernels/...`
+        /// (`kernels/` when the folder itself cannot be read).
+        file: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A shader that does not fit its manifest: its reflected entry point,
+    /// bindings, uniform blocks or overrides.
     #[error("kernel {kernel}: {message}")]
-    Layout { kernel: String, message: String },
+    Layout {
+        /// The kernel's name.
+        kernel: String,
+        /// What does not match.
+        message: String,
+    },
+    /// A kernel's own check of its params failed (e.g. a cloud top not
+    /// above its base); the message names the values.
     #[error("{0}")]
     Invalid(String),
 }
@@ -261,6 +317,7 @@ impl Kernel {
         Ok(Kernel { cpu, manifest, origin: Box::leak(origin.into()) })
     }
 
+    /// The kernel's name: the manifest's file stem.
     pub fn name(&self) -> &'static str {
         self.manifest.name
     }
@@ -272,9 +329,11 @@ impl Kernel {
     pub fn origin(&self) -> &'static str {
         self.origin
     }
+    /// The declared parameters, in manifest order.
     pub fn params(&self) -> &'static [ParamSpec] {
         self.manifest.params
     }
+    /// The named presets, in manifest order.
     pub fn presets(&self) -> &'static [Preset] {
         self.manifest.presets
     }
@@ -724,6 +783,7 @@ impl Registry {
         })
     }
 
+    /// Every kernel that parsed, in manifest file order.
     pub fn kernels(&self) -> &[&'static Kernel] {
         &self.kernels
     }

@@ -134,7 +134,9 @@ struct RawParam {
 /// One factor of the work estimate: a sum of params and constants.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WorkFactor {
+    /// The number params summed into this factor.
     pub params: Vec<&'static str>,
+    /// The sum of the factor's constant terms.
     pub constant: f64,
 }
 
@@ -151,12 +153,16 @@ pub enum HashPlane {
 /// project's manifests once and keeps its kernels for its whole life.
 #[derive(Debug, Clone)]
 pub struct Manifest {
+    /// The kernel's name: the manifest's file stem.
     pub name: &'static str,
+    /// One line for `vista list` (`summary`).
     pub summary: &'static str,
+    /// The WGSL file under `shaders/` (`shader`; default `<name>.wgsl`).
     pub shader: &'static str,
     /// The PNG view, where the manifest gives one (else display, or
     /// normalize for an integer format: `Kernel::view`).
     pub output: Option<Output>,
+    /// `display_alpha = "opaque"`: display alpha is forced to 1 (the RGB is already composited).
     pub opaque_display: bool,
     /// The compute entry point (`[[pass]] entry`, default `main`).
     pub entry: &'static str,
@@ -185,7 +191,10 @@ pub struct Manifest {
     /// Values of `override` constants (`overrides = { BLOCK = 128 }`); a
     /// param of an override's name feeds it too, and wins.
     pub overrides: Vec<(&'static str, f64)>,
+    /// The work estimate per pixel: the product of these factors (`work`).
     pub work: Vec<WorkFactor>,
+    /// Inclusive bounds of every raw RGB value (`output_range`); `None`: by the
+    /// view (display [0, 1], hdr [0, inf)).
     pub output_range: Option<(f64, f64)>,
     /// The z every fbm2/ridged2 call of the shader takes.
     pub hash_plane: Option<HashPlane>,
@@ -193,8 +202,12 @@ pub struct Manifest {
     /// rather than only a uniform, so the shader can drop the other cases
     /// at composition.
     pub specialize: Vec<&'static str>,
+    /// The declared parameters (`[[param]]`), in manifest order.
     pub params: &'static [ParamSpec],
+    /// The presets (`[preset.NAME]`), in manifest order.
     pub presets: &'static [Preset],
+    /// `[sweep_reference]`: the params (values as text) of the high-quality
+    /// reference that sweeps compare against.
     pub sweep_reference: &'static [(&'static str, &'static str)],
 }
 

@@ -103,13 +103,17 @@ pub fn lattice_hash(seed: u32, i: i32, j: i32, k: i32) -> u32 {
 /// The noise basis N of SPEC 3.1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Basis {
+    /// Ken Perlin's improved gradient noise over a seeded permutation.
     Perlin,
+    /// Quintic-faded trilinear interpolation of pcg3d-hashed lattice values in [-1, 1).
     Value,
 }
 
+/// The basis names, as the kernels' `basis` enum params spell them.
 pub const BASIS_NAMES: &[&str] = &["perlin", "value"];
 
 impl Basis {
+    /// The basis a `basis` param names: `value`, else Perlin.
     pub fn from_name(name: &str) -> Basis {
         match name {
             "value" => Basis::Value,

@@ -15,13 +15,39 @@ use crate::ParamError;
 #[derive(Debug, Clone, Copy)]
 pub enum Kind {
     /// A real number in `[min, max]`, or `(min, max]` when `open_min`.
-    Float { min: f64, max: f64, open_min: bool },
+    Float {
+        /// The smallest value allowed (excluded when `open_min`).
+        min: f64,
+        /// The largest value allowed.
+        max: f64,
+        /// Whether `min` itself is excluded.
+        open_min: bool,
+    },
     /// An integer in `[min, max]`.
-    Int { min: i64, max: i64 },
+    Int {
+        /// The smallest value allowed.
+        min: i64,
+        /// The largest value allowed.
+        max: i64,
+    },
     /// `n` comma-separated reals, each in `[min, max]`.
-    Vector { n: usize, min: f64, max: f64 },
+    Vector {
+        /// The number of components.
+        n: usize,
+        /// The smallest value allowed for each component.
+        min: f64,
+        /// The largest value allowed for each component.
+        max: f64,
+    },
     /// `n` comma-separated integers, each in `[min, max]`.
-    IntVector { n: usize, min: i64, max: i64 },
+    IntVector {
+        /// The number of components.
+        n: usize,
+        /// The smallest value allowed for each component.
+        min: i64,
+        /// The largest value allowed for each component.
+        max: i64,
+    },
     /// One name out of a fixed list.
     Enum(&'static [&'static str]),
     /// true | false (also 1 | 0).
@@ -31,12 +57,16 @@ pub enum Kind {
 /// The scalar of a WGSL leaf.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Scalar {
+    /// WGSL `f32`.
     F32,
+    /// WGSL `u32`.
     U32,
+    /// WGSL `i32`.
     I32,
 }
 
 impl Scalar {
+    /// The WGSL spelling: `f32`, `u32` or `i32`.
     pub fn wgsl(self) -> &'static str {
         match self {
             Scalar::F32 => "f32",
@@ -51,8 +81,12 @@ impl Scalar {
 /// normalised WGSL name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Leaf {
+    /// The scalar of every component.
     pub scalar: Scalar,
+    /// The number of scalar components (e.g. 16 for `mat4x4<f32>` or
+    /// `array<vec4<f32>, 4>`).
     pub count: usize,
+    /// The normalised WGSL type name, e.g. `vec2<u32>`.
     pub name: &'static str,
 }
 
@@ -101,8 +135,11 @@ pub fn wgsl_leaf(text: &str) -> Option<(Scalar, usize, String)> {
 /// The manifest's `type`: what the WGSL `Params` field must be.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ParamType {
+    /// WGSL `u32`.
     U32,
+    /// WGSL `i32`.
     I32,
+    /// WGSL `f32`.
     F32,
     /// Carried as u32 (0 or 1).
     Bool,
@@ -115,6 +152,8 @@ pub enum ParamType {
 }
 
 impl ParamType {
+    /// Parses the manifest's `type`: `u32`, `i32`, `f32`, `bool`, `vec2` to
+    /// `vec4`, `enum`, or a WGSL leaf type ([`wgsl_leaf`]); `None` otherwise.
     pub fn from_name(name: &str) -> Option<ParamType> {
         Some(match name {
             "u32" => ParamType::U32,
@@ -166,12 +205,15 @@ impl ParamType {
 }
 
 impl Kind {
+    /// A real in `[min, max]`.
     pub const fn float(min: f64, max: f64) -> Kind {
         Kind::Float { min, max, open_min: false }
     }
+    /// A real in `(min, max]` (the minimum itself not allowed).
     pub const fn float_open(min: f64, max: f64) -> Kind {
         Kind::Float { min, max, open_min: true }
     }
+    /// An integer in `[min, max]`.
     pub const fn int(min: i64, max: i64) -> Kind {
         Kind::Int { min, max }
     }
@@ -198,28 +240,42 @@ impl Kind {
 /// One declared parameter.
 #[derive(Debug, Clone, Copy)]
 pub struct ParamSpec {
+    /// The parameter's name (`--set NAME=VALUE`); it also names the uniform
+    /// leaf (bare or as `variable.path`) or `override` it feeds, if any.
     pub name: &'static str,
+    /// The manifest's `type`: what the WGSL field it feeds must be.
     pub ty: ParamType,
+    /// What values it takes, with their allowed range.
     pub kind: Kind,
+    /// The default value as text (validated when the manifest is parsed).
     pub default: &'static str,
+    /// One line for `vista list`.
     pub doc: &'static str,
 }
 
 /// A named set of overrides on top of the defaults.
 #[derive(Debug, Clone, Copy)]
 pub struct Preset {
+    /// The preset's name (`--preset`).
     pub name: &'static str,
+    /// One line saying what the preset is for.
     pub doc: &'static str,
+    /// `(param, value)` pairs as text, applied over the defaults.
     pub set: &'static [(&'static str, &'static str)],
 }
 
 /// A parsed, validated parameter value.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Value {
+    /// A real ([`Kind::Float`]).
     Float(f64),
+    /// An integer ([`Kind::Int`]).
     Int(i64),
+    /// The components of a [`Kind::Vector`] or [`Kind::IntVector`] (integers held as f64).
     Vector(Vec<f64>),
+    /// The chosen name out of a [`Kind::Enum`] list.
     Enum(&'static str),
+    /// A [`Kind::Bool`] value.
     Bool(bool),
 }
 
@@ -344,6 +400,7 @@ impl ParamSet {
         Ok(())
     }
 
+    /// The name of the kernel these values belong to.
     pub fn kernel(&self) -> &'static str {
         self.kernel
     }
@@ -352,6 +409,10 @@ impl ParamSet {
         self.values.get(name).unwrap_or_else(|| panic!("kernel {} has no parameter {name}", self.kernel))
     }
 
+    /// The value of number param `name` (an integer widened to f64).
+    ///
+    /// # Panics
+    /// If the kernel has no such param or it is not a number.
     pub fn f64(&self, name: &str) -> f64 {
         match self.get(name) {
             Value::Float(v) => *v,
@@ -359,38 +420,58 @@ impl ParamSet {
             v => panic!("{}.{name} is {v:?}, not a number", self.kernel),
         }
     }
+    /// [`ParamSet::f64`] narrowed to f32.
     pub fn f32(&self, name: &str) -> f32 {
         self.f64(name) as f32
     }
+    /// The value of integer param `name`.
+    ///
+    /// # Panics
+    /// If the kernel has no such param or it is not an integer.
     pub fn int(&self, name: &str) -> i64 {
         match self.get(name) {
             Value::Int(v) => *v,
             v => panic!("{}.{name} is {v:?}, not an integer", self.kernel),
         }
     }
+    /// [`ParamSet::int`] cast to u32 (`as`: a negative value wraps).
     pub fn u32(&self, name: &str) -> u32 {
         self.int(name) as u32
     }
+    /// The components of vector param `name` (integer vectors as f64).
+    ///
+    /// # Panics
+    /// If the kernel has no such param or it is not a vector.
     pub fn vector(&self, name: &str) -> &[f64] {
         match self.get(name) {
             Value::Vector(v) => v,
             v => panic!("{}.{name} is {v:?}, not a vector", self.kernel),
         }
     }
+    /// The first three components of vector param `name` (panics with fewer).
     pub fn vec3(&self, name: &str) -> [f64; 3] {
         let v = self.vector(name);
         [v[0], v[1], v[2]]
     }
+    /// The first two components of vector param `name` (panics with fewer).
     pub fn vec2(&self, name: &str) -> [f64; 2] {
         let v = self.vector(name);
         [v[0], v[1]]
     }
+    /// The chosen name of enum param `name`.
+    ///
+    /// # Panics
+    /// If the kernel has no such param or it is not an enum.
     pub fn choice(&self, name: &str) -> &'static str {
         match self.get(name) {
             Value::Enum(s) => s,
             v => panic!("{}.{name} is {v:?}, not an enum", self.kernel),
         }
     }
+    /// The value of bool param `name`.
+    ///
+    /// # Panics
+    /// If the kernel has no such param or it is not a bool.
     pub fn flag(&self, name: &str) -> bool {
         match self.get(name) {
             Value::Bool(b) => *b,
@@ -414,6 +495,7 @@ impl ParamSet {
         self.values.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";")
     }
 
+    /// Every `(name, value)` pair, sorted by name.
     pub fn iter(&self) -> impl Iterator<Item = (&'static str, &Value)> {
         self.values.iter().map(|(k, v)| (*k, v))
     }

@@ -11,15 +11,21 @@ use crate::{ParamError, ParamSet};
 /// A storage texture's dimension, as the manifest spells it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Dimension {
+    /// `1d` (`texture_storage_1d`).
     D1,
+    /// `2d` (`texture_storage_2d`).
     D2,
+    /// `2d-array` (`texture_storage_2d_array`).
     D2Array,
+    /// `3d` (`texture_storage_3d`).
     D3,
 }
 
 impl Dimension {
+    /// The names [`Dimension::parse`] accepts, for messages.
     pub const NAMES: &'static str = "1d|2d|2d-array|3d";
 
+    /// The manifest's name: `1d`, `2d`, `2d-array` or `3d`.
     pub fn name(self) -> &'static str {
         match self {
             Dimension::D1 => "1d",
@@ -29,6 +35,7 @@ impl Dimension {
         }
     }
 
+    /// The dimension the manifest names, or `None` for any other text.
     pub fn parse(text: &str) -> Option<Dimension> {
         [Dimension::D1, Dimension::D2, Dimension::D2Array, Dimension::D3].into_iter().find(|d| d.name() == text)
     }
@@ -46,25 +53,33 @@ impl Dimension {
 /// How the pass may use a storage texture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Access {
+    /// Write-only (`write`).
     Write,
     /// Read-only (an input of a pass graph).
     Read,
+    /// Read and written (`read_write`).
     ReadWrite,
 }
 
 /// A storage texture binding as WGSL declares it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Storage {
+    /// Its texel format, one of [`crate::bindings::STORAGE_FORMATS`].
     pub format: &'static str,
+    /// Its dimension.
     pub dimension: Dimension,
+    /// How the pass may use it.
     pub access: Access,
 }
 
 /// A `[[resource]]` table of kind `texture`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TextureResource {
+    /// The resource's name, which `bind` refers to.
     pub name: &'static str,
+    /// Its format, if given (it must match the binding's).
     pub format: Option<&'static str>,
+    /// Its dimension, if given (it must match the binding's).
     pub dimension: Option<Dimension>,
     /// `[w]`, `[w, h]` or `[w, h, layers or depth]`; default the case size.
     pub size: Option<Vec<Expr>>,
@@ -74,8 +89,11 @@ pub struct TextureResource {
 /// the resource that gives its size (none: the case size).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Target {
+    /// The WGSL variable the pass writes.
     pub var: String,
+    /// How that variable is declared.
     pub storage: Storage,
+    /// The `[[resource]]` that `bind` gives it, if any (its `size` sets the extent).
     pub resource: Option<TextureResource>,
 }
 
@@ -83,8 +101,11 @@ pub struct Target {
 /// for 1d and 2d).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Extent {
+    /// Texels across.
     pub width: u32,
+    /// Rows (1 for 1d).
     pub height: u32,
+    /// Layers of a 2d-array or depth of a 3d texture (1 otherwise).
     pub layers: u32,
 }
 

@@ -1,3 +1,4 @@
+#![deny(missing_docs)]
 //! Quality-versus-cost sweeps: render a kernel at every value of one
 //! parameter (or every point of a two-parameter grid), compare each render
 //! with a high-quality reference render, and record PSNR, SSIM, max-abs and
@@ -38,6 +39,7 @@ pub enum Metric {
 }
 
 impl Metric {
+    /// Parses a `--metric` value (`display` or `linear`).
     pub fn parse(text: &str) -> Result<Metric, RenderError> {
         match text {
             "display" => Ok(Metric::Display),
@@ -45,6 +47,7 @@ impl Metric {
             _ => Err(bad(format!("--metric={text} is not valid; expected one of display|linear"))),
         }
     }
+    /// The metric's name, as `--metric` takes it.
     pub fn name(self) -> &'static str {
         match self {
             Metric::Display => "display",
@@ -56,7 +59,9 @@ impl Metric {
 /// One swept parameter and its values, as typed by the user.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Axis {
+    /// The parameter's name.
     pub name: String,
+    /// Its values, as typed.
     pub values: Vec<String>,
 }
 
@@ -70,29 +75,42 @@ pub type SweepPoint = (String, Option<String>, ParamSet);
 /// What to sweep.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct SweepSpec {
+    /// The kernel swept.
     #[serde(serialize_with = "kernel_name")]
     pub kernel: &'static Kernel,
+    /// The preset every point and the reference start from; the kernel's
+    /// defaults when `None`.
     pub preset: Option<String>,
     /// Fixed overrides applied to every point and to the reference.
     pub base: Vec<(String, String)>,
+    /// The swept parameter (the x axis).
     pub x: Axis,
+    /// The second swept parameter, for a two-parameter grid.
     pub y: Option<Axis>,
     /// Overrides of the reference render (default: the kernel's high-quality settings).
     pub reference: Vec<(String, String)>,
+    /// Render width in pixels, of every point and the reference.
     pub width: u32,
+    /// Render height in pixels, of every point and the reference.
     pub height: u32,
+    /// PSNR (dB) a point must reach to count as good enough (`--target-psnr`).
     pub target_psnr: f64,
     /// Timed renders per point (median reported).
     pub runs: u32,
+    /// What the images are compared on.
     pub metric: Metric,
 }
 
 /// One measured point.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Point {
+    /// The x parameter's value, as typed.
     pub x: String,
+    /// The y parameter's value, for a two-parameter grid.
     pub y: Option<String>,
+    /// The point's render compared with the reference render, on `spec.metric`.
     pub metrics: Metrics,
+    /// Median GPU wall time of the point's render, in milliseconds.
     pub gpu_ms: f64,
     /// Work per pixel of the point's settings: the manifest's estimate,
     /// averaged over the image's rays where it varies per ray.
@@ -105,10 +123,15 @@ pub struct Point {
 /// A finished sweep: `curve.json` is this, serialised.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Sweep {
+    /// What was swept.
     pub spec: SweepSpec,
+    /// The description of the adapter the sweep ran on.
     pub adapter: String,
+    /// Median GPU wall time of the reference render, in milliseconds.
     pub reference_ms: f64,
+    /// The reference's resolved parameters, canonical (`name=value;...`).
     pub reference_params: String,
+    /// Every measured point: x values inner, y values outer.
     pub points: Vec<Point>,
 }
 

@@ -14,6 +14,8 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::Sweep;
 
+/// Why the plots could not be drawn or written: no usable font, a drawing
+/// or encoding failure, or a failed write.
 #[derive(Debug)]
 pub struct PlotError(pub String);
 

@@ -130,10 +130,15 @@ pub fn fisheye_direction(u: Real, v: Real, width: u32, height: u32) -> Option<Ve
 pub struct Sky {
     /// Unit vector toward the sun, (0, sin e_s, cos e_s).
     pub sun: Vec3,
+    /// Camera height above the ground (m).
     pub camera_altitude: Real,
+    /// E_sun: the sun's irradiance, which scales all in-scattered radiance.
     pub sun_intensity: Real,
+    /// Henyey-Greenstein asymmetry g of the Mie phase, in [-0.99, 0.99].
     pub mie_g: Real,
+    /// Midpoint steps along the view ray's segment inside the atmosphere.
     pub view_samples: u32,
+    /// Midpoint steps toward the sun from each view sample.
     pub light_samples: u32,
     /// Multipliers of the (Rayleigh, Mie) densities: (1, 1) for SPEC 3.5's
     /// air (the atmosphere kernel), (0, 0) for none.
@@ -141,6 +146,7 @@ pub struct Sky {
 }
 
 impl Sky {
+    /// Resolves an `atmosphere` param set: the sun at azimuth 0, SPEC 3.5's air.
     pub fn from_params(p: &ParamSet) -> Sky {
         Sky {
             sun: sun_direction(real(p, "sun_elevation_deg")),
@@ -159,6 +165,8 @@ impl Sky {
         [r * self.density_scale[0], m * self.density_scale[1]]
     }
 
+    /// The camera's position (m), straight above the planet's centre at the
+    /// origin: (0, R_GROUND + camera_altitude, 0).
     pub fn camera(&self) -> Vec3 {
         Vec3::new(0.0, R_GROUND + self.camera_altitude, 0.0)
     }

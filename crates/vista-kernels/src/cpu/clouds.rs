@@ -109,6 +109,7 @@ pub struct StepLayout {
 }
 
 impl StepLayout {
+    /// The layout of `n` steps whose last is `spread` times the first (1: uniform).
     pub fn new(n: u32, spread: Real) -> StepLayout {
         let log_r = spread.ln() / (n.max(2) - 1) as Real;
         StepLayout { n, log_r, total: (n as Real * log_r).exp_m1() }
@@ -150,39 +151,65 @@ pub struct RayResult {
 /// Everything the march needs, resolved from a parameter set in Real.
 #[derive(Debug, Clone)]
 pub struct Clouds {
+    /// Slab or shell geometry.
     pub layer: Layer,
     /// x and z of the shell's centre (the camera's): it lies at
     /// (x, -[`PLANET_RADIUS_KM`], z).
     pub centre_xz: [Real; 2],
+    /// Altitude of the layer's bottom (km).
     pub base: Real,
+    /// Altitude of the layer's top (km), above `base`.
     pub top: Real,
+    /// Coverage in [0, 1]: cloud where G exceeds 1 - coverage (about the cloud
+    /// fraction; from `coverage_oktas` when that is set, see [`coverage_of`]).
     pub coverage: Real,
+    /// Extinction (1/km) where the remapped noise and the height profile are 1.
     pub density_scale: Real,
+    /// sigma_a / sigma_s: sigma_t = (1 + absorption) sigma_s (0: pure scattering).
     pub absorption: Real,
+    /// The height profile.
     pub profile: Profile,
+    /// Rounding of the profile at the base, as a fraction of the layer's thickness.
     pub profile_bottom: Real,
+    /// Rounding of the profile at the top, as a fraction of the layer's thickness.
     pub profile_top: Real,
     /// Noise frequency per axis: noise_scale * noise_stretch.
     pub frequency: V3,
+    /// Offset added in noise space, after `frequency` (animate it to move the clouds).
     pub wind: V3,
+    /// The density's 3D fBm octaves (no octave rotation).
     pub fbm: Fbm,
+    /// The fBm's seeded basis.
     pub noise: Noise,
+    /// 1 / A, A the fBm's amplitude sum: scales fbm3 to about [-1, 1].
     pub inv_amplitude: Real,
     /// Position and basis; the aspect is set per image in [`Clouds::ray`].
     pub view: Camera,
+    /// Rays and light rays are cut at this distance (km).
     pub max_distance: Real,
+    /// Unit direction toward the sun (azimuth from +z toward +x, elevation above the horizon).
     pub sun_dir: V3,
     /// sun_color * sun_intensity.
     pub sun: V3,
+    /// Asymmetry g of the first (forward) Henyey-Greenstein lobe, in [-0.99, 0.99].
     pub g1: Real,
+    /// Asymmetry g of the second (backward) Henyey-Greenstein lobe, in [-0.99, 0.99].
     pub g2: Real,
+    /// Weight of the g2 lobe: P = (1 - blend) HG(g1) + blend HG(g2).
     pub blend: Real,
+    /// Powder term strength: sun light times (1 - powder exp(-2 tau_sun)); 0 = off.
     pub powder: Real,
+    /// Isotropic sky radiance scattered by the cloud (linear RGB).
     pub ambient: V3,
+    /// Ambient factor at the layer's base, rising linearly to 1 at its top.
     pub ambient_bottom: Real,
+    /// Background sky radiance straight up (linear RGB).
     pub sky_zenith: V3,
+    /// Background sky radiance at and below the horizon (linear RGB).
     pub sky_horizon: V3,
+    /// Primary march steps per ray (with `step_km` > 0, the most a ray takes).
     pub steps: u32,
+    /// Light march steps toward the sun from each sample that holds cloud.
     pub light_steps: u32,
     /// Last light step / first light step (1 = uniform).
     pub light_spread: Real,
@@ -190,13 +217,21 @@ pub struct Clouds {
     pub step_spread: Real,
     /// Primary step length (km); 0 = always `steps` steps.
     pub step_km: Real,
+    /// Where in its step each primary sample sits.
     pub jitter_steps: JitterSteps,
+    /// How each step's in-scattering is integrated.
     pub integrator: Integrator,
+    /// The per-pixel first-sample offset.
     pub jitter: Jitter,
+    /// Seed of the jitter hash (white: hashed; ign: shifts the pattern, period 64).
     pub jitter_seed: u32,
 }
 
 impl Clouds {
+    /// Resolves a `clouds` param set (angles in degrees become radians).
+    ///
+    /// # Panics
+    /// If `layer` names no [`Layer`] (`CloudsKernel::check` refuses that).
     pub fn from_params(p: &ParamSet) -> Clouds {
         let fbm = Fbm { octaves: p.u32("octaves"), lacunarity: real(p, "lacunarity"), gain: real(p, "gain"), theta: 0.0 };
         let stretch = real3(p, "noise_stretch");

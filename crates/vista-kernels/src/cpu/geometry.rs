@@ -49,9 +49,13 @@ fn fmt3(v: V3) -> String {
 /// The pinhole camera of SPEC 3.4.
 #[derive(Debug, Clone, Copy)]
 pub struct Camera {
+    /// Eye position (km in the kernels that use it).
     pub pos: V3,
+    /// Unit view direction f.
     pub forward: V3,
+    /// Unit right vector r = normalize(cross(f, (0, 1, 0))).
     pub right: V3,
+    /// Unit up vector cross(r, f).
     pub up: V3,
     /// tan(fov / 2), fov vertical.
     pub tan_half: Real,

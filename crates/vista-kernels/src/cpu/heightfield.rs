@@ -19,11 +19,17 @@ pub const KOSCHMIEDER: Real = 3.912;
 
 // Linear-light colours of the shading model (shared with shaders/heightfield.wgsl
 // and shaders/lib/terrain.wgsl); the sun's colour is the `sun_color` param.
+/// Sky ambient light on the terrain (linear RGB), times (0.5 + 0.5 n.y).
 pub const AMBIENT: [Real; 3] = [0.16, 0.22, 0.32];
+/// Sky colour at and below the horizon, which fog also blends toward (linear RGB).
 pub const SKY_HORIZON: [Real; 3] = [0.60, 0.70, 0.82];
+/// Sky colour straight up (linear RGB).
 pub const SKY_ZENITH: [Real; 3] = [0.18, 0.34, 0.66];
+/// Albedo of steep ground (linear RGB).
 pub const ROCK: [Real; 3] = [0.36, 0.31, 0.27];
+/// Albedo of flat ground (linear RGB).
 pub const GRASS: [Real; 3] = [0.16, 0.26, 0.08];
+/// Albedo of snow on flat-enough ground above the snow line (linear RGB).
 pub const SNOW: [Real; 3] = [0.85, 0.87, 0.90];
 /// Snow fades in over this height (km) above `snow_line`.
 pub const SNOW_FADE: Real = 0.2;
@@ -31,13 +37,19 @@ pub const SNOW_FADE: Real = 0.2;
 /// h(x, z) and everything needed to evaluate it in Real.
 #[derive(Debug, Clone)]
 pub struct Terrain {
+    /// Which height function T the terrain is.
     pub kind: TerrainKind,
+    /// Height scale (km); for a plane, its height h0 at x = z = 0.
     pub amplitude: Real,
+    /// Horizontal frequency of T (1/km); 1 for a plane.
     pub scale: Real,
     /// (s, r) of the plane h = amplitude + s x + r z.
     pub slope: [Real; 2],
+    /// The seeded basis of the fbm and ridged terrains.
     pub noise: Noise,
+    /// The fBm octaves (fbm terrain).
     pub fbm: Fbm,
+    /// The ridged octaves (ridged terrain).
     pub ridged: Ridged,
     /// 1 / A (fbm) or 1 / ridged_max (ridged).
     pub inv_norm: Real,
@@ -67,6 +79,8 @@ impl Terrain {
         Terrain::analytic(TerrainKind::Sine, amplitude, scale, [0.0, 0.0])
     }
 
+    /// Resolves `terrain`, `amplitude`, `scale`, `plane_slope` and the noise and
+    /// octave params of a param set.
     pub fn from_params(p: &ParamSet) -> Terrain {
         let kind = match p.choice("terrain") {
             "ridged" => TerrainKind::Ridged,
@@ -146,13 +160,18 @@ impl Terrain {
 /// Settings of the relax march (SPEC 3.4).
 #[derive(Debug, Clone, Copy)]
 pub struct MarchSettings {
+    /// Far limit of the march (km).
     pub t_max: Real,
+    /// Step factor a in [0, 1]: t += a D(t).
     pub relax: Real,
+    /// Hit when D(t) < eps t (the pixel-footprint rule).
     pub eps: Real,
+    /// Step limit; reaching it counts as a miss.
     pub max_steps: u32,
 }
 
 impl MarchSettings {
+    /// Reads `t_max`, `relax`, `eps` and `max_steps`.
     pub fn from_params(p: &ParamSet) -> MarchSettings {
         MarchSettings { t_max: real(p, "t_max"), relax: real(p, "relax"), eps: real(p, "eps"), max_steps: p.u32("max_steps") }
     }
@@ -161,8 +180,11 @@ impl MarchSettings {
 /// Outcome of one march: hit flag, (refined) distance, steps taken k.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct March {
+    /// Whether the march hit the terrain.
     pub hit: bool,
+    /// Distance along the ray (km): the refined hit, else where the march stopped.
     pub t: Real,
+    /// Steps taken, k.
     pub steps: u32,
 }
 
@@ -365,8 +387,11 @@ pub fn max_encoded_colour(sun_color: V3) -> Real {
 /// The soft shadow's fixed samples (see [`soft_shadow`]).
 #[derive(Debug, Clone, Copy)]
 pub struct ShadowSettings {
+    /// Samples toward the sun (0: no shadow, fully lit).
     pub steps: u32,
+    /// Reach of the shadow march (km).
     pub distance: Real,
+    /// Penumbra sharpness k: shadow = smoothstep(min_i k D_i / t_i).
     pub softness: Real,
 }
 
@@ -374,8 +399,11 @@ pub struct ShadowSettings {
 /// colour arriving there, the sky's ambient colour (x (0.5 + 0.5 n.y)).
 #[derive(Debug, Clone, Copy)]
 pub struct SurfaceLight {
+    /// Unit direction toward the sun.
     pub sun_dir: V3,
+    /// The sun's colour arriving at the point (linear RGB).
     pub sun: V3,
+    /// The sky's ambient colour (linear RGB), times (0.5 + 0.5 n.y).
     pub ambient: V3,
 }
 
@@ -411,20 +439,33 @@ pub fn surface_radiance(
 /// Everything one pixel needs, resolved from a parameter set.
 #[derive(Debug, Clone)]
 pub struct Scene {
+    /// The terrain h(x, z).
     pub terrain: Terrain,
+    /// The pinhole camera (km).
     pub camera: Camera,
+    /// The relax march settings (also `t_max` and `eps` of the oracle).
     pub march: MarchSettings,
+    /// The `view` param: `color`, `depth`, `steps` or `normal`.
     pub view: &'static str,
+    /// Unit direction toward the sun.
     pub sun: V3,
+    /// Soft-shadow samples toward the sun (0: no shadow).
     pub shadow_steps: u32,
+    /// Reach of the shadow march (km).
     pub shadow_distance: Real,
+    /// Penumbra sharpness k of the soft shadow.
     pub shadow_softness: Real,
+    /// Fog extinction (1/km): 3.912 / visibility_km.
     pub sigma: Real,
+    /// Altitude (km) above which flat ground turns to snow.
     pub snow_line: Real,
+    /// Sun colour (linear RGB), times Lambert and the soft shadow.
     pub sun_color: V3,
 }
 
 impl Scene {
+    /// Resolves a `heightfield` param set for a `width` x `height` image; an
+    /// error when the camera's view direction is undefined ([`Camera::new`]).
     pub fn from_params(p: &ParamSet, width: u32, height: u32) -> Result<Scene, ParamError> {
         let camera = camera_of(p, width, height)?;
         Ok(Scene {

@@ -25,19 +25,29 @@ const KM: Real = 1000.0;
 /// Everything one pixel needs, resolved from a parameter set.
 #[derive(Debug, Clone)]
 pub struct Landscape {
+    /// The terrain h(x, z) (km).
     pub terrain: Terrain,
+    /// The terrain's relax march settings (`t_max` and `eps` also rule the oracle's hits).
     pub march: MarchSettings,
+    /// The terrain's soft-shadow samples.
     pub shadow: ShadowSettings,
+    /// Altitude (km) above which flat ground turns to snow.
     pub snow_line: Real,
+    /// Sky light on the terrain (linear RGB), times (0.5 + 0.5 n.y).
     pub ground_ambient: V3,
+    /// The atmosphere (m), its camera at the view's altitude.
     pub sky: Sky,
+    /// The cloud layer (km), lit through the atmosphere (its own `sun` and sky colours unused).
     pub clouds: Clouds,
     /// Position and basis; the aspect is set per image.
     pub view: Camera,
+    /// `projection = latlong`: the atmosphere kernel's upper hemisphere instead of the pinhole view.
     pub latlong: bool,
     /// `view = depth`: t / t_max of the terrain hit, 1 without one.
     pub depth: bool,
+    /// Unit direction toward the sun (azimuth from +z toward +x, elevation above the horizon).
     pub sun_dir: V3,
+    /// E_sun: the sun's irradiance above the atmosphere.
     pub sun_intensity: Real,
 }
 
@@ -50,6 +60,11 @@ fn profile_of(name: &str) -> Profile {
 }
 
 impl Landscape {
+    /// Resolves a `landscape` param set (angles in degrees become radians; the
+    /// atmosphere's camera altitude in m comes from camera_pos's y in km).
+    ///
+    /// # Panics
+    /// If `cloud_layer` names no cloud layer (`LandscapeKernel::check` refuses that).
     pub fn from_params(p: &ParamSet) -> Landscape {
         let sun_dir = direction(real(p, "sun_azimuth_deg").to_radians(), real(p, "sun_elevation_deg").to_radians());
         let pos = real3(p, "camera_pos");

@@ -86,16 +86,21 @@ pub fn value(seed: u32, x: Real, y: Real, z: Real) -> Real {
 /// A seeded basis ready to evaluate: owns its permutation table.
 #[derive(Debug, Clone)]
 pub struct Noise {
+    /// Which basis it evaluates.
     pub basis: Basis,
+    /// The seed: it picks Perlin's permutation (0: Perlin's own) and offsets
+    /// value noise's lattice hash.
     pub seed: u32,
     perm: Vec<u32>,
 }
 
 impl Noise {
+    /// The basis seeded with `seed`, with its permutation built.
     pub fn new(basis: Basis, seed: u32) -> Noise {
         Noise { basis, seed, perm: permutation(seed) }
     }
 
+    /// N(x, y, z): the basis at a point, in lattice units.
     pub fn eval(&self, x: Real, y: Real, z: Real) -> Real {
         match self.basis {
             Basis::Perlin => perlin(&self.perm, x, y, z),
@@ -116,8 +121,11 @@ impl Noise {
 /// fBm octave parameters (SPEC 3.2).
 #[derive(Debug, Clone, Copy)]
 pub struct Fbm {
+    /// The number of octaves summed.
     pub octaves: u32,
+    /// The frequency factor from one octave to the next.
     pub lacunarity: Real,
+    /// The amplitude factor from one octave to the next.
     pub gain: Real,
     /// Octave rotation angle in radians.
     pub theta: Real,
@@ -160,10 +168,15 @@ impl Fbm {
 /// Musgrave's ridged multifractal parameters (SPEC 3.3).
 #[derive(Debug, Clone, Copy)]
 pub struct Ridged {
+    /// The number of octaves summed.
     pub octaves: u32,
+    /// The frequency factor from one octave to the next.
     pub lacunarity: Real,
+    /// The fractal increment H: octave i is weighted lacunarity^(-i H).
     pub h: Real,
+    /// Subtracted from |N| before squaring: an octave's signal is (offset - |N|)^2.
     pub offset: Real,
+    /// Scales an octave's signal into the next octave's weight (clamped to [0, 1]).
     pub gain: Real,
 }
 

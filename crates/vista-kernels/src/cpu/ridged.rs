@@ -6,6 +6,7 @@ use super::{Real, real, render_cpu};
 use crate::ParamSet;
 use vista_image::Image;
 
+/// The ridged octave settings of a param set (`octaves`, `lacunarity`, `h`, `offset`, `gain`).
 pub fn ridged_of(p: &ParamSet) -> Ridged {
     Ridged {
         octaves: p.u32("octaves"),
