@@ -81,6 +81,8 @@ impl Context {
         let invocations = x as u64 * y as u64 * z as u64;
         let size = format!("@workgroup_size({x}, {y}, {z})");
         let most = n.workgroups.iter().copied().max().unwrap_or(0) as u64;
+        // Bindings of one kind, against their per-stage limit.
+        let count = |k: u32, what: &str, name: &'static str| (format!("{k} {what}"), name, k as u64);
         let checks: Vec<(String, &str, u64)> = vec![
             (
                 format!("{size}: {invocations} invocations per workgroup"),
@@ -92,27 +94,11 @@ impl Context {
             (size, "maxComputeWorkgroupSizeZ", z as u64),
             (format!("{most} workgroups along one axis"), "maxComputeWorkgroupsPerDimension", most),
             (format!("bind group {}", n.bind_groups.saturating_sub(1)), "maxBindGroups", n.bind_groups as u64),
-            (
-                format!("{} uniform buffers", n.uniform_buffers),
-                "maxUniformBuffersPerShaderStage",
-                n.uniform_buffers as u64,
-            ),
-            (
-                format!("{} storage buffers", n.storage_buffers),
-                "maxStorageBuffersPerShaderStage",
-                n.storage_buffers as u64,
-            ),
-            (
-                format!("{} storage textures", n.storage_textures),
-                "maxStorageTexturesPerShaderStage",
-                n.storage_textures as u64,
-            ),
-            (
-                format!("{} sampled textures", n.sampled_textures),
-                "maxSampledTexturesPerShaderStage",
-                n.sampled_textures as u64,
-            ),
-            (format!("{} samplers", n.samplers), "maxSamplersPerShaderStage", n.samplers as u64),
+            count(n.uniform_buffers, "uniform buffers", "maxUniformBuffersPerShaderStage"),
+            count(n.storage_buffers, "storage buffers", "maxStorageBuffersPerShaderStage"),
+            count(n.storage_textures, "storage textures", "maxStorageTexturesPerShaderStage"),
+            count(n.sampled_textures, "sampled textures", "maxSampledTexturesPerShaderStage"),
+            count(n.samplers, "samplers", "maxSamplersPerShaderStage"),
         ];
         for (need, name, value) in &checks {
             self.require(&format!("{what}: {need}"), name, *value)?;
