@@ -81,6 +81,14 @@ pub enum JitterSteps {
     Golden,
 }
 
+/// Each `integrator` value's meaning (for [`ParamSet::choice_in`]).
+pub const INTEGRATORS: &[(&str, Integrator)] = &[("riemann", Integrator::Riemann), ("analytic", Integrator::Analytic)];
+/// Each `jitter` value's meaning.
+pub const JITTERS: &[(&str, Jitter)] = &[("none", Jitter::None), ("white", Jitter::White), ("ign", Jitter::Ign)];
+/// Each `profile` value's meaning.
+pub const PROFILES: &[(&str, Profile)] =
+    &[("stratiform", Profile::Stratiform), ("cumuliform", Profile::Cumuliform), ("anvil", Profile::Anvil)];
+
 /// The cloud layer's geometry: a flat slab between the altitudes base and
 /// top (y), or a shell between the spheres of radius R + base and R + top
 /// around the atmosphere's planet (R = 6360 km, centre (camera x, -R,

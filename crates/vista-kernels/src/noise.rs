@@ -112,15 +112,8 @@ pub enum Basis {
 /// The basis names, as the kernels' `basis` enum params spell them.
 pub const BASIS_NAMES: &[&str] = &["perlin", "value"];
 
-impl Basis {
-    /// The basis a `basis` param names: `value`, else Perlin.
-    pub fn from_name(name: &str) -> Basis {
-        match name {
-            "value" => Basis::Value,
-            _ => Basis::Perlin,
-        }
-    }
-}
+/// Each basis name's meaning (for [`crate::ParamSet::choice_in`]).
+pub const BASES: &[(&str, Basis)] = &[("perlin", Basis::Perlin), ("value", Basis::Value)];
 
 #[cfg(test)]
 mod tests {

@@ -468,6 +468,28 @@ impl ParamSet {
             v => panic!("{}.{name} is {v:?}, not an enum", self.kernel),
         }
     }
+    /// Enum param `name`'s value as the CPU reference means it: `table`
+    /// maps every value the manifest lists. There is no default arm: a
+    /// manifest value missing from `table` is a reference that does not know
+    /// its own kernel, which `every_enum_value_has_a_meaning_in_the_cpu_reference`
+    /// catches for every built-in, rather than a silent fallback.
+    ///
+    /// # Panics
+    /// If the value is not in `table` (or `name` is not an enum param).
+    pub fn choice_in<T: Copy>(&self, name: &str, table: &[(&str, T)]) -> T {
+        let v = self.choice(name);
+        match table.iter().find(|(n, _)| *n == v) {
+            Some((_, t)) => *t,
+            None => {
+                let known: Vec<&str> = table.iter().map(|(n, _)| *n).collect();
+                panic!(
+                    "{}.{name} = {v} has no meaning in the CPU reference (it knows {})",
+                    self.kernel,
+                    known.join("|")
+                )
+            }
+        }
+    }
     /// The value of bool param `name`.
     ///
     /// # Panics

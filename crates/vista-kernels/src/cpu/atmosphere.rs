@@ -252,7 +252,7 @@ pub fn max_phase(g: Real) -> Real {
 /// The raw output (linear radiance) of the `atmosphere` kernel.
 pub fn render(p: &ParamSet, width: u32, height: u32) -> Image {
     let sky = Sky::from_params(p);
-    let fisheye = p.choice("projection") == "fisheye";
+    let fisheye = p.choice_in("projection", &[("latlong", false), ("fisheye", true)]);
     render_cpu(width, height, |u, v, _, _| {
         let dir = if fisheye { fisheye_direction(u, v, width, height) } else { Some(latlong_direction(u, v)) };
         let [r, g, b] = dir.map_or([0.0; 3], |d| sky.radiance(d));

@@ -7,7 +7,7 @@ use super::phase::dual_hg;
 use super::{Real, pixel_uv, real, real3, render_cpu};
 use crate::ParamSet;
 use crate::clouds::{Integrator, Jitter, JitterSteps, Layer, Profile, layer_of};
-use crate::noise::{Basis, pcg3d};
+use crate::noise::pcg3d;
 use vista_image::Image;
 
 /// A ray stops once its transmittance falls below this; the remainder is
@@ -248,17 +248,13 @@ impl Clouds {
             coverage: coverage_of(p),
             density_scale: real(p, "density_scale"),
             absorption: real(p, "absorption"),
-            profile: match p.choice("profile") {
-                "stratiform" => Profile::Stratiform,
-                "anvil" => Profile::Anvil,
-                _ => Profile::Cumuliform,
-            },
+            profile: p.choice_in("profile", crate::clouds::PROFILES),
             profile_bottom: real(p, "profile_bottom"),
             profile_top: real(p, "profile_top"),
             frequency: stretch.map(|s| s * ns),
             wind: real3(p, "wind_offset"),
             fbm,
-            noise: Noise::new(Basis::from_name(p.choice("basis")), p.u32("seed")),
+            noise: Noise::new(p.choice_in("basis", crate::noise::BASES), p.u32("seed")),
             inv_amplitude: 1.0 / fbm.amplitude_sum(),
             view: Camera::looking(camera, forward, real(p, "fov_deg"), 1.0),
             max_distance: real(p, "max_distance_km"),
@@ -277,13 +273,9 @@ impl Clouds {
             light_spread: real(p, "light_spread"),
             step_spread: real(p, "step_spread"),
             step_km: real(p, "step_km"),
-            jitter_steps: if p.choice("jitter_steps") == "golden" { JitterSteps::Golden } else { JitterSteps::Shared },
-            integrator: if p.choice("integrator") == "analytic" { Integrator::Analytic } else { Integrator::Riemann },
-            jitter: match p.choice("jitter") {
-                "white" => Jitter::White,
-                "ign" => Jitter::Ign,
-                _ => Jitter::None,
-            },
+            jitter_steps: p.choice_in("jitter_steps", &[("shared", JitterSteps::Shared), ("golden", JitterSteps::Golden)]),
+            integrator: p.choice_in("integrator", crate::clouds::INTEGRATORS),
+            jitter: p.choice_in("jitter", crate::clouds::JITTERS),
             jitter_seed: p.u32("jitter_seed"),
         }
     }

@@ -3,12 +3,11 @@
 use super::noise::{Fbm, Noise};
 use super::{Real, real, real2, render_cpu};
 use crate::ParamSet;
-use crate::noise::Basis;
 use vista_image::Image;
 
 /// Builds the seeded noise basis named by `basis` / `seed`.
 pub fn noise_of(p: &ParamSet) -> Noise {
-    Noise::new(Basis::from_name(p.choice("basis")), p.u32("seed"))
+    Noise::new(p.choice_in("basis", crate::noise::BASES), p.u32("seed"))
 }
 
 /// The fBm octave settings of a parameter set.

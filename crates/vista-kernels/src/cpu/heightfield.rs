@@ -82,12 +82,15 @@ impl Terrain {
     /// Resolves `terrain`, `amplitude`, `scale`, `plane_slope` and the noise and
     /// octave params of a param set.
     pub fn from_params(p: &ParamSet) -> Terrain {
-        let kind = match p.choice("terrain") {
-            "ridged" => TerrainKind::Ridged,
-            "plane" => TerrainKind::Plane,
-            "sine" => TerrainKind::Sine,
-            _ => TerrainKind::Fbm,
-        };
+        let kind = p.choice_in(
+            "terrain",
+            &[
+                ("fbm", TerrainKind::Fbm),
+                ("ridged", TerrainKind::Ridged),
+                ("plane", TerrainKind::Plane),
+                ("sine", TerrainKind::Sine),
+            ],
+        );
         let fbm = fbm_of(p);
         let ridged = Ridged {
             octaves: p.u32("octaves"),
@@ -472,7 +475,8 @@ impl Scene {
             terrain: Terrain::from_params(p),
             camera,
             march: MarchSettings::from_params(p),
-            view: p.choice("view"),
+            // Every view the manifest lists; "color" is the match arms' last.
+            view: p.choice_in("view", &[("color", "color"), ("depth", "depth"), ("steps", "steps"), ("normal", "normal")]),
             sun: sun_direction(real(p, "sun_azimuth_deg"), real(p, "sun_elevation_deg")),
             shadow_steps: p.u32("shadow_steps"),
             shadow_distance: real(p, "shadow_distance"),

@@ -14,9 +14,8 @@ use super::heightfield::{
 use super::noise::{Fbm, Noise};
 use super::{Real, Vec3, pixel_uv, real, real3, render_cpu};
 use crate::ParamSet;
-use crate::clouds::{Integrator, Jitter, JitterSteps, Profile};
+use crate::clouds::JitterSteps;
 use crate::heightfield::{BRUTE_STEPS, HitSearch};
-use crate::noise::Basis;
 use vista_image::Image;
 
 /// Metres per kilometre: the scene is in km, the atmosphere in m.
@@ -49,14 +48,6 @@ pub struct Landscape {
     pub sun_dir: V3,
     /// E_sun: the sun's irradiance above the atmosphere.
     pub sun_intensity: Real,
-}
-
-fn profile_of(name: &str) -> Profile {
-    match name {
-        "stratiform" => Profile::Stratiform,
-        "anvil" => Profile::Anvil,
-        _ => Profile::Cumuliform,
-    }
 }
 
 impl Landscape {
@@ -96,13 +87,13 @@ impl Landscape {
             coverage: real(p, "coverage"),
             density_scale: real(p, "density_scale"),
             absorption: real(p, "absorption"),
-            profile: profile_of(p.choice("profile")),
+            profile: p.choice_in("profile", crate::clouds::PROFILES),
             profile_bottom: real(p, "profile_bottom"),
             profile_top: real(p, "profile_top"),
             frequency: real3(p, "noise_stretch").map(|s| s * ns),
             wind: real3(p, "wind_offset"),
             fbm,
-            noise: Noise::new(Basis::from_name(p.choice("cloud_basis")), p.u32("seed")),
+            noise: Noise::new(p.choice_in("cloud_basis", crate::noise::BASES), p.u32("seed")),
             inv_amplitude: 1.0 / fbm.amplitude_sum(),
             view,
             max_distance: real(p, "cloud_max_distance_km"),
@@ -123,16 +114,8 @@ impl Landscape {
             step_spread: 1.0,
             step_km: 0.0,
             jitter_steps: JitterSteps::Shared,
-            integrator: if p.choice("cloud_integrator") == "analytic" {
-                Integrator::Analytic
-            } else {
-                Integrator::Riemann
-            },
-            jitter: match p.choice("cloud_jitter") {
-                "white" => Jitter::White,
-                "ign" => Jitter::Ign,
-                _ => Jitter::None,
-            },
+            integrator: p.choice_in("cloud_integrator", crate::clouds::INTEGRATORS),
+            jitter: p.choice_in("cloud_jitter", crate::clouds::JITTERS),
             jitter_seed: p.u32("cloud_jitter_seed"),
         };
         Landscape {
@@ -148,8 +131,8 @@ impl Landscape {
             sky,
             clouds,
             view,
-            latlong: p.choice("projection") == "latlong",
-            depth: p.choice("view") == "depth",
+            latlong: p.choice_in("projection", &[("pinhole", false), ("latlong", true)]),
+            depth: p.choice_in("view", &[("color", false), ("depth", true)]),
             sun_dir,
             sun_intensity,
         }
