@@ -68,6 +68,8 @@ const FAULTS: &[Fault] = &[
     ("atmosphere", "lib/sky.wgsl", "const BETA_M: f32 = 3.996e-6;", "const BETA_M: f32 = 4.1958e-6;"),
     ("clouds", "lib/cloud_slab.wgsl", "return plateau * (1.0 - 0.5 * h);", "return plateau * (1.0 - 0.525 * h);"),
     ("clouds", "lib/phase.wgsl", "(4.0 * PI * denom * sqrt(denom))", "(4.2 * PI * denom * sqrt(denom))"),
+    // The powder term's exponent: only the powder setting (no preset turns it on) sees it.
+    ("clouds", "lib/cloud_slab.wgsl", "s.c.powder * exp(-2.0 * tau_sun)", "s.c.powder * exp(-2.1 * tau_sun)"),
     // Issue 19's sampling options: geometric primary steps, golden-ratio
     // offsets, steps per ray from step_km.
     (
