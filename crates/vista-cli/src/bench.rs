@@ -48,6 +48,8 @@ pub fn bench(
         limits: config.limits,
         root: project.root().map(Into::into),
     };
+    // GPU timestamps around each graph pass, where the device has them.
+    ctx.time_passes(true);
     // Warm-up: compiles the pipeline and touches every allocation path once.
     // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
     let first = vista_render::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();

@@ -325,6 +325,9 @@ pub struct Context {
     pub creation_time: Duration,
     /// Whether the Khronos validation layer is on.
     pub(crate) validate: bool,
+    /// Whether graph passes read GPU timestamps (`vista bench` turns it
+    /// on): a readback per pass run, which checks need not pay.
+    pub(crate) time_passes: std::sync::atomic::AtomicBool,
 }
 
 pub(crate) enum Engine {
@@ -494,6 +497,7 @@ impl Context {
             submit_lock: Mutex::new(()),
             creation_time: start.elapsed(),
             validate,
+            time_passes: Default::default(),
         })
     }
 
@@ -525,7 +529,15 @@ impl Context {
             submit_lock: Mutex::new(()),
             creation_time: start.elapsed(),
             validate: false,
+            time_passes: Default::default(),
         })
+    }
+
+    /// Turns GPU timestamps around every graph pass run on or off (where
+    /// the device has them): `Rendered::pass_gpu_times` for benches. Off by
+    /// default, since each run then waits for a timestamp readback.
+    pub fn time_passes(&self, on: bool) {
+        self.time_passes.store(on, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// The same context with another GPU watchdog (mutation runs use a short

@@ -299,7 +299,8 @@ pub struct GraphReadback {
     /// Wall time of each pass, all its repeats together.
     pub pass_times: Vec<Duration>,
     /// GPU time of each pass from the device's timestamps, all its repeats
-    /// together; `None` where the backend has no timestamps.
+    /// together; `None` where the backend has no timestamps or
+    /// [`Context::time_passes`] is off.
     pub pass_gpu_times: Vec<Option<Duration>>,
 }
 
@@ -428,7 +429,9 @@ impl Context {
         // Which physical resource each name binds now (swaps exchange them).
         let mut current: Vec<usize> = (0..g.resources.len()).collect();
         let mut pass_times = vec![Duration::ZERO; g.passes.len()];
-        let stamps = w.device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Stamps::new(w));
+        let stamps = (self.time_passes.load(std::sync::atomic::Ordering::Relaxed)
+            && w.device.features().contains(wgpu::Features::TIMESTAMP_QUERY))
+        .then(|| Stamps::new(w));
         let mut gpu_times = vec![Duration::ZERO; g.passes.len()];
         let _serial = self.submit_lock.lock().expect("submit lock");
         for (pi, pass, compiled) in run_order(&g.passes).into_iter().map(|i| (i, &g.passes[i], &pipelines[i])) {

@@ -94,7 +94,7 @@ pub struct Rendered {
     /// Wall time of each graph pass (all its repeats).
     pub pass_times: Vec<std::time::Duration>,
     /// GPU time of each graph pass from the device's timestamps (all its
-    /// repeats), where the backend has them.
+    /// repeats), where the backend has them and `Context::time_passes` is on.
     pub pass_gpu_times: Vec<Option<std::time::Duration>>,
     to_display: DisplayMap,
     /// Display values, made on first use unless they are `raw` itself: a
