@@ -83,9 +83,6 @@ pub struct Outcome {
     /// Metrics of the render against the golden; `None` when no comparison was
     /// made.
     pub metrics: Option<Metrics>,
-    /// `metrics.psnr` is of the main image's raw values (its EXR golden),
-    /// the rest of the metrics of its view.
-    pub psnr_of_raw: bool,
     /// The PSNR threshold that applied, and whether the adapter matched the
     /// manifest's (60 dB same driver, 35 dB other driver by default).
     pub psnr_threshold: f64,
@@ -136,6 +133,12 @@ pub struct Outcome {
 pub const BAD_PIXEL_LIMIT: &str = "1/255";
 
 impl Outcome {
+    /// Whether `metrics.psnr` is of the main image's raw values (its EXR
+    /// golden, which judged it), the rest of the metrics of its view.
+    pub fn psnr_of_raw(&self) -> bool {
+        self.outputs.first().is_some_and(|o| o.by_raw && o.raw_psnr.is_some())
+    }
+
     /// Passing for the run: a pass, or a failure that an expectation names.
     pub fn passed(&self) -> bool {
         matches!(self.verdict, Verdict::Pass | Verdict::ExpectedFail)
@@ -159,7 +162,7 @@ impl Outcome {
                 "  PSNR {}{} (>= {:.1} dB, {} driver) | SSIM {:.5}{} | FLIP {} | max-abs {:.3e} | bad pixels {} \
                      ({:.3}%, > {BAD_PIXEL_LIMIT}) | NaN/Inf {}\n",
                 metrics::format_psnr(m.psnr),
-                if self.psnr_of_raw { " of raw values" } else { "" },
+                if self.psnr_of_raw() { " of raw values" } else { "" },
                 self.psnr_threshold,
                 if self.same_driver { "same" } else { "other" },
                 m.ssim,
@@ -293,7 +296,6 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
         kernel: case.kernel.name().to_string(),
         verdict: Verdict::Pass,
         metrics: None,
-        psnr_of_raw: false,
         psnr_threshold: case.psnr_same_driver,
         same_driver: true,
         min_ssim: case.min_ssim,
@@ -502,7 +504,6 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
         // Its raw values (the EXR golden) carry the PSNR verdict (a failure
         // is the output's problem); the view's other metrics stay.
         m.psnr = raw;
-        out.psnr_of_raw = true;
     } else if m.psnr < out.psnr_threshold {
         out.problems.push(format!(
             "PSNR {} is below the threshold {:.1} dB",

@@ -90,21 +90,23 @@ pub fn inputs_of(case: &Case, root: Option<&std::path::Path>) -> Vec<(String, St
 /// An input texture as the report shows it: as is when its RGB values lie
 /// in [0, 1], else mapped from their min..max; alpha 1.
 fn shown(img: &Image) -> Image {
-    let values = img.data.iter().flat_map(|p| p[..3].iter().copied()).filter(|v| v.is_finite());
-    let (lo, hi) = values.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
-    let (lo, span) = match lo >= 0.0 && hi <= 1.0 {
-        true => (0.0, 1.0),
-        false => (lo, (hi - lo).max(f32::MIN_POSITIVE)),
-    };
-    let data = img
-        .data
-        .iter()
-        .map(|p| {
-            let f = |v: f32| if v.is_finite() { ((v - lo) / span).clamp(0.0, 1.0) } else { 0.0 };
-            [f(p[0]), f(p[1]), f(p[2]), 1.0]
-        })
-        .collect();
-    Image::from_raw(img.width, img.height, data).expect("same size")
+    let in_unit = img.data.iter().flat_map(|p| p[..3].iter()).all(|v| !v.is_finite() || (0.0..=1.0).contains(v));
+    match in_unit {
+        // As is (non-finite values black, alpha 1), like the normalized view.
+        true => Image::from_raw(
+            img.width,
+            img.height,
+            img.data
+                .iter()
+                .map(|p| {
+                    let f = |v: f32| if v.is_finite() { v } else { 0.0 };
+                    [f(p[0]), f(p[1]), f(p[2]), 1.0]
+                })
+                .collect(),
+        )
+        .expect("same size"),
+        false => vista_kernels::normalized(img, 3),
+    }
 }
 
 /// This run's side of `case`'s provenance: backend, adapter, params hash

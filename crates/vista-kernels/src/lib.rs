@@ -265,7 +265,7 @@ impl DisplayMap {
 /// `raw` mapped to [0, 1] by the min and max of the finite values of its
 /// first `channels` of R, G, B (a constant image maps to 0), alpha 1;
 /// non-finite values map to 0. A single channel is shown grey.
-fn normalized(raw: &Image, channels: u8) -> Image {
+pub fn normalized(raw: &Image, channels: u8) -> Image {
     let n = channels.clamp(1, 3) as usize;
     let finite = raw.data.iter().flat_map(|p| p[..n].iter().copied()).filter(|v| v.is_finite());
     let (lo, hi) = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));

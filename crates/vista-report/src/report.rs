@@ -429,7 +429,7 @@ fn metric_cells(o: &Outcome) -> (String, String) {
                  <tr><th>max abs</th><td>{:.3e}</td><td></td></tr>\
                  <tr><th>bad pixels</th><td>{} ({:.3}%)</td><td>a channel differs by &gt; {BAD_PIXEL_LIMIT}</td></tr>\
                  <tr><th>NaN/Inf</th><td{}>{}</td><td>none allowed</td></tr></table>",
-                if o.psnr_of_raw { " (raw values)" } else { "" },
+                if o.psnr_of_raw() { " (raw values)" } else { "" },
                 cls(psnr_bad),
                 format_psnr(m.psnr),
                 o.psnr_threshold,
