@@ -259,6 +259,15 @@ pub struct Graph<'a> {
     pub outputs: Vec<usize>,
 }
 
+/// The view a binding of `t` sees: six layers as a cube for a sampled
+/// `texture_cube`, else the texture's own dimension.
+fn view_dimension(t: &TextureDesc, cube: bool) -> wgpu::TextureViewDimension {
+    match cube {
+        true => wgpu::TextureViewDimension::Cube,
+        false => t.dimension.view(),
+    }
+}
+
 /// The order passes run in: each group (a pass with span n and the n - 1
 /// after it) `repeat` times over, a pass alone `repeat` times in a row.
 pub fn run_order(passes: &[GraphPass]) -> Vec<usize> {
@@ -463,10 +472,7 @@ impl Context {
                             let Resource::Texture(t) = &g.resources[resource] else { return None };
                             let cube = matches!(s.bind, Bind::Sampled { cube: true, .. });
                             Some(made.textures[&current[resource]].create_view(&wgpu::TextureViewDescriptor {
-                                dimension: Some(match cube {
-                                    true => wgpu::TextureViewDimension::Cube,
-                                    false => t.dimension.view(),
-                                }),
+                                dimension: Some(view_dimension(t, cube)),
                                 ..Default::default()
                             }))
                         }
@@ -885,10 +891,7 @@ impl Context {
                                 wgpu::TextureSampleType::Float { filterable: !format.is_float32() || filterable32 }
                             }
                         },
-                        view_dimension: match cube {
-                            true => wgpu::TextureViewDimension::Cube,
-                            false => t.dimension.view(),
-                        },
+                        view_dimension: view_dimension(t, cube),
                         multisampled: false,
                     }
                 }
