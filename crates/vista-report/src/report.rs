@@ -135,6 +135,19 @@ fn write_inputs(dir: &Path, out: &mut Outcome, inputs: &[(String, String, Option
     Ok(())
 }
 
+/// A thumbnail of an outputs or inputs table row, linked to its file;
+/// nothing when there is no image.
+fn linked_image(path: Option<&String>, alt: &str) -> String {
+    match path {
+        Some(p) => format!(
+            "<a href=\"{0}\"><img class=\"thumb\" src=\"{0}\" alt=\"{1}\"></a>",
+            html_escape(p),
+            html_escape(alt)
+        ),
+        None => String::new(),
+    }
+}
+
 /// A pass graph's inputs: each resource that starts from a file or inline
 /// data, where from, and a texture's image.
 fn inputs_table(o: &Outcome) -> String {
@@ -143,16 +156,7 @@ fn inputs_table(o: &Outcome) -> String {
     }
     let mut t = String::from("<table class=\"outputs inputs\"><tr><th>input</th><th>from</th><th>image</th></tr>");
     for (name, what, path) in &o.files.inputs {
-        let img = path
-            .as_ref()
-            .map(|p| {
-                format!(
-                    "<a href=\"{0}\"><img class=\"thumb\" src=\"{0}\" alt=\"{1}\"></a>",
-                    html_escape(p),
-                    html_escape(name)
-                )
-            })
-            .unwrap_or_default();
+        let img = linked_image(path.as_ref(), name);
         t += &format!("<tr><td><b>{}</b></td><td>{}</td><td>{img}</td></tr>", html_escape(name), html_escape(what));
     }
     t + "</table>"
@@ -197,14 +201,7 @@ fn outputs_table(o: &Outcome) -> String {
     );
     for v in &o.outputs {
         let images = o.files.outputs.iter().find(|(n, _, _)| *n == v.name);
-        let img = |p: Option<&String>| match p {
-            Some(p) => format!(
-                "<a href=\"{0}\"><img class=\"thumb\" src=\"{0}\" alt=\"{1}\"></a>",
-                html_escape(p),
-                html_escape(&v.name)
-            ),
-            None => String::new(),
-        };
+        let img = |p: Option<&String>| linked_image(p, &v.name);
         let mut result: Vec<String> =
             v.problems.iter().map(|p| format!("<div class=\"problem\">{}</div>", html_escape(p))).collect();
         result.extend(
