@@ -3,6 +3,7 @@
 // The integral itself is shaders/lib/sky.wgsl, shared with the landscape kernel.
 #import vista::geometry::latlong_direction
 #import vista::sky::{Atmosphere, sky_radiance}
+#import vista::enums::PROJECTION_LATLONG
 
 // Packed by name from kernels/atmosphere.toml (exposure is the host's tone map).
 struct Params {
@@ -38,7 +39,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let uv = (vec2<f32>(id.xy) + 0.5) / size;
     let a = atmosphere();
     var l = vec3(0.0);
-    if params.projection == 0u {
+    if params.projection == PROJECTION_LATLONG {
         l = sky_radiance(a, latlong_direction(uv.x, uv.y));
     } else {
         // Equidistant fisheye: zenith at the centre, horizon on the inscribed

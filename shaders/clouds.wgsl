@@ -12,52 +12,24 @@
 struct Params {
     width: u32,
     height: u32,
-    steps: u32,
-    light_steps: u32,
-    integrator: u32,
+    // The layer's params, by name (kernels/clouds.toml's [[group]]); its
+    // coverage is replaced by coverage() below when coverage_oktas >= 0.
+    cloud: CloudParams,
     jitter: u32,
     jitter_seed: u32,
-    profile: u32,
-    octaves: u32,
-    seed: u32,
-    lacunarity: f32,
-    gain: f32,
-    cloud_base_km: f32,
-    cloud_top_km: f32,
-    coverage: f32,
     coverage_oktas: i32,
     okta_coverage_low: vec4<f32>,
     okta_coverage_high: vec4<f32>,
-    density_scale: f32,
-    absorption: f32,
-    profile_bottom: f32,
-    profile_top: f32,
-    noise_scale: f32,
-    noise_stretch: vec3<f32>,
     yaw_deg: f32,
-    wind_offset: vec3<f32>,
     pitch_deg: f32,
     camera_pos: vec3<f32>,
     fov_deg: f32,
     sun_color: vec3<f32>,
-    max_distance_km: f32,
-    ambient: vec3<f32>,
     sun_azimuth_deg: f32,
     sky_zenith: vec3<f32>,
     sun_elevation_deg: f32,
     sky_horizon: vec3<f32>,
     sun_intensity: f32,
-    g1: f32,
-    g2: f32,
-    phase_blend: f32,
-    powder: f32,
-    ambient_bottom: f32,
-    light_spread: f32,
-    step_spread: f32,
-    jitter_steps: u32,
-    step_km: f32,
-    layer: u32,
-    basis: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -68,7 +40,7 @@ struct Params {
 fn coverage() -> f32 {
     let n = params.coverage_oktas;
     if n < 0 {
-        return params.coverage;
+        return params.cloud.coverage;
     }
     if n == 0 {
         return 0.0;
@@ -80,12 +52,9 @@ fn coverage() -> f32 {
 }
 
 fn slab() -> CloudSlab {
-    return cloud_slab(CloudParams(params.cloud_base_km, params.cloud_top_km, coverage(), params.density_scale,
-        params.absorption, params.profile, params.profile_bottom, params.profile_top, params.noise_scale,
-        params.noise_stretch, params.wind_offset, params.octaves, params.lacunarity, params.gain, params.seed,
-        params.max_distance_km, params.steps, params.light_steps, params.light_spread, params.step_spread, params.step_km, params.jitter_steps, params.integrator, params.g1,
-        params.g2, params.phase_blend, params.powder, params.ambient, params.ambient_bottom, params.layer, params.basis),
-        params.camera_pos);
+    var c = params.cloud;
+    c.coverage = coverage();
+    return cloud_slab(c, params.camera_pos);
 }
 
 @compute @workgroup_size(8, 8)

@@ -7,6 +7,7 @@
 // terrain normaliser in lib/terrain.wgsl: in WGSL, never on the host.
 #import vista::geometry::{direction, pinhole_look_at, pinhole_ray}
 #import vista::terrain::{Light, March, Shadow, Terrain, TerrainParams, march, normal_at, surface_radiance, terrain_of}
+#import vista::enums::{VIEW_DEPTH, VIEW_NORMAL, VIEW_STEPS}
 
 struct Params {
     width: u32,
@@ -45,9 +46,6 @@ struct Params {
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
 
-const VIEW_DEPTH: u32 = 1u;
-const VIEW_STEPS: u32 = 2u;
-const VIEW_NORMAL: u32 = 3u;
 
 // Shading colours (linear), the same constants as crates/vista-kernels/src/cpu/heightfield.rs.
 const AMBIENT = vec3(0.16, 0.22, 0.32);

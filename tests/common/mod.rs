@@ -86,13 +86,11 @@ pub fn with_edit(gpu: &Renderer<'static>, file: &str, from: &str, to: &str) -> R
     let files = project().shader_files().expect("the checkout's shaders");
     let target = files.iter().find(|f| f.rel == file).unwrap_or_else(|| panic!("no shader {file}"));
     assert_eq!(target.text.matches(from).count(), 1, "{file}: '{from}' must occur exactly once (shader changed?)");
-    let shaders = vista_gpu::ShaderSet::from_files(
-        "edited",
-        files.into_iter().map(|f| {
-            let text = if f.rel == file { f.text.replace(from, to) } else { f.text };
-            (f.rel, text, f.origin)
-        }),
-    );
+    let shaders = vista_render::edited_shader_set(&project(), "edited", |rel, text| match rel == file {
+        true => text.replace(from, to),
+        false => text,
+    })
+    .expect("the checkout's shaders");
     Renderer { ctx: gpu.ctx, shaders, limits: gpu.limits, root: gpu.root.clone() }
 }
 

@@ -2412,6 +2412,106 @@ fn overrides_take_manifest_values_and_params() {
     );
 }
 
+/// Enum values reach WGSL as constants generated from the manifest
+/// (`vista::enums`), and a `[[group]]` fills a nested struct of the uniform
+/// by the group's rule (leaf x from param p_x, else x); each wrong use is
+/// one error line, exit 2. A built-in's manifest whose enum order
+/// contradicts a library constant (`vista::noise`'s BASIS_VALUE) is refused.
+fn enum_constants_and_param_groups_come_from_the_manifest() {
+    let shader = r#"#import vista::enums::{MODE_B, MODE_C}
+struct Inner {
+    a: f32,
+    b: f32,
+    mode: u32,
+}
+struct Params {
+    width: u32,
+    height: u32,
+    a: f32,
+    @align(16) inner: Inner,
+}
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    let m = params.inner.mode;
+    let mode = select(select(0.0, 0.5, m == MODE_B), 1.0, m == MODE_C);
+    textureStore(output, id.xy, vec4(params.a, params.inner.a, params.inner.b, mode));
+}
+"#;
+    let param = |name: &str, default: f32| {
+        format!("[[param]]\nname = \"{name}\"\ntype = \"f32\"\nrange = [0, 1]\ndefault = {default}\n")
+    };
+    let manifest = format!(
+        "summary = \"groups\"\n[[group]]\nfield = \"inner\"\nprefix = \"p_\"\n{}{}{}[[param]]\nname = \"mode\"\n\
+         type = \"enum\"\nvalues = [\"a-one\", \"b\", \"c\"]\ndefault = \"b\"\n",
+        param("a", 0.25),
+        param("p_a", 0.5),
+        param("b", 0.75),
+    );
+    let d = kernel_project(&manifest, shader);
+    for backend in ["lavapipe", "browser"] {
+        for (mode, alpha) in [("a-one", 0.0), ("b", 0.5), ("c", 1.0)] {
+            let out = d.path().join(format!("{backend}-{mode}.exr"));
+            let set = format!("mode={mode}");
+            let args =
+                ["render", "k", "--size", "9x5", "--set", &set, "--backend", backend, "-o", out.to_str().unwrap()];
+            let r = vista_in(Some(d.path()), &[], &args);
+            assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+            let img = vista_image::load(&out).unwrap();
+            let want = [0.25, 0.5, 0.75, alpha];
+            assert!(img.data.iter().all(|p| *p == want), "{backend} {mode}: {:?}, want {want:?}", img.get(0, 0));
+        }
+    }
+    let reject = |manifest: &str, shader: &str, needles: &[&str]| {
+        let d = kernel_project(manifest, shader);
+        assert_rejected(&render_exr(d.path(), "8x8", "x").0, 2, needles);
+    };
+    reject(
+        &manifest.replace("field = \"inner\"", "field = \"outer\""),
+        shader,
+        &["[[group]] field = \"outer\" is no struct field of the uniform in k.wgsl", "its struct fields: inner"],
+    );
+    reject(
+        &manifest.replace("default = \"b\"", "default = \"b\"\nconstants = \"mode\""),
+        shader,
+        &["param mode: constants = \"mode\" is not a WGSL constant prefix"],
+    );
+    reject(&manifest.replace("name = \"p_a\"", "name = \"q_a\""), shader, &["param q_a (f32) has no field"]);
+    // Two enums whose constants collide with other values.
+    let clash = format!(
+        "{manifest}[[param]]\nname = \"other\"\ntype = \"enum\"\nvalues = [\"c\", \"b\"]\nconstants = \"MODE\"\n\
+         default = \"c\"\n"
+    );
+    reject(&clash, shader, &["param other: WGSL constant MODE_C would be 0 here but 2 for an earlier enum"]);
+    // A constant the manifest does not generate.
+    let unknown = shader.replace("MODE_C}", "MODE_C, MODE_D}").replace("1.0, m == MODE_C", "1.0, m == MODE_D");
+    let e = render_exr(kernel_project(&manifest, &unknown).path(), "8x8", "x").0;
+    assert_eq!(e.code, 2, "{}", e.stderr);
+    assert!(e.stderr.contains("MODE_D"), "{}", e.stderr);
+
+    // fbm's basis listed in another order than lib/noise.wgsl's constants.
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    std::fs::create_dir(d.path().join("kernels")).unwrap();
+    let fbm = std::fs::read_to_string(repo().join("kernels/fbm.toml")).unwrap();
+    assert!(fbm.contains("values = [\"perlin\", \"value\"]"), "the fbm manifest's basis");
+    std::fs::write(
+        d.path().join("kernels/fbm.toml"),
+        fbm.replace("[\"perlin\", \"value\"]", "[\"value\", \"perlin\"]"),
+    )
+    .unwrap();
+    let out = d.path().join("f.png");
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["render", "fbm", "--size", "8x8", "-o", out.to_str().unwrap()]),
+        2,
+        &["enum constant BASIS_PERLIN is 1u by the kernel's manifest but 0u in lib/noise.wgsl"],
+    );
+}
+
 /// A project kernel named like a built-in but with other params is a kernel
 /// of its own: it renders, checks and benches without the built-in's CPU
 /// reference (which read the built-in's params and panicked, exit 101).
@@ -3760,6 +3860,7 @@ fn main() {
         Gpu several_uniforms_are_packed_by_variable_path,
         Gpu module_paths_tell_uniforms_of_two_modules_apart,
         Gpu a_project_kernel_named_like_a_builtin_does_not_get_its_reference,
+    Gpu enum_constants_and_param_groups_come_from_the_manifest,
         Gpu overrides_take_manifest_values_and_params,
         Gpu the_real_kernels_example_passes_on_every_backend_with_a_copied_binary,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,

@@ -600,8 +600,9 @@ impl Context {
     ) -> Result<String, GpuError> {
         let module = shaders.compose(shader)?;
         let (resolved, info) = crate::shaders::resolve_overrides(shader, &module, entry, constants)?;
-        naga::back::wgsl::write_string(&resolved, &info, naga::back::wgsl::WriterFlags::empty())
-            .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))
+        let text = naga::back::wgsl::write_string(&resolved, &info, naga::back::wgsl::WriterFlags::empty())
+            .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))?;
+        crate::shaders::keep_struct_layouts(shader, &resolved, text)
     }
 
     /// Compiles (once per source hash, entry, slots and format) the pipeline

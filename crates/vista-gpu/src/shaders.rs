@@ -27,7 +27,14 @@ pub struct ShaderSet {
     /// Composed modules by kernel file: the sources never change once the
     /// set is built, so each file is composed once per set.
     composed: Arc<Mutex<HashMap<String, Arc<naga::Module>>>>,
+    /// The generated module `vista::enums` of each kernel file (from its
+    /// manifest's enum params), or why there is none (two manifests that
+    /// share the file declare different enums).
+    enums: BTreeMap<String, Result<String, String>>,
 }
+
+/// The import path of the module generated from a kernel's manifest.
+pub const ENUMS_MODULE: &str = "vista::enums";
 
 impl ShaderSet {
     /// A set from `(relative path, text, origin)` triples; files under
@@ -46,7 +53,34 @@ impl ShaderSet {
             }
         }
         lib.sort();
-        ShaderSet { label: label.to_string(), lib, kernels, composed: Default::default() }
+        ShaderSet { label: label.to_string(), lib, kernels, composed: Default::default(), enums: BTreeMap::new() }
+    }
+
+    /// This set with a generated `vista::enums` module per kernel file:
+    /// `(file, kernel, module text)` for every file each kernel's passes use.
+    /// Two kernels that give one file different modules make composing it
+    /// fail, naming both, when it imports `vista::enums`.
+    pub fn with_enums(mut self, modules: impl IntoIterator<Item = (String, String, String)>) -> ShaderSet {
+        let mut owner: BTreeMap<String, String> = BTreeMap::new();
+        for (file, kernel, text) in modules {
+            match self.enums.get(&file) {
+                Some(Ok(t)) if *t != text => {
+                    let first = owner.get(&file).cloned().unwrap_or_default();
+                    let why = format!(
+                        "kernels {first} and {kernel} share {file}, which imports {ENUMS_MODULE}, but declare \
+                         different enum params; give each kernel its own shader file"
+                    );
+                    self.enums.insert(file, Err(why));
+                }
+                Some(_) => {}
+                None => {
+                    owner.insert(file.clone(), kernel);
+                    self.enums.insert(file, Ok(text));
+                }
+            }
+        }
+        self.composed = Default::default();
+        self
     }
 
     /// What this set is (a project root, or "built-in").
@@ -72,11 +106,84 @@ impl ShaderSet {
         })
     }
 
-    /// A composer holding every library module. naga_oil wants a module's
-    /// imports added before it, so modules are added in rounds until all fit.
-    fn composer(&self) -> Result<Composer, GpuError> {
+    /// The generated `vista::enums` text for kernel file `name` when it or
+    /// a module it imports imports it.
+    fn enums_for(&self, name: &str) -> Result<Option<&str>, GpuError> {
+        let file = name.split_once('?').map_or(name, |(file, _)| file);
+        let (source, _) = self.kernel_source(name)?;
+        let imports_enums = |text: &str| {
+            text.lines().filter_map(|l| l.trim().strip_prefix("#import")).any(|rest| {
+                let rest = rest.trim();
+                rest == ENUMS_MODULE || rest.starts_with(&format!("{ENUMS_MODULE}::"))
+            })
+        };
+        if !imports_enums(source) && !self.imported_lib(source).iter().any(|e| imports_enums(&e.1)) {
+            return Ok(None);
+        }
+        match self.enums.get(file) {
+            Some(Ok(text)) => Ok(Some(text)),
+            Some(Err(why)) => Err(GpuError::Shader(format!("{file}: {why}"))),
+            None => Err(GpuError::Shader(format!(
+                "{file} imports {ENUMS_MODULE}, which is generated from the enum params of the kernel manifest \
+                 that names the file; no manifest in {} names {file}",
+                self.label
+            ))),
+        }
+    }
+
+    /// Refuses a generated constant that a library module the kernel
+    /// imports also defines with another value: the library's meaning of
+    /// the index (`vista::noise`'s `BASIS_VALUE`) and the manifest's order
+    /// must agree.
+    fn check_enums(&self, name: &str, enums: &str) -> Result<(), GpuError> {
+        let (source, _) = self.kernel_source(name)?;
+        let consts = |text: &str| -> Vec<(String, String)> {
+            text.lines()
+                .filter_map(|l| l.trim().strip_prefix("const "))
+                .filter_map(|rest| {
+                    let (name, rest) = rest.split_once(':')?;
+                    let value = rest.split_once('=')?.1.trim().trim_end_matches(';').trim();
+                    Some((name.trim().to_string(), value.to_string()))
+                })
+                .collect()
+        };
+        let generated = consts(enums);
+        for (path, text) in self.imported_lib(source) {
+            for (c, lib_value) in consts(text) {
+                if let Some((_, value)) = generated.iter().find(|(g, _)| *g == c)
+                    && *value != lib_value
+                {
+                    return Err(GpuError::Shader(format!(
+                        "{}: enum constant {c} is {value} by the kernel's manifest but {lib_value} in {path}; list the \
+                         enum's values in the order {path} gives them",
+                        name.split_once('?').map_or(name, |(f, _)| f)
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A composer holding the generated `vista::enums` module (if any)
+    /// and the library modules the kernel source reaches. naga_oil wants a
+    /// module's imports added before it, so modules are added in rounds
+    /// until all fit.
+    fn composer(&self, source: &str, enums: Option<&str>) -> Result<Composer, GpuError> {
         let mut composer = Composer::default();
-        let mut pending: Vec<&(String, String)> = self.lib.iter().collect();
+        if let Some(text) = enums {
+            let desc = ComposableModuleDescriptor {
+                source: text,
+                file_path: "<generated>/vista/enums.wgsl",
+                language: ShaderLanguage::Wgsl,
+                as_name: None,
+                additional_imports: &[],
+                shader_defs: HashMap::new(),
+            };
+            if let Err(e) = composer.add_composable_module(desc) {
+                return Err(GpuError::Shader(describe(&composer, &self.label, &e)));
+            }
+        }
+        let mut pending: Vec<&(String, String)> = self.imported_lib(source);
         while !pending.is_empty() {
             let mut failed = Vec::new();
             let mut last_error = None;
@@ -131,7 +238,14 @@ impl ShaderSet {
             validate(name, &module)?;
             return Ok(module);
         }
-        let mut composer = self.composer()?;
+        // The manifest's constants must agree with the library's even where
+        // the kernel passes the index through without naming it.
+        let file = name.split_once('?').map_or(name, |(file, _)| file);
+        if let Some(Ok(text)) = self.enums.get(file) {
+            self.check_enums(name, text)?;
+        }
+        let enums = self.enums_for(name)?;
+        let mut composer = self.composer(source, enums)?;
         let module = composer
             .make_naga_module(NagaModuleDescriptor {
                 source,
@@ -157,6 +271,10 @@ impl ShaderSet {
             h.update(path.as_bytes());
             h.update(source.as_bytes());
         }
+        if let Some(text) = self.enums_for(name)? {
+            h.update(ENUMS_MODULE.as_bytes());
+            h.update(text.as_bytes());
+        }
         Ok(h.finalize().to_hex()[..16].to_string())
     }
 
@@ -165,8 +283,10 @@ impl ShaderSet {
     pub fn file_hashes(&self, name: &str) -> Result<std::collections::BTreeMap<String, String>, GpuError> {
         let (source, _) = self.kernel_source(name)?;
         let hash = |text: &str| blake3::hash(text.as_bytes()).to_hex()[..16].to_string();
+        let enums = self.enums_for(name)?.map(|text| (format!("{ENUMS_MODULE} (from the manifest)"), hash(text)));
         Ok(std::iter::once((name.to_string(), hash(source)))
             .chain(self.imported_lib(source).into_iter().map(|(path, text)| (path.clone(), hash(text))))
+            .chain(enums)
             .collect())
     }
 
@@ -221,6 +341,47 @@ pub fn resolve_overrides(
     )
     .map_err(|e| GpuError::Shader(format!("{name}: override values do not resolve: {e}")))?;
     Ok((resolved.into_owned(), resolved_info.into_owned()))
+}
+
+/// `text` (naga's WGSL of `module`) with every struct member's offset and
+/// every struct's size as in `module`. naga's writer drops `@align` and
+/// `@size`, so a struct the source laid out with them would reach Tint with
+/// other offsets than the ones vista packs its uniforms by (Chrome's
+/// relaxed uniform layout then accepts it and reads shifted values). Each
+/// member whose offset or struct size differs gets `@size(next offset -
+/// offset)`; structs that already agree are left as written.
+pub fn keep_struct_layouts(name: &str, module: &naga::Module, text: String) -> Result<String, GpuError> {
+    use naga::TypeInner;
+    let written = naga::front::wgsl::parse_str(&text)
+        .map_err(|e| GpuError::Shader(format!("{name}: naga cannot read back its own WGSL: {e}")))?;
+    let layout = |m: &naga::Module, ty: &str| {
+        m.types.iter().find_map(|(_, t)| match (&t.inner, t.name.as_deref()) {
+            (TypeInner::Struct { members, span }, Some(n)) if n == ty => {
+                Some((members.iter().map(|m| m.offset).collect::<Vec<u32>>(), *span))
+            }
+            _ => None,
+        })
+    };
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    for (_, t) in module.types.iter() {
+        let (TypeInner::Struct { members, span }, Some(ty)) = (&t.inner, t.name.as_deref()) else { continue };
+        let want: Vec<u32> = members.iter().map(|m| m.offset).collect();
+        let Some((got, got_span)) = layout(&written, ty) else { continue };
+        if got == want && got_span == *span {
+            continue;
+        }
+        let Some(start) = lines.iter().position(|l| l.trim() == format!("struct {ty} {{")) else {
+            return Err(GpuError::Shader(format!("{name}: struct {ty} not found in naga's WGSL")));
+        };
+        for (i, line) in lines[start + 1..start + 1 + members.len()].iter_mut().enumerate() {
+            let end = want.get(i + 1).copied().unwrap_or(*span);
+            let indent = line.len() - line.trim_start().len();
+            line.insert_str(indent, &format!("@size({}) ", end - want[i]));
+        }
+    }
+    let mut out = lines.join("\n");
+    out.push('\n');
+    Ok(out)
 }
 
 /// The path a module declares with `#define_import_path`, if any.

@@ -85,6 +85,8 @@ pub enum JitterSteps {
 pub const INTEGRATORS: &[(&str, Integrator)] = &[("riemann", Integrator::Riemann), ("analytic", Integrator::Analytic)];
 /// Each `jitter` value's meaning.
 pub const JITTERS: &[(&str, Jitter)] = &[("none", Jitter::None), ("white", Jitter::White), ("ign", Jitter::Ign)];
+/// Each `jitter_steps` value's meaning.
+pub const JITTER_STEPS: &[(&str, JitterSteps)] = &[("shared", JitterSteps::Shared), ("golden", JitterSteps::Golden)];
 /// Each `profile` value's meaning.
 pub const PROFILES: &[(&str, Profile)] =
     &[("stratiform", Profile::Stratiform), ("cumuliform", Profile::Cumuliform), ("anvil", Profile::Anvil)];
@@ -130,6 +132,21 @@ pub fn layer_of(p: &ParamSet, param: &str) -> Result<Layer, ParamError> {
     let name = p.choice(param);
     Layer::from_name(name)
         .ok_or_else(|| ParamError::Invalid(format!("{param}={name} is not a cloud layer; allowed: slab, shell")))
+}
+
+/// The `cloud` group of built-in kernel `kernel`'s manifest (the params
+/// that fill its uniform's `CloudParams`): the CPU references read the
+/// group's leaves through the same rule as the GPU's packing. A project
+/// manifest gets a built-in's reference only with the built-in's groups.
+///
+/// # Panics
+/// If the built-in manifest has no `cloud` group.
+pub fn cloud_group(kernel: &str) -> &'static crate::manifest::ParamGroup {
+    crate::Registry::builtin()
+        .find(kernel)
+        .ok()
+        .and_then(|k| k.group("cloud"))
+        .unwrap_or_else(|| panic!("built-in kernel {kernel} has no [[group]] field = \"cloud\""))
 }
 
 /// The built-in `clouds` kernel (derefs to its [`Kernel`](crate::Kernel);

@@ -144,17 +144,79 @@ pub fn blocks_of(
                 None => f.key.clone(),
             };
         }
-        for (i, f) in fields[start..].iter().enumerate() {
-            if let Some(g) = fields[start..start + i].iter().find(|g| g.name == f.name) {
-                return Err(bad(format!(
-                    "{shader}: Params fields {} and {} share the name '{}'",
-                    g.path, f.path, f.name
-                )));
-            }
-        }
         blocks.push(Block { group: uniform.group, binding: uniform.binding, var: name, size });
     }
     Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module), output: None })
+}
+
+/// Names each leaf by the param that feeds it: a leaf inside a
+/// `[[group]]`'s struct field takes [`crate::manifest::ParamGroup::param`]'s
+/// name, the others keep their own. Then refuses two ungrouped leaves of
+/// one uniform that share a name, and (with `strict`, one layout per kernel) a group
+/// whose field is no struct field of the uniform.
+pub fn name_leaves(kernel: &Kernel, shader: &str, l: &mut UniformLayout, strict: bool) -> Result<(), ParamError> {
+    let bad = |message: String| ParamError::Layout { kernel: kernel.name().to_string(), message };
+    let has = |n: &str| kernel.params().iter().any(|s| s.name == n);
+    for g in &kernel.manifest.groups {
+        let inside =
+            |f: &Field| f.path.starts_with(&format!("{}.", g.field)) || f.key.starts_with(&format!("{}.", g.field));
+        let mut any = false;
+        for f in l.fields.iter_mut().filter(|f| inside(f)) {
+            f.name = g.param(&f.name, has);
+            any = true;
+        }
+        if strict && !any {
+            let structs: Vec<String> = l
+                .fields
+                .iter()
+                .filter_map(|f| f.path.rsplit_once('.').map(|(s, _)| s.to_string()))
+                .fold(Vec::new(), |mut v, s| {
+                    if !v.contains(&s) {
+                        v.push(s);
+                    }
+                    v
+                });
+            return Err(bad(format!(
+                "[[group]] field = \"{}\" is no struct field of the uniform in {shader}; its struct fields: {}",
+                g.field,
+                if structs.is_empty() { "none".to_string() } else { structs.join(", ") }
+            )));
+        }
+    }
+    // A grouped leaf may share its param with another leaf (landscape's
+    // clouds take the terrain's seed): the group's rule says so. Two
+    // ungrouped leaves of one name would silently take one value.
+    let grouped = |f: &Field| grouped(kernel, f);
+    for (i, f) in l.fields.iter().enumerate() {
+        if let Some(g) =
+            l.fields[..i].iter().find(|g| g.block == f.block && g.name == f.name && !grouped(g) && !grouped(f))
+        {
+            return Err(bad(format!("{shader}: Params fields {} and {} share the name '{}'", g.path, f.path, f.name)));
+        }
+    }
+    Ok(())
+}
+
+/// Whether leaf `f` lies in a `[[group]]`'s struct field.
+fn grouped(kernel: &Kernel, f: &Field) -> bool {
+    kernel.manifest.groups.iter().any(|g| {
+        let dot = format!("{}.", g.field);
+        f.path.starts_with(&dot) || f.key.starts_with(&dot)
+    })
+}
+
+/// Every `[[group]]` field is a struct field of one of a graph's uniforms.
+pub fn check_groups(kernel: &Kernel, layouts: &[&UniformLayout]) -> Result<(), ParamError> {
+    for g in &kernel.manifest.groups {
+        let dot = format!("{}.", g.field);
+        if !layouts.iter().any(|l| l.fields.iter().any(|f| f.path.starts_with(&dot) || f.key.starts_with(&dot))) {
+            return Err(ParamError::Layout {
+                kernel: kernel.name().to_string(),
+                message: format!("[[group]] field = \"{}\" is no struct field of any pass's uniform", g.field),
+            });
+        }
+    }
+    Ok(())
 }
 
 fn override_names(module: &naga::Module) -> Vec<String> {
@@ -386,7 +448,7 @@ fn check_names(kernel: &Kernel, layout: &UniformLayout, fed_elsewhere: &[&str], 
         let by_key: Vec<&Field> =
             if by_qualified { layout.fields.iter().filter(|f| f.qualified == spec.name).collect() } else { by_key };
         let by_name: Vec<&Field> = layout.fields.iter().filter(|f| f.name == spec.name).collect();
-        if by_key.is_empty() && by_name.len() > 1 {
+        if by_key.is_empty() && by_name.iter().filter(|f| !grouped(kernel, f)).count() > 1 {
             return Err(bad(format!(
                 "param {} is ambiguous: leaves of two uniforms share the name ({}); name one as {}",
                 spec.name,

@@ -532,6 +532,23 @@ impl Kernel {
         self.with_defs(self.shader(), p)
     }
 
+    /// The WGSL module `vista::enums` of this kernel: every enum value as a
+    /// `u32` constant named `PREFIX_VALUE` (the manifest's order), so WGSL
+    /// names the values the manifest declares instead of repeating indices.
+    pub fn enum_module(&self) -> String {
+        let mut out = String::from("#define_import_path vista::enums\n\n");
+        out.push_str(&format!("// Generated from the manifest of kernel {}.\n", self.name()));
+        for (name, value) in &self.manifest.enum_constants {
+            out.push_str(&format!("const {name}: u32 = {value}u;\n"));
+        }
+        out
+    }
+
+    /// The manifest's `[[group]]` for uniform field `field`, if any.
+    pub fn group(&self, field: &str) -> Option<&manifest::ParamGroup> {
+        self.manifest.groups.iter().find(|g| g.field == field)
+    }
+
     /// `file` with the defs of [`Kernel::shader_for`].
     fn with_defs(&self, file: &str, p: &ParamSet) -> String {
         let mut defs: Vec<String> = self.manifest.defs.clone();
@@ -614,10 +631,12 @@ impl Kernel {
                         && !g.resources.iter().any(|r| r.name == b.name)
                 })
                 .collect();
-            let l = layout::blocks_of(self.name(), shader, module, fed)?;
+            let mut l = layout::blocks_of(self.name(), shader, module, fed)?;
+            layout::name_leaves(self, shader, &mut l, false)?;
             layout::check_fields(self, &l)?;
             layouts.push(l);
         }
+        layout::check_groups(self, &layouts.iter().collect::<Vec<_>>())?;
         layout::check_params(self, &layouts.iter().collect::<Vec<_>>())?;
         Ok((resolved, layouts))
     }
@@ -683,6 +702,7 @@ impl Kernel {
     /// Reflects and checks the uniform layout of this kernel's composed module.
     pub fn layout(&self, module: &naga::Module) -> Result<UniformLayout, ParamError> {
         let mut l = layout::reflect(self.name(), self.shader(), self.entry(), module)?;
+        layout::name_leaves(self, self.shader(), &mut l, true)?;
         layout::check(self, &l)?;
         l.output = Some(resources::resolve(&self.manifest, &l.bindings, module)?);
         Ok(l)
@@ -728,7 +748,7 @@ fn same_params_as_builtin(m: &manifest::Manifest) -> bool {
     };
     let Ok(builtin) = manifest::parse(m.name, "<built-in>", text) else { return false };
     let sig = |ps: &[ParamSpec]| ps.iter().map(|p| (p.name, p.ty)).collect::<Vec<_>>();
-    sig(builtin.params) == sig(m.params)
+    sig(builtin.params) == sig(m.params) && builtin.groups == m.groups
 }
 
 /// A project's kernels. A manifest that does not parse breaks only its own

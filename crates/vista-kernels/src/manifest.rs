@@ -37,6 +37,17 @@
 //! open_min = false                 # optional: the lower bound is excluded
 //! default = 8
 //! doc = "number of octaves"
+//! [[param]]
+//! name = "cloud_profile"
+//! type = "enum"
+//! values = ["stratiform", "anvil"]  # WGSL gets their indices as u32
+//! constants = "PROFILE"            # optional: `vista::enums` then has PROFILE_STRATIFORM = 0u,
+//!                                  # PROFILE_ANVIL = 1u (default prefix: the name, upper case)
+//! default = "anvil"
+//! [[group]]                        # optional: params filling a nested struct of the uniform
+//! field = "cloud"                  # the struct-typed field
+//! prefix = "cloud_"                # its leaf x is fed by param cloud_x if there is one, else by x
+//! rename = { forward_g = "g1" }    # optional: leaf forward_g is param (cloud_)g1
 //! [sweep_reference]                # optional: the high-quality settings sweeps compare against
 //! octaves = 16
 //! [preset.rough]                   # presets override defaults; `default` (the defaults) always resolves
@@ -78,6 +89,9 @@ struct RawManifest {
     specialize: Vec<String>,
     #[serde(default, rename = "param")]
     params: Vec<RawParam>,
+    /// `[[group]]` tables: params that fill a nested struct of the uniform.
+    #[serde(default, rename = "group")]
+    groups: Vec<RawGroup>,
     #[serde(default)]
     sweep_reference: toml::Table,
     /// Ordered as written (toml's `preserve_order`), which `vista list` keeps.
@@ -126,9 +140,51 @@ struct RawParam {
     #[serde(default)]
     open_min: bool,
     values: Option<Vec<String>>,
+    /// An enum's WGSL constant prefix (default: the name in upper case).
+    constants: Option<String>,
     default: toml::Value,
     #[serde(default)]
     doc: String,
+}
+
+/// A `[[group]]` table.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawGroup {
+    field: String,
+    #[serde(default)]
+    prefix: String,
+    #[serde(default)]
+    rename: toml::Table,
+}
+
+/// A group of params filling one struct-typed field of the uniform
+/// (`[[group]] field = "cloud"`, `prefix = "cloud_"`): the field's leaf
+/// `x` is fed by param `<prefix>x` when the manifest has one, else by `x`;
+/// `rename = { forward_g = "g1" }` first gives leaf `forward_g` the name `g1`.
+/// Two kernels with differently named params can so fill one WGSL struct,
+/// and their CPU references one Rust constructor ([`ParamGroup::param`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamGroup {
+    /// The uniform's struct-typed field (its path below the variable).
+    pub field: String,
+    /// Prepended to a leaf's name to find its param first.
+    pub prefix: String,
+    /// Leaf name -> the name its param has in place of it (before the prefix).
+    pub rename: Vec<(String, String)>,
+}
+
+impl ParamGroup {
+    /// The param that feeds the group's leaf `leaf`, given the params a
+    /// kernel has: `<prefix><leaf>` if it is one of them, else `leaf`.
+    pub fn param(&self, leaf: &str, has: impl Fn(&str) -> bool) -> String {
+        let leaf = self.rename.iter().find(|(l, _)| l == leaf).map_or(leaf, |(_, n)| n.as_str());
+        let prefixed = format!("{}{leaf}", self.prefix);
+        match !self.prefix.is_empty() && has(&prefixed) {
+            true => prefixed,
+            false => leaf.to_string(),
+        }
+    }
 }
 
 /// One factor of the work estimate: a sum of params and constants.
@@ -204,6 +260,11 @@ pub struct Manifest {
     pub specialize: Vec<&'static str>,
     /// The declared parameters (`[[param]]`), in manifest order.
     pub params: &'static [ParamSpec],
+    /// Every enum value as a WGSL constant (`PREFIX_VALUE`, its index):
+    /// the module `vista::enums` the kernel's WGSL imports them from.
+    pub enum_constants: Vec<(String, u32)>,
+    /// `[[group]]` tables: params filling a nested struct of the uniform.
+    pub groups: Vec<ParamGroup>,
     /// The presets (`[preset.NAME]`), in manifest order.
     pub presets: &'static [Preset],
     /// `[sweep_reference]`: the params (values as text) of the high-quality
@@ -213,6 +274,12 @@ pub struct Manifest {
 
 pub(crate) fn leak(s: impl Into<String>) -> &'static str {
     Box::leak(s.into().into_boxed_str())
+}
+
+/// A name as a WGSL constant's part: upper case, any other character `_`
+/// (`cumuliform` -> `CUMULIFORM`, `cloud_layer` -> `CLOUD_LAYER`).
+pub fn constant_name(s: &str) -> String {
+    s.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' }).collect()
 }
 
 /// Text form of a TOML value as `--set` would take it (vectors comma-separated).
@@ -287,6 +354,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     };
 
     let mut params: Vec<ParamSpec> = Vec::new();
+    let mut enum_constants: Vec<(String, u32)> = Vec::new();
     for p in &raw.params {
         let pfail = |message: String| kfail(format!("param {}: {message}", p.name));
         let ident = |w: &str| !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
@@ -387,6 +455,38 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         };
         if p.values.is_some() && ty != ParamType::Enum {
             return Err(pfail(format!("values is only for type enum, not {}", p.ty)));
+        }
+        if let Kind::Enum(values) = kind {
+            let prefix = match &p.constants {
+                Some(c)
+                    if c.starts_with(|c: char| c.is_ascii_uppercase())
+                        && c.chars().all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_') =>
+                {
+                    c.clone()
+                }
+                Some(c) => {
+                    return Err(pfail(format!(
+                        "constants = \"{c}\" is not a WGSL constant prefix; allowed: upper-case letters, digits \
+                         and '_', starting with a letter"
+                    )));
+                }
+                None => constant_name(&p.name),
+            };
+            for (i, v) in values.iter().enumerate() {
+                let name = format!("{prefix}_{}", constant_name(v));
+                match enum_constants.iter().find(|(n, _)| *n == name) {
+                    Some((_, j)) if *j != i as u32 => {
+                        return Err(pfail(format!(
+                            "WGSL constant {name} would be {i} here but {j} for an earlier enum; give one of \
+                             them other constants = \"...\""
+                        )));
+                    }
+                    Some(_) => {}
+                    None => enum_constants.push((name, i as u32)),
+                }
+            }
+        } else if p.constants.is_some() {
+            return Err(pfail(format!("constants is only for type enum, not {}", p.ty)));
         }
         if p.open_min && !matches!(ty, ParamType::F32) {
             return Err(pfail("open_min is only for type f32".into()));
@@ -560,6 +660,35 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         };
         overrides.push((leak(k.as_str()), value));
     }
+    let mut groups: Vec<ParamGroup> = Vec::new();
+    for g in &raw.groups {
+        let ident = |w: &str| !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !g.field.split('.').all(ident) {
+            return Err(kfail(format!(
+                "[[group]] field = \"{}\" is not a uniform field path (letters, digits and '_' between dots)",
+                g.field
+            )));
+        }
+        if !g.prefix.is_empty() && !ident(&g.prefix) {
+            return Err(kfail(format!("[[group]] prefix = \"{}\" is not valid; letters, digits and '_'", g.prefix)));
+        }
+        if groups.iter().any(|h| h.field == g.field) {
+            return Err(kfail(format!("[[group]] field = \"{}\" is listed twice", g.field)));
+        }
+        let mut rename = Vec::new();
+        for (leaf, name) in &g.rename {
+            match name.as_str() {
+                Some(n) if ident(leaf) && ident(n) => rename.push((leaf.clone(), n.to_string())),
+                _ => {
+                    return Err(kfail(format!(
+                        "[[group]] rename: {leaf} = {name} is not valid; expected leaf = \"param_name\" (letters, \
+                         digits and '_')"
+                    )));
+                }
+            }
+        }
+        groups.push(ParamGroup { field: g.field.clone(), prefix: g.prefix.clone(), rename });
+    }
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
         name: leak(name),
@@ -582,6 +711,8 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         hash_plane,
         specialize,
         params,
+        enum_constants,
+        groups,
         presets: Box::leak(presets.into_boxed_slice()),
         sweep_reference,
     })

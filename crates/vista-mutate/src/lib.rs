@@ -511,6 +511,7 @@ pub fn run(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<MutantReport>, GoldenError> {
     let files = project.shader_files()?;
+    let enums = vista_render::enum_modules(project)?;
     let label = "mutant";
     let set = |edit: Option<&Mutant>| {
         ShaderSet::from_files(
@@ -523,6 +524,7 @@ pub fn run(
                 (f.rel.clone(), text, f.origin.clone())
             }),
         )
+        .with_enums(enums.iter().cloned())
     };
     let manifest = store.manifest()?;
     let original = Renderer { ctx, shaders: set(None), limits, root: project.root().map(Into::into) };

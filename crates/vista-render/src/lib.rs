@@ -223,8 +223,38 @@ pub fn shader_set(project: &vista_project::Project) -> Result<ShaderSet, RenderE
         Some(r) => format!("project {}", r.display()),
         None => "built-in shaders".to_string(),
     };
-    let files = project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin));
-    Ok(ShaderSet::from_files(&label, files))
+    edited_shader_set(project, &label, |_, text| text)
+}
+
+/// The project's WGSL with every file's text passed through `edit(relative
+/// path, text)` (a mutant, a deliberate fault), composed in memory: nothing
+/// is written. Kernel files keep their generated `vista::enums` modules.
+pub fn edited_shader_set(
+    project: &vista_project::Project,
+    label: &str,
+    edit: impl Fn(&str, String) -> String,
+) -> Result<ShaderSet, RenderError> {
+    let files = project.shader_files()?.into_iter().map(|f| {
+        let text = edit(&f.rel, f.text);
+        (f.rel, text, f.origin)
+    });
+    Ok(ShaderSet::from_files(label, files).with_enums(enum_modules(project)?))
+}
+
+/// Each kernel's generated `vista::enums` module (from its manifest's enum
+/// params), as `(shader file, kernel, text)` for every file its passes use.
+/// A manifest that does not parse contributes none (its error comes when
+/// the kernel is named).
+pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, String, String)>, RenderError> {
+    let registry = vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let mut out = Vec::new();
+    for k in registry.kernels() {
+        let text = k.enum_module();
+        for f in k.shader_files() {
+            out.push((f.to_string(), k.name().to_string(), text.clone()));
+        }
+    }
+    Ok(out)
 }
 
 /// One render as every engine runs it: the kernel file as composed for

@@ -227,56 +227,99 @@ pub struct Clouds {
     pub jitter_seed: u32,
 }
 
+/// What a kernel gives its clouds besides the `cloud` group's params: the
+/// camera, the sun, the sky behind, and the per-pixel jitter.
+#[derive(Debug, Clone)]
+pub struct CloudFrame {
+    /// The camera (its position also centres the shell).
+    pub view: Camera,
+    /// Unit direction toward the sun.
+    pub sun_dir: V3,
+    /// Sun radiance (unused by the landscape, which lights through the atmosphere).
+    pub sun: V3,
+    /// Background sky straight up.
+    pub sky_zenith: V3,
+    /// Background sky at and below the horizon.
+    pub sky_horizon: V3,
+    /// The per-pixel first-sample offset.
+    pub jitter: Jitter,
+    /// Seed of the jitter hash.
+    pub jitter_seed: u32,
+}
+
 impl Clouds {
     /// Resolves a `clouds` param set (angles in degrees become radians).
     ///
     /// # Panics
     /// If `layer` names no [`Layer`] (`CloudsKernel::check` refuses that).
     pub fn from_params(p: &ParamSet) -> Clouds {
-        let fbm = Fbm { octaves: p.u32("octaves"), lacunarity: real(p, "lacunarity"), gain: real(p, "gain"), theta: 0.0 };
-        let stretch = real3(p, "noise_stretch");
-        let ns = real(p, "noise_scale");
         // pitch is within +-89 deg, so forward is never vertical.
         let forward = direction(real(p, "yaw_deg").to_radians(), real(p, "pitch_deg").to_radians());
-        let sun_color = real3(p, "sun_color");
-        let camera = real3(p, "camera_pos");
-        Clouds {
-            layer: layer_of(p, "layer").expect("CloudsKernel::check refuses other layers"),
-            centre_xz: [camera[0], camera[2]],
-            base: real(p, "cloud_base_km"),
-            top: real(p, "cloud_top_km"),
-            coverage: coverage_of(p),
-            density_scale: real(p, "density_scale"),
-            absorption: real(p, "absorption"),
-            profile: p.choice_in("profile", crate::clouds::PROFILES),
-            profile_bottom: real(p, "profile_bottom"),
-            profile_top: real(p, "profile_top"),
-            frequency: stretch.map(|s| s * ns),
-            wind: real3(p, "wind_offset"),
-            fbm,
-            noise: Noise::new(p.choice_in("basis", crate::noise::BASES), p.u32("seed")),
-            inv_amplitude: 1.0 / fbm.amplitude_sum(),
-            view: Camera::looking(camera, forward, real(p, "fov_deg"), 1.0),
-            max_distance: real(p, "max_distance_km"),
+        let frame = CloudFrame {
+            view: Camera::looking(real3(p, "camera_pos"), forward, real(p, "fov_deg"), 1.0),
             sun_dir: direction(real(p, "sun_azimuth_deg").to_radians(), real(p, "sun_elevation_deg").to_radians()),
-            sun: sun_color.map(|c| c * real(p, "sun_intensity")),
-            g1: real(p, "g1"),
-            g2: real(p, "g2"),
-            blend: real(p, "phase_blend"),
-            powder: real(p, "powder"),
-            ambient: real3(p, "ambient"),
-            ambient_bottom: real(p, "ambient_bottom"),
+            sun: real3(p, "sun_color").map(|c| c * real(p, "sun_intensity")),
             sky_zenith: real3(p, "sky_zenith"),
             sky_horizon: real3(p, "sky_horizon"),
-            steps: p.u32("steps"),
-            light_steps: p.u32("light_steps"),
-            light_spread: real(p, "light_spread"),
-            step_spread: real(p, "step_spread"),
-            step_km: real(p, "step_km"),
-            jitter_steps: p.choice_in("jitter_steps", &[("shared", JitterSteps::Shared), ("golden", JitterSteps::Golden)]),
-            integrator: p.choice_in("integrator", crate::clouds::INTEGRATORS),
             jitter: p.choice_in("jitter", crate::clouds::JITTERS),
             jitter_seed: p.u32("jitter_seed"),
+        };
+        // As clouds.wgsl: the group's coverage, unless coverage_oktas picks one.
+        Clouds { coverage: coverage_of(p), ..Clouds::from_group(p, frame) }
+    }
+
+    /// The layer from the params of the kernel's `cloud` group (the WGSL
+    /// `CloudParams` its uniform holds, `[[group]] field = "cloud"` in its
+    /// manifest): the one constructor of the clouds and landscape kernels.
+    /// Each leaf is read from the param the manifest's group rule names.
+    ///
+    /// # Panics
+    /// If the kernel's manifest has no `cloud` group or the layer is not a
+    /// [`Layer`] (the kernels' `check` refuses that).
+    pub fn from_group(p: &ParamSet, frame: CloudFrame) -> Clouds {
+        let group = crate::clouds::cloud_group(p.kernel());
+        let name = |leaf: &str| group.param(leaf, |n| p.value(n).is_some());
+        let r = |leaf: &str| real(p, &name(leaf));
+        let fbm = Fbm { octaves: p.u32(&name("octaves")), lacunarity: r("lacunarity"), gain: r("gain"), theta: 0.0 };
+        let ns = r("noise_scale");
+        let camera = frame.view.pos;
+        Clouds {
+            layer: layer_of(p, &name("layer")).expect("the kernel's check refuses other layers"),
+            centre_xz: [camera[0], camera[2]],
+            base: r("base_km"),
+            top: r("top_km"),
+            coverage: r("coverage"),
+            density_scale: r("density_scale"),
+            absorption: r("absorption"),
+            profile: p.choice_in(&name("profile"), crate::clouds::PROFILES),
+            profile_bottom: r("profile_bottom"),
+            profile_top: r("profile_top"),
+            frequency: real3(p, &name("noise_stretch")).map(|s| s * ns),
+            wind: real3(p, &name("wind_offset")),
+            fbm,
+            noise: Noise::new(p.choice_in(&name("basis"), crate::noise::BASES), p.u32(&name("seed"))),
+            inv_amplitude: 1.0 / fbm.amplitude_sum(),
+            view: frame.view,
+            max_distance: r("max_distance_km"),
+            sun_dir: frame.sun_dir,
+            sun: frame.sun,
+            g1: r("forward_g"),
+            g2: r("backward_g"),
+            blend: r("phase_blend"),
+            powder: r("powder"),
+            ambient: real3(p, &name("ambient")),
+            ambient_bottom: r("ambient_bottom"),
+            sky_zenith: frame.sky_zenith,
+            sky_horizon: frame.sky_horizon,
+            steps: p.u32(&name("steps")),
+            light_steps: p.u32(&name("light_steps")),
+            light_spread: r("light_spread"),
+            step_spread: r("step_spread"),
+            step_km: r("step_km"),
+            jitter_steps: p.choice_in(&name("jitter_steps"), crate::clouds::JITTER_STEPS),
+            integrator: p.choice_in(&name("integrator"), crate::clouds::INTEGRATORS),
+            jitter: frame.jitter,
+            jitter_seed: frame.jitter_seed,
         }
     }
 

@@ -5,16 +5,14 @@
 //! reference's, the cloud march the clouds reference's.
 
 use super::atmosphere::{Sky, latlong_direction};
-use super::clouds::Clouds;
+use super::clouds::{CloudFrame, Clouds};
 use super::consts::PI;
 use super::geometry::{Camera, V3, add, direction, scale};
 use super::heightfield::{
     MarchSettings, ShadowSettings, SurfaceLight, Terrain, brute_force_hit, relax_march, surface_radiance,
 };
-use super::noise::{Fbm, Noise};
 use super::{Real, Vec3, pixel_uv, real, real3, render_cpu};
 use crate::ParamSet;
-use crate::clouds::JitterSteps;
 use crate::heightfield::{BRUTE_STEPS, HitSearch};
 use vista_image::Image;
 
@@ -72,52 +70,19 @@ impl Landscape {
             light_samples: p.u32("light_samples"),
             density_scale: [real(p, "rayleigh_density"), real(p, "mie_density")],
         };
-        let fbm = Fbm {
-            octaves: p.u32("cloud_octaves"),
-            lacunarity: real(p, "cloud_lacunarity"),
-            gain: real(p, "cloud_gain"),
-            theta: 0.0,
-        };
-        let ns = real(p, "noise_scale");
-        let clouds = Clouds {
-            layer: crate::clouds::layer_of(p, "cloud_layer").expect("LandscapeKernel::check refuses other layers"),
-            centre_xz: [pos[0], pos[2]],
-            base: real(p, "cloud_base_km"),
-            top: real(p, "cloud_top_km"),
-            coverage: real(p, "coverage"),
-            density_scale: real(p, "density_scale"),
-            absorption: real(p, "absorption"),
-            profile: p.choice_in("profile", crate::clouds::PROFILES),
-            profile_bottom: real(p, "profile_bottom"),
-            profile_top: real(p, "profile_top"),
-            frequency: real3(p, "noise_stretch").map(|s| s * ns),
-            wind: real3(p, "wind_offset"),
-            fbm,
-            noise: Noise::new(p.choice_in("cloud_basis", crate::noise::BASES), p.u32("seed")),
-            inv_amplitude: 1.0 / fbm.amplitude_sum(),
-            view,
-            max_distance: real(p, "cloud_max_distance_km"),
-            sun_dir,
-            // Unused: the landscape lights its clouds through the atmosphere.
-            sun: [0.0; 3],
-            g1: real(p, "cloud_g1"),
-            g2: real(p, "cloud_g2"),
-            blend: real(p, "cloud_phase_blend"),
-            powder: real(p, "powder"),
-            ambient: real3(p, "cloud_ambient"),
-            ambient_bottom: real(p, "ambient_bottom"),
-            sky_zenith: [0.0; 3],
-            sky_horizon: [0.0; 3],
-            steps: p.u32("cloud_steps"),
-            light_steps: p.u32("cloud_light_steps"),
-            light_spread: real(p, "light_spread"),
-            step_spread: 1.0,
-            step_km: 0.0,
-            jitter_steps: JitterSteps::Shared,
-            integrator: p.choice_in("cloud_integrator", crate::clouds::INTEGRATORS),
-            jitter: p.choice_in("cloud_jitter", crate::clouds::JITTERS),
-            jitter_seed: p.u32("cloud_jitter_seed"),
-        };
+        let clouds = Clouds::from_group(
+            p,
+            CloudFrame {
+                view,
+                sun_dir,
+                // Unused: the landscape lights its clouds through the atmosphere.
+                sun: [0.0; 3],
+                sky_zenith: [0.0; 3],
+                sky_horizon: [0.0; 3],
+                jitter: p.choice_in("cloud_jitter", crate::clouds::JITTERS),
+                jitter_seed: p.u32("cloud_jitter_seed"),
+            },
+        );
         Landscape {
             terrain: Terrain::from_params(p),
             march: MarchSettings::from_params(p),
