@@ -7,7 +7,7 @@
 mod common;
 
 use vista_image::Image;
-use vista_kernels::heightfield::{Camera, HeightfieldKernel, HitSearch, Terrain, brute_force_hit, camera_of};
+use vista_kernels::heightfield::{Camera, HeightfieldKernel, Terrain, brute_force_hit, camera_of};
 use vista_kernels::{ParamSet, pixel_uv};
 
 const W: u32 = 64;
@@ -225,7 +225,7 @@ fn cpu_f32_relax_march_matches_the_gpu(ctx: &vista_render::Renderer) {
     for preset in ["valley", "ridges", "grazing"] {
         let p = params(preset, &[]);
         let g = vista_render::render(ctx, &HeightfieldKernel, &p, w, h).expect("render").raw;
-        let march = vista_kernels::cpu32::heightfield::render(&p, w, h, HitSearch::RelaxMarch).expect("valid");
+        let march = HeightfieldKernel.shader_algorithm_f32(&p, w, h).expect("the f32 relax march port");
         let oracle = HeightfieldKernel.reference(&p, w, h);
         let differs = |a: &[f32; 4], b: &[f32; 4]| (0..3).any(|c| (a[c] - b[c]).abs() > 1.0 / 255.0);
         let flipped: Vec<usize> = (0..g.data.len()).filter(|&i| differs(&g.data[i], &march.data[i])).collect();

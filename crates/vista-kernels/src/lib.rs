@@ -3,8 +3,10 @@
 //! (`kernels/<name>.toml`, [`manifest`]) with its WGSL; the uniform block
 //! packed from naga's reflection of the composed module ([`layout`]); and,
 //! for the built-ins, the CPU references written from the math in SPEC
-//! (`src/cpu/`), built twice: in f64 as the oracles ([`cpu64`], re-exported
-//! by each kernel module) and in f32 as the throughput baseline ([`cpu32`]),
+//! (`src/cpu/`), built twice: in f64 as the oracles (private `cpu64`, whose
+//! items each kernel module re-exports: public once) and in f32 as the
+//! throughput baseline (private `cpu32`, reached through
+//! [`Kernel::reference_f32`] and [`Kernel::shader_algorithm_f32`]),
 //! registered by kernel name ([`CpuReference`]).
 //!
 //! Not for: GPU work (see `vista-gpu`), files or goldens (see `vista-golden`).
@@ -61,8 +63,11 @@ macro_rules! builtin_handle {
 }
 pub(crate) use builtin_handle;
 
-pub mod cpu32;
-pub mod cpu64;
+// The f32 build is reached through `CpuReference`; most of its items
+// (helpers the f64 build's callers use by name) go unused.
+#[allow(dead_code)]
+mod cpu32;
+mod cpu64;
 
 pub mod atmosphere;
 pub mod bindings;
@@ -185,7 +190,7 @@ pub enum Output {
 pub trait CpuReference: Send + Sync {
     /// The f64 CPU reference of the raw output (what the GPU writes).
     fn reference(&self, p: &ParamSet, width: u32, height: u32) -> Image;
-    /// The same reference computed in f32 ([`cpu32`]): a throughput
+    /// The same reference computed in f32 (the private `cpu32` build): a throughput
     /// baseline for benches (checked against f64 in `tests/precision.rs`).
     fn reference_f32(&self, p: &ParamSet, width: u32, height: u32) -> Image;
     /// Cross-parameter checks beyond each value's own range.
