@@ -12,6 +12,11 @@ fn repo_shaders() -> ShaderSet {
 
 /// A set over the `.wgsl` files of a directory tree (paths relative to it).
 fn set_of_dir(dir: &std::path::Path) -> ShaderSet {
+    // The checkout's manifests generate each kernel file's vista::enums.
+    set_with_enums(dir, vista_render::enum_modules(&common::project()).expect("the checkout's manifests"))
+}
+
+fn set_with_enums(dir: &std::path::Path, enums: Vec<(String, String, String)>) -> ShaderSet {
     let mut files = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
@@ -25,7 +30,7 @@ fn set_of_dir(dir: &std::path::Path) -> ShaderSet {
             }
         }
     }
-    ShaderSet::from_files(&dir.display().to_string(), files)
+    ShaderSet::from_files(&dir.display().to_string(), files).with_enums(enums)
 }
 
 #[test]
@@ -133,6 +138,17 @@ fn shader_hash_covers_transitive_imports_only() {
         let s = std::fs::read_to_string(&p).unwrap();
         std::fs::write(&p, s + "\n// edited\n").unwrap();
     };
+    // The manifest's enum values are part of what the kernel composes.
+    let other_enums = vista_render::enum_modules(&common::project())
+        .unwrap()
+        .into_iter()
+        .map(|(f, k, text)| (f, k, text.replace("= 0u", "= 7u")))
+        .collect::<Vec<_>>();
+    assert_ne!(
+        set_with_enums(tmp.path(), other_enums).source_hash("atmosphere.wgsl").unwrap(),
+        atmo0,
+        "atmosphere imports vista::enums"
+    );
     append("lib/geometry.wgsl");
     assert_eq!(hash("fbm.wgsl"), fbm0, "fbm does not import geometry");
     assert_ne!(hash("atmosphere.wgsl"), atmo0, "atmosphere imports geometry");
