@@ -36,7 +36,17 @@ pub struct Config {
     pub fault: Option<String>,
     /// `GITHUB_ACTIONS=true`: check also prints `::error` annotations.
     pub github_actions: bool,
+    /// `MESA_SHADER_CACHE_DIR` is set: the user placed Mesa's shader cache,
+    /// so the binary leaves it where it is (else it goes under the
+    /// project's `target/vista-cache/mesa`, see [`MESA_CACHE`]).
+    pub mesa_cache_placed: bool,
 }
+
+/// Where under a project root the binary places Mesa's shader cache
+/// (lavapipe's compiled pipelines) unless `MESA_SHADER_CACHE_DIR` is set:
+/// beside the report under `target/`, the folder CI jobs cache, so a warm
+/// check compiles nothing even on a fresh runner that restores it.
+pub const MESA_CACHE: &str = "target/vista-cache/mesa";
 
 /// The command-line flags that override the environment.
 #[derive(Debug, Clone, Default)]
@@ -101,6 +111,7 @@ impl Config {
             crate_dir: get("CARGO_MANIFEST_DIR").filter(|v| !v.is_empty()).map(PathBuf::from),
             github_actions: text("GITHUB_ACTIONS").is_some_and(|v| v.eq_ignore_ascii_case("true")),
             fault: text("VISTA_FAULT"),
+            mesa_cache_placed: get("MESA_SHADER_CACHE_DIR").is_some_and(|v| !v.is_empty()),
         })
     }
 

@@ -303,6 +303,17 @@ fn main() -> ExitCode {
             return ExitCode::from(e.exit_code() as u8);
         }
     };
+    if let Some(root) = project.root()
+        && !config.mesa_cache_placed
+    {
+        let dir = root.join(vista::config::MESA_CACHE);
+        // Mesa does not create the folder's parents; without it the cache
+        // is off, which costs time, not correctness.
+        let _ = std::fs::create_dir_all(&dir);
+        // SAFETY: nothing else runs yet (no thread, no GPU context), and
+        // Mesa reads the variable when the Vulkan device is created, later.
+        unsafe { std::env::set_var("MESA_SHADER_CACHE_DIR", dir) };
+    }
     match run(&project, &config, cli.command) {
         Ok(code) => ExitCode::from(code as u8),
         Err(e) => {
@@ -733,10 +744,16 @@ fn check(
     let opts = CheckOptions { twice: false };
     let mut outcomes = Vec::new();
     let mut pending = std::collections::BTreeMap::new();
+    let mut time = Phases::start(ctx);
     for case in picked {
+        let started = std::time::Instant::now();
         let mut checked = vista_golden::check_case(ctx, &store, &manifest, case, &opts);
+        time.cases += started.elapsed();
         let entry = checked.pending.take();
+        let started = std::time::Instant::now();
         let o = vista_report::file_case(&report_dir, checked);
+        time.report += started.elapsed();
+        time.gpu += std::time::Duration::from_secs_f64(o.gpu_ms / 1000.0);
         // A failing or missing case's render, as bless --from-report may take it.
         if let Some(mut entry) = entry
             && matches!(o.verdict, vista_golden::Verdict::Fail | vista_golden::Verdict::Missing)
@@ -779,7 +796,9 @@ fn check(
         pending: pending.keys().cloned().collect(),
         accept_from: report_dir.display().to_string(),
     };
+    let started = std::time::Instant::now();
     let index = vista_report::write_report(&report_dir, &run, &outcomes)?;
+    time.report += started.elapsed();
     let accept = (!pending.is_empty()).then(|| format!("vista bless --from-report {}", report_dir.display()));
     vista_golden::pending::write_pending(&report_dir, pending)?;
     // results.json beside the report: what `check --failed` reads next time.
@@ -832,8 +851,51 @@ fn check(
             );
         }
     }
+    println!("{}", time.summary(ctx, outcomes.len()));
     println!("report: {}", index.display());
     Ok(if failed == 0 && !orphans_fail { 0 } else { 1 })
+}
+
+/// Where a check's wall time went: compiling (composing WGSL, creating
+/// pipelines), the GPU runs, the rest of each case (planning, the CPU's
+/// part of running it, judging), and writing the report.
+struct Phases {
+    started: std::time::Instant,
+    compile0: std::time::Duration,
+    cases: std::time::Duration,
+    gpu: std::time::Duration,
+    report: std::time::Duration,
+}
+
+impl Phases {
+    fn start(ctx: &Renderer) -> Phases {
+        Phases {
+            started: std::time::Instant::now(),
+            compile0: ctx.compile_time() + ctx.shaders.compose_time(),
+            cases: Default::default(),
+            gpu: Default::default(),
+            report: Default::default(),
+        }
+    }
+
+    /// One line: `time: 9.52 s for 74 cases: compiling 2.10 s (22%), ...`.
+    fn summary(&self, ctx: &Renderer, cases: usize) -> String {
+        let total = self.started.elapsed().as_secs_f64();
+        let compile = (ctx.compile_time() + ctx.shaders.compose_time()).saturating_sub(self.compile0).as_secs_f64();
+        let gpu = self.gpu.as_secs_f64();
+        let rest = (self.cases.as_secs_f64() - compile - gpu).max(0.0);
+        let report = self.report.as_secs_f64();
+        let share = |t: f64| format!("{t:.2} s ({:.0}%)", 100.0 * t / total.max(1e-9));
+        format!(
+            "time: {total:.2} s for {cases} case{}: compiling {}, GPU runs {}, planning and judging {}, report {}{}",
+            if cases == 1 { "" } else { "s" },
+            share(compile),
+            share(gpu),
+            share(rest),
+            share(report),
+            if ctx.backend() == "browser" { " (the browser compiles inside its runs)" } else { "" }
+        )
+    }
 }
 
 /// This process's command line as a user would type it again (`vista` and

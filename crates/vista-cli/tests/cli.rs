@@ -813,7 +813,12 @@ fn repo() -> PathBuf {
 
 fn run_in(bin: &Path, cwd: &Path, env: &[(&str, &str)], args: &[&str]) -> Run {
     let mut cmd = Command::new(bin);
-    cmd.args(args).current_dir(cwd).env("XDG_RUNTIME_DIR", "/tmp").env_remove("CI").env_remove("VISTA_ROOT");
+    cmd.args(args)
+        .current_dir(cwd)
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .env_remove("CI")
+        .env_remove("VISTA_ROOT")
+        .env_remove("MESA_SHADER_CACHE_DIR");
     for (k, v) in env {
         cmd.env(k, v);
     }
@@ -1364,10 +1369,24 @@ fn init_writes_a_project_that_blesses_and_checks() {
     let r = run_in(Path::new(env!("CARGO_BIN_EXE_vista")), t.path(), &[], &["init", "mine"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(r.stdout.contains("next: cd mine && vista bless && vista check"), "{}", r.stdout);
-    let b = vista_in(Some(&dir), &[], &["bless"]);
+    let cache = t.path().join("elsewhere");
+    let placed = [("MESA_SHADER_CACHE_DIR", cache.to_str().unwrap())];
+    let b = vista_in(Some(&dir), &placed, &["bless"]);
     assert!(b.code == 0 && b.stdout.contains("blessed 2 cases"), "{}{}", b.stdout, b.stderr);
+    let c = vista_in(Some(&dir), &placed, &["check"]);
+    assert!(c.code == 0 && c.stdout.contains("2 passed, 0 failed"), "{}", c.stdout);
+    assert!(!dir.join("target/vista-cache").exists(), "a cache the user placed stays where it is");
     let c = vista_in(Some(&dir), &[], &["check"]);
     assert!(c.code == 0 && c.stdout.contains("2 passed, 0 failed"), "{}", c.stdout);
+    // Mesa's shader cache goes under the project's target/ (lavapipe's
+    // compiled pipelines: a warm check compiles nothing), and the check
+    // says where its time went.
+    let mesa = dir.join("target/vista-cache/mesa");
+    assert!(std::fs::read_dir(&mesa).is_ok_and(|mut d| d.next().is_some()), "no Mesa cache in {}", mesa.display());
+    let time = c.stdout.lines().find(|l| l.starts_with("time: ")).unwrap_or_else(|| panic!("{}", c.stdout));
+    for part in ["for 2 cases", "compiling", "GPU runs", "planning and judging", "report"] {
+        assert!(time.contains(part), "{time}");
+    }
     // A second init refuses, naming the file, and changes nothing.
     let before = std::fs::read_to_string(dir.join("kernels/rings.toml")).unwrap();
     std::fs::write(dir.join("kernels/rings.toml"), format!("{before}# mine\n")).unwrap();

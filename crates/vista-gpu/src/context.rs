@@ -328,6 +328,19 @@ pub struct Context {
     /// Whether graph passes read GPU timestamps (`vista bench` turns it
     /// on): a readback per pass run, which checks need not pay.
     pub(crate) time_passes: std::sync::atomic::AtomicBool,
+    /// Nanoseconds spent creating shader modules and pipelines (the
+    /// driver's compile; a warm Mesa shader cache makes it short).
+    pub(crate) compile_nanos: std::sync::atomic::AtomicU64,
+}
+
+/// Adds the time since `.1` to the counter `.0` when dropped, so an early
+/// return still counts.
+struct CountInto<'a>(&'a std::sync::atomic::AtomicU64, std::time::Instant);
+
+impl Drop for CountInto<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_add(self.1.elapsed().as_nanos() as u64, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
 pub(crate) enum Engine {
@@ -498,6 +511,7 @@ impl Context {
             creation_time: start.elapsed(),
             validate,
             time_passes: Default::default(),
+            compile_nanos: Default::default(),
         })
     }
 
@@ -530,6 +544,7 @@ impl Context {
             creation_time: start.elapsed(),
             validate: false,
             time_passes: Default::default(),
+            compile_nanos: Default::default(),
         })
     }
 
@@ -553,6 +568,12 @@ impl Context {
     /// Whether the Khronos validation layer is on (`VISTA_VALIDATION=1`).
     pub fn validating(&self) -> bool {
         self.validate
+    }
+
+    /// Time spent so far creating shader modules and pipelines (on the
+    /// browser, compiling is inside the page and not counted here).
+    pub fn compile_time(&self) -> Duration {
+        Duration::from_nanos(self.compile_nanos.load(std::sync::atomic::Ordering::Relaxed))
     }
 
     /// lavapipe | swiftshader | gpu (or "named" for WGPU_ADAPTER_NAME).
@@ -678,6 +699,8 @@ impl Context {
         layouts: &[Vec<wgpu::BindGroupLayoutEntry>],
     ) -> Result<Arc<Compiled>, GpuError> {
         let module = shaders.compose(shader)?;
+        let started = std::time::Instant::now();
+        let _count = CountInto(&self.compile_nanos, started);
         let scope = w.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let sm = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(shader),

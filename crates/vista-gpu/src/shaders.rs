@@ -31,6 +31,9 @@ pub struct ShaderSet {
     /// manifest's enum params), or why there is none (two manifests that
     /// share the file declare different enums).
     enums: BTreeMap<String, Result<String, String>>,
+    /// Nanoseconds spent composing and validating (naga_oil, naga), shared
+    /// by clones of the set.
+    compose_nanos: Arc<std::sync::atomic::AtomicU64>,
 }
 
 /// The import path of the module generated from a kernel's manifest.
@@ -53,7 +56,14 @@ impl ShaderSet {
             }
         }
         lib.sort();
-        ShaderSet { label: label.to_string(), lib, kernels, composed: Default::default(), enums: BTreeMap::new() }
+        ShaderSet {
+            label: label.to_string(),
+            lib,
+            kernels,
+            composed: Default::default(),
+            enums: BTreeMap::new(),
+            compose_nanos: Default::default(),
+        }
     }
 
     /// This set with a generated `vista::enums` module per kernel file:
@@ -81,6 +91,11 @@ impl ShaderSet {
         }
         self.composed = Default::default();
         self
+    }
+
+    /// Time spent so far composing and validating this set's kernels.
+    pub fn compose_time(&self) -> std::time::Duration {
+        std::time::Duration::from_nanos(self.compose_nanos.load(std::sync::atomic::Ordering::Relaxed))
     }
 
     /// What this set is (a project root, or "built-in").
@@ -216,7 +231,10 @@ impl ShaderSet {
         if let Some(m) = self.composed.lock().expect("compose cache").get(name) {
             return Ok(m.clone());
         }
-        let module = Arc::new(self.compose_uncached(name)?);
+        let started = std::time::Instant::now();
+        let module = self.compose_uncached(name);
+        self.compose_nanos.fetch_add(started.elapsed().as_nanos() as u64, std::sync::atomic::Ordering::Relaxed);
+        let module = Arc::new(module?);
         self.composed.lock().expect("compose cache").insert(name.to_string(), module.clone());
         Ok(module)
     }
