@@ -2531,6 +2531,48 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     );
 }
 
+/// A kernel whose PNG view is opaque (`display_alpha = "opaque"`: the
+/// clouds' RGB is already composited) keeps its raw alpha (1 - T) in
+/// `<case>.alpha.png` beside the view, and a change only the alpha sees
+/// fails the check (before, the alpha was compared nowhere).
+fn an_opaque_views_alpha_is_kept_and_judged() {
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    std::fs::create_dir_all(d.path().join("golden")).unwrap();
+    std::fs::write(
+        d.path().join("golden/cases.toml"),
+        "[[case]]\nid = \"c\"\nkernel = \"clouds\"\npreset = \"cumulus\"\nsize = \"48x32\"\n",
+    )
+    .unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let alpha = vista_image::read_png16(&d.path().join("golden/clouds/c.alpha.png")).unwrap();
+    let view = vista_image::read_png16(&d.path().join("golden/clouds/c.png")).unwrap();
+    assert!(view.data.iter().all(|p| p[3] == 1.0), "the view is opaque");
+    assert!(alpha.data.iter().any(|p| p[0] > 0.01) && alpha.data.iter().any(|p| p[0] < 0.99), "alpha is 1 - T");
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 0, "{}", c.stdout);
+    // The shader's alpha halved: RGB (and so the view) unchanged.
+    std::fs::create_dir_all(d.path().join("shaders")).unwrap();
+    let shader = std::fs::read_to_string(repo().join("shaders/clouds.wgsl")).unwrap();
+    let from = "cloud.a * background, 1.0 - cloud.a)";
+    assert_eq!(shader.matches(from).count(), 1, "clouds.wgsl's store changed");
+    std::fs::write(
+        d.path().join("shaders/clouds.wgsl"),
+        shader.replace(from, "cloud.a * background, 0.5 - 0.5 * cloud.a)"),
+    )
+    .unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("PSNR identical"), "the view did not change: {}", c.stdout);
+    assert!(c.stdout.contains("output image: alpha PSNR") && c.stdout.contains("c.alpha.png"), "{}", c.stdout);
+    // Missing, it is named with the bless command.
+    std::fs::remove_file(d.path().join("shaders/clouds.wgsl")).unwrap();
+    std::fs::remove_file(d.path().join("golden/clouds/c.alpha.png")).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("c.alpha.png") && c.stdout.contains("does not exist"), "{}", c.stdout);
+}
+
 /// A project kernel named like a built-in but with other params is a kernel
 /// of its own: it renders, checks and benches without the built-in's CPU
 /// reference (which read the built-in's params and panicked, exit 101).
@@ -3880,6 +3922,7 @@ fn main() {
         Gpu module_paths_tell_uniforms_of_two_modules_apart,
         Gpu a_project_kernel_named_like_a_builtin_does_not_get_its_reference,
     Gpu enum_constants_and_param_groups_come_from_the_manifest,
+    Gpu an_opaque_views_alpha_is_kept_and_judged,
         Gpu overrides_take_manifest_values_and_params,
         Gpu the_real_kernels_example_passes_on_every_backend_with_a_copied_binary,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,

@@ -7,7 +7,10 @@
 //! buffers), max_abs, max_rel, max_ulp, rmse or histogram_emd; a float
 //! texture without one by the case's PSNR thresholds on its raw values
 //! (on its view where it keeps no EXR). A one-pass kernel that keeps raw
-//! goldens is treated as a graph of one output ([`outputs_of`]).
+//! goldens is treated as a graph of one output ([`outputs_of`]), and so is
+//! one whose view is opaque while its alpha means something
+//! (`display_alpha = "opaque"`): its alpha is kept in `<case>.alpha.png`
+//! (16-bit gray) and judged by the case's PSNR threshold.
 
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -28,12 +31,15 @@ pub struct OutputFiles {
     pub exr: Option<PathBuf>,
     /// A buffer's values.
     pub npy: Option<PathBuf>,
+    /// The alpha an opaque view drops (the main image of a kernel with
+    /// `display_alpha = "opaque"`), as 16-bit gray.
+    pub alpha: Option<PathBuf>,
 }
 
 impl OutputFiles {
-    /// Every file, in png, exr, npy order.
+    /// Every file, in png, exr, npy, alpha order.
     pub fn all(&self) -> Vec<&PathBuf> {
-        [&self.png, &self.exr, &self.npy].into_iter().flatten().collect()
+        [&self.png, &self.exr, &self.npy, &self.alpha].into_iter().flatten().collect()
     }
 }
 
@@ -64,10 +70,10 @@ pub fn keeps_raw(kernel: &Kernel, format: &str) -> bool {
 pub const MAIN_OUTPUT: &str = "image";
 
 /// A render's outputs as goldens see them: a graph's own, or a one-pass
-/// kernel's image as its one output where it keeps raw goldens; empty for
-/// the seed's contract (judged by its PNG alone).
+/// kernel's image as its one output where it keeps raw goldens or its
+/// alpha; empty for the seed's contract (judged by its PNG alone).
 pub fn outputs_of<'a>(case: &Case, r: &'a Rendered) -> Cow<'a, [OutputRender]> {
-    match r.outputs.is_empty() && keeps_raw(case.kernel, r.format) {
+    match r.outputs.is_empty() && (keeps_raw(case.kernel, r.format) || case.kernel.opaque_display()) {
         true => Cow::Owned(r.main_output(case.kernel, MAIN_OUTPUT).into_iter().collect()),
         false => Cow::Borrowed(&r.outputs),
     }
@@ -88,6 +94,7 @@ pub fn output_files(golden_dir: &Path, case: &Case, key: &str, index: usize, out
             png: Some(at("png")),
             exr: (effective_tolerance(out).is_some() || keeps_raw(case.kernel, format)).then(|| at("exr")),
             npy: None,
+            alpha: (index == 0 && case.kernel.opaque_display()).then(|| at("alpha.png")),
         },
     }
 }
@@ -153,6 +160,9 @@ pub fn compare_output(
         judged_by: match (tolerance, &files.exr, index) {
             (Some(t), _, _) => t.describe(),
             (None, Some(_), _) => format!("PSNR >= {psnr_threshold:.1} dB of its raw values"),
+            (None, None, 0) if files.alpha.is_some() => {
+                format!("the case's thresholds (the main image); its alpha PSNR >= {psnr_threshold:.1} dB")
+            }
             (None, None, 0) => "the case's thresholds (the main image)".into(),
             (None, None, _) => format!("PSNR >= {psnr_threshold:.1} dB of its view"),
         },
@@ -255,6 +265,9 @@ pub fn compare_output(
                     },
                 }
             }
+            if let Some(alpha) = &files.alpha {
+                judge_alpha(&mut v, case, alpha, raw, psnr_threshold);
+            }
             let png = files.png.expect("a texture's png");
             if index > 0 && tolerance.is_none() && files.exr.is_none() {
                 // A float texture without a tolerance or raw golden: its view by PSNR.
@@ -350,12 +363,78 @@ pub fn golden_bytes(
         if let (Some(exr), OutputValue::Texture { raw, .. }) = (&files.exr, &o.value) {
             out.push((exr.clone(), vista_image::encode_exr(exr, raw)?));
         }
+        if let (Some(alpha), OutputValue::Texture { raw, .. }) = (&files.alpha, &o.value) {
+            out.push((alpha.clone(), vista_image::encode_png16_channel(alpha, raw, 3)?));
+        }
         if let Some(npy) = &files.npy {
             let (descr, shape) = o.npy().expect("a buffer");
             out.push((npy.clone(), vista_image::npy::encode_npy(&descr, &shape, o.buffer_body().expect("a buffer"))));
         }
     }
     Ok(out)
+}
+
+/// Judges the alpha an opaque view drops against its golden (16-bit gray):
+/// PSNR (peak 1) of the raw alpha, clamped and quantized as the golden was,
+/// against the case's threshold; the main image's ignore rectangles are
+/// left out.
+fn judge_alpha(v: &mut OutputVerdict, case: &Case, path: &Path, raw: &Image, threshold: f64) {
+    if !path.exists() {
+        v.missing.push(path.to_path_buf());
+        return;
+    }
+    let golden = match vista_image::read_png16(path) {
+        Ok(g) => g,
+        Err(e) => {
+            v.errors.push(e.to_string());
+            return;
+        }
+    };
+    if (golden.width, golden.height) != (raw.width, raw.height) {
+        v.problems.push(format!(
+            "output {}: golden {} is {}x{} but the render is {}x{}",
+            v.name,
+            path.display(),
+            golden.width,
+            golden.height,
+            raw.width,
+            raw.height
+        ));
+        return;
+    }
+    let ignored =
+        |x: u32, y: u32| case.ignore.iter().any(|&[rx, ry, w, h]| x >= rx && x < rx + w && y >= ry && y < ry + h);
+    let (mut sum, mut count, mut worst) = (0.0f64, 0u64, (0.0f64, 0u32, 0u32));
+    for y in 0..raw.height {
+        for x in 0..raw.width {
+            if ignored(x, y) {
+                continue;
+            }
+            let a = vista_image::quantize16(raw.get(x, y)[3]) as f64 / 65535.0;
+            let d = (a - golden.get(x, y)[0] as f64).abs();
+            sum += d * d;
+            count += 1;
+            if d > worst.0 || d.is_nan() {
+                worst = (d, x, y);
+            }
+        }
+    }
+    let mse = if count == 0 { 0.0 } else { sum / count as f64 };
+    let psnr = if mse == 0.0 { f64::INFINITY } else { 10.0 * (1.0 / mse).log10() };
+    let shown = vista_image::metrics::format_psnr(psnr);
+    v.summary = format!("output {}: alpha PSNR {shown} (>= {threshold:.1} dB; the view is opaque)", v.name);
+    if psnr < threshold {
+        v.problems.push(format!(
+            "output {}: alpha PSNR {shown} is below the threshold {threshold:.1} dB (the PNG view is opaque; the \
+             alpha is kept in {}); worst ({}, {}) {:.5} vs golden {:.5}",
+            v.name,
+            path.display(),
+            worst.1,
+            worst.2,
+            raw.get(worst.1, worst.2)[3],
+            golden.get(worst.1, worst.2)[0]
+        ));
+    }
 }
 
 /// Judges a float texture's raw values against its EXR golden by PSNR over

@@ -63,6 +63,21 @@ pub fn read_png16(path: &Path) -> Result<Image, ImageError> {
     decode_png16(path, &read_file(path)?)
 }
 
+/// One channel of `img` (alpha is 3) as a 16-bit grayscale PNG's bytes,
+/// values clamped to [0, 1] (`path` names the file in errors): a channel
+/// the PNG view does not show, kept beside it.
+pub fn encode_png16_channel(path: &Path, img: &Image, channel: usize) -> Result<Vec<u8>, ImageError> {
+    use image::ImageEncoder;
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let samples: Vec<u8> = img.data.iter().flat_map(|p| quantize16(p[channel]).to_ne_bytes()).collect();
+    let mut bytes = Vec::new();
+    let encoder = PngEncoder::new_with_quality(&mut bytes, CompressionType::Best, FilterType::Adaptive);
+    encoder
+        .write_image(&samples, img.width, img.height, image::ExtendedColorType::L16)
+        .map_err(|e| encode_error(path, "PNG", e))?;
+    Ok(bytes)
+}
+
 /// [`read_png16`] of bytes already read from `path` (which errors name), for
 /// callers that also hash the file.
 pub fn decode_png16(path: &Path, bytes: &[u8]) -> Result<Image, ImageError> {

@@ -554,6 +554,13 @@ impl Kernel {
         self.manifest.groups.iter().find(|g| g.field == field)
     }
 
+    /// `display_alpha = "opaque"`: the PNG view's alpha is 1 (its RGB is
+    /// already composited) while the raw alpha means something (the clouds'
+    /// 1 - T), so goldens keep that alpha beside the view.
+    pub fn opaque_display(&self) -> bool {
+        self.manifest.opaque_display
+    }
+
     /// `file` with the defs of [`Kernel::shader_for`].
     fn with_defs(&self, file: &str, p: &ParamSet) -> String {
         let mut defs: Vec<String> = self.manifest.defs.clone();
