@@ -2573,6 +2573,34 @@ fn an_opaque_views_alpha_is_kept_and_judged() {
     assert!(c.stdout.contains("c.alpha.png") && c.stdout.contains("does not exist"), "{}", c.stdout);
 }
 
+/// A view that keeps the kernel's alpha has it compared, by the case's
+/// PSNR threshold: a shader whose alpha changes while its RGB does not
+/// fails the check (PSNR, SSIM and FLIP see RGB only).
+fn a_views_alpha_is_compared() {
+    let shader = |alpha: &str| {
+        format!(
+            "struct Params {{\n    width: u32,\n    height: u32,\n}}\n\
+             @group(0) @binding(0) var<uniform> params: Params;\n\
+             @group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;\n\
+             @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+             if id.x >= params.width || id.y >= params.height {{\n        return;\n    }}\n\
+             let u = f32(id.x) / f32(params.width);\n\
+             textureStore(output, id.xy, vec4(0.5, u, 0.25, {alpha}));\n}}\n"
+        )
+    };
+    let d = kernel_project("summary = \"alpha\"\n", &shader("u"));
+    std::fs::create_dir_all(d.path().join("golden")).unwrap();
+    std::fs::write(d.path().join("golden/cases.toml"), "[[case]]\nid = \"a\"\nkernel = \"k\"\nsize = \"16x8\"\n")
+        .unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0);
+    std::fs::write(d.path().join("shaders/k.wgsl"), shader("0.9 * u")).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("PSNR identical") && c.stdout.contains("alpha PSNR"), "{}", c.stdout);
+    assert!(c.stdout.contains("is below the threshold"), "{}", c.stdout);
+}
+
 /// A project kernel named like a built-in but with other params is a kernel
 /// of its own: it renders, checks and benches without the built-in's CPU
 /// reference (which read the built-in's params and panicked, exit 101).
@@ -3923,6 +3951,7 @@ fn main() {
         Gpu a_project_kernel_named_like_a_builtin_does_not_get_its_reference,
     Gpu enum_constants_and_param_groups_come_from_the_manifest,
     Gpu an_opaque_views_alpha_is_kept_and_judged,
+    Gpu a_views_alpha_is_compared,
         Gpu overrides_take_manifest_values_and_params,
         Gpu the_real_kernels_example_passes_on_every_backend_with_a_copied_binary,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,

@@ -511,6 +511,20 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
             out.psnr_threshold
         ));
     }
+    // PSNR, SSIM and FLIP see RGB; a view that keeps the kernel's alpha
+    // (display_alpha = "keep") has it compared here, by the same threshold.
+    // An opaque view's alpha is the `alpha` output's (outputs.rs).
+    if !case.kernel.opaque_display() && !by_bad_pixels {
+        let alpha = alpha_psnr(expected, actual);
+        if alpha < out.psnr_threshold {
+            out.problems.push(format!(
+                "alpha PSNR {} is below the threshold {:.1} dB (the view's RGB: PSNR {})",
+                metrics::format_psnr(alpha),
+                out.psnr_threshold,
+                metrics::format_psnr(m.psnr)
+            ));
+        }
+    }
     if let Some(t) = case.min_ssim
         && m.ssim < t
     {
@@ -538,6 +552,13 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
         ));
     }
     out.metrics = Some(m);
+}
+
+/// PSNR (peak 1) of two views' alpha channels.
+fn alpha_psnr(a: &Image, b: &Image) -> f64 {
+    let n = a.data.len().max(1) as f64;
+    let mse: f64 = a.data.iter().zip(&b.data).map(|(x, y)| (x[3] as f64 - y[3] as f64).powi(2)).sum::<f64>() / n;
+    if mse == 0.0 { f64::INFINITY } else { 10.0 * (1.0 / mse).log10() }
 }
 
 /// Folds a graph's output verdicts into the case's: a missing golden file
