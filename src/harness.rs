@@ -136,6 +136,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
                 let o = vista_report::file_case(
                     &report_dir,
                     vista_golden::check_case(ctx, &store, &manifest, &case, &opts),
+                    vista_report::Detail::Failing,
                 );
                 let result = if o.passed() { Ok(()) } else { Err(Failed::from(o.explain(&report_dir))) };
                 outcomes.lock().expect("outcomes").push(o);

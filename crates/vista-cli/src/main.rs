@@ -146,6 +146,10 @@ enum Command {
         /// instead of failing the check.
         #[arg(long)]
         allow_orphans: bool,
+        /// Write the pixel viewer's data for passing cases too (by default
+        /// only cases that do not pass get it: about 1 MB per 256x256 case).
+        #[arg(long)]
+        full_report: bool,
     },
     /// Re-render cases and write their goldens (refused under CI=true without --force).
     Bless {
@@ -491,10 +495,22 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
         Command::Check { case, report_dir, matrix: true, .. } => {
             matrix::matrix(project, config, case.as_deref(), report_dir)
         }
-        Command::Check { case, report_dir, matrix: false, junit, json, changed, failed, partition, allow_orphans } => {
+        Command::Check {
+            case,
+            report_dir,
+            matrix: false,
+            junit,
+            json,
+            changed,
+            failed,
+            partition,
+            allow_orphans,
+            full_report,
+        } => {
             let partition = partition.as_deref().map(vista_golden::selection::parse_partition).transpose()?;
             let pick = Pick { glob: case, changed, failed, partition, allow_orphans };
-            check(project, config, &pick, report_dir, Results { junit, json })
+            let viewers = if full_report { vista_report::Detail::All } else { vista_report::Detail::Failing };
+            check(project, config, &pick, report_dir, Results { junit, json }, viewers)
         }
         Command::Bless { case, force, from_report: Some(dir), .. } => {
             let store = Store::of_project(project, "vista bless")?;
@@ -697,6 +713,7 @@ fn check(
     pick: &Pick,
     report_dir: Option<PathBuf>,
     results: Results,
+    viewers: vista_report::Detail,
 ) -> Result<i32, GoldenError> {
     if let Some(p) = &results.junit {
         check_results_path("--junit", p)?;
@@ -751,7 +768,7 @@ fn check(
         time.cases += started.elapsed();
         let entry = checked.pending.take();
         let started = std::time::Instant::now();
-        let o = vista_report::file_case(&report_dir, checked);
+        let o = vista_report::file_case(&report_dir, checked, viewers);
         time.report += started.elapsed();
         time.gpu += std::time::Duration::from_secs_f64(o.gpu_ms / 1000.0);
         // A failing or missing case's render, as bless --from-report may take it.

@@ -46,7 +46,10 @@ pub fn matrix(
         let (dir, opts) = (report_dir.join(b), CheckOptions { twice: false });
         let outcomes: Vec<Outcome> = picked
             .iter()
-            .map(|c| vista_report::file_case(&dir, vista_golden::check_case(&gpu, &store, &manifest, c, &opts)))
+            .map(|c| {
+                let checked = vista_golden::check_case(&gpu, &store, &manifest, c, &opts);
+                vista_report::file_case(&dir, checked, vista_report::Detail::Failing)
+            })
             .collect();
         columns.push((b.to_string(), Ok((ctx.adapter_description(), outcomes))));
     }

@@ -94,6 +94,7 @@ pub fn watch(
             let o = vista_report::file_case(
                 &report_dir,
                 vista_golden::check_case(&gpu, &store, &manifest, case, &CheckOptions { twice: false }),
+                vista_report::Detail::Failing,
             );
             let label = if o.passed() { "ok" } else { "FAIL" };
             println!("{label:<6} {:<40} {:>8.1} ms", o.id, o.gpu_ms);

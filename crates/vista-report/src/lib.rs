@@ -14,7 +14,9 @@ mod results;
 
 pub use matrix::{MatrixColumn, cell as matrix_cell, matrix_page};
 pub use mutation::mutation_page;
-pub use report::{CASE_MARKER, RunSummary, clear_case_folders, file_case, view_js, write_case_files, write_report};
+pub use report::{
+    CASE_MARKER, Detail, RunSummary, clear_case_folders, file_case, view_js, write_case_files, write_report,
+};
 pub use results::{case_line, github_annotations, json_results, junit_xml, verdict_name};
 
 /// The stylesheet every page carries inline (a copied report folder opens

@@ -41,7 +41,7 @@ pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
 
 /// A checked case with its images written into `dir`: the outcome with
 /// `files` filled in (a failure to write them makes the case an error).
-pub fn file_case(dir: &Path, checked: vista_golden::Checked) -> Outcome {
+pub fn file_case(dir: &Path, checked: vista_golden::Checked, detail: Detail) -> Outcome {
     let vista_golden::Checked { mut outcome, actual, expected, output_images, pending_files, inputs, .. } = checked;
     if let Err(e) = write_inputs(dir, &mut outcome, &inputs) {
         outcome.verdict = Verdict::Error;
@@ -65,7 +65,7 @@ pub fn file_case(dir: &Path, checked: vista_golden::Checked) -> Outcome {
         outcome.problems.push(e.to_string());
     }
     if let Some(actual) = &actual
-        && let Err(e) = write_case_files(dir, &mut outcome, actual, expected.as_ref())
+        && let Err(e) = write_case_files(dir, &mut outcome, actual, expected.as_ref(), detail)
     {
         outcome.verdict = Verdict::Error;
         outcome.problems.push(e.to_string());
@@ -237,10 +237,17 @@ pub fn write_case_files(
     out: &mut Outcome,
     actual: &Image,
     expected: Option<&Image>,
+    detail: Detail,
 ) -> Result<(), GoldenError> {
     let id = out.id.clone();
     let case_dir = case_folder(dir, &id)?;
+    // A case that passed gets 8-bit images only (what a browser shows);
+    // one that did not, or a full report, the 16-bit values too.
+    let full = detail == Detail::All || !out.passed();
     let write = |name: &str, img: &Image, bits16: bool| -> Result<Option<String>, GoldenError> {
+        if bits16 && !full {
+            return Ok(None);
+        }
         if bits16 {
             vista_image::write_png16(&case_dir.join(name), img)?;
         } else {
@@ -279,10 +286,27 @@ pub fn write_case_files(
         out.files.diff = write("diff.png", &heat, true)?;
         out.files.diff8 = write("diff8.png", &heat, false)?;
     }
-    let view = view_js(&id, comparable, actual, out.first_bad.as_ref().map(|b| (b.0, b.1)));
-    vista_image::atomic_write(&case_dir.join("view.js"), view.as_bytes())?;
-    out.files.view = Some(format!("{id}/view.js"));
+    // The viewer's data is both images' 16-bit values in base64: about
+    // 1 MB per 256 x 256 case, more than half of a report. A reviewer
+    // inspects pixels where a case did not pass.
+    if full {
+        let view = view_js(&id, comparable, actual, out.first_bad.as_ref().map(|b| (b.0, b.1)));
+        vista_image::atomic_write(&case_dir.join("view.js"), view.as_bytes())?;
+        out.files.view = Some(format!("{id}/view.js"));
+    }
     Ok(())
+}
+
+/// Which cases get their 16-bit images and the pixel viewer's data
+/// (`view.js`) in the report; the others get 8-bit images.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Detail {
+    /// Cases that did not pass (the default: a passing case's 16-bit copies
+    /// and viewer data were two thirds of a report that nobody opens).
+    #[default]
+    Failing,
+    /// Every case (`vista check --full-report`).
+    All,
 }
 
 /// What a report says about the run that made it.
@@ -357,6 +381,11 @@ fn thumb(path: &Option<String>, full: &Option<String>, alt: &str) -> String {
         (Some(p), Some(f)) => format!(
             "<a href=\"{f}\" title=\"16-bit file\"><img class=\"thumb\" src=\"{p}\" alt=\"{alt}\" loading=\"lazy\"></a>",
             f = html_escape(f),
+            p = html_escape(p)
+        ),
+        // A passing case keeps its 8-bit image only.
+        (Some(p), None) => format!(
+            "<a href=\"{p}\" title=\"8-bit file\"><img class=\"thumb\" src=\"{p}\" alt=\"{alt}\" loading=\"lazy\"></a>",
             p = html_escape(p)
         ),
         _ => format!("<span class=\"none\">no {alt}</span>"),
@@ -474,6 +503,11 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
             html_escape(&o.id),
             html_escape(v)
         ),
+        None if o.files.actual8.is_some() => format!(
+            "<p class=\"note\">The pixel viewer and 16-bit images are written for cases that do not pass; for \
+             this one: <code class=\"cmd\">vista check --case '{}' --full-report</code></p>",
+            html_escape(&o.id)
+        ),
         None => String::new(),
     };
     format!(
@@ -490,7 +524,7 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
         id = html_escape(&o.id),
         kernel = html_escape(&o.kernel),
         gpu = o.gpu_ms,
-        thumbs = match (&o.files.actual, o.outputs.is_empty()) {
+        thumbs = match (&o.files.actual8, o.outputs.is_empty()) {
             // A graph whose first output is a buffer has no main image.
             (None, false) => format!(
                 "<span class=\"none\">outputs: {}</span>",
