@@ -40,7 +40,14 @@ pub fn bench(
         }
     };
     if cpu && !k.has_reference() {
-        return Err(bad(format!("--cpu: kernel {kernel} has no CPU reference (only built-in kernels have one)")));
+        return Err(bad(match k.reference_mismatch() {
+            Some(how) => format!(
+                "--cpu: kernel {kernel} has no CPU reference: its manifest ({}) is the built-in {kernel}'s {how}, \
+                 and the built-in's reference reads those",
+                k.origin()
+            ),
+            None => format!("--cpu: kernel {kernel} has no CPU reference (only built-in kernels have one)"),
+        }));
     }
     let ctx = &Renderer {
         ctx: Context::shared(&config.gpu)?,

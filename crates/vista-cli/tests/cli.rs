@@ -2638,7 +2638,7 @@ fn a_project_kernel_named_like_a_builtin_does_not_get_its_reference() {
     assert_rejected(
         &vista_in(Some(d.path()), &[], &["bench", "fbm", "--cpu", "--size", "8x8"]),
         2,
-        &["fbm has no CPU reference"],
+        &["fbm has no CPU reference", "without the built-in's octave_rotation_deg"],
     );
     // The unchanged built-in keeps its reference.
     assert_eq!(vista(&["bench", "fbm", "--cpu", "--size", "8x8", "--runs", "1"]).code, 0);

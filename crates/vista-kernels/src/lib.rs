@@ -726,6 +726,15 @@ impl Kernel {
         layout::pack(self, layout, p, width, height)
     }
 
+    /// Why a kernel named like a built-in has no CPU reference: how its
+    /// manifest differs from the built-in's in what the reference reads.
+    pub fn reference_mismatch(&self) -> Option<String> {
+        if self.cpu.is_some() {
+            return None;
+        }
+        builtin_mismatch(&self.manifest)
+    }
+
     /// The f64 CPU reference of the raw output.
     ///
     /// # Panics
@@ -754,13 +763,34 @@ impl Kernel {
 /// A project's kernels: its `kernels/*.toml` over the built-ins, by name.
 /// Whether `m` declares the params of the built-in kernel of its name.
 fn same_params_as_builtin(m: &manifest::Manifest) -> bool {
+    builtin_mismatch(m).is_none()
+}
+
+/// How manifest `m` differs from the built-in of its name in what the
+/// built-in's CPU reference reads (params' names and types, `[[group]]`s),
+/// or `None` when it does not (or no built-in has its name).
+fn builtin_mismatch(m: &manifest::Manifest) -> Option<String> {
     let file = format!("{}.toml", m.name);
-    let Some((_, text)) = vista_project::builtin::KERNELS.iter().find(|(rel, _)| *rel == file) else {
-        return false;
-    };
-    let Ok(builtin) = manifest::parse(m.name, "<built-in>", text) else { return false };
+    let (_, text) = vista_project::builtin::KERNELS.iter().find(|(rel, _)| *rel == file)?;
+    let builtin = manifest::parse(m.name, "<built-in>", text).ok()?;
     let sig = |ps: &[ParamSpec]| ps.iter().map(|p| (p.name, p.ty)).collect::<Vec<_>>();
-    sig(builtin.params) == sig(m.params) && builtin.groups == m.groups
+    let (theirs, ours) = (sig(builtin.params), sig(m.params));
+    let mut diffs = Vec::new();
+    let missing: Vec<&str> = theirs.iter().filter(|p| !ours.contains(p)).map(|p| p.0).collect();
+    let extra: Vec<&str> = ours.iter().filter(|p| !theirs.contains(p)).map(|p| p.0).collect();
+    if !missing.is_empty() {
+        diffs.push(format!("without the built-in's {}", missing.join(", ")));
+    }
+    if !extra.is_empty() {
+        diffs.push(format!("with {} the built-in lacks (or types it otherwise)", extra.join(", ")));
+    }
+    if missing.is_empty() && extra.is_empty() && theirs != ours {
+        diffs.push("its params in another order".into());
+    }
+    if builtin.groups != m.groups {
+        diffs.push("other [[group]] tables".into());
+    }
+    (!diffs.is_empty()).then(|| diffs.join("; "))
 }
 
 /// A project's kernels. A manifest that does not parse breaks only its own
