@@ -410,7 +410,8 @@ fn judge_alpha(v: &mut OutputVerdict, case: &Case, path: &Path, raw: &Image, thr
             if ignored(x, y) {
                 continue;
             }
-            let a = vista_image::quantize16(raw.get(x, y)[3]) as f64 / 65535.0;
+            // As the golden was written and is read back: 16 bits, then f32.
+            let a = (vista_image::quantize16(raw.get(x, y)[3]) as f32 / 65535.0) as f64;
             let d = (a - golden.get(x, y)[0] as f64).abs();
             sum += d * d;
             count += 1;
