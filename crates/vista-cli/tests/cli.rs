@@ -824,6 +824,14 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).unwrap().to_path_buf()
 }
 
+/// One Mesa shader cache for the suite's vista processes (Mesa creates the
+/// folder but not its parents; this one's parent is cargo's).
+fn shared_mesa_cache() -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("mesa-cache");
+    std::fs::create_dir_all(&dir).expect("the suite's Mesa cache folder");
+    dir
+}
+
 fn run_in(bin: &Path, cwd: &Path, env: &[(&str, &str)], args: &[&str]) -> Run {
     let mut cmd = Command::new(bin);
     cmd.args(args)
@@ -831,9 +839,15 @@ fn run_in(bin: &Path, cwd: &Path, env: &[(&str, &str)], args: &[&str]) -> Run {
         .env("XDG_RUNTIME_DIR", "/tmp")
         .env_remove("CI")
         .env_remove("VISTA_ROOT")
-        .env_remove("MESA_SHADER_CACHE_DIR");
+        // Every temporary project would start Mesa's cache cold under its
+        // own target/ (half again the suite's time): one warm cache for all,
+        // except where a test passes "" to see the binary place it.
+        .env("MESA_SHADER_CACHE_DIR", shared_mesa_cache());
     for (k, v) in env {
-        cmd.env(k, v);
+        match v.is_empty() {
+            true => cmd.env_remove(k),
+            false => cmd.env(k, v),
+        };
     }
     // A binary copied moments ago can fail to exec with ETXTBSY while a child
     // forked by a parallel test still holds the copy's write descriptor; that
@@ -1067,6 +1081,16 @@ fn {entry}(@builtin(global_invocation_id) id: vec3<u32>) {{
 }}
 "#
     )
+}
+
+/// Kernel `k` of project `d` rendered on `backend` at `size` with one
+/// `--set`, as raw values; the render must succeed.
+fn render_k_on(d: &Path, backend: &str, size: &str, set: &str) -> vista_image::Image {
+    let out = d.join(format!("{backend}-{}.exr", set.replace(['=', ',', '.'], "_")));
+    let args = ["render", "k", "--size", size, "--set", set, "--backend", backend, "-o", out.to_str().unwrap()];
+    let r = vista_in(Some(d), &[], &args);
+    assert_eq!(r.code, 0, "{backend} {set}: {}", r.stderr);
+    vista_image::load(&out).unwrap()
 }
 
 fn render_exr(d: &Path, size: &str, name: &str) -> (Run, PathBuf) {
@@ -1389,7 +1413,7 @@ fn init_writes_a_project_that_blesses_and_checks() {
     let c = vista_in(Some(&dir), &placed, &["check"]);
     assert!(c.code == 0 && c.stdout.contains("2 passed, 0 failed"), "{}", c.stdout);
     assert!(!dir.join("target/vista-cache").exists(), "a cache the user placed stays where it is");
-    let c = vista_in(Some(&dir), &[], &["check"]);
+    let c = vista_in(Some(&dir), &[("MESA_SHADER_CACHE_DIR", "")], &["check"]);
     assert!(c.code == 0 && c.stdout.contains("2 passed, 0 failed"), "{}", c.stdout);
     // Mesa's shader cache goes under the project's target/ (lavapipe's
     // compiled pipelines: a warm check compiles nothing), and the check
@@ -2413,13 +2437,7 @@ fn overrides_take_manifest_values_and_params() {
     let mut first: Option<vista_image::Image> = None;
     for backend in ["lavapipe", "swiftshader", "browser"] {
         for block in ["1", "16"] {
-            let out = d.path().join(format!("{backend}{block}.exr"));
-            let set = format!("BLOCK={block}");
-            let args =
-                ["render", "k", "--size", "21x9", "--set", &set, "--backend", backend, "-o", out.to_str().unwrap()];
-            let r = vista_in(Some(d.path()), &[], &args);
-            assert_eq!(r.code, 0, "{backend} BLOCK={block}: {}", r.stderr);
-            let img = vista_image::load(&out).unwrap();
+            let img = render_k_on(d.path(), backend, "21x9", &format!("BLOCK={block}"));
             assert!(img.data.iter().all(|p| p[2] == 0.25), "{backend}: GAIN 0.5 x gain 0.5");
             match &first {
                 None => first = Some(img),
@@ -2487,13 +2505,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let d = kernel_project(&manifest, shader);
     for backend in ["lavapipe", "browser"] {
         for (mode, alpha) in [("a-one", 0.0), ("b", 0.5), ("c", 1.0)] {
-            let out = d.path().join(format!("{backend}-{mode}.exr"));
-            let set = format!("mode={mode}");
-            let args =
-                ["render", "k", "--size", "9x5", "--set", &set, "--backend", backend, "-o", out.to_str().unwrap()];
-            let r = vista_in(Some(d.path()), &[], &args);
-            assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
-            let img = vista_image::load(&out).unwrap();
+            let img = render_k_on(d.path(), backend, "9x5", &format!("mode={mode}"));
             let want = [0.25, 0.5, 0.75, alpha];
             assert!(img.data.iter().all(|p| *p == want), "{backend} {mode}: {:?}, want {want:?}", img.get(0, 0));
         }
@@ -2728,12 +2740,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     );
     let d = kernel_project(&manifest, shader);
     for backend in ["lavapipe", "swiftshader", "browser"] {
-        let out = d.path().join(format!("{backend}.exr"));
-        let args =
-            ["render", "k", "--size", "9x5", "--set", "flip.gain=1", "--backend", backend, "-o", out.to_str().unwrap()];
-        let r = vista_in(Some(d.path()), &[], &args);
-        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
-        let img = vista_image::load(&out).unwrap();
+        let img = render_k_on(d.path(), backend, "9x5", "flip.gain=1");
         assert!(img.data.iter().all(|p| *p == [0.25, 0.5, 0.75, 1.0]), "{backend}: {:?}", img.get(0, 0));
     }
     let ambiguous = manifest
