@@ -558,7 +558,7 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
 fn alpha_psnr(a: &Image, b: &Image) -> f64 {
     let n = a.data.len().max(1) as f64;
     let mse: f64 = a.data.iter().zip(&b.data).map(|(x, y)| (x[3] as f64 - y[3] as f64).powi(2)).sum::<f64>() / n;
-    if mse == 0.0 { f64::INFINITY } else { 10.0 * (1.0 / mse).log10() }
+    metrics::psnr_from_mse(mse, 1.0)
 }
 
 /// Folds a graph's output verdicts into the case's: a missing golden file

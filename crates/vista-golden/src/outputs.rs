@@ -421,7 +421,7 @@ fn judge_alpha(v: &mut OutputVerdict, case: &Case, path: &Path, raw: &Image, thr
         }
     }
     let mse = if count == 0 { 0.0 } else { sum / count as f64 };
-    let psnr = if mse == 0.0 { f64::INFINITY } else { 10.0 * (1.0 / mse).log10() };
+    let psnr = vista_image::metrics::psnr_from_mse(mse, 1.0);
     let shown = vista_image::metrics::format_psnr(psnr);
     v.summary = format!("output {}: alpha PSNR {shown} (>= {threshold:.1} dB; the view is opaque)", v.name);
     if psnr < threshold {
@@ -484,7 +484,7 @@ fn judge_raw(
         false => 1.0,
     };
     let mse = if count == 0 { 0.0 } else { sum / count as f64 };
-    let psnr = if mse == 0.0 { f64::INFINITY } else { 10.0 * (peak * peak / mse).log10() };
+    let psnr = vista_image::metrics::psnr_from_mse(mse, peak);
     let shown = vista_image::metrics::format_psnr(psnr);
     let worst_at = match worst.0 > 0.0 {
         true => format!(

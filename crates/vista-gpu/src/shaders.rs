@@ -111,7 +111,7 @@ impl ShaderSet {
     /// `name` is a kernel file, optionally followed by `?DEF&DEF...`: naga_oil
     /// shader defs (boolean) to compose it with, e.g. `fbm.wgsl?VISTA_HASH_PLANE`.
     fn kernel_source(&self, name: &str) -> Result<&(String, String), GpuError> {
-        let name = name.split_once('?').map_or(name, |(file, _)| file);
+        let name = file_of(name);
         self.kernels.get(name).ok_or_else(|| {
             GpuError::Shader(format!(
                 "shader {name} not found in {} (kernel files: {})",
@@ -121,18 +121,18 @@ impl ShaderSet {
         })
     }
 
-    /// The generated `vista::enums` text for kernel file `name` when it or
-    /// a module it imports imports it.
-    fn enums_for(&self, name: &str) -> Result<Option<&str>, GpuError> {
-        let file = name.split_once('?').map_or(name, |(file, _)| file);
-        let (source, _) = self.kernel_source(name)?;
+    /// The generated `vista::enums` text for kernel file `name` (its
+    /// `source`, and `lib`, the library modules it reaches) when it or one
+    /// of those modules imports it.
+    fn enums_for(&self, name: &str, source: &str, lib: &[&(String, String)]) -> Result<Option<&str>, GpuError> {
+        let file = file_of(name);
         let imports_enums = |text: &str| {
             text.lines().filter_map(|l| l.trim().strip_prefix("#import")).any(|rest| {
                 let rest = rest.trim();
                 rest == ENUMS_MODULE || rest.starts_with(&format!("{ENUMS_MODULE}::"))
             })
         };
-        if !imports_enums(source) && !self.imported_lib(source).iter().any(|e| imports_enums(&e.1)) {
+        if !imports_enums(source) && !lib.iter().any(|e| imports_enums(&e.1)) {
             return Ok(None);
         }
         match self.enums.get(file) {
@@ -150,8 +150,7 @@ impl ShaderSet {
     /// imports also defines with another value: the library's meaning of
     /// the index (`vista::noise`'s `BASIS_VALUE`) and the manifest's order
     /// must agree.
-    fn check_enums(&self, name: &str, enums: &str) -> Result<(), GpuError> {
-        let (source, _) = self.kernel_source(name)?;
+    fn check_enums(&self, name: &str, enums: &str, lib: &[&(String, String)]) -> Result<(), GpuError> {
         let consts = |text: &str| -> Vec<(String, String)> {
             text.lines()
                 .filter_map(|l| l.trim().strip_prefix("const "))
@@ -163,7 +162,7 @@ impl ShaderSet {
                 .collect()
         };
         let generated = consts(enums);
-        for (path, text) in self.imported_lib(source) {
+        for (path, text) in lib.iter().map(|e| (&e.0, &e.1)) {
             for (c, lib_value) in consts(text) {
                 if let Some((_, value)) = generated.iter().find(|(g, _)| *g == c)
                     && *value != lib_value
@@ -171,7 +170,7 @@ impl ShaderSet {
                     return Err(GpuError::Shader(format!(
                         "{}: enum constant {c} is {value} by the kernel's manifest but {lib_value} in {path}; list the \
                          enum's values in the order {path} gives them",
-                        name.split_once('?').map_or(name, |(f, _)| f)
+                        file_of(name)
                     )));
                 }
             }
@@ -183,7 +182,7 @@ impl ShaderSet {
     /// and the library modules the kernel source reaches. naga_oil wants a
     /// module's imports added before it, so modules are added in rounds
     /// until all fit.
-    fn composer(&self, source: &str, enums: Option<&str>) -> Result<Composer, GpuError> {
+    fn composer(&self, lib: &[&(String, String)], enums: Option<&str>) -> Result<Composer, GpuError> {
         let mut composer = Composer::default();
         if let Some(text) = enums {
             let desc = ComposableModuleDescriptor {
@@ -198,7 +197,7 @@ impl ShaderSet {
                 return Err(GpuError::Shader(describe(&composer, &self.label, &e)));
             }
         }
-        let mut pending: Vec<&(String, String)> = self.imported_lib(source);
+        let mut pending: Vec<&(String, String)> = lib.to_vec();
         while !pending.is_empty() {
             let mut failed = Vec::new();
             let mut last_error = None;
@@ -258,12 +257,12 @@ impl ShaderSet {
         }
         // The manifest's constants must agree with the library's even where
         // the kernel passes the index through without naming it.
-        let file = name.split_once('?').map_or(name, |(file, _)| file);
-        if let Some(Ok(text)) = self.enums.get(file) {
-            self.check_enums(name, text)?;
+        let lib = self.imported_lib(source);
+        if let Some(Ok(text)) = self.enums.get(file_of(name)) {
+            self.check_enums(name, text, &lib)?;
         }
-        let enums = self.enums_for(name)?;
-        let mut composer = self.composer(source, enums)?;
+        let enums = self.enums_for(name, source, &lib)?;
+        let mut composer = self.composer(&lib, enums)?;
         let module = composer
             .make_naga_module(NagaModuleDescriptor {
                 source,
@@ -285,11 +284,12 @@ impl ShaderSet {
         let mut h = blake3::Hasher::new();
         h.update(name.as_bytes());
         h.update(source.as_bytes());
-        for (path, source) in self.imported_lib(source) {
+        let lib = self.imported_lib(source);
+        for (path, text) in &lib {
             h.update(path.as_bytes());
-            h.update(source.as_bytes());
+            h.update(text.as_bytes());
         }
-        if let Some(text) = self.enums_for(name)? {
+        if let Some(text) = self.enums_for(name, source, &lib)? {
             h.update(ENUMS_MODULE.as_bytes());
             h.update(text.as_bytes());
         }
@@ -301,9 +301,11 @@ impl ShaderSet {
     pub fn file_hashes(&self, name: &str) -> Result<std::collections::BTreeMap<String, String>, GpuError> {
         let (source, _) = self.kernel_source(name)?;
         let hash = |text: &str| blake3::hash(text.as_bytes()).to_hex()[..16].to_string();
-        let enums = self.enums_for(name)?.map(|text| (format!("{ENUMS_MODULE} (from the manifest)"), hash(text)));
+        let lib = self.imported_lib(source);
+        let enums =
+            self.enums_for(name, source, &lib)?.map(|text| (format!("{ENUMS_MODULE} (from the manifest)"), hash(text)));
         Ok(std::iter::once((name.to_string(), hash(source)))
-            .chain(self.imported_lib(source).into_iter().map(|(path, text)| (path.clone(), hash(text))))
+            .chain(lib.iter().map(|(path, text)| (path.clone(), hash(text))))
             .chain(enums)
             .collect())
     }
@@ -400,6 +402,11 @@ pub fn keep_struct_layouts(name: &str, module: &naga::Module, text: String) -> R
     let mut out = lines.join("\n");
     out.push('\n');
     Ok(out)
+}
+
+/// The kernel file of a kernel name (`fbm.wgsl?A&B` -> `fbm.wgsl`).
+fn file_of(name: &str) -> &str {
+    name.split_once('?').map_or(name, |(file, _)| file)
 }
 
 /// The path a module declares with `#define_import_path`, if any.

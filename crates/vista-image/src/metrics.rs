@@ -188,7 +188,8 @@ fn all_metrics(reference: &Image, actual: &Image, peak: f64) -> Metrics {
     }
 }
 
-fn psnr_from_mse(mse: f64, peak: f64) -> f64 {
+/// `10 log10(peak² / mse)`; `+inf` when `mse` is 0.
+pub fn psnr_from_mse(mse: f64, peak: f64) -> f64 {
     if mse == 0.0 { f64::INFINITY } else { 10.0 * (peak * peak / mse).log10() }
 }
 

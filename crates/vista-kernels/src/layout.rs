@@ -152,35 +152,14 @@ pub fn blocks_of(
 /// Names each leaf by the param that feeds it: a leaf inside a
 /// `[[group]]`'s struct field takes [`crate::manifest::ParamGroup::param`]'s
 /// name, the others keep their own. Then refuses two ungrouped leaves of
-/// one uniform that share a name, and (with `strict`, one layout per kernel) a group
-/// whose field is no struct field of the uniform.
-pub fn name_leaves(kernel: &Kernel, shader: &str, l: &mut UniformLayout, strict: bool) -> Result<(), ParamError> {
+/// one uniform that share a name. ([`check_groups`] refuses a group that
+/// names no struct field.)
+pub fn name_leaves(kernel: &Kernel, shader: &str, l: &mut UniformLayout) -> Result<(), ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.name().to_string(), message };
     let has = |n: &str| kernel.params().iter().any(|s| s.name == n);
     for g in &kernel.manifest.groups {
-        let inside =
-            |f: &Field| f.path.starts_with(&format!("{}.", g.field)) || f.key.starts_with(&format!("{}.", g.field));
-        let mut any = false;
-        for f in l.fields.iter_mut().filter(|f| inside(f)) {
+        for f in l.fields.iter_mut().filter(|f| in_group(g, f)) {
             f.name = g.param(&f.name, has);
-            any = true;
-        }
-        if strict && !any {
-            let structs: Vec<String> = l
-                .fields
-                .iter()
-                .filter_map(|f| f.path.rsplit_once('.').map(|(s, _)| s.to_string()))
-                .fold(Vec::new(), |mut v, s| {
-                    if !v.contains(&s) {
-                        v.push(s);
-                    }
-                    v
-                });
-            return Err(bad(format!(
-                "[[group]] field = \"{}\" is no struct field of the uniform in {shader}; its struct fields: {}",
-                g.field,
-                if structs.is_empty() { "none".to_string() } else { structs.join(", ") }
-            )));
         }
     }
     // A grouped leaf may share its param with another leaf (landscape's
@@ -197,24 +176,42 @@ pub fn name_leaves(kernel: &Kernel, shader: &str, l: &mut UniformLayout, strict:
     Ok(())
 }
 
-/// Whether leaf `f` lies in a `[[group]]`'s struct field.
-fn grouped(kernel: &Kernel, f: &Field) -> bool {
-    kernel.manifest.groups.iter().any(|g| {
-        let dot = format!("{}.", g.field);
-        f.path.starts_with(&dot) || f.key.starts_with(&dot)
-    })
+/// Whether leaf `f` lies in group `g`'s struct field (by its path below
+/// the variable, or as `variable.path`).
+fn in_group(g: &crate::manifest::ParamGroup, f: &Field) -> bool {
+    let dot = format!("{}.", g.field);
+    f.path.starts_with(&dot) || f.key.starts_with(&dot)
 }
 
-/// Every `[[group]]` field is a struct field of one of a graph's uniforms.
+/// Whether leaf `f` lies in any of the kernel's `[[group]]`s.
+fn grouped(kernel: &Kernel, f: &Field) -> bool {
+    kernel.manifest.groups.iter().any(|g| in_group(g, f))
+}
+
+/// Every `[[group]]` field is a struct field of the uniform of one of the
+/// kernel's passes (`layouts`); the refusal lists the struct fields there are.
 pub fn check_groups(kernel: &Kernel, layouts: &[&UniformLayout]) -> Result<(), ParamError> {
     for g in &kernel.manifest.groups {
-        let dot = format!("{}.", g.field);
-        if !layouts.iter().any(|l| l.fields.iter().any(|f| f.path.starts_with(&dot) || f.key.starts_with(&dot))) {
-            return Err(ParamError::Layout {
-                kernel: kernel.name().to_string(),
-                message: format!("[[group]] field = \"{}\" is no struct field of any pass's uniform", g.field),
-            });
+        if layouts.iter().any(|l| l.fields.iter().any(|f| in_group(g, f))) {
+            continue;
         }
+        let mut structs: Vec<&str> = Vec::new();
+        for f in layouts.iter().flat_map(|l| &l.fields) {
+            if let Some((s, _)) = f.path.rsplit_once('.')
+                && !structs.contains(&s)
+            {
+                structs.push(s);
+            }
+        }
+        return Err(ParamError::Layout {
+            kernel: kernel.name().to_string(),
+            message: format!(
+                "[[group]] field = \"{}\" is no struct field of the uniform in {}; its struct fields: {}",
+                g.field,
+                kernel.shader_files().join(" or "),
+                if structs.is_empty() { "none".to_string() } else { structs.join(", ") }
+            ),
+        });
     }
     Ok(())
 }

@@ -643,12 +643,15 @@ impl Kernel {
                         && !g.resources.iter().any(|r| r.name == b.name)
                 })
                 .collect();
-            let mut l = layout::blocks_of(self.name(), shader, module, fed)?;
-            layout::name_leaves(self, shader, &mut l, false)?;
-            layout::check_fields(self, &l)?;
-            layouts.push(l);
+            layouts.push((*shader, layout::blocks_of(self.name(), shader, module, fed)?));
         }
-        layout::check_groups(self, &layouts.iter().collect::<Vec<_>>())?;
+        // As for one pass: a group that names no struct field first.
+        layout::check_groups(self, &layouts.iter().map(|(_, l)| l).collect::<Vec<_>>())?;
+        for (shader, l) in &mut layouts {
+            layout::name_leaves(self, shader, l)?;
+            layout::check_fields(self, l)?;
+        }
+        let layouts: Vec<UniformLayout> = layouts.into_iter().map(|(_, l)| l).collect();
         layout::check_params(self, &layouts.iter().collect::<Vec<_>>())?;
         Ok((resolved, layouts))
     }
@@ -714,7 +717,10 @@ impl Kernel {
     /// Reflects and checks the uniform layout of this kernel's composed module.
     pub fn layout(&self, module: &naga::Module) -> Result<UniformLayout, ParamError> {
         let mut l = layout::reflect(self.name(), self.shader(), self.entry(), module)?;
-        layout::name_leaves(self, self.shader(), &mut l, true)?;
+        // A group that names no struct field first: its leaves would
+        // otherwise look like ungrouped leaves sharing names.
+        layout::check_groups(self, &[&l])?;
+        layout::name_leaves(self, self.shader(), &mut l)?;
         layout::check(self, &l)?;
         l.output = Some(resources::resolve(&self.manifest, &l.bindings, module)?);
         Ok(l)
