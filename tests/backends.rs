@@ -78,7 +78,7 @@ fn backends_agree(contexts: &[Context]) -> Result<(), String> {
         let outs: Vec<(Image, Image)> = renderers
             .iter()
             .map(|r| {
-                render(r, case.kernel, &case.params, case.width, case.height)
+                render(r, &case.kernel, &case.params, case.width, case.height)
                     .map(|o| {
                         let display = vista_render::quantize16(o.display());
                         (o.raw, display)

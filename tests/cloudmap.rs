@@ -14,7 +14,7 @@ fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
 fn gpu_matches_f64_reference_on_every_preset(ctx: &vista_render::Renderer) {
     let (w, h) = (128, 96);
     let mut settings: Vec<(String, ParamSet)> =
-        CloudmapKernel.presets().iter().map(|p| (p.name.to_string(), params(p.name, &[]))).collect();
+        CloudmapKernel.presets().iter().map(|p| (p.name.to_string(), params(&p.name, &[]))).collect();
     settings.push((
         "seed 9, sharpness 0.9, time 7.3".into(),
         params("default", &[("seed", "9"), ("sharpness", "0.9"), ("time", "7.3")]),

@@ -107,7 +107,7 @@ fn renders_are_deterministic_and_jitter_follows_its_seed(ctx: &vista_render::Ren
 /// `seed_experiment_analytic_ign_at_half_the_steps_beats_riemann_64x12`.
 fn seed_experiment_on_the_gpu(ctx: &vista_render::Renderer) {
     let (w, h) = (48, 48);
-    let mut hq: Vec<(&str, &str)> = CloudsKernel.high_quality().to_vec();
+    let mut hq: Vec<(&str, &str)> = CloudsKernel.high_quality();
     hq.push(("jitter", "none"));
     let reference = CloudsKernel.reference(&params("cumulus", &hq), w, h);
     let peak = hdr_peak(&reference);

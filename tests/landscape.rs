@@ -130,7 +130,7 @@ fn flat_ground_gives_the_atmosphere_kernels_sky_above_the_horizon(ctx: &Renderer
 /// raw value finite and >= 0.
 fn radiance_is_finite_and_non_negative_in_every_preset(ctx: &Renderer) {
     let mut cases: Vec<(String, ParamSet)> =
-        LandscapeKernel.presets().iter().map(|p| (p.name.to_string(), params(p.name, &[]))).collect();
+        LandscapeKernel.presets().iter().map(|p| (p.name.to_string(), params(&p.name, &[]))).collect();
     cases.push(("seed, sun 1 deg".into(), params("seed", &[("sun_elevation_deg", "1")])));
     cases.push((
         "flythrough, analytic + ign".into(),

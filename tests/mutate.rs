@@ -23,7 +23,7 @@ fn run_one(gpu: &Renderer, file: &str, line_text: &str, before: &str, after: &st
         .find(|m| m.line == line && m.before == before && m.after == after)
         .unwrap_or_else(|| panic!("no mutant {before} -> {after} on {file}:{line}"));
     let kernel = vista_kernels::find("fbm").unwrap();
-    let planned = [Planned { kernel, mutant }];
+    let planned = [Planned { kernel: kernel.clone(), mutant }];
     let mut r = vista_mutate::run(gpu.ctx, &project, &store, &cases, &planned, 1, gpu.limits, &|_, _| {}).unwrap();
     r.pop().unwrap()
 }
@@ -54,7 +54,7 @@ fn only_functions_the_kernel_reaches_are_mutated(_gpu: &Renderer) {
     let fbm = vista_kernels::find("fbm").unwrap();
     let opts =
         vista_mutate::Options { kernel: None, case_glob: None, sample: None, seed: 1, jobs: 1, partition: (1, 1) };
-    let plan = vista_mutate::plan(&files, &shaders, &[fbm], &opts).unwrap();
+    let plan = vista_mutate::plan(&files, &shaders, std::slice::from_ref(fbm), &opts).unwrap();
     let fractal = files.iter().find(|f| f.rel == "lib/fractal.wgsl").unwrap();
     let fns = vista_mutate::mutants::functions(&fractal.text);
     let body = |name: &str| fns.iter().find(|f| f.name == name).unwrap().body;

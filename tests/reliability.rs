@@ -5,6 +5,7 @@
 mod common;
 
 use std::cell::Cell;
+use std::sync::Arc;
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
@@ -14,12 +15,13 @@ use vista_kernels::{Kernel, Kind, ParamSpec};
 
 /// Test-only kernel backed by `shaders/test/nan.wgsl`, described as data
 /// like any project's kernel (no params, no CPU reference).
-fn nan_kernel() -> &'static Kernel {
-    static NAN: std::sync::OnceLock<Kernel> = std::sync::OnceLock::new();
+fn nan_kernel() -> Arc<Kernel> {
+    static NAN: std::sync::OnceLock<Arc<Kernel>> = std::sync::OnceLock::new();
     NAN.get_or_init(|| {
         let manifest = "summary = \"writes NaN at (5, 3) and +Inf at (7, 3)\"\nshader = \"test/nan.wgsl\"\n";
-        Kernel::from_manifest("test-nan", "tests/reliability.rs", manifest).expect("valid manifest")
+        Arc::new(Kernel::from_manifest("test-nan", "tests/reliability.rs", manifest).expect("valid manifest"))
     })
+    .clone()
 }
 
 fn nan_case() -> Case {
@@ -62,7 +64,7 @@ fn injected_nan_fails_the_case_naming_count_and_first_pixel(ctx: &vista_render::
 }
 
 fn render_path_reports_nan_from_the_gpu_bit_exactly(ctx: &vista_render::Renderer) {
-    let r = vista_render::render(ctx, nan_kernel(), &nan_case().params, 16, 8).unwrap();
+    let r = vista_render::render(ctx, &nan_kernel(), &nan_case().params, 16, 8).unwrap();
     assert!(r.raw.get(5, 3)[0].is_nan());
     assert_eq!(r.raw.get(7, 3)[0], f32::INFINITY);
     assert_eq!(r.raw.first_nonfinite(), Some((5, 3)));
@@ -71,13 +73,15 @@ fn render_path_reports_nan_from_the_gpu_bit_exactly(ctx: &vista_render::Renderer
 
 /// Test-only kernel backed by `shaders/test/partial.wgsl`: writes the
 /// columns x < cut only.
-fn partial_kernel() -> &'static Kernel {
-    static PARTIAL: std::sync::OnceLock<Kernel> = std::sync::OnceLock::new();
-    PARTIAL.get_or_init(|| {
-        let manifest = "summary = \"writes 1 to the columns x < cut\"\nshader = \"test/partial.wgsl\"\n\
+fn partial_kernel() -> Arc<Kernel> {
+    static PARTIAL: std::sync::OnceLock<Arc<Kernel>> = std::sync::OnceLock::new();
+    PARTIAL
+        .get_or_init(|| {
+            let manifest = "summary = \"writes 1 to the columns x < cut\"\nshader = \"test/partial.wgsl\"\n\
                         [[param]]\nname = \"cut\"\ntype = \"u32\"\nrange = [0, 64]\ndefault = 16\n";
-        Kernel::from_manifest("test-partial", "tests/reliability.rs", manifest).expect("valid manifest")
-    })
+            Arc::new(Kernel::from_manifest("test-partial", "tests/reliability.rs", manifest).expect("valid manifest"))
+        })
+        .clone()
 }
 
 /// Runs of one size share an output texture (vista-gpu's scratch): a pixel
@@ -85,10 +89,10 @@ fn partial_kernel() -> &'static Kernel {
 /// never the value an earlier run wrote there.
 fn an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it(ctx: &vista_render::Renderer) {
     let k = partial_kernel();
-    let full = vista_render::render(ctx, k, &k.resolve(None, &[]).unwrap(), 16, 8).unwrap();
+    let full = vista_render::render(ctx, &k, &k.resolve(None, &[]).unwrap(), 16, 8).unwrap();
     assert_eq!(full.raw.get(12, 5), [1.0; 4]);
     for _ in 0..2 {
-        let part = vista_render::render(ctx, k, &k.resolve(None, &[("cut".into(), "4".into())]).unwrap(), 16, 8);
+        let part = vista_render::render(ctx, &k, &k.resolve(None, &[("cut".into(), "4".into())]).unwrap(), 16, 8);
         let part = part.unwrap().raw;
         assert_eq!(part.get(3, 5), [1.0; 4]);
         assert_eq!(part.get(4, 0), [0.0; 4], "an earlier run's value leaked into an unwritten pixel");
@@ -100,7 +104,7 @@ fn an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it(ctx: &vista_render::R
 
 /// A strategy producing text for one parameter, anywhere in its range.
 fn value_strategy(spec: &ParamSpec) -> BoxedStrategy<String> {
-    match spec.kind {
+    match spec.kind.clone() {
         Kind::Float { min, max, open_min } => {
             let lo = if open_min { min + (max - min) * 1e-6 } else { min };
             prop_oneof![
@@ -131,7 +135,7 @@ fn value_strategy(spec: &ParamSpec) -> BoxedStrategy<String> {
         Kind::Vector { n, min, max } => proptest::collection::vec(min..=max, n)
             .prop_map(|v| v.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(","))
             .boxed(),
-        Kind::Enum(names) => proptest::sample::select(names.to_vec()).prop_map(str::to_string).boxed(),
+        Kind::Enum(names) => proptest::sample::select(names.to_vec()).boxed(),
         Kind::Bool => proptest::bool::ANY.prop_map(|b| b.to_string()).boxed(),
     }
 }

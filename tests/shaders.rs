@@ -61,7 +61,7 @@ fn uniform_blocks_are_packed_by_name_at_naga_offsets() {
     for k in vista_kernels::registry() {
         let module = set.compose(k.shader()).unwrap();
         let layout = k.layout(&module).unwrap_or_else(|e| panic!("{e}"));
-        let p = k.resolve(k.presets().last().map(|p| p.name), &[]).unwrap();
+        let p = k.resolve(k.presets().last().map(|p| p.name.as_str()), &[]).unwrap();
         let bytes = k.uniforms(&layout, &p, 64, 32).remove(0);
         assert_eq!(bytes.len() % 16, 0);
         assert!(bytes.len() as u32 >= layout.blocks[0].size);
@@ -77,7 +77,7 @@ fn uniform_blocks_are_packed_by_name_at_naga_offsets() {
                     Value::Bool(b) => vec![*b as u32],
                     Value::Vector(v) => v.iter().map(|c| (*c as f32).to_bits()).collect(),
                     Value::Enum(e) => {
-                        let Kind::Enum(names) = k.params().iter().find(|s| s.name == name).unwrap().kind else {
+                        let Kind::Enum(ref names) = k.params().iter().find(|s| s.name == name).unwrap().kind else {
                             unreachable!()
                         };
                         vec![names.iter().position(|n| n == e).unwrap() as u32]

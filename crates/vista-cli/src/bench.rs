@@ -23,19 +23,19 @@ pub fn bench(
     if !(1..=1000).contains(&runs) {
         return Err(bad(format!("--runs {runs} is out of range; allowed: [1, 1000]")));
     }
-    let k = crate::registry(project)?.find(kernel).map_err(bad)?;
+    let k = crate::registry(project)?.find(kernel).cloned().map_err(bad)?;
     let p = k.resolve(preset, &parse_sets(set)?).map_err(bad)?;
     let (w, h) = vista_kernels::parse_size(size).map_err(bad)?;
     let shaders = vista_render::shader_set(project)?;
     // Every check that needs no device, before it is made.
     let graph_passes = match k.graph() {
         Some(_) => {
-            vista_render::check_request(k, &p, w, h, &config.limits)?;
-            let plan = vista_render::plan_graph(&shaders, project.root(), k, &p, &[], w, h)?;
+            vista_render::check_request(&k, &p, w, h, &config.limits)?;
+            let plan = vista_render::plan_graph(&shaders, project.root(), &k, &p, &[], w, h)?;
             plan.passes.iter().map(|p| p.label.clone()).collect()
         }
         None => {
-            vista_render::plan(&shaders, k, &p, w, h, &config.limits)?;
+            vista_render::plan(&shaders, &k, &p, w, h, &config.limits)?;
             Vec::new()
         }
     };
@@ -59,12 +59,12 @@ pub fn bench(
     ctx.time_passes(true);
     // Warm-up: compiles the pipeline and touches every allocation path once.
     // Whole first call: WGSL composition, pipeline creation (lavapipe JIT), dispatch, readback.
-    let first = vista_render::render(ctx, k, &p, w, h)?.stats.total.as_secs_f64();
+    let first = vista_render::render(ctx, &k, &p, w, h)?.stats.total.as_secs_f64();
     let mut stats = Vec::new();
     let mut pass_times: Vec<Vec<std::time::Duration>> = vec![Vec::new(); graph_passes.len()];
     let mut gpu_times: Vec<Vec<std::time::Duration>> = vec![Vec::new(); graph_passes.len()];
     for _ in 0..runs {
-        let r = vista_render::render(ctx, k, &p, w, h)?;
+        let r = vista_render::render(ctx, &k, &p, w, h)?;
         for (all, t) in pass_times.iter_mut().zip(&r.pass_times) {
             all.push(*t);
         }

@@ -374,7 +374,7 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             Ok(if kernels.broken().is_empty() { 0 } else { 2 })
         }
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
-            let k = registry(project)?.find(&kernel).map_err(bad)?;
+            let k = registry(project)?.find(&kernel).cloned().map_err(bad)?;
             let p = k.resolve(preset.as_deref(), &parse_sets(&set)?).map_err(bad)?;
             let (w, h) = vista_kernels::parse_size(&size).map_err(bad)?;
             if !(1..=16).contains(&zoom) {
@@ -389,19 +389,19 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
                 check_parent_writable(&out)?;
                 let shaders = vista_render::shader_set(project)?;
                 // Every check that needs no device (bindings, input files) before one is made.
-                vista_render::check_request(k, &p, w, h, &config.limits)?;
-                let plan = vista_render::plan_graph(&shaders, project.root(), k, &p, &[], w, h)?;
+                vista_render::check_request(&k, &p, w, h, &config.limits)?;
+                let plan = vista_render::plan_graph(&shaders, project.root(), &k, &p, &[], w, h)?;
                 let ctx = &Renderer {
                     ctx: Context::shared(&config.gpu)?,
                     shaders,
                     limits: config.limits,
                     root: project.root().map(Into::into),
                 };
-                return graph_render::render(ctx, k, &plan, &out);
+                return graph_render::render(ctx, &k, &plan, &out);
             }
             check_output_path(&out)?;
             let shaders = vista_render::shader_set(project)?;
-            let plan = vista_render::plan(&shaders, k, &p, w, h, &config.limits)?;
+            let plan = vista_render::plan(&shaders, &k, &p, w, h, &config.limits)?;
             // Layers and slices are stacked top to bottom: crop that image.
             let rect = crop.as_deref().map(|c| parse_crop(c, plan.width, plan.height * plan.layers)).transpose()?;
             let ctx = &Renderer {

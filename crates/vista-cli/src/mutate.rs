@@ -67,12 +67,12 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
     let store = Store::of_project(project, "vista mutate")?;
     let all_cases = store.load_cases()?;
     let cases = vista_golden::select(&all_cases, a.case.as_deref())?;
-    let kernels: Vec<&'static vista_kernels::Kernel> = match &a.kernel {
-        Some(name) => vec![store.kernels.find(name).map_err(bad)?],
+    let kernels: Vec<std::sync::Arc<vista_kernels::Kernel>> = match &a.kernel {
+        Some(name) => vec![store.kernels.find(name).cloned().map_err(bad)?],
         None => {
-            let mut ks: Vec<_> = cases.iter().map(|c| c.kernel).collect();
-            ks.sort_by_key(|k| k.name());
-            ks.dedup_by_key(|k| k.name());
+            let mut ks: Vec<_> = cases.iter().map(|c| c.kernel.clone()).collect();
+            ks.sort_by(|a, b| a.name().cmp(b.name()));
+            ks.dedup_by(|a, b| a.name() == b.name());
             ks
         }
     };

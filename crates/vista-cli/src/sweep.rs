@@ -49,7 +49,7 @@ pub struct Args {
 }
 
 pub fn sweep(project: &Project, config: &vista::Config, a: Args) -> Result<i32, GoldenError> {
-    let kernel = crate::registry(project)?.find(&a.kernel).map_err(bad)?;
+    let kernel = crate::registry(project)?.find(&a.kernel).cloned().map_err(bad)?;
     let (width, height) = vista_kernels::parse_size(&a.size).map_err(bad)?;
     let y = match (a.param2, a.values2) {
         (Some(name), Some(v)) => Some(Axis { name, values: vista_sweep::parse_values("--values2", &v)? }),

@@ -76,7 +76,7 @@ pub fn watch(
                         f.starts_with("golden/")
                             || f == &format!("kernels/{}.toml", c.kernel.name())
                             || f.strip_prefix("shaders/").is_some_and(|rel| {
-                                gpu.kernel_file_hashes(c.kernel).map(|h| h.contains_key(rel)).unwrap_or(true)
+                                gpu.kernel_file_hashes(&c.kernel).map(|h| h.contains_key(rel)).unwrap_or(true)
                             })
                     })
                 })

@@ -137,9 +137,9 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             backend: ctx.backend().to_string(),
             adapter: adapter.clone(),
             params_hash: params_hash(case),
-            shader_hash: ctx.kernel_shader_hash(case.kernel)?,
+            shader_hash: ctx.kernel_shader_hash(&case.kernel)?,
         };
-        let files = ctx.kernel_file_hashes(case.kernel)?;
+        let files = ctx.kernel_file_hashes(&case.kernel)?;
         if r.raw.width == 0 {
             // No main image (a graph whose first output is a buffer).
             let previous = manifest.case.get(&key);

@@ -102,7 +102,7 @@ pub struct Case {
     /// Unique id: the test name and the golden's file stem.
     pub id: String,
     /// The kernel the case renders.
-    pub kernel: &'static vista_kernels::Kernel,
+    pub kernel: std::sync::Arc<vista_kernels::Kernel>,
     /// The kernel preset the case names, if any.
     pub preset: Option<String>,
     /// The case's `set` overrides as (name, value text), in name order.
@@ -254,7 +254,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         }
         out.push(Case {
             id: raw.id,
-            kernel,
+            kernel: kernel.clone(),
             preset: raw.preset,
             overrides,
             params,

@@ -73,8 +73,8 @@ pub const MAIN_OUTPUT: &str = "image";
 /// kernel's image as its one output where it keeps raw goldens or its
 /// alpha; empty for the seed's contract (judged by its PNG alone).
 pub fn outputs_of<'a>(case: &Case, r: &'a Rendered) -> Cow<'a, [OutputRender]> {
-    match r.outputs.is_empty() && (keeps_raw(case.kernel, r.format) || case.kernel.opaque_display()) {
-        true => Cow::Owned(r.main_output(case.kernel, MAIN_OUTPUT).into_iter().collect()),
+    match r.outputs.is_empty() && (keeps_raw(&case.kernel, r.format) || case.kernel.opaque_display()) {
+        true => Cow::Owned(r.main_output(&case.kernel, MAIN_OUTPUT).into_iter().collect()),
         false => Cow::Borrowed(&r.outputs),
     }
 }
@@ -92,7 +92,7 @@ pub fn output_files(golden_dir: &Path, case: &Case, key: &str, index: usize, out
         OutputValue::Buffer { .. } => OutputFiles { npy: Some(at("npy")), ..Default::default() },
         OutputValue::Texture { format, .. } => OutputFiles {
             png: Some(at("png")),
-            exr: (effective_tolerance(out).is_some() || keeps_raw(case.kernel, format)).then(|| at("exr")),
+            exr: (effective_tolerance(out).is_some() || keeps_raw(&case.kernel, format)).then(|| at("exr")),
             npy: None,
             alpha: (index == 0 && case.kernel.opaque_display()).then(|| at("alpha.png")),
         },

@@ -116,7 +116,7 @@ pub fn run_info(ctx: &Renderer, case: &Case) -> RunInfo {
         backend: ctx.backend().to_string(),
         adapter: ctx.adapter_description(),
         params_hash: params_hash(case),
-        shader_hash: ctx.kernel_shader_hash(case.kernel).unwrap_or_else(|e| format!("unavailable: {e}")),
+        shader_hash: ctx.kernel_shader_hash(&case.kernel).unwrap_or_else(|e| format!("unavailable: {e}")),
     }
 }
 
@@ -150,7 +150,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
             true => Some(same_render(&render_case(ctx, case).map_err(|e| e.to_string())?, &r)),
             false => None,
         };
-        let files = ctx.kernel_file_hashes(case.kernel).map_err(|e| e.to_string())?;
+        let files = ctx.kernel_file_hashes(&case.kernel).map_err(|e| e.to_string())?;
         let path = golden_path.clone();
         let golden = match path.exists() {
             false => None,
@@ -272,7 +272,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
 
 /// Renders a case: its kernel, params, size and replacement inputs.
 pub fn render_case(ctx: &Renderer, case: &Case) -> Result<Rendered, vista_render::RenderError> {
-    render_with(ctx, case.kernel, &case.params, &case.inputs, case.width, case.height)
+    render_with(ctx, &case.kernel, &case.params, &case.inputs, case.width, case.height)
 }
 
 /// Whether two renders are bit-identical in every output.

@@ -11,7 +11,7 @@ pub enum Expr {
     /// An integer literal.
     Num(i64),
     /// A param, `width` or `height`.
-    Name(&'static str),
+    Name(String),
     /// `a op b`, op one of `+ - * /` (`+ - *` saturate; `/` is Euclidean
     /// division, an error by zero).
     Bin(char, Box<Expr>, Box<Expr>),
@@ -131,10 +131,10 @@ impl Parser<'_> {
             Some(Tok::Name(n)) => {
                 self.at += 1;
                 match n.as_str() {
-                    "width" => Ok(Expr::Name("width")),
-                    "height" => Ok(Expr::Name("height")),
+                    "width" => Ok(Expr::Name("width".into())),
+                    "height" => Ok(Expr::Name("height".into())),
                     _ => match self.params.iter().find(|p| p.name == n) {
-                        Some(p) if matches!(p.kind, Kind::Int { .. }) => Ok(Expr::Name(p.name)),
+                        Some(p) if matches!(p.kind, Kind::Int { .. }) => Ok(Expr::Name(p.name.clone())),
                         Some(p) => Err(format!("param {n} takes {}, not an integer", p.kind.range_text())),
                         None => Err(format!(
                             "'{n}' is not an integer param, width or height; integer params: {}",
@@ -149,7 +149,7 @@ impl Parser<'_> {
 }
 
 fn names(params: &[ParamSpec]) -> String {
-    let n: Vec<&str> = params.iter().filter(|p| matches!(p.kind, Kind::Int { .. })).map(|p| p.name).collect();
+    let n: Vec<&str> = params.iter().filter(|p| matches!(p.kind, Kind::Int { .. })).map(|p| p.name.as_str()).collect();
     if n.is_empty() { "none".into() } else { n.join(", ") }
 }
 
@@ -167,13 +167,13 @@ impl Expr {
     pub fn mentions(&self, name: &str) -> bool {
         match self {
             Expr::Num(_) => false,
-            Expr::Name(n) => *n == name,
+            Expr::Name(n) => n == name,
             Expr::Bin(_, a, b) | Expr::CeilDiv(a, b) => a.mentions(name) || b.mentions(name),
         }
     }
 
     /// Every param (or size) name the expression reads, added to `out`.
-    pub fn names(&self, out: &mut Vec<&'static str>) {
+    pub fn names<'a>(&'a self, out: &mut Vec<&'a str>) {
         match self {
             Expr::Num(_) => {}
             Expr::Name(n) => out.push(n),
@@ -214,8 +214,8 @@ impl Expr {
     pub fn eval(&self, p: &ParamSet, width: u32, height: u32) -> Result<i64, String> {
         Ok(match self {
             Expr::Num(n) => *n,
-            Expr::Name("width") => width as i64,
-            Expr::Name("height") => height as i64,
+            Expr::Name(n) if n == "width" => width as i64,
+            Expr::Name(n) if n == "height" => height as i64,
             Expr::Name(n) => p.int(n),
             Expr::Bin(op, a, b) => {
                 let (a, b) = (a.eval(p, width, height)?, b.eval(p, width, height)?);

@@ -118,7 +118,7 @@ pub enum Repeat {
     /// A fixed number of runs, in [1, 100000].
     Count(u32),
     /// The value of this integer param.
-    Param(&'static str),
+    Param(String),
 }
 
 /// One `[[pass]]` table.
@@ -136,7 +136,7 @@ pub struct PassSpec {
     /// case size (exclusive with `dispatch`).
     pub workgroups: Option<[Expr; 3]>,
     /// Params overridden for this pass's uniforms: (param, value text).
-    pub set: Vec<(&'static str, String)>,
+    pub set: Vec<(String, String)>,
     /// How many times the pass runs (on a group's first pass: the whole group's runs).
     pub repeat: Repeat,
     /// Resource pairs exchanged after every run of the pass.
@@ -268,7 +268,7 @@ pub(crate) fn parse(
     outputs: &[toml::Value],
     deterministic: Option<bool>,
     default_view: Option<Output>,
-    params: &'static [ParamSpec],
+    params: &[ParamSpec],
     fail: &dyn Fn(String) -> ParamError,
 ) -> Result<GraphSpec, ParamError> {
     let mut res: Vec<ResourceSpec> = Vec::new();
@@ -523,13 +523,13 @@ pub(crate) fn parse(
             None => {}
             Some(toml::Value::Table(s)) => {
                 for (k, v) in s {
-                    let Some(spec) = params.iter().find(|p| p.name == k) else {
-                        let all: Vec<&str> = params.iter().map(|p| p.name).collect();
+                    let Some(spec) = params.iter().find(|p| &p.name == k) else {
+                        let all: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
                         return Err(at(format!("set: {k} is not a param; params: {}", all.join(", "))));
                     };
                     let text = crate::manifest::value_text(v);
                     crate::params::parse_value(spec, &text).map_err(|e| at(format!("set: {e}")))?;
-                    set.push((spec.name, text));
+                    set.push((spec.name.clone(), text));
                 }
             }
             Some(other) => return Err(at(format!("set = {other} is not valid; expected a table of params"))),
@@ -537,9 +537,9 @@ pub(crate) fn parse(
         let repeat = match t.get("repeat") {
             None => Repeat::Count(1),
             Some(toml::Value::Integer(n)) if (1..=100_000).contains(n) => Repeat::Count(*n as u32),
-            Some(toml::Value::String(s)) => match params.iter().find(|p| p.name == s) {
+            Some(toml::Value::String(s)) => match params.iter().find(|p| &p.name == s) {
                 Some(p) if p.ty == crate::params::ParamType::U32 || p.ty == crate::params::ParamType::I32 => {
-                    Repeat::Param(p.name)
+                    Repeat::Param(p.name.clone())
                 }
                 _ => return Err(at(format!("repeat = \"{s}\" must name an integer param"))),
             },
@@ -1198,8 +1198,8 @@ fn leaves_of(
 
 /// Every param a graph consumes outside uniforms and overrides: repeat
 /// counts, sizes, lengths and workgroup expressions.
-pub fn host_params(graph: &GraphSpec) -> Vec<&'static str> {
-    let mut names: Vec<&'static str> = Vec::new();
+pub fn host_params(graph: &GraphSpec) -> Vec<&str> {
+    let mut names: Vec<&str> = Vec::new();
     let mut exprs: Vec<&Expr> = Vec::new();
     for r in &graph.resources {
         match &r.kind {
@@ -1209,7 +1209,7 @@ pub fn host_params(graph: &GraphSpec) -> Vec<&'static str> {
         }
     }
     for p in &graph.passes {
-        if let Repeat::Param(n) = p.repeat {
+        if let Repeat::Param(n) = &p.repeat {
             names.push(n);
         }
         exprs.extend(p.workgroups.iter().flatten());

@@ -417,9 +417,9 @@ pub fn check_params(kernel: &Kernel, layouts: &[&UniformLayout]) -> Result<(), P
     for layout in layouts {
         for spec in kernel.params() {
             if layout.fields.iter().any(|f| f.qualified == spec.name || f.key == spec.name || f.name == spec.name)
-                || layout.overrides.iter().any(|o| o == spec.name)
+                || layout.overrides.contains(&spec.name)
             {
-                fed.push(spec.name);
+                fed.push(&spec.name);
             }
         }
     }
@@ -453,12 +453,12 @@ fn check_names(kernel: &Kernel, layout: &UniformLayout, fed_elsewhere: &[&str], 
                 by_name.iter().map(|f| f.key.as_str()).collect::<Vec<_>>().join(" or ")
             )));
         }
-        let feeds_override = layout.overrides.iter().any(|o| o == spec.name);
+        let feeds_override = layout.overrides.contains(&spec.name);
         if by_key.is_empty()
             && by_name.is_empty()
-            && !host_only(kernel, spec.name)
+            && !host_only(kernel, &spec.name)
             && !feeds_override
-            && !(graph && fed_elsewhere.contains(&spec.name))
+            && !(graph && fed_elsewhere.contains(&spec.name.as_str()))
         {
             return Err(bad(format!(
                 "param {} ({}) has no field in the Params struct of {}; add `{}: {}` to it",
@@ -489,7 +489,7 @@ pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, h
                 let Some(spec) = param_of(kernel, f) else {
                     continue; // padding: stays zero
                 };
-                let name = spec.name;
+                let name = spec.name.as_str();
                 let scalar = |v: f64| match f.ty.scalar {
                     Scalar::F32 => (v as f32).to_le_bytes(),
                     Scalar::U32 => (v as u32).to_le_bytes(),
@@ -501,7 +501,7 @@ pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, h
                     Value::Float(v) => vec![(*v as f32).to_le_bytes()],
                     Value::Bool(b) => vec![(*b as u32).to_le_bytes()],
                     Value::Enum(s) => {
-                        let crate::Kind::Enum(names) = spec.kind else { unreachable!("enum value of an enum param") };
+                        let crate::Kind::Enum(names) = &spec.kind else { unreachable!("enum value of an enum param") };
                         vec![(names.iter().position(|n| n == s).expect("validated enum value") as u32).to_le_bytes()]
                     }
                     Value::Vector(v) => v.iter().map(|c| scalar(*c)).collect(),

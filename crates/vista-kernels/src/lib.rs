@@ -86,7 +86,7 @@ pub mod phase;
 pub mod resources;
 pub mod ridged;
 
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 pub use cpu64::geometry;
 pub use cpu64::{pixel_uv, render_cpu};
@@ -295,11 +295,12 @@ pub fn is_integer_format(format: &str) -> bool {
 }
 
 /// One kernel: its manifest, where it came from, and its CPU reference if
-/// one is registered under its name. Kernels live for the whole process.
+/// one is registered under its name. A registry owns its kernels and
+/// shares them by `Arc`.
 #[derive(Clone)]
 pub struct Kernel {
     manifest: manifest::Manifest,
-    origin: &'static str,
+    origin: String,
     cpu: Option<&'static dyn CpuReference>,
 }
 
@@ -318,37 +319,37 @@ impl Kernel {
     /// the built-in's params, and would find them missing).
     pub fn from_manifest(name: &str, origin: &str, text: &str) -> Result<Kernel, ParamError> {
         let manifest = manifest::parse(name, origin, text)?;
-        let cpu = cpu_reference(manifest.name).filter(|_| same_params_as_builtin(&manifest));
-        Ok(Kernel { cpu, manifest, origin: Box::leak(origin.into()) })
+        let cpu = cpu_reference(&manifest.name).filter(|_| same_params_as_builtin(&manifest));
+        Ok(Kernel { cpu, manifest, origin: origin.to_string() })
     }
 
     /// The kernel's name: the manifest's file stem.
-    pub fn name(&self) -> &'static str {
-        self.manifest.name
+    pub fn name(&self) -> &str {
+        &self.manifest.name
     }
     /// One line for `vista list`.
-    pub fn summary(&self) -> &'static str {
-        self.manifest.summary
+    pub fn summary(&self) -> &str {
+        &self.manifest.summary
     }
     /// The manifest's path (or `<built-in>/kernels/...`).
-    pub fn origin(&self) -> &'static str {
-        self.origin
+    pub fn origin(&self) -> &str {
+        &self.origin
     }
     /// The declared parameters, in manifest order.
-    pub fn params(&self) -> &'static [ParamSpec] {
-        self.manifest.params
+    pub fn params(&self) -> &[ParamSpec] {
+        &self.manifest.params
     }
     /// The named presets, in manifest order.
-    pub fn presets(&self) -> &'static [Preset] {
-        self.manifest.presets
+    pub fn presets(&self) -> &[Preset] {
+        &self.manifest.presets
     }
     /// WGSL file under `shaders/` holding the compute entry point.
-    pub fn shader(&self) -> &'static str {
-        self.manifest.shader
+    pub fn shader(&self) -> &str {
+        &self.manifest.shader
     }
     /// The compute entry point (`[[pass]] entry`, default `main`).
-    pub fn entry(&self) -> &'static str {
-        self.manifest.entry
+    pub fn entry(&self) -> &str {
+        &self.manifest.entry
     }
     /// Whether texels the kernel leaves unwritten are allowed (`[[output]] partial`).
     pub fn partial(&self) -> bool {
@@ -484,8 +485,8 @@ impl Kernel {
     }
 
     /// Settings of the high-quality reference that sweeps compare against.
-    pub fn high_quality(&self) -> &'static [(&'static str, &'static str)] {
-        self.manifest.sweep_reference
+    pub fn high_quality(&self) -> Vec<(&str, &str)> {
+        self.manifest.sweep_reference.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect()
     }
 
     /// Read-only u32 table for binding 2, if the module declares it:
@@ -517,8 +518,8 @@ impl Kernel {
     /// that plane's corner hashes and the shader is composed with
     /// VISTA_HASH_PLANE (lib/noise.wgsl).
     pub fn hash_plane(&self, p: &ParamSet) -> Option<i64> {
-        match self.manifest.hash_plane? {
-            HashPlane::Fixed(z) => Some(z),
+        match self.manifest.hash_plane.as_ref()? {
+            HashPlane::Fixed(z) => Some(*z),
             HashPlane::Param(name) => match p.value(name) {
                 Some(Value::Float(z)) if z.fract() == 0.0 => Some(*z as i64),
                 _ => None,
@@ -593,7 +594,7 @@ impl Kernel {
     }
 
     /// The manifest's `overrides` values, by name.
-    pub fn manifest_overrides(&self) -> &[(&'static str, f64)] {
+    pub fn manifest_overrides(&self) -> &[(String, f64)] {
         &self.manifest.overrides
     }
 
@@ -675,7 +676,7 @@ impl Kernel {
         let bad = |message: String| ParamError::Layout { kernel: self.name().to_string(), message };
         let names: Vec<&str> = module.overrides.iter().filter_map(|(_, o)| o.name.as_deref()).collect();
         for (k, _) in &self.manifest.overrides {
-            if strict && !names.contains(k) {
+            if strict && !names.contains(&k.as_str()) {
                 return Err(bad(format!(
                     "overrides: {k} is not an override of {}; its overrides: {}",
                     self.shader(),
@@ -690,7 +691,7 @@ impl Kernel {
                 Some(Value::Int(v)) => Some(*v as f64),
                 Some(Value::Float(v)) => Some(*v),
                 Some(Value::Bool(b)) => Some(*b as u8 as f64),
-                Some(Value::Enum(v)) => match self.params().iter().find(|s| s.name == name).map(|s| s.kind) {
+                Some(Value::Enum(v)) => match self.params().iter().find(|s| s.name == name).map(|s| &s.kind) {
                     Some(crate::Kind::Enum(names)) => names.iter().position(|n| n == v).map(|i| i as f64),
                     _ => None,
                 },
@@ -778,9 +779,11 @@ fn same_params_as_builtin(m: &manifest::Manifest) -> bool {
 fn builtin_mismatch(m: &manifest::Manifest) -> Option<String> {
     let file = format!("{}.toml", m.name);
     let (_, text) = vista_project::builtin::KERNELS.iter().find(|(rel, _)| *rel == file)?;
-    let builtin = manifest::parse(m.name, "<built-in>", text).ok()?;
-    let sig = |ps: &[ParamSpec]| ps.iter().map(|p| (p.name, p.ty)).collect::<Vec<_>>();
-    let (theirs, ours) = (sig(builtin.params), sig(m.params));
+    let builtin = manifest::parse(&m.name, "<built-in>", text).ok()?;
+    fn sig(ps: &[ParamSpec]) -> Vec<(&str, ParamType)> {
+        ps.iter().map(|p| (p.name.as_str(), p.ty.clone())).collect()
+    }
+    let (theirs, ours) = (sig(&builtin.params), sig(&m.params));
     let mut diffs = Vec::new();
     let missing: Vec<&str> = theirs.iter().filter(|p| !ours.contains(p)).map(|p| p.0).collect();
     let extra: Vec<&str> = ours.iter().filter(|p| !theirs.contains(p)).map(|p| p.0).collect();
@@ -804,7 +807,7 @@ fn builtin_mismatch(m: &manifest::Manifest) -> Option<String> {
 /// broken one gives its error.
 #[derive(Debug, Clone)]
 pub struct Registry {
-    kernels: Vec<&'static Kernel>,
+    kernels: Vec<Arc<Kernel>>,
     broken: Vec<(String, ParamError)>,
 }
 
@@ -818,7 +821,7 @@ impl Registry {
                 continue;
             }
             match Kernel::from_manifest(name, &f.origin, &f.text) {
-                Ok(k) => kernels.push(&*Box::leak(Box::new(k))),
+                Ok(k) => kernels.push(Arc::new(k)),
                 Err(e) => broken.push((name.to_string(), e)),
             }
         }
@@ -852,16 +855,16 @@ impl Registry {
     }
 
     /// Every kernel that parsed, in manifest file order.
-    pub fn kernels(&self) -> &[&'static Kernel] {
+    pub fn kernels(&self) -> &[Arc<Kernel>] {
         &self.kernels
     }
 
     /// Looks a kernel up by name.
-    pub fn find(&self, name: &str) -> Result<&'static Kernel, ParamError> {
+    pub fn find(&self, name: &str) -> Result<&Arc<Kernel>, ParamError> {
         if let Some((_, e)) = self.broken.iter().find(|(n, _)| n == name) {
             return Err(e.clone());
         }
-        self.kernels.iter().copied().find(|k| k.name() == name).ok_or_else(|| ParamError::UnknownKernel {
+        self.kernels.iter().find(|k| k.name() == name).ok_or_else(|| ParamError::UnknownKernel {
             name: name.to_string(),
             valid: self.kernels.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),
         })
@@ -869,12 +872,12 @@ impl Registry {
 }
 
 /// The built-in kernels, in the order `vista list` shows them.
-pub fn registry() -> &'static [&'static Kernel] {
+pub fn registry() -> &'static [Arc<Kernel>] {
     Registry::builtin().kernels()
 }
 
 /// Looks a built-in kernel up by name.
-pub fn find(name: &str) -> Result<&'static Kernel, ParamError> {
+pub fn find(name: &str) -> Result<&'static Arc<Kernel>, ParamError> {
     Registry::builtin().find(name)
 }
 
@@ -908,4 +911,31 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), ParamError> {
     let h: u32 = h.trim().parse().map_err(|_| bad())?;
     check_size(w, h)?;
     Ok((w, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A registry owns its kernels: dropping it frees every kernel and the
+    /// strings its manifest held, so `vista watch`, which re-reads a project's
+    /// manifests on every change, does not grow with each read.
+    #[test]
+    fn a_dropped_registry_frees_its_kernels() {
+        let file = |rel: &str, text: &str| vista_project::SourceFile {
+            rel: rel.into(),
+            text: text.into(),
+            origin: format!("kernels/{rel}"),
+        };
+        let manifest = "summary = \"one param\"\n[[param]]\nname = \"gain\"\ntype = \"f32\"\nrange = [0, 1]\ndefault = 0.5\n";
+        let registry = Registry::from_files(&[file("gain.toml", manifest)]);
+        let kernel = registry.find("gain").expect("parsed");
+        assert_eq!((kernel.params()[0].name.as_str(), kernel.origin()), ("gain", "kernels/gain.toml"));
+        let weak = Arc::downgrade(kernel);
+        let held = registry.find("gain").cloned().expect("parsed");
+        drop(registry);
+        assert!(weak.upgrade().is_some(), "a case's Arc keeps its kernel alive");
+        drop(held);
+        assert!(weak.upgrade().is_none(), "the kernel outlived every owner");
+    }
 }

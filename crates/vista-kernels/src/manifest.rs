@@ -191,37 +191,36 @@ impl ParamGroup {
 #[derive(Debug, Clone, PartialEq)]
 pub struct WorkFactor {
     /// The number params summed into this factor.
-    pub params: Vec<&'static str>,
+    pub params: Vec<String>,
     /// The sum of the factor's constant terms.
     pub constant: f64,
 }
 
 /// Where a kernel's fbm2/ridged2 calls sample z (manifest `hash_plane`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum HashPlane {
     /// At this f32 param's value: a hash plane when it is an integer.
-    Param(&'static str),
+    Param(String),
     /// Always at this integer z (the terrains' height field, z = 0).
     Fixed(i64),
 }
 
-/// A parsed, validated manifest. Strings are leaked: a process loads each
-/// project's manifests once and keeps its kernels for its whole life.
+/// A parsed, validated manifest; it owns everything it holds.
 #[derive(Debug, Clone)]
 pub struct Manifest {
     /// The kernel's name: the manifest's file stem.
-    pub name: &'static str,
+    pub name: String,
     /// One line for `vista list` (`summary`).
-    pub summary: &'static str,
+    pub summary: String,
     /// The WGSL file under `shaders/` (`shader`; default `<name>.wgsl`).
-    pub shader: &'static str,
+    pub shader: String,
     /// The PNG view, where the manifest gives one (else display, or
     /// normalize for an integer format: `Kernel::view`).
     pub output: Option<Output>,
     /// `display_alpha = "opaque"`: display alpha is forced to 1 (the RGB is already composited).
     pub opaque_display: bool,
     /// The compute entry point (`[[pass]] entry`, default `main`).
-    pub entry: &'static str,
+    pub entry: String,
     /// An explicit workgroup count (`[[pass]] workgroups`), else the plan
     /// covers the output with the reflected workgroup size.
     pub workgroups: Option<[crate::expr::Expr; 3]>,
@@ -232,7 +231,7 @@ pub struct Manifest {
     /// The pass's `bind`: WGSL variable name -> resource name.
     pub bind: Vec<(String, String)>,
     /// `[[output]] resource`: a resource's name or the WGSL variable.
-    pub output_resource: Option<&'static str>,
+    pub output_resource: Option<String>,
     /// A pass graph (SPEC 14 part 2), where the manifest has one; then
     /// `entry`, `workgroups`, `resources`, `bind` and `output_resource`
     /// are unused (the first pass's entry is kept for messages).
@@ -246,7 +245,7 @@ pub struct Manifest {
     pub defs: Vec<String>,
     /// Values of `override` constants (`overrides = { BLOCK = 128 }`); a
     /// param of an override's name feeds it too, and wins.
-    pub overrides: Vec<(&'static str, f64)>,
+    pub overrides: Vec<(String, f64)>,
     /// The work estimate per pixel: the product of these factors (`work`).
     pub work: Vec<WorkFactor>,
     /// Inclusive bounds of every raw RGB value (`output_range`); `None`: by the
@@ -257,23 +256,19 @@ pub struct Manifest {
     /// Enum params whose value is a shader def (`NAME_IS_VALUE`, upper case)
     /// rather than only a uniform, so the shader can drop the other cases
     /// at composition.
-    pub specialize: Vec<&'static str>,
+    pub specialize: Vec<String>,
     /// The declared parameters (`[[param]]`), in manifest order.
-    pub params: &'static [ParamSpec],
+    pub params: Vec<ParamSpec>,
     /// Every enum value as a WGSL constant (`PREFIX_VALUE`, its index):
     /// the module `vista::enums` the kernel's WGSL imports them from.
     pub enum_constants: Vec<(String, u32)>,
     /// `[[group]]` tables: params filling a nested struct of the uniform.
     pub groups: Vec<ParamGroup>,
     /// The presets (`[preset.NAME]`), in manifest order.
-    pub presets: &'static [Preset],
+    pub presets: Vec<Preset>,
     /// `[sweep_reference]`: the params (values as text) of the high-quality
     /// reference that sweeps compare against.
-    pub sweep_reference: &'static [(&'static str, &'static str)],
-}
-
-pub(crate) fn leak(s: impl Into<String>) -> &'static str {
-    Box::leak(s.into().into_boxed_str())
+    pub sweep_reference: Vec<(String, String)>,
 }
 
 /// A name as a WGSL constant's part: upper case, any other character `_`
@@ -339,7 +334,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             {
                 return Err(kfail("[[output]] resource must name the kernel's storage texture".into()));
             }
-            (o.view.as_deref().map(view).transpose()?, o.partial, o.resource.map(leak))
+            (o.view.as_deref().map(view).transpose()?, o.partial, o.resource)
         }
         Some(other) => {
             return Err(kfail(format!(
@@ -405,7 +400,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             }
             Ok((r.0 as i64, r.1 as i64))
         };
-        let kind = match ty {
+        let kind = match &ty {
             ParamType::U32 => {
                 let (min, max) = int(range((0.0, u32::MAX as f64))?)?;
                 Kind::Int { min, max }
@@ -420,7 +415,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             }
             ParamType::Vec(n) => {
                 let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
-                Kind::Vector { n: n as usize, min, max }
+                Kind::Vector { n: *n as usize, min, max }
             }
             ParamType::Wgsl(leaf) => match leaf.scalar {
                 crate::params::Scalar::F32 => {
@@ -450,13 +445,13 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
                         return Err(pfail(format!("values: '{v}' is empty or repeated")));
                     }
                 }
-                Kind::Enum(Box::leak(values.iter().map(|v| leak(v.as_str())).collect::<Vec<_>>().into_boxed_slice()))
+                Kind::Enum(values.clone())
             }
         };
         if p.values.is_some() && ty != ParamType::Enum {
             return Err(pfail(format!("values is only for type enum, not {}", p.ty)));
         }
-        if let Kind::Enum(values) = kind {
+        if let Kind::Enum(values) = &kind {
             let prefix = match &p.constants {
                 Some(c)
                     if c.starts_with(|c: char| c.is_ascii_uppercase())
@@ -491,36 +486,28 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         if p.open_min && !matches!(ty, ParamType::F32) {
             return Err(pfail("open_min is only for type f32".into()));
         }
-        let spec = ParamSpec {
-            name: leak(p.name.as_str()),
-            ty,
-            kind,
-            default: leak(value_text(&p.default)),
-            doc: leak(p.doc.as_str()),
-        };
-        parse_value(&spec, spec.default).map_err(|e| pfail(format!("default: {e}")))?;
+        let spec = ParamSpec { name: p.name.clone(), ty, kind, default: value_text(&p.default), doc: p.doc.clone() };
+        parse_value(&spec, &spec.default).map_err(|e| pfail(format!("default: {e}")))?;
         params.push(spec);
     }
-    let params: &'static [ParamSpec] = Box::leak(params.into_boxed_slice());
-    let find = |pname: &str, context: &str| -> Result<&'static ParamSpec, ParamError> {
+    let find = |pname: &str, context: &str| -> Result<&ParamSpec, ParamError> {
         params.iter().find(|s| s.name == pname).ok_or_else(|| {
             kfail(format!(
                 "{context} names unknown param '{pname}'; valid params: {}",
-                params.iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+                params.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
             ))
         })
     };
-    let settings =
-        |table: &toml::Table, context: &str| -> Result<&'static [(&'static str, &'static str)], ParamError> {
-            let mut out = Vec::new();
-            for (k, v) in table {
-                let spec = find(k, context)?;
-                let text = value_text(v);
-                parse_value(spec, &text).map_err(|e| kfail(format!("{context}: {e}")))?;
-                out.push((spec.name, leak(text)));
-            }
-            Ok(Box::leak(out.into_boxed_slice()))
-        };
+    let settings = |table: &toml::Table, context: &str| -> Result<Vec<(String, String)>, ParamError> {
+        let mut out = Vec::new();
+        for (k, v) in table {
+            let spec = find(k, context)?;
+            let text = value_text(v);
+            parse_value(spec, &text).map_err(|e| kfail(format!("{context}: {e}")))?;
+            out.push((spec.name.clone(), text));
+        }
+        Ok(out)
+    };
 
     let mut presets = Vec::new();
     for (pname, table) in &raw.preset {
@@ -533,7 +520,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             Some(other) => return Err(kfail(format!("preset {pname}: doc = {other} must be a string"))),
         };
         let set = settings(&table, &format!("preset {pname}"))?;
-        presets.push(Preset { name: leak(pname.as_str()), doc: leak(doc), set });
+        presets.push(Preset { name: pname.clone(), doc, set });
     }
     let sweep_reference = settings(&raw.sweep_reference, "sweep_reference")?;
 
@@ -549,7 +536,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             if !matches!(spec.kind, Kind::Int { .. } | Kind::Float { .. }) {
                 return Err(kfail(format!("work entry \"{entry}\": '{term}' is not a number param")));
             }
-            factor.params.push(spec.name);
+            factor.params.push(spec.name.clone());
         }
         work.push(factor);
     }
@@ -566,15 +553,17 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let hash_plane = match &raw.hash_plane {
         None => None,
         Some(toml::Value::Integer(z)) => Some(HashPlane::Fixed(*z)),
-        Some(v) => match params.iter().find(|p| v.as_str() == Some(p.name)) {
-            Some(p) if matches!(p.kind, Kind::Float { .. }) => Some(HashPlane::Param(p.name)),
+        Some(v) => match params.iter().find(|p| v.as_str() == Some(p.name.as_str())) {
+            Some(p) if matches!(p.kind, Kind::Float { .. }) => Some(HashPlane::Param(p.name.clone())),
             _ => return Err(kfail(format!("hash_plane = {v} must name an f32 param or be an integer z"))),
         },
     };
-    let mut specialize: Vec<&'static str> = Vec::new();
+    let mut specialize: Vec<String> = Vec::new();
     for n in &raw.specialize {
-        match params.iter().find(|p| p.name == n) {
-            Some(p) if matches!(p.kind, Kind::Enum(_)) && !specialize.contains(&p.name) => specialize.push(p.name),
+        match params.iter().find(|p| &p.name == n) {
+            Some(p) if matches!(p.kind, Kind::Enum(_)) && !specialize.contains(&p.name) => {
+                specialize.push(p.name.clone())
+            }
             Some(p) if matches!(p.kind, Kind::Enum(_)) => {
                 return Err(kfail(format!("specialize lists \"{n}\" twice")));
             }
@@ -588,7 +577,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             &output_tables,
             raw.deterministic,
             output,
-            params,
+            &params,
             &kfail,
         )?),
         false => None,
@@ -607,7 +596,8 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             let mut out = Vec::new();
             for v in list {
                 out.push(
-                    crate::expr::Expr::parse_entry(v, params).map_err(|e| kfail(format!("[[pass]] workgroups {e}")))?,
+                    crate::expr::Expr::parse_entry(v, &params)
+                        .map_err(|e| kfail(format!("[[pass]] workgroups {e}")))?,
                 );
             }
             let [x, y, z]: [crate::expr::Expr; 3] = out.try_into().expect("three entries");
@@ -619,13 +609,13 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     };
     let (resources, bind) = match is_graph {
         true => (Vec::new(), Vec::new()),
-        false => crate::resources::parse(&raw.resources, pass.and_then(|p| p.bind.as_ref()), params, &kfail)?,
+        false => crate::resources::parse(&raw.resources, pass.and_then(|p| p.bind.as_ref()), &params, &kfail)?,
     };
-    if let Some(named) = output_resource
+    if let Some(named) = &output_resource
         && !resources.is_empty()
-        && !resources.iter().any(|r| r.name == named)
+        && !resources.iter().any(|r| &r.name == named)
     {
-        let names: Vec<&str> = resources.iter().map(|r| r.name).collect();
+        let names: Vec<&str> = resources.iter().map(|r| r.name.as_str()).collect();
         return Err(kfail(format!(
             "[[output]] resource = \"{named}\" names no resource; resources: {}",
             names.join(", ")
@@ -658,7 +648,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
                 return Err(kfail(format!("overrides: {k} = {other} is not valid; expected a number or a bool")));
             }
         };
-        overrides.push((leak(k.as_str()), value));
+        overrides.push((k.clone(), value));
     }
     let mut groups: Vec<ParamGroup> = Vec::new();
     for g in &raw.groups {
@@ -691,12 +681,12 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     }
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
-        name: leak(name),
-        summary: leak(raw.summary),
-        shader: leak(shader),
+        name: name.to_string(),
+        summary: raw.summary,
+        shader,
         output,
         opaque_display,
-        entry: leak(entry),
+        entry,
         workgroups,
         partial,
         resources,
@@ -713,7 +703,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         params,
         enum_constants,
         groups,
-        presets: Box::leak(presets.into_boxed_slice()),
+        presets,
         sweep_reference,
     })
 }

@@ -12,7 +12,7 @@ use std::fmt;
 use crate::ParamError;
 
 /// The kind of a parameter and its allowed range (inclusive unless noted).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Kind {
     /// A real number in `[min, max]`, or `(min, max]` when `open_min`.
     Float {
@@ -49,7 +49,7 @@ pub enum Kind {
         max: i64,
     },
     /// One name out of a fixed list.
-    Enum(&'static [&'static str]),
+    Enum(Vec<String>),
     /// true | false (also 1 | 0).
     Bool,
 }
@@ -79,7 +79,7 @@ impl Scalar {
 /// A uniform leaf spelled as WGSL spells it: `vec2<u32>`, `mat4x4<f32>`,
 /// `array<vec4<f32>, 4>`: its scalar, its number of components, and its
 /// normalised WGSL name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Leaf {
     /// The scalar of every component.
     pub scalar: Scalar,
@@ -87,7 +87,7 @@ pub struct Leaf {
     /// `array<vec4<f32>, 4>`).
     pub count: usize,
     /// The normalised WGSL type name, e.g. `vec2<u32>`.
-    pub name: &'static str,
+    pub name: String,
 }
 
 /// Parses a WGSL type a uniform leaf may have: a scalar, `vecN<T>` (or
@@ -133,7 +133,7 @@ pub fn wgsl_leaf(text: &str) -> Option<(Scalar, usize, String)> {
 }
 
 /// The manifest's `type`: what the WGSL `Params` field must be.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum ParamType {
     /// WGSL `u32`.
     U32,
@@ -171,7 +171,7 @@ impl ParamType {
                     (Scalar::U32, 1, "u32") => ParamType::U32,
                     (Scalar::I32, 1, "i32") => ParamType::I32,
                     (Scalar::F32, n, v) if v.starts_with("vec") => ParamType::Vec(n as u8),
-                    _ => ParamType::Wgsl(Leaf { scalar, count, name: Box::leak(name.into_boxed_str()) }),
+                    _ => ParamType::Wgsl(Leaf { scalar, count, name }),
                 }
             }
         })
@@ -184,12 +184,12 @@ impl ParamType {
             ParamType::I32 => "i32".into(),
             ParamType::F32 => "f32".into(),
             ParamType::Vec(n) => format!("vec{n}<f32>"),
-            ParamType::Wgsl(l) => l.name.into(),
+            ParamType::Wgsl(l) => l.name.clone(),
         }
     }
 
     /// The manifest's name of this type.
-    pub fn name(&self) -> &'static str {
+    pub fn name(&self) -> &str {
         match self {
             ParamType::U32 => "u32",
             ParamType::I32 => "i32",
@@ -199,7 +199,7 @@ impl ParamType {
             ParamType::Vec(3) => "vec3",
             ParamType::Vec(_) => "vec4",
             ParamType::Enum => "enum",
-            ParamType::Wgsl(l) => l.name,
+            ParamType::Wgsl(l) => &l.name,
         }
     }
 }
@@ -231,37 +231,37 @@ impl Kind {
             Kind::IntVector { n, min, max } => {
                 format!("{n} comma-separated integers each in [{min}, {max}]")
             }
-            Kind::Enum(names) => format!("one of {}", names.join("|")),
+            Kind::Enum(ref names) => format!("one of {}", names.join("|")),
             Kind::Bool => "true|false".into(),
         }
     }
 }
 
 /// One declared parameter.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct ParamSpec {
     /// The parameter's name (`--set NAME=VALUE`); it also names the uniform
     /// leaf (bare or as `variable.path`) or `override` it feeds, if any.
-    pub name: &'static str,
+    pub name: String,
     /// The manifest's `type`: what the WGSL field it feeds must be.
     pub ty: ParamType,
     /// What values it takes, with their allowed range.
     pub kind: Kind,
     /// The default value as text (validated when the manifest is parsed).
-    pub default: &'static str,
+    pub default: String,
     /// One line for `vista list`.
-    pub doc: &'static str,
+    pub doc: String,
 }
 
 /// A named set of overrides on top of the defaults.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Preset {
     /// The preset's name (`--preset`).
-    pub name: &'static str,
+    pub name: String,
     /// One line saying what the preset is for.
-    pub doc: &'static str,
+    pub doc: String,
     /// `(param, value)` pairs as text, applied over the defaults.
-    pub set: &'static [(&'static str, &'static str)],
+    pub set: Vec<(String, String)>,
 }
 
 /// A parsed, validated parameter value.
@@ -274,7 +274,7 @@ pub enum Value {
     /// The components of a [`Kind::Vector`] or [`Kind::IntVector`] (integers held as f64).
     Vector(Vec<f64>),
     /// The chosen name out of a [`Kind::Enum`] list.
-    Enum(&'static str),
+    Enum(String),
     /// A [`Kind::Bool`] value.
     Bool(bool),
 }
@@ -337,10 +337,10 @@ pub fn parse_value(spec: &ParamSpec, text: &str) -> Result<Value, ParamError> {
                 false => Err(out_of_range()),
             }
         }
-        Kind::Enum(names) => names
+        Kind::Enum(ref names) => names
             .iter()
             .find(|n| n.eq_ignore_ascii_case(t))
-            .map(|n| Value::Enum(n))
+            .map(|n| Value::Enum(n.clone()))
             .ok_or_else(|| bad(spec.kind.range_text())),
         Kind::Bool => match t {
             "true" | "1" => Ok(Value::Bool(true)),
@@ -353,34 +353,34 @@ pub fn parse_value(spec: &ParamSpec, text: &str) -> Result<Value, ParamError> {
 /// A complete, validated assignment of every parameter of one kernel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParamSet {
-    kernel: &'static str,
-    values: BTreeMap<&'static str, Value>,
+    kernel: String,
+    values: BTreeMap<String, Value>,
 }
 
 impl ParamSet {
     /// Defaults, then the preset's overrides, then `overrides` (later wins).
     pub fn resolve(
-        kernel: &'static str,
-        specs: &'static [ParamSpec],
-        presets: &'static [Preset],
+        kernel: &str,
+        specs: &[ParamSpec],
+        presets: &[Preset],
         preset: Option<&str>,
         overrides: &[(String, String)],
     ) -> Result<ParamSet, ParamError> {
-        let mut set = ParamSet { kernel, values: BTreeMap::new() };
+        let mut set = ParamSet { kernel: kernel.to_string(), values: BTreeMap::new() };
         for spec in specs {
             // Manifests are validated when parsed, defaults included.
-            let v = parse_value(spec, spec.default)
+            let v = parse_value(spec, &spec.default)
                 .unwrap_or_else(|e| panic!("kernel {kernel}: default of {} is invalid: {e}", spec.name));
-            set.values.insert(spec.name, v);
+            set.values.insert(spec.name.clone(), v);
         }
         // `default` always resolves: to the declared preset of that name, else the defaults.
         if let Some(name) = preset.filter(|n| *n != "default" || presets.iter().any(|p| p.name == *n)) {
             let p = presets.iter().find(|p| p.name == name).ok_or_else(|| ParamError::UnknownPreset {
                 kernel: kernel.to_string(),
                 name: name.to_string(),
-                valid: presets.iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
+                valid: presets.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", "),
             })?;
-            for (k, v) in p.set {
+            for (k, v) in &p.set {
                 set.apply(specs, k, v)?;
             }
         }
@@ -390,19 +390,19 @@ impl ParamSet {
         Ok(set)
     }
 
-    fn apply(&mut self, specs: &'static [ParamSpec], name: &str, text: &str) -> Result<(), ParamError> {
+    fn apply(&mut self, specs: &[ParamSpec], name: &str, text: &str) -> Result<(), ParamError> {
         let spec = specs.iter().find(|s| s.name == name).ok_or_else(|| ParamError::UnknownParam {
             kernel: self.kernel.to_string(),
             name: name.to_string(),
-            valid: specs.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
+            valid: specs.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "),
         })?;
-        self.values.insert(spec.name, parse_value(spec, text)?);
+        self.values.insert(spec.name.clone(), parse_value(spec, text)?);
         Ok(())
     }
 
     /// The name of the kernel these values belong to.
-    pub fn kernel(&self) -> &'static str {
-        self.kernel
+    pub fn kernel(&self) -> &str {
+        &self.kernel
     }
 
     fn get(&self, name: &str) -> &Value {
@@ -462,7 +462,7 @@ impl ParamSet {
     ///
     /// # Panics
     /// If the kernel has no such param or it is not an enum.
-    pub fn choice(&self, name: &str) -> &'static str {
+    pub fn choice(&self, name: &str) -> &str {
         match self.get(name) {
             Value::Enum(s) => s,
             v => panic!("{}.{name} is {v:?}, not an enum", self.kernel),
@@ -506,7 +506,7 @@ impl ParamSet {
     }
 
     /// Sets one value by text (validated), for sweeps and tests.
-    pub fn with(mut self, specs: &'static [ParamSpec], name: &str, text: &str) -> Result<ParamSet, ParamError> {
+    pub fn with(mut self, specs: &[ParamSpec], name: &str, text: &str) -> Result<ParamSet, ParamError> {
         self.apply(specs, name, text)?;
         Ok(self)
     }
@@ -518,7 +518,7 @@ impl ParamSet {
     }
 
     /// Every `(name, value)` pair, sorted by name.
-    pub fn iter(&self) -> impl Iterator<Item = (&'static str, &Value)> {
-        self.values.iter().map(|(k, v)| (*k, v))
+    pub fn iter(&self) -> impl Iterator<Item = (&str, &Value)> {
+        self.values.iter().map(|(k, v)| (k.as_str(), v))
     }
 }

@@ -76,7 +76,7 @@ pub struct Storage {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TextureResource {
     /// The resource's name, which `bind` refers to.
-    pub name: &'static str,
+    pub name: String,
     /// Its format, if given (it must match the binding's).
     pub format: Option<&'static str>,
     /// Its dimension, if given (it must match the binding's).
@@ -200,7 +200,7 @@ pub(crate) fn parse(
             }
             Some(other) => return Err(at(format!("size = {other} is not valid; expected a list"))),
         };
-        out.push(TextureResource { name: crate::manifest::leak(name.as_str()), format, dimension, size });
+        out.push(TextureResource { name: name.clone(), format, dimension, size });
     }
     let mut binds = Vec::new();
     for (var, res) in bind.into_iter().flatten() {
@@ -208,7 +208,7 @@ pub(crate) fn parse(
             return Err(fail(format!("[[pass]] bind: {var} = {res} is not valid; expected a resource name")));
         };
         if !out.iter().any(|r| r.name == res) {
-            let names: Vec<&str> = out.iter().map(|r| r.name).collect();
+            let names: Vec<&str> = out.iter().map(|r| r.name.as_str()).collect();
             return Err(fail(format!(
                 "[[pass]] bind: {var} = \"{res}\" names no resource; resources: {}",
                 if names.is_empty() { "none ([[resource]] tables declare them)".into() } else { names.join(", ") }
@@ -229,7 +229,7 @@ pub(crate) fn resolve(
     module: &naga::Module,
 ) -> Result<Target, ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.name.to_string(), message };
-    let entry = kernel.entry;
+    let entry = kernel.entry.as_str();
     let describe = |b: &Binding| {
         format!(
             "{} (@group({}) @binding({}), {})",
@@ -248,7 +248,7 @@ pub(crate) fn resolve(
                 reached.join(", ")
             )));
         };
-        let r = kernel.resources.iter().find(|r| r.name == res).expect("manifest checks bind targets");
+        let r = kernel.resources.iter().find(|r| &r.name == res).expect("manifest checks bind targets");
         let Feed::Output(storage) = b.feed else {
             return Err(bad(format!(
                 "pass {entry}: resource {res} (a texture) is bound to {}, which a texture cannot feed; it needs {}",
@@ -292,7 +292,7 @@ pub(crate) fn resolve(
         resource = Some(r.clone());
     }
     let (out, storage) = crate::bindings::output(bindings);
-    if let Some(named) = kernel.output_resource {
+    if let Some(named) = kernel.output_resource.as_deref() {
         let fits = resource.as_ref().map(|r| r.name == named).unwrap_or(named == out.name);
         if !fits {
             return Err(bad(format!(
@@ -320,7 +320,7 @@ impl Target {
                 kernel: kernel.to_string(),
                 message: format!(
                     "resource {} size[{i}] {m}",
-                    self.resource.as_ref().map(|r| r.name).unwrap_or_default()
+                    self.resource.as_ref().map(|r| r.name.as_str()).unwrap_or_default()
                 ),
             };
             let n = e.eval(p, width, height).map_err(&fail)?;

@@ -226,7 +226,7 @@ fn params_are_validated() {
     let p = resolve(None, &[]).unwrap();
     assert_eq!(AtmosphereKernel.work_per_pixel(&p), 32.0 * 9.0);
     // high_quality() settings are valid values.
-    let hq: Vec<(&str, &str)> = AtmosphereKernel.high_quality().to_vec();
+    let hq: Vec<(&str, &str)> = AtmosphereKernel.high_quality();
     resolve(None, &hq).unwrap();
 }
 

@@ -175,12 +175,12 @@ fn bad_parameters_are_rejected_with_the_value_and_range() {
 
 #[test]
 fn presets_are_valid_and_state_their_altitudes() {
-    let names: Vec<&str> = CloudsKernel.presets().iter().map(|p| p.name).collect();
+    let names: Vec<&str> = CloudsKernel.presets().iter().map(|p| p.name.as_str()).collect();
     for g in GENERA.iter().chain(&["clear"]) {
         assert!(names.contains(g), "missing preset {g}");
     }
     for preset in CloudsKernel.presets() {
-        let p = params(preset.name, &[]);
+        let p = params(&preset.name, &[]);
         if preset.name != "clear" {
             let (base, top) = (p.f64("cloud_base_km"), p.f64("cloud_top_km"));
             assert!(
@@ -219,7 +219,7 @@ fn work_estimate_and_high_quality() {
     let p = params("cumulus", &[]);
     let wpp = CloudsKernel.work_per_pixel(&p);
     assert_eq!(wpp, 64.0 * 13.0 * p.f64("octaves"));
-    let hq = CloudsKernel.high_quality();
+    let hq: Vec<(&str, &str)> = CloudsKernel.high_quality();
     assert!(hq.contains(&("steps", "512")) && hq.contains(&("light_steps", "32")), "{hq:?}");
 }
 
@@ -239,7 +239,7 @@ fn output_stays_within_the_declared_bounds() {
 }
 
 fn hq(preset: &str, set: &[(&str, &str)]) -> ParamSet {
-    let mut all: Vec<(&str, &str)> = CloudsKernel.high_quality().to_vec();
+    let mut all: Vec<(&str, &str)> = CloudsKernel.high_quality();
     all.extend_from_slice(set);
     params(preset, &all)
 }

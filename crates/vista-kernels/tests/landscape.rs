@@ -40,7 +40,7 @@ fn clouds_seen_by(landscape: &ParamSet) -> ParamSet {
     let mut set: Vec<(String, String)> = Vec::new();
     for spec in clouds.params() {
         // The leaf this clouds param feeds, if it feeds one of the group's.
-        let leaf = spec.name.strip_prefix(cg.prefix.as_str()).unwrap_or(spec.name);
+        let leaf = spec.name.strip_prefix(cg.prefix.as_str()).unwrap_or(&spec.name);
         let leaf = cg.rename.iter().find(|(_, n)| n == leaf).map_or(leaf, |(l, _)| l.as_str());
         let fed_by = |n: &str| clouds.params().iter().any(|s| s.name == n);
         if cg.param(leaf, fed_by) != spec.name {

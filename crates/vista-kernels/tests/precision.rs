@@ -21,7 +21,7 @@ fn f32_build_matches_the_f64_oracle_on_every_preset() {
         let field =
             k.output() == Output::Display && k.shader_algorithm_f32(&k.resolve(None, &[]).unwrap(), 1, 1).is_none();
         for preset in k.presets() {
-            let p = k.resolve(Some(preset.name), &[]).expect("presets are valid");
+            let p = k.resolve(Some(&preset.name), &[]).expect("presets are valid");
             let (r64, r32) = (k.reference(&p, w, h), k.reference_f32(&p, w, h));
             let nonfinite = r32.nonfinite_count();
             let max_abs = vista_image::metrics::max_abs(&r64, &r32);

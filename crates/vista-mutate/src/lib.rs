@@ -17,8 +17,8 @@
 #![deny(missing_docs)]
 
 use std::collections::BTreeMap;
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 use rand::seq::SliceRandom;
 use rand_pcg::Pcg32;
@@ -256,7 +256,7 @@ pub fn parse_partition(text: &str) -> Result<(usize, usize), String> {
 #[derive(Debug, Clone)]
 pub struct Planned {
     /// Whose suite runs it.
-    pub kernel: &'static Kernel,
+    pub kernel: Arc<Kernel>,
     /// The change.
     pub mutant: Mutant,
 }
@@ -270,11 +270,11 @@ pub struct Planned {
 pub fn plan(
     files: &[SourceFile],
     shaders: &ShaderSet,
-    kernels: &[&'static Kernel],
+    kernels: &[Arc<Kernel>],
     opts: &Options,
 ) -> Result<Vec<Planned>, GoldenError> {
     let mut kernels = kernels.to_vec();
-    kernels.sort_by_key(|k| k.name());
+    kernels.sort_by(|a, b| a.name().cmp(b.name()));
     let mut all = Vec::new();
     for k in kernels {
         // Every file any pass reaches, and every pass's entry point as a root.
@@ -321,7 +321,7 @@ pub fn plan(
         if let Some(n) = opts.sample {
             list.truncate(n);
         }
-        all.extend(list.into_iter().map(|mutant| Planned { kernel: k, mutant }));
+        all.extend(list.into_iter().map(|mutant| Planned { kernel: k.clone(), mutant }));
     }
     let (k, n) = opts.partition;
     Ok(all.into_iter().enumerate().filter(|(i, _)| i % n == k - 1).map(|(_, p)| p).collect())
@@ -415,7 +415,7 @@ fn judge_case(
 ) -> vista_golden::Outcome {
     let actual = vista_render::quantize16(r.display());
     let run = vista_golden::run_info(gpu, b.case);
-    let files = gpu.kernel_file_hashes(b.case.kernel).unwrap_or_default();
+    let files = gpu.kernel_file_hashes(&b.case.kernel).unwrap_or_default();
     let path = std::path::PathBuf::from(b.case.golden_rel_path());
     let entry = manifest.case.get(&b.case.id);
     let threshold = match entry.is_none_or(|e| e.adapter == run.adapter) {
@@ -531,7 +531,7 @@ pub fn run(
     let mut baselines = BTreeMap::new();
     for p in planned {
         if !baselines.contains_key(p.kernel.name()) {
-            baselines.insert(p.kernel.name(), baseline(&original, store, &manifest, p.kernel, cases)?);
+            baselines.insert(p.kernel.name(), baseline(&original, store, &manifest, &p.kernel, cases)?);
         }
     }
     let results: Mutex<Vec<Option<MutantReport>>> = Mutex::new(vec![None; planned.len()]);
@@ -545,7 +545,7 @@ pub fn run(
                     let Some(p) = planned.get(i) else { break };
                     let gpu =
                         Renderer { ctx, shaders: set(Some(&p.mutant)), limits, root: project.root().map(Into::into) };
-                    let r = judge(&gpu, &manifest, p.kernel, &baselines[p.kernel.name()], &p.mutant);
+                    let r = judge(&gpu, &manifest, &p.kernel, &baselines[p.kernel.name()], &p.mutant);
                     results.lock().expect("results")[i] = Some(r);
                     progress(done.fetch_add(1, Ordering::SeqCst) + 1, planned.len());
                 }

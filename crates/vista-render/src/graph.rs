@@ -360,8 +360,8 @@ pub fn plan_graph(
                 wg
             }
         };
-        let repeat = match pass.repeat {
-            vista_kernels::graph::Repeat::Count(n) => n,
+        let repeat = match &pass.repeat {
+            vista_kernels::graph::Repeat::Count(n) => *n,
             vista_kernels::graph::Repeat::Param(name) => {
                 let n = pp.int(name);
                 u32::try_from(n)

@@ -18,6 +18,7 @@ mod plot;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use vista_image::metrics::{self, Metrics};
 use vista_kernels::{Kernel, Kind, ParamSet};
@@ -65,7 +66,7 @@ pub struct Axis {
     pub values: Vec<String>,
 }
 
-fn kernel_name<S: serde::Serializer>(k: &&'static Kernel, s: S) -> Result<S::Ok, S::Error> {
+fn kernel_name<S: serde::Serializer>(k: &Arc<Kernel>, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(k.name())
 }
 
@@ -77,7 +78,7 @@ pub type SweepPoint = (String, Option<String>, ParamSet);
 pub struct SweepSpec {
     /// The kernel swept.
     #[serde(serialize_with = "kernel_name")]
-    pub kernel: &'static Kernel,
+    pub kernel: Arc<Kernel>,
     /// The preset every point and the reference start from; the kernel's
     /// defaults when `None`.
     pub preset: Option<String>,
@@ -157,14 +158,14 @@ impl SweepSpec {
     /// any GPU work: unknown names and out-of-range values fail here, and so
     /// does a sweep whose total work is past the per-dispatch cap.
     pub fn resolve(&self, limits: &vista_render::RenderLimits) -> Result<(ParamSet, Vec<SweepPoint>), RenderError> {
-        let k = self.kernel;
+        let k = &self.kernel;
         for axis in std::iter::once(&self.x).chain(&self.y) {
             let spec = k.params().iter().find(|s| s.name == axis.name).ok_or_else(|| {
                 bad(format!(
                     "{} has no parameter '{}'; valid: {}",
                     k.name(),
                     axis.name,
-                    k.params().iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+                    k.params().iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
                 ))
             })?;
             if !matches!(spec.kind, Kind::Float { .. } | Kind::Int { .. }) {
@@ -216,7 +217,7 @@ pub fn run(
     mut progress: impl FnMut(usize, usize, &str),
 ) -> Result<Sweep, RenderError> {
     let (reference_params, points) = spec.resolve(&ctx.limits)?;
-    let (k, w, h) = (spec.kernel, spec.width, spec.height);
+    let (k, w, h) = (&spec.kernel, spec.width, spec.height);
     let total = points.len() + 1;
     progress(0, total, "reference");
     // Warm-up: pipeline compilation is not part of any timing.

@@ -59,8 +59,10 @@ fn ensure_font(configured: Option<&Path>) -> Result<(), PlotError> {
                 .to_string()
         })?;
         let bytes = std::fs::read(&path).map_err(|e| format!("cannot read font {}: {e}", path.display()))?;
-        // plotters keeps fonts for the whole process and wants 'static bytes.
-        let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+        // plotters keeps fonts for the whole process and wants 'static
+        // bytes: a static holds them (read once, as DONE runs once).
+        static BYTES: OnceLock<Vec<u8>> = OnceLock::new();
+        let bytes: &'static [u8] = BYTES.get_or_init(|| bytes);
         plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
             .map_err(|_| format!("{} is not a usable TrueType font (VISTA_FONT)", path.display()))
     })

@@ -10,7 +10,7 @@ fn point(x: &str, y: Option<&str>, psnr: f64, gpu_ms: f64, work: f64) -> Point {
 
 fn sweep(y: Option<Axis>, points: Vec<Point>) -> Sweep {
     let spec = SweepSpec {
-        kernel: vista_kernels::find("clouds").unwrap(),
+        kernel: vista_kernels::find("clouds").unwrap().clone(),
         preset: Some("cumulus".into()),
         base: vec![],
         x: Axis { name: "steps".into(), values: vec!["16".into(), "32".into(), "64".into()] },
