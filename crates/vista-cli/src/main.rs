@@ -150,6 +150,11 @@ enum Command {
         /// only cases that do not pass get it: about 1 MB per 256x256 case).
         #[arg(long)]
         full_report: bool,
+        /// Cases checked at once: while one case runs on the device, others
+        /// are planned, judged and written to the report (1..=64). Under the
+        /// validation layer one at a time, so each message names its case.
+        #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=64))]
+        jobs: u16,
     },
     /// Re-render cases and write their goldens (refused under CI=true without --force).
     Bless {
@@ -506,9 +511,10 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             partition,
             allow_orphans,
             full_report,
+            jobs,
         } => {
             let partition = partition.as_deref().map(vista_golden::selection::parse_partition).transpose()?;
-            let pick = Pick { glob: case, changed, failed, partition, allow_orphans };
+            let pick = Pick { glob: case, changed, failed, partition, allow_orphans, jobs: jobs as usize };
             let viewers = if full_report { vista_report::Detail::All } else { vista_report::Detail::Failing };
             check(project, config, &pick, report_dir, Results { junit, json }, viewers)
         }
@@ -691,6 +697,8 @@ struct Pick {
     partition: Option<(u64, u64)>,
     /// Orphaned goldens warn instead of failing.
     allow_orphans: bool,
+    /// Cases checked at once (`--jobs`).
+    jobs: usize,
 }
 
 /// Machine-readable results a check also writes.
@@ -762,50 +770,80 @@ fn check(
     let mut outcomes = Vec::new();
     let mut pending = std::collections::BTreeMap::new();
     let mut time = Phases::start(ctx);
-    for case in picked {
-        let started = std::time::Instant::now();
-        let mut checked = vista_golden::check_case(ctx, &store, &manifest, case, &opts);
-        time.cases += started.elapsed();
-        let entry = checked.pending.take();
-        let started = std::time::Instant::now();
-        let o = vista_report::file_case(&report_dir, checked, viewers);
-        time.report += started.elapsed();
-        time.gpu += std::time::Duration::from_secs_f64(o.gpu_ms / 1000.0);
-        // A failing or missing case's render, as bless --from-report may take it.
-        if let Some(mut entry) = entry
-            && matches!(o.verdict, vista_golden::Verdict::Fail | vista_golden::Verdict::Missing)
-        {
-            // A graph whose first output is a buffer has no main PNG.
-            let png = match o.files.actual {
-                Some(_) => std::fs::read(vista_golden::pending::pending_png(&report_dir, &o.id))
-                    .ok()
-                    .map(|bytes| vista_golden::short_hash_bytes(&bytes)),
-                None => Some(String::new()),
-            };
-            if let Some(hash) = png {
-                entry.golden_hash = hash;
-                pending.insert(o.id.clone(), entry);
+    // The validation layer's messages are collected process-wide: one case
+    // at a time, so each is attributed to the dispatch that caused it.
+    let jobs = if ctx.validating() { 1 } else { pick.jobs.clamp(1, picked.len().max(1)) };
+    time.jobs = jobs;
+    // `jobs` workers take cases in order; the device serialises their GPU
+    // runs (vista-gpu's submit lock) while the others plan, judge and write
+    // their case's report folder. Outcomes are taken in case order.
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs {
+            let (tx, next, picked, store, manifest, report_dir, opts) =
+                (tx.clone(), &next, &picked, &store, &manifest, &report_dir, &opts);
+            scope.spawn(move || {
+                loop {
+                    let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let Some(case) = picked.get(i) else { break };
+                    let started = std::time::Instant::now();
+                    let mut checked = vista_golden::check_case(ctx, store, manifest, case, opts);
+                    let case_time = started.elapsed();
+                    let entry = checked.pending.take();
+                    let started = std::time::Instant::now();
+                    let o = vista_report::file_case(report_dir, checked, viewers);
+                    if tx.send((i, o, entry, case_time, started.elapsed())).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(tx);
+        let mut waiting = std::collections::BTreeMap::new();
+        for (i, o, entry, case_time, report_time) in rx {
+            time.cases += case_time;
+            time.report += report_time;
+            waiting.insert(i, (o, entry));
+            while let Some((o, entry)) = waiting.remove(&outcomes.len()) {
+                time.gpu += std::time::Duration::from_secs_f64(o.gpu_ms / 1000.0);
+                // A failing or missing case's render, as bless --from-report may take it.
+                if let Some(mut entry) = entry
+                    && matches!(o.verdict, vista_golden::Verdict::Fail | vista_golden::Verdict::Missing)
+                {
+                    // A graph whose first output is a buffer has no main PNG.
+                    let png = match o.files.actual {
+                        Some(_) => std::fs::read(vista_golden::pending::pending_png(&report_dir, &o.id))
+                            .ok()
+                            .map(|bytes| vista_golden::short_hash_bytes(&bytes)),
+                        None => Some(String::new()),
+                    };
+                    if let Some(hash) = png {
+                        entry.golden_hash = hash;
+                        pending.insert(o.id.clone(), entry);
+                    }
+                }
+                let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
+                let label = match o.verdict {
+                    vista_golden::Verdict::Pass => "ok",
+                    vista_golden::Verdict::ExpectedFail => "xfail",
+                    _ => "FAIL",
+                };
+                // A per-backend golden is named on the case's line.
+                let per_backend = match o.golden_file.rsplit_once('@') {
+                    Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
+                    None => String::new(),
+                };
+                println!("{label:<6} {:<40} PSNR {:<12} {:>8.1} ms{per_backend}", o.id, psnr, o.gpu_ms);
+                if !o.passed() {
+                    print!("{}", o.explain(&report_dir));
+                } else if o.verdict == vista_golden::Verdict::ExpectedFail {
+                    o.notes.iter().for_each(|n| println!("  note: {n}"));
+                }
+                outcomes.push(o);
             }
         }
-        let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
-        let label = match o.verdict {
-            vista_golden::Verdict::Pass => "ok",
-            vista_golden::Verdict::ExpectedFail => "xfail",
-            _ => "FAIL",
-        };
-        // A per-backend golden is named on the case's line.
-        let per_backend = match o.golden_file.rsplit_once('@') {
-            Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
-            None => String::new(),
-        };
-        println!("{label:<6} {:<40} PSNR {:<12} {:>8.1} ms{per_backend}", o.id, psnr, o.gpu_ms);
-        if !o.passed() {
-            print!("{}", o.explain(&report_dir));
-        } else if o.verdict == vista_golden::Verdict::ExpectedFail {
-            o.notes.iter().for_each(|n| println!("  note: {n}"));
-        }
-        outcomes.push(o);
-    }
+    });
     let run = vista_report::RunSummary {
         command: command_line(),
         backend: ctx.backend().to_string(),
@@ -882,6 +920,8 @@ struct Phases {
     cases: std::time::Duration,
     gpu: std::time::Duration,
     report: std::time::Duration,
+    /// Cases checked at once: the phases then add up to more than the wall time.
+    jobs: usize,
 }
 
 impl Phases {
@@ -892,6 +932,7 @@ impl Phases {
             cases: Default::default(),
             gpu: Default::default(),
             report: Default::default(),
+            jobs: 1,
         }
     }
 
@@ -903,6 +944,20 @@ impl Phases {
         let rest = (self.cases.as_secs_f64() - compile - gpu).max(0.0);
         let report = self.report.as_secs_f64();
         let share = |t: f64| format!("{t:.2} s ({:.0}%)", 100.0 * t / total.max(1e-9));
+        // With cases checked at once the other phases overlap the GPU runs
+        // (and include waiting for the device), so only their sums are given.
+        if self.jobs > 1 {
+            return format!(
+                "time: {total:.2} s for {cases} case{}, {} at once: GPU runs {}; the rest of the wall time {:.2} s \
+                 ({:.0}%); summed over the workers: compiling {compile:.2} s, report {report:.2} s{}",
+                if cases == 1 { "" } else { "s" },
+                self.jobs,
+                share(gpu),
+                (total - gpu).max(0.0),
+                100.0 * (total - gpu).max(0.0) / total.max(1e-9),
+                if ctx.backend() == "browser" { " (the browser compiles inside its runs)" } else { "" }
+            );
+        }
         format!(
             "time: {total:.2} s for {cases} case{}: compiling {}, GPU runs {}, planning and judging {}, report {}{}",
             if cases == 1 { "" } else { "s" },

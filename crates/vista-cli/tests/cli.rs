@@ -1712,6 +1712,42 @@ fn check_selects_changed_failed_and_partitions() {
     assert_rejected(&check(&["--failed"]), 2, &["results.json", "run vista check once first"]);
 }
 
+/// `--jobs`: cases checked at once print, judge and report exactly as one
+/// at a time: the same lines in case order, the same verdicts and metrics in
+/// results.json, the same exit code (one case failing, one missing).
+fn check_jobs_change_nothing_but_the_time() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let cases = CASES.replace("set = { basis = \"value\" }", "set = { basis = \"value\", seed = 9 }");
+    std::fs::write(cases_path(d.path()), cases).unwrap();
+    std::fs::remove_file(d.path().join("golden/ridged/c.png")).unwrap();
+    let run = |jobs: &str| {
+        let r = vista_in(Some(d.path()), &[], &["check", "--jobs", jobs]);
+        let lines: Vec<String> = r
+            .stdout
+            .lines()
+            .filter(|l| ["ok ", "FAIL ", "xfail "].iter().any(|p| l.starts_with(p)))
+            // The case's GPU milliseconds, last on its line, differ run to run.
+            .map(|l| l.rsplit_once("  ").map_or(l, |(head, _)| head).trim_end().to_string())
+            .collect();
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(report(d.path()).join("results.json")).unwrap()).unwrap();
+        let verdicts: Vec<String> = json["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| format!("{} {} {}", c["id"], c["verdict"], c["metrics"]["psnr"]))
+            .collect();
+        (r.code, lines, verdicts, r.stdout)
+    };
+    let (one, many) = (run("1"), run("3"));
+    assert_eq!(one.0, 1, "{}", one.3);
+    assert_eq!(one.1.len(), 3, "{}", one.3);
+    assert_eq!((&one.0, &one.1, &one.2), (&many.0, &many.1, &many.2), "{}\n{}", one.3, many.3);
+    assert!(many.3.contains("for 3 cases, 3 at once"), "{}", many.3);
+    assert_rejected(&vista_in(Some(d.path()), &[], &["check", "--jobs", "0"]), 2, &["--jobs", "1..=64"]);
+}
+
 /// Goldens from CI's own output: a check in one clone keeps its failing and
 /// missing renders with pending.toml; another clone with the same sources
 /// accepts exactly those files (no render) and then checks clean; after an
@@ -3948,6 +3984,7 @@ fn main() {
         Cpu adapter_is_a_hidden_alias_of_backend,
         Cpu readme_schemas_match_the_parsers,
         Gpu check_selects_changed_failed_and_partitions,
+        Gpu check_jobs_change_nothing_but_the_time,
         Gpu orphans_lfs_pointers_and_bad_pixel_budgets,
         Gpu a_read_write_run_does_not_hide_the_next_runs_unwritten_texels,
         Gpu float_outputs_keep_raw_values_beside_their_view,

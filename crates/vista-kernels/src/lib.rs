@@ -927,7 +927,8 @@ mod tests {
             text: text.into(),
             origin: format!("kernels/{rel}"),
         };
-        let manifest = "summary = \"one param\"\n[[param]]\nname = \"gain\"\ntype = \"f32\"\nrange = [0, 1]\ndefault = 0.5\n";
+        let manifest =
+            "summary = \"one param\"\n[[param]]\nname = \"gain\"\ntype = \"f32\"\nrange = [0, 1]\ndefault = 0.5\n";
         let registry = Registry::from_files(&[file("gain.toml", manifest)]);
         let kernel = registry.find("gain").expect("parsed");
         assert_eq!((kernel.params()[0].name.as_str(), kernel.origin()), ("gain", "kernels/gain.toml"));
