@@ -34,15 +34,15 @@ demo: lavapipe build
 # reported skipped, never ok.
 test: lavapipe swiftshader validation browser
 	mkdir -p target
-	set -o pipefail; CARGO=$(CARGO) bash ci/test-parallel.sh 2>&1 | tee target/test.log
+	# The workspace's test binaries and three more runs of the golden harness,
+	# two at a time: every golden case again on SwiftShader (other-driver
+	# thresholds, expectations from golden/cases.toml), in headless Chromium's
+	# WebGPU (naga's WGSL through Tint and Dawn), and under the Khronos
+	# validation layer (any message fails the case). Each writes its own report.
+	set -o pipefail; CARGO=$(CARGO) PASSES=$$'VISTA_BACKEND=swiftshader\nVISTA_BACKEND=browser\nVISTA_VALIDATION=1' \
+		bash ci/test-parallel.sh 2>&1 | tee target/test.log
 	@echo "---- examples/harness-crate: another crate's cargo test running its golden cases through vista::harness::main()"
 	set -o pipefail; CARGO=$(CARGO) bash ci/harness-example.sh 2>&1 | tee -a target/test.log
-	@echo "---- every golden case again on SwiftShader (other-driver thresholds, expectations from golden/cases.toml)"
-	set -o pipefail; VISTA_BACKEND=swiftshader $(CARGO) test --test golden 2>&1 | tee -a target/test.log
-	@echo "---- every golden case again in headless Chromium's WebGPU (naga's WGSL through Tint and Dawn)"
-	set -o pipefail; VISTA_BACKEND=browser $(CARGO) test --test golden 2>&1 | tee -a target/test.log
-	@echo "---- every golden case under the Khronos validation layer (VISTA_VALIDATION=1): any message fails the case"
-	set -o pipefail; VISTA_VALIDATION=1 $(CARGO) test --test golden 2>&1 | tee -a target/test.log
 	bash ci/test-summary.sh target/test.log
 	bash ci/no-gpu-skips.sh
 

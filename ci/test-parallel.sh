@@ -28,13 +28,29 @@ if [ -n "${EXCLUDE:-}" ]; then
     mv "$logs/list.kept" "$logs/list"
 fi
 [ -s "$logs/list" ] || { echo "test-parallel: no test binaries found" >&2; exit 1; }
+# PASSES: "NAME=VALUE ..." environments, each one more run of the golden
+# harness (tests/golden.rs) in the same pool, e.g. every case on SwiftShader.
+# Each is printed as its own binary, after the workspace's ones.
+if [ -n "${PASSES:-}" ]; then
+    golden=$(grep ' [^ ]*/tests/golden.rs ' "$logs/list" | head -n 1)
+    [ -n "$golden" ] || { echo "test-parallel: PASSES needs tests/golden.rs" >&2; exit 1; }
+    while IFS= read -r pass; do
+        [ -n "$pass" ] && echo "$golden env:${pass// /,}" >>"$logs/list"
+    done <<<"$PASSES"
+fi
+# Longest first, so that the last one to start is short (the order of the
+# printed output stays cargo's): the CLI suite and the golden runs.
+awk '{ long = ($2 ~ /\/tests\/(cli|golden)\.rs$/) ? 0 : 1; print long "\t" NR "\t" $0 }' "$logs/list" |
+    sort -k1,1n -k2,2n | cut -f2- >"$logs/order"
 
-run_one() { # index package-dir source executable args...
-    local i=$1 dir=$2 src=$3 exe=$4
-    shift 4
+run_one() { # index package-dir source executable env args...
+    local i=$1 dir=$2 src=$3 exe=$4 envs=$5
+    shift 5
+    local vars=()
+    [ -n "$envs" ] && IFS=, read -r -a vars <<<"${envs#env:}"
     {
-        echo "     Running ${src#"$dir"/} (${exe#"$root"/})"
-        (cd "$dir" && "$exe" "$@") 2>&1
+        echo "     Running ${src#"$dir"/} (${exe#"$root"/})${envs:+ with ${vars[*]}}"
+        (cd "$dir" && env "${vars[@]}" "$exe" "$@") 2>&1
         echo "exit $?" >"$logs/rc.$i"
     } >"$logs/out.$i" 2>&1
 }
@@ -42,11 +58,10 @@ export -f run_one
 export logs root
 
 n=$(wc -l <"$logs/list")
-i=0
-while read -r dir src exe; do
-    printf '%s\0%s\0%s\0%s\0' "$i" "$dir" "$src" "$exe"
-    i=$((i + 1))
-done <"$logs/list" | xargs -0 -n 4 -P "$jobs" bash -c 'run_one "$@" '"$(printf '%q ' "$@")" _
+while IFS=$'\t' read -r i line; do
+    read -r dir src exe envs <<<"$line"
+    printf '%s\0%s\0%s\0%s\0%s\0' "$((i - 1))" "$dir" "$src" "$exe" "${envs:-}"
+done <"$logs/order" | xargs -0 -n 5 -P "$jobs" bash -c 'run_one "$@" '"$(printf '%q ' "$@")" _
 
 failed=0
 for ((i = 0; i < n; i++)); do

@@ -25,7 +25,9 @@
 //! so libtest's arguments work as in any `cargo test` (a filter, `--exact`,
 //! `--list`, `--ignored`, `--skip`) and nextest lists and partitions them.
 //! After the run the report is written (`target/vista-report/` of the
-//! project, `target/vista-report-<backend>/` for another `VISTA_BACKEND`).
+//! project, `target/vista-report-<backend>/` for another `VISTA_BACKEND`,
+//! `target/vista-report-<backend>-validation/` under `VISTA_VALIDATION=1`),
+//! so runs side by side do not clear each other's case folders.
 //! Without an adapter every case fails naming the install command, unless
 //! `VISTA_ALLOW_NO_GPU=1`: then each is reported ignored and a loud line
 //! names them.
@@ -81,11 +83,13 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
     let cases = store.load_cases().unwrap_or_else(|e| fail(&format!("cannot load golden cases: {e}")));
     let manifest = Arc::new(store.manifest().unwrap_or_else(|e| fail(&format!("cannot load the manifest: {e}"))));
     let root = project.root().expect("a store has a root");
-    // One report per implementation (VISTA_BACKEND), so runs do not overwrite each other.
+    // One report per implementation (VISTA_BACKEND) and for the validation
+    // layer, so runs (side by side in `make test`) do not overwrite each other.
     let backend = config.gpu.adapter.backend_name();
-    let report_dir = match backend {
-        "lavapipe" => project.report_dir().expect("a root"),
-        b => root.join(format!("target/vista-report-{b}")),
+    let report_dir = match (backend, config.gpu.validate) {
+        ("lavapipe", false) => project.report_dir().expect("a root"),
+        (b, false) => root.join(format!("target/vista-report-{b}")),
+        (b, true) => root.join(format!("target/vista-report-{b}-validation")),
     };
     let outcomes = Arc::new(Mutex::new(Vec::new()));
     // Listing needs no device (nextest lists before it runs). One renderer

@@ -948,12 +948,12 @@ impl Phases {
         // (and include waiting for the device), so only their sums are given.
         if self.jobs > 1 {
             return format!(
-                "time: {total:.2} s for {cases} case{}, {} at once: GPU runs {}; the rest of the wall time {:.2} s \
-                 ({:.0}%); summed over the workers: compiling {compile:.2} s, report {report:.2} s{}",
+                "time: {total:.2} s for {cases} case{}, {} at once: GPU runs {}, the rest of the wall time {:.0}%; \
+                 summed over the workers: compiling {compile:.2} s, planning and judging {rest:.2} s (waiting for the \
+                 device included), report {report:.2} s{}",
                 if cases == 1 { "" } else { "s" },
                 self.jobs,
                 share(gpu),
-                (total - gpu).max(0.0),
                 100.0 * (total - gpu).max(0.0) / total.max(1e-9),
                 if ctx.backend() == "browser" { " (the browser compiles inside its runs)" } else { "" }
             );

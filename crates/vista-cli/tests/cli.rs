@@ -895,8 +895,13 @@ fn a_copied_binary_checks_the_checkout_it_runs_in() {
         there.stdout
     );
     assert!(there.stdout.contains(&clone.join("target/vista-report").display().to_string()), "{}", there.stdout);
-    let here = run_in(&bin, &repo(), &[], &case);
+    // In this checkout the report goes elsewhere: its target/vista-report
+    // is the golden suite's, which may be running beside this test.
+    let report_here = t.path().join("report-here");
+    let case_here = [&case[..], &["--report-dir", report_here.to_str().unwrap()]].concat();
+    let here = run_in(&bin, &repo(), &[], &case_here);
     assert_eq!(here.code, 0, "the original must pass: {}{}", here.stdout, here.stderr);
+    assert!(report_here.join("index.html").exists(), "{}", here.stdout);
 
     let golden_rel = "golden/fbm/fbm-perlin-default.png";
     let original = std::fs::read(repo().join(golden_rel)).unwrap();
@@ -913,7 +918,7 @@ fn a_copied_binary_checks_the_checkout_it_runs_in() {
         &["--root", clone.to_str().unwrap(), "check", "--case", "fbm-perlin-default"],
     );
     assert_eq!(by_flag.code, 0, "{}{}", by_flag.stdout, by_flag.stderr);
-    let by_env = run_in(&bin, outside.path(), &[("VISTA_ROOT", repo().to_str().unwrap())], &case);
+    let by_env = run_in(&bin, outside.path(), &[("VISTA_ROOT", repo().to_str().unwrap())], &case_here);
     assert_eq!(by_env.code, 0, "{}{}", by_env.stdout, by_env.stderr);
 }
 
