@@ -4,17 +4,29 @@
 # all of its tests ignored and none passed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+root=$(pwd)
 suites=(golden agreement atmosphere clouds cloudmap heightfield landscape mutate noise reliability backends)
-args=()
-for s in "${suites[@]}"; do args+=(--test "$s"); done
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
+# The test executables `cargo test --workspace` built (make test's), run
+# directly: `cargo test -p ...` or one package's `--test` would resolve
+# features for fewer packages and rebuild vista's crates (a minute in CI).
+built=$(${CARGO:-cargo} test --workspace --no-run --message-format=json 2>/dev/null |
+    grep -E '"profile":\{[^}]*"test":true' | grep '"executable":"/')
+run_suite() { # package-dir suite
+    local exe
+    exe=$(echo "$built" | grep -F "\"src_path\":\"$1/tests/$2.rs\"" | sed -E 's/.*"executable":"([^"]*)".*/\1/' | head -n 1)
+    [ -n "$exe" ] || { echo "no-gpu-skips: no test executable for $1/tests/$2.rs"; exit 1; }
+    (cd "$1" && "$exe")
+}
 # No Vulkan driver and no Chromium: every backend is missing.
 export VISTA_CHROMIUM=/nonexistent/chromium
-VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json VISTA_ALLOW_NO_GPU=1 \
-    ${CARGO:-cargo} test -q "${args[@]}" >"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: the suites failed without an adapter"; exit 1; }
+for s in "${suites[@]}"; do
+    VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json VISTA_ALLOW_NO_GPU=1 \
+        run_suite "$root" "$s" >>"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: suite $s failed without an adapter"; exit 1; }
+done
 # The browser crate's own suite needs only Chromium.
-VISTA_ALLOW_NO_GPU=1 ${CARGO:-cargo} test -q -p vista-browser --test run >>"$log" 2>&1 \
+VISTA_ALLOW_NO_GPU=1 run_suite "$root/crates/vista-browser" run >>"$log" 2>&1 \
     || { cat "$log"; echo "no-gpu-skips: the browser suite failed without Chromium"; exit 1; }
 suites+=(vista-browser/run)
 results=$(grep -E '^test result:' "$log")
@@ -40,7 +52,7 @@ echo "no-gpu-skips: without an adapter all $skipped GPU tests of ${#suites[@]} s
 # The CLI suite mixes both: its rendering tests must be ignored, its
 # bad-input tests (which stop before any GPU work) must still pass.
 VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json VISTA_ALLOW_NO_GPU=1 \
-    ${CARGO:-cargo} test -q -p vista-cli --test cli >"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: the CLI suite failed without an adapter"; exit 1; }
+    run_suite "$root/crates/vista-cli" cli >"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: the CLI suite failed without an adapter"; exit 1; }
 cli=$(grep -E '^test result:' "$log")
 if ! echo "$cli" | grep -qE ' [1-9][0-9]* passed; 0 failed; [1-9][0-9]* ignored'; then
     echo "$cli"; echo "no-gpu-skips: the CLI suite did not both run its bad-input tests and ignore its rendering ones"; exit 1

@@ -959,6 +959,41 @@ fn builtin_kernels_render_outside_any_project_from_the_embedded_sources() {
     }
 }
 
+/// `make test` builds `examples/harness-crate` in vista's target directory:
+/// it reuses vista's dependencies only while its profiles are vista's (a
+/// proc macro at another opt-level rebuilt naga, wgpu and the rest, about
+/// 4 minutes of a clean CI run). Its `[profile.dev]` and every package
+/// override must be vista's, and each of vista's library crates, a
+/// dependency there, gets vista's `[profile.dev]`.
+fn the_harness_example_builds_with_vistas_profiles() {
+    let read =
+        |rel: &str| -> toml::Table { toml::from_str(&std::fs::read_to_string(repo().join(rel)).unwrap()).unwrap() };
+    let (root, example) = (read("Cargo.toml"), read("examples/harness-crate/Cargo.toml"));
+    let dev = |t: &toml::Table| t["profile"]["dev"].as_table().unwrap().clone();
+    let (ours, theirs) = (dev(&root), dev(&example));
+    let settings = |t: &toml::Table| -> toml::Table {
+        t.iter().filter(|(k, _)| *k != "package").map(|(k, v)| (k.clone(), v.clone())).collect()
+    };
+    assert_eq!(settings(&ours), settings(&theirs), "[profile.dev]");
+    let mut want = ours["package"].as_table().unwrap().clone();
+    let members: Vec<String> = std::fs::read_dir(repo().join("crates"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n != "vista-cli")
+        .chain(["vista".to_string()])
+        .collect();
+    for m in &members {
+        want.insert(m.clone(), toml::Value::Table(settings(&ours)));
+    }
+    let got = theirs["package"].as_table().unwrap().clone();
+    for (name, v) in &want {
+        assert_eq!(got.get(name), Some(v), "examples/harness-crate/Cargo.toml: [profile.dev.package.{name}]");
+    }
+    let extra: Vec<&String> = got.keys().filter(|k| !want.contains_key(*k)).collect();
+    assert!(extra.is_empty(), "examples/harness-crate/Cargo.toml overrides what vista does not: {extra:?}");
+}
+
 /// No library or binary source finds files through build-time paths
 /// (`CARGO_MANIFEST_DIR`, `env!`, `option_env!`) or the old per-directory
 /// variables; only test code and benches may name the checkout.
@@ -4040,6 +4075,7 @@ fn main() {
         Cpu check_and_bless_without_a_project_name_what_was_looked_for_and_where,
         Gpu builtin_kernels_render_outside_any_project_from_the_embedded_sources,
         Cpu no_build_time_paths_in_non_test_code,
+        Cpu the_harness_example_builds_with_vistas_profiles,
         Gpu a_kernel_described_as_data_renders,
         Cpu params_field_without_a_param_is_refused,
         Cpu param_without_a_params_field_is_refused,
