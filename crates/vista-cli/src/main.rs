@@ -774,76 +774,60 @@ fn check(
     // at a time, so each is attributed to the dispatch that caused it.
     let jobs = if ctx.validating() { 1 } else { pick.jobs.clamp(1, picked.len().max(1)) };
     time.jobs = jobs;
-    // `jobs` workers take cases in order; the device serialises their GPU
-    // runs (vista-gpu's submit lock) while the others plan, judge and write
-    // their case's report folder. Outcomes are taken in case order.
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let (tx, rx) = std::sync::mpsc::channel();
-    std::thread::scope(|scope| {
-        for _ in 0..jobs {
-            let (tx, next, picked, store, manifest, report_dir, opts) =
-                (tx.clone(), &next, &picked, &store, &manifest, &report_dir, &opts);
-            scope.spawn(move || {
-                loop {
-                    let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    let Some(case) = picked.get(i) else { break };
-                    let started = std::time::Instant::now();
-                    let mut checked = vista_golden::check_case(ctx, store, manifest, case, opts);
-                    let case_time = started.elapsed();
-                    let entry = checked.pending.take();
-                    let started = std::time::Instant::now();
-                    let o = vista_report::file_case(report_dir, checked, viewers);
-                    if tx.send((i, o, entry, case_time, started.elapsed())).is_err() {
-                        break;
-                    }
-                }
-            });
-        }
-        drop(tx);
-        let mut waiting = std::collections::BTreeMap::new();
-        for (i, o, entry, case_time, report_time) in rx {
+    // Outcomes come back in case order; the device serialises the workers'
+    // GPU runs while the others plan, judge and write their report folder.
+    vista_golden::in_order(
+        &picked,
+        jobs,
+        |case| {
+            let started = std::time::Instant::now();
+            let mut checked = vista_golden::check_case(ctx, &store, &manifest, case, &opts);
+            let case_time = started.elapsed();
+            let entry = checked.pending.take();
+            let started = std::time::Instant::now();
+            let o = vista_report::file_case(&report_dir, checked, viewers);
+            (o, entry, case_time, started.elapsed())
+        },
+        |_, (o, entry, case_time, report_time)| {
             time.cases += case_time;
             time.report += report_time;
-            waiting.insert(i, (o, entry));
-            while let Some((o, entry)) = waiting.remove(&outcomes.len()) {
-                time.gpu += std::time::Duration::from_secs_f64(o.gpu_ms / 1000.0);
-                // A failing or missing case's render, as bless --from-report may take it.
-                if let Some(mut entry) = entry
-                    && matches!(o.verdict, vista_golden::Verdict::Fail | vista_golden::Verdict::Missing)
-                {
-                    // A graph whose first output is a buffer has no main PNG.
-                    let png = match o.files.actual {
-                        Some(_) => std::fs::read(vista_golden::pending::pending_png(&report_dir, &o.id))
-                            .ok()
-                            .map(|bytes| vista_golden::short_hash_bytes(&bytes)),
-                        None => Some(String::new()),
-                    };
-                    if let Some(hash) = png {
-                        entry.golden_hash = hash;
-                        pending.insert(o.id.clone(), entry);
-                    }
-                }
-                let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
-                let label = match o.verdict {
-                    vista_golden::Verdict::Pass => "ok",
-                    vista_golden::Verdict::ExpectedFail => "xfail",
-                    _ => "FAIL",
+            time.gpu += std::time::Duration::from_secs_f64(o.gpu_ms / 1000.0);
+            // A failing or missing case's render, as bless --from-report may take it.
+            if let Some(mut entry) = entry
+                && matches!(o.verdict, vista_golden::Verdict::Fail | vista_golden::Verdict::Missing)
+            {
+                // A graph whose first output is a buffer has no main PNG.
+                let png = match o.files.actual {
+                    Some(_) => std::fs::read(vista_golden::pending::pending_png(&report_dir, &o.id))
+                        .ok()
+                        .map(|bytes| vista_golden::short_hash_bytes(&bytes)),
+                    None => Some(String::new()),
                 };
-                // A per-backend golden is named on the case's line.
-                let per_backend = match o.golden_file.rsplit_once('@') {
-                    Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
-                    None => String::new(),
-                };
-                println!("{label:<6} {:<40} PSNR {:<12} {:>8.1} ms{per_backend}", o.id, psnr, o.gpu_ms);
-                if !o.passed() {
-                    print!("{}", o.explain(&report_dir));
-                } else if o.verdict == vista_golden::Verdict::ExpectedFail {
-                    o.notes.iter().for_each(|n| println!("  note: {n}"));
+                if let Some(hash) = png {
+                    entry.golden_hash = hash;
+                    pending.insert(o.id.clone(), entry);
                 }
-                outcomes.push(o);
             }
-        }
-    });
+            let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
+            let label = match o.verdict {
+                vista_golden::Verdict::Pass => "ok",
+                vista_golden::Verdict::ExpectedFail => "xfail",
+                _ => "FAIL",
+            };
+            // A per-backend golden is named on the case's line.
+            let per_backend = match o.golden_file.rsplit_once('@') {
+                Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
+                None => String::new(),
+            };
+            println!("{label:<6} {:<40} PSNR {:<12} {:>8.1} ms{per_backend}", o.id, psnr, o.gpu_ms);
+            if !o.passed() {
+                print!("{}", o.explain(&report_dir));
+            } else if o.verdict == vista_golden::Verdict::ExpectedFail {
+                o.notes.iter().for_each(|n| println!("  note: {n}"));
+            }
+            outcomes.push(o);
+        },
+    );
     let run = vista_report::RunSummary {
         command: command_line(),
         backend: ctx.backend().to_string(),

@@ -25,7 +25,7 @@ pub use check::{
     BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, changed_files, first_out_of_range, guards, judge,
     unwritten_problem,
 };
-pub use run::{CheckOptions, Checked, check_case, run_info};
+pub use run::{CheckOptions, Checked, check_case, in_order, run_info};
 pub use store::{Manifest, ManifestEntry, Store, params_hash};
 
 use vista_gpu::GpuError;

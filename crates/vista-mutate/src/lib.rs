@@ -17,8 +17,7 @@
 #![deny(missing_docs)]
 
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use rand::seq::SliceRandom;
 use rand_pcg::Pcg32;
@@ -534,25 +533,20 @@ pub fn run(
             baselines.insert(p.kernel.name(), baseline(&original, store, &manifest, &p.kernel, cases)?);
         }
     }
-    let results: Mutex<Vec<Option<MutantReport>>> = Mutex::new(vec![None; planned.len()]);
-    let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
-    std::thread::scope(|s| {
-        for _ in 0..jobs.max(1) {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::SeqCst);
-                    let Some(p) = planned.get(i) else { break };
-                    let gpu =
-                        Renderer { ctx, shaders: set(Some(&p.mutant)), limits, root: project.root().map(Into::into) };
-                    let r = judge(&gpu, &manifest, &p.kernel, &baselines[p.kernel.name()], &p.mutant);
-                    results.lock().expect("results")[i] = Some(r);
-                    progress(done.fetch_add(1, Ordering::SeqCst) + 1, planned.len());
-                }
-            });
-        }
-    });
-    Ok(results.into_inner().expect("results").into_iter().map(|r| r.expect("every mutant ran")).collect())
+    let mut results = Vec::with_capacity(planned.len());
+    vista_golden::in_order(
+        planned,
+        jobs,
+        |p| {
+            let gpu = Renderer { ctx, shaders: set(Some(&p.mutant)), limits, root: project.root().map(Into::into) };
+            judge(&gpu, &manifest, &p.kernel, &baselines[p.kernel.name()], &p.mutant)
+        },
+        |i, r| {
+            results.push(r);
+            progress(i + 1, planned.len());
+        },
+    );
+    Ok(results)
 }
 
 #[cfg(test)]
