@@ -28,18 +28,19 @@ demo: lavapipe build
 
 # The whole suite (what .ci/run calls): `cargo test --workspace`, two test
 # binaries at a time (ci/test-parallel.sh; JOBS=1 for one at a time): unit
-# tests, CPU references, invariants, and every golden case on lavapipe; every golden case again on
-# SwiftShader, in headless Chromium's WebGPU and under the validation layer;
-# then a closing count, and proof that without an adapter the GPU tests are
+# tests, CPU references, invariants, and every golden case on lavapipe
+# under the validation layer; every golden case again on SwiftShader and in
+# headless Chromium's WebGPU; then a closing count, and proof that without an adapter the GPU tests are
 # reported skipped, never ok.
 test: lavapipe swiftshader validation browser
 	mkdir -p target
-	# The workspace's test binaries and three more runs of the golden harness,
-	# two at a time: every golden case again on SwiftShader (other-driver
-	# thresholds, expectations from golden/cases.toml), in headless Chromium's
-	# WebGPU (naga's WGSL through Tint and Dawn), and under the Khronos
-	# validation layer (any message fails the case). Each writes its own report.
-	set -o pipefail; CARGO=$(CARGO) PASSES=$$'VISTA_BACKEND=swiftshader\nVISTA_BACKEND=browser\nVISTA_VALIDATION=1' \
+	# The workspace's test binaries, two at a time, its golden harness on
+	# lavapipe under the Khronos validation layer (any message fails the
+	# case), and two more runs of the golden harness: every golden case again
+	# on SwiftShader (other-driver thresholds, expectations from
+	# golden/cases.toml) and in headless Chromium's WebGPU (naga's WGSL
+	# through Tint and Dawn). Each writes its own report.
+	set -o pipefail; CARGO=$(CARGO) GOLDEN_ENV=VISTA_VALIDATION=1 PASSES=$$'VISTA_BACKEND=swiftshader\nVISTA_BACKEND=browser' \
 		bash ci/test-parallel.sh 2>&1 | tee target/test.log
 	@echo "---- examples/harness-crate: another crate's cargo test running its golden cases through vista::harness::main()"
 	set -o pipefail; CARGO=$(CARGO) bash ci/harness-example.sh 2>&1 | tee -a target/test.log

@@ -21,9 +21,14 @@ run_suite() { # package-dir suite
 }
 # No Vulkan driver and no Chromium: every backend is missing.
 export VISTA_CHROMIUM=/nonexistent/chromium
+# The golden harness runs as make test ran it, under the validation layer,
+# so that it targets the report make test wrote (checked below).
 for s in "${suites[@]}"; do
+    validation=0
+    [ "$s" = golden ] && validation=1
     VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json VISTA_ALLOW_NO_GPU=1 \
-        run_suite "$root" "$s" >>"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: suite $s failed without an adapter"; exit 1; }
+        VISTA_VALIDATION=$validation run_suite "$root" "$s" >>"$log" 2>&1 \
+        || { cat "$log"; echo "no-gpu-skips: suite $s failed without an adapter"; exit 1; }
 done
 # The browser crate's own suite needs only Chromium.
 VISTA_ALLOW_NO_GPU=1 run_suite "$root/crates/vista-browser" run >>"$log" 2>&1 \
@@ -38,7 +43,7 @@ if echo "$results" | grep -vqE ' 0 passed; 0 failed; [1-9][0-9]* ignored'; then
     echo "$results"; echo "no-gpu-skips: a GPU test passed or failed without an adapter instead of being ignored"; exit 1
 fi
 # The skip run must leave the last real report whole: every file it links exists.
-report=target/vista-report
+report=target/vista-report-lavapipe-validation
 if [ -f "$report/index.html" ]; then
     broken=$(grep -oE '(src|href|data-src)="[^"#:]+\.(png|js)"' "$report/index.html" | sed -E 's/^[a-z-]+="//; s/"$//' |
         while read -r f; do [ -f "$report/$f" ] || echo "$f"; done | head -3)

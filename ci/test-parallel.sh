@@ -31,12 +31,21 @@ fi
 # PASSES: "NAME=VALUE ..." environments, each one more run of the golden
 # harness (tests/golden.rs) in the same pool, e.g. every case on SwiftShader.
 # Each is printed as its own binary, after the workspace's ones.
+# GOLDEN_ENV: "NAME=VALUE ..." for the workspace's own golden run, e.g.
+# VISTA_VALIDATION=1, so that one run covers lavapipe and the validation
+# layer instead of two runs of the same cases on the same driver.
+golden=$(grep ' [^ ]*/tests/golden.rs ' "$logs/list" | head -n 1)
+if [ -n "${PASSES:-}${GOLDEN_ENV:-}" ] && [ -z "$golden" ]; then
+    echo "test-parallel: PASSES and GOLDEN_ENV need tests/golden.rs" >&2; exit 1
+fi
 if [ -n "${PASSES:-}" ]; then
-    golden=$(grep ' [^ ]*/tests/golden.rs ' "$logs/list" | head -n 1)
-    [ -n "$golden" ] || { echo "test-parallel: PASSES needs tests/golden.rs" >&2; exit 1; }
     while IFS= read -r pass; do
         [ -n "$pass" ] && echo "$golden env:${pass// /,}" >>"$logs/list"
     done <<<"$PASSES"
+fi
+if [ -n "${GOLDEN_ENV:-}" ]; then
+    awk -v g="$golden" -v e="env:${GOLDEN_ENV// /,}" '$0 == g { $0 = $0 " " e } { print }' "$logs/list" >"$logs/list.env"
+    mv "$logs/list.env" "$logs/list"
 fi
 # Longest first, so that the last one to start is short (the order of the
 # printed output stays cargo's): the CLI suite and the golden runs.
