@@ -30,8 +30,8 @@ demo: lavapipe build
 # binaries at a time (ci/test-parallel.sh; JOBS=1 for one at a time): unit
 # tests, CPU references, invariants, and every golden case on lavapipe
 # under the validation layer; every golden case again on SwiftShader and in
-# headless Chromium's WebGPU; then a closing count, and proof that without an adapter the GPU tests are
-# reported skipped, never ok.
+# headless Chromium's WebGPU; then a closing count, and proof that without
+# an adapter the GPU tests are reported skipped, never ok.
 test: lavapipe swiftshader validation browser
 	mkdir -p target
 	# The workspace's test binaries, two at a time, its golden harness on
