@@ -22,6 +22,17 @@ fn vista(args: &[&str]) -> Run {
     vista_in(None, &[], args)
 }
 
+/// `check --matrix` ran every one of `cases` on every backend, in one
+/// process: each backend's column must pass every case.
+fn assert_matrix_passes(matrix: &Run, cases: usize) {
+    assert!(
+        matrix.code == 0 && matrix.stdout.contains(&format!("{cases} cases x 3 backends, 0 failed")),
+        "{}{}",
+        matrix.stdout,
+        matrix.stderr
+    );
+}
+
 /// A bad input: exit `code`, one `error:` line containing every `needle`, no panic.
 fn assert_rejected(r: &Run, code: i32, needles: &[&str]) {
     assert_eq!(r.code, code, "exit code; stderr: {}", r.stderr);
@@ -3164,15 +3175,7 @@ fn the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu() {
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
     let cases = std::fs::read_to_string(root.join("golden/cases.toml")).unwrap().matches("[[case]]").count();
     assert!(cases >= 6, "{cases} cases");
-    // Every case on every backend, in one process (`--matrix`): each
-    // backend's column must pass every case.
-    let matrix = run(&["check", "--matrix"]);
-    assert!(
-        matrix.code == 0 && matrix.stdout.contains(&format!("{cases} cases x 3 backends, 0 failed")),
-        "{}{}",
-        matrix.stdout,
-        matrix.stderr
-    );
+    assert_matrix_passes(&run(&["check", "--matrix"]), cases);
     // Exclusive prefix sum: exactly the CPU's.
     let r = run(&["render", "scan", "-o", "scan.npy"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -3695,15 +3698,7 @@ fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
     std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
     copy_tree(&repo().join("examples/real-kernels"), &root);
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
-    // Every case on every backend, in one process (`--matrix`): each
-    // backend's column must pass every case.
-    let matrix = run(&["check", "--matrix"]);
-    assert!(
-        matrix.code == 0 && matrix.stdout.contains("6 cases x 3 backends, 0 failed"),
-        "{}{}",
-        matrix.stdout,
-        matrix.stderr
-    );
+    assert_matrix_passes(&run(&["check", "--matrix"]), 6);
     // The read_write terrain is unsupported in Chromium, as its expectation says.
     let browser = run(&["check", "--backend", "browser", "--case", "terrain-default"]);
     assert!(
