@@ -135,7 +135,8 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
                     None => return Err(Failed::from("listed, not run")),
                 };
                 // The in-process determinism check (two renders, bit-identical)
-                // runs on the bless-time driver; other backends render once.
+                // runs on the bless-time driver where the render is not the
+                // bless-time bits (`CheckOptions::twice`); other backends render once.
                 let opts = CheckOptions { twice: ctx.backend() == "lavapipe" };
                 let o = vista_report::file_case(
                     &report_dir,
