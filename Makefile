@@ -71,4 +71,4 @@ mutants: lavapipe build
 	bash ci/mutants.sh $(VISTA) docs/mutants
 
 bench: lavapipe
-	$(CARGO) bench -p vista
+	$(CARGO) bench -p vista --features bench
