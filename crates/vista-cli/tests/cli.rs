@@ -994,8 +994,12 @@ fn the_harness_example_builds_with_vistas_profiles() {
         .filter(|n| n != "vista-cli")
         .chain(["vista".to_string()])
         .collect();
+    // vista's own crates compile again there whatever their settings (cargo
+    // hashes their paths relative to the building workspace): opt-level 0.
+    let mut vista_crates = settings(&ours);
+    vista_crates.insert("opt-level".into(), toml::Value::Integer(0));
     for m in &members {
-        want.insert(m.clone(), toml::Value::Table(settings(&ours)));
+        want.insert(m.clone(), toml::Value::Table(vista_crates.clone()));
     }
     let got = theirs["package"].as_table().unwrap().clone();
     for (name, v) in &want {
