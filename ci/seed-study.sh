@@ -52,6 +52,7 @@ IFS=x read -r w h <<<"$size"
 cw=$((w / 4)) ch=$((h / 4)) cx=$((w * 5 / 8)) cy=$((h / 10))
 [ "$preset" = seed-scene ] && cx=$((w * 3 / 8))
 zoom=$((960 / w > 1 ? 960 / w : 1))
+[ "$zoom" -gt 16 ] && zoom=16 # vista render --zoom allows 1 to 16
 shots=(
     "reference:--set cloud_steps=512 --set cloud_light_steps=32"
     "64x12:--set cloud_steps=64 --set cloud_light_steps=12"
@@ -65,11 +66,12 @@ shots=(
 for s in "${shots[@]}"; do
     name=${s%%:*} sets=${s#*:}
     # shellcheck disable=SC2086
-    "$vista" render landscape --preset "$preset" $extra $sets --size "$size" -o "$tmp/$name-frame.png" 2>/dev/null
+    "$vista" render landscape --preset "$preset" $extra $sets --size "$size" -o "$tmp/$name-frame.png" 2>"$tmp/log" ||
+        { cat "$tmp/log" >&2; exit 1; }
     case $name in 64x6 | 128x12 | 64x12-analytic-ign) continue ;; esac
     # shellcheck disable=SC2086
     "$vista" render landscape --preset "$preset" $extra $sets --size "$size" \
-        --crop "$cx,$cy,$cw,$ch" --zoom "$zoom" -o "$tmp/crop-$name.png" 2>/dev/null
+        --crop "$cx,$cy,$cw,$ch" --zoom "$zoom" -o "$tmp/crop-$name.png" 2>"$tmp/log" || { cat "$tmp/log" >&2; exit 1; }
 done
 cp "$tmp/reference-frame.png" "$tmp/frame.png"
 
