@@ -481,6 +481,24 @@ fn bless_then_check_passes_and_bless_is_refused_in_ci() {
     );
 }
 
+/// Check requires the bless-time raw bits on the same adapter, shader and
+/// params (what lets the golden harness skip its second render): a
+/// manifest whose raw hash the render does not reproduce fails the case.
+fn a_render_unlike_the_bless_time_bits_fails_check() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    assert_eq!(vista_in(Some(d.path()), &[], &["check", "--case", "a"]).code, 0);
+    let path = d.path().join("golden/manifest.toml");
+    let mut manifest: toml::Table = toml::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let mut edited = manifest["case"]["a"].as_table().unwrap().clone();
+    edited.insert("raw_hash".into(), toml::Value::String("0000000000000000".into()));
+    manifest["case"].as_table_mut().unwrap().insert("a".into(), toml::Value::Table(edited));
+    std::fs::write(&path, toml::to_string(&manifest).unwrap()).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--case", "a"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(r.stdout.contains("not bit-identical with the bless-time render"), "{}", r.stdout);
+}
+
 fn a_changed_render_fails_check_with_metrics_and_images() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -4063,6 +4081,7 @@ fn main() {
         Gpu a_foreign_import_path_composes_and_is_named_when_edited,
         Gpu unwritten_texels_fail_unless_the_output_is_partial,
         Gpu a_changed_render_fails_check_with_metrics_and_images,
+        Gpu a_render_unlike_the_bless_time_bits_fails_check,
         Gpu corrupt_and_wrong_size_goldens_fail_clearly,
         Cpu malformed_cases_toml_names_the_line,
         Gpu interrupted_bless_leaves_every_golden_old_or_new,

@@ -389,17 +389,15 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
             // Integer outputs compare exactly in `outputs` (their EXR golden).
             if e.params_hash != run.params_hash {
                 out.notes.push("case parameters changed since the last bless".into());
-            } else if obs.deterministic
-                && out.same_driver
-                && e.shader_hash == run.shader_hash
-                && e.raw_hash != obs.raw.content_hash()
-            {
-                out.problems.push(format!(
-                    "not bit-identical with the bless-time render on the same adapter, shader and params \
-                     (raw hash {} vs manifest {})",
-                    obs.raw.content_hash(),
-                    e.raw_hash
-                ));
+            } else if obs.deterministic && e.same_inputs(&run) {
+                let raw_hash = obs.raw.content_hash();
+                if e.raw_hash != raw_hash {
+                    out.problems.push(format!(
+                        "not bit-identical with the bless-time render on the same adapter, shader and params \
+                         (raw hash {raw_hash} vs manifest {})",
+                        e.raw_hash
+                    ));
+                }
             }
         }
         None => out.notes.push("no manifest entry for this case".into()),

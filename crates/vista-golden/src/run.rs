@@ -126,12 +126,9 @@ pub fn run_info(ctx: &Renderer, case: &Case) -> RunInfo {
 /// the kernel deterministic across processes, and check's second render
 /// (`CheckOptions::twice`) would only repeat it: it runs where this cannot
 /// speak, or fails, to tell a non-deterministic kernel from a changed one.
-/// Half the lavapipe golden run's work.
+/// A third of the lavapipe golden run's time (40.7 s to 26.7 s).
 fn as_blessed(entry: Option<&crate::ManifestEntry>, run: &RunInfo, raw_hash: &str) -> bool {
-    entry.is_some_and(|e| {
-        (&e.adapter, &e.shader_hash, &e.params_hash) == (&run.adapter, &run.shader_hash, &run.params_hash)
-            && e.raw_hash == raw_hash
-    })
+    entry.is_some_and(|e| e.same_inputs(run) && e.raw_hash == raw_hash)
 }
 
 /// Renders `case` and judges it against its golden and manifest entry

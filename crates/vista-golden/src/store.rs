@@ -52,6 +52,13 @@ pub struct ManifestEntry {
 }
 
 impl ManifestEntry {
+    /// Whether `run` renders what this entry's bless rendered: the same
+    /// adapter, shader and params, so a deterministic kernel must
+    /// reproduce `raw_hash` bit for bit.
+    pub(crate) fn same_inputs(&self, run: &crate::RunInfo) -> bool {
+        (&self.adapter, &self.shader_hash, &self.params_hash) == (&run.adapter, &run.shader_hash, &run.params_hash)
+    }
+
     /// The entry a bless of one render of `case` writes, dated now: this
     /// run's provenance, the hash of each WGSL file the kernel reaches, the
     /// raw output's hash, the PSNR against the golden it replaces and the
