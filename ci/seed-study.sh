@@ -63,15 +63,18 @@ shots=(
     "32x12-analytic-ign:--set cloud_steps=32 --set cloud_light_steps=12 --set cloud_integrator=analytic --set cloud_jitter=ign"
     "64x12-analytic-ign:--set cloud_steps=64 --set cloud_light_steps=12 --set cloud_integrator=analytic --set cloud_jitter=ign"
 )
+# One render of the frame: quiet, but a failing one's error is printed.
+render() {
+    # shellcheck disable=SC2086
+    "$vista" render landscape --preset "$preset" $extra --size "$size" "$@" 2>"$tmp/log" || { cat "$tmp/log" >&2; exit 1; }
+}
 for s in "${shots[@]}"; do
     name=${s%%:*} sets=${s#*:}
     # shellcheck disable=SC2086
-    "$vista" render landscape --preset "$preset" $extra $sets --size "$size" -o "$tmp/$name-frame.png" 2>"$tmp/log" ||
-        { cat "$tmp/log" >&2; exit 1; }
+    render $sets -o "$tmp/$name-frame.png"
     case $name in 64x6 | 128x12 | 64x12-analytic-ign) continue ;; esac
     # shellcheck disable=SC2086
-    "$vista" render landscape --preset "$preset" $extra $sets --size "$size" \
-        --crop "$cx,$cy,$cw,$ch" --zoom "$zoom" -o "$tmp/crop-$name.png" 2>"$tmp/log" || { cat "$tmp/log" >&2; exit 1; }
+    render $sets --crop "$cx,$cy,$cw,$ch" --zoom "$zoom" -o "$tmp/crop-$name.png"
 done
 cp "$tmp/reference-frame.png" "$tmp/frame.png"
 
