@@ -23,7 +23,9 @@ build:
 	$(CARGO) build -p vista-cli
 
 # Render every preset into out/, check every golden case, print the report path.
-demo: lavapipe build
+# lavapipe installs (apt, network) while the binary builds (CPU).
+demo:
+	bash ci/build-while-installing.sh lavapipe $(CARGO) build -p vista-cli
 	bash ci/demo.sh $(VISTA) out
 
 # The whole suite (what .ci/run calls): `cargo test --workspace`, two test
@@ -32,8 +34,9 @@ demo: lavapipe build
 # under the validation layer; every golden case again on SwiftShader and in
 # headless Chromium's WebGPU; then a closing count, and proof that without
 # an adapter the GPU tests are reported skipped, never ok.
-test: lavapipe swiftshader validation browser
-	mkdir -p target
+test:
+	# The drivers install (apt, network) while the tests build (CPU).
+	bash ci/build-while-installing.sh "lavapipe swiftshader validation browser" $(CARGO) test --workspace --no-run
 	# The workspace's test binaries, two at a time, its golden harness on
 	# lavapipe under the Khronos validation layer (any message fails the
 	# case), and two more runs of the golden harness: every golden case again
