@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves seed-study bench mutants lavapipe swiftshader validation browser build
+.PHONY: demo test golden curves seed-study bench mutants device-figures lavapipe swiftshader validation browser build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -65,6 +65,12 @@ seed-study: lavapipe build
 	bash ci/seed-study.sh $(VISTA) docs/seed-study/slab $(or $(SIZE),480x270) seed
 	bash ci/seed-study.sh $(VISTA) docs/seed-study/shell $(or $(SIZE),480x270) seed-scene
 	bash ci/seed-study-index.sh docs/seed-study
+
+# Issue 31's hardware-GPU figures into docs/device: `vista bench` for every
+# kernel and the seed study on both scenes at 1920x1080 with --backend gpu
+# (BACKEND=lavapipe SIZE=64x36 tries it without a GPU). Never part of make test.
+device-figures: build
+	bash ci/device-figures.sh $(VISTA) docs/device $(or $(SIZE),1920x1080)
 
 # Mutation score of every kernel's suite into docs/mutants (not part of make test).
 mutants: lavapipe build
