@@ -31,12 +31,13 @@ for k in $kernels; do
     "$vista" bench "$k" --size "$size" --backend "$backend" --json >>"$out/bench.jsonl.tmp"
 done
 mv "$out/bench.jsonl.tmp" "$out/bench.jsonl"
+# One field of the JSON object in $line, by name, so that a new field in
+# bench's JSON moves nothing.
+f() { sed -E "s/.*\"$1\":(\"[^\"]*\"|[^,}]*).*/\\1/; s/^\"//; s/\"$//" <<<"$line"; }
 {
     echo "| kernel | size | median ms | Mpix/s | first dispatch ms | adapter |"
     echo "|---|---|---|---|---|---|"
-    # Fields by name, so a new field in bench's JSON moves nothing.
     while IFS= read -r line; do
-        f() { sed -E "s/.*\"$1\":(\"[^\"]*\"|[^,}]*).*/\\1/; s/^\"//; s/\"$//" <<<"$line"; }
         printf '| %s | %sx%s | %.3f | %.1f | %.1f | %s |\n' "$(f kernel)" "$(f width)" "$(f height)" \
             "$(f median_ms)" "$(f mpix_per_s)" "$(f first_dispatch_ms)" "$(f adapter | sed 's/ | .*//')"
     done <"$out/bench.jsonl"
