@@ -40,6 +40,10 @@ pub struct Config {
     /// so the binary leaves it where it is (else it goes under the
     /// project's `target/vista-cache/mesa`, see [`MESA_CACHE`]).
     pub mesa_cache_placed: bool,
+    /// `VK_INSTANCE_LAYERS`, `VK_LOADER_LAYERS_ENABLE` or
+    /// `VK_LOADER_LAYERS_DISABLE` is set: the user chose Vulkan layers, so
+    /// the binary leaves the loader alone (see [`Config::hidden_layers`]).
+    pub vulkan_layers_chosen: bool,
 }
 
 /// Where under a project root the binary places Mesa's shader cache
@@ -112,7 +116,22 @@ impl Config {
             github_actions: text("GITHUB_ACTIONS").is_some_and(|v| v.eq_ignore_ascii_case("true")),
             fault: text("VISTA_FAULT"),
             mesa_cache_placed: get("MESA_SHADER_CACHE_DIR").is_some_and(|v| !v.is_empty()),
+            vulkan_layers_chosen: ["VK_INSTANCE_LAYERS", "VK_LOADER_LAYERS_ENABLE", "VK_LOADER_LAYERS_DISABLE"]
+                .iter()
+                .any(|k| get(k).is_some_and(|v| !v.is_empty())),
         })
+    }
+
+    /// The Vulkan loader's variable, and its value, that keep the Khronos
+    /// validation layer out of a `vista` process that will not validate.
+    /// wgpu opens the layer whenever it is installed (to ask what it
+    /// supports), and loading it was 80 of a small render's 670 million
+    /// instructions (callgrind); the CLI suite and `make demo` start
+    /// hundreds of `vista` processes. `None` under `VISTA_VALIDATION=1`, or
+    /// when the user chose layers through the loader's own variables.
+    pub fn hidden_layers(&self) -> Option<(&'static str, &'static str)> {
+        (!self.gpu.validate && !self.vulkan_layers_chosen)
+            .then_some(("VK_LOADER_LAYERS_DISABLE", "VK_LAYER_KHRONOS_validation"))
     }
 
     /// The configuration of `flags` over this process's environment.
@@ -194,6 +213,20 @@ mod tests {
         }
     }
 
+    #[test]
+    fn the_validation_layer_is_hidden_only_when_nothing_asks_for_it() {
+        let none = Flags::default();
+        let hide = Some(("VK_LOADER_LAYERS_DISABLE", "VK_LAYER_KHRONOS_validation"));
+        assert_eq!(config(&none, &[]).unwrap().hidden_layers(), hide);
+        let validating = config(&none, &[("VISTA_VALIDATION", "1")]).unwrap();
+        assert_eq!(validating.hidden_layers(), None, "VISTA_VALIDATION=1 needs the layer");
+        for var in ["VK_INSTANCE_LAYERS", "VK_LOADER_LAYERS_ENABLE", "VK_LOADER_LAYERS_DISABLE"] {
+            let chosen = config(&none, &[(var, "VK_LAYER_KHRONOS_validation")]).unwrap();
+            assert_eq!(chosen.hidden_layers(), None, "{var} is the user's choice");
+            assert_eq!(config(&none, &[(var, "")]).unwrap().hidden_layers(), hide, "{var} empty chooses nothing");
+        }
+    }
+
     /// The non-test sources of every library crate (all of `crates/` but the
     /// binary) read no environment variable, and nothing anywhere sets one.
     #[test]
@@ -231,11 +264,13 @@ mod tests {
                 let reads = ["env::var(", "env::var_os(", "env::vars(", "env::vars_os(", "Backends::from_env("];
                 let writes = ["set_var(", "remove_var("];
                 let at_edge = f.starts_with(&binary) || rel == "src/config.rs";
-                // The one write: the binary's main places Mesa's shader cache
-                // before any thread or device exists (see MESA_CACHE).
-                let placing_mesa_cache = rel == "crates/vista-cli/src/main.rs"
-                    && line.contains("std::env::set_var(\"MESA_SHADER_CACHE_DIR\", dir)");
-                if (writes.iter().any(|w| line.contains(w)) && !placing_mesa_cache)
+                // The two writes: the binary's main places Mesa's shader
+                // cache and hides an unused Vulkan layer, before any thread
+                // or device exists (see MESA_CACHE, Config::hidden_layers).
+                let at_start = rel == "crates/vista-cli/src/main.rs"
+                    && (line.contains("std::env::set_var(\"MESA_SHADER_CACHE_DIR\", dir)")
+                        || line.contains("std::env::set_var(name, value)"));
+                if (writes.iter().any(|w| line.contains(w)) && !at_start)
                     || (!at_edge && reads.iter().any(|r| line.contains(r)))
                 {
                     offenders.push(format!("{rel}:{}: {line}", n + 1));

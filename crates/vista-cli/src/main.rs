@@ -323,6 +323,11 @@ fn main() -> ExitCode {
         // Mesa reads the variable when the Vulkan device is created, later.
         unsafe { std::env::set_var("MESA_SHADER_CACHE_DIR", dir) };
     }
+    if let Some((name, value)) = config.hidden_layers() {
+        // SAFETY: as above; the Vulkan loader reads it when wgpu creates
+        // the instance, later.
+        unsafe { std::env::set_var(name, value) };
+    }
     match run(&project, &config, cli.command) {
         Ok(code) => ExitCode::from(code as u8),
         Err(e) => {
