@@ -319,7 +319,12 @@ impl Kernel {
     /// the built-in's params, and would find them missing).
     pub fn from_manifest(name: &str, origin: &str, text: &str) -> Result<Kernel, ParamError> {
         let manifest = manifest::parse(name, origin, text)?;
-        let cpu = cpu_reference(&manifest.name).filter(|_| same_params_as_builtin(&manifest));
+        // A copy of the built-in's manifest (the usual case: `vista init`,
+        // the examples, every test project) declares its params without
+        // parsing the built-in a second time; each `vista` process parses
+        // every manifest, and the CLI suite starts hundreds of them.
+        let cpu = cpu_reference(&manifest.name)
+            .filter(|_| builtin_manifest(&manifest.name) == Some(text) || same_params_as_builtin(&manifest));
         Ok(Kernel { cpu, manifest, origin: origin.to_string() })
     }
 
@@ -767,19 +772,22 @@ impl Kernel {
     }
 }
 
-/// A project's kernels: its `kernels/*.toml` over the built-ins, by name.
 /// Whether `m` declares the params of the built-in kernel of its name.
 fn same_params_as_builtin(m: &manifest::Manifest) -> bool {
     builtin_mismatch(m).is_none()
+}
+
+/// The text of the built-in manifest named `name`, if there is one.
+fn builtin_manifest(name: &str) -> Option<&'static str> {
+    let file = format!("{name}.toml");
+    vista_project::builtin::KERNELS.iter().find(|(rel, _)| *rel == file).map(|(_, text)| *text)
 }
 
 /// How manifest `m` differs from the built-in of its name in what the
 /// built-in's CPU reference reads (params' names and types, `[[group]]`s),
 /// or `None` when it does not (or no built-in has its name).
 fn builtin_mismatch(m: &manifest::Manifest) -> Option<String> {
-    let file = format!("{}.toml", m.name);
-    let (_, text) = vista_project::builtin::KERNELS.iter().find(|(rel, _)| *rel == file)?;
-    let builtin = manifest::parse(&m.name, "<built-in>", text).ok()?;
+    let builtin = manifest::parse(&m.name, "<built-in>", builtin_manifest(&m.name)?).ok()?;
     fn sig(ps: &[ParamSpec]) -> Vec<(&str, ParamType)> {
         ps.iter().map(|p| (p.name.as_str(), p.ty.clone())).collect()
     }
