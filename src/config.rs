@@ -125,7 +125,7 @@ impl Config {
     /// The Vulkan loader's variable, and its value, that keep the Khronos
     /// validation layer out of a `vista` process that will not validate.
     /// wgpu opens the layer whenever it is installed (to ask what it
-    /// supports), and loading it was 80 of a small render's 670 million
+    /// supports), and loading it was 81 of a small render's 673 million
     /// instructions (callgrind); the CLI suite and `make demo` start
     /// hundreds of `vista` processes. `None` under `VISTA_VALIDATION=1`, or
     /// when the user chose layers through the loader's own variables.
@@ -228,7 +228,8 @@ mod tests {
     }
 
     /// The non-test sources of every library crate (all of `crates/` but the
-    /// binary) read no environment variable, and nothing anywhere sets one.
+    /// binary) read no environment variable, and only the binary's start
+    /// sets one.
     #[test]
     fn no_library_crate_reads_the_environment() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
