@@ -43,6 +43,42 @@ fn every_kernel_shader_composes_and_validates_without_a_device() {
     }
 }
 
+/// A set reuses its naga_oil composers from one kernel to the next (library
+/// modules parsed once, the generated `vista::enums` swapped per kernel):
+/// every shader variant the built-in kernels and presets use composes to
+/// the same module as in a set of its own, in either order. Only the spans
+/// differ, which carry naga_oil's module index for error messages.
+#[test]
+fn a_shared_composer_composes_each_kernel_as_a_fresh_one_does() {
+    let mut names = std::collections::BTreeSet::new();
+    for k in vista_kernels::registry() {
+        for preset in std::iter::once(None).chain(k.presets().iter().map(|p| Some(p.name.as_str()))) {
+            names.insert(k.shader_for(&k.resolve(preset, &[]).unwrap()));
+        }
+    }
+    assert!(names.len() > vista_kernels::registry().len(), "expected shader-def variants: {names:?}");
+    let text = |set: &vista_gpu::ShaderSet, n: &str| without_spans(&format!("{:?}", set.compose(n).unwrap()));
+    let alone: Vec<String> = names.iter().map(|n| text(&repo_shaders(), n)).collect();
+    for order in [names.iter().collect::<Vec<_>>(), names.iter().rev().collect()] {
+        let shared = repo_shaders();
+        for n in order {
+            let i = names.iter().position(|m| m == n).unwrap();
+            assert_eq!(text(&shared, n), alone[i], "{n} composed differently in a shared set");
+        }
+    }
+}
+
+/// `text` (a module's `Debug`) with every `Span { .. }` reduced to `Span`.
+fn without_spans(text: &str) -> String {
+    let (mut out, mut rest) = (String::new(), text);
+    while let Some(i) = rest.find("Span {") {
+        out.push_str(&rest[..i]);
+        out.push_str("Span");
+        rest = &rest[i + rest[i..].find('}').unwrap() + 1..];
+    }
+    out + rest
+}
+
 #[test]
 fn every_registered_kernel_has_a_shader_file() {
     let set = repo_shaders();

@@ -27,6 +27,11 @@ pub struct ShaderSet {
     /// Composed modules by kernel file: the sources never change once the
     /// set is built, so each file is composed once per set.
     composed: Arc<Mutex<HashMap<String, Arc<naga::Module>>>>,
+    /// naga_oil composers kept between compositions: building one compiles
+    /// about 20 regexes, and the library modules it holds stay parsed, so
+    /// kernels that share `lib/` modules parse them once per set. A pool,
+    /// so that kernels still compose in parallel.
+    composers: Arc<Mutex<Vec<Pooled>>>,
     /// The generated module `vista::enums` of each kernel file (from its
     /// manifest's enum params), or why there is none (two manifests that
     /// share the file declare different enums).
@@ -34,6 +39,14 @@ pub struct ShaderSet {
     /// Nanoseconds spent composing and validating (naga_oil, naga), shared
     /// by clones of the set.
     compose_nanos: Arc<std::sync::atomic::AtomicU64>,
+}
+
+/// A composer of [`ShaderSet`]'s pool and the generated `vista::enums`
+/// text it holds, if any.
+#[derive(Debug, Default)]
+struct Pooled {
+    composer: Composer,
+    enums: Option<String>,
 }
 
 /// The import path of the module generated from a kernel's manifest.
@@ -61,6 +74,7 @@ impl ShaderSet {
             lib,
             kernels,
             composed: Default::default(),
+            composers: Default::default(),
             enums: BTreeMap::new(),
             compose_nanos: Default::default(),
         }
@@ -90,6 +104,7 @@ impl ShaderSet {
             }
         }
         self.composed = Default::default();
+        self.composers = Default::default();
         self
     }
 
@@ -178,13 +193,17 @@ impl ShaderSet {
         Ok(())
     }
 
-    /// A composer holding the generated `vista::enums` module (if any)
-    /// and the library modules the kernel source reaches. naga_oil wants a
-    /// module's imports added before it, so modules are added in rounds
-    /// until all fit.
-    fn composer(&self, lib: &[&(String, String)], enums: Option<&str>) -> Result<Composer, GpuError> {
-        let mut composer = Composer::default();
-        if let Some(text) = enums {
+    /// Makes `pooled` hold the generated `vista::enums` module `enums` (if
+    /// the kernel needs one; replacing another drops the modules built on
+    /// it) and every library module in `lib`, the modules the kernel source
+    /// reaches; modules it already holds stay. naga_oil wants a module's
+    /// imports added before it, so modules are added in rounds until all fit.
+    fn prepare(&self, pooled: &mut Pooled, lib: &[&(String, String)], enums: Option<&str>) -> Result<(), GpuError> {
+        let composer = &mut pooled.composer;
+        if let Some(text) = enums
+            && pooled.enums.as_deref() != Some(text)
+        {
+            pooled.enums = None;
             let desc = ComposableModuleDescriptor {
                 source: text,
                 file_path: "<generated>/vista/enums.wgsl",
@@ -194,10 +213,12 @@ impl ShaderSet {
                 shader_defs: HashMap::new(),
             };
             if let Err(e) = composer.add_composable_module(desc) {
-                return Err(GpuError::Shader(describe(&composer, &self.label, &e)));
+                return Err(GpuError::Shader(describe(composer, &self.label, &e)));
             }
+            pooled.enums = Some(text.to_string());
         }
-        let mut pending: Vec<&(String, String)> = lib.to_vec();
+        let mut pending: Vec<&(String, String)> =
+            lib.iter().filter(|e| !import_path(&e.1).is_some_and(|p| composer.contains_module(&p))).copied().collect();
         while !pending.is_empty() {
             let mut failed = Vec::new();
             let mut last_error = None;
@@ -212,7 +233,7 @@ impl ShaderSet {
                     shader_defs: HashMap::new(),
                 };
                 if let Err(e) = composer.add_composable_module(desc) {
-                    last_error = Some(describe(&composer, &self.label, &e));
+                    last_error = Some(describe(composer, &self.label, &e));
                     failed.push(*entry);
                 }
             }
@@ -221,7 +242,7 @@ impl ShaderSet {
             }
             pending = failed;
         }
-        Ok(composer)
+        Ok(())
     }
 
     /// Composes and validates the kernel file `name` (relative to
@@ -262,15 +283,20 @@ impl ShaderSet {
             self.check_enums(name, text, &lib)?;
         }
         let enums = self.enums_for(name, source, &lib)?;
-        let mut composer = self.composer(&lib, enums)?;
-        let module = composer
+        let mut pooled = self.composers.lock().expect("composer pool").pop().unwrap_or_default();
+        self.prepare(&mut pooled, &lib, enums)?;
+        let module = pooled
+            .composer
             .make_naga_module(NagaModuleDescriptor {
                 source,
                 file_path: origin,
                 shader_defs: shader_defs(name),
                 ..Default::default()
             })
-            .map_err(|e| GpuError::Shader(describe(&composer, &self.label, &e)))?;
+            .map_err(|e| GpuError::Shader(describe(&pooled.composer, &self.label, &e)))?;
+        // Back to the pool only after a clean composition: a failed one
+        // drops its composer rather than leave a half-built state behind.
+        self.composers.lock().expect("composer pool").push(pooled);
         validate(name, &module)?;
         Ok(module)
     }
