@@ -323,8 +323,8 @@ fn main() -> ExitCode {
         // Mesa reads the variable when the Vulkan device is created, later.
         unsafe { std::env::set_var("MESA_SHADER_CACHE_DIR", dir) };
     }
-    if let Some((name, value)) = config.hidden_layers() {
-        // SAFETY: as above; the Vulkan loader reads it when wgpu creates
+    for (name, value) in config.hidden_layers().into_iter().chain(config.hidden_drivers()) {
+        // SAFETY: as above; the Vulkan loader reads them when wgpu creates
         // the instance, later.
         unsafe { std::env::set_var(name, value) };
     }

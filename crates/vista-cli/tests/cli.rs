@@ -736,6 +736,35 @@ fn gpu_watchdog_turns_a_long_wait_into_a_clear_error() {
     assert_rejected(&r, 1, &["GPU wait exceeded", "VISTA_GPU_TIMEOUT_S"]);
 }
 
+/// On a software backend the Vulkan loader opens only lavapipe's and
+/// SwiftShader's drivers: every other manifest it finds is ignored (the
+/// loader's own log says so), lavapipe's is not. A driver variable the user
+/// set is theirs: selecting no driver leaves vista without its adapter.
+fn software_backends_leave_other_vulkan_drivers_unloaded() {
+    let d = tmp();
+    let r =
+        vista_in(None, &[("VK_LOADER_DEBUG", "driver")], &["render", "fbm", "--size", "8x8", "-o", &out_png(d.path())]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let found: std::collections::BTreeSet<&str> = r
+        .stderr
+        .lines()
+        .filter_map(|l| l.split("Found ICD manifest file ").nth(1))
+        .filter_map(|rest| rest.split(',').next()?.rsplit('/').next())
+        .collect();
+    assert!(found.iter().any(|f| f.starts_with("lvp_icd")), "lavapipe's manifest not found: {}", r.stderr);
+    for f in found {
+        let ignored = r.stderr.contains(&format!("Driver \"{f}\" ignored because not selected"));
+        let software = f.contains("lvp") || f.contains("swiftshader");
+        assert_eq!(ignored, !software, "{f}: ignored {ignored}\n{}", r.stderr);
+    }
+    let chosen = vista_in(
+        None,
+        &[("VK_LOADER_DRIVERS_SELECT", "*no-such-driver*")],
+        &["render", "fbm", "--size", "8x8", "-o", &out_png(d.path())],
+    );
+    assert_rejected(&chosen, 1, &["no lavapipe Vulkan adapter"]);
+}
+
 fn list_shows_params_ranges_and_presets() {
     let r = vista(&["list"]);
     assert_eq!(r.code, 0);
@@ -4087,6 +4116,7 @@ fn main() {
         Gpu interrupted_bless_leaves_every_golden_old_or_new,
         Gpu bless_keeps_orphans_unless_pruned,
         Gpu gpu_watchdog_turns_a_long_wait_into_a_clear_error,
+        Gpu software_backends_leave_other_vulkan_drivers_unloaded,
         Cpu list_shows_params_ranges_and_presets,
         Gpu bench_json_reports_throughput,
         Gpu bench_cpu_reports_the_f32_reference_and_ratio,
