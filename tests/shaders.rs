@@ -191,3 +191,96 @@ fn shader_hash_covers_transitive_imports_only() {
     append("lib/hash.wgsl");
     assert_ne!(hash("fbm.wgsl"), fbm0, "fbm reaches hash through fractal and noise");
 }
+
+/// A bevy-like module tree: modules that import each other with grouped,
+/// nested, multi-line and aliased imports (the shapes naga_oil accepts).
+fn module_tree(kernel: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |rel: &str, text: &str| {
+        let p = dir.path().join(rel);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, text).unwrap();
+    };
+    write(
+        "sky/types.wgsl",
+        "#define_import_path mylib::sky::types\n\nconst R_GROUND: f32 = 6360.0;\nstruct Atmosphere {\n    bottom: f32,\n    top: f32,\n}\n",
+    );
+    write("math.wgsl", "#define_import_path mylib::math\n\nconst PI: f32 = 3.14159265;\n");
+    // A module whose own grouped import reaches two others.
+    write(
+        "sky/functions.wgsl",
+        "#define_import_path mylib::sky::functions\n\n#import mylib::{sky::types::{Atmosphere, R_GROUND}, math::PI}\n\n\
+         fn thickness(a: Atmosphere) -> f32 {\n    return (a.top - a.bottom) / R_GROUND * PI;\n}\n",
+    );
+    write(
+        "sky/bindings.wgsl",
+        "#define_import_path mylib::sky::bindings\n\n#import mylib::sky::types::Atmosphere\n\n\
+         @group(0) @binding(0) var<uniform> atmosphere: Atmosphere;\n",
+    );
+    write("k.wgsl", kernel);
+    dir
+}
+
+/// Which modules a file imports comes from naga_oil's parser: a grouped
+/// import names every module in the group, not the prefix before `::{`.
+#[test]
+fn grouped_nested_multiline_and_aliased_imports_reach_every_module() {
+    let body = "\n@group(0) @binding(1) var out: texture_storage_2d<rgba32float, write>;\n\n\
+                @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n    \
+                textureStore(out, id.xy, vec4<f32>(USE, 0.0, 0.0, 1.0));\n}\n";
+    let cases = [
+        // grouped, across two modules (bevy's atmosphere kernels)
+        ("#import mylib::sky::{types::R_GROUND, bindings::atmosphere}\n", "atmosphere.top / R_GROUND"),
+        // nested groups
+        ("#import mylib::{sky::{types::R_GROUND, bindings::atmosphere}, math::PI}\n", "atmosphere.top / R_GROUND * PI"),
+        // multi-line
+        ("#import mylib::sky::{\n    bindings::atmosphere,\n    functions::thickness,\n}\n", "thickness(atmosphere)"),
+        // aliased module
+        ("#import mylib::sky::functions as f\n#import mylib::sky::bindings::atmosphere\n", "f::thickness(atmosphere)"),
+    ];
+    for (imports, use_) in cases {
+        let dir = module_tree(&format!("{imports}{}", body.replace("USE", use_)));
+        let set = set_of_dir(dir.path());
+        set.compose("k.wgsl").unwrap_or_else(|e| panic!("{imports}: {e}"));
+        let closure = set.import_closure("k.wgsl").unwrap();
+        for module in ["sky/types.wgsl", "sky/bindings.wgsl"] {
+            assert!(closure.iter().any(|f| f == module), "{imports}: closure {closure:?} lacks {module}");
+        }
+        // Every module reached, directly or through another, is in the hash.
+        let before = set.source_hash("k.wgsl").unwrap();
+        let types = dir.path().join("sky/types.wgsl");
+        let text = std::fs::read_to_string(&types).unwrap();
+        std::fs::write(&types, text + "// edited\n").unwrap();
+        assert_ne!(
+            set_of_dir(dir.path()).source_hash("k.wgsl").unwrap(),
+            before,
+            "{imports}: types edit not in the hash"
+        );
+        // math is reached only by the nested and multi-line/aliased cases.
+        let reaches_math = use_.contains("PI") || use_.contains("thickness");
+        assert_eq!(closure.iter().any(|f| f == "math.wgsl"), reaches_math, "{imports}: {closure:?}");
+    }
+}
+
+/// A module that no file declares is named with the file and line whose
+/// `#import` names it, in a kernel and in a module.
+#[test]
+fn a_missing_module_names_the_importing_file_and_line() {
+    let kernel = "// a kernel\n\n#import mylib::sky::{\n    types::R_GROUND,\n    missing::thing,\n}\n\n\
+                  @compute @workgroup_size(1)\nfn main() {\n    let a = thing(R_GROUND);\n}\n";
+    let dir = module_tree(kernel);
+    let err = set_of_dir(dir.path()).compose("k.wgsl").unwrap_err().to_string();
+    assert!(err.contains("k.wgsl:3:") && err.contains("mylib::sky::missing"), "{err}");
+    // In a module: bindings imports a module that does not exist.
+    let dir = module_tree(
+        "#import mylib::sky::bindings::atmosphere\n@compute @workgroup_size(1)\nfn main() { let a = atmosphere.top; }\n",
+    );
+    std::fs::write(
+        dir.path().join("sky/bindings.wgsl"),
+        "#define_import_path mylib::sky::bindings\n\n#import mylib::sky::{types::Atmosphere, gone::G}\n\n\
+         @group(0) @binding(0) var<uniform> atmosphere: Atmosphere;\nconst X: f32 = G;\n",
+    )
+    .unwrap();
+    let err = set_of_dir(dir.path()).source_hash("k.wgsl").unwrap_err().to_string();
+    assert!(err.contains("bindings.wgsl:3:") && err.contains("mylib::sky::gone"), "{err}");
+}

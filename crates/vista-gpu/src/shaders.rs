@@ -20,10 +20,11 @@ use crate::GpuError;
 pub struct ShaderSet {
     /// Names the set in errors (a project root, or "built-in").
     label: String,
-    /// (path relative to `shaders/`, source) of every file under `lib/`, sorted.
-    lib: Vec<(String, String)>,
-    /// Kernel files (not under `lib/`): relative path -> (source, origin path).
-    kernels: BTreeMap<String, (String, String)>,
+    /// Every import module (files under `lib/` and any with its own
+    /// `#define_import_path`), sorted by relative path.
+    lib: Vec<Source>,
+    /// Kernel files (not under `lib/`) by relative path.
+    kernels: BTreeMap<String, Source>,
     /// Composed modules by kernel file: the sources never change once the
     /// set is built, so each file is composed once per set.
     composed: Arc<Mutex<HashMap<String, Arc<naga::Module>>>>,
@@ -39,6 +40,40 @@ pub struct ShaderSet {
     /// Nanoseconds spent composing and validating (naga_oil, naga), shared
     /// by clones of the set.
     compose_nanos: Arc<std::sync::atomic::AtomicU64>,
+}
+
+/// One WGSL file of a [`ShaderSet`] and what naga_oil's preprocessor reads
+/// from it once, when the set is built.
+#[derive(Debug, Clone)]
+struct Source {
+    /// Path relative to `shaders/`.
+    rel: String,
+    text: String,
+    /// A real path or `<built-in>/...`: what errors name.
+    origin: String,
+    /// The path it declares with `#define_import_path`, if any.
+    module: Option<String>,
+    /// The modules it imports, by naga_oil's own parser.
+    imports: Vec<Import>,
+}
+
+/// A module a file imports, and the line (1-based) of the `#import`
+/// statement that names it.
+#[derive(Debug, Clone)]
+struct Import {
+    module: String,
+    line: Option<usize>,
+}
+
+impl Source {
+    fn new(rel: String, text: String, origin: String) -> Source {
+        let (module, imports) = preprocess(&text);
+        Source { rel, text, origin, module, imports }
+    }
+
+    fn imports(&self, module: &str) -> bool {
+        self.imports.iter().any(|i| i.module == module)
+    }
 }
 
 /// A composer of [`ShaderSet`]'s pool and the generated `vista::enums`
@@ -60,15 +95,16 @@ impl ShaderSet {
         let mut lib = Vec::new();
         let mut kernels = BTreeMap::new();
         for (rel, text, origin) in files {
+            let source = Source::new(rel, text, origin);
             // An import module is a file under lib/ or any file with its own
             // `#define_import_path` (a project's foreign module layout).
-            if rel.starts_with("lib/") || import_path(&text).is_some() {
-                lib.push((rel, text));
+            if source.rel.starts_with("lib/") || source.module.is_some() {
+                lib.push(source);
             } else {
-                kernels.insert(rel, (text, origin));
+                kernels.insert(source.rel.clone(), source);
             }
         }
-        lib.sort();
+        lib.sort_by(|a, b| a.rel.cmp(&b.rel));
         ShaderSet {
             label: label.to_string(),
             lib,
@@ -125,7 +161,7 @@ impl ShaderSet {
 
     /// `name` is a kernel file, optionally followed by `?DEF&DEF...`: naga_oil
     /// shader defs (boolean) to compose it with, e.g. `fbm.wgsl?VISTA_HASH_PLANE`.
-    fn kernel_source(&self, name: &str) -> Result<&(String, String), GpuError> {
+    fn kernel_source(&self, name: &str) -> Result<&Source, GpuError> {
         let name = file_of(name);
         self.kernels.get(name).ok_or_else(|| {
             GpuError::Shader(format!(
@@ -139,15 +175,9 @@ impl ShaderSet {
     /// The generated `vista::enums` text for kernel file `name` (its
     /// `source`, and `lib`, the library modules it reaches) when it or one
     /// of those modules imports it.
-    fn enums_for(&self, name: &str, source: &str, lib: &[&(String, String)]) -> Result<Option<&str>, GpuError> {
+    fn enums_for(&self, name: &str, source: &Source, lib: &[&Source]) -> Result<Option<&str>, GpuError> {
         let file = file_of(name);
-        let imports_enums = |text: &str| {
-            text.lines().filter_map(|l| l.trim().strip_prefix("#import")).any(|rest| {
-                let rest = rest.trim();
-                rest == ENUMS_MODULE || rest.starts_with(&format!("{ENUMS_MODULE}::"))
-            })
-        };
-        if !imports_enums(source) && !lib.iter().any(|e| imports_enums(&e.1)) {
+        if !source.imports(ENUMS_MODULE) && !lib.iter().any(|e| e.imports(ENUMS_MODULE)) {
             return Ok(None);
         }
         match self.enums.get(file) {
@@ -165,7 +195,7 @@ impl ShaderSet {
     /// imports also defines with another value: the library's meaning of
     /// the index (`vista::noise`'s `BASIS_VALUE`) and the manifest's order
     /// must agree.
-    fn check_enums(&self, name: &str, enums: &str, lib: &[&(String, String)]) -> Result<(), GpuError> {
+    fn check_enums(&self, name: &str, enums: &str, lib: &[&Source]) -> Result<(), GpuError> {
         let consts = |text: &str| -> Vec<(String, String)> {
             text.lines()
                 .filter_map(|l| l.trim().strip_prefix("const "))
@@ -177,7 +207,7 @@ impl ShaderSet {
                 .collect()
         };
         let generated = consts(enums);
-        for (path, text) in lib.iter().map(|e| (&e.0, &e.1)) {
+        for (path, text) in lib.iter().map(|e| (&e.rel, &e.text)) {
             for (c, lib_value) in consts(text) {
                 if let Some((_, value)) = generated.iter().find(|(g, _)| *g == c)
                     && *value != lib_value
@@ -198,7 +228,7 @@ impl ShaderSet {
     /// it) and every library module in `lib`, the modules the kernel source
     /// reaches; modules it already holds stay. naga_oil wants a module's
     /// imports added before it, so modules are added in rounds until all fit.
-    fn prepare(&self, pooled: &mut Pooled, lib: &[&(String, String)], enums: Option<&str>) -> Result<(), GpuError> {
+    fn prepare(&self, pooled: &mut Pooled, lib: &[&Source], enums: Option<&str>) -> Result<(), GpuError> {
         let composer = &mut pooled.composer;
         if let Some(text) = enums
             && pooled.enums.as_deref() != Some(text)
@@ -217,16 +247,15 @@ impl ShaderSet {
             }
             pooled.enums = Some(text.to_string());
         }
-        let mut pending: Vec<&(String, String)> =
-            lib.iter().filter(|e| !import_path(&e.1).is_some_and(|p| composer.contains_module(&p))).copied().collect();
+        let mut pending: Vec<&Source> =
+            lib.iter().filter(|e| !e.module.as_ref().is_some_and(|p| composer.contains_module(p))).copied().collect();
         while !pending.is_empty() {
             let mut failed = Vec::new();
             let mut last_error = None;
             for entry in &pending {
-                let (path, source) = (&entry.0, &entry.1);
                 let desc = ComposableModuleDescriptor {
-                    source,
-                    file_path: path,
+                    source: &entry.text,
+                    file_path: &entry.origin,
                     language: ShaderLanguage::Wgsl,
                     as_name: None,
                     additional_imports: &[],
@@ -260,7 +289,8 @@ impl ShaderSet {
     }
 
     fn compose_uncached(&self, name: &str) -> Result<naga::Module, GpuError> {
-        let (source, origin) = self.kernel_source(name)?;
+        let kernel = self.kernel_source(name)?;
+        let (source, origin) = (&kernel.text, &kernel.origin);
         // A file without preprocessor directives needs no composition; naga
         // parses it directly. naga_oil 0.23 loses the expressions of an
         // `override` named in `@workgroup_size` ("Handle N of Expression is
@@ -278,11 +308,11 @@ impl ShaderSet {
         }
         // The manifest's constants must agree with the library's even where
         // the kernel passes the index through without naming it.
-        let lib = self.imported_lib(source);
+        let lib = self.imported_lib(kernel)?;
         if let Some(Ok(text)) = self.enums.get(file_of(name)) {
             self.check_enums(name, text, &lib)?;
         }
-        let enums = self.enums_for(name, source, &lib)?;
+        let enums = self.enums_for(name, kernel, &lib)?;
         let mut pooled = self.composers.lock().expect("composer pool").pop().unwrap_or_default();
         self.prepare(&mut pooled, &lib, enums)?;
         let module = pooled
@@ -306,16 +336,16 @@ impl ShaderSet {
     /// kernel's output changes it, and edits to unrelated modules do not
     /// (so they do not mark every golden's provenance stale).
     pub fn source_hash(&self, name: &str) -> Result<String, GpuError> {
-        let (source, _) = self.kernel_source(name)?;
+        let kernel = self.kernel_source(name)?;
         let mut h = blake3::Hasher::new();
         h.update(name.as_bytes());
-        h.update(source.as_bytes());
-        let lib = self.imported_lib(source);
-        for (path, text) in &lib {
-            h.update(path.as_bytes());
-            h.update(text.as_bytes());
+        h.update(kernel.text.as_bytes());
+        let lib = self.imported_lib(kernel)?;
+        for e in &lib {
+            h.update(e.rel.as_bytes());
+            h.update(e.text.as_bytes());
         }
-        if let Some(text) = self.enums_for(name, source, &lib)? {
+        if let Some(text) = self.enums_for(name, kernel, &lib)? {
             h.update(ENUMS_MODULE.as_bytes());
             h.update(text.as_bytes());
         }
@@ -325,13 +355,13 @@ impl ShaderSet {
     /// Each file of [`ShaderSet::import_closure`] with the hash of its text:
     /// recorded at bless time so that a check can name the files that changed.
     pub fn file_hashes(&self, name: &str) -> Result<std::collections::BTreeMap<String, String>, GpuError> {
-        let (source, _) = self.kernel_source(name)?;
+        let kernel = self.kernel_source(name)?;
         let hash = |text: &str| blake3::hash(text.as_bytes()).to_hex()[..16].to_string();
-        let lib = self.imported_lib(source);
+        let lib = self.imported_lib(kernel)?;
         let enums =
-            self.enums_for(name, source, &lib)?.map(|text| (format!("{ENUMS_MODULE} (from the manifest)"), hash(text)));
-        Ok(std::iter::once((name.to_string(), hash(source)))
-            .chain(lib.iter().map(|(path, text)| (path.clone(), hash(text))))
+            self.enums_for(name, kernel, &lib)?.map(|text| (format!("{ENUMS_MODULE} (from the manifest)"), hash(text)));
+        Ok(std::iter::once((name.to_string(), hash(&kernel.text)))
+            .chain(lib.iter().map(|e| (e.rel.clone(), hash(&e.text))))
             .chain(enums)
             .collect())
     }
@@ -339,28 +369,40 @@ impl ShaderSet {
     /// The kernel file and the lib modules it reaches through `#import`
     /// (paths relative to `shaders/`): every file whose edit can change it.
     pub fn import_closure(&self, name: &str) -> Result<Vec<String>, GpuError> {
-        let (source, _) = self.kernel_source(name)?;
+        let kernel = self.kernel_source(name)?;
         Ok(std::iter::once(name.to_string())
-            .chain(self.imported_lib(source).into_iter().map(|e| e.0.clone()))
+            .chain(self.imported_lib(kernel)?.into_iter().map(|e| e.rel.clone()))
             .collect())
     }
 
-    /// Library files reachable from `source` through `#import`, in `lib` order.
-    fn imported_lib(&self, source: &str) -> Vec<&(String, String)> {
-        let path_of = |src: &str| import_path(src);
-        let defined: Vec<String> = self.lib.iter().filter_map(|e| import_path(&e.1)).collect();
-        let imports = |src: &str| imports(src, &defined);
-        let mut wanted: Vec<String> = imports(source);
+    /// Library files reachable from `kernel` through `#import`, in `lib`
+    /// order. A module that no file declares is refused, naming the file
+    /// and line that import it (the generated `vista::enums` aside).
+    fn imported_lib(&self, kernel: &Source) -> Result<Vec<&Source>, GpuError> {
+        let mut wanted: Vec<(&Source, &Import)> = kernel.imports.iter().map(|i| (kernel, i)).collect();
         let mut used = vec![false; self.lib.len()];
-        while let Some(module) = wanted.pop() {
-            for (k, entry) in self.lib.iter().enumerate() {
-                if !used[k] && path_of(&entry.1).as_deref() == Some(module.as_str()) {
-                    used[k] = true;
-                    wanted.extend(imports(&entry.1));
-                }
+        while let Some((importer, import)) = wanted.pop() {
+            if import.module == ENUMS_MODULE {
+                continue;
+            }
+            let Some(k) = self.lib.iter().position(|e| e.module.as_deref() == Some(import.module.as_str())) else {
+                let at = import.line.map_or(String::new(), |l| format!(":{l}"));
+                let mut known: Vec<&str> = self.lib.iter().filter_map(|e| e.module.as_deref()).collect();
+                known.sort();
+                return Err(GpuError::Shader(format!(
+                    "{}{at}: imports module {}, which no file in {} declares with #define_import_path (modules: {})",
+                    importer.origin,
+                    import.module,
+                    self.label,
+                    known.join(", ")
+                )));
+            };
+            if !used[k] {
+                used[k] = true;
+                wanted.extend(self.lib[k].imports.iter().map(|i| (&self.lib[k], i)));
             }
         }
-        self.lib.iter().zip(used).filter(|(_, u)| *u).map(|(e, _)| e).collect()
+        Ok(self.lib.iter().zip(used).filter(|(_, u)| *u).map(|(e, _)| e).collect())
     }
 }
 
@@ -435,30 +477,66 @@ fn file_of(name: &str) -> &str {
     name.split_once('?').map_or(name, |(file, _)| file)
 }
 
-/// The path a module declares with `#define_import_path`, if any.
-fn import_path(source: &str) -> Option<String> {
-    source.lines().find_map(|l| l.trim().strip_prefix("#define_import_path").map(|p| p.trim().to_string()))
+/// The module path `source` declares and the modules it imports, both by
+/// naga_oil's own preprocessor (grouped, nested, multi-line and aliased
+/// imports, as naga_oil composes them: a module counts where an item of it
+/// is used). Each import carries the line of the `#import` naming it.
+fn preprocess(source: &str) -> (Option<String>, Vec<Import>) {
+    let (module, imports, _) = naga_oil::compose::get_preprocessor_data(source);
+    // naga_oil yields nothing for a file it cannot parse; composing it then
+    // reports the error. The declared path is still wanted to place the file.
+    let module = module.or_else(|| {
+        source.lines().find_map(|l| l.trim().strip_prefix("#define_import_path").map(|p| p.trim().to_string()))
+    });
+    let statements = import_statements(source);
+    let imports = imports
+        .into_iter()
+        .map(|d| {
+            let line = statements.iter().find(|(_, paths)| {
+                paths
+                    .iter()
+                    .any(|p| *p == d.import || p.strip_prefix(d.import.as_str()).is_some_and(|r| r.starts_with("::")))
+            });
+            Import { module: d.import, line: line.map(|(l, _)| *l) }
+        })
+        .collect();
+    (module, imports)
 }
 
-/// Module paths named by `#import` lines: for each, the longest declared
-/// module path it starts with (`#import vista::noise::{a, b}`,
-/// `#import vista::noise`, `#import mylib::sky::types as t` and
-/// `#import mylib::sky::types::scale` all name their module).
-fn imports(source: &str, defined: &[String]) -> Vec<String> {
-    source
-        .lines()
-        .filter_map(|l| l.trim().strip_prefix("#import"))
-        .filter_map(|rest| {
-            let text = rest.trim();
-            let text = text.split(" as ").next().unwrap_or(text).trim();
-            let text = text.split("::{").next().unwrap_or(text).trim();
-            defined
-                .iter()
-                .filter(|p| text == p.as_str() || text.starts_with(&format!("{p}::")))
-                .max_by_key(|p| p.len())
-                .cloned()
-        })
-        .collect()
+/// Each `#import` statement of `source` (one or several lines, until its
+/// braces close): its first line (1-based) and the full paths naga_oil's
+/// import parser declares from it. Only used to say where a module is
+/// imported; which modules are imported comes from [`preprocess`].
+fn import_statements(source: &str) -> Vec<(usize, Vec<String>)> {
+    let uncommented = |l: &str| l.split("//").next().unwrap_or("").to_string();
+    let lines: Vec<String> = source.lines().map(uncommented).collect();
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < lines.len() {
+        let start = k;
+        let is_import = lines[k].trim_start().strip_prefix('#').is_some_and(|r| r.trim_start().starts_with("import"));
+        if !is_import {
+            k += 1;
+            continue;
+        }
+        let mut text = String::new();
+        let mut open = 0usize;
+        while k < lines.len() {
+            open += lines[k].matches('{').count();
+            open = open.saturating_sub(lines[k].matches('}').count());
+            text.push_str(&lines[k]);
+            text.push('\n');
+            k += 1;
+            if open == 0 {
+                break;
+            }
+        }
+        let mut declared = Default::default();
+        if naga_oil::compose::parse_imports::parse_imports(&text, &mut declared).is_ok() {
+            out.push((start + 1, declared.into_values().flatten().collect()));
+        }
+    }
+    out
 }
 
 fn describe(composer: &Composer, label: &str, e: &ComposerError) -> String {
