@@ -2890,7 +2890,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_rejected(
         &render_exr(d.path(), "8x8", "a").0,
         2,
-        &["param gain is ambiguous", "frame.gain, flip.gain", "name one as frame.gain or flip.gain"],
+        &["param gain is ambiguous", "frame.gain, flip.gain", "name each by its full path: frame.gain or flip.gain"],
     );
 }
 

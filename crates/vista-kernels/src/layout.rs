@@ -151,29 +151,46 @@ pub fn blocks_of(
 
 /// Names each leaf by the param that feeds it: a leaf inside a
 /// `[[group]]`'s struct field takes [`crate::manifest::ParamGroup::param`]'s
-/// name, the others keep their own. Then refuses two ungrouped leaves of
-/// one uniform that share a name. ([`check_groups`] refuses a group that
-/// names no struct field.)
-pub fn name_leaves(kernel: &Kernel, shader: &str, l: &mut UniformLayout) -> Result<(), ParamError> {
-    let bad = |message: String| ParamError::Layout { kernel: kernel.name().to_string(), message };
+/// name, the others keep their own. Leaves of one uniform may share a name
+/// (`camera.inv_proj`, `ocean_camera.inv_proj`): a param reaches each by
+/// its full path, and [`check_fields`] refuses the bare name for them.
+/// ([`check_groups`] refuses a group that names no struct field.)
+pub fn name_leaves(kernel: &Kernel, l: &mut UniformLayout) {
     let has = |n: &str| kernel.params().iter().any(|s| s.name == n);
     for g in &kernel.manifest.groups {
         for f in l.fields.iter_mut().filter(|f| in_group(g, f)) {
             f.name = g.param(&f.name, has);
         }
     }
-    // A grouped leaf may share its param with another leaf (landscape's
-    // clouds take the terrain's seed): the group's rule says so. Two
-    // ungrouped leaves of one name would silently take one value.
-    let grouped = |f: &Field| grouped(kernel, f);
-    for (i, f) in l.fields.iter().enumerate() {
-        if let Some(g) =
-            l.fields[..i].iter().find(|g| g.block == f.block && g.name == f.name && !grouped(g) && !grouped(f))
-        {
-            return Err(bad(format!("{shader}: Params fields {} and {} share the name '{}'", g.path, f.path, f.name)));
-        }
+}
+
+/// The ungrouped leaves of `fields` whose own name is `name`, when more
+/// than one: a bare param name would feed them all with one value. A
+/// grouped leaf may share its param with another (landscape's clouds take
+/// the terrain's seed): the group's rule says so.
+fn twins<'f>(kernel: &Kernel, fields: &'f [Field], name: &str) -> Vec<&'f Field> {
+    let same: Vec<&Field> = fields.iter().filter(|g| g.name == name && !grouped(kernel, g)).collect();
+    if same.len() > 1 { same } else { Vec::new() }
+}
+
+/// The refusal of a bare param name that several leaves share, listing the
+/// full paths that reach each (the module-qualified one where two modules'
+/// uniforms share a variable name).
+fn ambiguous(kernel: &Kernel, name: &str, leaves: &[&Field]) -> ParamError {
+    let full = |f: &Field| {
+        let key_shared = leaves.iter().filter(|g| g.key == f.key).count() > 1;
+        if key_shared { f.qualified.clone() } else { f.key.clone() }
+    };
+    let paths: Vec<String> = leaves.iter().map(|f| full(f)).collect();
+    ParamError::Layout {
+        kernel: kernel.name().to_string(),
+        message: format!(
+            "param {name} is ambiguous: {} leaves share the name ({}); name each by its full path: {}",
+            leaves.len(),
+            leaves.iter().map(|f| f.key.as_str()).collect::<Vec<_>>().join(", "),
+            paths.join(" or ")
+        ),
     }
-    Ok(())
 }
 
 /// Whether leaf `f` lies in group `g`'s struct field (by its path below
@@ -384,16 +401,19 @@ pub fn check_fields(kernel: &Kernel, layout: &UniformLayout) -> Result<(), Param
         if spec.is_none() && f.name.starts_with('_') {
             continue;
         }
+        let shared = twins(kernel, &layout.fields, &f.name);
         let Some(spec) = spec else {
+            let names = if shared.is_empty() { format!("{} (or {})", f.name, f.key) } else { f.key.clone() };
             return Err(bad(format!(
-                "Params field {} (WGSL {}) has no param in {}; declare a [[param]] named {} (or {}) or compute it in WGSL",
+                "Params field {} (WGSL {}) has no param in {}; declare a [[param]] named {names} or compute it in WGSL",
                 f.path,
                 f.ty.wgsl(),
                 kernel.origin(),
-                f.name,
-                f.key
             )));
         };
+        if spec.name == f.name && spec.name != f.key && spec.name != f.qualified && !shared.is_empty() {
+            return Err(ambiguous(kernel, &spec.name, &shared));
+        }
         let want = spec.ty.wgsl();
         if want != f.ty.name {
             return Err(bad(format!(
@@ -445,13 +465,9 @@ fn check_names(kernel: &Kernel, layout: &UniformLayout, fed_elsewhere: &[&str], 
         let by_key: Vec<&Field> =
             if by_qualified { layout.fields.iter().filter(|f| f.qualified == spec.name).collect() } else { by_key };
         let by_name: Vec<&Field> = layout.fields.iter().filter(|f| f.name == spec.name).collect();
-        if by_key.is_empty() && by_name.iter().filter(|f| !grouped(kernel, f)).count() > 1 {
-            return Err(bad(format!(
-                "param {} is ambiguous: leaves of two uniforms share the name ({}); name one as {}",
-                spec.name,
-                by_name.iter().map(|f| f.key.as_str()).collect::<Vec<_>>().join(", "),
-                by_name.iter().map(|f| f.key.as_str()).collect::<Vec<_>>().join(" or ")
-            )));
+        let shared = twins(kernel, &layout.fields, &spec.name);
+        if by_key.is_empty() && !shared.is_empty() {
+            return Err(ambiguous(kernel, &spec.name, &shared));
         }
         let feeds_override = layout.overrides.contains(&spec.name);
         if by_key.is_empty()
@@ -584,13 +600,55 @@ default = -3
         let k = Kernel::from_manifest("nested", "nested.toml", MANIFEST).unwrap();
         let m = module("struct A { fov: f32 }\nstruct Params { width: u32, height: u32, a: A, fov: f32 }");
         let e = k.layout(&m).unwrap_err().to_string();
-        assert!(e.contains("Params fields a.fov and fov share the name 'fov'"), "{e}");
+        assert!(
+            e.contains("param fov is ambiguous: 2 leaves share the name (params.a.fov, params.fov); name each by its full path: \
+                        params.a.fov or params.fov"),
+            "{e}"
+        );
         let m = module("struct Params { width: u32, height: u32, m: array<array<f32, 2>, 2> }");
         let e = k.layout(&m).unwrap_err().to_string();
         assert!(e.contains("Params field m is an array of arrays"), "{e}");
         let m = module("struct Params { width: u32, height: f32 }");
         let e = k.layout(&m).unwrap_err().to_string();
         assert!(e.contains("Params field height is WGSL f32 but the image size is u32"), "{e}");
+    }
+
+    /// Two leaves of one uniform that share their last name (a camera and
+    /// an ocean camera, each with `inv_proj`), one of them three structs
+    /// deep: `variable.path` reaches each; the bare name is refused,
+    /// listing the full paths that would work.
+    #[test]
+    fn same_named_leaves_are_reached_by_their_full_paths() {
+        const TWINS: &str = r#"summary = "twins"
+[[param]]
+name = "params.camera.inv_proj"
+type = "f32"
+range = [-10, 10]
+default = 1.5
+[[param]]
+name = "params.ocean.view.cam.inv_proj"
+type = "f32"
+range = [-10, 10]
+default = -2.5
+"#;
+        let structs = "struct Cam { inv_proj: f32 }\nstruct View { cam: Cam }\nstruct Ocean { view: View }\n\
+                       struct Params { width: u32, height: u32, camera: Cam, ocean: Ocean }";
+        let k = Kernel::from_manifest("twins", "twins.toml", TWINS).unwrap();
+        let layout = k.layout(&module(structs)).unwrap();
+        let b = k.uniforms(&layout, &k.resolve(None, &[]).unwrap(), 1, 1).remove(0);
+        let f = |o: usize| f32::from_le_bytes(b[o..o + 4].try_into().unwrap());
+        assert_eq!((f(8), f(12)), (1.5, -2.5), "each leaf its own param");
+        let bare = TWINS.replace("params.camera.inv_proj", "inv_proj");
+        let k = Kernel::from_manifest("twins", "twins.toml", &bare).unwrap();
+        let e = k.layout(&module(structs)).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "param inv_proj is ambiguous: 2 leaves share the name (params.camera.inv_proj, \
+                        params.ocean.view.cam.inv_proj); \
+                        name each by its full path: params.camera.inv_proj or params.ocean.view.cam.inv_proj"
+            ),
+            "{e}"
+        );
     }
 
     const LEAVES: &str = r#"summary = "every leaf type"

@@ -653,8 +653,8 @@ impl Kernel {
         }
         // As for one pass: a group that names no struct field first.
         layout::check_groups(self, &layouts.iter().map(|(_, l)| l).collect::<Vec<_>>())?;
-        for (shader, l) in &mut layouts {
-            layout::name_leaves(self, shader, l)?;
+        for (_, l) in &mut layouts {
+            layout::name_leaves(self, l);
             layout::check_fields(self, l)?;
         }
         let layouts: Vec<UniformLayout> = layouts.into_iter().map(|(_, l)| l).collect();
@@ -726,7 +726,7 @@ impl Kernel {
         // A group that names no struct field first: its leaves would
         // otherwise look like ungrouped leaves sharing names.
         layout::check_groups(self, &[&l])?;
-        layout::name_leaves(self, self.shader(), &mut l)?;
+        layout::name_leaves(self, &mut l);
         layout::check(self, &l)?;
         l.output = Some(resources::resolve(&self.manifest, &l.bindings, module)?);
         Ok(l)
