@@ -1,5 +1,5 @@
 //! GPU against the f64 CPU reference, every kernel, with bounds set from the
-//! measured agreement (README "GPU vs CPU bounds"), all four channels
+//! measured agreement (docs/guide.md "GPU vs CPU bounds"), all four channels
 //! compared. Then the proof that those bounds can fail: a 5% change of a
 //! physical or shading constant in the shaders, composed in memory, three
 //! per kernel, must break at least one setting's bound; and dropping the
@@ -28,7 +28,7 @@ fn gpu_agrees_with_the_f64_reference_within_measured_bounds(gpu: &Renderer) {
     let mut failures = Vec::new();
     for s in settings() {
         let j = judge_setting(gpu, s).unwrap_or_else(|e| panic!("{e}"));
-        // A README table row (`-- --nocapture`).
+        // A row of docs/guide.md's table (`-- --nocapture`).
         eprintln!(
             "| {} | {} {:?} | {:.1} dB | {:.2e} | {} dB / {:.0e} | {} |",
             s.kernel,

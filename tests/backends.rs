@@ -7,7 +7,7 @@
 //! SwiftShader paths a display PSNR and a raw max-abs of their own.
 //!
 //! By default the first case of each kernel runs; `VISTA_BACKENDS_CASES=glob`
-//! picks others (`'*'` for all, as the README's table was made).
+//! picks others (`'*'` for all, as docs/guide.md's table was made).
 
 use common::allow_no_gpu;
 use libtest_mimic::{Arguments, Trial};

@@ -542,7 +542,7 @@ fn calibrate_oktas() {
     }
 }
 
-/// Where the 1/16 cannot hold, and why (measured; README "Cloud amount in
+/// Where the 1/16 cannot hold, and why (measured; docs/guide.md "Cloud amount in
 /// oktas"): (genus, oktas, allowed distance of the held-out mean from n / 8).
 /// Cirrostratus is a veil of 0.25/km whose vertical optical depth is about
 /// 0.09: even at full coverage its thinnest directions stay under tau = 0.1,
