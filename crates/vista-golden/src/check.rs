@@ -368,9 +368,9 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
     let run = out.run.clone();
     match entry {
         Some(e) => {
-            out.same_driver = e.adapter == run.adapter;
+            let threshold = crate::DriverThreshold::of(case, Some(e), &run.adapter);
+            (out.same_driver, out.psnr_threshold) = (threshold.same_driver, threshold.psnr);
             if !out.same_driver {
-                out.psnr_threshold = case.psnr_other_driver;
                 out.notes.push(format!("golden blessed on '{}', running on '{}'", e.adapter, run.adapter));
             }
             if e.shader_hash != run.shader_hash {

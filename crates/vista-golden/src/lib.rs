@@ -26,7 +26,7 @@ pub use check::{
     unwritten_problem,
 };
 pub use run::{CheckOptions, Checked, check_case, in_order, run_info};
-pub use store::{Manifest, ManifestEntry, Store, params_hash};
+pub use store::{DriverThreshold, Manifest, ManifestEntry, Store, params_hash};
 
 use vista_gpu::GpuError;
 use vista_image::ImageError;

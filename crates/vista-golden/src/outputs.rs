@@ -43,11 +43,24 @@ impl OutputFiles {
     }
 }
 
+/// The allowance a float buffer without a tolerance gets on a driver other
+/// than the one that blessed it (SPEC 16): each value within this many f32
+/// units in the last place of the golden's...
+pub const CROSS_DRIVER_MAX_ULP: u64 = 16;
+/// ...or, for values near zero where ulps are tiny, within this absolute
+/// difference. The blessing driver itself compares exactly.
+pub const CROSS_DRIVER_MAX_ABS: f64 = 1e-6;
+
 /// How an output is judged: its tolerance, else exact for an integer
-/// texture or a buffer, else `None` (a float texture: PSNR of its view).
-pub fn effective_tolerance(out: &OutputRender) -> Option<Tolerance> {
+/// texture or a buffer (a float buffer on another driver than the
+/// blessing one: within [`CROSS_DRIVER_MAX_ULP`] or [`CROSS_DRIVER_MAX_ABS`]),
+/// else `None` (a float texture: PSNR of its view).
+pub fn effective_tolerance(out: &OutputRender, same_driver: bool) -> Option<Tolerance> {
     match (&out.value, out.tolerance) {
         (_, Some(t)) => Some(t),
+        (OutputValue::Buffer { element, .. }, None) if !same_driver && is_f32(element) => {
+            Some(Tolerance::UlpOrAbs { max_ulp: CROSS_DRIVER_MAX_ULP, max_abs: CROSS_DRIVER_MAX_ABS })
+        }
         (OutputValue::Buffer { .. }, None) => Some(Tolerance::Exact),
         (OutputValue::Texture { format, .. }, None) if vista_kernels::is_integer_format(format) => {
             Some(Tolerance::Exact)
@@ -92,7 +105,7 @@ pub fn output_files(golden_dir: &Path, case: &Case, key: &str, index: usize, out
         OutputValue::Buffer { .. } => OutputFiles { npy: Some(at("npy")), ..Default::default() },
         OutputValue::Texture { format, .. } => OutputFiles {
             png: Some(at("png")),
-            exr: (effective_tolerance(out).is_some() || keeps_raw(&case.kernel, format)).then(|| at("exr")),
+            exr: (effective_tolerance(out, true).is_some() || keeps_raw(&case.kernel, format)).then(|| at("exr")),
             npy: None,
             alpha: (index == 0 && case.kernel.opaque_display()).then(|| at("alpha.png")),
         },
@@ -143,11 +156,12 @@ pub fn compare_output(
     key: &str,
     index: usize,
     out: &OutputRender,
-    psnr_threshold: f64,
+    threshold: crate::DriverThreshold,
     blessed: Option<&crate::ManifestEntry>,
 ) -> OutputVerdict {
     let files = output_files(golden_dir, case, key, index, out);
-    let tolerance = effective_tolerance(out);
+    let tolerance = effective_tolerance(out, threshold.same_driver);
+    let psnr_threshold = threshold.psnr;
     let mut v = OutputVerdict {
         name: out.name.clone(),
         kind: match &out.value {
@@ -654,17 +668,31 @@ pub fn within_at(
             if !floats {
                 return Err("max_ulp applies to f32 values; this output holds integers (use exact or max_abs)".into());
             }
-            let ulp = |i: usize| {
-                let key = |v: f64| {
-                    let b = (v as f32).to_bits() as i64;
-                    if b < 0x8000_0000 { b } else { 0x8000_0000 - b }
-                };
-                (key(actual[i]) - key(expected[i])).unsigned_abs() as f64
-            };
+            let ulp = |i: usize| ulps(actual[i], expected[i]);
             let m = (0..actual.len()).map(ulp).fold(0.0, f64::max);
             match m <= bound as f64 {
                 true => Ok(format!("max_ulp {m} (<= {bound})")),
                 false => Err(format!("max_ulp {m} is above {bound}: {}", worst(&ulp))),
+            }
+        }
+        Tolerance::UlpOrAbs { max_ulp, max_abs } => {
+            // A value's excess over the allowance: 0 where either bound holds.
+            let excess = |i: usize| {
+                if diff(i) <= max_abs { 0.0 } else { (ulps(actual[i], expected[i]) - max_ulp as f64).max(0.0) }
+            };
+            let (m, a) = (0..actual.len()).fold((0.0f64, 0.0f64), |(m, a), i| {
+                if excess(i) > 0.0 { (m.max(ulps(actual[i], expected[i])), a.max(diff(i))) } else { (m, a) }
+            });
+            match m == 0.0 {
+                true => Ok(format!(
+                    "{} values within max_ulp {max_ulp} or max_abs {max_abs:e} (the cross-driver default)",
+                    actual.len()
+                )),
+                false => Err(format!(
+                    "max_ulp {m} (above {max_ulp}) where max_abs {a:.3e} is above {max_abs:e} (the cross-driver \
+                     default for a float buffer): {}",
+                    worst(&excess)
+                )),
             }
         }
         Tolerance::Rmse(bound) => {
@@ -683,6 +711,15 @@ pub fn within_at(
             }
         }
     }
+}
+
+/// How many f32 units in the last place lie between `a` and `b` (as f32).
+fn ulps(a: f64, b: f64) -> f64 {
+    let key = |v: f64| {
+        let b = (v as f32).to_bits() as i64;
+        if b < 0x8000_0000 { b } else { 0x8000_0000 - b }
+    };
+    (key(a) - key(b)).unsigned_abs() as f64
 }
 
 /// Earth mover's distance between the value histograms of `a` and `b`,
@@ -738,5 +775,38 @@ mod tests {
         let t = Tolerance::HistogramEmd { max: 0.1, bins: 10 };
         assert!(within(t, &[0.0, 0.0], &[1.0, 1.0], true).is_err());
         assert!(within(Tolerance::MaxAbs(1.0), &g, &[1.0, f64::NAN, 3.0, 4.0], true).unwrap_err().contains("NaN"));
+    }
+
+    /// A float buffer compares exactly on the blessing driver and within
+    /// the cross-driver default on another (one ulp apart, as boids on
+    /// SwiftShader against lavapipe); an integer buffer stays exact.
+    #[test]
+    fn float_buffers_get_the_cross_driver_default_on_another_driver() {
+        let buffer = |kind: char| OutputRender {
+            name: "boids".into(),
+            tolerance: None,
+            partial: false,
+            value: OutputValue::Buffer {
+                bytes: vec![0; 16],
+                element: vista_kernels::graph::Element {
+                    stride: 16,
+                    header: 0,
+                    fixed: None,
+                    leaves: vec![(0, kind, "pos".into()), (8, kind, "vel".into())],
+                    wgsl: "Boid".into(),
+                },
+                count: 1,
+            },
+        };
+        let default = Tolerance::UlpOrAbs { max_ulp: CROSS_DRIVER_MAX_ULP, max_abs: CROSS_DRIVER_MAX_ABS };
+        assert_eq!(effective_tolerance(&buffer('f'), true), Some(Tolerance::Exact));
+        assert_eq!(effective_tolerance(&buffer('f'), false), Some(default));
+        assert_eq!(effective_tolerance(&buffer('u'), false), Some(Tolerance::Exact));
+        let g = [0.25, -0.5, 1e-9, 3.0];
+        let one_ulp = f32::from_bits(0.25f32.to_bits() + 1) as f64;
+        assert!(within(Tolerance::Exact, &g, &[one_ulp, -0.5, 1e-9, 3.0], true).is_err(), "same driver: exact");
+        assert!(within(default, &g, &[one_ulp, -0.5, -1e-9, 3.0], true).is_ok(), "1 ulp, and a sign flip near 0");
+        let e = within(default, &g, &[0.25, -0.5, 1e-9, 3.001], true).unwrap_err();
+        assert!(e.contains("[3] 3.001 vs golden 3") && e.contains("cross-driver default"), "{e}");
     }
 }

@@ -194,8 +194,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
                     GoldenRead::Present { path, hash, image: image.as_ref().map_err(|e| e.as_str()) }
                 }
             };
-            let same_driver = entry.is_none_or(|e| e.adapter == run.adapter);
-            let threshold = if same_driver { case.psnr_same_driver } else { case.psnr_other_driver };
+            let threshold = crate::DriverThreshold::of(case, entry, &run.adapter);
             let outputs: Vec<crate::outputs::OutputVerdict> = crate::outputs::outputs_of(case, &r)
                 .iter()
                 .enumerate()

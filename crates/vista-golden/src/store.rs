@@ -209,3 +209,25 @@ impl Store {
 pub fn params_hash(case: &Case) -> String {
     crate::short_hash(&format!("{}|{}x{}|{}", case.kernel.name(), case.width, case.height, case.params.canonical()))
 }
+
+/// Whether a run is on the driver that blessed the case's golden (no golden
+/// yet counts as the same), and the PSNR threshold that follows: the one
+/// place that chooses between a case's same-driver and other-driver
+/// thresholds (SPEC 4, 11). Buffers take their cross-driver allowance from
+/// the same choice ([`crate::outputs::effective_tolerance`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriverThreshold {
+    /// The adapter and driver are the bless-time ones.
+    pub same_driver: bool,
+    /// The case's PSNR threshold for that.
+    pub psnr: f64,
+}
+
+impl DriverThreshold {
+    /// The threshold for `case` run on `adapter`, against its manifest `entry`.
+    pub fn of(case: &Case, entry: Option<&ManifestEntry>, adapter: &str) -> DriverThreshold {
+        let same_driver = entry.is_none_or(|e| e.adapter == adapter);
+        let psnr = if same_driver { case.psnr_same_driver } else { case.psnr_other_driver };
+        DriverThreshold { same_driver, psnr }
+    }
+}

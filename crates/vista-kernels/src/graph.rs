@@ -172,6 +172,15 @@ pub enum Tolerance {
     MaxUlp(u64),
     /// The root-mean-square difference from the golden is at most this.
     Rmse(f64),
+    /// Each value within `max_ulp` f32 units in the last place or within
+    /// `max_abs` of the golden's: the cross-driver allowance of a float
+    /// buffer without a tolerance (not a manifest key).
+    UlpOrAbs {
+        /// Units in the last place.
+        max_ulp: u64,
+        /// Absolute difference, for values near zero.
+        max_abs: f64,
+    },
     /// Earth mover's distance between the value histograms (`bins` bins
     /// over the golden's range), in units of that range.
     HistogramEmd {
@@ -194,6 +203,9 @@ impl Tolerance {
             Tolerance::MaxRel(v) => format!("max_rel {v}"),
             Tolerance::MaxUlp(v) => format!("max_ulp {v}"),
             Tolerance::Rmse(v) => format!("rmse {v}"),
+            Tolerance::UlpOrAbs { max_ulp, max_abs } => {
+                format!("max_ulp {max_ulp} or max_abs {max_abs:e} per value (the cross-driver default)")
+            }
             Tolerance::HistogramEmd { max, bins } => format!("histogram_emd {max} over {bins} bins"),
         }
     }

@@ -417,10 +417,7 @@ fn judge_case(
     let files = gpu.kernel_file_hashes(&b.case.kernel).unwrap_or_default();
     let path = std::path::PathBuf::from(b.case.golden_rel_path());
     let entry = manifest.case.get(&b.case.id);
-    let threshold = match entry.is_none_or(|e| e.adapter == run.adapter) {
-        true => b.case.psnr_same_driver,
-        false => b.case.psnr_other_driver,
-    };
+    let threshold = vista_golden::DriverThreshold::of(b.case, entry, &run.adapter);
     // Any output's verdict kills a mutant (a graph's, or a raw golden's).
     let outputs: Vec<vista_golden::outputs::OutputVerdict> = vista_golden::outputs::outputs_of(b.case, r)
         .iter()
