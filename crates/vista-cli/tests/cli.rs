@@ -2484,6 +2484,42 @@ fn valued_defs_reach_imported_modules() {
     assert_rejected(&render_exr(d.path(), "8x8", "d").0, 2, &["defs: STEPS = 2.5 is not valid", "an integer"]);
 }
 
+/// One file composed per pass with different defs, as bevy's downsampler
+/// is (`FIRST_PASS` for one pipeline, the rest for the other): a pass's
+/// `defs` merge over the kernel's, a pass's value winning.
+fn per_pass_defs_compose_one_file_twice() {
+    let shader = "#if LEVEL == 2\nconst LEVEL_F: f32 = 2.0;\n#else\nconst LEVEL_F: f32 = 1.0;\n#endif\n\
+                  #ifdef FIRST_PASS\n\
+                  @group(0) @binding(0) var dst: texture_storage_2d<rgba32float, write>;\n\
+                  @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n    \
+                  textureStore(dst, id.xy, vec4<f32>(0.25, LEVEL_F, 0.0, 1.0));\n}\n\
+                  #else\n\
+                  @group(0) @binding(0) var src: texture_2d<f32>;\n\
+                  @group(0) @binding(1) var dst: texture_storage_2d<rgba32float, write>;\n\
+                  @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n    \
+                  let v = textureLoad(src, id.xy, 0);\n    \
+                  textureStore(dst, id.xy, vec4<f32>(v.r * 2.0, v.g, LEVEL_F, 1.0));\n}\n\
+                  #endif\n";
+    let manifest = |second: &str| {
+        format!(
+            "summary = \"two passes from one file\"\ndefs = {{ LEVEL = 1 }}\n\
+             [[resource]]\nname = \"mid\"\nkind = \"texture\"\nformat = \"rgba32float\"\n\
+             [[resource]]\nname = \"out\"\nkind = \"texture\"\nformat = \"rgba32float\"\n\
+             [[pass]]\ndefs = {{ FIRST_PASS = true }}\nbind = {{ dst = \"mid\" }}\n\
+             [[pass]]\ndefs = {second}\nbind = {{ src = \"mid\", dst = \"out\" }}\n\
+             [[output]]\nresource = \"out\"\n"
+        )
+    };
+    let d = kernel_project(&manifest("{ LEVEL = 2 }"), shader);
+    let (r, out) = render_exr(d.path(), "8x8", "d");
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    // Pass 1 (FIRST_PASS, the kernel's LEVEL 1) wrote 0.25 and 1; pass 2
+    // (its own LEVEL 2) doubled the first and wrote 2.
+    assert_eq!(vista_image::load(&out).unwrap().get(3, 3), [0.5, 1.0, 2.0, 1.0]);
+    let d = kernel_project(&manifest("{ LEVEL = 2.5 }"), shader);
+    assert_rejected(&render_exr(d.path(), "8x8", "d").0, 2, &["[[pass]] 2: defs: LEVEL = 2.5 is not valid"]);
+}
+
 /// A uniform as real kernels lay theirs out: a matrix, integer vectors, an
 /// array and padding fields, packed from the manifest's params by name on
 /// every implementation.
@@ -4091,6 +4127,7 @@ fn main() {
         Gpu a_kernel_without_a_uniform_renders,
         Cpu unfed_globals_are_refused,
         Gpu valued_defs_reach_imported_modules,
+        Gpu per_pass_defs_compose_one_file_twice,
         Gpu several_uniforms_are_packed_by_variable_path,
         Gpu module_paths_tell_uniforms_of_two_modules_apart,
         Gpu a_project_kernel_named_like_a_builtin_does_not_get_its_reference,

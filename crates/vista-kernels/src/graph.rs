@@ -128,6 +128,10 @@ pub struct PassSpec {
     pub entry: String,
     /// Default: the manifest's shader.
     pub shader: Option<String>,
+    /// Shader defs (`NAME=value`) merged over the kernel's `defs` for this
+    /// pass: one composed module per distinct set (bevy's downsampler,
+    /// `FIRST_PASS` for one pipeline and `SECOND_PASS` for the other).
+    pub defs: Vec<String>,
     /// WGSL variable name -> resource name.
     pub bind: Vec<(String, String)>,
     /// Cover this resource with the reflected workgroup size.
@@ -242,8 +246,8 @@ pub struct GraphSpec {
 pub const RESOURCE_KEYS: [&str; 12] =
     ["name", "kind", "format", "dimension", "size", "file", "data", "fill", "length", "filter", "address", "compare"];
 /// The keys of a `[[pass]]` table.
-pub const PASS_KEYS: [&str; 9] =
-    ["entry", "shader", "bind", "dispatch", "workgroups", "set", "repeat", "swap", "group"];
+pub const PASS_KEYS: [&str; 10] =
+    ["entry", "shader", "defs", "bind", "dispatch", "workgroups", "set", "repeat", "swap", "group"];
 /// The keys of an `[[output]]` table.
 pub const OUTPUT_KEYS: [&str; 4] = ["resource", "view", "partial", "tolerance"];
 
@@ -265,7 +269,7 @@ pub(crate) fn is_graph(
                 || r.get("kind").and_then(|k| k.as_str()).is_some_and(|k| k != "texture")
                 || r.get("dimension").and_then(|k| k.as_str()) == Some("cube")
         })
-        || passes.iter().any(|p| has(p, &["shader", "dispatch", "set", "repeat", "swap", "group"]))
+        || passes.iter().any(|p| has(p, &["shader", "defs", "dispatch", "set", "repeat", "swap", "group"]))
         || outputs.iter().any(|o| has(o, &["tolerance"]))
 }
 
@@ -493,6 +497,11 @@ pub(crate) fn parse(
             return Err(at(format!("entry = \"{entry}\" is not a WGSL function name")));
         }
         let shader = text("shader")?;
+        let defs = match t.get("defs") {
+            None => Vec::new(),
+            Some(toml::Value::Table(d)) => crate::manifest::parse_defs(d).map_err(at)?,
+            Some(other) => return Err(at(format!("defs = {other} is not valid; expected a table {{ NAME = value }}"))),
+        };
         let mut bind = Vec::new();
         match t.get("bind") {
             None => {}
@@ -600,7 +609,7 @@ pub(crate) fn parse(
                 _ => {}
             }
         }
-        out_passes.push(PassSpec { entry, shader, bind, dispatch, workgroups, set, repeat, swap, group });
+        out_passes.push(PassSpec { entry, shader, defs, bind, dispatch, workgroups, set, repeat, swap, group });
     }
     let mut outs = Vec::new();
     for t in outputs {

@@ -540,7 +540,7 @@ impl Kernel {
     /// `fbm.wgsl?VISTA_HASH_PLANE&BASIS_IS_PERLIN`. Each distinct name is
     /// composed, cached and compiled as its own pipeline.
     pub fn shader_for(&self, p: &ParamSet) -> String {
-        self.with_defs(self.shader(), p)
+        self.with_defs(self.shader(), &[], p)
     }
 
     /// The WGSL module `vista::enums` of this kernel: every enum value as a
@@ -568,8 +568,12 @@ impl Kernel {
     }
 
     /// `file` with the defs of [`Kernel::shader_for`].
-    fn with_defs(&self, file: &str, p: &ParamSet) -> String {
-        let mut defs: Vec<String> = self.manifest.defs.clone();
+    fn with_defs(&self, file: &str, pass_defs: &[String], p: &ParamSet) -> String {
+        // A pass's def replaces the kernel's of the same name.
+        let name = |d: &String| d.split('=').next().unwrap_or_default().to_string();
+        let mut defs: Vec<String> =
+            self.manifest.defs.iter().filter(|d| !pass_defs.iter().any(|q| name(q) == name(d))).cloned().collect();
+        defs.extend(pass_defs.iter().cloned());
         if self.hash_plane(p).is_some() {
             defs.push("VISTA_HASH_PLANE".into());
         }
@@ -618,8 +622,9 @@ impl Kernel {
     /// The file of graph pass `i` as composed for `p`: its `shader` (else
     /// the manifest's) with the defs of [`Kernel::shader_for`].
     pub fn pass_shader_for(&self, i: usize, p: &ParamSet) -> String {
-        let file = self.graph().and_then(|g| g.passes[i].shader.as_deref()).unwrap_or(self.shader());
-        self.with_defs(file, p)
+        let pass = self.graph().map(|g| &g.passes[i]);
+        let file = pass.and_then(|s| s.shader.as_deref()).unwrap_or(self.shader());
+        self.with_defs(file, pass.map_or(&[], |s| s.defs.as_slice()), p)
     }
 
     /// Reflects every pass of the graph (`modules[i]`: pass i's composed

@@ -111,6 +111,8 @@ struct RawPass {
     /// WGSL variable name -> resource name.
     bind: Option<toml::Table>,
     shader: Option<toml::Value>,
+    /// Per-pass shader defs (read by graph.rs).
+    defs: Option<toml::Value>,
     dispatch: Option<toml::Value>,
     set: Option<toml::Value>,
     repeat: Option<toml::Value>,
@@ -621,23 +623,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             names.join(", ")
         )));
     }
-    let mut defs = Vec::new();
-    for (k, v) in &raw.defs {
-        if k.is_empty() || !k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            return Err(kfail(format!("defs: '{k}' is not a shader def name (letters, digits and '_')")));
-        }
-        match v {
-            toml::Value::Boolean(b) => defs.push(format!("{k}={b}")),
-            toml::Value::Integer(i) if (i32::MIN as i64..=u32::MAX as i64).contains(i) => defs.push(format!("{k}={i}")),
-            other => {
-                return Err(kfail(format!(
-                    "defs: {k} = {other} is not valid; expected true, false or an integer in [{}, {}]",
-                    i32::MIN,
-                    u32::MAX
-                )));
-            }
-        }
-    }
+    let defs = parse_defs(&raw.defs).map_err(kfail)?;
     let mut overrides = Vec::new();
     for (k, v) in &raw.overrides {
         let value = match v {
@@ -706,4 +692,27 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         presets,
         sweep_reference,
     })
+}
+
+/// A `defs` table (the kernel's, or a pass's) as `NAME=value` strings:
+/// naga_oil shader defs, bool or integer.
+pub(crate) fn parse_defs(table: &toml::Table) -> Result<Vec<String>, String> {
+    let mut defs = Vec::new();
+    for (k, v) in table {
+        if k.is_empty() || !k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(format!("defs: '{k}' is not a shader def name (letters, digits and '_')"));
+        }
+        match v {
+            toml::Value::Boolean(b) => defs.push(format!("{k}={b}")),
+            toml::Value::Integer(i) if (i32::MIN as i64..=u32::MAX as i64).contains(i) => defs.push(format!("{k}={i}")),
+            other => {
+                return Err(format!(
+                    "defs: {k} = {other} is not valid; expected true, false or an integer in [{}, {}]",
+                    i32::MIN,
+                    u32::MAX
+                ));
+            }
+        }
+    }
+    Ok(defs)
 }
