@@ -750,8 +750,8 @@ fn check(
         picked.retain(|c| {
             // Every file any pass reaches, as the manifest records them.
             let mut files = std::collections::BTreeMap::new();
-            for f in c.kernel.shader_files() {
-                files.extend(shaders.file_hashes(f).unwrap_or_default());
+            for f in c.kernel.shader_units() {
+                files.extend(shaders.file_hashes(&f).unwrap_or_default());
             }
             vista_golden::selection::change(c, &manifest, &files).is_some()
         });

@@ -3704,6 +3704,18 @@ fn the_ci_recipe_runs_as_written() {
 
 // ---- examples/project: a project outside the built-ins ---------------------
 
+/// `examples/<name>` and the binary copied into a temporary directory
+/// (kept while the first value lives), after its `cases` pass `check
+/// --matrix` on all three backends: (the directory, the binary, the copy).
+fn copied_example(name: &str, cases: usize) -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let t = tmp();
+    let (bin, root) = (t.path().join("vista"), t.path().join(name));
+    std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
+    copy_tree(&repo().join("examples").join(name), &root);
+    assert_matrix_passes(&run_in(&bin, &root, &[], &["check", "--matrix"]), cases);
+    (t, bin, root)
+}
+
 fn copy_tree(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for e in std::fs::read_dir(from).unwrap().flatten() {
@@ -3782,12 +3794,8 @@ fn the_example_project_works_with_a_copied_binary() {
 /// a valued def), checked against their committed goldens with a copied
 /// binary on lavapipe, SwiftShader and in Chromium.
 fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
-    let t = tmp();
-    let (bin, root) = (t.path().join("vista"), t.path().join("real"));
-    std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
-    copy_tree(&repo().join("examples/real-kernels"), &root);
+    let (_t, bin, root) = copied_example("real-kernels", 6);
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
-    assert_matrix_passes(&run(&["check", "--matrix"]), 6);
     // The read_write terrain is unsupported in Chromium, as its expectation says.
     let browser = run(&["check", "--backend", "browser", "--case", "terrain-default"]);
     assert!(
@@ -3839,6 +3847,100 @@ fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
     assert_eq!(sweep.code, 0, "{}", sweep.stderr);
     let bench = run(&["bench", "mandelbrot", "--size", "64x64", "--runs", "2", "--json"]);
     assert!(bench.code == 0 && bench.stdout.contains("\"mpix_per_s\":"), "{}", bench.stderr);
+}
+
+/// examples/sources, kernels whose projects assemble the source (SPEC 16):
+/// a bevy-like module tree, one file composed per pass with a host format
+/// placeholder, #include in four spellings, files a host joins. Checked
+/// against their committed goldens with a copied binary on lavapipe,
+/// SwiftShader and in Chromium, under the validation layer, and by
+/// mutation, sweep and bench.
+fn the_sources_example_passes_on_every_backend_with_a_copied_binary() {
+    let (_t, bin, root) = copied_example("sources", 6);
+    let run = |args: &[&str]| run_in(&bin, &root, &[], args);
+    let validated = run_in(&bin, &root, &[("VISTA_VALIDATION", "1")], &["check"]);
+    assert_eq!(validated.code, 0, "{}{}", validated.stdout, validated.stderr);
+    // Mutants reach included files and imported modules.
+    for (kernel, files) in [("cells", "include/"), ("transmittance", "atmos/functions.wgsl")] {
+        let m = run(&["mutate", "--kernel", kernel, "--sample", "6", "--json", "m.json"]);
+        assert_eq!(m.code, 0, "{}{}", m.stdout, m.stderr);
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(root.join("m.json")).unwrap()).unwrap();
+        let mutants = report["mutants"].as_array().unwrap();
+        assert!(mutants.iter().any(|m| m["file"].as_str().unwrap().starts_with(files)), "{kernel}: {report}");
+    }
+    // A sweep over the param the host writes into the source.
+    let sweep =
+        run(&["sweep", "clouds_joined", "--param", "octaves", "--values", "1,2,4", "--runs", "1", "--out", "sw"]);
+    assert_eq!(sweep.code, 0, "{}", sweep.stderr);
+    let bench = run(&["bench", "cells", "--size", "64x64", "--runs", "2", "--json"]);
+    assert!(bench.code == 0 && bench.stdout.contains("\"mpix_per_s\":"), "{}", bench.stderr);
+}
+
+/// Every file an assembly reaches, and every replacement, is in the shader
+/// hash and the per-file hashes: editing one makes check name that file.
+/// A WGSL error in an included file names that file and its own line.
+fn assembled_sources_name_their_own_files() {
+    let t = tmp();
+    let root = t.path().join("sources");
+    copy_tree(&repo().join("examples/sources"), &root);
+    let run = |args: &[&str]| vista_in(Some(&root), &[], args);
+    let edit = |rel: &str, f: &dyn Fn(String) -> String| {
+        let p = root.join(rel);
+        std::fs::write(&p, f(std::fs::read_to_string(&p).unwrap())).unwrap();
+    };
+    let changed = |case: &str| -> Vec<String> {
+        let r = run(&["check", "--json", "r.json"]);
+        assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(root.join("r.json")).unwrap()).unwrap();
+        let c = v["cases"].as_array().unwrap().iter().find(|c| c["id"] == case).unwrap().clone();
+        c["changed_files"].as_array().unwrap().iter().map(|f| f.as_str().unwrap().to_string()).collect()
+    };
+    for (file, case) in [
+        ("shaders/include/rng.inc.wgsl", "cells"),          // included from a folder
+        ("shaders/cells/common.wgsl", "cells"),             // included next to the file
+        ("shaders/joined/noise_lib.wgsl", "clouds-joined"), // prepended
+        ("shaders/joined/tone.wgsl", "clouds-joined"),      // appended
+        ("shaders/atmos/types.wgsl", "transmittance"),      // imported by a module the kernel imports
+    ] {
+        edit(file, &|s| s + "// edited\n");
+        assert_eq!(changed(case), [file.strip_prefix("shaders/").unwrap()], "{file}");
+        edit(file, &|s| s.strip_suffix("// edited\n").unwrap().to_string());
+    }
+    edit("kernels/mips.toml", &|s| {
+        s.replace("\"##TEXTURE_FORMAT##\" = \"rgba16float\"", "\"##TEXTURE_FORMAT##\" =  \"rgba16float\" ")
+    });
+    assert!(changed("mips").is_empty(), "the same replacement written otherwise");
+    // A replacement that changes only a comment: the output is the same, the
+    // manifest's replacements are named.
+    edit("kernels/mips.toml", &|s| s.replace("{ \"##", "{ \"Karis average\" = \"Karis mean\", \"##"));
+    assert_eq!(changed("mips"), ["[source] replace (from the manifest)"]);
+    // An error on line 7 of an included file is reported there.
+    edit("shaders/include/noise/value.wgsl", &|s| s.replace("f * 6.0", "f * six"));
+    let r = run(&["render", "cells", "--size", "8x8", "-o", "x.png"]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("include/noise/value.wgsl:7:"), "{}", r.stderr);
+    // A replacement key in no reached file, an include cycle, a missing include.
+    edit("kernels/mips.toml", &|s| s.replace("##TEXTURE_FORMAT##", "{TEXTURE_FORMAT}"));
+    assert_rejected(
+        &run(&["render", "mips", "--size", "64x64", "-o", "m.png"]),
+        2,
+        &["\"{TEXTURE_FORMAT}\" is found in no file the pass reaches (shaders/downsample.wgsl)"],
+    );
+    edit("shaders/include/noise/value.wgsl", &|s| s.replace("f * six", "f * 6.0"));
+    edit("shaders/include/noise/hash.wgsl", &|s| format!("#include <noise/value>\n{s}"));
+    assert_rejected(
+        &run(&["render", "cells", "--size", "8x8", "-o", "x.png"]),
+        2,
+        &["#include cycle:", "cells.wgsl:6 -> ", "value.wgsl:1 -> ", "hash.wgsl:1 -> ", "value.wgsl"],
+    );
+    edit("shaders/include/noise/hash.wgsl", &|s| s.replace("#include <noise/value>", "#include <noise/gone>"));
+    assert_rejected(
+        &run(&["render", "cells", "--size", "8x8", "-o", "x.png"]),
+        2,
+        &["#include \"noise/gone\" not found; tried"],
+    );
 }
 
 fn expected_failures_are_data_and_an_unexpected_pass_fails() {
@@ -4136,6 +4238,8 @@ fn main() {
     Gpu a_views_alpha_is_compared,
         Gpu overrides_take_manifest_values_and_params,
         Gpu the_real_kernels_example_passes_on_every_backend_with_a_copied_binary,
+        Gpu the_sources_example_passes_on_every_backend_with_a_copied_binary,
+        Gpu assembled_sources_name_their_own_files,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,
         Gpu graph_inputs_are_checked_before_gpu_work,
         Gpu every_output_of_a_graph_is_judged,

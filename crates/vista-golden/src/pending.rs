@@ -108,8 +108,8 @@ pub fn bless_from_report(
             return Err(stale(id, "its params (preset, set or size) changed since the check".into()));
         }
         let mut now = BTreeMap::new();
-        for f in case.kernel.shader_files() {
-            now.extend(files_now(f).map_err(|e| stale(id, e))?);
+        for f in case.kernel.shader_units() {
+            now.extend(files_now(&f).map_err(|e| stale(id, e))?);
         }
         let changed = crate::changed_files(&entry.shader_files, &now);
         if !changed.is_empty() {

@@ -25,7 +25,7 @@ pub use graph::{
     SamplerDesc, TextureDesc,
 };
 pub use limits::Needs;
-pub use shaders::{ENUMS_MODULE, ShaderSet, resolve_overrides, validate};
+pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
 pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \

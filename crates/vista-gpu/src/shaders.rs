@@ -40,6 +40,40 @@ pub struct ShaderSet {
     /// Nanoseconds spent composing and validating (naga_oil, naga), shared
     /// by clones of the set.
     compose_nanos: Arc<std::sync::atomic::AtomicU64>,
+    /// The manifests' `[source]` assemblies by id (`file|id` names use them).
+    sources: BTreeMap<String, vista_source::SourceSpec>,
+    /// Reads a file an assembly reaches outside this set's own files.
+    reader: Reader,
+    /// Assembled kernel sources by name without defs, built once per set.
+    units: Arc<Mutex<HashMap<String, Arc<Unit>>>>,
+}
+
+/// A root-relative path's text and origin, for files an assembly reaches
+/// outside `shaders/` (the project layer reads them; this crate reads none).
+#[derive(Clone, Default)]
+pub struct Reader(Option<Arc<ReadFn>>);
+
+/// A root-relative path to its text and origin.
+type ReadFn = dyn Fn(&str) -> Option<(String, String)> + Send + Sync;
+
+impl Reader {
+    /// A reader over `read`.
+    pub fn new(read: impl Fn(&str) -> Option<(String, String)> + Send + Sync + 'static) -> Reader {
+        Reader(Some(Arc::new(read)))
+    }
+}
+
+impl std::fmt::Debug for Reader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.is_some() { "Reader(project)" } else { "Reader(none)" })
+    }
+}
+
+/// What a name composes: a kernel file's text, or its assembly.
+#[derive(Debug)]
+struct Unit {
+    source: Source,
+    assembled: Option<vista_source::Assembled>,
 }
 
 /// One WGSL file of a [`ShaderSet`] and what naga_oil's preprocessor reads
@@ -113,7 +147,26 @@ impl ShaderSet {
             composers: Default::default(),
             enums: BTreeMap::new(),
             compose_nanos: Default::default(),
+            sources: BTreeMap::new(),
+            reader: Reader::default(),
+            units: Default::default(),
         }
+    }
+
+    /// This set with the manifests' `[source]` assemblies (`(id, spec)`,
+    /// [`vista_source::SourceSpec::id`]) and a reader for the files they
+    /// reach outside `shaders/`. A name `file|id?...` composes `file` as
+    /// assembled by spec `id`.
+    pub fn with_sources(
+        mut self,
+        specs: impl IntoIterator<Item = (String, vista_source::SourceSpec)>,
+        reader: Reader,
+    ) -> ShaderSet {
+        self.sources.extend(specs);
+        self.reader = reader;
+        self.composed = Default::default();
+        self.units = Default::default();
+        self
     }
 
     /// This set with a generated `vista::enums` module per kernel file:
@@ -170,6 +223,46 @@ impl ShaderSet {
                 self.kernels.keys().cloned().collect::<Vec<_>>().join(", ")
             ))
         })
+    }
+
+    /// What `name` composes: its kernel file, or (`file|id`) that file as
+    /// the `[source]` spec `id` assembles it with the replacement texts the
+    /// name carries (`%i=text`). Built once per set.
+    fn unit(&self, name: &str) -> Result<Arc<Unit>, GpuError> {
+        let key = unit_key(name);
+        if let Some(u) = self.units.lock().expect("unit cache").get(&key) {
+            return Ok(u.clone());
+        }
+        let kernel = self.kernel_source(name)?;
+        let unit = match spec_id(name) {
+            None => Unit { source: kernel.clone(), assembled: None },
+            Some(id) => {
+                let spec = self.sources.get(id).ok_or_else(|| {
+                    GpuError::Shader(format!("{}: no [source] assembly {id} in {}", file_of(name), self.label))
+                })?;
+                let values = replacement_values(name, spec);
+                let read = |path: &str| self.read(path);
+                let assembled = vista_source::assemble(&format!("shaders/{}", file_of(name)), spec, &values, &read)
+                    .map_err(|e| GpuError::Shader(format!("{}: {e}", kernel.origin)))?;
+                let source = Source::new(kernel.rel.clone(), assembled.text.clone(), kernel.origin.clone());
+                Unit { source, assembled: Some(assembled) }
+            }
+        };
+        let unit = Arc::new(unit);
+        self.units.lock().expect("unit cache").insert(key, unit.clone());
+        Ok(unit)
+    }
+
+    /// A root-relative path's text and origin: this set's own file (an
+    /// edited one, under mutation) for `shaders/...`, else the reader's.
+    fn read(&self, path: &str) -> Option<(String, String)> {
+        if let Some(rel) = path.strip_prefix("shaders/") {
+            let own = self.kernels.get(rel).or_else(|| self.lib.iter().find(|e| e.rel == rel));
+            if let Some(s) = own {
+                return Some((s.text.clone(), s.origin.clone()));
+            }
+        }
+        self.reader.0.as_ref().and_then(|r| r(path))
     }
 
     /// The generated `vista::enums` text for kernel file `name` (its
@@ -289,7 +382,16 @@ impl ShaderSet {
     }
 
     fn compose_uncached(&self, name: &str) -> Result<naga::Module, GpuError> {
-        let kernel = self.kernel_source(name)?;
+        let unit = self.unit(name)?;
+        // An assembled source's errors name the file and line each came from.
+        let located = |e: GpuError| match (e, &unit.assembled) {
+            (GpuError::Shader(m), Some(a)) => GpuError::Shader(locate(&m, &unit.source.origin, a)),
+            (e, _) => e,
+        };
+        self.compose_unit(name, &unit.source).map_err(located)
+    }
+
+    fn compose_unit(&self, name: &str, kernel: &Source) -> Result<naga::Module, GpuError> {
         let (source, origin) = (&kernel.text, &kernel.origin);
         // A file without preprocessor directives needs no composition; naga
         // parses it directly. naga_oil 0.23 loses the expressions of an
@@ -336,7 +438,8 @@ impl ShaderSet {
     /// kernel's output changes it, and edits to unrelated modules do not
     /// (so they do not mark every golden's provenance stale).
     pub fn source_hash(&self, name: &str) -> Result<String, GpuError> {
-        let kernel = self.kernel_source(name)?;
+        let unit = self.unit(name)?;
+        let kernel = &unit.source;
         let mut h = blake3::Hasher::new();
         h.update(name.as_bytes());
         h.update(kernel.text.as_bytes());
@@ -355,24 +458,44 @@ impl ShaderSet {
     /// Each file of [`ShaderSet::import_closure`] with the hash of its text:
     /// recorded at bless time so that a check can name the files that changed.
     pub fn file_hashes(&self, name: &str) -> Result<std::collections::BTreeMap<String, String>, GpuError> {
-        let kernel = self.kernel_source(name)?;
+        let unit = self.unit(name)?;
+        let kernel = &unit.source;
         let hash = |text: &str| blake3::hash(text.as_bytes()).to_hex()[..16].to_string();
         let lib = self.imported_lib(kernel)?;
         let enums =
             self.enums_for(name, kernel, &lib)?.map(|text| (format!("{ENUMS_MODULE} (from the manifest)"), hash(text)));
-        Ok(std::iter::once((name.to_string(), hash(&kernel.text)))
-            .chain(lib.iter().map(|e| (e.rel.clone(), hash(&e.text))))
-            .chain(enums)
-            .collect())
+        // An assembly: every file it reached by its own path (under
+        // shaders/ relative to it, like the rest), and the replacements.
+        let parts: Vec<(String, String)> = match (&unit.assembled, spec_id(name).and_then(|id| self.sources.get(id))) {
+            (Some(a), Some(spec)) => {
+                let mut v: Vec<(String, String)> =
+                    a.parts.iter().map(|p| (shader_rel(&p.path), hash(&p.text))).collect();
+                if !spec.replace.is_empty() {
+                    v.push(("[source] replace (from the manifest)".into(), hash(&format!("{:?}", spec.replace))));
+                }
+                v
+            }
+            _ => vec![(name.to_string(), hash(&kernel.text))],
+        };
+        Ok(parts.into_iter().chain(lib.iter().map(|e| (e.rel.clone(), hash(&e.text)))).chain(enums).collect())
     }
 
     /// The kernel file and the lib modules it reaches through `#import`
     /// (paths relative to `shaders/`): every file whose edit can change it.
     pub fn import_closure(&self, name: &str) -> Result<Vec<String>, GpuError> {
-        let kernel = self.kernel_source(name)?;
-        Ok(std::iter::once(name.to_string())
-            .chain(self.imported_lib(kernel)?.into_iter().map(|e| e.rel.clone()))
-            .collect())
+        let unit = self.unit(name)?;
+        // An assembly's parts that are files of this set (under shaders/).
+        let parts: Vec<String> = match &unit.assembled {
+            None => vec![name.to_string()],
+            Some(a) => a
+                .parts
+                .iter()
+                .filter_map(|p| p.path.strip_prefix("shaders/"))
+                .filter(|rel| self.kernels.contains_key(*rel) || self.lib.iter().any(|e| e.rel == *rel))
+                .map(str::to_string)
+                .collect(),
+        };
+        Ok(parts.into_iter().chain(self.imported_lib(&unit.source)?.into_iter().map(|e| e.rel.clone())).collect())
     }
 
     /// Library files reachable from `kernel` through `#import`, in `lib`
@@ -472,9 +595,67 @@ pub fn keep_struct_layouts(name: &str, module: &naga::Module, text: String) -> R
     Ok(out)
 }
 
-/// The kernel file of a kernel name (`fbm.wgsl?A&B` -> `fbm.wgsl`).
+/// The kernel file of a kernel name (`fbm.wgsl?A&B` -> `fbm.wgsl`,
+/// `k.wgsl|1a2b3c4d?%0=r32float` -> `k.wgsl`).
 fn file_of(name: &str) -> &str {
-    name.split_once('?').map_or(name, |(file, _)| file)
+    let unit = name.split_once('?').map_or(name, |(file, _)| file);
+    unit.split_once('|').map_or(unit, |(file, _)| file)
+}
+
+/// The `[source]` spec id of a name (`k.wgsl|1a2b3c4d?...`), if any.
+fn spec_id(name: &str) -> Option<&str> {
+    let unit = name.split_once('?').map_or(name, |(file, _)| file);
+    unit.split_once('|').map(|(_, id)| id)
+}
+
+/// A name without its shader defs: what one assembly is keyed by (the
+/// file, the spec id, the replacement texts).
+fn unit_key(name: &str) -> String {
+    let (unit, rest) = name.split_once('?').unwrap_or((name, ""));
+    let values: Vec<&str> = rest.split('&').filter(|d| d.starts_with('%')).collect();
+    if values.is_empty() { unit.to_string() } else { format!("{unit}?{}", values.join("&")) }
+}
+
+/// The text of each `{ param = .. }` replacement of `spec`, from the name's
+/// `%i=text` items; a name without them (a hash over the manifest's
+/// assembly, whatever the params) puts `<param>` in their place.
+fn replacement_values(name: &str, spec: &vista_source::SourceSpec) -> Vec<String> {
+    let rest = name.split_once('?').map_or("", |(_, d)| d);
+    spec.params()
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            rest.split('&')
+                .find_map(|d| d.strip_prefix(&format!("%{i}=")))
+                .map_or_else(|| format!("<{p}>"), str::to_string)
+        })
+        .collect()
+}
+
+/// A root-relative path as per-file hashes name files: relative to
+/// `shaders/` where it lies there (as a kernel's own files), else as is.
+fn shader_rel(path: &str) -> String {
+    path.strip_prefix("shaders/").unwrap_or(path).to_string()
+}
+
+/// `message` with every `origin:LINE:COL` of the assembled text replaced by
+/// the file and line that line came from.
+fn locate(message: &str, origin: &str, a: &vista_source::Assembled) -> String {
+    let needle = format!("{origin}:");
+    let mut out = String::new();
+    let mut rest = message;
+    while let Some(at) = rest.find(&needle) {
+        out.push_str(&rest[..at]);
+        let after = &rest[at + needle.len()..];
+        let digits = after.chars().take_while(char::is_ascii_digit).count();
+        match after[..digits].parse::<usize>().ok().and_then(|l| a.locate(l)) {
+            Some((file, line)) if after[digits..].starts_with(':') => out.push_str(&format!("{file}:{line}")),
+            _ => out.push_str(&format!("{origin}:{}", &after[..digits])),
+        }
+        rest = &after[digits..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// The module path `source` declares and the modules it imports, both by
@@ -556,7 +737,7 @@ fn shader_defs(name: &str) -> HashMap<String, naga_oil::compose::ShaderDefValue>
     use naga_oil::compose::ShaderDefValue as V;
     let defs = name.split_once('?').map_or("", |(_, d)| d);
     defs.split('&')
-        .filter(|d| !d.is_empty())
+        .filter(|d| !d.is_empty() && !d.starts_with('%'))
         .map(|d| match d.split_once('=') {
             None => (d.to_string(), V::Bool(true)),
             Some((k, v)) => {

@@ -132,6 +132,9 @@ pub struct PassSpec {
     /// pass: one composed module per distinct set (bevy's downsampler,
     /// `FIRST_PASS` for one pipeline and `SECOND_PASS` for the other).
     pub defs: Vec<String>,
+    /// The pass's `source` keys (merged over the kernel's `[source]` by
+    /// [`crate::Kernel::source_for`]).
+    pub source: vista_source::SourceSpec,
     /// WGSL variable name -> resource name.
     pub bind: Vec<(String, String)>,
     /// Cover this resource with the reflected workgroup size.
@@ -246,8 +249,8 @@ pub struct GraphSpec {
 pub const RESOURCE_KEYS: [&str; 12] =
     ["name", "kind", "format", "dimension", "size", "file", "data", "fill", "length", "filter", "address", "compare"];
 /// The keys of a `[[pass]]` table.
-pub const PASS_KEYS: [&str; 10] =
-    ["entry", "shader", "defs", "bind", "dispatch", "workgroups", "set", "repeat", "swap", "group"];
+pub const PASS_KEYS: [&str; 11] =
+    ["entry", "shader", "defs", "source", "bind", "dispatch", "workgroups", "set", "repeat", "swap", "group"];
 /// The keys of an `[[output]]` table.
 pub const OUTPUT_KEYS: [&str; 4] = ["resource", "view", "partial", "tolerance"];
 
@@ -269,7 +272,7 @@ pub(crate) fn is_graph(
                 || r.get("kind").and_then(|k| k.as_str()).is_some_and(|k| k != "texture")
                 || r.get("dimension").and_then(|k| k.as_str()) == Some("cube")
         })
-        || passes.iter().any(|p| has(p, &["shader", "defs", "dispatch", "set", "repeat", "swap", "group"]))
+        || passes.iter().any(|p| has(p, &["shader", "defs", "source", "dispatch", "set", "repeat", "swap", "group"]))
         || outputs.iter().any(|o| has(o, &["tolerance"]))
 }
 
@@ -502,6 +505,11 @@ pub(crate) fn parse(
             Some(toml::Value::Table(d)) => crate::manifest::parse_defs(d).map_err(at)?,
             Some(other) => return Err(at(format!("defs = {other} is not valid; expected a table {{ NAME = value }}"))),
         };
+        let source = match t.get("source") {
+            None => Default::default(),
+            Some(toml::Value::Table(s)) => vista_source::SourceSpec::parse(s).map_err(at)?,
+            Some(other) => return Err(at(format!("source = {other} is not valid; expected a table like [source]"))),
+        };
         let mut bind = Vec::new();
         match t.get("bind") {
             None => {}
@@ -609,7 +617,7 @@ pub(crate) fn parse(
                 _ => {}
             }
         }
-        out_passes.push(PassSpec { entry, shader, defs, bind, dispatch, workgroups, set, repeat, swap, group });
+        out_passes.push(PassSpec { entry, shader, defs, source, bind, dispatch, workgroups, set, repeat, swap, group });
     }
     let mut outs = Vec::new();
     for t in outputs {

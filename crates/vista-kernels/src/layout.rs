@@ -365,6 +365,8 @@ fn host_only(kernel: &Kernel, name: &str) -> bool {
         || m.workgroups.iter().flatten().any(|e| e.mentions(name))
         || m.resources.iter().filter_map(|r| r.size.as_ref()).flatten().any(|e| e.mentions(name))
         || m.graph.as_ref().is_some_and(|g| crate::graph::host_params(g).contains(&name))
+        || m.source.params().contains(&name)
+        || m.graph.iter().flat_map(|g| &g.passes).any(|p| p.source.params().contains(&name))
 }
 
 /// The param feeding `f`, if any: one named by its `variable.path`, else

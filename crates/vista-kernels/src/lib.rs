@@ -540,7 +540,46 @@ impl Kernel {
     /// `fbm.wgsl?VISTA_HASH_PLANE&BASIS_IS_PERLIN`. Each distinct name is
     /// composed, cached and compiled as its own pipeline.
     pub fn shader_for(&self, p: &ParamSet) -> String {
-        self.with_defs(self.shader(), &[], p)
+        self.with_defs(self.shader(), &[], &self.manifest.source, p)
+    }
+
+    /// How pass `i`'s text is assembled: the kernel's `[source]` with the
+    /// pass's `source` keys over it.
+    pub fn source_for(&self, i: usize) -> vista_source::SourceSpec {
+        match self.graph() {
+            Some(g) => self.manifest.source.merged(&g.passes[i].source),
+            None => self.manifest.source.clone(),
+        }
+    }
+
+    /// Every distinct assembly the kernel's passes use, by
+    /// [`vista_source::SourceSpec::id`] (none without `[source]`).
+    pub fn source_specs(&self) -> Vec<(String, vista_source::SourceSpec)> {
+        let n = self.graph().map_or(1, |g| g.passes.len());
+        let mut out: Vec<(String, vista_source::SourceSpec)> = Vec::new();
+        for spec in (0..n).map(|i| self.source_for(i)).filter(|s| !s.is_empty()) {
+            if !out.iter().any(|(id, _)| *id == spec.id()) {
+                out.push((spec.id(), spec));
+            }
+        }
+        out
+    }
+
+    /// What each pass composes, without defs: its file, or `file|id` where
+    /// a `[source]` assembles it ([`Kernel::source_specs`]). The shader
+    /// hash and per-file hashes are taken over these.
+    pub fn shader_units(&self) -> Vec<String> {
+        let n = self.graph().map_or(1, |g| g.passes.len());
+        let mut out: Vec<String> = Vec::new();
+        for i in 0..n {
+            let file = self.graph().and_then(|g| g.passes[i].shader.as_deref()).unwrap_or(self.shader());
+            let spec = self.source_for(i);
+            let unit = if spec.is_empty() { file.to_string() } else { format!("{file}|{}", spec.id()) };
+            if !out.contains(&unit) {
+                out.push(unit);
+            }
+        }
+        out
     }
 
     /// The WGSL module `vista::enums` of this kernel: every enum value as a
@@ -568,7 +607,11 @@ impl Kernel {
     }
 
     /// `file` with the defs of [`Kernel::shader_for`].
-    fn with_defs(&self, file: &str, pass_defs: &[String], p: &ParamSet) -> String {
+    ///
+    /// With a `[source]`, the file becomes `file|id` and each `{ param = .. }`
+    /// replacement's text follows the defs as `%i=text` (an enum's value
+    /// name, a number's decimal text), so each distinct text composes once.
+    fn with_defs(&self, file: &str, pass_defs: &[String], source: &vista_source::SourceSpec, p: &ParamSet) -> String {
         // A pass's def replaces the kernel's of the same name.
         let name = |d: &String| d.split('=').next().unwrap_or_default().to_string();
         let mut defs: Vec<String> =
@@ -582,8 +625,21 @@ impl Kernel {
                 defs.push(format!("{name}_is_{v}").to_uppercase().replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
             }
         }
-        match defs.is_empty() {
+        let file = match source.is_empty() {
             true => file.to_string(),
+            false => format!("{file}|{}", source.id()),
+        };
+        for (i, name) in source.params().into_iter().enumerate() {
+            let text = match p.value(name) {
+                Some(Value::Enum(v)) => v.clone(),
+                Some(Value::Int(v)) => v.to_string(),
+                Some(Value::Float(v)) => format!("{:?}", *v as f32),
+                other => unreachable!("the manifest allows only enum and number params here, got {other:?}"),
+            };
+            defs.push(format!("%{i}={text}"));
+        }
+        match defs.is_empty() {
+            true => file,
             false => format!("{file}?{}", defs.join("&")),
         }
     }
@@ -624,7 +680,7 @@ impl Kernel {
     pub fn pass_shader_for(&self, i: usize, p: &ParamSet) -> String {
         let pass = self.graph().map(|g| &g.passes[i]);
         let file = pass.and_then(|s| s.shader.as_deref()).unwrap_or(self.shader());
-        self.with_defs(file, pass.map_or(&[], |s| s.defs.as_slice()), p)
+        self.with_defs(file, pass.map_or(&[], |s| s.defs.as_slice()), &self.source_for(i), p)
     }
 
     /// Reflects every pass of the graph (`modules[i]`: pass i's composed

@@ -77,6 +77,8 @@ struct RawManifest {
     /// naga_oil shader defs: bool or integer values.
     #[serde(default)]
     defs: toml::Table,
+    /// How the shader's text is assembled (SPEC 16).
+    source: Option<toml::Table>,
     /// Values of the shader's pipeline-overridable constants.
     #[serde(default)]
     overrides: toml::Table,
@@ -111,8 +113,9 @@ struct RawPass {
     /// WGSL variable name -> resource name.
     bind: Option<toml::Table>,
     shader: Option<toml::Value>,
-    /// Per-pass shader defs (read by graph.rs).
+    /// Per-pass shader defs and source keys (read by graph.rs).
     defs: Option<toml::Value>,
+    source: Option<toml::Value>,
     dispatch: Option<toml::Value>,
     set: Option<toml::Value>,
     repeat: Option<toml::Value>,
@@ -245,6 +248,9 @@ pub struct Manifest {
     /// naga_oil shader defs (`defs = { MAX_LIGHTS = 10, FIRST_PASS = true }`),
     /// as `NAME=value` in declaration order.
     pub defs: Vec<String>,
+    /// The kernel's `[source]`: how its shaders' text is assembled (a
+    /// pass's `source` merges over it).
+    pub source: vista_source::SourceSpec,
     /// Values of `override` constants (`overrides = { BLOCK = 128 }`); a
     /// param of an override's name feeds it too, and wins.
     pub overrides: Vec<(String, f64)>,
@@ -624,6 +630,10 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         )));
     }
     let defs = parse_defs(&raw.defs).map_err(kfail)?;
+    let source = match &raw.source {
+        Some(t) => vista_source::SourceSpec::parse(t).map_err(kfail)?,
+        None => Default::default(),
+    };
     let mut overrides = Vec::new();
     for (k, v) in &raw.overrides {
         let value = match v {
@@ -665,6 +675,26 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         }
         groups.push(ParamGroup { field: g.field.clone(), prefix: g.prefix.clone(), rename });
     }
+    // A replacement's param gives text: an enum's value name or a number.
+    let pass_sources = graph.iter().flat_map(|g| g.passes.iter().map(|p| &p.source));
+    for p in std::iter::once(&source).chain(pass_sources).flat_map(|s| s.params()) {
+        match params.iter().find(|s| s.name == p).map(|s| &s.ty) {
+            Some(ParamType::Enum | ParamType::U32 | ParamType::I32 | ParamType::F32) => {}
+            Some(other) => {
+                return Err(kfail(format!(
+                    "[source] replace: param {p} is {}; a replacement takes an enum or a number (u32, i32, f32)",
+                    other.name()
+                )));
+            }
+            None => {
+                let names: Vec<&str> = params.iter().map(|s| s.name.as_str()).collect();
+                return Err(kfail(format!(
+                    "[source] replace: {{ param = \"{p}\" }} names no param; params: {}",
+                    if names.is_empty() { "none".into() } else { names.join(", ") }
+                )));
+            }
+        }
+    }
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
         name: name.to_string(),
@@ -681,6 +711,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         graph,
         describes_resources,
         defs,
+        source,
         overrides,
         work,
         output_range: raw.output_range.map(|[a, b]| (a, b)),

@@ -278,8 +278,8 @@ pub fn plan(
     for k in kernels {
         // Every file any pass reaches, and every pass's entry point as a root.
         let mut closure: Vec<&SourceFile> = Vec::new();
-        for shader in k.shader_files() {
-            for rel in shaders.import_closure(shader)? {
+        for shader in k.shader_units() {
+            for rel in shaders.import_closure(&shader)? {
                 let f = files.iter().find(|f| f.rel == rel).expect("the closure names files of the set");
                 if !closure.iter().any(|c| c.rel == f.rel) {
                     closure.push(f);
@@ -508,6 +508,7 @@ pub fn run(
 ) -> Result<Vec<MutantReport>, GoldenError> {
     let files = project.shader_files()?;
     let enums = vista_render::enum_modules(project)?;
+    let (sources, reader) = vista_render::source_specs(project)?;
     let label = "mutant";
     let set = |edit: Option<&Mutant>| {
         ShaderSet::from_files(
@@ -521,6 +522,7 @@ pub fn run(
             }),
         )
         .with_enums(enums.iter().cloned())
+        .with_sources(sources.iter().cloned(), reader.clone())
     };
     let manifest = store.manifest()?;
     let original = Renderer { ctx, shaders: set(None), limits, root: project.root().map(Into::into) };

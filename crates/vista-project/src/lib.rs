@@ -199,6 +199,18 @@ impl Project {
         self.layered("shaders", builtin::SHADERS, "wgsl")
     }
 
+    /// The text and path of a file under the root (`rel` relative to it,
+    /// `/` separators, no `..`), for the files a kernel's `[source]`
+    /// reaches; `None` without a root or such a file.
+    pub fn read_text(&self, rel: &str) -> Option<(String, String)> {
+        if rel.split('/').any(|c| c == "..") {
+            return None;
+        }
+        let path = self.root()?.join(rel);
+        let text = fs::read_to_string(&path).ok()?;
+        Some((text, path.display().to_string()))
+    }
+
     /// Every kernel manifest (`kernels/*.toml`): the built-ins overlaid by
     /// the project's, sorted by path.
     pub fn kernel_files(&self) -> Result<Vec<SourceFile>, ProjectError> {

@@ -191,8 +191,8 @@ impl<'a> Renderer<'a> {
     /// Provenance hash of every file a kernel's passes reach (one file:
     /// [`Renderer::shader_hash`] of it).
     pub fn kernel_shader_hash(&self, kernel: &Kernel) -> Result<String, RenderError> {
-        let files = kernel.shader_files();
-        if let [one] = files[..] {
+        let files = kernel.shader_units();
+        if let [one] = &files[..] {
             return self.shader_hash(one);
         }
         let hashes: Vec<String> = files.iter().map(|f| self.shader_hash(f)).collect::<Result<_, _>>()?;
@@ -205,8 +205,8 @@ impl<'a> Renderer<'a> {
         kernel: &Kernel,
     ) -> Result<std::collections::BTreeMap<String, String>, RenderError> {
         let mut out = std::collections::BTreeMap::new();
-        for f in kernel.shader_files() {
-            out.extend(self.shader_file_hashes(f)?);
+        for f in kernel.shader_units() {
+            out.extend(self.shader_file_hashes(&f)?);
         }
         Ok(out)
     }
@@ -238,7 +238,19 @@ pub fn edited_shader_set(
         let text = edit(&f.rel, f.text);
         (f.rel, text, f.origin)
     });
-    Ok(ShaderSet::from_files(label, files).with_enums(enum_modules(project)?))
+    let (specs, reader) = source_specs(project)?;
+    Ok(ShaderSet::from_files(label, files).with_enums(enum_modules(project)?).with_sources(specs, reader))
+}
+
+/// Every kernel's `[source]` assemblies, by id (SPEC 16), and a reader of
+/// the project's files for what they reach outside `shaders/`.
+pub fn source_specs(
+    project: &vista_project::Project,
+) -> Result<(Vec<(String, vista_source::SourceSpec)>, vista_gpu::Reader), RenderError> {
+    let registry = vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let project = project.clone();
+    let specs = registry.kernels().iter().flat_map(|k| k.source_specs()).collect();
+    Ok((specs, vista_gpu::Reader::new(move |rel| project.read_text(rel))))
 }
 
 /// Each kernel's generated `vista::enums` module (from its manifest's enum

@@ -1,0 +1,16 @@
+//! Source assembly (SPEC 16): the WGSL text of one pass as a project's host
+//! builds it before the compiler sees it — textual `#include`, files joined
+//! before and after the shader, literal text replacements — with every
+//! assembled line traced to the file and line it came from, so errors name
+//! the file the user wrote.
+//!
+//! Not for: `#import` and shader defs (naga_oil's, in `vista-gpu`), WESL,
+//! or reading files: the caller hands in a reader, so this crate does no
+//! I/O and knows no project layout.
+#![deny(missing_docs)]
+
+mod assemble;
+mod spec;
+
+pub use assemble::{Assembled, Part, assemble};
+pub use spec::{Replacement, SourceSpec};
