@@ -3856,12 +3856,12 @@ fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
 /// SwiftShader and in Chromium, under the validation layer, and by
 /// mutation, sweep and bench.
 fn the_sources_example_passes_on_every_backend_with_a_copied_binary() {
-    let (_t, bin, root) = copied_example("sources", 6);
+    let (_t, bin, root) = copied_example("sources", 7);
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
     let validated = run_in(&bin, &root, &[("VISTA_VALIDATION", "1")], &["check"]);
     assert_eq!(validated.code, 0, "{}{}", validated.stdout, validated.stderr);
     // Mutants reach included files and imported modules.
-    for (kernel, files) in [("cells", "include/"), ("transmittance", "atmos/functions.wgsl")] {
+    for (kernel, files) in [("cells", "include/"), ("transmittance", "atmos/functions.wgsl"), ("relief", "geo/")] {
         let m = run(&["mutate", "--kernel", kernel, "--sample", "6", "--json", "m.json"]);
         assert_eq!(m.code, 0, "{}{}", m.stdout, m.stderr);
         let report: serde_json::Value =
@@ -3903,6 +3903,8 @@ fn assembled_sources_name_their_own_files() {
         ("shaders/joined/noise_lib.wgsl", "clouds-joined"), // prepended
         ("shaders/joined/tone.wgsl", "clouds-joined"),      // appended
         ("shaders/atmos/types.wgsl", "transmittance"),      // imported by a module the kernel imports
+        ("shaders/wesl/palette.wesl", "relief"),            // a WESL module of the package
+        ("shaders/geo/noise.wesl", "relief"),               // a WESL module of another package
     ] {
         edit(file, &|s| s + "// edited\n");
         assert_eq!(changed(case), [file.strip_prefix("shaders/").unwrap()], "{file}");
@@ -3916,6 +3918,13 @@ fn assembled_sources_name_their_own_files() {
     // manifest's replacements are named.
     edit("kernels/mips.toml", &|s| s.replace("{ \"##", "{ \"Karis average\" = \"Karis mean\", \"##"));
     assert_eq!(changed("mips"), ["[source] replace (from the manifest)"]);
+    // WESL: the SNOW feature is the manifest's bool def; a package that
+    // [source] packages does not list is named.
+    edit("kernels/relief.toml", &|s| s.replace("SNOW = true", "SNOW = false"));
+    assert_eq!(run(&["check", "--case", "relief"]).code, 1, "without snow the relief differs");
+    edit("kernels/relief.toml", &|s| s.replace("packages = { geo = \"shaders/geo\" }", ""));
+    let r = run(&["render", "relief", "--size", "8x8", "-o", "x.png"]);
+    assert!(r.code == 2 && r.stderr.contains("package geo is not in [source] packages"), "{}", r.stderr);
     // An error on line 7 of an included file is reported there.
     edit("shaders/include/noise/value.wgsl", &|s| s.replace("f * 6.0", "f * six"));
     let r = run(&["render", "cells", "--size", "8x8", "-o", "x.png"]);

@@ -234,18 +234,50 @@ impl ShaderSet {
             return Ok(u.clone());
         }
         let kernel = self.kernel_source(name)?;
-        let unit = match spec_id(name) {
+        let default = vista_source::SourceSpec::default();
+        let spec = match spec_id(name) {
+            None => None,
+            Some(id) => Some(self.sources.get(id).ok_or_else(|| {
+                GpuError::Shader(format!("{}: no [source] assembly {id} in {}", file_of(name), self.label))
+            })?),
+        };
+        let read = |path: &str| self.read(path);
+        let main = format!("shaders/{}", file_of(name));
+        let assembled = if main.ends_with(".wesl") {
+            // WESL: the wesl crate resolves its imports; bool defs are its features.
+            let spec = spec.unwrap_or(&default);
+            if spec.include.is_some() || spec.prepend.is_some() || spec.append.is_some() || !spec.replace.is_empty() {
+                return Err(GpuError::Shader(format!(
+                    "{}: [source] include, prepend, append and replace apply to WGSL text, not to a .wesl shader",
+                    kernel.origin
+                )));
+            }
+            let features: Vec<(String, bool)> = shader_defs(name)
+                .into_iter()
+                .filter_map(|(k, v)| match v {
+                    naga_oil::compose::ShaderDefValue::Bool(b) => Some((k, b)),
+                    _ => None,
+                })
+                .collect();
+            Some(vista_source::compile_wesl(&main, spec, &features, &read).map_err(GpuError::Shader)?)
+        } else if let Some(spec) = spec {
+            let values = replacement_values(name, spec);
+            Some(
+                vista_source::assemble(&main, spec, &values, &read)
+                    .map_err(|e| GpuError::Shader(format!("{}: {e}", kernel.origin)))?,
+            )
+        } else {
+            None
+        };
+        let unit = match assembled {
             None => Unit { source: kernel.clone(), assembled: None },
-            Some(id) => {
-                let spec = self.sources.get(id).ok_or_else(|| {
-                    GpuError::Shader(format!("{}: no [source] assembly {id} in {}", file_of(name), self.label))
-                })?;
-                let values = replacement_values(name, spec);
-                let read = |path: &str| self.read(path);
-                let assembled = vista_source::assemble(&format!("shaders/{}", file_of(name)), spec, &values, &read)
-                    .map_err(|e| GpuError::Shader(format!("{}: {e}", kernel.origin)))?;
-                let source = Source::new(kernel.rel.clone(), assembled.text.clone(), kernel.origin.clone());
-                Unit { source, assembled: Some(assembled) }
+            Some(a) => {
+                // A compiler's output names its root file as compiled.
+                let origin = match a.traced() {
+                    true => kernel.origin.clone(),
+                    false => format!("{} (as the wesl crate compiled it)", kernel.origin),
+                };
+                Unit { source: Source::new(kernel.rel.clone(), a.text.clone(), origin), assembled: Some(a) }
             }
         };
         let unit = Arc::new(unit);
@@ -443,6 +475,12 @@ impl ShaderSet {
         let mut h = blake3::Hasher::new();
         h.update(name.as_bytes());
         h.update(kernel.text.as_bytes());
+        // Every file an assembly read, as written: an edit a compiler drops
+        // (a WESL comment) is still an edit `check` names.
+        for p in unit.assembled.iter().flat_map(|a| &a.parts) {
+            h.update(p.path.as_bytes());
+            h.update(p.text.as_bytes());
+        }
         let lib = self.imported_lib(kernel)?;
         for e in &lib {
             h.update(e.rel.as_bytes());
@@ -466,16 +504,18 @@ impl ShaderSet {
             self.enums_for(name, kernel, &lib)?.map(|text| (format!("{ENUMS_MODULE} (from the manifest)"), hash(text)));
         // An assembly: every file it reached by its own path (under
         // shaders/ relative to it, like the rest), and the replacements.
-        let parts: Vec<(String, String)> = match (&unit.assembled, spec_id(name).and_then(|id| self.sources.get(id))) {
-            (Some(a), Some(spec)) => {
+        let parts: Vec<(String, String)> = match &unit.assembled {
+            Some(a) => {
                 let mut v: Vec<(String, String)> =
                     a.parts.iter().map(|p| (shader_rel(&p.path), hash(&p.text))).collect();
-                if !spec.replace.is_empty() {
+                if let Some(spec) = spec_id(name).and_then(|id| self.sources.get(id))
+                    && !spec.replace.is_empty()
+                {
                     v.push(("[source] replace (from the manifest)".into(), hash(&format!("{:?}", spec.replace))));
                 }
                 v
             }
-            _ => vec![(name.to_string(), hash(&kernel.text))],
+            None => vec![(name.to_string(), hash(&kernel.text))],
         };
         Ok(parts.into_iter().chain(lib.iter().map(|e| (e.rel.clone(), hash(&e.text)))).chain(enums).collect())
     }
@@ -611,6 +651,10 @@ fn spec_id(name: &str) -> Option<&str> {
 /// A name without its shader defs: what one assembly is keyed by (the
 /// file, the spec id, the replacement texts).
 fn unit_key(name: &str) -> String {
+    // A .wesl shader's text depends on its defs (its @if features).
+    if file_of(name).ends_with(".wesl") {
+        return name.to_string();
+    }
     let (unit, rest) = name.split_once('?').unwrap_or((name, ""));
     let values: Vec<&str> = rest.split('&').filter(|d| d.starts_with('%')).collect();
     if values.is_empty() { unit.to_string() } else { format!("{unit}?{}", values.join("&")) }

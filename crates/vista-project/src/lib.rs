@@ -193,10 +193,10 @@ impl Project {
         self.root().map(|r| r.join("target").join("vista-report"))
     }
 
-    /// Every `.wgsl` file: the built-ins, overlaid by the project's
+    /// Every `.wgsl` and `.wesl` file: the built-ins, overlaid by the project's
     /// `shaders/` tree (same relative path wins), sorted by path.
     pub fn shader_files(&self) -> Result<Vec<SourceFile>, ProjectError> {
-        self.layered("shaders", builtin::SHADERS, "wgsl")
+        self.layered("shaders", builtin::SHADERS, &["wgsl", "wesl"])
     }
 
     /// The text and path of a file under the root (`rel` relative to it,
@@ -214,10 +214,10 @@ impl Project {
     /// Every kernel manifest (`kernels/*.toml`): the built-ins overlaid by
     /// the project's, sorted by path.
     pub fn kernel_files(&self) -> Result<Vec<SourceFile>, ProjectError> {
-        self.layered("kernels", builtin::KERNELS, "toml")
+        self.layered("kernels", builtin::KERNELS, &["toml"])
     }
 
-    fn layered(&self, sub: &str, embedded: &[(&str, &str)], ext: &str) -> Result<Vec<SourceFile>, ProjectError> {
+    fn layered(&self, sub: &str, embedded: &[(&str, &str)], ext: &[&str]) -> Result<Vec<SourceFile>, ProjectError> {
         let mut files: BTreeMap<String, SourceFile> = embedded
             .iter()
             .map(|(rel, text)| {
@@ -252,7 +252,7 @@ fn read(path: &Path) -> Result<String, ProjectError> {
         .map_err(|e| ProjectError::Io { path: path.display().to_string(), message: format!("cannot read: {e}") })
 }
 
-fn files_with_ext(dir: &Path, ext: &str) -> Result<Vec<PathBuf>, ProjectError> {
+fn files_with_ext(dir: &Path, ext: &[&str]) -> Result<Vec<PathBuf>, ProjectError> {
     let mut out = Vec::new();
     let entries = fs::read_dir(dir)
         .map_err(|e| ProjectError::Io { path: dir.display().to_string(), message: format!("cannot list: {e}") })?;
@@ -260,7 +260,7 @@ fn files_with_ext(dir: &Path, ext: &str) -> Result<Vec<PathBuf>, ProjectError> {
         let path = entry.path();
         if path.is_dir() {
             out.extend(files_with_ext(&path, ext)?);
-        } else if path.extension().is_some_and(|e| e == ext) {
+        } else if path.extension().is_some_and(|e| ext.iter().any(|x| e == *x)) {
             out.push(path);
         }
     }

@@ -29,6 +29,16 @@ pub struct Assembled {
 }
 
 impl Assembled {
+    /// A text whose lines are not traced to files (a compiler's output).
+    pub(crate) fn untraced(text: String, parts: Vec<Part>) -> Assembled {
+        Assembled { text, parts, replaced: Vec::new(), lines: Vec::new() }
+    }
+
+    /// Whether each line is traced to the file it came from.
+    pub fn traced(&self) -> bool {
+        !self.lines.is_empty()
+    }
+
     /// The file (its origin) and 1-based line that line `line` (1-based)
     /// of the assembled text came from.
     pub fn locate(&self, line: usize) -> Option<(&str, usize)> {
@@ -338,10 +348,12 @@ mod tests {
         assert_eq!(m.replace[1], ("X".into(), Replacement::Text("2".into())));
         assert_ne!(m.id(), kernel.id());
         for (bad, want) in [
-            ("inlcude = []", "unknown key inlcude; allowed: include, prepend, append, replace"),
+            ("inlcude = []", "unknown key inlcude"),
             ("prepend = [\"../x.wgsl\"]", "without .."),
             ("replace = { \"A\" = 1 }", "expected a string or { param = \"name\" }"),
             ("include = \"shaders\"", "expected a list of paths"),
+            ("unknown = 1", "allowed: include, prepend, append, replace, packages"),
+            ("packages = { a = \"../x\" }", "expected a folder under the project root"),
         ] {
             let e = SourceSpec::parse(&toml::from_str(bad).unwrap()).unwrap_err();
             assert!(e.contains(want), "{bad}: {e}");

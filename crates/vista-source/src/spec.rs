@@ -22,10 +22,13 @@ pub struct SourceSpec {
     pub append: Option<Vec<String>>,
     /// Literal replacements applied after includes and joins, in order.
     pub replace: Vec<(String, Replacement)>,
+    /// WESL packages: an import's first name -> its folder
+    /// (`bevy_render = "shaders/bevy_render"`).
+    pub packages: Vec<(String, String)>,
 }
 
 /// The keys a `[source]` table may have.
-pub const KEYS: [&str; 4] = ["include", "prepend", "append", "replace"];
+pub const KEYS: [&str; 5] = ["include", "prepend", "append", "replace", "packages"];
 
 impl SourceSpec {
     /// Parses a `[source]` table; errors name the key and what is allowed.
@@ -80,7 +83,32 @@ impl SourceSpec {
                 ));
             }
         }
-        Ok(SourceSpec { include: paths("include")?, prepend: paths("prepend")?, append: paths("append")?, replace })
+        let mut packages = Vec::new();
+        match t.get("packages") {
+            None => {}
+            Some(toml::Value::Table(p)) => {
+                for (name, dir) in p {
+                    let dir = dir.as_str().filter(|d| !d.is_empty() && !d.starts_with('/') && !d.contains(".."));
+                    let Some(dir) = dir else {
+                        return Err(format!(
+                            "[source] packages: {name} = {} is not valid; expected a folder under the project root",
+                            p[name]
+                        ));
+                    };
+                    packages.push((name.clone(), dir.trim_end_matches('/').to_string()));
+                }
+            }
+            Some(other) => {
+                return Err(format!("[source] packages = {other} is not valid; expected {{ name = \"folder\" }}"));
+            }
+        }
+        Ok(SourceSpec {
+            include: paths("include")?,
+            prepend: paths("prepend")?,
+            append: paths("append")?,
+            replace,
+            packages,
+        })
     }
 
     /// `pass` over `self` (the kernel's): a key the pass gives replaces the
@@ -94,6 +122,7 @@ impl SourceSpec {
             prepend: pass.prepend.clone().or_else(|| self.prepend.clone()),
             append: pass.append.clone().or_else(|| self.append.clone()),
             replace,
+            packages: if pass.packages.is_empty() { self.packages.clone() } else { pass.packages.clone() },
         }
     }
 

@@ -1,0 +1,184 @@
+//! `.wesl` shaders, compiled by the `wesl` crate (pinned: 0.5 and later
+//! need a newer Rust): `import package::...` resolves under `shaders/`,
+//! another package's imports through `[source] packages`, and bool defs are
+//! `@if` features.
+
+use std::borrow::Cow;
+use std::cell::RefCell;
+
+use wesl::{ModulePath, ResolveError, Resolver, syntax::PathOrigin};
+
+use crate::{Assembled, Part, SourceSpec};
+
+/// Resolves module paths to files through the caller's reader, and keeps
+/// every file it read (the parts the shader hash covers).
+struct Files<'a> {
+    packages: &'a [(String, String)],
+    read: &'a dyn Fn(&str) -> Option<(String, String)>,
+    parts: RefCell<Vec<Part>>,
+}
+
+impl Files<'_> {
+    /// The folder a module path's first component is taken in.
+    fn base(&self, path: &ModulePath) -> Result<String, String> {
+        match &path.origin {
+            PathOrigin::Absolute => Ok("shaders".into()),
+            PathOrigin::Package(name) => {
+                self.packages.iter().find(|(p, _)| p == name).map(|(_, dir)| dir.clone()).ok_or_else(|| {
+                    let known: Vec<&str> = self.packages.iter().map(|(p, _)| p.as_str()).collect();
+                    format!(
+                        "package {name} is not in [source] packages ({}); add {name} = \"shaders/{name}\"",
+                        if known.is_empty() { "none".into() } else { known.join(", ") }
+                    )
+                })
+            }
+            PathOrigin::Relative(_) => Err(format!("relative module path {path} reached the resolver")),
+        }
+    }
+}
+
+impl Resolver for Files<'_> {
+    fn resolve_source<'a>(&'a self, path: &ModulePath) -> Result<Cow<'a, str>, ResolveError> {
+        let base = self.base(path).map_err(|e| ResolveError::ModuleNotFound(path.clone(), e))?;
+        // A package's own root module (`constants::GROUP`): package.wesl or
+        // mod.wesl in its folder, or the folder's name with .wesl.
+        let candidates: Vec<String> = match path.components.is_empty() {
+            true => vec![format!("{base}/package.wesl"), format!("{base}/mod.wesl"), format!("{base}.wesl")],
+            false => {
+                let stem = format!("{base}/{}", path.components.join("/"));
+                vec![format!("{stem}.wesl"), format!("{stem}.wgsl")]
+            }
+        };
+        for file in &candidates {
+            if let Some((text, origin)) = (self.read)(file) {
+                let mut parts = self.parts.borrow_mut();
+                if !parts.iter().any(|p| p.path == *file) {
+                    parts.push(Part { path: file.clone(), origin, text: text.clone() });
+                }
+                return Ok(Cow::Owned(without_visibility(&text)));
+            }
+        }
+        Err(ResolveError::ModuleNotFound(path.clone(), format!("tried {}", candidates.join(", "))))
+    }
+
+    fn display_name(&self, path: &ModulePath) -> Option<String> {
+        let stem = format!("{}/{}", self.base(path).ok()?, path.components.join("/"));
+        let parts = self.parts.borrow();
+        parts.iter().find(|p| p.path.starts_with(&stem)).map(|p| p.origin.clone())
+    }
+}
+
+/// Compiles `.wesl` shader `main` (a root-relative path under `shaders/`)
+/// with `features` (`@if` flags) and `spec.packages`, to WGSL. The result's
+/// lines are not traced to files (its errors are the wesl crate's, which
+/// name them); its parts are every module file read.
+pub fn compile_wesl(
+    main: &str,
+    spec: &SourceSpec,
+    features: &[(String, bool)],
+    read: &dyn Fn(&str) -> Option<(String, String)>,
+) -> Result<Assembled, String> {
+    let Some(module) = main.strip_prefix("shaders/").and_then(|m| m.strip_suffix(".wesl")) else {
+        return Err(format!("{main}: a .wesl shader lies under shaders/"));
+    };
+    let root = ModulePath { origin: PathOrigin::Absolute, components: module.split('/').map(str::to_string).collect() };
+    let files = Files { packages: &spec.packages, read, parts: RefCell::new(Vec::new()) };
+    let mut compiler = wesl::Wesl::new("shaders").set_custom_resolver(files);
+    for (name, on) in features {
+        compiler.set_feature(name, *on);
+    }
+    let result = compiler.compile(&root).map_err(|e| format!("WESL error: {}", plain(&e.to_string())))?;
+    let text = result.to_string();
+    let parts = compiler.resolver().parts.take();
+    Ok(Assembled::untraced(text, parts))
+}
+
+/// `text` without terminal colour codes (the wesl crate's diagnostics carry
+/// them whatever the output is).
+fn plain(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars();
+    while let Some(c) = chars.next() {
+        if c == '\u{1b}' {
+            // ESC [ ... final byte in @..~
+            for d in chars.by_ref() {
+                if ('@'..='~').contains(&d) && d != '[' {
+                    break;
+                }
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// `text` with the `public` visibility keyword dropped before declarations
+/// (`public fn`, `@binding(0) public var`): newer WESL marks what a module
+/// exports with it, and this version of the wesl crate does not read it.
+/// `public` is a reserved word in WGSL, so it names nothing else; every
+/// declaration stays visible, which is what this version assumes anyway.
+fn without_visibility(text: &str) -> String {
+    const DECLARATIONS: [&str; 6] = ["fn", "var", "struct", "const", "alias", "override"];
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find("public") {
+        let before_ok = rest[..at].chars().next_back().is_none_or(|c| !(c.is_alphanumeric() || c == '_'));
+        let after = &rest[at + "public".len()..];
+        let next = after.trim_start();
+        let word: String = next.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+        let spaced = after.starts_with(char::is_whitespace);
+        out.push_str(&rest[..at]);
+        if before_ok && spaced && DECLARATIONS.contains(&word.as_str()) {
+            // Keep the columns: the keyword becomes spaces.
+            out.push_str("      ");
+        } else {
+            out.push_str("public");
+        }
+        rest = after;
+    }
+    out.push_str(rest);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn public_is_dropped_only_before_declarations() {
+        let src = "@group(0) @binding(1) public var t: f32;\npublic fn f() {}\nfn publicity() { let public_x = 1; }\n";
+        assert_eq!(
+            without_visibility(src),
+            "@group(0) @binding(1)        var t: f32;\n       fn f() {}\nfn publicity() { let public_x = 1; }\n"
+        );
+    }
+
+    /// A package's root module, a module of this package, features, and
+    /// the reached files as parts.
+    #[test]
+    fn packages_features_and_parts() {
+        let files: Vec<(&str, &str)> = vec![
+            (
+                "shaders/k.wesl",
+                "import package::m::half;\nimport consts::SCALE;\n@compute @workgroup_size(1) fn main() { let x = half() * SCALE; }\n",
+            ),
+            (
+                "shaders/m.wesl",
+                "@if(BIG) public fn half() -> f32 { return 5.0; }\n@if(!BIG) public fn half() -> f32 { return 0.5; }\n",
+            ),
+            ("vendor/consts/package.wesl", "public const SCALE: f32 = 2.0;\n"),
+        ];
+        let read = |p: &str| files.iter().find(|(f, _)| *f == p).map(|(_, t)| (t.to_string(), format!("/p/{p}")));
+        let spec = SourceSpec { packages: vec![("consts".into(), "vendor/consts".into())], ..Default::default() };
+        let small = compile_wesl("shaders/k.wesl", &spec, &[("BIG".into(), false)], &read).unwrap();
+        assert!(small.text.contains("0.5") && !small.text.contains("5.0"), "{}", small.text);
+        let big = compile_wesl("shaders/k.wesl", &spec, &[("BIG".into(), true)], &read).unwrap();
+        assert!(big.text.contains("5.0"), "{}", big.text);
+        let mut paths: Vec<&str> = big.parts.iter().map(|p| p.path.as_str()).collect();
+        paths.sort();
+        assert_eq!(paths, ["shaders/k.wesl", "shaders/m.wesl", "vendor/consts/package.wesl"]);
+        let e = compile_wesl("shaders/k.wesl", &SourceSpec::default(), &[], &read).unwrap_err();
+        assert!(e.contains("package consts is not in [source] packages (none)"), "{e}");
+    }
+}
