@@ -49,6 +49,11 @@ pub struct Config {
     /// user chose Vulkan drivers, so the binary leaves the loader alone (see
     /// [`Config::hidden_drivers`]).
     pub vulkan_drivers_chosen: bool,
+    /// `XDG_RUNTIME_DIR` is set: otherwise Mesa's drivers print "error:
+    /// XDG_RUNTIME_DIR is invalid or not set in the environment." twice in
+    /// every process (containers CI jobs run in leave it unset), and the
+    /// binary gives them a private one ([`Config::private_runtime_dir`]).
+    pub runtime_dir_set: bool,
 }
 
 /// Where under a project root the binary places Mesa's shader cache
@@ -133,7 +138,15 @@ impl Config {
             ]
             .iter()
             .any(|k| get(k).is_some_and(|v| !v.is_empty())),
+            runtime_dir_set: get("XDG_RUNTIME_DIR").is_some_and(|v| !v.is_empty()),
         })
+    }
+
+    /// The runtime directory the binary gives the drivers when the
+    /// environment names none: one per user under the temporary folder,
+    /// as a login session would give (`None` where one is set).
+    pub fn private_runtime_dir(&self, uid: u32) -> Option<PathBuf> {
+        (!self.runtime_dir_set).then(|| std::env::temp_dir().join(format!("vista-runtime-{uid}")))
     }
 
     /// The Vulkan loader's variable, and its value, that keep the Khronos
@@ -326,6 +339,7 @@ mod tests {
                 // Config::hidden_layers, Config::hidden_drivers).
                 let at_start = rel == "crates/vista-cli/src/main.rs"
                     && (line.contains("std::env::set_var(\"MESA_SHADER_CACHE_DIR\", dir)")
+                        || line.contains("std::env::set_var(\"XDG_RUNTIME_DIR\", dir)")
                         || line.contains("std::env::set_var(name, value)"));
                 if (writes.iter().any(|w| line.contains(w)) && !at_start)
                     || (!at_edge && reads.iter().any(|r| line.contains(r)))

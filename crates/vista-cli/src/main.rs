@@ -323,6 +323,17 @@ fn main() -> ExitCode {
         // Mesa reads the variable when the Vulkan device is created, later.
         unsafe { std::env::set_var("MESA_SHADER_CACHE_DIR", dir) };
     }
+    // SAFETY (getuid): no preconditions.
+    if let Some(dir) = config.private_runtime_dir(unsafe { libc::getuid() }) {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt};
+        let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        // Only a folder of this user's (another's of that name is not ours).
+        if std::fs::metadata(&dir).is_ok_and(|m| m.is_dir() && m.uid() == unsafe { libc::getuid() }) {
+            // SAFETY: nothing else runs yet (no thread, no GPU context); Mesa
+            // reads it when wgpu creates the Vulkan instance, later.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir) };
+        }
+    }
     for (name, value) in config.hidden_layers().into_iter().chain(config.hidden_drivers()) {
         // SAFETY: as above; the Vulkan loader reads them when wgpu creates
         // the instance, later.
@@ -381,7 +392,17 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
                 println!("{name} — broken manifest: {e}\n");
                 eprintln!("error: kernel {name} is not usable: {e}");
             }
-            Ok(if kernels.broken().is_empty() { 0 } else { 2 })
+            // So is a kernel whose WGSL does not compose.
+            let shaders = vista_render::shader_set(project)?;
+            let mut bad_wgsl = 0;
+            for k in kernels.kernels() {
+                if let Err(e) = vista_render::composes(&shaders, k) {
+                    println!("{} — bad — WGSL: {e}\n", k.name());
+                    eprintln!("error: kernel {} does not compose: {e}", k.name());
+                    bad_wgsl += 1;
+                }
+            }
+            Ok(if kernels.broken().is_empty() && bad_wgsl == 0 { 0 } else { 2 })
         }
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             let k = registry(project)?.find(&kernel).cloned().map_err(bad)?;
@@ -813,7 +834,6 @@ fn check(
                     pending.insert(o.id.clone(), entry);
                 }
             }
-            let psnr = o.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into());
             let label = match o.verdict {
                 vista_golden::Verdict::Pass => "ok",
                 vista_golden::Verdict::ExpectedFail => "xfail",
@@ -824,7 +844,7 @@ fn check(
                 Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
                 None => String::new(),
             };
-            println!("{label:<6} {:<40} PSNR {:<12} {:>8.1} ms{per_backend}", o.id, psnr, o.gpu_ms);
+            println!("{label:<6} {:<40} {:<17} {:>8.1} ms{per_backend}", o.id, o.headline(), o.gpu_ms);
             if !o.passed() {
                 print!("{}", o.explain(&report_dir));
             } else if o.verdict == vista_golden::Verdict::ExpectedFail {

@@ -116,6 +116,21 @@ fn wrong_type_names_value_and_expected_kind() {
 
 /// The environment is read once, at start, and a value that does not parse
 /// is refused by name before anything runs (it used to fall back silently).
+/// Without XDG_RUNTIME_DIR (containers CI jobs run in), Mesa's drivers
+/// printed "error: XDG_RUNTIME_DIR is invalid or not set in the
+/// environment." twice before every command's own output: the binary gives
+/// them a private runtime directory, so an error line is vista's own.
+fn no_driver_noise_without_a_runtime_dir() {
+    let d = tmp();
+    let out = d.path().join("f.png");
+    let ok =
+        vista_in(None, &[("XDG_RUNTIME_DIR", "")], &["render", "fbm", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    assert_eq!(ok.code, 0, "{}", ok.stderr);
+    assert!(!ok.stderr.contains("XDG_RUNTIME_DIR") && !ok.stdout.contains("XDG_RUNTIME_DIR"), "{}", ok.stderr);
+    let bad = vista_in(None, &[("XDG_RUNTIME_DIR", "")], &["render", "fbm", "--set", "octaves=99", "-o", "x.png"]);
+    assert_rejected(&bad, 2, &["octaves=99 is out of range"]);
+}
+
 fn bad_environment_values_are_named() {
     for (var, value, allowed) in [
         ("VISTA_MAX_WORK", "lots", "expected a positive number"),
@@ -2174,6 +2189,33 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
     let c = vista_in(Some(d.path()), &[], &["check", "--backend", "swiftshader"]);
     assert!(c.code == 0 && c.stdout.contains("xfail"), "{}", c.stdout);
+    // Without an expectation the advice is the expectation, not a bless.
+    let c = vista_in(Some(d.path()), &[], &["check", "--backend", "browser"]);
+    assert!(
+        c.code == 1
+            && c.stdout.contains(
+                "if browser cannot run it, expect it in golden/cases.toml: expect_fail = [{ backend = \"browser\", \
+                 unsupported = \"maxComputeInvocationsPerWorkgroup\""
+            )
+            && !c.stdout.contains("bless it"),
+        "{}",
+        c.stdout
+    );
+    // A shader that does not compile: where, and no bless.
+    std::fs::write(d.path().join("shaders/k.wgsl"), shader.replace("0.5, 1.0", "0.5, one")).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert!(
+        c.code == 1
+            && c.stdout.contains("k.wgsl:5:")
+            && c.stdout.contains("the shader does not compile")
+            && !c.stdout.contains("bless it"),
+        "{}",
+        c.stdout
+    );
+    // vista list marks it, as it does a broken manifest, and exits 2.
+    let l = vista_in(Some(d.path()), &[], &["list"]);
+    assert_rejected(&l, 2, &["kernel k does not compose", "k.wgsl:5:"]);
+    assert!(l.stdout.contains("k — bad — WGSL: ") && l.stdout.contains("fbm —"), "{}", l.stdout);
 }
 
 /// One process runs a read_write kernel, then a write-only kernel of the same
@@ -3265,6 +3307,10 @@ fn the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu() {
     let cases = std::fs::read_to_string(root.join("golden/cases.toml")).unwrap().matches("[[case]]").count();
     assert!(cases >= 6, "{cases} cases");
     assert_matrix_passes(&run(&["check", "--matrix"]), cases);
+    // A case judged by a tolerance shows the value it was judged by.
+    let c = run(&["check", "--case", "droplets"]);
+    let line = c.stdout.lines().find(|l| l.contains("droplets")).unwrap_or_default().to_string();
+    assert!(line.starts_with("ok") && line.contains("rmse ") && line.contains("(<= 6.000e-2)"), "{}", c.stdout);
     // Exclusive prefix sum: exactly the CPU's.
     let r = run(&["render", "scan", "-o", "scan.npy"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -4194,6 +4240,7 @@ fn main() {
         Cpu out_of_range_value_names_value_and_range,
         Cpu wrong_type_names_value_and_expected_kind,
         Cpu bad_environment_values_are_named,
+        Gpu no_driver_noise_without_a_runtime_dir,
         Cpu bad_sizes_are_rejected_before_gpu_work,
         Cpu bad_crops_are_rejected_before_gpu_work,
         Gpu a_crop_is_the_rectangle_of_the_frame,

@@ -185,9 +185,46 @@ impl Outcome {
         }
         if !self.passed() {
             s += &format!("  report: {}#case-{}\n", report_dir.join("index.html").display(), self.id);
-            s += &format!("  if this change is intended, bless it: {}\n", self.bless_command);
+            s += &format!("  {}\n", self.advice());
         }
         s
+    }
+
+    /// What the case's status line shows: where its main output is judged
+    /// by a tolerance, the value it was judged by (`rmse 2.350e-2 (<=
+    /// 6.000e-2)`), else its PSNR.
+    pub fn headline(&self) -> String {
+        if let Some(main) = self.outputs.first().filter(|o| o.by_tolerance && !o.summary.is_empty()) {
+            let prefix = format!("output {}: ", main.name);
+            return main.summary.strip_prefix(&prefix).unwrap_or(&main.summary).to_string();
+        }
+        format!("PSNR {}", self.metrics.map(|m| metrics::format_psnr(m.psnr)).unwrap_or_else(|| "-".into()))
+    }
+
+    /// The next step for a case that did not pass: blessing fixes a change
+    /// of output, not a shader that does not compile or a backend that
+    /// lacks a feature.
+    pub fn advice(&self) -> String {
+        let text = self.problems.join("\n");
+        if let Some(at) = text.find("unsupported on ") {
+            let feature = text[at..]
+                .split("needs ")
+                .nth(1)
+                .and_then(|r| r.split([' ', ',', ';']).next())
+                .filter(|f| !f.is_empty())
+                .unwrap_or("<feature>");
+            return format!(
+                "if {} cannot run it, expect it in golden/cases.toml: expect_fail = [{{ backend = \"{}\", \
+                 unsupported = \"{feature}\", reason = \"...\" }}]",
+                self.run.backend, self.run.backend
+            );
+        }
+        if self.verdict == Verdict::Error
+            && ["WGSL error", "WESL error", "naga validation failed", "#include"].iter().any(|w| text.contains(w))
+        {
+            return "the shader does not compile: fix it at the file and line above (bless cannot)".into();
+        }
+        format!("if this change is intended, bless it: {}", self.bless_command)
     }
 }
 

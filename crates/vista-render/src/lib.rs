@@ -242,6 +242,35 @@ pub fn edited_shader_set(
     Ok(ShaderSet::from_files(label, files).with_enums(enum_modules(project)?).with_sources(specs, reader))
 }
 
+/// Whether every pass of `kernel` composes at its default params: `Err`
+/// holds the first error on one line (`file:line:col: message`), for
+/// `vista list`.
+pub fn composes(shaders: &ShaderSet, kernel: &Kernel) -> Result<(), String> {
+    let p = kernel.resolve(None, &[]).map_err(|e| e.to_string())?;
+    let names: Vec<String> = match kernel.graph() {
+        Some(g) => (0..g.passes.len()).map(|i| kernel.pass_shader_for(i, &p)).collect(),
+        None => vec![kernel.shader_for(&p)],
+    };
+    for name in names {
+        if let Err(e) = shaders.compose(&name) {
+            let text = e.to_string();
+            let at = text.lines().find_map(|l| l.trim().strip_prefix("┌─ ")).map(str::trim);
+            let message = text
+                .lines()
+                .map(str::trim)
+                .filter(|l| l.starts_with("error:") || l.contains("not found") || l.contains("failed"))
+                .map(|l| l.trim_start_matches("error:").trim())
+                .find(|l| !l.is_empty())
+                .unwrap_or_else(|| text.lines().next().unwrap_or_default());
+            return Err(match at {
+                Some(at) => format!("{at}: {message}"),
+                None => message.to_string(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Every kernel's `[source]` assemblies, by id (SPEC 16), and a reader of
 /// the project's files for what they reach outside `shaders/`.
 pub fn source_specs(
