@@ -2526,6 +2526,34 @@ fn valued_defs_reach_imported_modules() {
     assert_rejected(&render_exr(d.path(), "8x8", "d").0, 2, &["defs: STEPS = 2.5 is not valid", "an integer"]);
 }
 
+/// The hdr view needs no fake param: its exposure is an output setting
+/// (`[[output]] exposure`, default 1), and an `exposure` param, which no
+/// uniform field needs, still sets it.
+fn the_hdr_view_takes_its_exposure_from_the_output() {
+    let shader = gradient_shader("main", "8, 8", "params.height");
+    let png = |manifest: &str, name: &str| {
+        let d = kernel_project(manifest, &shader);
+        let out = d.path().join(format!("{name}.png"));
+        let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", out.to_str().unwrap()]);
+        assert_eq!(r.code, 0, "{name}: {}", r.stderr);
+        vista_image::load(&out).unwrap()
+    };
+    let default = png(&format!("output = \"hdr\"\n{K_MANIFEST}"), "default");
+    let set = png(&format!("{K_MANIFEST}[[output]]\nview = \"hdr\"\nexposure = 2.0\n"), "set");
+    let param = png(
+        &format!(
+            "output = \"hdr\"\n{K_MANIFEST}[[param]]\nname = \"exposure\"\ntype = \"f32\"\nrange = [0.1, 8]\ndefault = 2.0\n"
+        ),
+        "param",
+    );
+    assert_eq!(set.data, param.data, "exposure 2 as a setting and as a param");
+    assert_ne!(default.data, set.data, "the default exposure is 1");
+    // 1 - exp(-L) at L = u = 7.5 / 8, sRGB-encoded, in the red channel.
+    let l: f64 = 1.0 - (-(7.5f64 / 8.0)).exp();
+    let srgb = if l <= 0.0031308 { 12.92 * l } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 };
+    assert!((default.get(7, 0)[0] as f64 - srgb).abs() < 1e-3, "{:?} vs {srgb}", default.get(7, 0));
+}
+
 /// One file composed per pass with different defs, as bevy's downsampler
 /// is (`FIRST_PASS` for one pipeline, the rest for the other): a pass's
 /// `defs` merge over the kernel's, a pass's value winning.
@@ -4286,6 +4314,7 @@ fn main() {
         Cpu unfed_globals_are_refused,
         Gpu valued_defs_reach_imported_modules,
         Gpu per_pass_defs_compose_one_file_twice,
+        Gpu the_hdr_view_takes_its_exposure_from_the_output,
         Gpu several_uniforms_are_packed_by_variable_path,
         Gpu module_paths_tell_uniforms_of_two_modules_apart,
         Gpu a_project_kernel_named_like_a_builtin_does_not_get_its_reference,

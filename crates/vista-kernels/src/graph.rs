@@ -230,6 +230,8 @@ pub struct OutputSpec {
     /// How it is compared with its golden; `None`: `vista-golden`'s default (exact
     /// for a buffer or integer texture, PSNR of the view otherwise).
     pub tolerance: Option<Tolerance>,
+    /// The hdr view's exposure (`exposure`; default 1, an `exposure` param wins).
+    pub exposure: Option<f64>,
 }
 
 /// A kernel's pass graph.
@@ -252,7 +254,7 @@ pub const RESOURCE_KEYS: [&str; 12] =
 pub const PASS_KEYS: [&str; 11] =
     ["entry", "shader", "defs", "source", "bind", "dispatch", "workgroups", "set", "repeat", "swap", "group"];
 /// The keys of an `[[output]]` table.
-pub const OUTPUT_KEYS: [&str; 4] = ["resource", "view", "partial", "tolerance"];
+pub const OUTPUT_KEYS: [&str; 5] = ["resource", "view", "partial", "tolerance", "exposure"];
 
 /// Whether these tables need the graph path: more than one pass or output,
 /// a buffer or sampler, an input file or contents, or any part-2 key of a
@@ -641,6 +643,13 @@ pub(crate) fn parse(
             }),
             Some(other) => return Err(at(format!("view = {other} is not valid; expected a string"))),
         };
+        let exposure = match t.get("exposure") {
+            None => None,
+            Some(v) => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
+                Some(e) if e.is_finite() && e > 0.0 => Some(e),
+                _ => return Err(at(format!("exposure = {v} is not valid; expected a number > 0"))),
+            },
+        };
         let partial = match t.get("partial") {
             None => false,
             Some(toml::Value::Boolean(b)) => *b,
@@ -660,14 +669,12 @@ pub(crate) fn parse(
         if outs.iter().any(|o: &OutputSpec| o.resource == resource) {
             return Err(at("is listed twice".into()));
         }
-        outs.push(OutputSpec { resource: resource.to_string(), view, partial, tolerance });
+        outs.push(OutputSpec { resource: resource.to_string(), view, partial, tolerance, exposure });
     }
     if outs.iter().any(|o| o.view == Some(Output::Hdr))
-        && !params.iter().any(|p| p.name == "exposure" && p.ty == crate::params::ParamType::F32)
+        && params.iter().any(|p| p.name == "exposure" && p.ty != crate::params::ParamType::F32)
     {
-        return Err(fail(
-            "an [[output]] with view = \"hdr\" needs an f32 param named exposure (the PNG tone map)".into(),
-        ));
+        return Err(fail("param exposure sets the hdr view's tone map; it must be an f32".into()));
     }
     let deterministic = deterministic.unwrap_or(true);
     if !deterministic {

@@ -431,12 +431,14 @@ impl Kernel {
 
     /// The display map of an output of `format` (see [`Kernel::view`]).
     pub fn display_map_of(&self, p: &ParamSet, format: &str) -> DisplayMap {
-        self.display_map_with(p, self.view(format), format)
+        self.display_map_with(p, self.view(format), format, self.manifest.output_exposure)
     }
 
     /// The display map of an output of `format` shown with `view` (a graph
-    /// output's own `view`).
-    pub fn display_map_with(&self, p: &ParamSet, view: Output, format: &str) -> DisplayMap {
+    /// output's own `view`), its hdr tone map at `exposure` (the output's
+    /// setting; default 1). A kernel's `exposure` param wins, so cases and
+    /// sweeps can vary it.
+    pub fn display_map_with(&self, p: &ParamSet, view: Output, format: &str, exposure: Option<f64>) -> DisplayMap {
         let channels = match format {
             f if f.starts_with("rg32") => 2,
             f if f.starts_with("r32") => 1,
@@ -444,7 +446,10 @@ impl Kernel {
         };
         DisplayMap {
             channels,
-            exposure: (view == Output::Hdr).then(|| p.f32("exposure")),
+            exposure: (view == Output::Hdr).then(|| match p.value("exposure") {
+                Some(_) => p.f32("exposure"),
+                None => exposure.unwrap_or(1.0) as f32,
+            }),
             opaque: self.manifest.opaque_display,
             normalize: view == Output::Normalize,
         }

@@ -133,6 +133,8 @@ struct RawOutput {
     #[serde(default)]
     partial: bool,
     tolerance: Option<toml::Value>,
+    /// The hdr view's exposure (default 1; an `exposure` param wins).
+    exposure: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -248,6 +250,9 @@ pub struct Manifest {
     /// naga_oil shader defs (`defs = { MAX_LIGHTS = 10, FIRST_PASS = true }`),
     /// as `NAME=value` in declaration order.
     pub defs: Vec<String>,
+    /// The hdr view's exposure from the one-pass kernel's `[[output]]`
+    /// table (default 1; an `exposure` param wins).
+    pub output_exposure: Option<f64>,
     /// The kernel's `[source]`: how its shaders' text is assembled (a
     /// pass's `source` merges over it).
     pub source: vista_source::SourceSpec,
@@ -320,14 +325,14 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         "normalize" => Ok(Output::Normalize),
         other => Err(kfail(format!("output view \"{other}\" is not valid; expected display|hdr|normalize"))),
     };
-    let (output, partial, output_resource) = match &raw.output {
-        None => (None, false, None),
-        Some(toml::Value::String(s)) => (Some(view(s)?), false, None),
+    let (output, partial, output_resource, output_exposure) = match &raw.output {
+        None => (None, false, None, None),
+        Some(toml::Value::String(s)) => (Some(view(s)?), false, None, None),
         Some(toml::Value::Array(tables)) if is_graph => {
             for t in tables {
                 RawOutput::deserialize(t.clone()).map_err(|e| kfail(format!("[[output]]: {e}")))?;
             }
-            (None, false, None)
+            (None, false, None, None)
         }
         Some(toml::Value::Array(tables)) => {
             if tables.len() != 1 {
@@ -342,7 +347,12 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             {
                 return Err(kfail("[[output]] resource must name the kernel's storage texture".into()));
             }
-            (o.view.as_deref().map(view).transpose()?, o.partial, o.resource)
+            if let Some(e) = o.exposure
+                && !(e.is_finite() && e > 0.0)
+            {
+                return Err(kfail(format!("[[output]] exposure = {e} is not valid; expected a number > 0")));
+            }
+            (o.view.as_deref().map(view).transpose()?, o.partial, o.resource, o.exposure)
         }
         Some(other) => {
             return Err(kfail(format!(
@@ -553,10 +563,11 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     {
         return Err(kfail(format!("output_range = [{lo}, {hi}] is not valid; expected min <= max")));
     }
-    if output == Some(Output::Hdr)
-        && !params.iter().any(|p| p.name == "exposure" && matches!(p.kind, Kind::Float { .. }))
+    if let Some(p) = params.iter().find(|p| p.name == "exposure")
+        && output == Some(Output::Hdr)
+        && !matches!(p.kind, Kind::Float { .. })
     {
-        return Err(kfail("output = \"hdr\" needs an f32 param named exposure (the PNG tone map)".into()));
+        return Err(kfail("param exposure sets the hdr view's tone map; it must be an f32".into()));
     }
     let hash_plane = match &raw.hash_plane {
         None => None,
@@ -711,6 +722,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         graph,
         describes_resources,
         defs,
+        output_exposure,
         source,
         overrides,
         work,

@@ -392,7 +392,8 @@ pub fn plan_graph(
         let kind = match &resources[r] {
             vista_gpu::Resource::Texture(t) => {
                 let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.default_view(t.format));
-                PlannedKind::Texture { format: t.format, view, display: kernel.display_map_with(p, view, t.format) }
+                let display = kernel.display_map_with(p, view, t.format, spec.and_then(|o| o.exposure));
+                PlannedKind::Texture { format: t.format, view, display }
             }
             vista_gpu::Resource::Buffer(b) => {
                 let e = resolved.resources[r].element.clone().expect("a bound buffer");
