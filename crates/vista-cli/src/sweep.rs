@@ -75,7 +75,7 @@ pub fn sweep(project: &Project, config: &vista::Config, a: Args) -> Result<i32, 
     };
     // Every value is checked before the device is touched.
     spec.resolve(&config.limits)?;
-    crate::check_output_dir(&a.out)?;
+    crate::render::check_output_dir(&a.out)?;
     let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
     let bar = ProgressBar::new(0);
     bar.set_style(

@@ -1,0 +1,162 @@
+//! `vista render`: one kernel at one setting into a PNG, EXR or `.npy`, and
+//! the output-path checks every writing command shares.
+
+use std::path::{Path, PathBuf};
+
+use vista::Config;
+use vista_golden::GoldenError;
+use vista_gpu::Context;
+use vista_project::Project;
+use vista_render::Renderer;
+
+use crate::{bad, graph_render, parse_sets, registry};
+
+/// The `render` command's arguments.
+pub struct Args {
+    pub kernel: String,
+    pub preset: Option<String>,
+    pub set: Vec<String>,
+    pub size: String,
+    pub crop: Option<String>,
+    pub zoom: u32,
+    pub out: std::path::PathBuf,
+}
+
+/// Renders `a.kernel` as asked; 1 where the output holds NaN/Inf or
+/// unwritten texels.
+pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, GoldenError> {
+    let Args { kernel, preset, set, size, crop, zoom, out } = a;
+    let k = registry(project)?.find(&kernel).cloned().map_err(bad)?;
+    let p = k.resolve(preset.as_deref(), &parse_sets(&set)?).map_err(bad)?;
+    let (w, h) = vista_kernels::parse_size(&size).map_err(bad)?;
+    if !(1..=16).contains(&zoom) {
+        return Err(bad(format!("--zoom {zoom} is out of range; allowed: 1 to 16")));
+    }
+    if k.graph().is_some() {
+        if crop.is_some() || zoom > 1 {
+            return Err(bad("--crop and --zoom apply to one-pass kernels; a pass graph writes every output whole"));
+        }
+        check_parent_writable(&out)?;
+        let shaders = vista_render::shader_set(project)?;
+        // Every check that needs no device (bindings, input files) before one is made.
+        vista_render::check_request(&k, &p, w, h, &config.limits)?;
+        let plan = vista_render::plan_graph(&shaders, project.root(), &k, &p, &[], w, h)?;
+        let ctx = &Renderer {
+            ctx: Context::shared(&config.gpu)?,
+            shaders,
+            limits: config.limits,
+            root: project.root().map(Into::into),
+        };
+        return graph_render::render(ctx, &k, &plan, &out);
+    }
+    check_output_path(&out)?;
+    let shaders = vista_render::shader_set(project)?;
+    let plan = vista_render::plan(&shaders, &k, &p, w, h, &config.limits)?;
+    // Layers and slices are stacked top to bottom: crop that image.
+    let rect = crop.as_deref().map(|c| parse_crop(c, plan.width, plan.height * plan.layers)).transpose()?;
+    let ctx = &Renderer {
+        ctx: Context::shared(&config.gpu)?,
+        shaders,
+        limits: config.limits,
+        root: project.root().map(Into::into),
+    };
+    let r = vista_render::run(ctx, &plan)?;
+    let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let mut img = if is_exr { r.raw.clone() } else { r.display().clone() };
+    if let Some((x, y, cw, ch)) = rect {
+        img = img.crop(x, y, cw, ch).expect("the crop was checked against the size");
+    }
+    if zoom > 1 {
+        img = img.zoom(zoom);
+    }
+    vista_image::save(&out, &img)?;
+    let shape = match plan.dimension {
+        vista_gpu::Dimension::D2 if plan.layers == 1 && (plan.width, plan.height) == (w, h) => {
+            format!("{w}x{h}")
+        }
+        d => format!(
+            "{}x{}x{} ({} output, stacked {}x{})",
+            plan.width,
+            plan.height,
+            plan.layers,
+            d.name(),
+            plan.width,
+            plan.height * plan.layers
+        ),
+    };
+    eprintln!(
+        "rendered {kernel} {shape} on {} in {:.1} ms -> {}",
+        ctx.adapter_description(),
+        r.stats.gpu_wall.as_secs_f64() * 1e3,
+        out.display()
+    );
+    if let Some((x, y)) = r.raw.first_nonfinite() {
+        eprintln!("error: output has {} NaN/Inf pixels, first at ({x}, {y})", r.raw.nonfinite_count());
+        return Ok(1);
+    }
+    if r.unwritten > 0 && !k.partial() {
+        eprintln!("error: kernel {kernel}: {}", vista_golden::unwritten_problem(r.unwritten, &r.raw));
+        return Ok(1);
+    }
+    Ok(0)
+}
+
+/// `X,Y,W,H` inside a `width` x `height` frame.
+pub fn parse_crop(text: &str, width: u32, height: u32) -> Result<(u32, u32, u32, u32), GoldenError> {
+    let allowed = format!("X,Y,W,H in pixels with W, H >= 1, X + W <= {width} and Y + H <= {height} (the image)");
+    let v: Vec<u32> = text
+        .split(',')
+        .map(|s| s.trim().parse::<u32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad(format!("--crop {text} is not valid; expected {allowed}")))?;
+    match v[..] {
+        [x, y, w, h]
+            if w >= 1 && h >= 1 && x as u64 + w as u64 <= width as u64 && y as u64 + h as u64 <= height as u64 =>
+        {
+            Ok((x, y, w, h))
+        }
+        _ => Err(bad(format!("--crop {text} does not fit; expected {allowed}"))),
+    }
+}
+
+fn check_output_path(out: &Path) -> Result<(), GoldenError> {
+    let ext_ok = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png") || e.eq_ignore_ascii_case("exr"));
+    if !ext_ok {
+        return Err(bad(format!("output {} must end in .png or .exr", out.display())));
+    }
+    check_parent_writable(out)
+}
+
+/// The directory a file will be written into exists, is one, and is writable.
+pub fn check_parent_writable(file: &Path) -> Result<(), GoldenError> {
+    let dir = match file.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if dir.exists() && !dir.is_dir() {
+        return Err(bad(format!("output directory {} is not a directory (it is a file)", dir.display())));
+    }
+    if !dir.is_dir() {
+        return Err(bad(format!("output directory {} does not exist", dir.display())));
+    }
+    probe_writable(&dir)
+}
+
+/// Creates the output directory of a sweep if needed and checks it is writable.
+pub fn check_output_dir(dir: &Path) -> Result<(), GoldenError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(bad(format!("--out {} exists and is not a directory", dir.display())));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| bad(format!("cannot create output directory {}: {e}", dir.display())))?;
+    probe_writable(dir)
+}
+
+fn probe_writable(dir: &Path) -> Result<(), GoldenError> {
+    let probe = dir.join(format!(".vista-write-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| bad(format!("output directory {} is not writable: {e}", dir.display())))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
