@@ -3931,7 +3931,7 @@ fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
 /// SwiftShader and in Chromium, under the validation layer, and by
 /// mutation, sweep and bench.
 fn the_sources_example_passes_on_every_backend_with_a_copied_binary() {
-    let (_t, bin, root) = copied_example("sources", 7);
+    let (_t, bin, root) = copied_example("sources", 8);
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
     let validated = run_in(&bin, &root, &[("VISTA_VALIDATION", "1")], &["check"]);
     assert_eq!(validated.code, 0, "{}{}", validated.stdout, validated.stderr);

@@ -1,5 +1,6 @@
 // A cloud cover mask whose host joins noise_lib.wgsl before it and
-// tone.wgsl after it, and writes the octave count in for {OCTAVES}.
+// tone.wgsl after it, and writes the octave count in for {OCTAVES} and the
+// tone curve's name in for {TONE}.
 const OCTAVES: u32 = {OCTAVES}u;
 
 struct Cover {
@@ -22,5 +23,5 @@ fn cloud_mask(@builtin(global_invocation_id) id: vec3<u32>) {
     // Remap so that `coverage` of the density range is cloud.
     let cloud = clamp((n - (1.0 - cover.coverage)) / max(cover.coverage, 1e-3), 0.0, 1.0);
     let c = mix(sky(uv.y), vec3(1.2), cloud);
-    textureStore(mask_out, id.xy, vec4(tone(c) * 1.5, 1.0));
+    textureStore(mask_out, id.xy, vec4(tone_{TONE}(c) * 1.5, 1.0));
 }
