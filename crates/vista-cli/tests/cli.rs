@@ -4005,6 +4005,11 @@ fn assembled_sources_name_their_own_files() {
     let r = run(&["render", "cells", "--size", "8x8", "-o", "x.png"]);
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("include/noise/value.wgsl:7:"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("7 │     let t = f * f * f * (f * (f * six"),
+        "the quoted line is numbered as in its file: {}",
+        r.stderr
+    );
     // A replacement key in no reached file, an include cycle, a missing include.
     edit("kernels/mips.toml", &|s| s.replace("##TEXTURE_FORMAT##", "{TEXTURE_FORMAT}"));
     assert_rejected(

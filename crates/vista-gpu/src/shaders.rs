@@ -683,8 +683,28 @@ fn shader_rel(path: &str) -> String {
 }
 
 /// `message` with every `origin:LINE:COL` of the assembled text replaced by
-/// the file and line that line came from.
+/// the file and line that line came from, and the line numbers of the
+/// quoted source (`36 │ let t = ...`) by that file's own.
 fn locate(message: &str, origin: &str, a: &vista_source::Assembled) -> String {
+    let located = locate_headers(message, origin, a);
+    let mut out = String::with_capacity(located.len());
+    for line in located.split_inclusive('\n') {
+        let indent = line.len() - line.trim_start().len();
+        let digits = line[indent..].chars().take_while(char::is_ascii_digit).count();
+        let number = line[indent..indent + digits].parse::<usize>().ok();
+        match number.and_then(|n| a.locate(n)) {
+            Some((_, own)) if line[indent + digits..].trim_start().starts_with('│') => {
+                let width = indent + digits;
+                out.push_str(&format!("{own:>width$}"));
+                out.push_str(&line[width..]);
+            }
+            _ => out.push_str(line),
+        }
+    }
+    out
+}
+
+fn locate_headers(message: &str, origin: &str, a: &vista_source::Assembled) -> String {
     let needle = format!("{origin}:");
     let mut out = String::new();
     let mut rest = message;
