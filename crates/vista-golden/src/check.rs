@@ -291,7 +291,7 @@ pub fn guards(
 ) -> (Vec<String>, Option<(u32, u32, String)>) {
     let (mut problems, mut first_bad) = (Vec::new(), None);
     if unwritten > 0 && !case.kernel.partial() {
-        problems.push(unwritten_problem(unwritten, raw));
+        problems.push(crate::outputs::unwritten_problem(unwritten, raw));
     }
     if let Some((x, y)) = raw.first_nonfinite() {
         first_bad = Some((x, y, format!("NaN/Inf {:?}", raw.get(x, y))));
@@ -310,16 +310,6 @@ pub fn guards(
         problems.push("two renders in one process are not bit-identical (non-deterministic kernel)".into());
     }
     (problems, first_bad)
-}
-
-/// "N of M texels never written": a workgroup size, dispatch or bounds check
-/// that does not cover the output. Shared by check, bless and render.
-pub fn unwritten_problem(unwritten: u64, raw: &Image) -> String {
-    format!(
-        "{unwritten} of {} texels never written (the dispatch or a bounds check does not cover the output); \
-         if that is intended, add [[output]] partial = true to the kernel's manifest",
-        raw.width as u64 * raw.height as u64
-    )
 }
 
 /// The verdict on one case: `observed` is what the run saw, or why it saw

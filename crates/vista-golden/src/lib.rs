@@ -23,8 +23,8 @@ pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, bless_all_command, load_cases, parse_cases, select};
 pub use check::{
     BAD_PIXEL_LIMIT, GoldenRead, Observed, Outcome, RunInfo, Verdict, changed_files, first_out_of_range, guards, judge,
-    unwritten_problem,
 };
+pub use outputs::unwritten_problem;
 pub use run::{CheckOptions, Checked, check_case, in_order, run_info};
 pub use store::{DriverThreshold, Manifest, ManifestEntry, Store, params_hash};
 

@@ -148,7 +148,7 @@ pub struct OutputVerdict {
 }
 
 /// Compares output `index` with its goldens. The first texture output's PNG
-/// is the case's main image, judged by `check::judge` itself; here it only
+/// is the case's main image, judged by the case's verdict (`check::judge`) itself; here it only
 /// gets its raw comparison, if it has one.
 pub fn compare_output(
     case: &Case,
@@ -319,6 +319,16 @@ pub fn compare_output(
     v
 }
 
+/// "N of M texels never written": a workgroup size, dispatch or bounds check
+/// that does not cover the output. Shared by check, bless and render.
+pub fn unwritten_problem(unwritten: u64, raw: &vista_image::Image) -> String {
+    format!(
+        "{unwritten} of {} texels never written (the dispatch or a bounds check does not cover the output); \
+         if that is intended, add [[output]] partial = true to the kernel's manifest",
+        raw.width as u64 * raw.height as u64
+    )
+}
+
 /// The checks of a graph's outputs that need no golden (the main image's
 /// are `check::guards`): every texel of each other texture written unless
 /// it is `partial`, finite textures and float buffers.
@@ -333,7 +343,7 @@ fn guard_one(i: usize, o: &OutputRender) -> Vec<String> {
         match &o.value {
             OutputValue::Texture { raw, unwritten, .. } if i > 0 => {
                 if *unwritten > 0 && !o.partial {
-                    problems.push(format!("output {}: {}", o.name, crate::check::unwritten_problem(*unwritten, raw)));
+                    problems.push(format!("output {}: {}", o.name, unwritten_problem(*unwritten, raw)));
                 }
                 if let Some((x, y)) = raw.first_nonfinite() {
                     problems.push(format!(

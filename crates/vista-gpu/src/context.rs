@@ -1198,6 +1198,29 @@ fn pick(adapters: Vec<wgpu::Adapter>, choice: &AdapterChoice) -> Option<wgpu::Ad
     adapters.into_iter().filter_map(|a| rank(&a).map(|r| (r, a))).min_by_key(|(r, _)| *r).map(|(_, a)| a)
 }
 
+impl Context {
+    /// The device's limit `name` (WebGPU's spelling), where the backend
+    /// reports it.
+    pub fn limit(&self, name: &str) -> Option<u64> {
+        match &self.engine {
+            Engine::Wgpu(w) => crate::limits::wgpu_limit(&w.device.limits(), name),
+            Engine::Browser(b) => b.browser.info().limits.get(name).map(|v| *v as u64),
+        }
+    }
+
+    /// Refuses `what` as unsupported when it needs more of limit `name`
+    /// than this device has.
+    pub fn require(&self, what: &str, name: &str, needed: u64) -> Result<(), GpuError> {
+        crate::limits::require(&|n| self.limit(n), &self.adapter_description(), what, name, needed)
+    }
+
+    /// Checks a dispatch's workgroup size and count and its bindings
+    /// against the device's limits; `what` names it (a pass, a kernel).
+    pub fn require_needs(&self, what: &str, n: &crate::Needs) -> Result<(), GpuError> {
+        crate::limits::require_needs(&|name| self.limit(name), &self.adapter_description(), what, n)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

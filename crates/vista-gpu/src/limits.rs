@@ -4,7 +4,6 @@
 //! any GPU work, instead of failing as a driver validation error.
 
 use crate::GpuError;
-use crate::context::{Context, Engine};
 
 /// What one dispatch needs of the device.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -51,58 +50,59 @@ const WGPU_LIMITS: [(&str, Read); 17] = [
     ("maxStorageBufferBindingSize", |l| l.max_storage_buffer_binding_size),
 ];
 
-impl Context {
-    /// The device's limit `name` (WebGPU's spelling), where the backend
-    /// reports it.
-    pub fn limit(&self, name: &str) -> Option<u64> {
-        match &self.engine {
-            Engine::Wgpu(w) => WGPU_LIMITS.iter().find(|(n, _)| *n == name).map(|(_, f)| f(&w.device.limits())),
-            Engine::Browser(b) => b.browser.info().limits.get(name).map(|v| *v as u64),
-        }
-    }
+/// Limit `name` (WebGPU's spelling) of a wgpu device, where vista checks it.
+pub(crate) fn wgpu_limit(limits: &wgpu::Limits, name: &str) -> Option<u64> {
+    WGPU_LIMITS.iter().find(|(n, _)| *n == name).map(|(_, f)| f(limits))
+}
 
-    /// Refuses `what` as unsupported when it needs more of limit `name`
-    /// than this device has.
-    pub fn require(&self, what: &str, name: &str, needed: u64) -> Result<(), GpuError> {
-        match self.limit(name) {
-            Some(have) if needed > have => Err(GpuError::Unsupported {
-                adapter: self.adapter_description(),
-                what: what.to_string(),
-                feature: format!("{name} >= {needed} (this device has {have})"),
-            }),
-            _ => Ok(()),
-        }
+/// Refuses `what` as unsupported on `adapter` when it needs more of limit
+/// `name` than `limit` (the device's, by name) gives.
+pub(crate) fn require(
+    limit: &dyn Fn(&str) -> Option<u64>,
+    adapter: &str,
+    what: &str,
+    name: &str,
+    needed: u64,
+) -> Result<(), GpuError> {
+    match limit(name) {
+        Some(have) if needed > have => Err(GpuError::Unsupported {
+            adapter: adapter.to_string(),
+            what: what.to_string(),
+            feature: format!("{name} >= {needed} (this device has {have})"),
+        }),
+        _ => Ok(()),
     }
+}
 
-    /// Checks a dispatch's workgroup size and count and its bindings
-    /// against the device's limits; `what` names it (a pass, a kernel).
-    pub fn require_needs(&self, what: &str, n: &Needs) -> Result<(), GpuError> {
-        let [x, y, z] = n.workgroup_size;
-        let invocations = x as u64 * y as u64 * z as u64;
-        let size = format!("@workgroup_size({x}, {y}, {z})");
-        let most = n.workgroups.iter().copied().max().unwrap_or(0) as u64;
-        // Bindings of one kind, against their per-stage limit.
-        let count = |k: u32, what: &str, name: &'static str| (format!("{k} {what}"), name, k as u64);
-        let checks: Vec<(String, &str, u64)> = vec![
-            (
-                format!("{size}: {invocations} invocations per workgroup"),
-                "maxComputeInvocationsPerWorkgroup",
-                invocations,
-            ),
-            (size.clone(), "maxComputeWorkgroupSizeX", x as u64),
-            (size.clone(), "maxComputeWorkgroupSizeY", y as u64),
-            (size, "maxComputeWorkgroupSizeZ", z as u64),
-            (format!("{most} workgroups along one axis"), "maxComputeWorkgroupsPerDimension", most),
-            (format!("bind group {}", n.bind_groups.saturating_sub(1)), "maxBindGroups", n.bind_groups as u64),
-            count(n.uniform_buffers, "uniform buffers", "maxUniformBuffersPerShaderStage"),
-            count(n.storage_buffers, "storage buffers", "maxStorageBuffersPerShaderStage"),
-            count(n.storage_textures, "storage textures", "maxStorageTexturesPerShaderStage"),
-            count(n.sampled_textures, "sampled textures", "maxSampledTexturesPerShaderStage"),
-            count(n.samplers, "samplers", "maxSamplersPerShaderStage"),
-        ];
-        for (need, name, value) in &checks {
-            self.require(&format!("{what}: {need}"), name, *value)?;
-        }
-        Ok(())
+/// Checks a dispatch's workgroup size and count and its bindings against
+/// `limit`; `what` names it (a pass, a kernel).
+pub(crate) fn require_needs(
+    limit: &dyn Fn(&str) -> Option<u64>,
+    adapter: &str,
+    what: &str,
+    n: &Needs,
+) -> Result<(), GpuError> {
+    let [x, y, z] = n.workgroup_size;
+    let invocations = x as u64 * y as u64 * z as u64;
+    let size = format!("@workgroup_size({x}, {y}, {z})");
+    let most = n.workgroups.iter().copied().max().unwrap_or(0) as u64;
+    // Bindings of one kind, against their per-stage limit.
+    let count = |k: u32, what: &str, name: &'static str| (format!("{k} {what}"), name, k as u64);
+    let checks: Vec<(String, &str, u64)> = vec![
+        (format!("{size}: {invocations} invocations per workgroup"), "maxComputeInvocationsPerWorkgroup", invocations),
+        (size.clone(), "maxComputeWorkgroupSizeX", x as u64),
+        (size.clone(), "maxComputeWorkgroupSizeY", y as u64),
+        (size, "maxComputeWorkgroupSizeZ", z as u64),
+        (format!("{most} workgroups along one axis"), "maxComputeWorkgroupsPerDimension", most),
+        (format!("bind group {}", n.bind_groups.saturating_sub(1)), "maxBindGroups", n.bind_groups as u64),
+        count(n.uniform_buffers, "uniform buffers", "maxUniformBuffersPerShaderStage"),
+        count(n.storage_buffers, "storage buffers", "maxStorageBuffersPerShaderStage"),
+        count(n.storage_textures, "storage textures", "maxStorageTexturesPerShaderStage"),
+        count(n.sampled_textures, "sampled textures", "maxSampledTexturesPerShaderStage"),
+        count(n.samplers, "samplers", "maxSamplersPerShaderStage"),
+    ];
+    for (need, name, value) in &checks {
+        require(limit, adapter, &format!("{what}: {need}"), name, *value)?;
     }
+    Ok(())
 }

@@ -12,7 +12,7 @@ use vista_image::Image;
 use vista_kernels::graph::{Element, ResourceKind, SampledDim, SlotFeed, Tolerance, Usage};
 use vista_kernels::{DisplayMap, Kernel, ParamSet};
 
-use crate::RenderError;
+use crate::error::RenderError;
 
 /// One output as planned.
 #[derive(Debug, Clone)]
@@ -282,7 +282,8 @@ pub fn plan_graph(
         }
         let module = &modules[i];
         let constants = kernel.overrides_in(module, &pp, false).map_err(|e| RenderError::BadInput(e.to_string()))?;
-        let size = crate::workgroup_size(module, &pass.entry, &constants).map_err(|e| bad(format!("{label}: {e}")))?;
+        let size = crate::reflect::workgroup_size(module, &pass.entry, &constants)
+            .map_err(|e| bad(format!("{label}: {e}")))?;
         let blocks = kernel.uniforms(layout, &pp, width, height);
         let table = kernel.table(layout, &pp);
         let mut gslots = Vec::new();

@@ -10,7 +10,11 @@
 //! writes), or knowing any kernel's meaning (`vista-kernels`).
 #![deny(missing_docs)]
 
+mod error;
 pub mod graph;
+mod reflect;
+
+pub use error::RenderError;
 pub use graph::{GraphPlan, Inputs, PlannedKind, PlannedOutput, plan_graph};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
@@ -18,43 +22,6 @@ use std::time::{Duration, Instant};
 use vista_gpu::{Context, Dispatch, RunStats, ShaderSet};
 use vista_image::Image;
 use vista_kernels::{DisplayMap, Kernel, ParamSet};
-
-/// Why a render could not be made.
-#[derive(Debug, thiserror::Error)]
-pub enum RenderError {
-    /// The request is the user's to fix (size, work cap, a shader that does
-    /// not compose, a `Params` struct that does not fit the manifest).
-    #[error("{0}")]
-    BadInput(String),
-    /// The device failed, or refused the request.
-    #[error(transparent)]
-    Gpu(#[from] vista_gpu::GpuError),
-    /// The project's files could not be read.
-    #[error(transparent)]
-    Project(#[from] vista_project::ProjectError),
-    /// An image could not be read, written or compared.
-    #[error(transparent)]
-    Image(#[from] vista_image::ImageError),
-    /// A file or directory could not be used.
-    #[error("{path}: {message}")]
-    Io {
-        /// The path.
-        path: String,
-        /// What went wrong.
-        message: String,
-    },
-}
-
-impl RenderError {
-    /// Process exit code: 2 for bad input, 1 for failures while running.
-    pub fn exit_code(&self) -> i32 {
-        match self {
-            RenderError::BadInput(_) | RenderError::Project(_) | RenderError::Image(_) | RenderError::Io { .. } => 2,
-            RenderError::Gpu(vista_gpu::GpuError::Request(_)) => 2,
-            RenderError::Gpu(_) => 1,
-        }
-    }
-}
 
 /// Default cap on `work_per_pixel * pixels`. Lavapipe on 2 cores evaluates
 /// roughly 1e8-1e9 noise samples per second, so this keeps any accepted
@@ -365,7 +332,7 @@ pub fn plan(
     let layout = kernel.layout(&module).map_err(|e| RenderError::BadInput(e.to_string()))?;
     let entry = kernel.entry();
     let constants = kernel.overrides(&module, p).map_err(|e| RenderError::BadInput(e.to_string()))?;
-    let workgroup_size = workgroup_size(&module, entry, &constants)
+    let workgroup_size = reflect::workgroup_size(&module, entry, &constants)
         .map_err(|e| RenderError::BadInput(format!("kernel {}: {shader}: {e}", kernel.name())))?;
     use vista_kernels::bindings::Feed;
     let slots: Vec<vista_gpu::Slot> = layout
@@ -426,30 +393,6 @@ pub fn plan(
         height: extent.height,
         display: kernel.display_map_of(p, format),
     })
-}
-
-/// The entry point's workgroup size; where it names `override`s, their
-/// values are substituted first.
-pub(crate) fn workgroup_size(
-    module: &naga::Module,
-    entry: &str,
-    constants: &[(String, f64)],
-) -> Result<[u32; 3], String> {
-    let find = |m: &naga::Module| {
-        m.entry_points
-            .iter()
-            .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
-            .map(|e| (e.workgroup_size, e.workgroup_size_overrides.is_some()))
-            .expect("Kernel::layout refuses an unknown entry point")
-    };
-    match find(module) {
-        (size, false) => Ok(size),
-        (_, true) => {
-            let (resolved, _) =
-                vista_gpu::resolve_overrides(entry, module, entry, constants).map_err(|e| e.to_string())?;
-            Ok(find(&resolved).0)
-        }
-    }
 }
 
 /// Runs a plan on the renderer's engine.
