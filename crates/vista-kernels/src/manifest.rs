@@ -319,20 +319,169 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let is_graph = crate::graph::is_graph(&raw.resources, &pass_tables, &output_tables, raw.deterministic);
     let describes_resources = !pass_tables.is_empty() || !raw.resources.is_empty() || !output_tables.is_empty();
 
+    let OneOutput { view: output, partial, resource: output_resource, exposure: output_exposure } =
+        parse_output(raw.output.as_ref(), is_graph, &kfail)?;
+    let opaque_display = match raw.display_alpha.as_deref() {
+        None | Some("keep") => false,
+        Some("opaque") => true,
+        Some(other) => return Err(kfail(format!("display_alpha = \"{other}\" is not valid; expected keep|opaque"))),
+    };
+
+    let (params, enum_constants) = parse_params(&raw.params, &kfail)?;
+    let (presets, sweep_reference) = parse_presets(&raw.preset, &raw.sweep_reference, &params, &kfail)?;
+
+    let work = parse_work(&raw.work, &params, &kfail)?;
+    if let Some([lo, hi]) = raw.output_range
+        && (lo.is_nan() || hi.is_nan() || lo > hi)
+    {
+        return Err(kfail(format!("output_range = [{lo}, {hi}] is not valid; expected min <= max")));
+    }
+    if let Some(p) = params.iter().find(|p| p.name == "exposure")
+        && output == Some(Output::Hdr)
+        && !matches!(p.kind, Kind::Float { .. })
+    {
+        return Err(kfail("param exposure sets the hdr view's tone map; it must be an f32".into()));
+    }
+    let hash_plane = match &raw.hash_plane {
+        None => None,
+        Some(toml::Value::Integer(z)) => Some(HashPlane::Fixed(*z)),
+        Some(v) => match params.iter().find(|p| v.as_str() == Some(p.name.as_str())) {
+            Some(p) if matches!(p.kind, Kind::Float { .. }) => Some(HashPlane::Param(p.name.clone())),
+            _ => return Err(kfail(format!("hash_plane = {v} must name an f32 param or be an integer z"))),
+        },
+    };
+    let mut specialize: Vec<String> = Vec::new();
+    for n in &raw.specialize {
+        match params.iter().find(|p| &p.name == n) {
+            Some(p) if matches!(p.kind, Kind::Enum(_)) && !specialize.contains(&p.name) => {
+                specialize.push(p.name.clone())
+            }
+            Some(p) if matches!(p.kind, Kind::Enum(_)) => {
+                return Err(kfail(format!("specialize lists \"{n}\" twice")));
+            }
+            _ => return Err(kfail(format!("specialize = [\"{n}\"]: \"{n}\" must name an enum param"))),
+        }
+    }
+    let graph = match is_graph {
+        true => Some(crate::graph::parse(
+            &raw.resources,
+            &pass_tables,
+            &output_tables,
+            raw.deterministic,
+            output,
+            &params,
+            &kfail,
+        )?),
+        false => None,
+    };
+    let pass = if is_graph { None } else { raw.passes.first() };
+    let entry = match &graph {
+        Some(g) => g.passes[0].entry.clone(),
+        None => pass.and_then(|p| p.entry.clone()).unwrap_or_else(|| "main".into()),
+    };
+    if entry.is_empty() || !entry.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(kfail(format!("[[pass]] entry = \"{entry}\" is not a WGSL function name")));
+    }
+    let workgroups = match pass.and_then(|p| p.workgroups.as_ref()) {
+        None => None,
+        Some(list) if list.len() == 3 => {
+            let mut out = Vec::new();
+            for v in list {
+                out.push(
+                    crate::expr::Expr::parse_entry(v, &params)
+                        .map_err(|e| kfail(format!("[[pass]] workgroups {e}")))?,
+                );
+            }
+            let [x, y, z]: [crate::expr::Expr; 3] = out.try_into().expect("three entries");
+            Some([x, y, z])
+        }
+        Some(list) => {
+            return Err(kfail(format!("[[pass]] workgroups has {} entries; expected [x, y, z]", list.len())));
+        }
+    };
+    let (resources, bind) = match is_graph {
+        true => (Vec::new(), Vec::new()),
+        false => crate::resources::parse(&raw.resources, pass.and_then(|p| p.bind.as_ref()), &params, &kfail)?,
+    };
+    if let Some(named) = &output_resource
+        && !resources.is_empty()
+        && !resources.iter().any(|r| &r.name == named)
+    {
+        let names: Vec<&str> = resources.iter().map(|r| r.name.as_str()).collect();
+        return Err(kfail(format!(
+            "[[output]] resource = \"{named}\" names no resource; resources: {}",
+            names.join(", ")
+        )));
+    }
+    let defs = parse_defs(&raw.defs).map_err(kfail)?;
+    let source = match &raw.source {
+        Some(t) => vista_source::SourceSpec::parse(t).map_err(kfail)?,
+        None => Default::default(),
+    };
+    let overrides = parse_overrides(&raw.overrides).map_err(kfail)?;
+    let groups = parse_groups(&raw.groups, &kfail)?;
+    let pass_sources = graph.iter().flat_map(|g| g.passes.iter().map(|p| &p.source));
+    check_replacements(std::iter::once(&source).chain(pass_sources), &params).map_err(kfail)?;
+    let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
+    Ok(Manifest {
+        name: name.to_string(),
+        summary: raw.summary,
+        shader,
+        output,
+        opaque_display,
+        entry,
+        workgroups,
+        partial,
+        resources,
+        bind,
+        output_resource,
+        graph,
+        describes_resources,
+        defs,
+        output_exposure,
+        source,
+        overrides,
+        work,
+        output_range: raw.output_range.map(|[a, b]| (a, b)),
+        hash_plane,
+        specialize,
+        params,
+        enum_constants,
+        groups,
+        presets,
+        sweep_reference,
+    })
+}
+
+/// The one-pass kernel's output: `output = "display"|"hdr"|"normalize"`,
+/// or its one `[[output]]` table (a graph's are `graph.rs`'s).
+#[derive(Default)]
+struct OneOutput {
+    view: Option<Output>,
+    partial: bool,
+    resource: Option<String>,
+    exposure: Option<f64>,
+}
+
+fn parse_output(
+    output: Option<&toml::Value>,
+    is_graph: bool,
+    kfail: &dyn Fn(String) -> ParamError,
+) -> Result<OneOutput, ParamError> {
     let view = |v: &str| match v {
         "display" => Ok(Output::Display),
         "hdr" => Ok(Output::Hdr),
         "normalize" => Ok(Output::Normalize),
         other => Err(kfail(format!("output view \"{other}\" is not valid; expected display|hdr|normalize"))),
     };
-    let (output, partial, output_resource, output_exposure) = match &raw.output {
-        None => (None, false, None, None),
-        Some(toml::Value::String(s)) => (Some(view(s)?), false, None, None),
+    Ok(match output {
+        None => OneOutput::default(),
+        Some(toml::Value::String(s)) => OneOutput { view: Some(view(s)?), ..Default::default() },
         Some(toml::Value::Array(tables)) if is_graph => {
             for t in tables {
                 RawOutput::deserialize(t.clone()).map_err(|e| kfail(format!("[[output]]: {e}")))?;
             }
-            (None, false, None, None)
+            OneOutput::default()
         }
         Some(toml::Value::Array(tables)) => {
             if tables.len() != 1 {
@@ -352,23 +501,36 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             {
                 return Err(kfail(format!("[[output]] exposure = {e} is not valid; expected a number > 0")));
             }
-            (o.view.as_deref().map(view).transpose()?, o.partial, o.resource, o.exposure)
+            OneOutput {
+                view: o.view.as_deref().map(view).transpose()?,
+                partial: o.partial,
+                resource: o.resource,
+                exposure: o.exposure,
+            }
         }
         Some(other) => {
             return Err(kfail(format!(
                 "output = {other} is not valid; expected \"display\", \"hdr\" or [[output]] tables"
             )));
         }
-    };
-    let opaque_display = match raw.display_alpha.as_deref() {
-        None | Some("keep") => false,
-        Some("opaque") => true,
-        Some(other) => return Err(kfail(format!("display_alpha = \"{other}\" is not valid; expected keep|opaque"))),
-    };
+    })
+}
 
+/// Each enum value's WGSL constant name and index.
+type EnumConstants = Vec<(String, u32)>;
+/// Param values by name, as written (`sweep_reference`, a preset's).
+type Settings = Vec<(String, String)>;
+
+/// The `[[param]]` tables: each param's type, range, default and doc, and
+/// the WGSL constants of the enum values (`PREFIX_VALUE`), every value and
+/// name checked; errors name the param.
+fn parse_params(
+    raw: &[RawParam],
+    kfail: &dyn Fn(String) -> ParamError,
+) -> Result<(Vec<ParamSpec>, EnumConstants), ParamError> {
     let mut params: Vec<ParamSpec> = Vec::new();
     let mut enum_constants: Vec<(String, u32)> = Vec::new();
-    for p in &raw.params {
+    for p in raw {
         let pfail = |message: String| kfail(format!("param {}: {message}", p.name));
         let ident = |w: &str| !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
         // `module::path::variable.path`: the module's path, then the name.
@@ -508,14 +670,18 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         parse_value(&spec, &spec.default).map_err(|e| pfail(format!("default: {e}")))?;
         params.push(spec);
     }
-    let find = |pname: &str, context: &str| -> Result<&ParamSpec, ParamError> {
-        params.iter().find(|s| s.name == pname).ok_or_else(|| {
-            kfail(format!(
-                "{context} names unknown param '{pname}'; valid params: {}",
-                params.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
-            ))
-        })
-    };
+    Ok((params, enum_constants))
+}
+
+/// The `[preset.<name>]` tables and `[sweep_reference]`: every value
+/// parsed against its param; an unknown param is named.
+fn parse_presets(
+    preset: &toml::Table,
+    sweep: &toml::Table,
+    params: &[ParamSpec],
+    kfail: &dyn Fn(String) -> ParamError,
+) -> Result<(Vec<Preset>, Settings), ParamError> {
+    let find = |pname: &str, context: &str| find_param(params, pname, context, kfail);
     let settings = |table: &toml::Table, context: &str| -> Result<Vec<(String, String)>, ParamError> {
         let mut out = Vec::new();
         for (k, v) in table {
@@ -528,7 +694,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     };
 
     let mut presets = Vec::new();
-    for (pname, table) in &raw.preset {
+    for (pname, table) in preset {
         let Some(mut table) = table.as_table().cloned() else {
             return Err(kfail(format!("preset {pname} must be a table ([preset.{pname}] with name = value lines)")));
         };
@@ -540,17 +706,25 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         let set = settings(&table, &format!("preset {pname}"))?;
         presets.push(Preset { name: pname.clone(), doc, set });
     }
-    let sweep_reference = settings(&raw.sweep_reference, "sweep_reference")?;
+    let sweep_reference = settings(sweep, "sweep_reference")?;
+    Ok((presets, sweep_reference))
+}
 
+/// The `work` entries: sums of number params and constants, multiplied.
+fn parse_work(
+    entries: &[String],
+    params: &[ParamSpec],
+    kfail: &dyn Fn(String) -> ParamError,
+) -> Result<Vec<WorkFactor>, ParamError> {
     let mut work = Vec::new();
-    for entry in &raw.work {
+    for entry in entries {
         let mut factor = WorkFactor { params: Vec::new(), constant: 0.0 };
         for term in entry.split('+').map(str::trim) {
             if let Ok(c) = term.parse::<f64>() {
                 factor.constant += c;
                 continue;
             }
-            let spec = find(term, &format!("work entry \"{entry}\""))?;
+            let spec = find_param(params, term, &format!("work entry \"{entry}\""), kfail)?;
             if !matches!(spec.kind, Kind::Int { .. } | Kind::Float { .. }) {
                 return Err(kfail(format!("work entry \"{entry}\": '{term}' is not a number param")));
             }
@@ -558,107 +732,29 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         }
         work.push(factor);
     }
-    if let Some([lo, hi]) = raw.output_range
-        && (lo.is_nan() || hi.is_nan() || lo > hi)
-    {
-        return Err(kfail(format!("output_range = [{lo}, {hi}] is not valid; expected min <= max")));
-    }
-    if let Some(p) = params.iter().find(|p| p.name == "exposure")
-        && output == Some(Output::Hdr)
-        && !matches!(p.kind, Kind::Float { .. })
-    {
-        return Err(kfail("param exposure sets the hdr view's tone map; it must be an f32".into()));
-    }
-    let hash_plane = match &raw.hash_plane {
-        None => None,
-        Some(toml::Value::Integer(z)) => Some(HashPlane::Fixed(*z)),
-        Some(v) => match params.iter().find(|p| v.as_str() == Some(p.name.as_str())) {
-            Some(p) if matches!(p.kind, Kind::Float { .. }) => Some(HashPlane::Param(p.name.clone())),
-            _ => return Err(kfail(format!("hash_plane = {v} must name an f32 param or be an integer z"))),
-        },
-    };
-    let mut specialize: Vec<String> = Vec::new();
-    for n in &raw.specialize {
-        match params.iter().find(|p| &p.name == n) {
-            Some(p) if matches!(p.kind, Kind::Enum(_)) && !specialize.contains(&p.name) => {
-                specialize.push(p.name.clone())
-            }
-            Some(p) if matches!(p.kind, Kind::Enum(_)) => {
-                return Err(kfail(format!("specialize lists \"{n}\" twice")));
-            }
-            _ => return Err(kfail(format!("specialize = [\"{n}\"]: \"{n}\" must name an enum param"))),
-        }
-    }
-    let graph = match is_graph {
-        true => Some(crate::graph::parse(
-            &raw.resources,
-            &pass_tables,
-            &output_tables,
-            raw.deterministic,
-            output,
-            &params,
-            &kfail,
-        )?),
-        false => None,
-    };
-    let pass = if is_graph { None } else { raw.passes.first() };
-    let entry = match &graph {
-        Some(g) => g.passes[0].entry.clone(),
-        None => pass.and_then(|p| p.entry.clone()).unwrap_or_else(|| "main".into()),
-    };
-    if entry.is_empty() || !entry.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-        return Err(kfail(format!("[[pass]] entry = \"{entry}\" is not a WGSL function name")));
-    }
-    let workgroups = match pass.and_then(|p| p.workgroups.as_ref()) {
-        None => None,
-        Some(list) if list.len() == 3 => {
-            let mut out = Vec::new();
-            for v in list {
-                out.push(
-                    crate::expr::Expr::parse_entry(v, &params)
-                        .map_err(|e| kfail(format!("[[pass]] workgroups {e}")))?,
-                );
-            }
-            let [x, y, z]: [crate::expr::Expr; 3] = out.try_into().expect("three entries");
-            Some([x, y, z])
-        }
-        Some(list) => {
-            return Err(kfail(format!("[[pass]] workgroups has {} entries; expected [x, y, z]", list.len())));
-        }
-    };
-    let (resources, bind) = match is_graph {
-        true => (Vec::new(), Vec::new()),
-        false => crate::resources::parse(&raw.resources, pass.and_then(|p| p.bind.as_ref()), &params, &kfail)?,
-    };
-    if let Some(named) = &output_resource
-        && !resources.is_empty()
-        && !resources.iter().any(|r| &r.name == named)
-    {
-        let names: Vec<&str> = resources.iter().map(|r| r.name.as_str()).collect();
-        return Err(kfail(format!(
-            "[[output]] resource = \"{named}\" names no resource; resources: {}",
-            names.join(", ")
-        )));
-    }
-    let defs = parse_defs(&raw.defs).map_err(kfail)?;
-    let source = match &raw.source {
-        Some(t) => vista_source::SourceSpec::parse(t).map_err(kfail)?,
-        None => Default::default(),
-    };
-    let mut overrides = Vec::new();
-    for (k, v) in &raw.overrides {
-        let value = match v {
-            toml::Value::Boolean(b) => *b as u8 as f64,
-            toml::Value::Integer(i) => *i as f64,
-            toml::Value::Float(f) if f.is_finite() => *f,
-            other => {
-                return Err(kfail(format!("overrides: {k} = {other} is not valid; expected a number or a bool")));
-            }
-        };
-        overrides.push((k.clone(), value));
-    }
+    Ok(work)
+}
+
+/// The param named `pname`, or an error naming `context` and the params.
+fn find_param<'p>(
+    params: &'p [ParamSpec],
+    pname: &str,
+    context: &str,
+    kfail: &dyn Fn(String) -> ParamError,
+) -> Result<&'p ParamSpec, ParamError> {
+    params.iter().find(|s| s.name == pname).ok_or_else(|| {
+        kfail(format!(
+            "{context} names unknown param '{pname}'; valid params: {}",
+            params.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+        ))
+    })
+}
+
+/// The `[[group]]` tables: a struct-typed uniform field, the prefix and
+/// renames of the params that fill its leaves.
+fn parse_groups(raw: &[RawGroup], kfail: &dyn Fn(String) -> ParamError) -> Result<Vec<ParamGroup>, ParamError> {
     let mut groups: Vec<ParamGroup> = Vec::new();
-    for g in &raw.groups {
+    for g in raw {
         let ident = |w: &str| !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
         if !g.field.split('.').all(ident) {
             return Err(kfail(format!(
@@ -686,55 +782,50 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         }
         groups.push(ParamGroup { field: g.field.clone(), prefix: g.prefix.clone(), rename });
     }
-    // A replacement's param gives text: an enum's value name or a number.
-    let pass_sources = graph.iter().flat_map(|g| g.passes.iter().map(|p| &p.source));
-    for p in std::iter::once(&source).chain(pass_sources).flat_map(|s| s.params()) {
+    Ok(groups)
+}
+
+/// The `overrides` table: each pipeline-overridable constant's value.
+fn parse_overrides(table: &toml::Table) -> Result<Vec<(String, f64)>, String> {
+    let mut overrides = Vec::new();
+    for (k, v) in table {
+        let value = match v {
+            toml::Value::Boolean(b) => *b as u8 as f64,
+            toml::Value::Integer(i) => *i as f64,
+            toml::Value::Float(f) if f.is_finite() => *f,
+            other => {
+                return Err(format!("overrides: {k} = {other} is not valid; expected a number or a bool"));
+            }
+        };
+        overrides.push((k.clone(), value));
+    }
+    Ok(overrides)
+}
+
+/// A replacement's param gives text: an enum's value name or a number's.
+fn check_replacements<'s>(
+    sources: impl Iterator<Item = &'s vista_source::SourceSpec>,
+    params: &[ParamSpec],
+) -> Result<(), String> {
+    for p in sources.flat_map(|s| s.params()) {
         match params.iter().find(|s| s.name == p).map(|s| &s.ty) {
             Some(ParamType::Enum | ParamType::U32 | ParamType::I32 | ParamType::F32) => {}
             Some(other) => {
-                return Err(kfail(format!(
+                return Err(format!(
                     "[source] replace: param {p} is {}; a replacement takes an enum or a number (u32, i32, f32)",
                     other.name()
-                )));
+                ));
             }
             None => {
                 let names: Vec<&str> = params.iter().map(|s| s.name.as_str()).collect();
-                return Err(kfail(format!(
+                return Err(format!(
                     "[source] replace: {{ param = \"{p}\" }} names no param; params: {}",
                     if names.is_empty() { "none".into() } else { names.join(", ") }
-                )));
+                ));
             }
         }
     }
-    let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
-    Ok(Manifest {
-        name: name.to_string(),
-        summary: raw.summary,
-        shader,
-        output,
-        opaque_display,
-        entry,
-        workgroups,
-        partial,
-        resources,
-        bind,
-        output_resource,
-        graph,
-        describes_resources,
-        defs,
-        output_exposure,
-        source,
-        overrides,
-        work,
-        output_range: raw.output_range.map(|[a, b]| (a, b)),
-        hash_plane,
-        specialize,
-        params,
-        enum_constants,
-        groups,
-        presets,
-        sweep_reference,
-    })
+    Ok(())
 }
 
 /// A `defs` table (the kernel's, or a pass's) as `NAME=value` strings:
