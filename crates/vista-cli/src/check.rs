@@ -39,6 +39,79 @@ fn check_results_path(flag: &str, path: &Path) -> Result<(), GoldenError> {
     check_parent_writable(path).map_err(|e| bad(format!("{flag} {}: {e}", path.display())))
 }
 
+/// A case's status line (`ok`, `xfail`, `FAIL`; the value it was judged
+/// by; a per-backend golden named), and for a failure its explanation.
+fn print_case(o: &vista_golden::Outcome, report_dir: &Path) {
+    let label = match o.verdict {
+        vista_golden::Verdict::Pass => "ok",
+        vista_golden::Verdict::ExpectedFail => "xfail",
+        _ => "FAIL",
+    };
+    let per_backend = match o.golden_file.rsplit_once('@') {
+        Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
+        None => String::new(),
+    };
+    println!("{label:<6} {:<40} {:<17} {:>8.1} ms{per_backend}", o.id, o.headline(), o.gpu_ms);
+    if !o.passed() {
+        print!("{}", o.explain(report_dir));
+    } else if o.verdict == vista_golden::Verdict::ExpectedFail {
+        o.notes.iter().for_each(|n| println!("  note: {n}"));
+    }
+}
+
+/// GitHub Actions `::error` annotations of the failing cases, with paths
+/// relative to the working directory, where the workflow runs.
+fn annotate(store: &Store, outcomes: &[vista_golden::Outcome]) {
+    let cases = store.cases_path();
+    let shown = std::env::current_dir()
+        .ok()
+        .and_then(|cwd| cases.strip_prefix(&cwd).ok().map(Path::to_path_buf))
+        .unwrap_or_else(|| cases.clone());
+    let text = std::fs::read_to_string(&cases).unwrap_or_default();
+    for line in vista_report::github_annotations(outcomes, &shown.display().to_string(), &text) {
+        println!("{line}");
+    }
+}
+
+/// Narrows `picked` (the cases `--case` matches) by `--changed`,
+/// `--failed` and `--partition`, in that order, and says so. Needs no
+/// device: hashes from the project's WGSL, the last report.
+fn narrow(
+    project: &Project,
+    pick: &Pick,
+    manifest: &vista_golden::Manifest,
+    report_dir: &Path,
+    picked: &mut Vec<&vista_golden::Case>,
+) -> Result<(), GoldenError> {
+    let all = picked.len();
+    let mut why: Vec<String> = Vec::new();
+    if pick.changed {
+        let shaders = vista_render::shader_set(project)?;
+        picked.retain(|c| {
+            // Every file any pass reaches, as the manifest records them.
+            let mut files = std::collections::BTreeMap::new();
+            for f in c.kernel.shader_units() {
+                files.extend(shaders.file_hashes(&f).unwrap_or_default());
+            }
+            vista_golden::selection::change(c, manifest, &files).is_some()
+        });
+        why.push("--changed".into());
+    }
+    if pick.failed {
+        let failures = vista_golden::selection::last_failures(report_dir)?;
+        picked.retain(|c| failures.contains(&c.id));
+        why.push("--failed".into());
+    }
+    if let Some(part) = pick.partition {
+        picked.retain(|c| vista_golden::selection::in_partition(&c.id, part));
+        why.push(format!("--partition {}/{}", part.0, part.1));
+    }
+    if !why.is_empty() {
+        println!("selected {} of {all} cases ({})", picked.len(), why.join(", "));
+    }
+    Ok(())
+}
+
 pub fn check(
     project: &Project,
     config: &Config,
@@ -61,33 +134,7 @@ pub fn check(
         Some(d) => d,
         None => project.report_dir().expect("a store implies a root"),
     };
-    // Selection needs no device: hashes from the project's WGSL, the last report.
-    let all = picked.len();
-    let mut why: Vec<String> = Vec::new();
-    if pick.changed {
-        let shaders = vista_render::shader_set(project)?;
-        picked.retain(|c| {
-            // Every file any pass reaches, as the manifest records them.
-            let mut files = std::collections::BTreeMap::new();
-            for f in c.kernel.shader_units() {
-                files.extend(shaders.file_hashes(&f).unwrap_or_default());
-            }
-            vista_golden::selection::change(c, &manifest, &files).is_some()
-        });
-        why.push("--changed".into());
-    }
-    if pick.failed {
-        let failures = vista_golden::selection::last_failures(&report_dir)?;
-        picked.retain(|c| failures.contains(&c.id));
-        why.push("--failed".into());
-    }
-    if let Some(part) = pick.partition {
-        picked.retain(|c| vista_golden::selection::in_partition(&c.id, part));
-        why.push(format!("--partition {}/{}", part.0, part.1));
-    }
-    if !why.is_empty() {
-        println!("selected {} of {all} cases ({})", picked.len(), why.join(", "));
-    }
+    narrow(project, pick, &manifest, &report_dir, &mut picked)?;
     let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
     vista_report::clear_case_folders(&report_dir)?;
     let opts = CheckOptions { twice: false };
@@ -132,22 +179,7 @@ pub fn check(
                     pending.insert(o.id.clone(), entry);
                 }
             }
-            let label = match o.verdict {
-                vista_golden::Verdict::Pass => "ok",
-                vista_golden::Verdict::ExpectedFail => "xfail",
-                _ => "FAIL",
-            };
-            // A per-backend golden is named on the case's line.
-            let per_backend = match o.golden_file.rsplit_once('@') {
-                Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
-                None => String::new(),
-            };
-            println!("{label:<6} {:<40} {:<17} {:>8.1} ms{per_backend}", o.id, o.headline(), o.gpu_ms);
-            if !o.passed() {
-                print!("{}", o.explain(&report_dir));
-            } else if o.verdict == vista_golden::Verdict::ExpectedFail {
-                o.notes.iter().for_each(|n| println!("  note: {n}"));
-            }
+            print_case(&o, &report_dir);
             outcomes.push(o);
         },
     );
@@ -173,16 +205,7 @@ pub fn check(
         vista_image::atomic_write(p, json_text.as_bytes())?;
     }
     if config.github_actions {
-        // Paths relative to the working directory, where the workflow runs.
-        let cases = store.cases_path();
-        let shown = std::env::current_dir()
-            .ok()
-            .and_then(|cwd| cases.strip_prefix(&cwd).ok().map(Path::to_path_buf))
-            .unwrap_or_else(|| cases.clone());
-        let text = std::fs::read_to_string(&cases).unwrap_or_default();
-        for line in vista_report::github_annotations(&outcomes, &shown.display().to_string(), &text) {
-            println!("{line}");
-        }
+        annotate(&store, &outcomes);
     }
     let failing: Vec<&str> = outcomes.iter().filter(|o| !o.passed()).map(|o| o.id.as_str()).collect();
     let failed = failing.len();
