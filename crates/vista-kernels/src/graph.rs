@@ -292,6 +292,36 @@ pub(crate) fn parse(
     params: &[ParamSpec],
     fail: &dyn Fn(String) -> ParamError,
 ) -> Result<GraphSpec, ParamError> {
+    let res = parse_resources(resources, params, fail)?;
+    let out_passes = parse_passes(passes, &res, params, fail)?;
+    let outs = parse_outputs(outputs, default_view, fail)?;
+    if outs.iter().any(|o| o.view == Some(Output::Hdr))
+        && params.iter().any(|p| p.name == "exposure" && p.ty != crate::params::ParamType::F32)
+    {
+        return Err(fail("param exposure sets the hdr view's tone map; it must be an f32".into()));
+    }
+    let deterministic = deterministic.unwrap_or(true);
+    if !deterministic {
+        if outs.is_empty() {
+            return Err(fail("deterministic = false needs [[output]] tables, each with a tolerance".into()));
+        }
+        if let Some(o) = outs.iter().find(|o| o.tolerance.is_none()) {
+            return Err(fail(format!(
+                "[[output]] {}: deterministic = false needs a tolerance on every output ({})",
+                o.resource,
+                Tolerance::KEYS[1..6].join(", ")
+            )));
+        }
+    }
+    Ok(GraphSpec { resources: res, passes: out_passes, outputs: outs, deterministic })
+}
+
+/// The `[[resource]]` tables: each resource's kind and its kind's keys.
+fn parse_resources(
+    resources: &[toml::Value],
+    params: &[ParamSpec],
+    fail: &dyn Fn(String) -> ParamError,
+) -> Result<Vec<ResourceSpec>, ParamError> {
     let mut res: Vec<ResourceSpec> = Vec::new();
     for t in resources {
         let Some(t) = t.as_table() else { return Err(fail("[[resource]] must be a table".into())) };
@@ -306,13 +336,7 @@ pub(crate) fn parse(
             return Err(fail(format!("[[resource]] name \"{name}\" is used twice")));
         }
         let at = |m: String| fail(format!("[[resource]] {name}: {m}"));
-        let text = |k: &str| -> Result<Option<String>, ParamError> {
-            match t.get(k) {
-                None => Ok(None),
-                Some(toml::Value::String(s)) => Ok(Some(s.clone())),
-                Some(other) => Err(at(format!("{k} = {other} is not valid; expected a string"))),
-            }
-        };
+        let text = |k: &str| string_key(t, k, &at);
         let kind = text("kind")?.ok_or_else(|| at("needs kind = \"texture\", \"buffer\" or \"sampler\"".into()))?;
         let allowed: &[&str] = match kind.as_str() {
             "texture" => &["name", "kind", "format", "dimension", "size", "file"],
@@ -332,148 +356,184 @@ pub(crate) fn parse(
             return Err(at(format!("file = \"{f}\" must be a path under the project root (no '/' start, no '..')")));
         }
         let kind = match kind.as_str() {
-            "texture" => {
-                let format = match text("format")? {
-                    None => None,
-                    Some(f) => {
-                        Some(crate::bindings::STORAGE_FORMATS.iter().copied().find(|n| *n == f).ok_or_else(|| {
-                            at(format!(
-                                "format = \"{f}\" is not valid; expected one of {}",
-                                crate::bindings::STORAGE_FORMATS.join(", ")
-                            ))
-                        })?)
-                    }
-                };
-                let dimension = match text("dimension")? {
-                    None => None,
-                    Some(d) => Some(match d.as_str() {
-                        "1d" => SampledDim::D1,
-                        "2d" => SampledDim::D2,
-                        "2d-array" => SampledDim::D2Array,
-                        "3d" => SampledDim::D3,
-                        "cube" => SampledDim::Cube,
-                        other => {
-                            return Err(at(format!(
-                                "dimension = \"{other}\" is not valid; expected 1d|2d|2d-array|3d|cube"
-                            )));
-                        }
-                    }),
-                };
-                if let Some(f) = &file
-                    && !(f.ends_with(".png") || f.ends_with(".exr"))
-                {
-                    return Err(at(format!("file = \"{f}\" is not valid for a texture; expected a .png or .exr file")));
-                }
-                let size = match t.get("size") {
-                    None => None,
-                    Some(toml::Value::Array(list)) => {
-                        let want = match dimension.unwrap_or(SampledDim::D2) {
-                            SampledDim::D1 => 1,
-                            SampledDim::D2 => 2,
-                            SampledDim::Cube => 1,
-                            _ => 3,
-                        };
-                        if list.len() != want {
-                            return Err(at(format!("size has {} entries; this texture takes {want}", list.len())));
-                        }
-                        let mut exprs = Vec::new();
-                        for v in list {
-                            exprs.push(Expr::parse_entry(v, params).map_err(|e| at(format!("size {e}")))?);
-                        }
-                        Some(exprs)
-                    }
-                    Some(other) => return Err(at(format!("size = {other} is not valid; expected a list"))),
-                };
-                ResourceKind::Texture { format, dimension, size, file }
-            }
-            "buffer" => {
-                let number = |v: &toml::Value| match v {
-                    toml::Value::Integer(i) => Some(*i as f64),
-                    toml::Value::Float(f) => Some(*f),
-                    toml::Value::Boolean(b) => Some(*b as u8 as f64),
-                    _ => None,
-                };
-                let data = match t.get("data") {
-                    None => None,
-                    Some(toml::Value::Array(list)) => {
-                        let mut out = Vec::new();
-                        fn flatten(v: &toml::Value, out: &mut Vec<toml::Value>) {
-                            match v {
-                                toml::Value::Array(l) => l.iter().for_each(|x| flatten(x, out)),
-                                other => out.push(other.clone()),
-                            }
-                        }
-                        let mut flat = Vec::new();
-                        list.iter().for_each(|v| flatten(v, &mut flat));
-                        for v in &flat {
-                            out.push(number(v).ok_or_else(|| at(format!("data entry {v} is not a number")))?);
-                        }
-                        Some(out)
-                    }
-                    Some(other) => return Err(at(format!("data = {other} is not valid; expected a list of numbers"))),
-                };
-                let fill = match t.get("fill") {
-                    None => None,
-                    Some(v) => {
-                        Some(number(v).ok_or_else(|| at(format!("fill = {v} is not valid; expected a number")))?)
-                    }
-                };
-                let length = match t.get("length") {
-                    None => None,
-                    Some(v) => Some(Expr::parse_entry(v, params).map_err(|e| at(format!("length {e}")))?),
-                };
-                if let Some(f) = &file
-                    && !(f.ends_with(".npy") || f.ends_with(".bin"))
-                {
-                    return Err(at(format!("file = \"{f}\" is not valid for a buffer; expected a .npy or .bin file")));
-                }
-                let sources = [file.is_some(), data.is_some(), fill.is_some()].iter().filter(|b| **b).count();
-                if sources > 1 {
-                    return Err(at("file, data and fill are exclusive; give one".into()));
-                }
-                if length.is_some() && (file.is_some() || data.is_some()) {
-                    return Err(at("length goes with fill or nothing; a file or data gives its own length".into()));
-                }
-                ResourceKind::Buffer { file, data, fill, length }
-            }
-            _ => {
-                let linear = match text("filter")?.as_deref() {
-                    None | Some("nearest") => false,
-                    Some("linear") => true,
-                    Some(other) => {
-                        return Err(at(format!("filter = \"{other}\" is not valid; expected nearest|linear")));
-                    }
-                };
-                let mode = |s: &str| {
-                    ADDRESS_MODES.iter().copied().find(|m| *m == s).ok_or_else(|| {
-                        at(format!("address \"{s}\" is not valid; expected {}", ADDRESS_MODES.join("|")))
-                    })
-                };
-                let address = match t.get("address") {
-                    None => ["clamp-to-edge"; 3],
-                    Some(toml::Value::String(s)) => [mode(s)?; 3],
-                    Some(toml::Value::Array(l)) if (1..=3).contains(&l.len()) => {
-                        let mut out = ["clamp-to-edge"; 3];
-                        for (i, v) in l.iter().enumerate() {
-                            out[i] = mode(v.as_str().ok_or_else(|| at(format!("address entry {v} is not a string")))?)?;
-                        }
-                        out
-                    }
-                    Some(other) => {
-                        return Err(at(format!("address = {other} is not valid; expected a mode or [u, v, w]")));
-                    }
-                };
-                let compare = match text("compare")? {
-                    None => None,
-                    Some(c) => Some(COMPARE_FUNCTIONS.iter().copied().find(|f| *f == c).ok_or_else(|| {
-                        at(format!("compare = \"{c}\" is not valid; expected {}", COMPARE_FUNCTIONS.join("|")))
-                    })?),
-                };
-                ResourceKind::Sampler { linear, address, compare }
-            }
+            "texture" => texture_kind(t, file, params, &at)?,
+            "buffer" => buffer_kind(t, file, params, &at)?,
+            _ => sampler_kind(t, &at)?,
         };
         res.push(ResourceSpec { name, kind });
     }
+    Ok(res)
+}
+
+/// A texture resource's keys: format, dimension, size (and its file).
+fn texture_kind(
+    t: &toml::Table,
+    file: Option<String>,
+    params: &[ParamSpec],
+    at: &dyn Fn(String) -> ParamError,
+) -> Result<ResourceKind, ParamError> {
+    let format = match string_key(t, "format", at)? {
+        None => None,
+        Some(f) => Some(crate::bindings::STORAGE_FORMATS.iter().copied().find(|n| *n == f).ok_or_else(|| {
+            at(format!(
+                "format = \"{f}\" is not valid; expected one of {}",
+                crate::bindings::STORAGE_FORMATS.join(", ")
+            ))
+        })?),
+    };
+    let dimension = match string_key(t, "dimension", at)? {
+        None => None,
+        Some(d) => Some(match d.as_str() {
+            "1d" => SampledDim::D1,
+            "2d" => SampledDim::D2,
+            "2d-array" => SampledDim::D2Array,
+            "3d" => SampledDim::D3,
+            "cube" => SampledDim::Cube,
+            other => {
+                return Err(at(format!("dimension = \"{other}\" is not valid; expected 1d|2d|2d-array|3d|cube")));
+            }
+        }),
+    };
+    if let Some(f) = &file
+        && !(f.ends_with(".png") || f.ends_with(".exr"))
+    {
+        return Err(at(format!("file = \"{f}\" is not valid for a texture; expected a .png or .exr file")));
+    }
+    let size = match t.get("size") {
+        None => None,
+        Some(toml::Value::Array(list)) => {
+            let want = match dimension.unwrap_or(SampledDim::D2) {
+                SampledDim::D1 => 1,
+                SampledDim::D2 => 2,
+                SampledDim::Cube => 1,
+                _ => 3,
+            };
+            if list.len() != want {
+                return Err(at(format!("size has {} entries; this texture takes {want}", list.len())));
+            }
+            let mut exprs = Vec::new();
+            for v in list {
+                exprs.push(Expr::parse_entry(v, params).map_err(|e| at(format!("size {e}")))?);
+            }
+            Some(exprs)
+        }
+        Some(other) => return Err(at(format!("size = {other} is not valid; expected a list"))),
+    };
+    Ok(ResourceKind::Texture { format, dimension, size, file })
+}
+
+/// A buffer resource's keys: its file, inline data, or fill and length.
+fn buffer_kind(
+    t: &toml::Table,
+    file: Option<String>,
+    params: &[ParamSpec],
+    at: &dyn Fn(String) -> ParamError,
+) -> Result<ResourceKind, ParamError> {
+    let number = |v: &toml::Value| match v {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(f) => Some(*f),
+        toml::Value::Boolean(b) => Some(*b as u8 as f64),
+        _ => None,
+    };
+    let data = match t.get("data") {
+        None => None,
+        Some(toml::Value::Array(list)) => {
+            let mut out = Vec::new();
+            fn flatten(v: &toml::Value, out: &mut Vec<toml::Value>) {
+                match v {
+                    toml::Value::Array(l) => l.iter().for_each(|x| flatten(x, out)),
+                    other => out.push(other.clone()),
+                }
+            }
+            let mut flat = Vec::new();
+            list.iter().for_each(|v| flatten(v, &mut flat));
+            for v in &flat {
+                out.push(number(v).ok_or_else(|| at(format!("data entry {v} is not a number")))?);
+            }
+            Some(out)
+        }
+        Some(other) => return Err(at(format!("data = {other} is not valid; expected a list of numbers"))),
+    };
+    let fill = match t.get("fill") {
+        None => None,
+        Some(v) => Some(number(v).ok_or_else(|| at(format!("fill = {v} is not valid; expected a number")))?),
+    };
+    let length = match t.get("length") {
+        None => None,
+        Some(v) => Some(Expr::parse_entry(v, params).map_err(|e| at(format!("length {e}")))?),
+    };
+    if let Some(f) = &file
+        && !(f.ends_with(".npy") || f.ends_with(".bin"))
+    {
+        return Err(at(format!("file = \"{f}\" is not valid for a buffer; expected a .npy or .bin file")));
+    }
+    let sources = [file.is_some(), data.is_some(), fill.is_some()].iter().filter(|b| **b).count();
+    if sources > 1 {
+        return Err(at("file, data and fill are exclusive; give one".into()));
+    }
+    if length.is_some() && (file.is_some() || data.is_some()) {
+        return Err(at("length goes with fill or nothing; a file or data gives its own length".into()));
+    }
+    Ok(ResourceKind::Buffer { file, data, fill, length })
+}
+
+/// A sampler resource's keys: filter, address modes, comparison.
+fn sampler_kind(t: &toml::Table, at: &dyn Fn(String) -> ParamError) -> Result<ResourceKind, ParamError> {
+    let linear = match string_key(t, "filter", at)?.as_deref() {
+        None | Some("nearest") => false,
+        Some("linear") => true,
+        Some(other) => {
+            return Err(at(format!("filter = \"{other}\" is not valid; expected nearest|linear")));
+        }
+    };
+    let mode = |s: &str| {
+        ADDRESS_MODES
+            .iter()
+            .copied()
+            .find(|m| *m == s)
+            .ok_or_else(|| at(format!("address \"{s}\" is not valid; expected {}", ADDRESS_MODES.join("|"))))
+    };
+    let address = match t.get("address") {
+        None => ["clamp-to-edge"; 3],
+        Some(toml::Value::String(s)) => [mode(s)?; 3],
+        Some(toml::Value::Array(l)) if (1..=3).contains(&l.len()) => {
+            let mut out = ["clamp-to-edge"; 3];
+            for (i, v) in l.iter().enumerate() {
+                out[i] = mode(v.as_str().ok_or_else(|| at(format!("address entry {v} is not a string")))?)?;
+            }
+            out
+        }
+        Some(other) => {
+            return Err(at(format!("address = {other} is not valid; expected a mode or [u, v, w]")));
+        }
+    };
+    let compare =
+        match string_key(t, "compare", at)? {
+            None => None,
+            Some(c) => Some(COMPARE_FUNCTIONS.iter().copied().find(|f| *f == c).ok_or_else(|| {
+                at(format!("compare = \"{c}\" is not valid; expected {}", COMPARE_FUNCTIONS.join("|")))
+            })?),
+        };
+    Ok(ResourceKind::Sampler { linear, address, compare })
+}
+
+/// Key `k` of `t` as a string, if given.
+fn string_key(t: &toml::Table, k: &str, at: &dyn Fn(String) -> ParamError) -> Result<Option<String>, ParamError> {
+    match t.get(k) {
+        None => Ok(None),
+        Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+        Some(other) => Err(at(format!("{k} = {other} is not valid; expected a string"))),
+    }
+}
+
+/// The `[[pass]]` tables (one default pass where there are none), their
+/// bindings naming resources of `res`.
+fn parse_passes(
+    passes: &[toml::Value],
+    res: &[ResourceSpec],
+    params: &[ParamSpec],
+    fail: &dyn Fn(String) -> ParamError,
+) -> Result<Vec<PassSpec>, ParamError> {
     let named = |r: &str| res.iter().any(|x| x.name == r);
     let names = || {
         let n: Vec<&str> = res.iter().map(|r| r.name.as_str()).collect();
@@ -490,13 +550,7 @@ pub(crate) fn parse(
                 return Err(at(format!("unknown key {k}; allowed: {}", PASS_KEYS.join(", "))));
             }
         }
-        let text = |k: &str| -> Result<Option<String>, ParamError> {
-            match t.get(k) {
-                None => Ok(None),
-                Some(toml::Value::String(s)) => Ok(Some(s.clone())),
-                Some(other) => Err(at(format!("{k} = {other} is not valid; expected a string"))),
-            }
-        };
+        let text = |k: &str| string_key(t, k, &at);
         let entry = text("entry")?.unwrap_or_else(|| "main".into());
         if entry.is_empty() || !entry.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
             return Err(at(format!("entry = \"{entry}\" is not a WGSL function name")));
@@ -621,6 +675,15 @@ pub(crate) fn parse(
         }
         out_passes.push(PassSpec { entry, shader, defs, source, bind, dispatch, workgroups, set, repeat, swap, group });
     }
+    Ok(out_passes)
+}
+
+/// The `[[output]]` tables: resource, view, exposure, partial, tolerance.
+fn parse_outputs(
+    outputs: &[toml::Value],
+    default_view: Option<Output>,
+    fail: &dyn Fn(String) -> ParamError,
+) -> Result<Vec<OutputSpec>, ParamError> {
     let mut outs = Vec::new();
     for t in outputs {
         let Some(t) = t.as_table() else { return Err(fail("[[output]] must be a table".into())) };
@@ -671,25 +734,7 @@ pub(crate) fn parse(
         }
         outs.push(OutputSpec { resource: resource.to_string(), view, partial, tolerance, exposure });
     }
-    if outs.iter().any(|o| o.view == Some(Output::Hdr))
-        && params.iter().any(|p| p.name == "exposure" && p.ty != crate::params::ParamType::F32)
-    {
-        return Err(fail("param exposure sets the hdr view's tone map; it must be an f32".into()));
-    }
-    let deterministic = deterministic.unwrap_or(true);
-    if !deterministic {
-        if outs.is_empty() {
-            return Err(fail("deterministic = false needs [[output]] tables, each with a tolerance".into()));
-        }
-        if let Some(o) = outs.iter().find(|o| o.tolerance.is_none()) {
-            return Err(fail(format!(
-                "[[output]] {}: deterministic = false needs a tolerance on every output ({})",
-                o.resource,
-                Tolerance::KEYS[1..6].join(", ")
-            )));
-        }
-    }
-    Ok(GraphSpec { resources: res, passes: out_passes, outputs: outs, deterministic })
+    Ok(outs)
 }
 
 fn tolerance(t: &toml::Table) -> Result<Tolerance, String> {
