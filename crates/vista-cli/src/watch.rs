@@ -1,7 +1,9 @@
 //! `vista watch`: checks the cases once, then, each time a saved file
 //! changes, re-checks the cases it reaches and rewrites the report, until
 //! interrupted (or `--timeout`). A WGSL file reaches the cases whose
-//! kernel imports it; a kernel manifest its kernel's cases; `golden/` files
+//! kernel imports it (or includes, prepends, appends it: the folders and
+//! files a `[source]` names outside `shaders/` are watched too); a kernel
+//! manifest its kernel's cases; `golden/` files
 //! (cases, goldens) every case. Changes are found by polling the files'
 //! hashes, so it needs no file-notification service and sees edits made by
 //! any editor (atomic renames included).
@@ -19,8 +21,8 @@ use crate::bad;
 
 /// Every watched file under the root, by path relative to it, with the
 /// hash of its bytes: `shaders/`, `kernels/`, `golden/cases.toml` and the
-/// goldens.
-fn snapshot(root: &Path) -> BTreeMap<String, String> {
+/// goldens, and `extra` (folders and files a `[source]` names).
+fn snapshot(root: &Path, extra: &[String]) -> BTreeMap<String, String> {
     fn walk(dir: &Path, root: &Path, out: &mut BTreeMap<String, String>) {
         let Ok(entries) = std::fs::read_dir(dir) else { return };
         for e in entries.flatten() {
@@ -37,8 +39,16 @@ fn snapshot(root: &Path) -> BTreeMap<String, String> {
         }
     }
     let mut out = BTreeMap::new();
-    for d in ["shaders", "kernels", "golden"] {
-        walk(&root.join(d), root, &mut out);
+    for d in ["shaders", "kernels", "golden"].into_iter().chain(extra.iter().map(String::as_str)) {
+        let p = root.join(d);
+        match p.is_file() {
+            true => {
+                if let Ok(bytes) = std::fs::read(&p) {
+                    out.insert(d.to_string(), vista_golden::short_hash_bytes(&bytes));
+                }
+            }
+            false => walk(&p, root, &mut out),
+        }
     }
     out.remove("golden/manifest.toml");
     out
@@ -56,7 +66,8 @@ pub fn watch(
     let report_dir = project.report_dir().expect("a root");
     let ctx = Context::shared(&config.gpu)?;
     let start = Instant::now();
-    let mut seen = snapshot(&root);
+    let extra = source_paths(project)?;
+    let mut seen = snapshot(&root, &extra);
     let mut outcomes: BTreeMap<String, Outcome> = BTreeMap::new();
     // The first round checks every selected case.
     let mut changed: Option<Vec<String>> = None;
@@ -75,9 +86,12 @@ pub fn watch(
                     files.iter().any(|f| {
                         f.starts_with("golden/")
                             || f == &format!("kernels/{}.toml", c.kernel.name())
-                            || f.strip_prefix("shaders/").is_some_and(|rel| {
-                                gpu.kernel_file_hashes(&c.kernel).map(|h| h.contains_key(rel)).unwrap_or(true)
-                            })
+                            || (f.starts_with("shaders/")
+                                || extra.iter().any(|e| f == e || f.starts_with(&format!("{e}/"))))
+                                && gpu
+                                    .kernel_file_hashes(&c.kernel)
+                                    .map(|h| h.contains_key(f.strip_prefix("shaders/").unwrap_or(f)))
+                                    .unwrap_or(true)
                     })
                 })
                 .collect(),
@@ -122,7 +136,7 @@ pub fn watch(
                 return Ok(0);
             }
             std::thread::sleep(interval);
-            let now = snapshot(&root);
+            let now = snapshot(&root, &extra);
             if now != seen {
                 let mut files: Vec<String> = now
                     .iter()
@@ -138,6 +152,22 @@ pub fn watch(
             }
         }
     }
+}
+
+/// The folders and files the project's `[source]` tables name outside
+/// `shaders/` (include folders, joined files, WESL packages).
+fn source_paths(project: &Project) -> Result<Vec<String>, GoldenError> {
+    let (specs, _) = vista_render::source_specs(project)?;
+    let mut out: Vec<String> = Vec::new();
+    for (_, s) in specs {
+        let named = s.include.iter().chain(&s.prepend).chain(&s.append).flatten().cloned();
+        for p in named.chain(s.packages.into_iter().map(|(_, dir)| dir)) {
+            if !p.starts_with("shaders/") && p != "shaders" && !out.contains(&p) {
+                out.push(p);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// `--interval MS`, checked.

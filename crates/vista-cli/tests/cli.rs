@@ -3686,6 +3686,50 @@ fn per_backend_goldens_cover_every_output_of_a_graph() {
 
 /// `vista watch` checks the cases, then re-checks exactly the cases a saved
 /// WGSL file reaches and rewrites the report, until its --timeout.
+/// A file a `[source]` includes from outside `shaders/` is watched too, and
+/// re-checks the cases whose kernels reach it.
+fn watch_follows_included_files_outside_shaders() {
+    let t = tmp();
+    let root = t.path().join("sources");
+    copy_tree(&repo().join("examples/sources"), &root);
+    std::fs::create_dir_all(root.join("vendor")).unwrap();
+    std::fs::rename(root.join("shaders/include"), root.join("vendor/include")).unwrap();
+    let manifest = root.join("kernels/cells.toml");
+    let text = std::fs::read_to_string(&manifest).unwrap().replace("\"shaders/include\"", "\"vendor/include\"");
+    std::fs::write(&manifest, text).unwrap();
+    let log = t.path().join("watch.log");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vista"))
+        .args(["watch", "--case", "cells*", "--interval", "100", "--timeout", "60"])
+        .current_dir(&root)
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .env_remove("CI")
+        .env_remove("VISTA_ROOT")
+        .stdout(std::fs::File::create(&log).unwrap())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let wait_for = |needle: &str| {
+        let start = std::time::Instant::now();
+        loop {
+            let text = std::fs::read_to_string(&log).unwrap_or_default();
+            if text.contains(needle) {
+                return text;
+            }
+            assert!(start.elapsed().as_secs() < 50, "watch never printed {needle:?}: {text}");
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+    };
+    let first = wait_for("(watching; Ctrl-C ends)");
+    assert!(first.contains("2 passed, 0 failed"), "{first}");
+    let rng = root.join("vendor/include/rng.inc.wgsl");
+    let text = std::fs::read_to_string(&rng).unwrap();
+    std::fs::write(&rng, text.replace("277803737u", "277803739u")).unwrap();
+    let after = wait_for("0 passed, 2 failed");
+    child.kill().ok();
+    child.wait().ok();
+    assert!(after.contains("changed: vendor/include/rng.inc.wgsl -> re-checking 2 cases"), "{after}");
+}
+
 fn watch_rechecks_what_a_saved_file_reaches() {
     let t = tmp();
     let root = t.path().join("real");
@@ -4330,6 +4374,7 @@ fn main() {
         Gpu overrides_take_manifest_values_and_params,
         Gpu the_real_kernels_example_passes_on_every_backend_with_a_copied_binary,
         Gpu the_sources_example_passes_on_every_backend_with_a_copied_binary,
+        Gpu watch_follows_included_files_outside_shaders,
         Gpu assembled_sources_name_their_own_files,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,
         Gpu graph_inputs_are_checked_before_gpu_work,
