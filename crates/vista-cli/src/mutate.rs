@@ -79,7 +79,9 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
     if let Some(k) = kernels.iter().find(|k| !cases.iter().any(|c| c.kernel.name() == k.name())) {
         return Err(bad(format!("kernel {} has no golden case selected; mutants need cases to run against", k.name())));
     }
-    let files = project.shader_files()?;
+    // The project's WGSL, and what its [source] tables reach outside shaders/.
+    let mut files = project.shader_files()?;
+    files.extend(vista_mutate::outside_files(project)?);
     let shaders = vista_render::shader_set(project)?;
     let opts = Options {
         kernel: a.kernel.clone(),

@@ -3686,9 +3686,9 @@ fn per_backend_goldens_cover_every_output_of_a_graph() {
 
 /// `vista watch` checks the cases, then re-checks exactly the cases a saved
 /// WGSL file reaches and rewrites the report, until its --timeout.
-/// A file a `[source]` includes from outside `shaders/` is watched too, and
-/// re-checks the cases whose kernels reach it.
-fn watch_follows_included_files_outside_shaders() {
+/// A file a `[source]` includes from outside `shaders/` is mutated, and
+/// watched: a change re-checks the cases whose kernels reach it.
+fn included_files_outside_shaders_are_mutated_and_watched() {
     let t = tmp();
     let root = t.path().join("sources");
     copy_tree(&repo().join("examples/sources"), &root);
@@ -3697,6 +3697,15 @@ fn watch_follows_included_files_outside_shaders() {
     let manifest = root.join("kernels/cells.toml");
     let text = std::fs::read_to_string(&manifest).unwrap().replace("\"shaders/include\"", "\"vendor/include\"");
     std::fs::write(&manifest, text).unwrap();
+    let m = vista_in(Some(&root), &[], &["mutate", "--kernel", "cells", "--sample", "6", "--json", "m.json"]);
+    assert_eq!(m.code, 0, "{}{}", m.stdout, m.stderr);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root.join("m.json")).unwrap()).unwrap();
+    let mutants = report["mutants"].as_array().unwrap();
+    assert!(
+        mutants.iter().any(|m| m["file"].as_str().unwrap().starts_with("vendor/include/") && m["outcome"] == "killed"),
+        "a mutant of an included file outside shaders/ reaches the render: {report}"
+    );
     let log = t.path().join("watch.log");
     let mut child = Command::new(env!("CARGO_BIN_EXE_vista"))
         .args(["watch", "--case", "cells*", "--interval", "100", "--timeout", "60"])
@@ -4374,7 +4383,7 @@ fn main() {
         Gpu overrides_take_manifest_values_and_params,
         Gpu the_real_kernels_example_passes_on_every_backend_with_a_copied_binary,
         Gpu the_sources_example_passes_on_every_backend_with_a_copied_binary,
-        Gpu watch_follows_included_files_outside_shaders,
+        Gpu included_files_outside_shaders_are_mutated_and_watched,
         Gpu assembled_sources_name_their_own_files,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,
         Gpu graph_inputs_are_checked_before_gpu_work,

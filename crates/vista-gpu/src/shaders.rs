@@ -61,6 +61,11 @@ impl Reader {
     pub fn new(read: impl Fn(&str) -> Option<(String, String)> + Send + Sync + 'static) -> Reader {
         Reader(Some(Arc::new(read)))
     }
+
+    /// The text and origin of root-relative `path`, if the reader has it.
+    pub fn read(&self, path: &str) -> Option<(String, String)> {
+        self.0.as_ref().and_then(|r| r(path))
+    }
 }
 
 impl std::fmt::Debug for Reader {
@@ -294,7 +299,7 @@ impl ShaderSet {
                 return Some((s.text.clone(), s.origin.clone()));
             }
         }
-        self.reader.0.as_ref().and_then(|r| r(path))
+        self.reader.read(path)
     }
 
     /// The generated `vista::enums` text for kernel file `name` (its
@@ -521,18 +526,24 @@ impl ShaderSet {
     }
 
     /// The kernel file and the lib modules it reaches through `#import`
-    /// (paths relative to `shaders/`): every file whose edit can change it.
+    /// (paths relative to `shaders/`), and the files its assembly reaches
+    /// outside `shaders/` (relative to the root): every file whose edit can
+    /// change it.
     pub fn import_closure(&self, name: &str) -> Result<Vec<String>, GpuError> {
         let unit = self.unit(name)?;
-        // An assembly's parts that are files of this set (under shaders/).
+        // An assembly's parts: files of this set by their path under
+        // shaders/, the others (an include folder elsewhere) by their path
+        // under the root.
         let parts: Vec<String> = match &unit.assembled {
             None => vec![name.to_string()],
             Some(a) => a
                 .parts
                 .iter()
-                .filter_map(|p| p.path.strip_prefix("shaders/"))
-                .filter(|rel| self.kernels.contains_key(*rel) || self.lib.iter().any(|e| e.rel == *rel))
-                .map(str::to_string)
+                .filter_map(|p| match p.path.strip_prefix("shaders/") {
+                    Some(rel) => (self.kernels.contains_key(rel) || self.lib.iter().any(|e| e.rel == rel))
+                        .then(|| rel.to_string()),
+                    None => Some(p.path.clone()),
+                })
                 .collect(),
         };
         Ok(parts.into_iter().chain(self.imported_lib(&unit.source)?.into_iter().map(|e| e.rel.clone())).collect())

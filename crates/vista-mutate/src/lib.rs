@@ -260,6 +260,27 @@ pub struct Planned {
     pub mutant: Mutant,
 }
 
+/// The WGSL files the project's `[source]` tables name outside `shaders/`
+/// (include folders, joined files, WESL packages), by path under the root.
+pub fn outside_files(project: &Project) -> Result<Vec<SourceFile>, GoldenError> {
+    let (specs, _) = vista_render::source_specs(project)?;
+    let mut out: Vec<SourceFile> = Vec::new();
+    for (_, s) in specs {
+        let named = s.include.iter().chain(&s.prepend).chain(&s.append).flatten().cloned();
+        for p in named.chain(s.packages.into_iter().map(|(_, dir)| dir)) {
+            if p.starts_with("shaders/") || p == "shaders" {
+                continue;
+            }
+            for f in project.files_under(&p, &["wgsl", "wesl"])? {
+                if !out.iter().any(|o| o.rel == f.rel) {
+                    out.push(f);
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// The deterministic plan: per kernel (sorted by name), every mutant of its
 /// import closure in source order, shuffled by `seed` and cut to `sample`;
 /// then this partition's slice (every n-th from the k-th). Only functions
@@ -507,10 +528,24 @@ pub fn run(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<MutantReport>, GoldenError> {
     let files = project.shader_files()?;
+    let outside = outside_files(project)?;
     let enums = vista_render::enum_modules(project)?;
     let (sources, reader) = vista_render::source_specs(project)?;
     let label = "mutant";
     let set = |edit: Option<&Mutant>| {
+        // A mutant of a file outside shaders/ reaches the assembly through
+        // the reader; the others through the set's own files.
+        let edited: Option<(String, String, String)> = edit.and_then(|m| {
+            outside.iter().find(|f| f.rel == m.file).map(|f| (f.rel.clone(), m.apply(&f.text), f.origin.clone()))
+        });
+        let read = reader.clone();
+        let reader = match edited {
+            None => read,
+            Some((rel, text, origin)) => vista_gpu::Reader::new(move |path| match path == rel {
+                true => Some((text.clone(), origin.clone())),
+                false => read.read(path),
+            }),
+        };
         ShaderSet::from_files(
             label,
             files.iter().map(|f| {
@@ -522,7 +557,7 @@ pub fn run(
             }),
         )
         .with_enums(enums.iter().cloned())
-        .with_sources(sources.iter().cloned(), reader.clone())
+        .with_sources(sources.iter().cloned(), reader)
     };
     let manifest = store.manifest()?;
     let original = Renderer { ctx, shaders: set(None), limits, root: project.root().map(Into::into) };

@@ -211,6 +211,29 @@ impl Project {
         Some((text, path.display().to_string()))
     }
 
+    /// Every file under `rel` (a folder or a file relative to the root, no
+    /// `..`) with one of the extensions `ext`, `rel` paths relative to the
+    /// root; empty without a root or such a path.
+    pub fn files_under(&self, rel: &str, ext: &[&str]) -> Result<Vec<SourceFile>, ProjectError> {
+        let Some(root) = self.root() else { return Ok(Vec::new()) };
+        if rel.split('/').any(|c| c == "..") {
+            return Ok(Vec::new());
+        }
+        let path = root.join(rel);
+        let paths = match path.is_file() {
+            true => vec![path],
+            false if path.is_dir() => files_with_ext(&path, ext)?,
+            false => Vec::new(),
+        };
+        paths
+            .into_iter()
+            .map(|p| {
+                let rel = p.strip_prefix(root).unwrap_or(&p).to_string_lossy().replace('\\', "/");
+                Ok(SourceFile { rel, text: read(&p)?, origin: p.display().to_string() })
+            })
+            .collect()
+    }
+
     /// Every kernel manifest (`kernels/*.toml`): the built-ins overlaid by
     /// the project's, sorted by path.
     pub fn kernel_files(&self) -> Result<Vec<SourceFile>, ProjectError> {
