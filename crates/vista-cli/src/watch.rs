@@ -66,7 +66,7 @@ pub fn watch(
     let report_dir = project.report_dir().expect("a root");
     let ctx = Context::shared(&config.gpu)?;
     let start = Instant::now();
-    let extra = source_paths(project)?;
+    let extra = vista_render::paths_outside_shaders(project)?;
     let mut seen = snapshot(&root, &extra);
     let mut outcomes: BTreeMap<String, Outcome> = BTreeMap::new();
     // The first round checks every selected case.
@@ -152,22 +152,6 @@ pub fn watch(
             }
         }
     }
-}
-
-/// The folders and files the project's `[source]` tables name outside
-/// `shaders/` (include folders, joined files, WESL packages).
-fn source_paths(project: &Project) -> Result<Vec<String>, GoldenError> {
-    let (specs, _) = vista_render::source_specs(project)?;
-    let mut out: Vec<String> = Vec::new();
-    for (_, s) in specs {
-        let named = s.include.iter().chain(&s.prepend).chain(&s.append).flatten().cloned();
-        for p in named.chain(s.packages.into_iter().map(|(_, dir)| dir)) {
-            if !p.starts_with("shaders/") && p != "shaders" && !out.contains(&p) {
-                out.push(p);
-            }
-        }
-    }
-    Ok(out)
 }
 
 /// `--interval MS`, checked.

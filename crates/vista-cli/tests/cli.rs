@@ -3686,6 +3686,34 @@ fn per_backend_goldens_cover_every_output_of_a_graph() {
 
 /// `vista watch` checks the cases, then re-checks exactly the cases a saved
 /// WGSL file reaches and rewrites the report, until its --timeout.
+/// `vista watch ARGS` in `root`, its output going to `log`.
+fn watching(root: &Path, log: &Path, args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_vista"))
+        .arg("watch")
+        .args(args)
+        .current_dir(root)
+        .env("XDG_RUNTIME_DIR", "/tmp")
+        .env_remove("CI")
+        .env_remove("VISTA_ROOT")
+        .stdout(std::fs::File::create(log).unwrap())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+/// The text of `log` once it holds `needle` (50 s at most).
+fn wait_for_line(log: &Path, needle: &str) -> String {
+    let start = std::time::Instant::now();
+    loop {
+        let text = std::fs::read_to_string(log).unwrap_or_default();
+        if text.contains(needle) {
+            return text;
+        }
+        assert!(start.elapsed().as_secs() < 50, "watch never printed {needle:?}: {text}");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+}
+
 /// A file a `[source]` includes from outside `shaders/` is mutated, and
 /// watched: a change re-checks the cases whose kernels reach it.
 fn included_files_outside_shaders_are_mutated_and_watched() {
@@ -3707,27 +3735,8 @@ fn included_files_outside_shaders_are_mutated_and_watched() {
         "a mutant of an included file outside shaders/ reaches the render: {report}"
     );
     let log = t.path().join("watch.log");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_vista"))
-        .args(["watch", "--case", "cells*", "--interval", "100", "--timeout", "60"])
-        .current_dir(&root)
-        .env("XDG_RUNTIME_DIR", "/tmp")
-        .env_remove("CI")
-        .env_remove("VISTA_ROOT")
-        .stdout(std::fs::File::create(&log).unwrap())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let wait_for = |needle: &str| {
-        let start = std::time::Instant::now();
-        loop {
-            let text = std::fs::read_to_string(&log).unwrap_or_default();
-            if text.contains(needle) {
-                return text;
-            }
-            assert!(start.elapsed().as_secs() < 50, "watch never printed {needle:?}: {text}");
-            std::thread::sleep(std::time::Duration::from_millis(100));
-        }
-    };
+    let mut child = watching(&root, &log, &["--case", "cells*", "--interval", "100", "--timeout", "60"]);
+    let wait_for = |needle: &str| wait_for_line(&log, needle);
     let first = wait_for("(watching; Ctrl-C ends)");
     assert!(first.contains("2 passed, 0 failed"), "{first}");
     let rng = root.join("vendor/include/rng.inc.wgsl");
@@ -3744,27 +3753,8 @@ fn watch_rechecks_what_a_saved_file_reaches() {
     let root = t.path().join("real");
     copy_tree(&repo().join("examples/real-kernels"), &root);
     let log = t.path().join("watch.log");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_vista"))
-        .args(["watch", "--interval", "100", "--timeout", "60"])
-        .current_dir(&root)
-        .env("XDG_RUNTIME_DIR", "/tmp")
-        .env_remove("CI")
-        .env_remove("VISTA_ROOT")
-        .stdout(std::fs::File::create(&log).unwrap())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let wait_for = |needle: &str| {
-        let start = std::time::Instant::now();
-        loop {
-            let text = std::fs::read_to_string(&log).unwrap_or_default();
-            if text.contains(needle) {
-                return text;
-            }
-            assert!(start.elapsed().as_secs() < 50, "watch never printed {needle:?}: {text}");
-            std::thread::sleep(std::time::Duration::from_millis(100));
-        }
-    };
+    let mut child = watching(&root, &log, &["--interval", "100", "--timeout", "60"]);
+    let wait_for = |needle: &str| wait_for_line(&log, needle);
     let first = wait_for("(watching; Ctrl-C ends)");
     assert!(first.contains("6 passed, 0 failed"), "{first}");
     let shader = root.join("shaders/fractals/mandelbrot.wgsl");

@@ -76,6 +76,15 @@ pub const STORAGE_FORMATS: &[&str] = &[
 ];
 
 /// The storage formats an output may have, by naga's name for them.
+/// `name` as one of [`STORAGE_FORMATS`], or the error listing them.
+pub(crate) fn storage_format(name: &str) -> Result<&'static str, String> {
+    STORAGE_FORMATS
+        .iter()
+        .copied()
+        .find(|n| *n == name)
+        .ok_or_else(|| format!("format = \"{name}\" is not valid; expected one of {}", STORAGE_FORMATS.join(", ")))
+}
+
 fn format_name(f: naga::StorageFormat) -> Option<&'static str> {
     use naga::StorageFormat as S;
     Some(match f {

@@ -374,12 +374,7 @@ fn texture_kind(
 ) -> Result<ResourceKind, ParamError> {
     let format = match string_key(t, "format", at)? {
         None => None,
-        Some(f) => Some(crate::bindings::STORAGE_FORMATS.iter().copied().find(|n| *n == f).ok_or_else(|| {
-            at(format!(
-                "format = \"{f}\" is not valid; expected one of {}",
-                crate::bindings::STORAGE_FORMATS.join(", ")
-            ))
-        })?),
+        Some(f) => Some(crate::bindings::storage_format(&f).map_err(at)?),
     };
     let dimension = match string_key(t, "dimension", at)? {
         None => None,

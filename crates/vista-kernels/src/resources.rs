@@ -162,12 +162,7 @@ pub(crate) fn parse(
         }
         let format = match text("format")? {
             None => None,
-            Some(f) => Some(crate::bindings::STORAGE_FORMATS.iter().copied().find(|n| *n == f).ok_or_else(|| {
-                at(format!(
-                    "format = \"{f}\" is not valid; expected one of {}",
-                    crate::bindings::STORAGE_FORMATS.join(", ")
-                ))
-            })?),
+            Some(f) => Some(crate::bindings::storage_format(&f).map_err(at)?),
         };
         let dimension = match text("dimension")? {
             None => None,

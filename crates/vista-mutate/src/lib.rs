@@ -263,18 +263,11 @@ pub struct Planned {
 /// The WGSL files the project's `[source]` tables name outside `shaders/`
 /// (include folders, joined files, WESL packages), by path under the root.
 pub fn outside_files(project: &Project) -> Result<Vec<SourceFile>, GoldenError> {
-    let (specs, _) = vista_render::source_specs(project)?;
     let mut out: Vec<SourceFile> = Vec::new();
-    for (_, s) in specs {
-        let named = s.include.iter().chain(&s.prepend).chain(&s.append).flatten().cloned();
-        for p in named.chain(s.packages.into_iter().map(|(_, dir)| dir)) {
-            if p.starts_with("shaders/") || p == "shaders" {
-                continue;
-            }
-            for f in project.files_under(&p, &["wgsl", "wesl"])? {
-                if !out.iter().any(|o| o.rel == f.rel) {
-                    out.push(f);
-                }
+    for p in vista_render::paths_outside_shaders(project)? {
+        for f in project.files_under(&p, &["wgsl", "wesl"])? {
+            if !out.iter().any(|o| o.rel == f.rel) {
+                out.push(f);
             }
         }
     }

@@ -238,6 +238,22 @@ pub fn composes(shaders: &ShaderSet, kernel: &Kernel) -> Result<(), String> {
     Ok(())
 }
 
+/// The folders and files the project's `[source]` tables name outside
+/// `shaders/` (include folders, joined files, WESL packages), each once.
+pub fn paths_outside_shaders(project: &vista_project::Project) -> Result<Vec<String>, RenderError> {
+    let (specs, _) = source_specs(project)?;
+    let mut out: Vec<String> = Vec::new();
+    for (_, s) in specs {
+        let named = s.include.iter().chain(&s.prepend).chain(&s.append).flatten().cloned();
+        for p in named.chain(s.packages.into_iter().map(|(_, dir)| dir)) {
+            if !p.starts_with("shaders/") && p != "shaders" && !out.contains(&p) {
+                out.push(p);
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// Every kernel's `[source]` assemblies, by id (SPEC 16), and a reader of
 /// the project's files for what they reach outside `shaders/`.
 pub fn source_specs(
