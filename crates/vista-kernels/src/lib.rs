@@ -563,8 +563,9 @@ impl Kernel {
         let n = self.graph().map_or(1, |g| g.passes.len());
         let mut out: Vec<(String, vista_source::SourceSpec)> = Vec::new();
         for spec in (0..n).map(|i| self.source_for(i)).filter(|s| !s.is_empty()) {
-            if !out.iter().any(|(id, _)| *id == spec.id()) {
-                out.push((spec.id(), spec));
+            let id = spec.id();
+            if !out.iter().any(|(known, _)| *known == id) {
+                out.push((id, spec));
             }
         }
         out

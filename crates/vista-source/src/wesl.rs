@@ -35,20 +35,25 @@ impl Files<'_> {
             PathOrigin::Relative(_) => Err(format!("relative module path {path} reached the resolver")),
         }
     }
-}
 
-impl Resolver for Files<'_> {
-    fn resolve_source<'a>(&'a self, path: &ModulePath) -> Result<Cow<'a, str>, ResolveError> {
-        let base = self.base(path).map_err(|e| ResolveError::ModuleNotFound(path.clone(), e))?;
-        // A package's own root module (`constants::GROUP`): package.wesl or
-        // mod.wesl in its folder, or the folder's name with .wesl.
-        let candidates: Vec<String> = match path.components.is_empty() {
+    /// The files a module path may be, in the order tried: `a/b.wesl`, then
+    /// `a/b.wgsl`; a package's own root module (`constants::GROUP`) is
+    /// package.wesl or mod.wesl in its folder, or the folder's name with .wesl.
+    fn candidates(&self, path: &ModulePath) -> Result<Vec<String>, String> {
+        let base = self.base(path)?;
+        Ok(match path.components.is_empty() {
             true => vec![format!("{base}/package.wesl"), format!("{base}/mod.wesl"), format!("{base}.wesl")],
             false => {
                 let stem = format!("{base}/{}", path.components.join("/"));
                 vec![format!("{stem}.wesl"), format!("{stem}.wgsl")]
             }
-        };
+        })
+    }
+}
+
+impl Resolver for Files<'_> {
+    fn resolve_source<'a>(&'a self, path: &ModulePath) -> Result<Cow<'a, str>, ResolveError> {
+        let candidates = self.candidates(path).map_err(|e| ResolveError::ModuleNotFound(path.clone(), e))?;
         for file in &candidates {
             if let Some((text, origin)) = (self.read)(file) {
                 let mut parts = self.parts.borrow_mut();
@@ -62,9 +67,9 @@ impl Resolver for Files<'_> {
     }
 
     fn display_name(&self, path: &ModulePath) -> Option<String> {
-        let stem = format!("{}/{}", self.base(path).ok()?, path.components.join("/"));
+        let candidates = self.candidates(path).ok()?;
         let parts = self.parts.borrow();
-        parts.iter().find(|p| p.path.starts_with(&stem)).map(|p| p.origin.clone())
+        parts.iter().find(|p| candidates.contains(&p.path)).map(|p| p.origin.clone())
     }
 }
 
