@@ -27,7 +27,8 @@ fn graphs(c: &mut Criterion) {
         let Some(case) = cases.iter().find(|c| c.kernel.name() == k.name()) else { continue };
         let (w, h) = (case.width, case.height);
         let p = &case.params;
-        let plan = vista_render::plan_graph(&ctx.shaders, project.root(), k, p, &case.inputs, w, h).expect("plan");
+        let plan =
+            vista_render::plan(&ctx.shaders, project.root(), k, p, &case.inputs, w, h, &ctx.limits).expect("plan");
         let labels: Vec<String> = plan.passes.iter().map(|p| p.label.clone()).collect();
         let render = || vista_golden::run::render_case(&ctx, case).expect("render");
         render(); // compiles every pass's pipeline

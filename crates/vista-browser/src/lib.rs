@@ -121,71 +121,6 @@ pub struct AdapterInfo {
     pub product: String,
 }
 
-/// One dispatch.
-#[derive(Debug, Clone)]
-pub struct Job<'a> {
-    /// Names the run in errors (vista passes the case or kernel name).
-    pub label: &'a str,
-    /// Pipeline cache key: equal keys must mean equal WGSL.
-    pub key: &'a str,
-    /// The WGSL module source, compiled in the page by Tint.
-    pub wgsl: &'a str,
-    /// The compute entry point.
-    pub entry: &'a str,
-    /// Workgroups dispatched along x, y and z.
-    pub workgroups: [u32; 3],
-    /// Every binding the entry point uses.
-    pub slots: &'a [Slot],
-    /// The output's storage format (WGSL and WebGPU share the names).
-    pub format: &'a str,
-    /// The texture's and its view's WebGPU dimension ("2d", "2d-array").
-    pub dimension: (&'a str, &'a str),
-    /// Array layers or depth; read back stacked top to bottom.
-    pub layers: u32,
-    /// The output is bound `read-write` rather than `write-only`.
-    pub read_write: bool,
-    /// Bytes of one output texel.
-    pub texel_bytes: u32,
-    /// One texel's bytes: the output holds it everywhere before the kernel runs.
-    pub fill: &'a [u8],
-    /// The bytes of each uniform block.
-    pub uniforms: &'a [Vec<u8>],
-    /// The words of the read-only `array<u32>` table buffer.
-    pub table: &'a [u32],
-    /// Output texture width in texels.
-    pub width: u32,
-    /// Output texture height in texels (of one layer).
-    pub height: u32,
-}
-
-/// One binding of a job: its group, number and what feeds it
-/// (`uniform`, `table` or `output`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub struct Slot {
-    /// The WGSL `@group` index.
-    pub group: u32,
-    /// The WGSL `@binding` number within the group.
-    pub binding: u32,
-    /// `"uniform"`, `"table"` or `"output"`.
-    pub kind: &'static str,
-    /// Which of the job's uniform blocks a `uniform` slot takes.
-    pub index: u32,
-}
-
-/// The texture as the kernel wrote it (its texel bytes, row-major,
-/// unpadded) and the page's timings.
-#[derive(Debug, Clone)]
-pub struct Output {
-    /// The output texels, row-major and unpadded, layers stacked in order.
-    pub bytes: Vec<u8>,
-    /// Submit to `onSubmittedWorkDone` of the compute pass.
-    pub kernel: Duration,
-    /// Copy, map and unpad in the page (not the DevTools transfer).
-    pub readback: Duration,
-    /// The whole call from Rust, transfer included.
-    pub total: Duration,
-}
-
 /// Standard base64, as the page's `fromBase64` reads it (for callers that
 /// build a graph job's JSON).
 pub fn base64(bytes: &[u8]) -> String {
@@ -195,7 +130,7 @@ pub fn base64(bytes: &[u8]) -> String {
 /// A pass graph's outputs as the page read them back (each output's bytes:
 /// a texture's texels row-major and unpadded, a buffer whole) and timings.
 #[derive(Debug, Clone)]
-pub struct GraphOutput {
+pub struct Output {
     /// Each output's bytes, in the order of the job's `outputs`.
     pub outputs: Vec<Vec<u8>>,
     /// Wall time of each pass in the page, all its repeats.
@@ -247,23 +182,6 @@ impl Browser {
         &self.path
     }
 
-    /// Runs `job` and reads its texture back. A failure drops the browser,
-    /// so one bad case cannot leave a wedged page for the next.
-    pub fn run(&self, job: &Job<'_>) -> Result<Output, BrowserError> {
-        let start = Instant::now();
-        let mut guard = self.session.lock().unwrap_or_else(|p| p.into_inner());
-        if guard.is_none() {
-            let (session, _) = Session::start(&self.path, self.timeout)?;
-            *guard = Some(session);
-        }
-        let session = guard.as_ref().expect("session just set");
-        let result = self.run_on(session, job, start);
-        if result.is_err() {
-            *guard = None;
-        }
-        result
-    }
-
     /// Crashes the page's renderer process (chrome://crash), as a broken
     /// driver would, and waits until Chromium reports it: for tests of the
     /// recovery path.
@@ -279,10 +197,10 @@ impl Browser {
         }
     }
 
-    /// Runs a pass graph (`runner.js`'s `vistaRunGraph`, whose comment
-    /// gives the job's shape) and reads every output back. As [`Browser::run`],
-    /// a failure drops the browser.
-    pub fn run_graph(&self, label: &str, job: &serde_json::Value) -> Result<GraphOutput, BrowserError> {
+    /// Runs a pass graph (`runner.js`'s `vistaRun`, whose comment gives
+    /// the job's shape) and reads every output back. A failure drops the
+    /// browser, so one bad case cannot leave a wedged page for the next.
+    pub fn run(&self, label: &str, job: &serde_json::Value) -> Result<Output, BrowserError> {
         let start = Instant::now();
         let mut guard = self.session.lock().unwrap_or_else(|p| p.into_inner());
         if guard.is_none() {
@@ -291,7 +209,7 @@ impl Browser {
         }
         let session = guard.as_ref().expect("session just set");
         let result = (|| {
-            let reply = session.call(label, &format!("vistaRunGraph({job})"), self.timeout)?;
+            let reply = session.call(label, &format!("vistaRun({job})"), self.timeout)?;
             #[derive(Deserialize)]
             struct Ran {
                 pass_ms: Vec<f64>,
@@ -308,7 +226,7 @@ impl Browser {
                 at += n;
             }
             let ms = |v: f64| Duration::from_secs_f64(v.max(0.0) / 1e3);
-            Ok(GraphOutput {
+            Ok(Output {
                 outputs,
                 passes: ran.pass_ms.into_iter().map(ms).collect(),
                 readback: ms(ran.readback_ms),
@@ -339,50 +257,6 @@ impl Browser {
             });
         }
         Ok(bytes)
-    }
-
-    fn run_on(&self, s: &Session, job: &Job<'_>, start: Instant) -> Result<Output, BrowserError> {
-        let table: Vec<u8> = job.table.iter().flat_map(|w| w.to_le_bytes()).collect();
-        let args = serde_json::json!({
-            "key": job.key,
-            "wgsl": job.wgsl,
-            "entry": job.entry,
-            "workgroups": job.workgroups,
-            "slots": job.slots,
-            "format": job.format,
-            "dimension": job.dimension.0,
-            "view_dimension": job.dimension.1,
-            "layers": job.layers,
-            "access": if job.read_write { "read-write" } else { "write-only" },
-            "texel_bytes": job.texel_bytes,
-            "fill": B64.encode(job.fill),
-            "uniforms": job.uniforms.iter().map(|u| B64.encode(u)).collect::<Vec<_>>(),
-            "table": B64.encode(&table),
-            "width": job.width,
-            "height": job.height,
-        });
-        let reply = s.call(job.label, &format!("vistaRun({args})"), self.timeout)?;
-        #[derive(Deserialize)]
-        struct Ran {
-            kernel_ms: f64,
-            readback_ms: f64,
-            bytes: usize,
-        }
-        let ran: Ran = parse_ok(&reply).map_err(|message| BrowserError::Page { case: job.label.into(), message })?;
-        let expected = job.width as usize * job.height as usize * job.layers as usize * job.texel_bytes as usize;
-        if ran.bytes != expected {
-            return Err(BrowserError::Page {
-                case: job.label.into(),
-                message: format!("the page read back {} bytes, expected {expected}", ran.bytes),
-            });
-        }
-        let bytes = self.fetch(s, job.label, expected)?;
-        Ok(Output {
-            bytes,
-            kernel: Duration::from_secs_f64(ran.kernel_ms.max(0.0) / 1e3),
-            readback: Duration::from_secs_f64(ran.readback_ms.max(0.0) / 1e3),
-            total: start.elapsed(),
-        })
     }
 }
 

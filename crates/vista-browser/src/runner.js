@@ -61,146 +61,20 @@ async function vistaInit() {
   }
 }
 
-// One bind group layout per group up to the highest the job binds.
-function groupLayouts(d, slots, job) {
-  const C = GPUShaderStage.COMPUTE;
-  const count = slots.reduce((m, s) => Math.max(m, s.group + 1), 0);
-  const groups = [];
-  for (let g = 0; g < count; g++) {
-    const entries = slots.filter((s) => s.group === g).map((s) => {
-      if (s.kind === "uniform") return { binding: s.binding, visibility: C, buffer: { type: "uniform" } };
-      if (s.kind === "table") return { binding: s.binding, visibility: C, buffer: { type: "read-only-storage" } };
-      return {
-        binding: s.binding,
-        visibility: C,
-        storageTexture: { access: job.access, format: job.format, viewDimension: job.view_dimension },
-      };
-    });
-    groups.push(d.createBindGroupLayout({ entries }));
-  }
-  return groups;
-}
-
-async function pipeline(job) {
-  const key = `${job.key}@${job.entry}${JSON.stringify(job.slots)}${job.format}${job.view_dimension}${job.access}`;
-  const cached = vista.pipelines.get(key);
-  if (cached) return cached;
-  const d = vista.device;
-  const wgsl = job.wgsl;
-  d.pushErrorScope("validation");
-  const module = d.createShaderModule({ code: wgsl, label: key });
-  const info = await module.getCompilationInfo();
-  const errors = info.messages.filter((m) => m.type === "error");
-  if (errors.length) {
-    await d.popErrorScope();
-    const lines = errors.map((m) => `line ${m.lineNum}:${m.linePos}: ${m.message}`);
-    throw new Error(`Tint rejected the WGSL: ${lines.join("; ")}`);
-  }
-  let p;
-  const groups = groupLayouts(d, job.slots, job);
-  try {
-    const layout = d.createPipelineLayout({ bindGroupLayouts: groups });
-    p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: job.entry } });
-  } finally {
-    const e = await d.popErrorScope();
-    if (e) throw new Error(`pipeline: ${e.message}`);
-  }
-  const compiled = { pipeline: p, groups };
-  vista.pipelines.set(key, compiled);
-  return compiled;
-}
-
-// job: { key, wgsl, entry, workgroups [x, y, z], slots [{group, binding, kind, index}], format, dimension,
-//        view_dimension, layers, access, texel_bytes, fill (one texel, base64), uniforms [base64, one per block],
-//        table (base64), width, height }
-// Layers (2d-array) and slices (3d) are read back stacked top to bottom.
-async function vistaRun(job) {
-  try {
-    const d = vista.device;
-    if (!d) throw new Error(`the WebGPU device is gone (${vista.lost || "never created"})`);
-    const compiled = await pipeline(job);
-    const start = performance.now();
-    d.pushErrorScope("out-of-memory");
-    d.pushErrorScope("validation");
-    const uniforms = job.uniforms.map((b64) => {
-      const bytes = fromBase64(b64);
-      const buffer = d.createBuffer({ size: Math.max(16, Math.ceil(bytes.length / 16) * 16), usage: GPUBufferUsage.UNIFORM, mappedAtCreation: true });
-      new Uint8Array(buffer.getMappedRange()).set(bytes);
-      buffer.unmap();
-      return buffer;
-    });
-    const words = fromBase64(job.table);
-    const table = d.createBuffer({ size: Math.max(16, Math.ceil(words.length / 4) * 4), usage: GPUBufferUsage.STORAGE, mappedAtCreation: true });
-    new Uint8Array(table.getMappedRange()).set(words);
-    table.unmap();
-    const size = { width: job.width, height: job.height, depthOrArrayLayers: job.layers };
-    const rows = job.height * job.layers;
-    const texture = d.createTexture({ size, dimension: job.dimension, format: job.format, usage: GPUTextureUsage.STORAGE_BINDING | GPUTextureUsage.COPY_SRC | GPUTextureUsage.COPY_DST });
-    // Every texel starts as the sentinel texel, so Rust can count those never written.
-    const rowBytes = job.width * job.texel_bytes;
-    const texel = fromBase64(job.fill);
-    const filled = new Uint8Array(rowBytes * rows);
-    for (let i = 0; i < filled.length; i += texel.length) filled.set(texel, i);
-    d.queue.writeTexture({ texture }, filled, { bytesPerRow: rowBytes, rowsPerImage: job.height }, size);
-    const paddedRow = Math.ceil(rowBytes / 256) * 256;
-    const readback = d.createBuffer({ size: paddedRow * rows, usage: GPUBufferUsage.COPY_DST | GPUBufferUsage.MAP_READ });
-    const view = texture.createView({ dimension: job.view_dimension });
-    const resource = (s) => (s.kind === "uniform" ? { buffer: uniforms[s.index] } : s.kind === "table" ? { buffer: table } : view);
-    const bindGroups = compiled.groups.map((layout, g) =>
-      d.createBindGroup({
-        layout,
-        entries: job.slots.filter((s) => s.group === g).map((s) => ({ binding: s.binding, resource: resource(s) })),
-      }),
-    );
-    // Two submissions, so the kernel and the readback are timed apart as on wgpu.
-    const compute = d.createCommandEncoder();
-    const pass = compute.beginComputePass();
-    pass.setPipeline(compiled.pipeline);
-    bindGroups.forEach((group, g) => pass.setBindGroup(g, group));
-    pass.dispatchWorkgroups(job.workgroups[0], job.workgroups[1], job.workgroups[2]);
-    pass.end();
-    const copy = d.createCommandEncoder();
-    copy.copyTextureToBuffer({ texture }, { buffer: readback, bytesPerRow: paddedRow, rowsPerImage: job.height }, size);
-    const validation = await d.popErrorScope();
-    const oom = await d.popErrorScope();
-    if (validation) throw new Error(`WebGPU validation: ${validation.message}`);
-    if (oom) throw new Error(`WebGPU out of memory: ${oom.message}`);
-    await d.queue.onSubmittedWorkDone();
-    const gpuStart = performance.now();
-    d.queue.submit([compute.finish()]);
-    await d.queue.onSubmittedWorkDone();
-    const kernelMs = performance.now() - gpuStart;
-    const copyStart = performance.now();
-    d.queue.submit([copy.finish()]);
-    await readback.mapAsync(GPUMapMode.READ);
-    const padded = new Uint8Array(readback.getMappedRange());
-    const out = new Uint8Array(rowBytes * rows);
-    for (let y = 0; y < rows; y++) out.set(padded.subarray(y * paddedRow, y * paddedRow + rowBytes), y * rowBytes);
-    readback.unmap();
-    const readbackMs = performance.now() - copyStart;
-    for (const b of [...uniforms, table, readback]) b.destroy();
-    texture.destroy();
-    if (!vista.device) throw new Error(`the WebGPU device was lost during the run (${vista.lost})`);
-    vista.out = out;
-    return JSON.stringify({ ok: true, kernel_ms: kernelMs, readback_ms: readbackMs, total_ms: performance.now() - start, bytes: out.length });
-  } catch (e) {
-    return fail(e);
-  }
-}
-
 // A slice of the last output, base64: DevTools messages stay a few MB each.
 function vistaChunk(offset, length) {
   return toBase64(vista.out.subarray(offset, offset + length));
 }
 
-// A pass graph (SPEC 14): job = { resources: [texture | buffer | sampler], passes: [{ key, wgsl, entry,
-// workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding, layout, owned (base64) | resource }] }],
-// outputs: [resource index] }. A texture: { kind, format, dimension, width, height, layers, texel_bytes,
-// contents (base64 or null: zeros) }; a buffer: { kind, contents (base64) }; a sampler: { kind, filter,
-// address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
+// A pass graph (SPEC 14; a one-pass kernel is a graph of one pass): job = { resources: [texture | buffer |
+// sampler], passes: [{ key, wgsl, entry, workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding,
+// layout, owned (base64) | resource }] }], outputs: [resource index] }. A texture: { kind, format, dimension,
+// width, height, layers, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
+// the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64) }; a sampler: { kind,
+// filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility); a texture slot's view dimension is its layout's. Outputs are read back one
 // after another into vista.out: textures unpadded, layers stacked; buffers whole.
-async function graphPipeline(pass) {
+async function pipeline(pass) {
   const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout]))}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
@@ -235,14 +109,14 @@ async function graphPipeline(pass) {
   return compiled;
 }
 
-async function vistaRunGraph(job) {
+async function vistaRun(job) {
   const made = [];
   const scratch = [];
   try {
     const d = vista.device;
     if (!d) throw new Error(`the WebGPU device is gone (${vista.lost || "never created"})`);
     const compiled = [];
-    for (const pass of job.passes) compiled.push(await graphPipeline(pass));
+    for (const pass of job.passes) compiled.push(await pipeline(pass));
     const start = performance.now();
     d.pushErrorScope("out-of-memory");
     d.pushErrorScope("validation");
@@ -253,9 +127,15 @@ async function vistaRunGraph(job) {
         const size = { width: r.width, height: r.height, depthOrArrayLayers: r.layers };
         const usage = T.STORAGE_BINDING | T.TEXTURE_BINDING | T.COPY_SRC | T.COPY_DST;
         const texture = d.createTexture({ size, dimension: r.dimension, format: r.format, usage });
+        const rowBytes = r.width * r.texel_bytes;
         if (r.contents) {
-          const rowBytes = r.width * r.texel_bytes;
           d.queue.writeTexture({ texture }, fromBase64(r.contents), { bytesPerRow: rowBytes, rowsPerImage: r.height }, size);
+        } else if (r.fill) {
+          // Every texel starts as the sentinel texel, so Rust can count those never written.
+          const texel = fromBase64(r.fill);
+          const filled = new Uint8Array(rowBytes * r.height * r.layers);
+          for (let i = 0; i < filled.length; i += texel.length) filled.set(texel, i);
+          d.queue.writeTexture({ texture }, filled, { bytesPerRow: rowBytes, rowsPerImage: r.height }, size);
         }
         made.push(texture);
       } else if (r.kind === "buffer") {

@@ -4,7 +4,8 @@
 
 use std::time::Duration;
 
-use vista_browser::{Browser, BrowserError, Job};
+use serde_json::{Value, json};
+use vista_browser::{Browser, BrowserError, base64};
 
 const GRADIENT: &str = r#"
 struct Params { width: u32, height: u32, scale: f32, pad: f32 }
@@ -73,40 +74,33 @@ fn failure(r: Result<vista_browser::Output, BrowserError>, what: &str) -> Browse
     }
 }
 
-/// vista's three bindings at their usual places.
-const SLOTS: [vista_browser::Slot; 3] = [
-    vista_browser::Slot { group: 0, binding: 0, kind: "uniform", index: 0 },
-    vista_browser::Slot { group: 0, binding: 1, kind: "output", index: 0 },
-    vista_browser::Slot { group: 0, binding: 2, kind: "table", index: 0 },
-];
-const FILL: [u8; 16] = [0; 16];
-
-/// A job over vista's usual bindings and an rgba32float output, 8 x 8
-/// workgroups covering `w` x `h`.
-fn job<'a>(label: &'a str, key: &'a str, wgsl: &'a str, u: &'a Vec<u8>, table: &'a [u32], w: u32, h: u32) -> Job<'a> {
-    Job {
-        label,
-        key,
-        wgsl,
-        entry: "main",
-        workgroups: [w.div_ceil(8), h.div_ceil(8), 1],
-        slots: &SLOTS,
-        format: "rgba32float",
-        dimension: ("2d", "2d"),
-        layers: 1,
-        read_write: false,
-        texel_bytes: 16,
-        fill: &FILL,
-        uniforms: std::slice::from_ref(u),
-        table,
-        width: w,
-        height: h,
-    }
+/// A one-pass graph over vista's usual bindings (uniforms at 0, an
+/// rgba32float output at 1, the table at 2), 8 x 8 workgroups covering
+/// `w` x `h`: the JSON `runner.js`'s `vistaRun` takes.
+fn job(key: &str, wgsl: &str, u: &[u8], table: &[u32], w: u32, h: u32) -> Value {
+    let table: Vec<u8> = table.iter().flat_map(|v| v.to_le_bytes()).collect();
+    json!({
+        "resources": [{
+            "kind": "texture", "format": "rgba32float", "dimension": "2d", "width": w, "height": h, "layers": 1,
+            "texel_bytes": 16, "contents": null, "fill": base64(&[0; 16]),
+        }],
+        "passes": [{
+            "key": key, "label": "pass 1", "wgsl": wgsl, "entry": "main",
+            "workgroups": [w.div_ceil(8), h.div_ceil(8), 1], "repeat": 1, "span": 1, "swap": [],
+            "slots": [
+                { "group": 0, "binding": 0, "layout": { "buffer": { "type": "uniform" } }, "owned": base64(u) },
+                { "group": 0, "binding": 1, "layout": { "storageTexture": {
+                    "access": "write-only", "format": "rgba32float", "viewDimension": "2d" } }, "resource": 0 },
+                { "group": 0, "binding": 2, "layout": { "buffer": { "type": "read-only-storage" } }, "owned": base64(&table) },
+            ],
+        }],
+        "outputs": [0],
+    })
 }
 
 /// The output's rgba32float texels.
 fn rgba(out: &vista_browser::Output) -> Vec<[f32; 4]> {
-    out.bytes
+    out.outputs[0]
         .chunks_exact(16)
         .map(|t| std::array::from_fn(|c| f32::from_le_bytes(t[c * 4..c * 4 + 4].try_into().unwrap())))
         .collect()
@@ -122,8 +116,7 @@ fn a_kernel_runs_and_reads_back_every_texel() {
     let (w, h) = (37u32, 11u32);
     let table = [10u32, 20, 30, 40];
     let u = uniforms(w, h, 0.5);
-    let job = job("gradient", "g1", GRADIENT, &u, &table, w, h);
-    let out = b.run(&job).unwrap();
+    let out = b.run("gradient", &job("g1", GRADIENT, &u, &table, w, h)).unwrap();
     assert_eq!(rgba(&out).len(), (w * h) as usize);
     for y in 0..h {
         for x in 0..w {
@@ -133,7 +126,7 @@ fn a_kernel_runs_and_reads_back_every_texel() {
     }
     // The same browser serves a second run with other uniforms.
     let u = uniforms(w, h, 2.0);
-    let out = b.run(&Job { uniforms: std::slice::from_ref(&u), ..job }).unwrap();
+    let out = b.run("gradient", &job("g1", GRADIENT, &u, &table, w, h)).unwrap();
     assert_eq!(rgba(&out)[(w - 1) as usize][0], (w - 1) as f32 * 2.0);
 }
 
@@ -142,11 +135,10 @@ fn tint_errors_name_the_case_and_the_next_run_works() {
     let bad = GRADIENT.replace("f32(id.y)", "id.y");
     let u = uniforms(8, 8, 1.0);
     let table = [0u32; 4];
-    let job = job("case-bad", "bad", &bad, &u, &table, 8, 8);
-    let e = failure(b.run(&job), "Tint accepted a type error").to_string();
-    assert!(e.starts_with("case-bad: in the browser: Tint rejected the WGSL: line"), "{e}");
-    let good = Job { label: "case-good", key: "good", wgsl: GRADIENT, ..job };
-    assert_eq!(b.run(&good).map(|o| rgba(&o)).unwrap().len(), 64);
+    let e = failure(b.run("case-bad", &job("bad", &bad, &u, &table, 8, 8)), "Tint accepted a type error").to_string();
+    assert!(e.starts_with("case-bad: in the browser: Tint rejected the WGSL of bad: line"), "{e}");
+    let good = job("good", GRADIENT, &u, &table, 8, 8);
+    assert_eq!(b.run("case-good", &good).map(|o| rgba(&o)).unwrap().len(), 64);
 }
 
 fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
@@ -160,21 +152,20 @@ fn a_hung_kernel_trips_the_watchdog_and_a_crashed_page_is_named() {
     );
     let u = uniforms(64, 64, 1.0);
     let table = [0u32; 4];
-    let job = job("case-hang", "hang", &forever, &u, &table, 64, 64);
     b.set_timeout(Duration::from_secs(1));
     let start = std::time::Instant::now();
-    let e = failure(b.run(&job), "the hung kernel returned");
+    let e = failure(b.run("case-hang", &job("hang", &forever, &u, &table, 64, 64)), "the hung kernel returned");
     let took = start.elapsed();
     b.set_timeout(Duration::from_secs(60));
     assert!(matches!(e, BrowserError::Timeout { .. } | BrowserError::Page { .. }), "{e}");
     assert!(e.to_string().starts_with("case-hang: "), "{e}");
     assert!(took < Duration::from_secs(30), "{took:?}");
-    let good = Job { label: "after-hang", key: "good", wgsl: GRADIENT, ..job };
-    assert_eq!(b.run(&good).map(|o| rgba(&o)).unwrap().len(), 64 * 64);
+    let good = job("good", GRADIENT, &u, &table, 64, 64);
+    assert_eq!(b.run("after-hang", &good).map(|o| rgba(&o)).unwrap().len(), 64 * 64);
 
     b.crash_page_for_test();
-    let e = failure(b.run(&Job { label: "case-crash", ..good.clone() }), "the crashed page returned");
+    let e = failure(b.run("case-crash", &good), "the crashed page returned");
     assert!(matches!(e, BrowserError::Died { .. }), "{e}");
     assert!(e.to_string().starts_with("case-crash: "), "{e}");
-    assert_eq!(b.run(&good).map(|o| rgba(&o)).unwrap().len(), 64 * 64, "a fresh browser after the crash");
+    assert_eq!(b.run("after-hang", &good).map(|o| rgba(&o)).unwrap().len(), 64 * 64, "a fresh browser after the crash");
 }

@@ -28,16 +28,10 @@ pub fn bench(
     let (w, h) = vista_kernels::parse_size(size).map_err(bad)?;
     let shaders = vista_render::shader_set(project)?;
     // Every check that needs no device, before it is made.
-    let graph_passes = match k.graph() {
-        Some(_) => {
-            vista_render::check_request(&k, &p, w, h, &config.limits)?;
-            let plan = vista_render::plan_graph(&shaders, project.root(), &k, &p, &[], w, h)?;
-            plan.passes.iter().map(|p| p.label.clone()).collect()
-        }
-        None => {
-            vista_render::plan(&shaders, &k, &p, w, h, &config.limits)?;
-            Vec::new()
-        }
+    let plan = vista_render::plan(&shaders, project.root(), &k, &p, &[], w, h, &config.limits)?;
+    let graph_passes: Vec<String> = match k.graph() {
+        Some(_) => plan.passes.iter().map(|p| p.label.clone()).collect(),
+        None => Vec::new(),
     };
     if cpu && !k.has_reference() {
         return Err(bad(match k.reference_mismatch() {

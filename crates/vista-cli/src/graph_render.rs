@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use vista_golden::GoldenError;
 use vista_kernels::Kernel;
-use vista_render::{GraphPlan, OutputValue, Renderer};
+use vista_render::{OutputValue, Plan, Renderer};
 
 use crate::bad;
 
@@ -27,7 +27,7 @@ pub fn output_path(out: &Path, first: bool, name: &str, buffer: bool) -> PathBuf
 
 /// Renders a graph kernel and writes its outputs; exit 1 on NaN or
 /// unwritten texels in any output, as for one-pass kernels.
-pub fn render(ctx: &Renderer, k: &Kernel, plan: &GraphPlan, out: &Path) -> Result<i32, GoldenError> {
+pub fn render(ctx: &Renderer, k: &Kernel, plan: &Plan, out: &Path) -> Result<i32, GoldenError> {
     let first_is_buffer =
         matches!(plan.outputs.first().map(|o| &o.kind), Some(vista_render::PlannedKind::Buffer { .. }));
     let ext = out.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
@@ -42,7 +42,7 @@ pub fn render(ctx: &Renderer, k: &Kernel, plan: &GraphPlan, out: &Path) -> Resul
             if first_is_buffer { "buffer" } else { "texture" }
         )));
     }
-    let r = vista_render::run_graph(ctx, plan)?;
+    let r = vista_render::run(ctx, plan)?;
     let mut code = 0;
     for (i, o) in r.outputs.iter().enumerate() {
         let is_buffer = matches!(o.value, OutputValue::Buffer { .. });

@@ -39,8 +39,7 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
         check_parent_writable(&out)?;
         let shaders = vista_render::shader_set(project)?;
         // Every check that needs no device (bindings, input files) before one is made.
-        vista_render::check_request(&k, &p, w, h, &config.limits)?;
-        let plan = vista_render::plan_graph(&shaders, project.root(), &k, &p, &[], w, h)?;
+        let plan = vista_render::plan(&shaders, project.root(), &k, &p, &[], w, h, &config.limits)?;
         let ctx = &Renderer {
             ctx: Context::shared(&config.gpu)?,
             shaders,
@@ -51,9 +50,10 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
     }
     check_output_path(&out)?;
     let shaders = vista_render::shader_set(project)?;
-    let plan = vista_render::plan(&shaders, &k, &p, w, h, &config.limits)?;
+    let plan = vista_render::plan(&shaders, project.root(), &k, &p, &[], w, h, &config.limits)?;
+    let t = plan.main_texture().cloned().expect("a one-pass kernel writes a texture");
     // Layers and slices are stacked top to bottom: crop that image.
-    let rect = crop.as_deref().map(|c| parse_crop(c, plan.width, plan.height * plan.layers)).transpose()?;
+    let rect = crop.as_deref().map(|c| parse_crop(c, t.width, t.height * t.layers)).transpose()?;
     let ctx = &Renderer {
         ctx: Context::shared(&config.gpu)?,
         shaders,
@@ -70,18 +70,16 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
         img = img.zoom(zoom);
     }
     vista_image::save(&out, &img)?;
-    let shape = match plan.dimension {
-        vista_gpu::Dimension::D2 if plan.layers == 1 && (plan.width, plan.height) == (w, h) => {
-            format!("{w}x{h}")
-        }
+    let shape = match t.dimension {
+        vista_gpu::Dimension::D2 if t.layers == 1 && (t.width, t.height) == (w, h) => format!("{w}x{h}"),
         d => format!(
             "{}x{}x{} ({} output, stacked {}x{})",
-            plan.width,
-            plan.height,
-            plan.layers,
+            t.width,
+            t.height,
+            t.layers,
             d.name(),
-            plan.width,
-            plan.height * plan.layers
+            t.width,
+            t.height * t.layers
         ),
     };
     eprintln!(

@@ -2174,7 +2174,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             1,
             &[
                 "unsupported on",
-                "main (k.wgsl): @workgroup_size(32, 32, 1): 1024 invocations per workgroup",
+                "pass 1 (main, k.wgsl): @workgroup_size(32, 32, 1): 1024 invocations per workgroup",
                 "needs maxComputeInvocationsPerWorkgroup >= 1024 (this device has 256)",
             ],
         );

@@ -117,7 +117,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             false => (store.golden_path(case), case.id.clone()),
         };
         // A pass graph's other files first: each atomic, named in the entry.
-        let extra = crate::outputs::golden_bytes(&store.dir, case, &key, &crate::outputs::outputs_of(case, &r))?;
+        let extra = crate::outputs::golden_bytes(&store.dir, case, &key, crate::outputs::outputs_of(case, &r))?;
         let mut extra_hashes = std::collections::BTreeMap::new();
         let mut extra_changed = false;
         for (file, bytes) in &extra {

@@ -12,7 +12,6 @@
 //! (`display_alpha = "opaque"`): its alpha is kept in `<case>.alpha.png`
 //! (16-bit gray) and judged by the case's PSNR threshold.
 
-use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 use vista_image::Image;
@@ -79,16 +78,17 @@ pub fn keeps_raw(kernel: &Kernel, format: &str) -> bool {
     kernel.describes_resources() || format != "rgba32float"
 }
 
-/// The name a one-pass kernel's image has as an output.
-pub const MAIN_OUTPUT: &str = "image";
+pub use vista_render::MAIN_OUTPUT;
 
 /// A render's outputs as goldens see them: a graph's own, or a one-pass
 /// kernel's image as its one output where it keeps raw goldens or its
-/// alpha; empty for the seed's contract (judged by its PNG alone).
-pub fn outputs_of<'a>(case: &Case, r: &'a Rendered) -> Cow<'a, [OutputRender]> {
-    match r.outputs.is_empty() && (keeps_raw(&case.kernel, r.format) || case.kernel.opaque_display()) {
-        true => Cow::Owned(r.main_output(&case.kernel, MAIN_OUTPUT).into_iter().collect()),
-        false => Cow::Borrowed(&r.outputs),
+/// alpha; none for the seed's contract (judged by its PNG alone).
+pub fn outputs_of<'a>(case: &Case, r: &'a Rendered) -> &'a [OutputRender] {
+    let seed_contract =
+        case.kernel.graph().is_none() && !(keeps_raw(&case.kernel, r.format) || case.kernel.opaque_display());
+    match seed_contract {
+        true => &[],
+        false => &r.outputs,
     }
 }
 

@@ -238,7 +238,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     let (pending, pending_files) = match pending {
         Some(mut e) if matches!(out.verdict, crate::Verdict::Fail | crate::Verdict::Missing) => {
             // Accepted as the case's own golden (bless --from-report writes no per-backend one).
-            match crate::outputs::golden_bytes(&store.dir, case, &case.id, &crate::outputs::outputs_of(case, &r)) {
+            match crate::outputs::golden_bytes(&store.dir, case, &case.id, crate::outputs::outputs_of(case, &r)) {
                 Ok(files) => {
                     let named: Vec<(String, Vec<u8>)> = files
                         .into_iter()

@@ -1,12 +1,10 @@
 //! The shared headless context and the dispatch/readback path.
 
 use std::collections::HashMap;
-use std::sync::mpsc;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 use vista_image::Image;
-use wgpu::util::DeviceExt;
 
 use crate::format::OutputFormat;
 use crate::shaders::ShaderSet;
@@ -160,46 +158,6 @@ impl AdapterChoice {
 pub const SWIFTSHADER_HINT: &str = "install Google's SwiftShader Vulkan ICD with `bash ci/install-swiftshader.sh` \
 (it extracts libvk_swiftshader.so from Debian's chromium-common); set VISTA_ALLOW_NO_GPU=1 to skip GPU tests loudly";
 
-/// One compute job over a W x H image.
-#[derive(Debug, Clone)]
-pub struct Dispatch<'a> {
-    /// The project's WGSL sources.
-    pub shaders: &'a ShaderSet,
-    /// Kernel WGSL file relative to `shaders/`.
-    pub shader: &'a str,
-    /// The compute entry point.
-    pub entry: &'a str,
-    /// Workgroups dispatched along x, y and z (the plan derives them from
-    /// the entry point's reflected workgroup size; nothing here assumes 8 x 8).
-    pub workgroups: [u32; 3],
-    /// The entry point's reflected workgroup size (checked against the
-    /// device's limits before any work).
-    pub workgroup_size: [u32; 3],
-    /// Every binding the entry point uses, and what feeds it.
-    pub slots: &'a [Slot],
-    /// The output's storage format (its WGSL name).
-    pub format: &'a str,
-    /// The output's dimension; its layers (2d-array) or depth (3d) are
-    /// read back stacked top to bottom, one `height`-row image each.
-    pub dimension: Dimension,
-    /// Array layers (2d-array) or depth (3d) of the output; 1 otherwise.
-    pub layers: u32,
-    /// The output is `read_write`: it starts as zeros (a resource's
-    /// default contents), since the kernel may read a texel before writing
-    /// it, and texels left as they were are not counted as unwritten.
-    pub read_write: bool,
-    /// Values of the module's pipeline-overridable constants, by name.
-    pub constants: &'a [(String, f64)],
-    /// The bytes of each uniform block (padded to 16 bytes by the caller).
-    pub uniforms: &'a [Vec<u8>],
-    /// Read-only u32 table for binding 2.
-    pub table: &'a [u32],
-    /// Output width in texels.
-    pub width: u32,
-    /// Output height in texels (of one layer).
-    pub height: u32,
-}
-
 /// Timing of one run, excluding device creation and shader compilation.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct RunStats {
@@ -276,41 +234,6 @@ impl Dimension {
 /// set); others need an adapter feature.
 const CORE_READ_WRITE: &[&str] = &["r32float", "r32uint", "r32sint"];
 
-/// What feeds a binding.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SlotKind {
-    /// The bytes of uniform block `n` of the job's `uniforms`.
-    Uniform(usize),
-    /// The read-only u32 table.
-    Table,
-    /// The output texture (write-only or read_write).
-    Output,
-}
-
-/// One binding of a dispatch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Slot {
-    /// The WGSL `@group` index.
-    pub group: u32,
-    /// The WGSL `@binding` number within the group.
-    pub binding: u32,
-    /// What feeds the binding.
-    pub kind: SlotKind,
-}
-
-/// A run's output: the image, its timing, and how many texels the kernel
-/// never wrote.
-#[derive(Debug, Clone)]
-pub struct Readback {
-    /// What the kernel wrote (unwritten texels read 0).
-    pub image: Image,
-    /// The first run's timing; `total` covers both runs when unwritten
-    /// texels needed a second.
-    pub stats: RunStats,
-    /// Texels still holding [`UNWRITTEN`] after the run.
-    pub unwritten: u64,
-}
-
 /// Headless state shared by everything in one process: a wgpu device, or
 /// the browser.
 pub struct Context {
@@ -354,14 +277,8 @@ pub(crate) struct WgpuEngine {
     /// Pipelines with their bind group layouts (one per group up to the
     /// highest the kernel binds), by shader hash, entry, slots and format.
     pub(crate) pipelines: Mutex<HashMap<String, Arc<Compiled>>>,
-    /// The last run's output texture, readback and sentinel buffers, which
-    /// the next run of the same size takes instead of allocating its own:
-    /// fresh ones cost a page fault per 4 KiB as they are first written
-    /// (filling a fresh 16 MiB image, 1024 x 1024, took 10-12 ms here). A
-    /// concurrent run finds it empty and allocates. Every run first copies
-    /// the sentinel over the texture, so a texel a kernel leaves unwritten
-    /// is counted, and never shows an earlier run's value.
-    scratch: Mutex<Option<Scratch>>,
+    /// What the last runs left for the next to take (see [`crate::wgpu_run::Spares`]).
+    pub(crate) spares: Mutex<crate::wgpu_run::Spares>,
     /// Storage formats this device binds `read_write`.
     read_write: Vec<&'static str>,
 }
@@ -369,22 +286,6 @@ pub(crate) struct WgpuEngine {
 pub(crate) struct Compiled {
     pub(crate) pipeline: wgpu::ComputePipeline,
     pub(crate) groups: Vec<wgpu::BindGroupLayout>,
-}
-
-struct Scratch {
-    width: u32,
-    height: u32,
-    layers: u32,
-    dimension: Dimension,
-    format: wgpu::TextureFormat,
-    /// A read_write run's fill buffer holds zeros, not the sentinel: only
-    /// another read_write run may take it.
-    read_write: bool,
-    texture: wgpu::Texture,
-    readback: wgpu::Buffer,
-    /// The output's size of sentinel-0 texels, copied over the texture
-    /// before every run.
-    sentinel: wgpu::Buffer,
 }
 
 pub(crate) struct BrowserEngine {
@@ -501,7 +402,7 @@ impl Context {
                 device,
                 queue,
                 pipelines: Mutex::new(HashMap::new()),
-                scratch: Mutex::new(None),
+                spares: Default::default(),
                 read_write,
             })),
             info,
@@ -626,67 +527,6 @@ impl Context {
         crate::shaders::keep_struct_layouts(shader, &resolved, text)
     }
 
-    /// Compiles (once per source hash, entry, slots and format) the pipeline
-    /// of a kernel file, with a bind group layout per group from the job's
-    /// slots. The cache is keyed by the hash of the file and its imports, so
-    /// two projects (or an edited copy) never share a stale pipeline.
-    fn pipeline(&self, w: &WgpuEngine, job: &Dispatch<'_>, format: &OutputFormat) -> Result<Arc<Compiled>, GpuError> {
-        let key = format!(
-            "{}#{}@{}{:?}{}{:?}{:?}{}",
-            job.shader,
-            job.shaders.source_hash(job.shader)?,
-            job.entry,
-            job.slots,
-            format.name,
-            job.constants,
-            job.dimension,
-            job.read_write
-        );
-        if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
-            return Ok(p.clone());
-        }
-        let last = job.slots.iter().map(|s| s.group).max();
-        let layouts: Vec<Vec<wgpu::BindGroupLayoutEntry>> = (0..last.map_or(0, |g| g + 1))
-            .map(|g| {
-                job.slots
-                    .iter()
-                    .filter(|s| s.group == g)
-                    .map(|s| {
-                        let ty = match s.kind {
-                            SlotKind::Uniform(_) => wgpu::BindingType::Buffer {
-                                ty: wgpu::BufferBindingType::Uniform,
-                                has_dynamic_offset: false,
-                                min_binding_size: None,
-                            },
-                            SlotKind::Table => wgpu::BindingType::Buffer {
-                                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                                has_dynamic_offset: false,
-                                min_binding_size: None,
-                            },
-                            SlotKind::Output => wgpu::BindingType::StorageTexture {
-                                access: match job.read_write {
-                                    true => wgpu::StorageTextureAccess::ReadWrite,
-                                    false => wgpu::StorageTextureAccess::WriteOnly,
-                                },
-                                format: format.wgpu,
-                                view_dimension: job.dimension.view(),
-                            },
-                        };
-                        wgpu::BindGroupLayoutEntry {
-                            binding: s.binding,
-                            visibility: wgpu::ShaderStages::COMPUTE,
-                            ty,
-                            count: None,
-                        }
-                    })
-                    .collect()
-            })
-            .collect();
-        let compiled = self.compile(w, job.shaders, job.shader, job.entry, job.constants, &layouts)?;
-        w.pipelines.lock().expect("pipeline cache").insert(key, compiled.clone());
-        Ok(compiled)
-    }
-
     /// Compiles a kernel file's entry point with one bind group layout per
     /// group (entries given per group, groups 0..n).
     pub(crate) fn compile(
@@ -736,57 +576,6 @@ impl Context {
         Ok(Arc::new(Compiled { pipeline, groups }))
     }
 
-    /// Runs one dispatch and reads the output texture back, counting the
-    /// texels the kernel never wrote: the texture starts as sentinel 0; a
-    /// texel still holding it after the run may yet have been written with
-    /// those very bits, so only then the job runs again over sentinel 1,
-    /// and a texel holding each run's sentinel is unwritten.
-    pub fn run(&self, job: &Dispatch<'_>) -> Result<Readback, GpuError> {
-        let max = self.max_dimension();
-        if job.width == 0 || job.height == 0 || job.width > max || job.height > max {
-            return Err(GpuError::Request(format!(
-                "size {}x{} is outside this device's range: each side in [1, {max}]",
-                job.width, job.height
-            )));
-        }
-        let needs = crate::Needs {
-            workgroup_size: job.workgroup_size,
-            workgroups: job.workgroups,
-            bind_groups: job.slots.iter().map(|s| s.group + 1).max().unwrap_or(0),
-            uniform_buffers: job.slots.iter().filter(|s| matches!(s.kind, SlotKind::Uniform(_))).count() as u32,
-            storage_buffers: job.slots.iter().filter(|s| matches!(s.kind, SlotKind::Table)).count() as u32,
-            storage_textures: job.slots.iter().filter(|s| matches!(s.kind, SlotKind::Output)).count() as u32,
-            ..Default::default()
-        };
-        self.require_needs(&format!("{} ({})", job.entry, job.shader), &needs)?;
-        let format = OutputFormat::parse(job.format)?;
-        if job.read_write && !self.binds_read_write(&format) {
-            let feature = self.read_write_feature();
-            return Err(GpuError::Unsupported {
-                adapter: self.adapter_description(),
-                what: format!("a read_write {} storage texture", format.name),
-                feature: feature.to_string(),
-            });
-        }
-        let start = Instant::now();
-        let (Texels { mut image, holding_sentinel: suspects }, mut stats) = self.run_over(job, &format, 0)?;
-        // A read_write output starts as zeros: nothing tells a texel left
-        // as it was from one never written.
-        let suspects = if job.read_write { Vec::new() } else { suspects };
-        let unwritten: Vec<usize> = match suspects.is_empty() {
-            true => suspects,
-            false => {
-                let (second, _) = self.run_over(job, &format, 1)?;
-                suspects.into_iter().filter(|i| second.holding_sentinel.binary_search(i).is_ok()).collect()
-            }
-        };
-        for &i in &unwritten {
-            image.data[i] = [0.0; 4];
-        }
-        stats.total = start.elapsed();
-        Ok(Readback { image, stats, unwritten: unwritten.len() as u64 })
-    }
-
     /// Whether this device binds `format` as a read_write (or read-only)
     /// storage texture: the core r32 formats everywhere, others where the
     /// adapter's format features (or Dawn's `texture-formats-tier2`) say so.
@@ -806,282 +595,6 @@ impl Context {
         }
     }
 
-    /// One run over sentinel `which`: the output decoded, and the texels
-    /// still holding that sentinel.
-    fn run_over(
-        &self,
-        job: &Dispatch<'_>,
-        format: &OutputFormat,
-        which: usize,
-    ) -> Result<(Texels, RunStats), GpuError> {
-        match &self.engine {
-            Engine::Wgpu(w) => self.run_wgpu(w, job, format, which),
-            Engine::Browser(b) => self.run_in_browser(b, job, format, which),
-        }
-    }
-
-    fn run_wgpu(
-        &self,
-        w: &WgpuEngine,
-        job: &Dispatch<'_>,
-        format: &OutputFormat,
-        which: usize,
-    ) -> Result<(Texels, RunStats), GpuError> {
-        let compiled = self.pipeline(w, job, format)?;
-        let start = Instant::now();
-        let d = &w.device;
-        let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-        let has = |k: SlotKind| job.slots.iter().any(|s| s.kind == k);
-        let uniforms: Vec<wgpu::Buffer> = job
-            .uniforms
-            .iter()
-            .map(|bytes| {
-                d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("params"),
-                    contents: bytes,
-                    usage: wgpu::BufferUsages::UNIFORM,
-                })
-            })
-            .collect();
-        let table = has(SlotKind::Table).then(|| {
-            let words: Vec<u32> = if job.table.is_empty() { vec![0; 4] } else { job.table.to_vec() };
-            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("table"),
-                contents: &words_to_bytes(&words),
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        });
-        let extent = wgpu::Extent3d { width: job.width, height: job.height, depth_or_array_layers: job.layers };
-        let rows = job.height * job.layers;
-        // Buffer rows must be 256-byte aligned; unpadded again after mapping.
-        let row_bytes = job.width * format.texel_bytes() as u32;
-        let padded_row = row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let fill = |which: usize| {
-            let texels = (padded_row as usize / format.texel_bytes()) * rows as usize;
-            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("unwritten sentinel"),
-                contents: &initial_texel(job, format, which).repeat(texels + 1),
-                usage: wgpu::BufferUsages::COPY_SRC,
-            })
-        };
-        let shape = (job.width, job.height, job.layers, job.dimension, format.wgpu, job.read_write);
-        let kept = w
-            .scratch
-            .lock()
-            .expect("scratch")
-            .take()
-            .filter(|s| (s.width, s.height, s.layers, s.dimension, s.format, s.read_write) == shape);
-        let Scratch { texture, readback, sentinel, .. } = match kept {
-            Some(s) => s,
-            None => Scratch {
-                width: job.width,
-                height: job.height,
-                layers: job.layers,
-                dimension: job.dimension,
-                format: format.wgpu,
-                read_write: job.read_write,
-                texture: d.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("output"),
-                    size: extent,
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: job.dimension.texture(),
-                    format: format.wgpu,
-                    usage: wgpu::TextureUsages::STORAGE_BINDING
-                        | wgpu::TextureUsages::COPY_SRC
-                        | wgpu::TextureUsages::COPY_DST,
-                    view_formats: &[],
-                }),
-                readback: d.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("readback"),
-                    size: padded_row as u64 * rows as u64,
-                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                    mapped_at_creation: false,
-                }),
-                sentinel: fill(0),
-            },
-        };
-        let other_fill = (which != 0).then(|| fill(which));
-        let view = texture
-            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(job.dimension.view()), ..Default::default() });
-        let groups: Vec<wgpu::BindGroup> = compiled
-            .groups
-            .iter()
-            .enumerate()
-            .map(|(g, layout)| {
-                let entries: Vec<wgpu::BindGroupEntry> = job
-                    .slots
-                    .iter()
-                    .filter(|s| s.group == g as u32)
-                    .map(|s| wgpu::BindGroupEntry {
-                        binding: s.binding,
-                        resource: match s.kind {
-                            SlotKind::Uniform(n) => uniforms[n].as_entire_binding(),
-                            SlotKind::Table => table.as_ref().expect("a table slot").as_entire_binding(),
-                            SlotKind::Output => wgpu::BindingResource::TextureView(&view),
-                        },
-                    })
-                    .collect();
-                d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("io"), layout, entries: &entries })
-            })
-            .collect();
-        // Three submissions: the sentinel fill (untimed), then the kernel and
-        // the readback, timed apart.
-        let layout = wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(padded_row),
-            rows_per_image: Some(job.height),
-        };
-        let mut fill_pass = d.create_command_encoder(&Default::default());
-        fill_pass.copy_buffer_to_texture(
-            wgpu::TexelCopyBufferInfo { buffer: other_fill.as_ref().unwrap_or(&sentinel), layout },
-            texture.as_image_copy(),
-            extent,
-        );
-        let mut compute = d.create_command_encoder(&Default::default());
-        encode_dispatch(&mut compute, &compiled, &groups, job.workgroups, None);
-        let mut encoder = d.create_command_encoder(&Default::default());
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo { buffer: &readback, layout },
-            extent,
-        );
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Validation { what: job.shader.to_string(), message: e.to_string() });
-        }
-        let _serial = self.submit_lock.lock().expect("submit lock");
-        let index = w.queue.submit([fill_pass.finish()]);
-        self.wait(w, index, job.shader)?;
-        let gpu_start = Instant::now();
-        let index = w.queue.submit([compute.finish()]);
-        self.wait(w, index, job.shader)?;
-        let kernel = gpu_start.elapsed();
-        let copy_start = Instant::now();
-        let index = w.queue.submit([encoder.finish()]);
-        let (tx, rx) = mpsc::channel();
-        readback.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.wait(w, index, job.shader)?;
-        let gpu_wall = gpu_start.elapsed();
-        match rx.recv_timeout(self.timeout) {
-            Ok(Ok(())) => {}
-            Ok(Err(e)) => {
-                return Err(GpuError::Validation { what: "readback map".into(), message: e.to_string() });
-            }
-            Err(_) => {
-                return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs_f64() });
-            }
-        }
-        let texels = {
-            let mapped = readback
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| GpuError::Validation { what: "readback map".into(), message: e.to_string() })?;
-            read_texels(&mapped, padded_row as usize, format, job.width, rows, &format.sentinel(which))
-        };
-        readback.unmap();
-        let readback_time = copy_start.elapsed();
-        *w.scratch.lock().expect("scratch") = Some(Scratch {
-            width: job.width,
-            height: job.height,
-            layers: job.layers,
-            dimension: job.dimension,
-            format: format.wgpu,
-            read_write: job.read_write,
-            texture,
-            readback,
-            sentinel,
-        });
-        if self.validate {
-            let messages = crate::validation::take();
-            if !messages.is_empty() {
-                return Err(GpuError::Validation {
-                    what: format!("{} (Khronos validation layer, {} messages)", job.shader, messages.len()),
-                    message: messages.join(" | "),
-                });
-            }
-        }
-        let stats = RunStats { gpu_wall, kernel, readback: readback_time, total: start.elapsed() };
-        Ok((texels, stats))
-    }
-
-    /// The same job in headless Chromium: naga's WGSL of the composed
-    /// module, the same slots, uniform bytes, table, sentinel and readback.
-    fn run_in_browser(
-        &self,
-        b: &BrowserEngine,
-        job: &Dispatch<'_>,
-        format: &OutputFormat,
-        which: usize,
-    ) -> Result<(Texels, RunStats), GpuError> {
-        // Override values are baked into the page's WGSL (see `wgsl_source`).
-        let key = format!("{}#{}@{}{:?}", job.shader, job.shaders.source_hash(job.shader)?, job.entry, job.constants);
-        let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
-        let wgsl = match cached {
-            Some(w) => w,
-            None => {
-                let w = Arc::new(Context::wgsl_source(job.shaders, job.shader, job.entry, job.constants)?);
-                b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
-                w
-            }
-        };
-        let slots: Vec<vista_browser::Slot> = job
-            .slots
-            .iter()
-            .map(|s| vista_browser::Slot {
-                group: s.group,
-                binding: s.binding,
-                kind: match s.kind {
-                    SlotKind::Uniform(_) => "uniform",
-                    SlotKind::Table => "table",
-                    SlotKind::Output => "output",
-                },
-                index: match s.kind {
-                    SlotKind::Uniform(n) => n as u32,
-                    _ => 0,
-                },
-            })
-            .collect();
-        let _serial = self.submit_lock.lock().expect("submit lock");
-        let out = b
-            .browser
-            .run(&vista_browser::Job {
-                label: job.shader,
-                key: &key,
-                wgsl: &wgsl,
-                entry: job.entry,
-                workgroups: job.workgroups,
-                slots: &slots,
-                format: format.name,
-                dimension: job.dimension.web(),
-                layers: job.layers,
-                read_write: job.read_write,
-                texel_bytes: format.texel_bytes() as u32,
-                fill: &initial_texel(job, format, which),
-                uniforms: job.uniforms,
-                table: job.table,
-                width: job.width,
-                height: job.height,
-            })
-            .map_err(|e| match e {
-                vista_browser::BrowserError::Timeout { case, seconds } => GpuError::Timeout { what: case, seconds },
-                vista_browser::BrowserError::Page { case, message } => {
-                    GpuError::Validation { what: format!("{case} (in the browser)"), message }
-                }
-                other => GpuError::Device { adapter: self.info.name.clone(), message: other.to_string() },
-            })?;
-        let stats = RunStats {
-            gpu_wall: out.kernel + out.readback,
-            kernel: out.kernel,
-            readback: out.readback,
-            total: out.total,
-        };
-        let row = job.width as usize * format.texel_bytes();
-        let rows = job.height * job.layers;
-        Ok((read_texels(&out.bytes, row, format, job.width, rows, &format.sentinel(which)), stats))
-    }
-
     /// Blocks until `index` completes, or fails after the watchdog timeout.
     pub(crate) fn wait(&self, w: &WgpuEngine, index: wgpu::SubmissionIndex, what: &str) -> Result<(), GpuError> {
         w.device
@@ -1094,45 +607,6 @@ impl Context {
                 other => GpuError::Validation { what: what.to_string(), message: other.to_string() },
             })
     }
-}
-
-/// One compute pass: the pipeline, its bind groups in order, the dispatch.
-pub(crate) fn encode_dispatch(
-    encoder: &mut wgpu::CommandEncoder,
-    compiled: &Compiled,
-    groups: &[wgpu::BindGroup],
-    workgroups: [u32; 3],
-    stamps: Option<&wgpu::QuerySet>,
-) {
-    // Timestamps 0 and 1 at the pass's beginning and end, where asked.
-    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-        label: None,
-        timestamp_writes: stamps.map(|query_set| wgpu::ComputePassTimestampWrites {
-            query_set,
-            beginning_of_pass_write_index: Some(0),
-            end_of_pass_write_index: Some(1),
-        }),
-    });
-    pass.set_pipeline(&compiled.pipeline);
-    for (g, group) in groups.iter().enumerate() {
-        pass.set_bind_group(g as u32, group, &[]);
-    }
-    let [x, y, z] = workgroups;
-    pass.dispatch_workgroups(x, y, z);
-}
-
-/// What every output texel holds before the kernel runs: sentinel `which`,
-/// or zeros for a read_write output (a resource's default contents, which
-/// the kernel may read; see `Dispatch::read_write`).
-fn initial_texel(job: &Dispatch<'_>, format: &OutputFormat, which: usize) -> Vec<u8> {
-    match job.read_write {
-        true => vec![0u8; format.texel_bytes()],
-        false => format.sentinel(which),
-    }
-}
-
-fn words_to_bytes(words: &[u32]) -> Vec<u8> {
-    words.iter().flat_map(|w| w.to_le_bytes()).collect()
 }
 
 /// One run's output: decoded, and the indices (ascending) of the texels

@@ -8,21 +8,23 @@
 //! an entry point, a workgroup count, a uniform block, a u32 table and a
 //! size; meaning lives in `vista-kernels`, the plan in `vista-render`.
 
+mod browser_run;
 mod context;
 mod format;
 mod graph;
 mod limits;
 mod shaders;
 pub mod validation;
+mod wgpu_run;
 
 pub use context::{
-    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dimension, Dispatch, GpuConfig, Readback,
-    RunStats, SWIFTSHADER_HINT, Slot, SlotKind, UNWRITTEN, VALIDATION_LAYER_JSON,
+    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dimension, GpuConfig, RunStats,
+    SWIFTSHADER_HINT, UNWRITTEN, VALIDATION_LAYER_JSON,
 };
 pub use format::{OutputFormat, SampleKind, format_names};
 pub use graph::{
-    Access, Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphReadback, GraphSlot, OutputData, Resource,
-    SamplerDesc, TextureDesc,
+    Access, Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Readback, Resource,
+    SamplerDesc, TextureDesc, run_order,
 };
 pub use limits::Needs;
 pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};

@@ -1,7 +1,7 @@
 //! Planning a pass graph (SPEC 14 part 2): every pass composed and
 //! reflected, every binding resolved to a param block, the table or a
 //! resource, every input file read and checked, and every resource, pass
-//! and output laid out for `vista_gpu::Context::run_graph`. All of it
+//! and output laid out for `vista_gpu::Context::run`. All of it
 //! before any GPU work: a bad file, size, element type or binding is bad
 //! input, one line naming the resource, the file and what was expected.
 
@@ -48,9 +48,10 @@ pub enum PlannedKind {
     },
 }
 
-/// A planned graph: what `run_graph` takes, and how to read its outputs.
+/// A planned graph (a one-pass kernel's has one pass): what [`crate::run`]
+/// takes, and how to read its outputs.
 #[derive(Debug, Clone)]
-pub struct GraphPlan {
+pub struct Plan {
     /// The kernel's name.
     pub kernel: String,
     /// Every resource with its initial contents.
@@ -67,13 +68,23 @@ pub struct GraphPlan {
     pub shaders: Vec<String>,
 }
 
+impl Plan {
+    /// The first output's texture, where it is one.
+    pub fn main_texture(&self) -> Option<&vista_gpu::TextureDesc> {
+        match self.resources.get(*self.output_ids.first()?) {
+            Some(vista_gpu::Resource::Texture(t)) => Some(t),
+            _ => None,
+        }
+    }
+}
+
 /// Case-level replacements of resource files (`inputs = { name = "file" }`).
 pub type Inputs = [(String, String)];
 
 /// Plans `kernel`'s graph for `p` at `width` x `height` (the case size
 /// that resources without a `size` take), reading input files under
 /// `root` (or the case's `inputs` instead).
-pub fn plan_graph(
+pub(crate) fn plan_graph(
     shaders: &vista_gpu::ShaderSet,
     root: Option<&Path>,
     kernel: &Kernel,
@@ -81,7 +92,7 @@ pub fn plan_graph(
     inputs: &Inputs,
     width: u32,
     height: u32,
-) -> Result<GraphPlan, RenderError> {
+) -> Result<Plan, RenderError> {
     let g = kernel.graph().expect("a graph kernel");
     let bad = |m: String| RenderError::BadInput(format!("kernel {}: {m}", kernel.name()));
     let mut files = Vec::new();
@@ -411,7 +422,7 @@ pub fn plan_graph(
         });
         output_ids.push(r);
     }
-    Ok(GraphPlan {
+    Ok(Plan {
         kernel: kernel.name().to_string(),
         resources,
         passes,

@@ -1,7 +1,8 @@
 //! vista's one render path: kernel + params + a project's shaders -> a
-//! [`Plan`] (every check that needs no device happens while making it) ->
-//! run on the context's engine (wgpu on lavapipe, SwiftShader or a GPU; or
-//! headless Chromium) -> the outputs ([`Rendered`]).
+//! [`Plan`] (a pass graph; a one-pass kernel is a graph of one pass; every
+//! check that needs no device happens while making it) -> [`run`] on the
+//! context's engine (wgpu on lavapipe, SwiftShader or a GPU; or headless
+//! Chromium) -> the outputs ([`Rendered`]).
 //!
 //! check, bless, sweep, bench, mutate and the test harnesses all render
 //! through this crate; nothing else dispatches a kernel.
@@ -12,14 +13,15 @@
 
 mod error;
 pub mod graph;
+mod one_pass;
 mod reflect;
 
 pub use error::RenderError;
-pub use graph::{GraphPlan, Inputs, PlannedKind, PlannedOutput, plan_graph};
+pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use vista_gpu::{Context, Dispatch, RunStats, ShaderSet};
+use vista_gpu::{Context, RunStats, ShaderSet};
 use vista_image::Image;
 use vista_kernels::{DisplayMap, Kernel, ParamSet};
 
@@ -54,9 +56,9 @@ pub struct Rendered {
     pub unwritten: u64,
     /// The output's storage format (an integer one compares exactly).
     pub format: &'static str,
-    /// A pass graph's outputs, the first (the main image) included; empty
-    /// for a one-pass kernel. A graph whose first output is a buffer has
-    /// an empty `raw` (0 x 0): its outputs say everything.
+    /// Every output, the first (the main image, [`MAIN_OUTPUT`] of a
+    /// one-pass kernel) included. A graph whose first output is a buffer
+    /// has an empty `raw` (0 x 0): its outputs say everything.
     pub outputs: Vec<OutputRender>,
     /// Wall time of each graph pass (all its repeats).
     pub pass_times: Vec<std::time::Duration>,
@@ -75,25 +77,10 @@ impl Rendered {
     pub fn display(&self) -> &Image {
         self.display.get_or_init(|| self.to_display.apply(&self.raw)).as_ref().unwrap_or(&self.raw)
     }
-
-    /// A one-pass render's image as an output named `name` (what a graph's
-    /// first output would be), so goldens treat both paths alike; `None`
-    /// when there is no image.
-    pub fn main_output(&self, kernel: &Kernel, name: &str) -> Option<OutputRender> {
-        (self.raw.width > 0).then(|| OutputRender {
-            name: name.to_string(),
-            tolerance: None,
-            partial: kernel.partial(),
-            value: OutputValue::Texture {
-                raw: self.raw.clone(),
-                format: self.format,
-                view: kernel.view(self.format),
-                unwritten: self.unwritten,
-                display: self.to_display,
-            },
-        })
-    }
 }
+
+/// The name a one-pass kernel's image has as an output.
+pub const MAIN_OUTPUT: &str = "image";
 
 /// Checks size and work bounds before any GPU work.
 pub fn check_request(
@@ -281,167 +268,27 @@ pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, Str
     Ok(out)
 }
 
-/// One render as every engine runs it: the kernel file as composed for
-/// these params, the uniform bytes packed from naga's reflection of the
-/// composed module, the binding-2 table, the size, and how raw output maps
-/// to display values. Made by [`plan`], where every check that needs no
-/// device happens; run by [`run`].
-#[derive(Debug, Clone)]
-pub struct Plan {
-    /// The kernel's name, for errors.
-    pub kernel: String,
-    /// The kernel file as composed for these params (`Kernel::shader_for`).
-    pub shader: String,
-    /// The compute entry point (the manifest's, default `main`).
-    pub entry: String,
-    /// The entry point's workgroup size, from naga's reflection.
-    pub workgroup_size: [u32; 3],
-    /// Workgroups dispatched: the manifest's `workgroups`, else enough of
-    /// `workgroup_size` to cover the output.
-    pub workgroups: [u32; 3],
-    /// Every binding the entry point reaches, and what feeds it.
-    pub slots: Vec<vista_gpu::Slot>,
-    /// The output's storage format (its WGSL name).
-    pub format: &'static str,
-    /// The output's dimension, and its layers (2d-array) or depth (3d):
-    /// read back stacked top to bottom into one `width` x `height * layers`
-    /// image.
-    pub dimension: vista_gpu::Dimension,
-    /// Array layers (2d-array) or depth (3d); 1 otherwise.
-    pub layers: u32,
-    /// The output is bound `read_write` (it starts as zeros).
-    pub read_write: bool,
-    /// Values of the module's `override` constants (params, the manifest's
-    /// `overrides`; absent ones take their defaults).
-    pub constants: Vec<(String, f64)>,
-    /// Each uniform block's bytes, in the layout's block order.
-    pub uniforms: Vec<Vec<u8>>,
-    /// The table's words (Perlin's permutation and its packed chains).
-    pub table: Vec<u32>,
-    /// Output width in pixels.
-    pub width: u32,
-    /// Output height in pixels (of one layer; 1 for a 1d output).
-    pub height: u32,
-    /// Raw output to display values.
-    pub display: DisplayMap,
-}
-
-/// The plan of `kernel` with `p` at `width` x `height`, after every check
-/// that needs no device: size and work bounds, composition of the kernel's
-/// WGSL, and its `Params` struct against the manifest (a field with no
-/// param, a param with no field, a type mismatch are bad input).
+/// The plan of `kernel` with `p` at `width` x `height` (the case size),
+/// after every check that needs no device: size and work bounds, every
+/// pass's composition and reflection, its uniforms against the manifest,
+/// every input file (`inputs` replaces resource files for a case). A
+/// one-pass kernel is planned as a graph of one pass writing one texture.
+#[allow(clippy::too_many_arguments)]
 pub fn plan(
     shaders: &ShaderSet,
+    root: Option<&std::path::Path>,
     kernel: &Kernel,
     p: &ParamSet,
+    inputs: &Inputs,
     width: u32,
     height: u32,
     limits: &RenderLimits,
 ) -> Result<Plan, RenderError> {
     check_request(kernel, p, width, height, limits)?;
-    let shader = kernel.shader_for(p);
-    let module = shaders.compose(&shader).map_err(|e| match e {
-        // A missing or broken shader file is the user's to fix.
-        vista_gpu::GpuError::Shader(m) => RenderError::BadInput(format!("kernel {}: {m}", kernel.name())),
-        other => RenderError::Gpu(other),
-    })?;
-    let layout = kernel.layout(&module).map_err(|e| RenderError::BadInput(e.to_string()))?;
-    let entry = kernel.entry();
-    let constants = kernel.overrides(&module, p).map_err(|e| RenderError::BadInput(e.to_string()))?;
-    let workgroup_size = reflect::workgroup_size(&module, entry, &constants)
-        .map_err(|e| RenderError::BadInput(format!("kernel {}: {shader}: {e}", kernel.name())))?;
-    use vista_kernels::bindings::Feed;
-    let slots: Vec<vista_gpu::Slot> = layout
-        .bindings
-        .iter()
-        .map(|b| vista_gpu::Slot {
-            group: b.group,
-            binding: b.binding,
-            kind: match b.feed {
-                Feed::Uniform => vista_gpu::SlotKind::Uniform(
-                    layout
-                        .blocks
-                        .iter()
-                        .position(|u| (u.group, u.binding) == (b.group, b.binding))
-                        .expect("every uniform binding is a block"),
-                ),
-                Feed::Table => vista_gpu::SlotKind::Table,
-                Feed::Output(_) => vista_gpu::SlotKind::Output,
-                _ => unreachable!("bindings::reflect refuses the graph feeds"),
-            },
-        })
-        .collect();
-    let target = layout.output.as_ref().expect("Kernel::layout resolves the output");
-    let format = target.storage.format;
-    let extent = target.extent(kernel.name(), p, width, height).map_err(|e| RenderError::BadInput(e.to_string()))?;
-    use vista_kernels::resources::{Access, Dimension};
-    let dimension = match target.storage.dimension {
-        Dimension::D1 => vista_gpu::Dimension::D1,
-        Dimension::D2 => vista_gpu::Dimension::D2,
-        Dimension::D2Array => vista_gpu::Dimension::D2Array,
-        Dimension::D3 => vista_gpu::Dimension::D3,
-    };
-    let workgroups = match kernel.workgroups(p, width, height).map_err(|e| RenderError::BadInput(e.to_string()))? {
-        Some(count) => count,
-        // Cover the output, layers and slices along z: the workgroup size
-        // is the shader's, never assumed.
-        None => [
-            extent.width.div_ceil(workgroup_size[0]),
-            extent.height.div_ceil(workgroup_size[1]),
-            extent.layers.div_ceil(workgroup_size[2]),
-        ],
-    };
-    Ok(Plan {
-        kernel: kernel.name().to_string(),
-        entry: entry.to_string(),
-        workgroup_size,
-        workgroups,
-        slots,
-        format,
-        dimension,
-        layers: extent.layers,
-        read_write: target.storage.access == Access::ReadWrite,
-        constants,
-        uniforms: kernel.uniforms(&layout, p, width, height),
-        table: kernel.table(&layout, p),
-        shader,
-        width: extent.width,
-        height: extent.height,
-        display: kernel.display_map_of(p, format),
-    })
-}
-
-/// Runs a plan on the renderer's engine.
-pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
-    let job = Dispatch {
-        shaders: &gpu.shaders,
-        shader: &plan.shader,
-        entry: &plan.entry,
-        workgroups: plan.workgroups,
-        workgroup_size: plan.workgroup_size,
-        slots: &plan.slots,
-        format: plan.format,
-        dimension: plan.dimension,
-        layers: plan.layers,
-        read_write: plan.read_write,
-        constants: &plan.constants,
-        uniforms: &plan.uniforms,
-        table: &plan.table,
-        width: plan.width,
-        height: plan.height,
-    };
-    let out = gpu.ctx.run(&job)?;
-    Ok(Rendered {
-        raw: out.image,
-        stats: out.stats,
-        unwritten: out.unwritten,
-        format: plan.format,
-        outputs: Vec::new(),
-        pass_times: Vec::new(),
-        pass_gpu_times: Vec::new(),
-        to_display: plan.display,
-        display: OnceLock::new(),
-    })
+    match kernel.graph() {
+        Some(_) => graph::plan_graph(shaders, root, kernel, p, inputs, width, height),
+        None => one_pass::plan(shaders, kernel, p, width, height),
+    }
 }
 
 /// One output of a pass graph as read back.
@@ -513,9 +360,9 @@ impl OutputRender {
     }
 }
 
-/// Runs a graph plan.
-pub fn run_graph(gpu: &Renderer, plan: &GraphPlan) -> Result<Rendered, RenderError> {
-    let out = gpu.ctx.run_graph(&vista_gpu::Graph {
+/// Runs a plan on the renderer's engine.
+pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
+    let out = gpu.ctx.run(&vista_gpu::Graph {
         shaders: &gpu.shaders,
         resources: plan.resources.clone(),
         passes: plan.passes.clone(),
@@ -560,8 +407,7 @@ pub fn run_graph(gpu: &Renderer, plan: &GraphPlan) -> Result<Rendered, RenderErr
     })
 }
 
-/// Renders `kernel` with `p` at `width` x `height`: [`plan`], then [`run`]
-/// (a pass graph: [`plan_graph`], then [`run_graph`]).
+/// Renders `kernel` with `p` at `width` x `height`: [`plan`], then [`run`].
 pub fn render(gpu: &Renderer, kernel: &Kernel, p: &ParamSet, width: u32, height: u32) -> Result<Rendered, RenderError> {
     render_with(gpu, kernel, p, &[], width, height)
 }
@@ -575,14 +421,8 @@ pub fn render_with(
     width: u32,
     height: u32,
 ) -> Result<Rendered, RenderError> {
-    match kernel.graph() {
-        Some(_) => {
-            check_request(kernel, p, width, height, &gpu.limits)?;
-            let plan = plan_graph(&gpu.shaders, gpu.root.as_deref(), kernel, p, inputs, width, height)?;
-            run_graph(gpu, &plan)
-        }
-        None => run(gpu, &plan(&gpu.shaders, kernel, p, width, height, &gpu.limits)?),
-    }
+    let plan = plan(&gpu.shaders, gpu.root.as_deref(), kernel, p, inputs, width, height, &gpu.limits)?;
+    run(gpu, &plan)
 }
 
 /// Renders `runs` (at least 1) times; returns the first render and the

@@ -1,0 +1,185 @@
+//! The browser engine's one executor: the same graph as JSON for
+//! `runner.js`'s `vistaRun` (naga's WGSL of each pass, the same resources,
+//! contents, bindings, repeats and swaps), the outputs decoded as on wgpu.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use serde_json::{Value, json};
+
+use crate::GpuError;
+use crate::context::{BrowserEngine, Context, RunStats, read_texels};
+use crate::format::{OutputFormat, SampleKind};
+use crate::graph::{Access, Bind, Contents, Graph, GraphPass, GraphSlot, OutputData, Readback, Resource};
+
+impl Context {
+    /// The same graph in headless Chromium: naga's WGSL of each pass, the
+    /// same resources, contents, bindings, repeats and swaps (`runner.js`,
+    /// `vistaRun`), the outputs decoded as on wgpu.
+    pub(crate) fn run_in_browser(
+        &self,
+        b: &BrowserEngine,
+        g: &Graph<'_>,
+        which: usize,
+    ) -> Result<(Readback, Vec<Vec<usize>>), GpuError> {
+        let b64 = vista_browser::base64;
+        let mut resources = Vec::new();
+        for r in &g.resources {
+            resources.push(match r {
+                Resource::Texture(t) => {
+                    let format = OutputFormat::parse(t.format)?;
+                    // A sentinel goes as one texel the page repeats.
+                    let (contents, fill) = match &t.contents {
+                        Contents::Zeros => (None, None),
+                        Contents::Bytes(bytes) => (Some(b64(bytes)), None),
+                        Contents::Sentinel => (None, Some(b64(&format.sentinel(which)))),
+                    };
+                    json!({
+                        "kind": "texture", "format": t.format, "dimension": t.dimension.web_names().0,
+                        "width": t.width, "height": t.height, "layers": t.layers,
+                        "texel_bytes": format.texel_bytes(), "contents": contents, "fill": fill,
+                    })
+                }
+                Resource::Buffer(bytes) => json!({ "kind": "buffer", "size": bytes.len(), "contents": b64(bytes) }),
+                Resource::Sampler(s) => json!({
+                    "kind": "sampler",
+                    "filter": if s.linear { "linear" } else { "nearest" },
+                    "address": s.address.iter().map(|a| a.web()).collect::<Vec<_>>(),
+                    "compare": s.compare,
+                }),
+            });
+        }
+        let mut passes = Vec::new();
+        for pass in &g.passes {
+            let key =
+                format!("{}#{}@{}{:?}", pass.shader, g.shaders.source_hash(&pass.shader)?, pass.entry, pass.constants);
+            let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
+            let wgsl = match cached {
+                Some(w) => w,
+                None => {
+                    let w = Arc::new(Context::wgsl_source(g.shaders, &pass.shader, &pass.entry, &pass.constants)?);
+                    b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
+                    w
+                }
+            };
+            let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
+            passes.push(json!({
+                "key": key, "label": pass.label, "wgsl": *wgsl, "entry": pass.entry,
+                "workgroups": pass.workgroups, "repeat": pass.repeat, "span": pass.span,
+                "swap": pass.swap.iter().map(|(a, b)| [a, b]).collect::<Vec<_>>(),
+                "slots": slots,
+            }));
+        }
+        let job = json!({ "resources": resources, "passes": passes, "outputs": g.outputs });
+        let label = g.passes.first().map(|p| p.shader.clone()).unwrap_or_default();
+        let _serial = self.submit_lock.lock().expect("submit lock");
+        let out = b.browser.run(&label, &job).map_err(|e| match e {
+            vista_browser::BrowserError::Timeout { case, seconds } => GpuError::Timeout { what: case, seconds },
+            vista_browser::BrowserError::Page { case, message } => {
+                GpuError::Validation { what: format!("{case} (in the browser)"), message }
+            }
+            other => GpuError::Device { adapter: self.adapter_description(), message: other.to_string() },
+        })?;
+        let mut outputs = Vec::new();
+        let mut sentinels = Vec::new();
+        for (&o, bytes) in g.outputs.iter().zip(out.outputs) {
+            match &g.resources[o] {
+                Resource::Texture(t) => {
+                    let format = OutputFormat::parse(t.format)?;
+                    let row = t.width as usize * format.texel_bytes();
+                    let texels =
+                        read_texels(&bytes, row, &format, t.width, t.height * t.layers, &format.sentinel(which));
+                    sentinels.push(match t.contents {
+                        Contents::Sentinel => texels.holding_sentinel,
+                        _ => Vec::new(),
+                    });
+                    outputs.push(OutputData::Texture { image: texels.image, unwritten: 0 });
+                }
+                _ => {
+                    sentinels.push(Vec::new());
+                    outputs.push(OutputData::Buffer(bytes));
+                }
+            }
+        }
+        let kernel: Duration = out.passes.iter().sum();
+        let stats = RunStats { gpu_wall: kernel + out.readback, kernel, readback: out.readback, total: out.total };
+        let pass_gpu_times = vec![None; out.passes.len()];
+        Ok((Readback { outputs, stats, pass_times: out.passes, pass_gpu_times }, sentinels))
+    }
+
+    /// One binding as the page takes it: its bind group layout entry, and
+    /// its source (a pass's own bytes, or a resource).
+    fn slot_json(&self, b: &BrowserEngine, g: &Graph<'_>, pass: &GraphPass, s: &GraphSlot) -> Result<Value, GpuError> {
+        let b64 = vista_browser::base64;
+        let filterable32 = b.features.iter().any(|f| f == "float32-filterable");
+
+        let texture = |r: usize| match &g.resources[r] {
+            Resource::Texture(t) => Ok(t),
+            _ => Err(GpuError::Request(format!("{}: a texture binding names a non-texture", pass.label))),
+        };
+        let (layout, source) = match &s.bind {
+            Bind::Uniform(bytes) => (json!({ "buffer": { "type": "uniform" } }), json!({ "owned": b64(bytes) })),
+            Bind::Table(words) => {
+                let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+                (json!({ "buffer": { "type": "read-only-storage" } }), json!({ "owned": b64(&bytes) }))
+            }
+            Bind::UniformBuffer(r) => (json!({ "buffer": { "type": "uniform" } }), json!({ "resource": r })),
+            Bind::Storage { resource, read_only } => (
+                json!({ "buffer": { "type": if *read_only { "read-only-storage" } else { "storage" } } }),
+                json!({ "resource": resource }),
+            ),
+            Bind::StorageTexture { resource, access } => {
+                let t = texture(*resource)?;
+                let format = OutputFormat::parse(t.format)?;
+                if *access == Access::ReadWrite && !self.binds_read_write(&format) {
+                    return Err(GpuError::Unsupported {
+                        adapter: self.adapter_description(),
+                        what: format!("{}: a {} {} storage texture", pass.label, access.name(), t.format),
+                        feature: self.read_write_feature().to_string(),
+                    });
+                }
+                let access = match access {
+                    Access::Write => "write-only",
+                    Access::Read => "read-only",
+                    Access::ReadWrite => "read-write",
+                };
+                (
+                    json!({ "storageTexture": { "access": access, "format": t.format, "viewDimension": t.dimension.web_names().1 } }),
+                    json!({ "resource": resource }),
+                )
+            }
+            Bind::Sampled { resource, depth, cube } => {
+                let t = texture(*resource)?;
+                let format = OutputFormat::parse(t.format)?;
+                let sample = match (depth, format.sample_kind()) {
+                    (true, _) => "depth",
+                    (_, SampleKind::Uint) => "uint",
+                    (_, SampleKind::Sint) => "sint",
+                    (_, SampleKind::Float) if format.is_float32() && !filterable32 => "unfilterable-float",
+                    (_, SampleKind::Float) => "float",
+                };
+                (
+                    json!({ "texture": { "sampleType": sample, "viewDimension": match cube {
+                        true => "cube",
+                        false => t.dimension.web_names().1,
+                    } } }),
+                    json!({ "resource": resource }),
+                )
+            }
+            Bind::Sampler(r) => {
+                let Resource::Sampler(sd) = &g.resources[*r] else {
+                    return Err(GpuError::Request(format!("{}: a sampler bound to a non-sampler", pass.label)));
+                };
+                let ty = match (sd.compare.is_some(), sd.linear) {
+                    (true, _) => "comparison",
+                    (false, true) => "filtering",
+                    (false, false) => "non-filtering",
+                };
+                (json!({ "sampler": { "type": ty } }), json!({ "resource": r }))
+            }
+        };
+        let mut slot = json!({ "group": s.group, "binding": s.binding, "layout": layout });
+        slot.as_object_mut().expect("an object").extend(source.as_object().expect("an object").clone());
+        Ok(slot)
+    }
+}

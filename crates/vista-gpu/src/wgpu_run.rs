@@ -1,0 +1,659 @@
+//! The wgpu engine's one executor: a graph's resources made (sentinel-
+//! filled outputs and readback buffers taken from the last run's spares),
+//! its pipelines compiled once, its passes dispatched in order, its outputs
+//! read back.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, mpsc};
+use std::time::{Duration, Instant};
+
+use wgpu::util::DeviceExt;
+
+use crate::GpuError;
+use crate::context::{Compiled, Context, RunStats, WgpuEngine, read_texels};
+use crate::format::{OutputFormat, SampleKind};
+use crate::graph::{
+    Access, Bind, Contents, Graph, GraphPass, OutputData, Readback, Resource, TextureDesc, compare_fn, run_order,
+    view_dimension,
+};
+
+/// Textures, sentinel fills and readback buffers a run leaves for the next
+/// run to take instead of allocating its own: fresh ones cost a page fault
+/// per 4 KiB as they are first written (filling a fresh 16 MiB image, 1024
+/// x 1024, took 10-12 ms here). Only sentinel-filled textures are kept:
+/// every run copies the sentinel over them first, so a texel a pass leaves
+/// unwritten is counted and never shows an earlier run's value. A
+/// concurrent run finds the pool empty and allocates.
+#[derive(Default)]
+pub(crate) struct Spares {
+    textures: Vec<(TextureKey, wgpu::Texture)>,
+    /// Sentinel `which` of a format, as many bytes as a padded copy needs.
+    fills: Vec<((&'static str, usize, u64), wgpu::Buffer)>,
+    staging: Vec<(u64, wgpu::Buffer)>,
+}
+
+/// Kept at most per kind: a graph's outputs, and a little more.
+const SPARES: usize = 8;
+
+type TextureKey = (&'static str, crate::context::Dimension, u32, u32, u32);
+
+fn texture_key(t: &TextureDesc) -> TextureKey {
+    (t.format, t.dimension, t.width, t.height, t.layers)
+}
+
+/// Takes the first spare with this key.
+fn take<K: PartialEq, V>(pool: &Mutex<Spares>, pick: impl Fn(&mut Spares) -> &mut Vec<(K, V)>, key: &K) -> Option<V> {
+    let mut spares = pool.lock().expect("spares");
+    let list = pick(&mut spares);
+    let at = list.iter().position(|(k, _)| k == key)?;
+    Some(list.remove(at).1)
+}
+
+/// Keeps a spare, dropping the oldest past [`SPARES`].
+fn keep<K, V>(list: &mut Vec<(K, V)>, key: K, value: V) {
+    list.push((key, value));
+    if list.len() > SPARES {
+        list.remove(0);
+    }
+}
+
+/// Bytes per padded row of a texture's readback or fill (rows of a buffer
+/// copy are 256-byte aligned).
+fn padded_row(t: &TextureDesc, format: &OutputFormat) -> u32 {
+    let row = t.width * format.texel_bytes() as u32;
+    row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
+}
+
+/// Two GPU timestamps around one pass run, resolved and read back.
+struct Stamps {
+    set: wgpu::QuerySet,
+    resolved: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    /// Nanoseconds per timestamp tick.
+    period: f64,
+}
+
+impl Stamps {
+    fn new(w: &WgpuEngine) -> Stamps {
+        let d = &w.device;
+        let buffer = |usage| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps"),
+                size: 16,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Stamps {
+            set: d.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            }),
+            resolved: buffer(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
+            staging: buffer(wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ),
+            period: w.queue.get_timestamp_period() as f64,
+        }
+    }
+
+    fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.resolve_query_set(&self.set, 0..2, &self.resolved, 0);
+        encoder.copy_buffer_to_buffer(&self.resolved, 0, &self.staging, 0, 16);
+    }
+
+    /// The pass's GPU time, once its submission is done.
+    fn read(&self, ctx: &Context, w: &WgpuEngine, what: &str) -> Result<Duration, GpuError> {
+        let (tx, rx) = mpsc::channel();
+        self.staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        w.device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(ctx.timeout) })
+            .map_err(|e| GpuError::Validation { what: format!("{what}: timestamps"), message: e.to_string() })?;
+        match rx.recv_timeout(ctx.timeout) {
+            Ok(Ok(())) => {}
+            _ => {
+                return Err(GpuError::Validation { what: format!("{what}: timestamps"), message: "map failed".into() });
+            }
+        }
+        let ticks = {
+            let mapped = self
+                .staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Validation { what: format!("{what}: timestamps"), message: e.to_string() })?;
+            let at = |i: usize| u64::from_le_bytes(mapped[i * 8..i * 8 + 8].try_into().expect("8 bytes"));
+            at(1).saturating_sub(at(0))
+        };
+        self.staging.unmap();
+        Ok(Duration::from_nanos((ticks as f64 * self.period) as u64))
+    }
+}
+
+struct Made {
+    textures: HashMap<usize, wgpu::Texture>,
+    buffers: HashMap<usize, wgpu::Buffer>,
+    samplers: HashMap<usize, wgpu::Sampler>,
+    /// Copies of the sentinel over sentinel-filled textures, and the fill
+    /// buffers they read (spares again after the run).
+    fill: wgpu::CommandEncoder,
+    fills: Vec<((&'static str, usize, u64), wgpu::Buffer)>,
+}
+
+impl Context {
+    /// One run over sentinel `which`: the outputs, and per output the
+    /// texels holding the sentinel (empty for buffers and non-sentinel
+    /// textures).
+    pub(crate) fn run_wgpu(
+        &self,
+        w: &WgpuEngine,
+        g: &Graph<'_>,
+        which: usize,
+    ) -> Result<(Readback, Vec<Vec<usize>>), GpuError> {
+        let d = &w.device;
+        let start = Instant::now();
+        let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut made = self.make_resources(w, g, which)?;
+        let pipelines: Vec<Arc<Compiled>> =
+            g.passes.iter().map(|p| self.pipeline(w, g, p)).collect::<Result<_, _>>()?;
+        let fill = std::mem::replace(&mut made.fill, d.create_command_encoder(&Default::default()));
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Validation { what: "the pass graph's resources".into(), message: e.to_string() });
+        }
+        // Contents and sentinels land before the first pass is timed.
+        let index = w.queue.submit([fill.finish()]);
+        self.wait(w, index, "the pass graph's resources")?;
+        // Which physical resource each name binds now (swaps exchange them).
+        let mut current: Vec<usize> = (0..g.resources.len()).collect();
+        let mut pass_times = vec![Duration::ZERO; g.passes.len()];
+        let stamps = (self.time_passes.load(std::sync::atomic::Ordering::Relaxed)
+            && w.device.features().contains(wgpu::Features::TIMESTAMP_QUERY))
+        .then(|| Stamps::new(w));
+        let mut gpu_times = vec![Duration::ZERO; g.passes.len()];
+        let _serial = self.submit_lock.lock().expect("submit lock");
+        for (pi, pass, compiled) in run_order(&g.passes).into_iter().map(|i| (i, &g.passes[i], &pipelines[i])) {
+            let pass_start = Instant::now();
+            {
+                let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+                let groups = bind_groups(d, g, pass, compiled, &made, &current);
+                let mut encoder = d.create_command_encoder(&Default::default());
+                encode_dispatch(&mut encoder, compiled, &groups, pass.workgroups, stamps.as_ref().map(|s| &s.set));
+                if let Some(s) = &stamps {
+                    s.resolve(&mut encoder);
+                }
+                if let Some(e) = pollster::block_on(scope.pop()) {
+                    return Err(GpuError::Validation { what: pass.label.clone(), message: e.to_string() });
+                }
+                let index = w.queue.submit([encoder.finish()]);
+                self.wait(w, index, &pass.label)?;
+                for &(a, b) in &pass.swap {
+                    current.swap(a, b);
+                }
+            }
+            pass_times[pi] += pass_start.elapsed();
+            // Read after the wall time stops: the map is not the pass's.
+            if let Some(s) = &stamps {
+                gpu_times[pi] += s.read(self, w, &pass.label)?;
+            }
+        }
+        let kernel: Duration = pass_times.iter().sum();
+        let copy_start = Instant::now();
+        let mut outputs = Vec::new();
+        let mut sentinels = Vec::new();
+        for &o in &g.outputs {
+            let (data, held) = self.read_resource(w, g, &made, o, current[o], which)?;
+            outputs.push(data);
+            sentinels.push(held);
+        }
+        let readback = copy_start.elapsed();
+        if self.validate {
+            let messages = crate::validation::take();
+            if !messages.is_empty() {
+                return Err(GpuError::Validation {
+                    what: format!("the pass graph (Khronos validation layer, {} messages)", messages.len()),
+                    message: messages.join(" | "),
+                });
+            }
+        }
+        let stats = RunStats { gpu_wall: kernel + readback, kernel, readback, total: start.elapsed() };
+        let pass_gpu_times = gpu_times.into_iter().map(|t| stamps.as_ref().map(|_| t)).collect();
+        let mut spares = w.spares.lock().expect("spares");
+        for (i, texture) in made.textures {
+            if let Resource::Texture(t @ TextureDesc { contents: Contents::Sentinel, .. }) = &g.resources[i] {
+                keep(&mut spares.textures, texture_key(t), texture);
+            }
+        }
+        for (key, buffer) in made.fills {
+            keep(&mut spares.fills, key, buffer);
+        }
+        Ok((Readback { outputs, stats, pass_times, pass_gpu_times }, sentinels))
+    }
+
+    /// Creates every resource with its initial contents (`which` picks the
+    /// sentinel of sentinel-filled textures).
+    fn make_resources(&self, w: &WgpuEngine, g: &Graph<'_>, which: usize) -> Result<Made, GpuError> {
+        let d = &w.device;
+        let mut made = Made {
+            textures: HashMap::new(),
+            buffers: HashMap::new(),
+            samplers: HashMap::new(),
+            fill: d.create_command_encoder(&Default::default()),
+            fills: Vec::new(),
+        };
+        for (i, r) in g.resources.iter().enumerate() {
+            match r {
+                Resource::Texture(t) => {
+                    let format = OutputFormat::parse(t.format)?;
+                    let size = wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: t.layers };
+                    let spare = match t.contents {
+                        Contents::Sentinel => take(&w.spares, |s| &mut s.textures, &texture_key(t)),
+                        _ => None,
+                    };
+                    let texture = spare.unwrap_or_else(|| {
+                        d.create_texture(&wgpu::TextureDescriptor {
+                            label: Some("resource"),
+                            size,
+                            mip_level_count: 1,
+                            sample_count: 1,
+                            dimension: t.dimension.texture(),
+                            format: format.wgpu,
+                            usage: wgpu::TextureUsages::STORAGE_BINDING
+                                | wgpu::TextureUsages::TEXTURE_BINDING
+                                | wgpu::TextureUsages::COPY_SRC
+                                | wgpu::TextureUsages::COPY_DST,
+                            view_formats: &[],
+                        })
+                    });
+                    let row = t.width * format.texel_bytes() as u32;
+                    match &t.contents {
+                        Contents::Zeros => {}
+                        Contents::Bytes(bytes) => {
+                            if bytes.len() != row as usize * (t.height * t.layers) as usize {
+                                return Err(GpuError::Request(format!(
+                                    "texture resource {i}: {} bytes of contents for {}x{}x{} {} texels",
+                                    bytes.len(),
+                                    t.width,
+                                    t.height,
+                                    t.layers,
+                                    t.format
+                                )));
+                            }
+                            w.queue.write_texture(
+                                texture.as_image_copy(),
+                                bytes,
+                                wgpu::TexelCopyBufferLayout {
+                                    offset: 0,
+                                    bytes_per_row: Some(row),
+                                    rows_per_image: Some(t.height),
+                                },
+                                size,
+                            );
+                        }
+                        Contents::Sentinel => {
+                            // A copy from a kept buffer of sentinel texels,
+                            // rows padded as buffer copies need them.
+                            let padded = padded_row(t, &format);
+                            let key = (t.format, which, padded as u64 * (t.height * t.layers) as u64);
+                            let buffer = take(&w.spares, |s| &mut s.fills, &key).unwrap_or_else(|| {
+                                d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                    label: Some("unwritten sentinel"),
+                                    contents: &format.sentinel(which).repeat(key.2 as usize / format.texel_bytes()),
+                                    usage: wgpu::BufferUsages::COPY_SRC,
+                                })
+                            });
+                            made.fill.copy_buffer_to_texture(
+                                wgpu::TexelCopyBufferInfo {
+                                    buffer: &buffer,
+                                    layout: wgpu::TexelCopyBufferLayout {
+                                        offset: 0,
+                                        bytes_per_row: Some(padded),
+                                        rows_per_image: Some(t.height),
+                                    },
+                                },
+                                texture.as_image_copy(),
+                                size,
+                            );
+                            made.fills.push((key, buffer));
+                        }
+                    }
+                    made.textures.insert(i, texture);
+                }
+                Resource::Buffer(bytes) => {
+                    // Zero-length buffers cannot be bound; a 4-byte floor.
+                    let mut contents = bytes.clone();
+                    contents.resize(contents.len().max(4).next_multiple_of(4), 0);
+                    made.buffers.insert(
+                        i,
+                        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                            label: Some("resource"),
+                            contents: &contents,
+                            usage: wgpu::BufferUsages::STORAGE
+                                | wgpu::BufferUsages::UNIFORM
+                                | wgpu::BufferUsages::COPY_SRC
+                                | wgpu::BufferUsages::COPY_DST,
+                        }),
+                    );
+                }
+                Resource::Sampler(s) => {
+                    let filter = if s.linear { wgpu::FilterMode::Linear } else { wgpu::FilterMode::Nearest };
+                    let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+                        label: Some("resource"),
+                        address_mode_u: s.address[0].wgpu(),
+                        address_mode_v: s.address[1].wgpu(),
+                        address_mode_w: s.address[2].wgpu(),
+                        mag_filter: filter,
+                        min_filter: filter,
+                        mipmap_filter: match s.linear {
+                            true => wgpu::MipmapFilterMode::Linear,
+                            false => wgpu::MipmapFilterMode::Nearest,
+                        },
+                        compare: s.compare.and_then(compare_fn),
+                        ..Default::default()
+                    });
+                    made.samplers.insert(i, sampler);
+                }
+            }
+        }
+        Ok(made)
+    }
+
+    /// The pipeline of one pass, with bind group layouts from its slots
+    /// and the resources they name; cached like single dispatches.
+    fn pipeline(&self, w: &WgpuEngine, g: &Graph<'_>, pass: &GraphPass) -> Result<Arc<Compiled>, GpuError> {
+        let filterable32 = w.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE);
+        let mut entries: Vec<(u32, wgpu::BindGroupLayoutEntry)> = Vec::new();
+        for s in &pass.slots {
+            let ty = match s.bind {
+                Bind::Uniform(_) | Bind::UniformBuffer(_) => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                Bind::Table(_) => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                Bind::Storage { read_only, .. } => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                Bind::StorageTexture { resource, access } => {
+                    let Resource::Texture(t) = &g.resources[resource] else {
+                        return Err(GpuError::Request(format!(
+                            "{}: a storage texture bound to a non-texture",
+                            pass.label
+                        )));
+                    };
+                    let format = OutputFormat::parse(t.format)?;
+                    // Read-only storage is core for every storage format;
+                    // read_write beyond the r32 formats needs a feature.
+                    if access == Access::ReadWrite && !self.binds_read_write(&format) {
+                        return Err(GpuError::Unsupported {
+                            adapter: self.adapter_description(),
+                            what: format!("{}: a {} {} storage texture", pass.label, access.name(), t.format),
+                            feature: self.read_write_feature().to_string(),
+                        });
+                    }
+                    wgpu::BindingType::StorageTexture {
+                        access: match access {
+                            Access::Write => wgpu::StorageTextureAccess::WriteOnly,
+                            Access::Read => wgpu::StorageTextureAccess::ReadOnly,
+                            Access::ReadWrite => wgpu::StorageTextureAccess::ReadWrite,
+                        },
+                        format: format.wgpu,
+                        view_dimension: t.dimension.view(),
+                    }
+                }
+                Bind::Sampled { resource, depth, cube } => {
+                    let Resource::Texture(t) = &g.resources[resource] else {
+                        return Err(GpuError::Request(format!("{}: a texture bound to a non-texture", pass.label)));
+                    };
+                    let format = OutputFormat::parse(t.format)?;
+                    wgpu::BindingType::Texture {
+                        sample_type: match (depth, format.sample_kind()) {
+                            (true, _) => wgpu::TextureSampleType::Depth,
+                            (_, SampleKind::Uint) => wgpu::TextureSampleType::Uint,
+                            (_, SampleKind::Sint) => wgpu::TextureSampleType::Sint,
+                            (_, SampleKind::Float) => {
+                                wgpu::TextureSampleType::Float { filterable: !format.is_float32() || filterable32 }
+                            }
+                        },
+                        view_dimension: view_dimension(t, cube),
+                        multisampled: false,
+                    }
+                }
+                Bind::Sampler(r) => {
+                    let Resource::Sampler(sd) = &g.resources[r] else {
+                        return Err(GpuError::Request(format!("{}: a sampler bound to a non-sampler", pass.label)));
+                    };
+                    wgpu::BindingType::Sampler(match (sd.compare.is_some(), sd.linear) {
+                        (true, _) => wgpu::SamplerBindingType::Comparison,
+                        (false, true) => wgpu::SamplerBindingType::Filtering,
+                        (false, false) => wgpu::SamplerBindingType::NonFiltering,
+                    })
+                }
+            };
+            entries.push((
+                s.group,
+                wgpu::BindGroupLayoutEntry {
+                    binding: s.binding,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty,
+                    count: None,
+                },
+            ));
+        }
+        let key = format!(
+            "graph {}#{}@{}{:?}{:?}",
+            pass.shader,
+            g.shaders.source_hash(&pass.shader)?,
+            pass.entry,
+            entries,
+            pass.constants
+        );
+        if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
+            return Ok(p.clone());
+        }
+        let last = entries.iter().map(|(g, _)| *g).max();
+        let layouts: Vec<Vec<wgpu::BindGroupLayoutEntry>> = (0..last.map_or(0, |g| g + 1))
+            .map(|gi| entries.iter().filter(|(g, _)| *g == gi).map(|(_, e)| *e).collect())
+            .collect();
+        let compiled = self.compile(w, g.shaders, &pass.shader, &pass.entry, &pass.constants, &layouts)?;
+        w.pipelines.lock().expect("pipeline cache").insert(key, compiled.clone());
+        Ok(compiled)
+    }
+
+    /// Reads one output back: `logical` is the name's index (its
+    /// description), `physical` the resource it binds after the swaps.
+    fn read_resource(
+        &self,
+        w: &WgpuEngine,
+        g: &Graph<'_>,
+        made: &Made,
+        logical: usize,
+        physical: usize,
+        which: usize,
+    ) -> Result<(OutputData, Vec<usize>), GpuError> {
+        let d = &w.device;
+        let mut encoder = d.create_command_encoder(&Default::default());
+        let staging_of = |size: u64| {
+            take(&w.spares, |s| &mut s.staging, &size).unwrap_or_else(|| {
+                d.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("readback"),
+                    size,
+                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                    mapped_at_creation: false,
+                })
+            })
+        };
+        let (staging, texture) = match &g.resources[logical] {
+            Resource::Texture(t) => {
+                let format = OutputFormat::parse(t.format)?;
+                let padded = padded_row(t, &format);
+                let rows = t.height * t.layers;
+                let staging = staging_of(padded as u64 * rows as u64);
+                encoder.copy_texture_to_buffer(
+                    made.textures[&physical].as_image_copy(),
+                    wgpu::TexelCopyBufferInfo {
+                        buffer: &staging,
+                        layout: wgpu::TexelCopyBufferLayout {
+                            offset: 0,
+                            bytes_per_row: Some(padded),
+                            rows_per_image: Some(t.height),
+                        },
+                    },
+                    wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: t.layers },
+                );
+                (staging, Some((t, format, padded, rows)))
+            }
+            Resource::Buffer(bytes) => {
+                let size = bytes.len().max(4).next_multiple_of(4) as u64;
+                let staging = staging_of(size);
+                encoder.copy_buffer_to_buffer(&made.buffers[&physical], 0, &staging, 0, size);
+                (staging, None)
+            }
+            Resource::Sampler(_) => return Err(GpuError::Request("a sampler cannot be an output".into())),
+        };
+        let index = w.queue.submit([encoder.finish()]);
+        let (tx, rx) = mpsc::channel();
+        staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait(w, index, "readback")?;
+        match rx.recv_timeout(self.timeout) {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return Err(GpuError::Validation { what: "readback map".into(), message: e.to_string() }),
+            Err(_) => {
+                return Err(GpuError::Timeout { what: "readback map".into(), seconds: self.timeout.as_secs_f64() });
+            }
+        }
+        let out = {
+            let mapped = staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Validation { what: "readback map".into(), message: e.to_string() })?;
+            match texture {
+                Some((t, format, padded, rows)) => {
+                    let sentinel = format.sentinel(which);
+                    let texels = read_texels(&mapped, padded as usize, &format, t.width, rows, &sentinel);
+                    let held = match t.contents {
+                        Contents::Sentinel => texels.holding_sentinel,
+                        _ => Vec::new(),
+                    };
+                    (OutputData::Texture { image: texels.image, unwritten: 0 }, held)
+                }
+                None => {
+                    let Resource::Buffer(bytes) = &g.resources[logical] else { unreachable!("a buffer") };
+                    (OutputData::Buffer(mapped[..bytes.len()].to_vec()), Vec::new())
+                }
+            }
+        };
+        staging.unmap();
+        keep(&mut w.spares.lock().expect("spares").staging, staging.size(), staging);
+        Ok(out)
+    }
+}
+
+/// The bind groups of one pass run: each slot's resource as the swaps
+/// left it, a pass's own uniform blocks and table in buffers of their own.
+fn bind_groups(
+    d: &wgpu::Device,
+    g: &Graph<'_>,
+    pass: &GraphPass,
+    compiled: &Compiled,
+    made: &Made,
+    current: &[usize],
+) -> Vec<wgpu::BindGroup> {
+    let owned: Vec<Option<wgpu::Buffer>> = pass
+        .slots
+        .iter()
+        .map(|s| match &s.bind {
+            Bind::Uniform(bytes) => Some(d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("params"),
+                contents: bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            })),
+            Bind::Table(words) => {
+                // An empty table still binds: four zero words.
+                let words: &[u32] = if words.is_empty() { &[0; 4] } else { words };
+                Some(d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("table"),
+                    contents: &words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>(),
+                    usage: wgpu::BufferUsages::STORAGE,
+                }))
+            }
+            _ => None,
+        })
+        .collect();
+    let views: Vec<Option<wgpu::TextureView>> = pass
+        .slots
+        .iter()
+        .map(|s| match s.bind {
+            Bind::StorageTexture { resource, .. } | Bind::Sampled { resource, .. } => {
+                let Resource::Texture(t) = &g.resources[resource] else { return None };
+                let cube = matches!(s.bind, Bind::Sampled { cube: true, .. });
+                Some(made.textures[&current[resource]].create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(view_dimension(t, cube)),
+                    ..Default::default()
+                }))
+            }
+            _ => None,
+        })
+        .collect();
+    compiled
+        .groups
+        .iter()
+        .enumerate()
+        .map(|(gi, layout)| {
+            let entries: Vec<wgpu::BindGroupEntry> = pass
+                .slots
+                .iter()
+                .enumerate()
+                .filter(|(_, s)| s.group == gi as u32)
+                .map(|(i, s)| wgpu::BindGroupEntry {
+                    binding: s.binding,
+                    resource: match s.bind {
+                        Bind::Uniform(_) | Bind::Table(_) => {
+                            owned[i].as_ref().expect("owned buffer").as_entire_binding()
+                        }
+                        Bind::UniformBuffer(r) | Bind::Storage { resource: r, .. } => {
+                            made.buffers[&current[r]].as_entire_binding()
+                        }
+                        Bind::StorageTexture { .. } | Bind::Sampled { .. } => {
+                            wgpu::BindingResource::TextureView(views[i].as_ref().expect("a view"))
+                        }
+                        Bind::Sampler(r) => wgpu::BindingResource::Sampler(&made.samplers[&current[r]]),
+                    },
+                })
+                .collect();
+            d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(&pass.label), layout, entries: &entries })
+        })
+        .collect()
+}
+
+/// One compute pass: the pipeline, its bind groups in order, the dispatch.
+fn encode_dispatch(
+    encoder: &mut wgpu::CommandEncoder,
+    compiled: &Compiled,
+    groups: &[wgpu::BindGroup],
+    workgroups: [u32; 3],
+    stamps: Option<&wgpu::QuerySet>,
+) {
+    // Timestamps 0 and 1 at the pass's beginning and end, where asked.
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: None,
+        timestamp_writes: stamps.map(|query_set| wgpu::ComputePassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: Some(0),
+            end_of_pass_write_index: Some(1),
+        }),
+    });
+    pass.set_pipeline(&compiled.pipeline);
+    for (g, group) in groups.iter().enumerate() {
+        pass.set_bind_group(g as u32, group, &[]);
+    }
+    let [x, y, z] = workgroups;
+    pass.dispatch_workgroups(x, y, z);
+}
