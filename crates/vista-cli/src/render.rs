@@ -71,7 +71,7 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
     }
     vista_image::save(&out, &img)?;
     let shape = match t.dimension {
-        vista_gpu::Dimension::D2 if t.layers == 1 && (t.width, t.height) == (w, h) => format!("{w}x{h}"),
+        vista_texel::Dimension::D2 if t.layers == 1 && (t.width, t.height) == (w, h) => format!("{w}x{h}"),
         d => format!(
             "{}x{}x{} ({} output, stacked {}x{})",
             t.width,

@@ -9,8 +9,8 @@ use serde_json::{Value, json};
 
 use crate::GpuError;
 use crate::context::{BrowserEngine, Context, RunStats, read_texels};
-use crate::format::{OutputFormat, SampleKind};
-use crate::graph::{Access, Bind, Contents, Graph, GraphPass, GraphSlot, OutputData, Readback, Resource};
+use crate::graph::{Bind, Contents, Graph, GraphPass, GraphSlot, OutputData, Readback, Resource};
+use vista_texel::{Access, SampleKind};
 
 impl Context {
     /// The same graph in headless Chromium: naga's WGSL of each pass, the
@@ -27,7 +27,7 @@ impl Context {
         for r in &g.resources {
             resources.push(match r {
                 Resource::Texture(t) => {
-                    let format = OutputFormat::parse(t.format)?;
+                    let format = crate::format::parse(t.format)?;
                     // A sentinel goes as one texel the page repeats.
                     let (contents, fill) = match &t.contents {
                         Contents::Zeros => (None, None),
@@ -35,7 +35,7 @@ impl Context {
                         Contents::Sentinel => (None, Some(b64(&format.sentinel(which)))),
                     };
                     json!({
-                        "kind": "texture", "format": t.format, "dimension": t.dimension.web_names().0,
+                        "kind": "texture", "format": t.format, "dimension": t.dimension.texture_name(),
                         "width": t.width, "height": t.height, "layers": t.layers,
                         "texel_bytes": format.texel_bytes(), "contents": contents, "fill": fill,
                     })
@@ -85,7 +85,7 @@ impl Context {
         for (&o, bytes) in g.outputs.iter().zip(out.outputs) {
             match &g.resources[o] {
                 Resource::Texture(t) => {
-                    let format = OutputFormat::parse(t.format)?;
+                    let format = crate::format::parse(t.format)?;
                     let row = t.width as usize * format.texel_bytes();
                     let texels =
                         read_texels(&bytes, row, &format, t.width, t.height * t.layers, &format.sentinel(which));
@@ -130,27 +130,23 @@ impl Context {
             ),
             Bind::StorageTexture { resource, access } => {
                 let t = texture(*resource)?;
-                let format = OutputFormat::parse(t.format)?;
+                let format = crate::format::parse(t.format)?;
                 if *access == Access::ReadWrite && !self.binds_read_write(&format) {
                     return Err(GpuError::Unsupported {
                         adapter: self.adapter_description(),
-                        what: format!("{}: a {} {} storage texture", pass.label, access.name(), t.format),
+                        what: format!("{}: a {} {} storage texture", pass.label, access.wgsl(), t.format),
                         feature: self.read_write_feature().to_string(),
                     });
                 }
-                let access = match access {
-                    Access::Write => "write-only",
-                    Access::Read => "read-only",
-                    Access::ReadWrite => "read-write",
-                };
+                let access = access.web();
                 (
-                    json!({ "storageTexture": { "access": access, "format": t.format, "viewDimension": t.dimension.web_names().1 } }),
+                    json!({ "storageTexture": { "access": access, "format": t.format, "viewDimension": t.dimension.name() } }),
                     json!({ "resource": resource }),
                 )
             }
             Bind::Sampled { resource, depth, cube } => {
                 let t = texture(*resource)?;
-                let format = OutputFormat::parse(t.format)?;
+                let format = crate::format::parse(t.format)?;
                 let sample = match (depth, format.sample_kind()) {
                     (true, _) => "depth",
                     (_, SampleKind::Uint) => "uint",
@@ -161,7 +157,7 @@ impl Context {
                 (
                     json!({ "texture": { "sampleType": sample, "viewDimension": match cube {
                         true => "cube",
-                        false => t.dimension.web_names().1,
+                        false => t.dimension.name(),
                     } } }),
                     json!({ "resource": resource }),
                 )

@@ -6,9 +6,9 @@ use std::time::{Duration, Instant};
 
 use vista_image::Image;
 
-use crate::format::OutputFormat;
 use crate::shaders::ShaderSet;
 use crate::{GpuError, INSTALL_HINT};
+use vista_texel::Format;
 
 /// Which adapter to ask for. Software adapters are chosen by name, never
 /// by whichever CPU driver the Vulkan loader lists first.
@@ -171,65 +171,6 @@ pub struct RunStats {
     pub total: Duration,
 }
 
-/// What each 32-bit channel of the output holds before the kernel runs
-/// (sentinel 0 of the 32-bit formats): a NaN with a payload no arithmetic
-/// produces (operations give the canonical NaN). A texel still holding the
-/// sentinel after the run was never written; it is read back as 0, as
-/// from a fresh texture. See [`crate::OutputFormat`] for the others.
-pub const UNWRITTEN: u32 = 0x7FC0_DEAD;
-
-/// An output texture's dimension.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Dimension {
-    /// A 1d texture (WebGPU `1d`).
-    D1,
-    /// A 2d texture (WebGPU `2d`).
-    D2,
-    /// A 2d texture of array layers, viewed as `2d-array`.
-    D2Array,
-    /// A 3d texture (WebGPU `3d`).
-    D3,
-}
-
-impl Dimension {
-    pub(crate) fn texture(self) -> wgpu::TextureDimension {
-        match self {
-            Dimension::D1 => wgpu::TextureDimension::D1,
-            Dimension::D2 | Dimension::D2Array => wgpu::TextureDimension::D2,
-            Dimension::D3 => wgpu::TextureDimension::D3,
-        }
-    }
-
-    pub(crate) fn view(self) -> wgpu::TextureViewDimension {
-        match self {
-            Dimension::D1 => wgpu::TextureViewDimension::D1,
-            Dimension::D2 => wgpu::TextureViewDimension::D2,
-            Dimension::D2Array => wgpu::TextureViewDimension::D2Array,
-            Dimension::D3 => wgpu::TextureViewDimension::D3,
-        }
-    }
-
-    /// The manifest's name (and WebGPU's view dimension).
-    pub fn name(self) -> &'static str {
-        self.web().1
-    }
-
-    /// WebGPU's names: the texture's dimension and its view's.
-    pub(crate) fn web_names(self) -> (&'static str, &'static str) {
-        self.web()
-    }
-
-    /// WebGPU's names: the texture's dimension and its view's.
-    fn web(self) -> (&'static str, &'static str) {
-        match self {
-            Dimension::D1 => ("1d", "1d"),
-            Dimension::D2 => ("2d", "2d"),
-            Dimension::D2Array => ("2d", "2d-array"),
-            Dimension::D3 => ("3d", "3d"),
-        }
-    }
-}
-
 /// Storage formats every WebGPU device may bind `read_write` (the core
 /// set); others need an adapter feature.
 const CORE_READ_WRITE: &[&str] = &["r32float", "r32uint", "r32sint"];
@@ -377,14 +318,14 @@ impl Context {
         // GPU timestamps around each graph pass, where the driver has them.
         let wanted = specific | wgpu::Features::FLOAT32_FILTERABLE | wgpu::Features::TIMESTAMP_QUERY;
         let required_features = adapter.features() & wanted;
-        let read_write = crate::format::format_names()
+        let read_write = vista_texel::format_names()
             .into_iter()
             .filter(|name| {
                 CORE_READ_WRITE.contains(name)
                     || (required_features.contains(specific)
-                        && OutputFormat::parse(name).is_ok_and(|f| {
+                        && crate::format::parse(name).is_ok_and(|f| {
                             adapter
-                                .get_texture_format_features(f.wgpu)
+                                .get_texture_format_features(crate::format::wgpu_format(&f))
                                 .flags
                                 .contains(wgpu::TextureFormatFeatureFlags::STORAGE_READ_WRITE)
                         }))
@@ -579,7 +520,7 @@ impl Context {
     /// Whether this device binds `format` as a read_write (or read-only)
     /// storage texture: the core r32 formats everywhere, others where the
     /// adapter's format features (or Dawn's `texture-formats-tier2`) say so.
-    pub(crate) fn binds_read_write(&self, format: &OutputFormat) -> bool {
+    pub(crate) fn binds_read_write(&self, format: &Format) -> bool {
         CORE_READ_WRITE.contains(&format.name)
             || match &self.engine {
                 Engine::Wgpu(w) => w.read_write.contains(&format.name),
@@ -622,7 +563,7 @@ pub(crate) struct Texels {
 pub(crate) fn read_texels(
     bytes: &[u8],
     stride: usize,
-    format: &OutputFormat,
+    format: &Format,
     width: u32,
     height: u32,
     sentinel: &[u8],
@@ -630,7 +571,7 @@ pub(crate) fn read_texels(
     let (w, tb) = (width as usize, format.texel_bytes());
     let mut data = vec![[0.0f32; 4]; w * height as usize];
     let mut holding_sentinel = Vec::new();
-    let rgba32 = format.wgpu == wgpu::TextureFormat::Rgba32Float;
+    let rgba32 = format.storage == naga::StorageFormat::Rgba32Float;
     for (y, dst) in data.chunks_exact_mut(w).enumerate() {
         let row = &bytes[y * stride..][..w * tb];
         for (x, (px, texel)) in dst.iter_mut().zip(row.chunks_exact(tb)).enumerate() {
@@ -713,14 +654,14 @@ mod tests {
                 }
             }
         }
-        let rgba32 = OutputFormat::parse("rgba32float").unwrap();
+        let rgba32 = crate::format::parse("rgba32float").unwrap();
         let sentinel = rgba32.sentinel(0);
         bytes[padded + 16..padded + 32].copy_from_slice(&sentinel);
         let t = read_texels(&bytes, padded, &rgba32, w, h, &sentinel);
         assert_eq!(t.image.get(2, 1), [120.0, 121.0, 122.0, 123.0]);
         assert_eq!(t.image.get(0, 0), [0.0, 1.0, 2.0, 3.0]);
         assert_eq!(t.holding_sentinel, [4], "texel (1, 1)");
-        let r8 = OutputFormat::parse("rgba8unorm").unwrap();
+        let r8 = crate::format::parse("rgba8unorm").unwrap();
         let t = read_texels(&[255, 0, 51, 255], 4, &r8, 1, 1, &r8.sentinel(0));
         assert_eq!((t.image.get(0, 0), t.holding_sentinel.len()), ([1.0, 0.0, 0.2, 1.0], 0));
     }

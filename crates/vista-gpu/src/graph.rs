@@ -10,7 +10,9 @@ use std::time::{Duration, Instant};
 use vista_image::Image;
 
 use crate::GpuError;
-use crate::context::{Context, Dimension, Engine, RunStats};
+use vista_texel::{Access, Dimension};
+
+use crate::context::{Context, Engine, RunStats};
 use crate::shaders::ShaderSet;
 
 /// What a texture holds before the first pass.
@@ -111,18 +113,6 @@ pub enum Resource {
     Buffer(Vec<u8>),
     /// A sampler.
     Sampler(SamplerDesc),
-}
-
-/// How a storage texture is bound.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Access {
-    /// WGSL `write` (WebGPU `write-only`).
-    Write,
-    /// WGSL `read` (WebGPU `read-only`).
-    Read,
-    /// WGSL `read_write` (WebGPU `read-write`); beyond the r32 formats it
-    /// needs an adapter feature.
-    ReadWrite,
 }
 
 /// What feeds one binding of a pass.
@@ -260,7 +250,7 @@ pub struct Graph<'a> {
 pub(crate) fn view_dimension(t: &TextureDesc, cube: bool) -> wgpu::TextureViewDimension {
     match cube {
         true => wgpu::TextureViewDimension::Cube,
-        false => t.dimension.view(),
+        false => crate::format::view_dimension(t.dimension),
     }
 }
 
@@ -351,15 +341,5 @@ impl Context {
         }
         first.0.stats.total = start.elapsed();
         Ok(first.0)
-    }
-}
-
-impl Access {
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            Access::Write => "write",
-            Access::Read => "read",
-            Access::ReadWrite => "read_write",
-        }
     }
 }

@@ -18,13 +18,12 @@ pub mod validation;
 mod wgpu_run;
 
 pub use context::{
-    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, Dimension, GpuConfig, RunStats,
-    SWIFTSHADER_HINT, UNWRITTEN, VALIDATION_LAYER_JSON,
+    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, GpuConfig, RunStats, SWIFTSHADER_HINT,
+    VALIDATION_LAYER_JSON,
 };
-pub use format::{OutputFormat, SampleKind, format_names};
 pub use graph::{
-    Access, Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Readback, Resource,
-    SamplerDesc, TextureDesc, run_order,
+    Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Readback, Resource, SamplerDesc,
+    TextureDesc, run_order,
 };
 pub use limits::Needs;
 pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};

@@ -11,11 +11,11 @@ use wgpu::util::DeviceExt;
 
 use crate::GpuError;
 use crate::context::{Compiled, Context, RunStats, WgpuEngine, read_texels};
-use crate::format::{OutputFormat, SampleKind};
 use crate::graph::{
-    Access, Bind, Contents, Graph, GraphPass, OutputData, Readback, Resource, TextureDesc, compare_fn, run_order,
+    Bind, Contents, Graph, GraphPass, OutputData, Readback, Resource, TextureDesc, compare_fn, run_order,
     view_dimension,
 };
+use vista_texel::{Access, Format, SampleKind};
 
 /// Textures, sentinel fills and readback buffers a run leaves for the next
 /// run to take instead of allocating its own: fresh ones cost a page fault
@@ -35,7 +35,7 @@ pub(crate) struct Spares {
 /// Kept at most per kind: a graph's outputs, and a little more.
 const SPARES: usize = 8;
 
-type TextureKey = (&'static str, crate::context::Dimension, u32, u32, u32);
+type TextureKey = (&'static str, vista_texel::Dimension, u32, u32, u32);
 
 fn texture_key(t: &TextureDesc) -> TextureKey {
     (t.format, t.dimension, t.width, t.height, t.layers)
@@ -59,7 +59,7 @@ fn keep<K, V>(list: &mut Vec<(K, V)>, key: K, value: V) {
 
 /// Bytes per padded row of a texture's readback or fill (rows of a buffer
 /// copy are 256-byte aligned).
-fn padded_row(t: &TextureDesc, format: &OutputFormat) -> u32 {
+fn padded_row(t: &TextureDesc, format: &Format) -> u32 {
     let row = t.width * format.texel_bytes() as u32;
     row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
 }
@@ -243,7 +243,7 @@ impl Context {
         for (i, r) in g.resources.iter().enumerate() {
             match r {
                 Resource::Texture(t) => {
-                    let format = OutputFormat::parse(t.format)?;
+                    let format = crate::format::parse(t.format)?;
                     let size = wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: t.layers };
                     let spare = match t.contents {
                         Contents::Sentinel => take(&w.spares, |s| &mut s.textures, &texture_key(t)),
@@ -255,8 +255,8 @@ impl Context {
                             size,
                             mip_level_count: 1,
                             sample_count: 1,
-                            dimension: t.dimension.texture(),
-                            format: format.wgpu,
+                            dimension: crate::format::texture_dimension(t.dimension),
+                            format: crate::format::wgpu_format(&format),
                             usage: wgpu::TextureUsages::STORAGE_BINDING
                                 | wgpu::TextureUsages::TEXTURE_BINDING
                                 | wgpu::TextureUsages::COPY_SRC
@@ -386,13 +386,13 @@ impl Context {
                             pass.label
                         )));
                     };
-                    let format = OutputFormat::parse(t.format)?;
+                    let format = crate::format::parse(t.format)?;
                     // Read-only storage is core for every storage format;
                     // read_write beyond the r32 formats needs a feature.
                     if access == Access::ReadWrite && !self.binds_read_write(&format) {
                         return Err(GpuError::Unsupported {
                             adapter: self.adapter_description(),
-                            what: format!("{}: a {} {} storage texture", pass.label, access.name(), t.format),
+                            what: format!("{}: a {} {} storage texture", pass.label, access.wgsl(), t.format),
                             feature: self.read_write_feature().to_string(),
                         });
                     }
@@ -402,15 +402,15 @@ impl Context {
                             Access::Read => wgpu::StorageTextureAccess::ReadOnly,
                             Access::ReadWrite => wgpu::StorageTextureAccess::ReadWrite,
                         },
-                        format: format.wgpu,
-                        view_dimension: t.dimension.view(),
+                        format: crate::format::wgpu_format(&format),
+                        view_dimension: crate::format::view_dimension(t.dimension),
                     }
                 }
                 Bind::Sampled { resource, depth, cube } => {
                     let Resource::Texture(t) = &g.resources[resource] else {
                         return Err(GpuError::Request(format!("{}: a texture bound to a non-texture", pass.label)));
                     };
-                    let format = OutputFormat::parse(t.format)?;
+                    let format = crate::format::parse(t.format)?;
                     wgpu::BindingType::Texture {
                         sample_type: match (depth, format.sample_kind()) {
                             (true, _) => wgpu::TextureSampleType::Depth,
@@ -490,7 +490,7 @@ impl Context {
         };
         let (staging, texture) = match &g.resources[logical] {
             Resource::Texture(t) => {
-                let format = OutputFormat::parse(t.format)?;
+                let format = crate::format::parse(t.format)?;
                 let padded = padded_row(t, &format);
                 let rows = t.height * t.layers;
                 let staging = staging_of(padded as u64 * rows as u64);

@@ -30,7 +30,7 @@ pub enum Feed {
     /// A sampled texture (pass graphs only).
     Sampled {
         /// The texture's dimension.
-        dim: crate::graph::SampledDim,
+        dim: vista_texel::Dimension,
         /// What sampling it returns.
         kind: crate::graph::SampledKind,
     },
@@ -55,57 +55,15 @@ pub struct Binding {
     pub(crate) global: Handle<naga::GlobalVariable>,
 }
 
-/// The storage formats an output may have (SPEC 14's list).
-pub const STORAGE_FORMATS: &[&str] = &[
-    "rgba8unorm",
-    "rgba8snorm",
-    "rgba8uint",
-    "rgba8sint",
-    "rgba16float",
-    "rgba16uint",
-    "rgba16sint",
-    "rgba32float",
-    "rgba32uint",
-    "rgba32sint",
-    "r32float",
-    "r32uint",
-    "r32sint",
-    "rg32float",
-    "rg32uint",
-    "rg32sint",
-];
-
-/// The storage formats an output may have, by naga's name for them.
-/// `name` as one of [`STORAGE_FORMATS`], or the error listing them.
+/// `name` as one of vista-texel's formats, or the error listing them.
 pub(crate) fn storage_format(name: &str) -> Result<&'static str, String> {
-    STORAGE_FORMATS
-        .iter()
-        .copied()
-        .find(|n| *n == name)
-        .ok_or_else(|| format!("format = \"{name}\" is not valid; expected one of {}", STORAGE_FORMATS.join(", ")))
+    vista_texel::Format::parse(name).map(|f| f.name).map_err(|_| {
+        format!("format = \"{name}\" is not valid; expected one of {}", vista_texel::format_names().join(", "))
+    })
 }
 
 fn format_name(f: naga::StorageFormat) -> Option<&'static str> {
-    use naga::StorageFormat as S;
-    Some(match f {
-        S::Rgba8Unorm => "rgba8unorm",
-        S::Rgba8Snorm => "rgba8snorm",
-        S::Rgba8Uint => "rgba8uint",
-        S::Rgba8Sint => "rgba8sint",
-        S::Rgba16Float => "rgba16float",
-        S::Rgba16Uint => "rgba16uint",
-        S::Rgba16Sint => "rgba16sint",
-        S::Rgba32Float => "rgba32float",
-        S::Rgba32Uint => "rgba32uint",
-        S::Rgba32Sint => "rgba32sint",
-        S::R32Float => "r32float",
-        S::R32Uint => "r32uint",
-        S::R32Sint => "r32sint",
-        S::Rg32Float => "rg32float",
-        S::Rg32Uint => "rg32uint",
-        S::Rg32Sint => "rg32sint",
-        _ => return None,
-    })
+    vista_texel::Format::of_naga(f).map(|f| f.name)
 }
 
 /// A name as its declaring module spells it, and that module's import
@@ -281,7 +239,8 @@ pub fn reflect_all(kernel: &str, shader: &str, entry: &str, module: &naga::Modul
                 wgsl_type(module, var)
             ))
         };
-        use crate::graph::{SampledDim, SampledKind};
+        use crate::graph::SampledKind;
+        use vista_texel::{Access, Dimension};
         let feed = match (&var.space, &module.types[var.ty].inner) {
             (AddressSpace::Uniform, _) => Feed::Uniform,
             (AddressSpace::Storage { access }, TypeInner::Array { base, .. })
@@ -292,19 +251,13 @@ pub fn reflect_all(kernel: &str, shader: &str, entry: &str, module: &naga::Modul
             }
             (AddressSpace::Storage { access }, _) => Feed::Buffer { read_only: !access.contains(StorageAccess::STORE) },
             (_, TypeInner::Image { dim, arrayed, class: ImageClass::Storage { format, access } }) => {
-                use crate::resources::{Access, Dimension};
-                let dimension = match (dim, arrayed) {
-                    (ImageDimension::D1, _) => Dimension::D1,
-                    (ImageDimension::D2, false) => Dimension::D2,
-                    (ImageDimension::D2, true) => Dimension::D2Array,
-                    (ImageDimension::D3, _) => Dimension::D3,
-                    _ => return Err(unfed("a storage texture of dimension 1d, 2d, 2d-array or 3d")),
+                let dimension = match Dimension::of_naga(*dim, *arrayed) {
+                    Some(Dimension::Cube) | None => {
+                        return Err(unfed("a storage texture of dimension 1d, 2d, 2d-array or 3d"));
+                    }
+                    Some(d) => d,
                 };
-                let access = match (access.contains(StorageAccess::LOAD), access.contains(StorageAccess::STORE)) {
-                    (true, true) => Access::ReadWrite,
-                    (false, _) => Access::Write,
-                    (true, false) => Access::Read,
-                };
+                let access = Access::of_naga(*access);
                 let Some(format) = format_name(*format) else {
                     return Err(unfed("a storage texture of a supported format (not bgra8unorm or a packed one)"));
                 };
@@ -312,13 +265,8 @@ pub fn reflect_all(kernel: &str, shader: &str, entry: &str, module: &naga::Modul
                 if access == Access::Read { Feed::StorageRead(storage) } else { Feed::Output(storage) }
             }
             (_, TypeInner::Image { dim, arrayed, class }) => {
-                let dim = match (dim, arrayed) {
-                    (ImageDimension::D1, false) => SampledDim::D1,
-                    (ImageDimension::D2, false) => SampledDim::D2,
-                    (ImageDimension::D2, true) => SampledDim::D2Array,
-                    (ImageDimension::D3, false) => SampledDim::D3,
-                    (ImageDimension::Cube, false) => SampledDim::Cube,
-                    _ => return Err(unfed("a texture of dimension 1d, 2d, 2d-array, 3d or cube")),
+                let Some(dim) = Dimension::of_naga(*dim, *arrayed) else {
+                    return Err(unfed("a texture of dimension 1d, 2d, 2d-array, 3d or cube"));
                 };
                 let kind = match class {
                     ImageClass::Sampled { multi: true, .. } | ImageClass::Depth { multi: true } => {

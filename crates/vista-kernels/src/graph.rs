@@ -17,21 +17,6 @@ use crate::params::ParamSpec;
 use crate::resources::{Access, Dimension, Storage};
 use crate::{Output, ParamError};
 
-/// A sampled texture's dimension (cube only for sampling).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SampledDim {
-    /// `1d`.
-    D1,
-    /// `2d`.
-    D2,
-    /// `2d-array`.
-    D2Array,
-    /// `3d`.
-    D3,
-    /// `cube`: six square layers, sampled as a cube (written as their 2d-array).
-    Cube,
-}
-
 /// What a sampled texture binding returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SampledKind {
@@ -56,11 +41,11 @@ pub const COMPARE_FUNCTIONS: [&str; 8] =
 pub enum ResourceKind {
     /// A texture (`kind = "texture"`): written as a storage texture, sampled, or both.
     Texture {
-        /// Its storage format (one of [`crate::bindings::STORAGE_FORMATS`]); `None`:
+        /// Its storage format (one of [`vista_texel::format_names`]); `None`:
         /// a storage binding's, else its file's.
         format: Option<&'static str>,
         /// 1d | 2d | 2d-array | 3d (storage and sampled) or cube (sampled).
-        dimension: Option<SampledDim>,
+        dimension: Option<Dimension>,
         /// Its size as expressions of the params and the case size: one entry for
         /// 1d or a cube (the face edge), two for 2d, three for 2d-array and 3d;
         /// `None`: its file's size, else the case's.
@@ -378,16 +363,10 @@ fn texture_kind(
     };
     let dimension = match string_key(t, "dimension", at)? {
         None => None,
-        Some(d) => Some(match d.as_str() {
-            "1d" => SampledDim::D1,
-            "2d" => SampledDim::D2,
-            "2d-array" => SampledDim::D2Array,
-            "3d" => SampledDim::D3,
-            "cube" => SampledDim::Cube,
-            other => {
-                return Err(at(format!("dimension = \"{other}\" is not valid; expected 1d|2d|2d-array|3d|cube")));
-            }
-        }),
+        Some(d) => Some(
+            Dimension::parse(&d)
+                .ok_or_else(|| at(format!("dimension = \"{d}\" is not valid; expected {}", Dimension::NAMES)))?,
+        ),
     };
     if let Some(f) = &file
         && !(f.ends_with(".png") || f.ends_with(".exr"))
@@ -397,12 +376,7 @@ fn texture_kind(
     let size = match t.get("size") {
         None => None,
         Some(toml::Value::Array(list)) => {
-            let want = match dimension.unwrap_or(SampledDim::D2) {
-                SampledDim::D1 => 1,
-                SampledDim::D2 => 2,
-                SampledDim::Cube => 1,
-                _ => 3,
-            };
+            let want = dimension.unwrap_or(Dimension::D2).size_entries();
             if list.len() != want {
                 return Err(at(format!("size has {} entries; this texture takes {want}", list.len())));
             }
@@ -791,7 +765,7 @@ pub enum Usage {
     /// A sampled texture.
     Sampled {
         /// The binding's dimension.
-        dim: SampledDim,
+        dim: Dimension,
         /// What sampling it returns.
         kind: SampledKind,
     },
@@ -866,33 +840,13 @@ pub struct ResolvedResource {
     /// file's (decided when the file is read: `None` here).
     pub format: Option<&'static str>,
     /// A texture's dimension: its own, else its bindings'.
-    pub dimension: Option<SampledDim>,
+    pub dimension: Option<Dimension>,
     /// A buffer's element (from its first storage or uniform binding).
     pub element: Option<Element>,
     /// Some pass writes it (a write or read_write storage binding).
     pub written: bool,
     /// Some pass reads it (sampled, read, read_write, storage read).
     pub read: bool,
-}
-
-fn storage_dim(d: Dimension) -> SampledDim {
-    match d {
-        Dimension::D1 => SampledDim::D1,
-        Dimension::D2 => SampledDim::D2,
-        Dimension::D2Array => SampledDim::D2Array,
-        Dimension::D3 => SampledDim::D3,
-    }
-}
-
-/// The manifest's name of a dimension: `1d`, `2d`, `2d-array`, `3d` or `cube`.
-pub fn dim_name(d: SampledDim) -> &'static str {
-    match d {
-        SampledDim::D1 => "1d",
-        SampledDim::D2 => "2d",
-        SampledDim::D2Array => "2d-array",
-        SampledDim::D3 => "3d",
-        SampledDim::Cube => "cube",
-    }
 }
 
 /// Checks every pass's reflected bindings against the graph and says what
@@ -1037,17 +991,17 @@ pub fn resolve(
                         }
                         _ => r.format = Some(storage.format),
                     }
-                    let dim = storage_dim(storage.dimension);
+                    let dim = storage.dimension;
                     match r.dimension {
                         // A cube's six faces are written through a 2d-array view.
-                        Some(SampledDim::Cube) if dim == SampledDim::D2Array => {}
+                        Some(Dimension::Cube) if dim == Dimension::D2Array => {}
                         Some(d) if d != dim => {
                             return Err(bad(format!(
                                 "{label}: resource {} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
                                 r.spec.name,
-                                dim_name(d),
+                                d.name(),
                                 describe(b),
-                                dim_name(dim)
+                                dim.name()
                             )));
                         }
                         _ => r.dimension = Some(dim),
@@ -1074,13 +1028,13 @@ pub fn resolve(
                     let r = &mut resources[ri];
                     match r.dimension {
                         // Six layers sampled as a cube, or a cube read as its 2d-array of faces.
-                        Some(SampledDim::Cube) if dim == SampledDim::D2Array => {}
-                        Some(d) if d != dim && !(d == SampledDim::D2Array && dim == SampledDim::Cube) => {
+                        Some(Dimension::Cube) if dim == Dimension::D2Array => {}
+                        Some(d) if d != dim && !(d == Dimension::D2Array && dim == Dimension::Cube) => {
                             return Err(bad(format!(
                                 "{label}: resource {rn} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
-                                dim_name(d),
+                                d.name(),
                                 describe(b),
-                                dim_name(dim)
+                                dim.name()
                             )));
                         }
                         _ => r.dimension = Some(dim),

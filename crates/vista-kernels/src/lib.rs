@@ -291,7 +291,7 @@ pub fn normalized(raw: &Image, channels: u8) -> Image {
 /// Whether a storage format holds integers (compared exactly, shown
 /// normalised by default).
 pub fn is_integer_format(format: &str) -> bool {
-    format.ends_with("uint") || format.ends_with("sint")
+    vista_texel::Format::parse(format).is_ok_and(|f| f.is_integer())
 }
 
 /// One kernel: its manifest, where it came from, and its CPU reference if

@@ -8,63 +8,12 @@ use crate::bindings::{Binding, Feed};
 use crate::expr::Expr;
 use crate::{ParamError, ParamSet};
 
-/// A storage texture's dimension, as the manifest spells it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Dimension {
-    /// `1d` (`texture_storage_1d`).
-    D1,
-    /// `2d` (`texture_storage_2d`).
-    D2,
-    /// `2d-array` (`texture_storage_2d_array`).
-    D2Array,
-    /// `3d` (`texture_storage_3d`).
-    D3,
-}
-
-impl Dimension {
-    /// The names [`Dimension::parse`] accepts, for messages.
-    pub const NAMES: &'static str = "1d|2d|2d-array|3d";
-
-    /// The manifest's name: `1d`, `2d`, `2d-array` or `3d`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Dimension::D1 => "1d",
-            Dimension::D2 => "2d",
-            Dimension::D2Array => "2d-array",
-            Dimension::D3 => "3d",
-        }
-    }
-
-    /// The dimension the manifest names, or `None` for any other text.
-    pub fn parse(text: &str) -> Option<Dimension> {
-        [Dimension::D1, Dimension::D2, Dimension::D2Array, Dimension::D3].into_iter().find(|d| d.name() == text)
-    }
-
-    /// Entries of a `size` for this dimension.
-    fn size_entries(self) -> usize {
-        match self {
-            Dimension::D1 => 1,
-            Dimension::D2 => 2,
-            _ => 3,
-        }
-    }
-}
-
-/// How the pass may use a storage texture.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Access {
-    /// Write-only (`write`).
-    Write,
-    /// Read-only (an input of a pass graph).
-    Read,
-    /// Read and written (`read_write`).
-    ReadWrite,
-}
+pub use vista_texel::{Access, Dimension};
 
 /// A storage texture binding as WGSL declares it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Storage {
-    /// Its texel format, one of [`crate::bindings::STORAGE_FORMATS`].
+    /// Its texel format, one of [`vista_texel::format_names`].
     pub format: &'static str,
     /// Its dimension.
     pub dimension: Dimension,
@@ -171,10 +120,9 @@ pub(crate) fn parse(
                     "dimension = \"cube\" is a sampled input, not supported yet; an output is 1d|2d|2d-array|3d".into(),
                 ));
             }
-            Some(d) => Some(
-                Dimension::parse(&d)
-                    .ok_or_else(|| at(format!("dimension = \"{d}\" is not valid; expected {}", Dimension::NAMES)))?,
-            ),
+            Some(d) => Some(Dimension::parse(&d).ok_or_else(|| {
+                at(format!("dimension = \"{d}\" is not valid; expected {}", Dimension::STORAGE_NAMES))
+            })?),
         };
         let size = match t.get("size") {
             None => None,

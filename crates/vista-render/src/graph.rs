@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 
 use vista_gpu::{Bind, Contents, GraphSlot};
 use vista_image::Image;
-use vista_kernels::graph::{Element, ResourceKind, SampledDim, SlotFeed, Tolerance, Usage};
+use vista_kernels::graph::{Element, ResourceKind, SlotFeed, Tolerance, Usage};
 use vista_kernels::{DisplayMap, Kernel, ParamSet};
+use vista_texel::Dimension;
 
 use crate::error::RenderError;
 
@@ -137,16 +138,10 @@ pub(crate) fn plan_graph(
             ResourceKind::Texture { size, file, .. } => {
                 let file = inputs.iter().find(|(n, _)| *n == r.spec.name).map(|(_, f)| f.clone()).or(file.clone());
                 let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
-                let dim = r.dimension.unwrap_or(SampledDim::D2);
-                let dimension = match dim {
-                    SampledDim::D1 => vista_gpu::Dimension::D1,
-                    SampledDim::D2 => vista_gpu::Dimension::D2,
-                    SampledDim::D2Array => vista_gpu::Dimension::D2Array,
-                    SampledDim::D3 => vista_gpu::Dimension::D3,
-                    // Six square layers: written through a 2d-array view, sampled through a cube view.
-                    SampledDim::Cube => vista_gpu::Dimension::D2Array,
-                };
-                let cube = dim == SampledDim::Cube;
+                let dim = r.dimension.unwrap_or(Dimension::D2);
+                // Six square layers: written through a 2d-array view, sampled through a cube view.
+                let dimension = dim.stored();
+                let cube = dim == Dimension::Cube;
                 let mut extent = match size {
                     Some(exprs) => {
                         let mut v = [1u32; 3];
@@ -197,7 +192,7 @@ pub(crate) fn plan_graph(
                             return Err(at(format!("file {f} holds NaN/Inf at ({x}, {y}); inputs must be finite")));
                         }
                         let format = r.format.unwrap_or(natural);
-                        let out = vista_gpu::OutputFormat::parse(format).map_err(|e| at(e.to_string()))?;
+                        let out = vista_texel::Format::parse(format).map_err(at)?;
                         let bytes: Vec<u8> = image.data.iter().flat_map(|px| out.encode(*px)).collect();
                         (format, Contents::Bytes(bytes))
                     }
@@ -211,9 +206,9 @@ pub(crate) fn plan_graph(
                 };
                 let [w, h, l] = match (extent, dim) {
                     (Some(e), _) => e,
-                    (None, SampledDim::D1) => [width, 1, 1],
-                    (None, SampledDim::Cube) if width == height => [width, width, 6],
-                    (None, SampledDim::Cube) => {
+                    (None, Dimension::D1) => [width, 1, 1],
+                    (None, Dimension::Cube) if width == height => [width, width, 6],
+                    (None, Dimension::Cube) => {
                         return Err(at(format!(
                             "a cube's faces are square but the case is {width}x{height}; give size = [N]"
                         )));
@@ -305,18 +300,11 @@ pub(crate) fn plan_graph(
                 SlotFeed::Resource(r, usage) => match usage {
                     Usage::UniformBuffer => Bind::UniformBuffer(*r),
                     Usage::StorageBuffer { read_only } => Bind::Storage { resource: *r, read_only: *read_only },
-                    Usage::StorageTexture(st) => Bind::StorageTexture {
-                        resource: *r,
-                        access: match st.access {
-                            vista_kernels::resources::Access::Write => vista_gpu::Access::Write,
-                            vista_kernels::resources::Access::Read => vista_gpu::Access::Read,
-                            vista_kernels::resources::Access::ReadWrite => vista_gpu::Access::ReadWrite,
-                        },
-                    },
+                    Usage::StorageTexture(st) => Bind::StorageTexture { resource: *r, access: st.access },
                     Usage::Sampled { kind, dim } => Bind::Sampled {
                         resource: *r,
                         depth: *kind == vista_kernels::graph::SampledKind::Depth,
-                        cube: *dim == SampledDim::Cube,
+                        cube: *dim == Dimension::Cube,
                     },
                     Usage::Sampler { .. } => Bind::Sampler(*r),
                 },
@@ -352,7 +340,7 @@ pub(crate) fn plan_graph(
                             .iter()
                             .filter_map(|s| match s.feed {
                                 SlotFeed::Resource(r, Usage::StorageTexture(st))
-                                    if st.access != vista_kernels::resources::Access::Read =>
+                                    if st.access != vista_texel::Access::Read =>
                                 {
                                     Some(r)
                                 }

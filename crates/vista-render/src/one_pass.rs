@@ -34,8 +34,7 @@ pub(crate) fn plan(
     let target = layout.output.as_ref().expect("Kernel::layout resolves the output");
     let format = target.storage.format;
     let extent = target.extent(kernel.name(), p, width, height).map_err(|e| RenderError::BadInput(e.to_string()))?;
-    use vista_kernels::resources::Access;
-    let read_write = target.storage.access == Access::ReadWrite;
+    let read_write = target.storage.access == vista_texel::Access::ReadWrite;
     let uniforms = kernel.uniforms(&layout, p, width, height);
     let table = kernel.table(&layout, p);
     use vista_kernels::bindings::Feed;
@@ -57,7 +56,7 @@ pub(crate) fn plan(
                 Feed::Table => Bind::Table(table.clone()),
                 Feed::Output(_) => Bind::StorageTexture {
                     resource: 0,
-                    access: if read_write { vista_gpu::Access::ReadWrite } else { vista_gpu::Access::Write },
+                    access: if read_write { vista_texel::Access::ReadWrite } else { vista_texel::Access::Write },
                 },
                 _ => unreachable!("bindings::reflect refuses the graph feeds"),
             },
@@ -73,16 +72,9 @@ pub(crate) fn plan(
             extent.layers.div_ceil(workgroup_size[2]),
         ],
     };
-    use vista_kernels::resources::Dimension;
-    let dimension = match target.storage.dimension {
-        Dimension::D1 => vista_gpu::Dimension::D1,
-        Dimension::D2 => vista_gpu::Dimension::D2,
-        Dimension::D2Array => vista_gpu::Dimension::D2Array,
-        Dimension::D3 => vista_gpu::Dimension::D3,
-    };
     let texture = vista_gpu::TextureDesc {
         format,
-        dimension,
+        dimension: target.storage.dimension,
         width: extent.width,
         height: extent.height,
         layers: extent.layers,
