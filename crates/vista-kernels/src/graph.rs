@@ -908,15 +908,6 @@ pub fn resolve(
                 .map(|(_, r)| r.clone())
                 .or_else(|| graph.resources.iter().find(|r| r.name == b.name).map(|r| r.name.clone()));
             let bound = bound.as_deref();
-            // The resource bound here must be of `kind`.
-            let needs = |resources: &[ResolvedResource], ri: usize, kind: &str| match kind_of(resources, ri) {
-                k if k == kind => Ok(()),
-                k => Err(bad(format!(
-                    "{label}: {} is bound to {}, a {k}; it needs a {kind}",
-                    describe(b),
-                    resources[ri].spec.name
-                ))),
-            };
             let feed = match (b.feed, bound) {
                 (Feed::Uniform, None) => {
                     blocks += 1;
@@ -924,13 +915,13 @@ pub fn resolve(
                 }
                 (Feed::Uniform, Some(r)) => {
                     let ri = find(&resources, r);
-                    needs(&resources, ri, "buffer")?;
+                    needs_kind(&resources, ri, "buffer", &label, &describe(b), &bad)?;
                     SlotFeed::Resource(ri, Usage::UniformBuffer)
                 }
                 (Feed::Table, None) => SlotFeed::Table,
                 (Feed::Table | Feed::Buffer { .. }, Some(r)) => {
                     let ri = find(&resources, r);
-                    needs(&resources, ri, "buffer")?;
+                    needs_kind(&resources, ri, "buffer", &label, &describe(b), &bad)?;
                     let read_only = match b.feed {
                         Feed::Buffer { read_only } => read_only,
                         _ => true,
@@ -944,103 +935,10 @@ pub fn resolve(
                     )));
                 }
                 (Feed::Output(storage) | Feed::StorageRead(storage), bound) => {
-                    let ri = match bound {
-                        Some(r) => find(&resources, r),
-                        None if storage.access == Access::Write => {
-                            // Implicit: one resource per unbound written variable.
-                            match resources.iter().position(|r| r.spec.name == b.name) {
-                                Some(ri) => ri,
-                                None => {
-                                    resources.push(ResolvedResource {
-                                        spec: ResourceSpec {
-                                            name: b.name.clone(),
-                                            kind: ResourceKind::Texture {
-                                                format: None,
-                                                dimension: None,
-                                                size: None,
-                                                file: None,
-                                            },
-                                        },
-                                        format: None,
-                                        dimension: None,
-                                        element: None,
-                                        written: false,
-                                        read: false,
-                                    });
-                                    resources.len() - 1
-                                }
-                            }
-                        }
-                        None => {
-                            return Err(bad(format!(
-                                "{label}: {} is fed by nothing; it needs a texture resource ([[resource]] kind = \"texture\", named in this pass's bind)",
-                                describe(b)
-                            )));
-                        }
-                    };
-                    needs(&resources, ri, "texture")?;
-                    let r = &mut resources[ri];
-                    match r.format {
-                        Some(f) if f != storage.format => {
-                            return Err(bad(format!(
-                                "{label}: resource {} has format {f} but is bound to {}; would fit: format = \"{}\"",
-                                r.spec.name,
-                                describe(b),
-                                storage.format
-                            )));
-                        }
-                        _ => r.format = Some(storage.format),
-                    }
-                    let dim = storage.dimension;
-                    match r.dimension {
-                        // A cube's six faces are written through a 2d-array view.
-                        Some(Dimension::Cube) if dim == Dimension::D2Array => {}
-                        Some(d) if d != dim => {
-                            return Err(bad(format!(
-                                "{label}: resource {} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
-                                r.spec.name,
-                                d.name(),
-                                describe(b),
-                                dim.name()
-                            )));
-                        }
-                        _ => r.dimension = Some(dim),
-                    }
-                    match storage.access {
-                        Access::Write => r.written = true,
-                        Access::Read => r.read = true,
-                        Access::ReadWrite => {
-                            r.written = true;
-                            r.read = true;
-                        }
-                    }
-                    SlotFeed::Resource(ri, Usage::StorageTexture(storage))
+                    storage_slot(&mut resources, storage, bound, b, &label, &describe(b), &bad)?
                 }
                 (Feed::Sampled { dim, kind }, bound) => {
-                    let Some(rn) = bound else {
-                        return Err(bad(format!(
-                            "{label}: {} is fed by nothing; it needs a texture resource ([[resource]] kind = \"texture\" with a file or written by an earlier pass, named in this pass's bind)",
-                            describe(b)
-                        )));
-                    };
-                    let ri = find(&resources, rn);
-                    needs(&resources, ri, "texture")?;
-                    let r = &mut resources[ri];
-                    match r.dimension {
-                        // Six layers sampled as a cube, or a cube read as its 2d-array of faces.
-                        Some(Dimension::Cube) if dim == Dimension::D2Array => {}
-                        Some(d) if d != dim && !(d == Dimension::D2Array && dim == Dimension::Cube) => {
-                            return Err(bad(format!(
-                                "{label}: resource {rn} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
-                                d.name(),
-                                describe(b),
-                                dim.name()
-                            )));
-                        }
-                        _ => r.dimension = Some(dim),
-                    }
-                    r.read = true;
-                    SlotFeed::Resource(ri, Usage::Sampled { dim, kind })
+                    sampled_slot(&mut resources, dim, kind, bound, &label, &describe(b), &bad)?
                 }
                 (Feed::Sampler { comparison }, bound) => {
                     let Some(rn) = bound else {
@@ -1050,7 +948,7 @@ pub fn resolve(
                         )));
                     };
                     let ri = find(&resources, rn);
-                    needs(&resources, ri, "sampler")?;
+                    needs_kind(&resources, ri, "sampler", &label, &describe(b), &bad)?;
                     if let ResourceKind::Sampler { compare, .. } = &resources[ri].spec.kind
                         && compare.is_some() != comparison
                     {
@@ -1098,6 +996,150 @@ pub fn resolve(
         }
         all_slots.push(slots);
     }
+    check_swaps_and_outputs(graph, &resources, &bad)?;
+    Ok(Resolved { resources, slots: all_slots })
+}
+
+/// A storage texture binding's feed: the resource bound to it (an unbound
+/// written variable gets an implicit texture of its own name), whose format
+/// and dimension it fixes and which it marks written or read.
+fn storage_slot(
+    resources: &mut Vec<ResolvedResource>,
+    storage: Storage,
+    bound: Option<&str>,
+    b: &Binding,
+    label: &str,
+    described: &str,
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<SlotFeed, ParamError> {
+    let ri = match bound {
+        Some(r) => find(resources, r),
+        None if storage.access == Access::Write => {
+            // Implicit: one resource per unbound written variable.
+            match resources.iter().position(|r| r.spec.name == b.name) {
+                Some(ri) => ri,
+                None => {
+                    resources.push(ResolvedResource {
+                        spec: ResourceSpec {
+                            name: b.name.clone(),
+                            kind: ResourceKind::Texture { format: None, dimension: None, size: None, file: None },
+                        },
+                        format: None,
+                        dimension: None,
+                        element: None,
+                        written: false,
+                        read: false,
+                    });
+                    resources.len() - 1
+                }
+            }
+        }
+        None => {
+            return Err(bad(format!(
+                "{label}: {} is fed by nothing; it needs a texture resource ([[resource]] kind = \"texture\", named in this pass's bind)",
+                described
+            )));
+        }
+    };
+    needs_kind(resources, ri, "texture", label, described, bad)?;
+    let r = &mut resources[ri];
+    match r.format {
+        Some(f) if f != storage.format => {
+            return Err(bad(format!(
+                "{label}: resource {} has format {f} but is bound to {}; would fit: format = \"{}\"",
+                r.spec.name, described, storage.format
+            )));
+        }
+        _ => r.format = Some(storage.format),
+    }
+    let dim = storage.dimension;
+    match r.dimension {
+        // A cube's six faces are written through a 2d-array view.
+        Some(Dimension::Cube) if dim == Dimension::D2Array => {}
+        Some(d) if d != dim => {
+            return Err(bad(format!(
+                "{label}: resource {} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
+                r.spec.name,
+                d.name(),
+                described,
+                dim.name()
+            )));
+        }
+        _ => r.dimension = Some(dim),
+    }
+    match storage.access {
+        Access::Write => r.written = true,
+        Access::Read => r.read = true,
+        Access::ReadWrite => {
+            r.written = true;
+            r.read = true;
+        }
+    }
+    Ok(SlotFeed::Resource(ri, Usage::StorageTexture(storage)))
+}
+
+/// A sampled texture binding's feed: the resource bound to it, whose
+/// dimension it fixes (a cube and its 2d-array of faces agree) and which
+/// it marks read.
+fn sampled_slot(
+    resources: &mut [ResolvedResource],
+    dim: Dimension,
+    kind: SampledKind,
+    bound: Option<&str>,
+    label: &str,
+    described: &str,
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<SlotFeed, ParamError> {
+    let Some(rn) = bound else {
+        return Err(bad(format!(
+            "{label}: {} is fed by nothing; it needs a texture resource ([[resource]] kind = \"texture\" with a file or written by an earlier pass, named in this pass's bind)",
+            described
+        )));
+    };
+    let ri = find(resources, rn);
+    needs_kind(resources, ri, "texture", label, described, bad)?;
+    let r = &mut resources[ri];
+    match r.dimension {
+        // Six layers sampled as a cube, or a cube read as its 2d-array of faces.
+        Some(Dimension::Cube) if dim == Dimension::D2Array => {}
+        Some(d) if d != dim && !(d == Dimension::D2Array && dim == Dimension::Cube) => {
+            return Err(bad(format!(
+                "{label}: resource {rn} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
+                d.name(),
+                described,
+                dim.name()
+            )));
+        }
+        _ => r.dimension = Some(dim),
+    }
+    r.read = true;
+    Ok(SlotFeed::Resource(ri, Usage::Sampled { dim, kind }))
+}
+
+/// Resource `ri` is of `kind`, or the error naming the binding.
+fn needs_kind(
+    resources: &[ResolvedResource],
+    ri: usize,
+    kind: &str,
+    label: &str,
+    described: &str,
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<(), ParamError> {
+    match kind_of(resources, ri) {
+        k if k == kind => Ok(()),
+        k => {
+            Err(bad(format!("{label}: {described} is bound to {}, a {k}; it needs a {kind}", resources[ri].spec.name)))
+        }
+    }
+}
+
+/// Swapped resources are alike; every output names a resource some pass
+/// writes (or swaps).
+fn check_swaps_and_outputs(
+    graph: &GraphSpec,
+    resources: &[ResolvedResource],
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<(), ParamError> {
     for (i, pass) in graph.passes.iter().enumerate() {
         for (a, b) in &pass.swap {
             let (ra, rb) = (
@@ -1131,7 +1173,7 @@ pub fn resolve(
             )));
         }
     }
-    Ok(Resolved { resources, slots: all_slots })
+    Ok(())
 }
 
 fn find(resources: &[ResolvedResource], name: &str) -> usize {

@@ -131,162 +131,241 @@ pub(crate) fn plan_graph(
             .map(|r| vec![r.spec.name.clone()])
             .ok_or_else(|| bad("no pass writes a texture; name the outputs in [[output]] tables".into()))?,
     };
-    let mut resources = Vec::new();
-    for r in &resolved.resources {
-        let is_output = outputs_named.contains(&r.spec.name);
-        resources.push(match &r.spec.kind {
+    let at = Planning { root, kernel, p, inputs, width, height };
+    let resources = resolved
+        .resources
+        .iter()
+        .map(|r| match &r.spec.kind {
             ResourceKind::Texture { size, file, .. } => {
-                let file = inputs.iter().find(|(n, _)| *n == r.spec.name).map(|(_, f)| f.clone()).or(file.clone());
-                let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
-                let dim = r.dimension.unwrap_or(Dimension::D2);
-                // Six square layers: written through a 2d-array view, sampled through a cube view.
-                let dimension = dim.stored();
-                let cube = dim == Dimension::Cube;
-                let mut extent = match size {
-                    Some(exprs) => {
-                        let mut v = [1u32; 3];
-                        for (i, e) in exprs.iter().enumerate() {
-                            let n = e.eval(p, width, height).map_err(|m| at(format!("size[{i}] {m}")))?;
-                            v[i] = u32::try_from(n)
-                                .ok()
-                                .filter(|n| (1..=16384).contains(n))
-                                .ok_or_else(|| at(format!("size[{i}] is {n} for these params; allowed: [1, 16384]")))?;
-                        }
-                        // A cube's size is its face's edge.
-                        Some(if cube { [v[0], v[0], 6] } else { v })
-                    }
-                    None => None,
-                };
-                let (format, contents) = match &file {
-                    Some(f) => {
-                        let (natural, image) = read_texture(root, f).map_err(at)?;
-                        let layers = extent.map(|e| e[2]).unwrap_or(1);
-                        let want_h = extent.map(|e| e[1] * layers);
-                        if let Some(e) = extent
-                            && (image.width != e[0] || Some(image.height) != want_h)
-                        {
-                            return Err(at(format!(
-                                "file {f} is {}x{} but size says {}x{}{}",
-                                image.width,
-                                image.height,
-                                e[0],
-                                e[1],
-                                if layers > 1 {
-                                    format!(" x {layers} layers stacked ({}x{})", e[0], e[1] * layers)
-                                } else {
-                                    String::new()
-                                }
-                            )));
-                        }
-                        if cube && extent.is_none() {
-                            if image.height != 6 * image.width {
-                                return Err(at(format!(
-                                    "file {f} is {}x{}; a cube's six square faces stack to W x 6W (or give size = [W])",
-                                    image.width, image.height
-                                )));
-                            }
-                            extent = Some([image.width, image.width, 6]);
-                        }
-                        extent.get_or_insert([image.width, image.height, 1]);
-                        if let Some((x, y)) = image.first_nonfinite() {
-                            return Err(at(format!("file {f} holds NaN/Inf at ({x}, {y}); inputs must be finite")));
-                        }
-                        let format = r.format.unwrap_or(natural);
-                        let out = vista_texel::Format::parse(format).map_err(at)?;
-                        let bytes: Vec<u8> = image.data.iter().flat_map(|px| out.encode(*px)).collect();
-                        (format, Contents::Bytes(bytes))
-                    }
-                    None => {
-                        let format = r.format.ok_or_else(|| {
-                            at("needs format = \"...\" (no file gives one and no storage binding declares one)".into())
-                        })?;
-                        let contents = if is_output && !r.read { Contents::Sentinel } else { Contents::Zeros };
-                        (format, contents)
-                    }
-                };
-                let [w, h, l] = match (extent, dim) {
-                    (Some(e), _) => e,
-                    (None, Dimension::D1) => [width, 1, 1],
-                    (None, Dimension::Cube) if width == height => [width, width, 6],
-                    (None, Dimension::Cube) => {
-                        return Err(at(format!(
-                            "a cube's faces are square but the case is {width}x{height}; give size = [N]"
-                        )));
-                    }
-                    (None, _) => [width, height, 1],
-                };
-                vista_gpu::Resource::Texture(vista_gpu::TextureDesc {
-                    format,
-                    dimension,
-                    width: w,
-                    height: h,
-                    layers: l,
-                    contents,
-                })
+                at.texture(r, size.as_deref(), file.as_ref(), outputs_named.contains(&r.spec.name))
             }
             ResourceKind::Buffer { file, data, fill, length } => {
-                let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
-                let Some(e) = &r.element else {
-                    return Err(at("no pass binds this buffer".into()));
-                };
-                let file = inputs.iter().find(|(n, _)| *n == r.spec.name).map(|(_, f)| f.clone()).or(file.clone());
-                let count = |n: i64| -> Result<u64, RenderError> {
-                    u64::try_from(n)
-                        .ok()
-                        .filter(|n| (1..=1 << 28).contains(n))
-                        .ok_or_else(|| at(format!("length is {n}; allowed: [1, 268435456]")))
-                };
-                let body = match (&file, data, fill, length) {
-                    (Some(f), ..) => read_buffer(root, f, e).map_err(at)?,
-                    (None, Some(values), ..) => encode_values(values, e).map_err(at)?,
-                    (None, None, fill, len) => {
-                        let n = match (len, e.fixed) {
-                            (Some(l), _) => count(l.eval(p, width, height).map_err(|m| at(format!("length {m}")))?)?,
-                            (None, Some(n)) => n as u64,
-                            (None, None) => {
-                                return Err(at(format!(
-                                    "{} is runtime-sized: give it length = N (with fill), data or a file",
-                                    e.wgsl
-                                )));
-                            }
-                        };
-                        let v = fill.unwrap_or(0.0);
-                        encode_values(&vec![v; (n * e.leaves.len() as u64) as usize], e).map_err(at)?
-                    }
-                };
-                let mut bytes = vec![0u8; e.header as usize];
-                bytes.extend(body);
-                if let Some(n) = e.fixed {
-                    let want = e.header as u64 + n as u64 * e.stride as u64;
-                    if bytes.len() as u64 != want {
-                        return Err(at(format!(
-                            "holds {} elements but {} is fixed at {n}",
-                            (bytes.len() as u64 - e.header as u64) / e.stride as u64,
-                            e.wgsl
-                        )));
-                    }
-                }
-                vista_gpu::Resource::Buffer(bytes)
+                at.buffer(r, file.as_ref(), data.as_deref(), *fill, length.as_ref())
             }
             ResourceKind::Sampler { linear, address, compare } => {
                 let a = |s: &str| vista_gpu::Address::parse(s).expect("manifest checks address modes");
-                vista_gpu::Resource::Sampler(vista_gpu::SamplerDesc {
+                Ok(vista_gpu::Resource::Sampler(vista_gpu::SamplerDesc {
                     linear: *linear,
                     address: [a(address[0]), a(address[1]), a(address[2])],
                     compare: *compare,
-                })
+                }))
             }
-        });
-    }
-    let index = |name: &str| resolved.resources.iter().position(|r| r.spec.name == name).expect("resolved");
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let mut passes = Vec::new();
     for (i, ((pass, slots), layout)) in g.passes.iter().zip(&resolved.slots).zip(&layouts).enumerate() {
-        let label = format!("pass {} ({}, {})", i + 1, pass.entry, files[i]);
+        passes.push(at.pass(i, pass, slots, layout, &modules[i], &files[i], &resources, &resolved)?);
+    }
+    let (outputs, output_ids) = at.outputs(&outputs_named, &resources, &resolved);
+    Ok(Plan {
+        kernel: kernel.name().to_string(),
+        resources,
+        passes,
+        output_ids,
+        outputs,
+        deterministic: g.deterministic,
+        shaders: files,
+    })
+}
+
+/// What planning each resource, pass and output of one graph reads.
+struct Planning<'a> {
+    root: Option<&'a Path>,
+    kernel: &'a Kernel,
+    p: &'a ParamSet,
+    inputs: &'a Inputs,
+    width: u32,
+    height: u32,
+}
+
+impl Planning<'_> {
+    fn bad(&self, m: String) -> RenderError {
+        RenderError::BadInput(format!("kernel {}: {m}", self.kernel.name()))
+    }
+
+    /// The file a case's `inputs` give resource `name`, else its own.
+    fn file_of(&self, name: &str, own: Option<&String>) -> Option<String> {
+        self.inputs.iter().find(|(n, _)| n == name).map(|(_, f)| f.clone()).or(own.cloned())
+    }
+
+    /// A texture resource: its size (its `size`, its file's, else the
+    /// case's), format and contents (its file's texels, the sentinel for
+    /// an output no pass reads, else zeros).
+    fn texture(
+        &self,
+        r: &vista_kernels::graph::ResolvedResource,
+        size: Option<&[vista_kernels::expr::Expr]>,
+        file: Option<&String>,
+        is_output: bool,
+    ) -> Result<vista_gpu::Resource, RenderError> {
+        let (root, p, width, height) = (self.root, self.p, self.width, self.height);
+        let bad = |m: String| self.bad(m);
+        let file = self.file_of(&r.spec.name, file);
+        let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
+        let dim = r.dimension.unwrap_or(Dimension::D2);
+        // Six square layers: written through a 2d-array view, sampled through a cube view.
+        let dimension = dim.stored();
+        let cube = dim == Dimension::Cube;
+        let mut extent = match size {
+            Some(exprs) => {
+                let mut v = [1u32; 3];
+                for (i, e) in exprs.iter().enumerate() {
+                    let n = e.eval(p, width, height).map_err(|m| at(format!("size[{i}] {m}")))?;
+                    v[i] = u32::try_from(n)
+                        .ok()
+                        .filter(|n| (1..=16384).contains(n))
+                        .ok_or_else(|| at(format!("size[{i}] is {n} for these params; allowed: [1, 16384]")))?;
+                }
+                // A cube's size is its face's edge.
+                Some(if cube { [v[0], v[0], 6] } else { v })
+            }
+            None => None,
+        };
+        let (format, contents) = match &file {
+            Some(f) => {
+                let (natural, image) = read_texture(root, f).map_err(at)?;
+                let layers = extent.map(|e| e[2]).unwrap_or(1);
+                let want_h = extent.map(|e| e[1] * layers);
+                if let Some(e) = extent
+                    && (image.width != e[0] || Some(image.height) != want_h)
+                {
+                    return Err(at(format!(
+                        "file {f} is {}x{} but size says {}x{}{}",
+                        image.width,
+                        image.height,
+                        e[0],
+                        e[1],
+                        if layers > 1 {
+                            format!(" x {layers} layers stacked ({}x{})", e[0], e[1] * layers)
+                        } else {
+                            String::new()
+                        }
+                    )));
+                }
+                if cube && extent.is_none() {
+                    if image.height != 6 * image.width {
+                        return Err(at(format!(
+                            "file {f} is {}x{}; a cube's six square faces stack to W x 6W (or give size = [W])",
+                            image.width, image.height
+                        )));
+                    }
+                    extent = Some([image.width, image.width, 6]);
+                }
+                extent.get_or_insert([image.width, image.height, 1]);
+                if let Some((x, y)) = image.first_nonfinite() {
+                    return Err(at(format!("file {f} holds NaN/Inf at ({x}, {y}); inputs must be finite")));
+                }
+                let format = r.format.unwrap_or(natural);
+                let out = vista_texel::Format::parse(format).map_err(at)?;
+                let bytes: Vec<u8> = image.data.iter().flat_map(|px| out.encode(*px)).collect();
+                (format, Contents::Bytes(bytes))
+            }
+            None => {
+                let format = r.format.ok_or_else(|| {
+                    at("needs format = \"...\" (no file gives one and no storage binding declares one)".into())
+                })?;
+                let contents = if is_output && !r.read { Contents::Sentinel } else { Contents::Zeros };
+                (format, contents)
+            }
+        };
+        let [w, h, l] = match (extent, dim) {
+            (Some(e), _) => e,
+            (None, Dimension::D1) => [width, 1, 1],
+            (None, Dimension::Cube) if width == height => [width, width, 6],
+            (None, Dimension::Cube) => {
+                return Err(at(format!("a cube's faces are square but the case is {width}x{height}; give size = [N]")));
+            }
+            (None, _) => [width, height, 1],
+        };
+        Ok(vista_gpu::Resource::Texture(vista_gpu::TextureDesc {
+            format,
+            dimension,
+            width: w,
+            height: h,
+            layers: l,
+            contents,
+        }))
+    }
+
+    /// A buffer resource: its header and elements from a file, inline
+    /// `data`, or `length` copies of `fill`.
+    fn buffer(
+        &self,
+        r: &vista_kernels::graph::ResolvedResource,
+        file: Option<&String>,
+        data: Option<&[f64]>,
+        fill: Option<f64>,
+        length: Option<&vista_kernels::expr::Expr>,
+    ) -> Result<vista_gpu::Resource, RenderError> {
+        let (root, p, width, height) = (self.root, self.p, self.width, self.height);
+        let bad = |m: String| self.bad(m);
+        let file = self.file_of(&r.spec.name, file);
+        let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
+        let Some(e) = &r.element else {
+            return Err(at("no pass binds this buffer".into()));
+        };
+        let count = |n: i64| -> Result<u64, RenderError> {
+            u64::try_from(n)
+                .ok()
+                .filter(|n| (1..=1 << 28).contains(n))
+                .ok_or_else(|| at(format!("length is {n}; allowed: [1, 268435456]")))
+        };
+        let body = match (&file, data, fill, length) {
+            (Some(f), ..) => read_buffer(root, f, e).map_err(at)?,
+            (None, Some(values), ..) => encode_values(values, e).map_err(at)?,
+            (None, None, fill, len) => {
+                let n = match (len, e.fixed) {
+                    (Some(l), _) => count(l.eval(p, width, height).map_err(|m| at(format!("length {m}")))?)?,
+                    (None, Some(n)) => n as u64,
+                    (None, None) => {
+                        return Err(at(format!(
+                            "{} is runtime-sized: give it length = N (with fill), data or a file",
+                            e.wgsl
+                        )));
+                    }
+                };
+                let v = fill.unwrap_or(0.0);
+                encode_values(&vec![v; (n * e.leaves.len() as u64) as usize], e).map_err(at)?
+            }
+        };
+        let mut bytes = vec![0u8; e.header as usize];
+        bytes.extend(body);
+        if let Some(n) = e.fixed {
+            let want = e.header as u64 + n as u64 * e.stride as u64;
+            if bytes.len() as u64 != want {
+                return Err(at(format!(
+                    "holds {} elements but {} is fixed at {n}",
+                    (bytes.len() as u64 - e.header as u64) / e.stride as u64,
+                    e.wgsl
+                )));
+            }
+        }
+        Ok(vista_gpu::Resource::Buffer(bytes))
+    }
+
+    /// Pass `i`: its constants, workgroup size and count, bindings (its
+    /// own uniform blocks and table, or resources), repeats and swaps.
+    #[allow(clippy::too_many_arguments)]
+    fn pass(
+        &self,
+        i: usize,
+        pass: &vista_kernels::graph::PassSpec,
+        slots: &[vista_kernels::graph::PassSlot],
+        layout: &vista_kernels::UniformLayout,
+        module: &naga::Module,
+        file: &str,
+        resources: &[vista_gpu::Resource],
+        resolved: &vista_kernels::graph::Resolved,
+    ) -> Result<vista_gpu::GraphPass, RenderError> {
+        let (kernel, p, width, height) = (self.kernel, self.p, self.width, self.height);
+        let g = kernel.graph().expect("a graph kernel");
+        let bad = |m: String| self.bad(m);
+        let index = |name: &str| resolved.resources.iter().position(|r| r.spec.name == name).expect("resolved");
+        let label = format!("pass {} ({}, {})", i + 1, pass.entry, file);
         let mut pp = p.clone();
         for (k, v) in &pass.set {
             pp = pp.with(kernel.params(), k, v).map_err(|e| bad(format!("{label}: set: {e}")))?;
         }
-        let module = &modules[i];
         let constants = kernel.overrides_in(module, &pp, false).map_err(|e| RenderError::BadInput(e.to_string()))?;
         let size = crate::reflect::workgroup_size(module, &pass.entry, &constants)
             .map_err(|e| bad(format!("{label}: {e}")))?;
@@ -371,9 +450,9 @@ pub(crate) fn plan_graph(
             }
         };
         let swap = pass.swap.iter().map(|(a, b)| (index(a), index(b))).collect();
-        passes.push(vista_gpu::GraphPass {
+        Ok(vista_gpu::GraphPass {
             label,
-            shader: files[i].clone(),
+            shader: file.to_string(),
             entry: pass.entry.clone(),
             constants,
             workgroups,
@@ -382,43 +461,48 @@ pub(crate) fn plan_graph(
             swap,
             span: g.span(i) as u32,
             workgroup_size: size,
-        });
+        })
     }
-    let mut outputs = Vec::new();
-    let mut output_ids = Vec::new();
-    for name in &outputs_named {
-        let r = index(name);
-        let spec = g.outputs.iter().find(|o| &o.resource == name);
-        let kind = match &resources[r] {
-            vista_gpu::Resource::Texture(t) => {
-                let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.default_view(t.format));
-                let display = kernel.display_map_with(p, view, t.format, spec.and_then(|o| o.exposure));
-                PlannedKind::Texture { format: t.format, view, display }
-            }
-            vista_gpu::Resource::Buffer(b) => {
-                let e = resolved.resources[r].element.clone().expect("a bound buffer");
-                let count = (b.len() as u64 - e.header as u64) / e.stride.max(1) as u64;
-                PlannedKind::Buffer { element: e, count }
-            }
-            vista_gpu::Resource::Sampler(_) => unreachable!("resolve refuses a sampler output"),
-        };
-        outputs.push(PlannedOutput {
-            name: name.clone(),
-            tolerance: spec.and_then(|o| o.tolerance),
-            partial: spec.is_some_and(|o| o.partial),
-            kind,
-        });
-        output_ids.push(r);
+
+    /// The outputs as planned, and the resource each reads.
+    fn outputs(
+        &self,
+        named: &[String],
+        resources: &[vista_gpu::Resource],
+        resolved: &vista_kernels::graph::Resolved,
+    ) -> (Vec<PlannedOutput>, Vec<usize>) {
+        let (kernel, p) = (self.kernel, self.p);
+        let g = kernel.graph().expect("a graph kernel");
+        let outputs_named = named;
+        let index = |name: &str| resolved.resources.iter().position(|r| r.spec.name == name).expect("resolved");
+        let mut outputs = Vec::new();
+        let mut output_ids = Vec::new();
+        for name in outputs_named {
+            let r = index(name);
+            let spec = g.outputs.iter().find(|o| &o.resource == name);
+            let kind = match &resources[r] {
+                vista_gpu::Resource::Texture(t) => {
+                    let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.default_view(t.format));
+                    let display = kernel.display_map_with(p, view, t.format, spec.and_then(|o| o.exposure));
+                    PlannedKind::Texture { format: t.format, view, display }
+                }
+                vista_gpu::Resource::Buffer(b) => {
+                    let e = resolved.resources[r].element.clone().expect("a bound buffer");
+                    let count = (b.len() as u64 - e.header as u64) / e.stride.max(1) as u64;
+                    PlannedKind::Buffer { element: e, count }
+                }
+                vista_gpu::Resource::Sampler(_) => unreachable!("resolve refuses a sampler output"),
+            };
+            outputs.push(PlannedOutput {
+                name: name.clone(),
+                tolerance: spec.and_then(|o| o.tolerance),
+                partial: spec.is_some_and(|o| o.partial),
+                kind,
+            });
+            output_ids.push(r);
+        }
+        (outputs, output_ids)
     }
-    Ok(Plan {
-        kernel: kernel.name().to_string(),
-        resources,
-        passes,
-        output_ids,
-        outputs,
-        deterministic: g.deterministic,
-        shaders: files,
-    })
 }
 
 /// A texture file under the project root: its natural format (8-bit PNG:
