@@ -17,5 +17,18 @@ done
 one=$("$cargo" test -q --test golden -- --exact golden::glow::glow-blue 2>&1)
 echo "$one" | grep -q "1 passed; 0 failed; 0 ignored; 0 measured; 1 filtered out" ||
     { echo "$one"; echo "harness-example: --exact did not select one case"; exit 1; }
-[ -f target/vista-report/index.html ] || { echo "harness-example: no report in examples/harness-crate/target/vista-report"; exit 1; }
+for f in index.html results.json; do
+    [ -f "target/vista-report/$f" ] || { echo "harness-example: no $f in examples/harness-crate/target/vista-report"; exit 1; }
+done
+# A golden no case refers to fails one more test, golden::orphans.
+orphan=golden/glow/gone.png
+cp golden/glow/glow.png "$orphan"
+trap 'rm -f "$orphan"' EXIT
+if out=$("$cargo" test -q --test golden 2>&1); then
+    echo "$out"; echo "harness-example: an orphaned golden did not fail the run"; exit 1
+fi
+echo "$out" | grep -q "golden::orphans.*FAILED\|---- golden::orphans" ||
+    { echo "$out"; echo "harness-example: the orphaned golden did not fail golden::orphans"; exit 1; }
+echo "$out" | grep -q "gone.png" || { echo "$out"; echo "harness-example: golden::orphans did not name the file"; exit 1; }
+rm -f "$orphan"
 echo "harness-example: the crate's own cargo test ran its 2 golden cases through vista::harness::main()"

@@ -27,7 +27,10 @@
 //! After the run the report is written (`target/vista-report/` of the
 //! project, `target/vista-report-<backend>/` for another `VISTA_BACKEND`,
 //! `target/vista-report-<backend>-validation/` under `VISTA_VALIDATION=1`),
-//! so runs side by side do not clear each other's case folders.
+//! so runs side by side do not clear each other's case folders, with
+//! `pending.toml` and `results.json` as `vista check` leaves them (the one
+//! driver, `vista-check`). Goldens no case refers to fail one more test,
+//! `golden::orphans`, present only when there are some.
 //! Without an adapter every case fails naming the install command, unless
 //! `VISTA_ALLOW_NO_GPU=1`: then each is reported ignored and a loud line
 //! names them.
@@ -36,7 +39,8 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use libtest_mimic::{Arguments, Failed, Trial};
-use vista_golden::{CheckOptions, Store};
+use vista_check::{Checker, Filed};
+use vista_golden::Store;
 use vista_project::Project;
 use vista_render::Renderer;
 
@@ -91,16 +95,13 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
         (b, false) => root.join(format!("target/vista-report-{b}")),
         (b, true) => root.join(format!("target/vista-report-{b}-validation")),
     };
-    let outcomes = Arc::new(Mutex::new(Vec::new()));
+    let filed: Arc<Mutex<Vec<Filed>>> = Arc::new(Mutex::new(Vec::new()));
     // Listing needs no device (nextest lists before it runs). One renderer
     // per process, shared by every case.
     static RENDERER: std::sync::OnceLock<Result<Renderer<'static>, String>> = std::sync::OnceLock::new();
     let renderer: Option<Result<&'static Renderer<'static>, String>> = (!args.list).then(|| {
         RENDERER
-            .get_or_init(|| {
-                let ctx = vista_gpu::Context::shared(&config.gpu).map_err(|e| e.to_string())?;
-                Renderer::new(ctx, project, config.limits).map_err(|e| e.to_string())
-            })
+            .get_or_init(|| Renderer::shared(&config.gpu, project, config.limits).map_err(|e| e.to_string()))
             .as_ref()
             .map_err(Clone::clone)
     });
@@ -122,11 +123,11 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
             cases.iter().map(|c| c.id.as_str()).collect::<Vec<_>>().join(", ")
         );
     }
-    let trials: Vec<Trial> = cases
+    let mut trials: Vec<Trial> = cases
         .iter()
         .map(|case| {
-            let (case, store, manifest, outcomes, report_dir, renderer) =
-                (case.clone(), store.clone(), manifest.clone(), outcomes.clone(), report_dir.clone(), renderer.clone());
+            let (case, store, manifest, filed, report_dir, renderer) =
+                (case.clone(), store.clone(), manifest.clone(), filed.clone(), report_dir.clone(), renderer.clone());
             let name = format!("golden::{}::{}", case.kernel.name(), case.id);
             Trial::test(name, move || {
                 let ctx = match renderer {
@@ -134,25 +135,41 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
                     Some(Err(e)) => return Err(Failed::from(format!("no GPU adapter: {e}"))),
                     None => return Err(Failed::from("listed, not run")),
                 };
-                // The in-process determinism check (two renders, bit-identical)
-                // runs on the bless-time driver where the render is not the
-                // bless-time bits (`CheckOptions::twice`); other backends render once.
-                let opts = CheckOptions { twice: ctx.backend() == "lavapipe" };
-                let o = vista_report::file_case(
-                    &report_dir,
-                    vista_golden::check_case(ctx, &store, &manifest, &case, &opts),
-                    vista_report::Detail::Failing,
-                );
+                let checker = Checker {
+                    ctx,
+                    store: &store,
+                    manifest: &manifest,
+                    report_dir: &report_dir,
+                    detail: vista_report::Detail::Failing,
+                };
+                let f = checker.check(&case);
+                let o = &f.outcome;
                 let result = if o.passed() { Ok(()) } else { Err(Failed::from(o.explain(&report_dir))) };
-                outcomes.lock().expect("outcomes").push(o);
+                filed.lock().expect("filed").push(f);
                 result
             })
             .with_ignored_flag(skip)
         })
         .collect();
+    let orphans = vista_check::orphans(&store, &cases);
+    if !orphans.is_empty() {
+        let listed: Vec<String> = orphans.iter().map(|o| o.display().to_string()).collect();
+        trials.push(
+            Trial::test("golden::orphans", move || {
+                Err(Failed::from(format!(
+                    "goldens with no case (a renamed or deleted case left them behind; delete them, or vista bless \
+                     --prune): {}",
+                    listed.join(", ")
+                )))
+            })
+            .with_ignored_flag(skip),
+        );
+    }
     let conclusion = libtest_mimic::run(args, trials);
-    let outcomes = outcomes.lock().expect("outcomes");
-    if !outcomes.is_empty()
+    let mut filed = filed.lock().expect("filed");
+    // In case order, as `vista check` lists them.
+    filed.sort_by_key(|f| cases.iter().position(|c| c.id == f.outcome.id));
+    if !filed.is_empty()
         && let Some(Ok(ctx)) = &renderer
     {
         let run = vista_report::RunSummary {
@@ -164,7 +181,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
             backend: ctx.backend().to_string(),
             ..Default::default()
         };
-        match vista_report::write_report(&report_dir, &run, &outcomes) {
+        match vista_check::finish(&report_dir, &run, &filed, &Default::default()) {
             Ok(index) => eprintln!("vista report: {}", index.display()),
             Err(e) => eprintln!("could not write the vista report: {e}"),
         }

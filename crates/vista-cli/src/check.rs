@@ -4,31 +4,22 @@
 use std::path::{Path, PathBuf};
 
 use vista::Config;
-use vista_golden::{CheckOptions, GoldenError, Store};
-use vista_gpu::Context;
+use vista_check::{Checker, Results};
+use vista_golden::{GoldenError, Store};
 use vista_project::Project;
 use vista_render::Renderer;
 
 use crate::bad;
 use crate::render::check_parent_writable;
 
-/// Which cases a check runs: `--case`, then `--changed`, `--failed`,
-/// `--partition` (each narrows the one before).
+/// Which cases a check runs, and how.
 pub struct Pick {
-    pub glob: Option<String>,
-    pub changed: bool,
-    pub failed: bool,
-    pub partition: Option<(u64, u64)>,
+    /// `--case`, `--changed`, `--failed`, `--partition`.
+    pub selection: vista_check::Pick,
     /// Orphaned goldens warn instead of failing.
     pub allow_orphans: bool,
     /// Cases checked at once (`--jobs`).
     pub jobs: usize,
-}
-
-/// Machine-readable results a check also writes.
-pub struct Results {
-    pub junit: Option<PathBuf>,
-    pub json: Option<PathBuf>,
 }
 
 /// A results file's directory must exist and be writable, before any GPU work.
@@ -73,45 +64,6 @@ fn annotate(store: &Store, outcomes: &[vista_golden::Outcome]) {
     }
 }
 
-/// Narrows `picked` (the cases `--case` matches) by `--changed`,
-/// `--failed` and `--partition`, in that order, and says so. Needs no
-/// device: hashes from the project's WGSL, the last report.
-fn narrow(
-    project: &Project,
-    pick: &Pick,
-    manifest: &vista_golden::Manifest,
-    report_dir: &Path,
-    picked: &mut Vec<&vista_golden::Case>,
-) -> Result<(), GoldenError> {
-    let all = picked.len();
-    let mut why: Vec<String> = Vec::new();
-    if pick.changed {
-        let shaders = vista_render::shader_set(project)?;
-        picked.retain(|c| {
-            // Every file any pass reaches, as the manifest records them.
-            let mut files = std::collections::BTreeMap::new();
-            for f in c.kernel.shader_units() {
-                files.extend(shaders.file_hashes(&f).unwrap_or_default());
-            }
-            vista_golden::selection::change(c, manifest, &files).is_some()
-        });
-        why.push("--changed".into());
-    }
-    if pick.failed {
-        let failures = vista_golden::selection::last_failures(report_dir)?;
-        picked.retain(|c| failures.contains(&c.id));
-        why.push("--failed".into());
-    }
-    if let Some(part) = pick.partition {
-        picked.retain(|c| vista_golden::selection::in_partition(&c.id, part));
-        why.push(format!("--partition {}/{}", part.0, part.1));
-    }
-    if !why.is_empty() {
-        println!("selected {} of {all} cases ({})", picked.len(), why.join(", "));
-    }
-    Ok(())
-}
-
 pub fn check(
     project: &Project,
     config: &Config,
@@ -128,82 +80,37 @@ pub fn check(
     }
     let store = Store::of_project(project, "vista check")?;
     let cases = store.load_cases()?;
-    let mut picked = vista_golden::select(&cases, pick.glob.as_deref())?;
     let manifest = store.manifest()?;
     let report_dir = match report_dir {
         Some(d) => d,
         None => project.report_dir().expect("a store implies a root"),
     };
-    narrow(project, pick, &manifest, &report_dir, &mut picked)?;
-    let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
+    let (picked, narrowed) = vista_check::select(project, &cases, &manifest, &pick.selection, &report_dir)?;
+    if let Some(line) = narrowed {
+        println!("{line}");
+    }
+    let ctx = &Renderer::shared(&config.gpu, project, config.limits)?;
     vista_report::clear_case_folders(&report_dir)?;
-    let opts = CheckOptions { twice: false };
-    let mut outcomes = Vec::new();
-    let mut pending = std::collections::BTreeMap::new();
     let mut time = Phases::start(ctx);
-    // The validation layer's messages are collected process-wide: one case
-    // at a time, so each is attributed to the dispatch that caused it.
-    let jobs = if ctx.validating() { 1 } else { pick.jobs.clamp(1, picked.len().max(1)) };
-    time.jobs = jobs;
-    // Outcomes come back in case order; the device serialises the workers'
-    // GPU runs while the others plan, judge and write their report folder.
-    vista_golden::in_order(
-        &picked,
-        jobs,
-        |case| {
-            let started = std::time::Instant::now();
-            let mut checked = vista_golden::check_case(ctx, &store, &manifest, case, &opts);
-            let case_time = started.elapsed();
-            let entry = checked.pending.take();
-            let started = std::time::Instant::now();
-            let o = vista_report::file_case(&report_dir, checked, viewers);
-            (o, entry, case_time, started.elapsed())
-        },
-        |_, (o, entry, case_time, report_time)| {
-            time.cases += case_time;
-            time.report += report_time;
-            time.gpu += std::time::Duration::from_secs_f64(o.gpu_ms / 1000.0);
-            // A failing or missing case's render, as bless --from-report may take it.
-            if let Some(mut entry) = entry
-                && matches!(o.verdict, vista_golden::Verdict::Fail | vista_golden::Verdict::Missing)
-            {
-                // A graph whose first output is a buffer has no main PNG.
-                let png = match o.files.actual {
-                    Some(_) => std::fs::read(vista_golden::pending::pending_png(&report_dir, &o.id))
-                        .ok()
-                        .map(|bytes| vista_golden::short_hash_bytes(&bytes)),
-                    None => Some(String::new()),
-                };
-                if let Some(hash) = png {
-                    entry.golden_hash = hash;
-                    pending.insert(o.id.clone(), entry);
-                }
-            }
-            print_case(&o, &report_dir);
-            outcomes.push(o);
-        },
-    );
+    let checker = Checker { ctx, store: &store, manifest: &manifest, report_dir: &report_dir, detail: viewers };
+    time.jobs = if ctx.validating() { 1 } else { pick.jobs.clamp(1, picked.len().max(1)) };
+    let filed = checker.check_all(&picked, pick.jobs, |f| {
+        time.cases += f.check_time;
+        time.report += f.report_time;
+        time.gpu += std::time::Duration::from_secs_f64(f.outcome.gpu_ms / 1000.0);
+        print_case(&f.outcome, &report_dir);
+    });
     let run = vista_report::RunSummary {
         command: command_line(),
         backend: ctx.backend().to_string(),
         adapter: ctx.adapter_description(),
-        pending: pending.keys().cloned().collect(),
-        accept_from: report_dir.display().to_string(),
+        ..Default::default()
     };
     let started = std::time::Instant::now();
-    let index = vista_report::write_report(&report_dir, &run, &outcomes)?;
+    let index = vista_check::finish(&report_dir, &run, &filed, &results)?;
     time.report += started.elapsed();
-    let accept = (!pending.is_empty()).then(|| format!("vista bless --from-report {}", report_dir.display()));
-    vista_golden::pending::write_pending(&report_dir, pending)?;
-    // results.json beside the report: what `check --failed` reads next time.
-    let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
-    vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;
-    if let Some(p) = &results.junit {
-        vista_image::atomic_write(p, vista_report::junit_xml(&run, &outcomes, &report_dir)?.as_bytes())?;
-    }
-    if let Some(p) = &results.json {
-        vista_image::atomic_write(p, json_text.as_bytes())?;
-    }
+    let accept = vista_check::accept_command(&report_dir, &filed);
+    let outcomes: Vec<vista_golden::Outcome> = filed.into_iter().map(|f| f.outcome).collect();
     if config.github_actions {
         annotate(&store, &outcomes);
     }
@@ -211,7 +118,7 @@ pub fn check(
     let failed = failing.len();
     println!("{} passed, {} failed", outcomes.len() - failed, failed);
     // Goldens no case refers to: a renamed or deleted case left them behind.
-    let orphans = store.orphans(&cases);
+    let orphans = vista_check::orphans(&store, &cases);
     for o in &orphans {
         println!(
             "{}: golden with no case: {} (delete it, or vista bless --prune)",

@@ -407,9 +407,10 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             jobs,
         } => {
             let partition = partition.as_deref().map(vista_golden::selection::parse_partition).transpose()?;
-            let pick = check::Pick { glob: case, changed, failed, partition, allow_orphans, jobs: jobs as usize };
+            let selection = vista_check::Pick { glob: case, changed, failed, partition };
+            let pick = check::Pick { selection, allow_orphans, jobs: jobs as usize };
             let viewers = if full_report { vista_report::Detail::All } else { vista_report::Detail::Failing };
-            check::check(project, config, &pick, report_dir, check::Results { junit, json }, viewers)
+            check::check(project, config, &pick, report_dir, vista_check::Results { junit, json }, viewers)
         }
         Command::Bless { case, force, from_report: Some(dir), .. } => {
             bless::from_report(project, config, case, force, &dir)

@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-use vista_golden::{CheckOptions, GoldenError, Outcome, Store};
+use vista_check::Checker;
+use vista_golden::{GoldenError, Outcome, Store};
 use vista_gpu::{AdapterChoice, Context};
 use vista_project::Project;
 use vista_render::Renderer;
@@ -43,14 +44,10 @@ pub fn matrix(
             limits: config.limits,
             root: project.root().map(Into::into),
         };
-        let (dir, opts) = (report_dir.join(b), CheckOptions { twice: false });
-        let outcomes: Vec<Outcome> = picked
-            .iter()
-            .map(|c| {
-                let checked = vista_golden::check_case(&gpu, &store, &manifest, c, &opts);
-                vista_report::file_case(&dir, checked, vista_report::Detail::Failing)
-            })
-            .collect();
+        let dir = report_dir.join(b);
+        let checker =
+            Checker { ctx: &gpu, store: &store, manifest: &manifest, report_dir: &dir, detail: Default::default() };
+        let outcomes: Vec<Outcome> = checker.check_all(&picked, 1, |_| {}).into_iter().map(|f| f.outcome).collect();
         columns.push((b.to_string(), Ok((ctx.adapter_description(), outcomes))));
     }
 

@@ -12,8 +12,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use vista_golden::{CheckOptions, GoldenError, Outcome, Store};
-use vista_gpu::Context;
+use vista_check::{Checker, Filed};
+use vista_golden::{GoldenError, Store};
 use vista_project::Project;
 use vista_render::Renderer;
 
@@ -64,11 +64,11 @@ pub fn watch(
 ) -> Result<i32, GoldenError> {
     let root = project.require_root("vista watch")?.to_path_buf();
     let report_dir = project.report_dir().expect("a root");
-    let ctx = Context::shared(&config.gpu)?;
+    let shared = Renderer::shared(&config.gpu, project, config.limits)?;
     let start = Instant::now();
     let extra = vista_render::paths_outside_shaders(project)?;
     let mut seen = snapshot(&root, &extra);
-    let mut outcomes: BTreeMap<String, Outcome> = BTreeMap::new();
+    let mut filed: BTreeMap<String, Filed> = BTreeMap::new();
     // The first round checks every selected case.
     let mut changed: Option<Vec<String>> = None;
     loop {
@@ -76,7 +76,7 @@ pub fn watch(
         let cases = store.load_cases()?;
         let picked = vista_golden::select(&cases, glob)?;
         let manifest = store.manifest()?;
-        let gpu = Renderer::new(ctx, project, config.limits)?;
+        let gpu = Renderer::new(shared.ctx, project, config.limits)?;
         let reached: Vec<&vista_golden::Case> = match &changed {
             None => picked.clone(),
             Some(files) => picked
@@ -104,31 +104,34 @@ pub fn watch(
                 if reached.len() == 1 { "" } else { "s" }
             );
         }
+        let checker = Checker {
+            ctx: &gpu,
+            store: &store,
+            manifest: &manifest,
+            report_dir: &report_dir,
+            detail: Default::default(),
+        };
         for case in reached {
-            let o = vista_report::file_case(
-                &report_dir,
-                vista_golden::check_case(&gpu, &store, &manifest, case, &CheckOptions { twice: false }),
-                vista_report::Detail::Failing,
-            );
+            let f = checker.check(case);
+            let o = &f.outcome;
             let label = if o.passed() { "ok" } else { "FAIL" };
             println!("{label:<6} {:<40} {:>8.1} ms", o.id, o.gpu_ms);
             if !o.passed() {
                 print!("{}", o.explain(&report_dir));
             }
-            outcomes.insert(o.id.clone(), o);
+            filed.insert(o.id.clone(), f);
         }
-        // Cases no longer selected (renamed, deleted) leave the report.
-        let live: Vec<&str> = picked.iter().map(|c| c.id.as_str()).collect();
-        outcomes.retain(|id, _| live.contains(&id.as_str()));
-        let all: Vec<Outcome> = outcomes.values().cloned().collect();
+        // Cases no longer selected (renamed, deleted) leave the report, in case order.
+        let all: Vec<Filed> = picked.iter().filter_map(|c| filed.get(&c.id).cloned()).collect();
+        filed.retain(|id, _| picked.iter().any(|c| &c.id == id));
         let run = vista_report::RunSummary {
             command: "vista watch".into(),
             backend: gpu.backend().to_string(),
             adapter: gpu.adapter_description(),
             ..Default::default()
         };
-        let index = vista_report::write_report(&report_dir, &run, &all)?;
-        let failed = all.iter().filter(|o| !o.passed()).count();
+        let index = vista_check::finish(&report_dir, &run, &all, &Default::default())?;
+        let failed = all.iter().filter(|f| !f.outcome.passed()).count();
         println!("{} passed, {failed} failed; report: {} (watching; Ctrl-C ends)", all.len() - failed, index.display());
         // Wait for the next change.
         loop {

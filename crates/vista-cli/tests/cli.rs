@@ -4243,6 +4243,28 @@ fn mutate_is_deterministic_shards_like_nextest_and_writes_nothing() {
     assert_eq!(snapshot(d.path()), before, "an interrupted mutate run changed the project's files");
 }
 
+/// Mutate checks each case as `vista check` does (one driver): a
+/// per-backend golden is the one it judges against on that backend. Here
+/// the case's own golden holds another case's image and only
+/// `a@lavapipe.png` is right: judged against the case's own, the unmutated
+/// suite would fail and mutate refuse to run (exit 2).
+fn mutate_judges_each_case_against_its_backends_own_golden() {
+    let d = mutate_project();
+    let bless = vista_in(Some(d.path()), &[], &["bless", "--backend", "lavapipe", "--per-backend", "--case", "a"]);
+    assert_eq!(bless.code, 0, "{}{}", bless.stdout, bless.stderr);
+    let own = golden(d.path(), "fbm", "a");
+    assert!(own.with_file_name("a@lavapipe.png").exists());
+    std::fs::copy(golden(d.path(), "fbm", "b"), &own).unwrap();
+    let check = vista_in(Some(d.path()), &[], &["check", "--case", "a"]);
+    assert_eq!(check.code, 0, "{}", check.stdout);
+    let out = d.path().join("m.json");
+    let args = ["mutate", "--case", "a", "--sample", "2", "--json", out.to_str().unwrap()];
+    let r = vista_in(Some(d.path()), &[], &args);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(v["mutants"].as_array().map(Vec::len), Some(2), "{v}");
+}
+
 fn mutate_bad_input_is_refused() {
     let d = golden_dir(CASES);
     for (args, needle) in [
@@ -4419,6 +4441,7 @@ fn main() {
         Gpu check_matrix_prints_one_row_per_case_and_one_column_per_backend,
         Gpu mutate_is_deterministic_shards_like_nextest_and_writes_nothing,
         Gpu mutate_bad_input_is_refused,
+        Gpu mutate_judges_each_case_against_its_backends_own_golden,
         Gpu check_clears_stale_case_folders_and_closes_with_one_bless_command,
     ];
     let args = libtest_mimic::Arguments::from_args();

@@ -41,6 +41,11 @@ pub struct Checked {
     /// A pass graph's inputs for the report: (resource, where it comes
     /// from, a texture's values as shown).
     pub inputs: Vec<(String, String, Option<Image>)>,
+    /// The render's raw hash (none when it failed).
+    pub raw_hash: Option<String>,
+    /// The render failed because the device's watchdog ended it (a hung
+    /// or endless kernel; `vista mutate` counts such a mutant a timeout).
+    pub timed_out: bool,
 }
 
 /// A pass graph's resources that start from a file or inline data (a
@@ -138,18 +143,19 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     // A per-backend golden, where this backend has one, with its own entry.
     let (golden_path, golden_key) = store.golden_for(case, ctx.backend());
     let entry = manifest.case.get(&golden_key);
-    let rendered = render_case(ctx, case).map_err(|e| e.to_string());
-    let r = match rendered {
+    let r = match render_case(ctx, case) {
         Ok(r) => r,
         Err(e) => {
             return Checked {
-                outcome: judge(case, entry, run, Err(e)),
+                timed_out: e.is_timeout(),
+                outcome: judge(case, entry, run, Err(e.to_string())),
                 actual: None,
                 expected: None,
                 pending: None,
                 pending_files: Vec::new(),
                 output_images: Vec::new(),
                 inputs: inputs_of(case, ctx.root.as_deref()),
+                raw_hash: None,
             };
         }
     };
@@ -277,6 +283,8 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         pending_files,
         output_images,
         inputs,
+        raw_hash: Some(r.raw.content_hash()),
+        timed_out: false,
     }
 }
 

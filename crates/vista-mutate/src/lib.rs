@@ -2,8 +2,10 @@
 //! checks. Every single-token mutant ([`mutants`]) of the kernel file and
 //! the lib modules in its import closure is composed in memory (the
 //! project's files are never written, not even to a temporary copy) and run
-//! against the kernel's golden cases, judged by `vista_golden::judge` (the
-//! verdict `vista check` gives: every metric, threshold and guard), and the
+//! against the kernel's golden cases, each checked by
+//! `vista_golden::check_case` (what `vista check` runs on a case: the
+//! backend's own golden where it has one, every metric, threshold and
+//! guard), and the
 //! kernel's GPU-vs-CPU agreement settings at the bounds the agreement tests
 //! use (`vista_golden::agreement`), stopping at the first failure.
 //!
@@ -22,12 +24,10 @@ use std::sync::Arc;
 use rand::seq::SliceRandom;
 use rand_pcg::Pcg32;
 use vista_golden::agreement::{self, Setting, SettingError};
-use vista_golden::{Case, GoldenError, GoldenRead, Manifest, Observed, Store};
-use vista_gpu::{Context, GpuError, ShaderSet};
-use vista_image::Image;
+use vista_golden::{Case, CheckOptions, GoldenError, Manifest, Store, Verdict};
 use vista_kernels::Kernel;
 use vista_project::{Project, SourceFile};
-use vista_render::Renderer;
+use vista_render::{Renderer, ShaderSet};
 
 pub mod mutants;
 pub use mutants::{Mutant, mutants};
@@ -340,16 +340,11 @@ pub fn plan(
     Ok(all.into_iter().enumerate().filter(|(i, _)| i % n == k - 1).map(|(_, p)| p).collect())
 }
 
-/// One golden case as the unmutated kernel renders it: the case, its
-/// golden (hash and image) and the unmutated raw output's hash.
+/// One golden case as the unmutated kernel renders it: the case and the
+/// unmutated raw output's hash.
 struct CaseBaseline<'a> {
     case: &'a Case,
-    /// The main golden PNG's hash and values (none for a pass graph whose
-    /// first output is a buffer).
-    golden: Option<(String, Image)>,
     raw_hash: String,
-    /// The golden directory, where a graph's other outputs' goldens lie.
-    golden_dir: std::path::PathBuf,
 }
 
 /// What an unmutated kernel looks like to its detectors: its golden cases
@@ -359,6 +354,10 @@ struct Baseline<'a> {
     cases: Vec<CaseBaseline<'a>>,
     settings: Vec<(&'static Setting, String)>,
 }
+
+/// A mutant's case is checked once: its verdict is the first render's, and
+/// the unmutated render was already shown deterministic by bless.
+const ONCE: CheckOptions = CheckOptions { twice: false };
 
 /// The unmutated kernel through the same detectors a mutant meets. Every
 /// case must have a readable golden and pass, and every agreement setting
@@ -373,25 +372,18 @@ fn baseline<'a>(
 ) -> Result<Baseline<'a>, GoldenError> {
     let mut out = Vec::new();
     for c in cases.iter().filter(|c| c.kernel.name() == kernel.name()) {
-        let path = store.golden_path(c);
-        let r = vista_golden::run::render_case(gpu, c)?;
-        let golden = match r.raw.width > 0 {
-            false => None,
-            true => {
-                let bytes = std::fs::read(&path).map_err(|e| {
-                    GoldenError::BadInput(format!(
-                        "case {}: golden {} cannot be read ({e}); mutation testing judges every case like vista \
-                         check, so bless it first: {}",
-                        c.id,
-                        path.display(),
-                        c.bless_command()
-                    ))
-                })?;
-                Some((vista_golden::short_hash_bytes(&bytes), vista_image::decode_png16(&path, &bytes)?))
-            }
-        };
-        let b = CaseBaseline { case: c, golden, raw_hash: r.raw.content_hash(), golden_dir: store.dir.clone() };
-        let o = judge_case(gpu, manifest, &b, &r);
+        let checked = vista_golden::check_case(gpu, store, manifest, c, &ONCE);
+        let o = &checked.outcome;
+        if o.verdict == Verdict::Missing {
+            let (path, _) = store.golden_for(c, gpu.backend());
+            return Err(GoldenError::BadInput(format!(
+                "case {}: golden {} cannot be read (it does not exist); mutation testing judges every case like \
+                 vista check, so bless it first: {}",
+                c.id,
+                path.display(),
+                c.bless_command()
+            )));
+        }
         if !o.passed() {
             return Err(GoldenError::BadInput(format!(
                 "case {} fails before any mutation ({}); fix or bless it before mutating",
@@ -399,7 +391,7 @@ fn baseline<'a>(
                 o.problems.join("; ")
             )));
         }
-        out.push(b);
+        out.push(CaseBaseline { case: c, raw_hash: checked.raw_hash.unwrap_or_default() });
     }
     let mut settings = Vec::new();
     if kernel.has_reference() {
@@ -417,46 +409,15 @@ fn baseline<'a>(
     Ok(Baseline { cases: out, settings })
 }
 
-/// A case's verdict as `vista check` gives it: the same function, every
-/// metric and threshold, bit-identity where the shader and driver are the
-/// manifest's.
-fn judge_case(
-    gpu: &Renderer,
-    manifest: &Manifest,
-    b: &CaseBaseline,
-    r: &vista_render::Rendered,
-) -> vista_golden::Outcome {
-    let actual = vista_render::quantize16(r.display());
-    let run = vista_golden::run_info(gpu, b.case);
-    let files = gpu.kernel_file_hashes(&b.case.kernel).unwrap_or_default();
-    let path = std::path::PathBuf::from(b.case.golden_rel_path());
-    let entry = manifest.case.get(&b.case.id);
-    let threshold = vista_golden::DriverThreshold::of(b.case, entry, &run.adapter);
-    // Any output's verdict kills a mutant (a graph's, or a raw golden's).
-    let outputs: Vec<vista_golden::outputs::OutputVerdict> = vista_golden::outputs::outputs_of(b.case, r)
-        .iter()
-        .enumerate()
-        .map(|(i, o)| vista_golden::outputs::compare_output(b.case, &b.golden_dir, &b.case.id, i, o, threshold, entry))
-        .collect();
-    let observed = Observed {
-        raw: &r.raw,
-        unwritten: r.unwritten,
-        format: r.format,
-        actual: &actual,
-        repeat_identical: None,
-        shader_files: &files,
-        golden: match &b.golden {
-            Some((hash, image)) => GoldenRead::Present { path: &path, hash, image: Ok(image) },
-            None => GoldenRead::NoImage,
-        },
-        outputs: &outputs,
-        deterministic: b.case.kernel.graph().is_none_or(|g| g.deterministic),
-    };
-    vista_golden::judge(b.case, manifest.case.get(&b.case.id), run, Ok(observed))
-}
-
 /// Runs one mutant against the detectors; the first failure kills it.
-fn judge(gpu: &Renderer, manifest: &Manifest, kernel: &Kernel, base: &Baseline, m: &Mutant) -> MutantReport {
+fn judge(
+    gpu: &Renderer,
+    store: &Store,
+    manifest: &Manifest,
+    kernel: &Kernel,
+    base: &Baseline,
+    m: &Mutant,
+) -> MutantReport {
     let report = |outcome: &str, killed_by: Option<(String, String)>, equivalent: bool, cases_run: usize| {
         let (killed_by, reason) = killed_by.unzip();
         MutantReport {
@@ -470,19 +431,17 @@ fn judge(gpu: &Renderer, manifest: &Manifest, kernel: &Kernel, base: &Baseline, 
             argument: None,
         }
     };
-    let failed = |e: &vista_render::RenderError| match e {
-        vista_render::RenderError::Gpu(GpuError::Timeout { .. }) => "timeout",
-        _ => "stillborn",
-    };
+    let failed = |timed_out: bool| if timed_out { "timeout" } else { "stillborn" };
     let mut identical = true;
     for (n, b) in base.cases.iter().enumerate() {
         let c = b.case;
-        let r = match vista_golden::run::render_case(gpu, c) {
-            Ok(r) => r,
-            Err(e) => return report(failed(&e), None, false, n + 1),
+        let checked = vista_golden::check_case(gpu, store, manifest, c, &ONCE);
+        // A render that failed is the mutant's failure to run, not a kill.
+        let Some(raw_hash) = &checked.raw_hash else {
+            return report(failed(checked.timed_out), None, false, n + 1);
         };
-        identical &= r.raw.content_hash() == b.raw_hash;
-        let o = judge_case(gpu, manifest, b, &r);
+        identical &= *raw_hash == b.raw_hash;
+        let o = &checked.outcome;
         if !o.passed() {
             let why = o.problems.first().cloned().unwrap_or_default();
             return report("killed", Some((c.id.clone(), why)), false, n + 1);
@@ -498,7 +457,7 @@ fn judge(gpu: &Renderer, manifest: &Manifest, kernel: &Kernel, base: &Baseline, 
                     return report("killed", Some(("cpu-reference".into(), broken)), false, run);
                 }
             }
-            Err(SettingError::Render { source, .. }) => return report(failed(&source), None, false, run),
+            Err(SettingError::Render { source, .. }) => return report(failed(source.is_timeout()), None, false, run),
             Err(SettingError::Unjudgeable(why)) => {
                 return report("killed", Some(("cpu-reference".into(), why)), false, run);
             }
@@ -507,57 +466,29 @@ fn judge(gpu: &Renderer, manifest: &Manifest, kernel: &Kernel, base: &Baseline, 
     report("survived", None, identical, run)
 }
 
-/// Runs the plan on `ctx` with `jobs` workers; `progress(done, total)` is
-/// called after each mutant. The project's files are only read.
-#[allow(clippy::too_many_arguments)]
+/// Runs the plan on `base` (the device, the unmutated shaders and the
+/// limits; its context's watchdog should be short: a mutant can loop for
+/// ever) with `jobs` workers; `progress(done, total)` is called after each
+/// mutant. The project's files are only read.
 pub fn run(
-    ctx: &Context,
+    base: &Renderer,
     project: &Project,
     store: &Store,
     cases: &[&Case],
     planned: &[Planned],
     jobs: usize,
-    limits: vista_render::RenderLimits,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<MutantReport>, GoldenError> {
-    let files = project.shader_files()?;
-    let outside = outside_files(project)?;
-    let enums = vista_render::enum_modules(project)?;
-    let (sources, reader) = vista_render::source_specs(project)?;
-    let label = "mutant";
-    let set = |edit: Option<&Mutant>| {
-        // A mutant of a file outside shaders/ reaches the assembly through
-        // the reader; the others through the set's own files.
-        let edited: Option<(String, String, String)> = edit.and_then(|m| {
-            outside.iter().find(|f| f.rel == m.file).map(|f| (f.rel.clone(), m.apply(&f.text), f.origin.clone()))
-        });
-        let read = reader.clone();
-        let reader = match edited {
-            None => read,
-            Some((rel, text, origin)) => vista_gpu::Reader::new(move |path| match path == rel {
-                true => Some((text.clone(), origin.clone())),
-                false => read.read(path),
-            }),
-        };
-        ShaderSet::from_files(
-            label,
-            files.iter().map(|f| {
-                let text = match edit {
-                    Some(m) if m.file == f.rel => m.apply(&f.text),
-                    _ => f.text.clone(),
-                };
-                (f.rel.clone(), text, f.origin.clone())
-            }),
-        )
-        .with_enums(enums.iter().cloned())
-        .with_sources(sources.iter().cloned(), reader)
-    };
+    let sources = vista_render::Sources::of(project)?;
+    // Each mutant's file as the project has it (under shaders/, or outside
+    // it where a [source] reaches).
+    let mut texts: BTreeMap<String, String> = project.shader_files()?.into_iter().map(|f| (f.rel, f.text)).collect();
+    texts.extend(outside_files(project)?.into_iter().map(|f| (f.rel, f.text)));
     let manifest = store.manifest()?;
-    let original = Renderer { ctx, shaders: set(None), limits, root: project.root().map(Into::into) };
     let mut baselines = BTreeMap::new();
     for p in planned {
         if !baselines.contains_key(p.kernel.name()) {
-            baselines.insert(p.kernel.name(), baseline(&original, store, &manifest, &p.kernel, cases)?);
+            baselines.insert(p.kernel.name(), baseline(base, store, &manifest, &p.kernel, cases)?);
         }
     }
     let mut results = Vec::with_capacity(planned.len());
@@ -565,8 +496,15 @@ pub fn run(
         planned,
         jobs,
         |p| {
-            let gpu = Renderer { ctx, shaders: set(Some(&p.mutant)), limits, root: project.root().map(Into::into) };
-            judge(&gpu, &manifest, &p.kernel, &baselines[p.kernel.name()], &p.mutant)
+            let m = &p.mutant;
+            let text = texts.get(&m.file).map(|t| m.apply(t)).unwrap_or_default();
+            let gpu = Renderer {
+                ctx: base.ctx,
+                shaders: sources.with_file("mutant", &m.file, text),
+                limits: base.limits,
+                root: base.root.clone(),
+            };
+            judge(&gpu, store, &manifest, &p.kernel, &baselines[p.kernel.name()], m)
         },
         |i, r| {
             results.push(r);

@@ -27,6 +27,11 @@ pub enum RenderError {
 }
 
 impl RenderError {
+    /// The device's watchdog ended the render (a hung or endless kernel).
+    pub fn is_timeout(&self) -> bool {
+        matches!(self, RenderError::Gpu(vista_gpu::GpuError::Timeout { .. }))
+    }
+
     /// Process exit code: 2 for bad input, 1 for failures while running.
     pub fn exit_code(&self) -> i32 {
         match self {

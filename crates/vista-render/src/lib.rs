@@ -21,7 +21,8 @@ pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use vista_gpu::{Context, RunStats, ShaderSet};
+pub use vista_gpu::ShaderSet;
+use vista_gpu::{Context, RunStats};
 use vista_image::Image;
 use vista_kernels::{DisplayMap, Kernel, ParamSet};
 
@@ -137,6 +138,16 @@ impl<'a> Renderer<'a> {
         Ok(Renderer { ctx, shaders: shader_set(project)?, limits, root: project.root().map(Into::into) })
     }
 
+    /// A renderer on the process's shared context (made from `gpu` on
+    /// first use: one process, one device).
+    pub fn shared(
+        gpu: &vista_gpu::GpuConfig,
+        project: &vista_project::Project,
+        limits: RenderLimits,
+    ) -> Result<Renderer<'static>, RenderError> {
+        Renderer::new(Context::shared(gpu)?, project, limits)
+    }
+
     /// Provenance hash of a kernel file and its imports.
     pub fn shader_hash(&self, shader: &str) -> Result<String, RenderError> {
         Ok(self.shaders.source_hash(shader)?)
@@ -173,11 +184,7 @@ impl<'a> Renderer<'a> {
 
 /// The project's WGSL as one [`ShaderSet`].
 pub fn shader_set(project: &vista_project::Project) -> Result<ShaderSet, RenderError> {
-    let label = match project.root() {
-        Some(r) => format!("project {}", r.display()),
-        None => "built-in shaders".to_string(),
-    };
-    edited_shader_set(project, &label, |_, text| text)
+    Ok(Sources::of(project)?.shader_set())
 }
 
 /// The project's WGSL with every file's text passed through `edit(relative
@@ -188,12 +195,69 @@ pub fn edited_shader_set(
     label: &str,
     edit: impl Fn(&str, String) -> String,
 ) -> Result<ShaderSet, RenderError> {
-    let files = project.shader_files()?.into_iter().map(|f| {
-        let text = edit(&f.rel, f.text);
-        (f.rel, text, f.origin)
-    });
-    let (specs, reader) = source_specs(project)?;
-    Ok(ShaderSet::from_files(label, files).with_enums(enum_modules(project)?).with_sources(specs, reader))
+    let mut sources = Sources::of(project)?;
+    sources.label = label.to_string();
+    for f in &mut sources.files {
+        f.1 = edit(&f.0, std::mem::take(&mut f.1));
+    }
+    Ok(sources.shader_set())
+}
+
+/// A project's WGSL read once: its `shaders/` files over the built-ins,
+/// each kernel's generated `vista::enums` module, its `[source]`
+/// assemblies and a reader of the files they reach outside `shaders/`.
+/// Makes the project's [`ShaderSet`], or one with a file's text replaced
+/// (each mutant of `vista mutate`), without reading the project again.
+#[derive(Debug, Clone)]
+pub struct Sources {
+    label: String,
+    /// (path relative to `shaders/`, text, origin).
+    files: Vec<(String, String, String)>,
+    enums: Vec<(String, String, String)>,
+    specs: Vec<(String, vista_source::SourceSpec)>,
+    reader: vista_gpu::Reader,
+}
+
+impl Sources {
+    /// The project's sources, read now.
+    pub fn of(project: &vista_project::Project) -> Result<Sources, RenderError> {
+        let label = match project.root() {
+            Some(r) => format!("project {}", r.display()),
+            None => "built-in shaders".to_string(),
+        };
+        let files = project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin)).collect();
+        let (specs, reader) = source_specs(project)?;
+        Ok(Sources { label, files, enums: enum_modules(project)?, specs, reader })
+    }
+
+    /// The project's shader set.
+    pub fn shader_set(&self) -> ShaderSet {
+        ShaderSet::from_files(&self.label, self.files.iter().cloned())
+            .with_enums(self.enums.iter().cloned())
+            .with_sources(self.specs.iter().cloned(), self.reader.clone())
+    }
+
+    /// The set with file `rel` holding `text` instead (a path relative to
+    /// `shaders/`, or relative to the root for a file a `[source]` reaches
+    /// outside it).
+    pub fn with_file(&self, label: &str, rel: &str, text: String) -> ShaderSet {
+        let files: Vec<(String, String, String)> = self
+            .files
+            .iter()
+            .map(|f| match f.0 == rel {
+                true => (f.0.clone(), text.clone(), f.2.clone()),
+                false => f.clone(),
+            })
+            .collect();
+        let (read, edited) = (self.reader.clone(), rel.to_string());
+        let reader = vista_gpu::Reader::new(move |path| match path == edited {
+            true => read.read(path).map(|(_, origin)| (text.clone(), origin)),
+            false => read.read(path),
+        });
+        ShaderSet::from_files(label, files)
+            .with_enums(self.enums.iter().cloned())
+            .with_sources(self.specs.iter().cloned(), reader)
+    }
 }
 
 /// Whether every pass of `kernel` composes at its default params: `Err`

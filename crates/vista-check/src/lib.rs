@@ -1,0 +1,208 @@
+#![deny(missing_docs)]
+//! vista's one check driver, behind `vista check`, `check --matrix`,
+//! `vista watch` and `vista::harness`: which cases run ([`Pick`],
+//! [`select`]), each one checked and filed in the report ([`Checker`]:
+//! `vista_golden::check_case` renders, reads the goldens and judges, with
+//! the one render-twice rule, [`options`]; `vista_report::file_case`
+//! writes its folder), then what a run
+//! leaves ([`finish`]: the report, `pending.toml`, `results.json`, JUnit)
+//! and the goldens no case refers to ([`orphans`]). `vista mutate` judges
+//! every mutant with the same `vista_golden::check_case`.
+//!
+//! Not for: rendering or judging themselves (`vista-render`,
+//! `vista-golden`), page layout (`vista-report`), or flags and printing
+//! (the binary and the harness).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use vista_golden::{Case, CheckOptions, GoldenError, Manifest, ManifestEntry, Outcome, Store, Verdict};
+use vista_project::Project;
+use vista_render::Renderer;
+use vista_report::{Detail, RunSummary};
+
+/// Which cases a check runs: `glob` (`--case`), then `--changed`,
+/// `--failed` and `--partition`, each narrowing the one before.
+#[derive(Debug, Clone, Default)]
+pub struct Pick {
+    /// Only cases whose id matches this glob.
+    pub glob: Option<String>,
+    /// Only cases whose params, WGSL or golden changed since the last bless.
+    pub changed: bool,
+    /// Only cases that failed in the last report.
+    pub failed: bool,
+    /// Only partition K of N (1-based).
+    pub partition: Option<(u64, u64)>,
+}
+
+/// The cases `pick` selects from `cases`, and when it narrowed by more than
+/// the glob, the line saying so (`selected 3 of 77 cases (--changed)`).
+/// Needs no device: hashes from the project's WGSL, the last report in
+/// `report_dir`.
+pub fn select<'c>(
+    project: &Project,
+    cases: &'c [Case],
+    manifest: &Manifest,
+    pick: &Pick,
+    report_dir: &Path,
+) -> Result<(Vec<&'c Case>, Option<String>), GoldenError> {
+    let mut picked = vista_golden::select(cases, pick.glob.as_deref())?;
+    let all = picked.len();
+    let mut why: Vec<String> = Vec::new();
+    if pick.changed {
+        let shaders = vista_render::shader_set(project)?;
+        picked.retain(|c| {
+            // Every file any pass reaches, as the manifest records them.
+            let mut files = BTreeMap::new();
+            for f in c.kernel.shader_units() {
+                files.extend(shaders.file_hashes(&f).unwrap_or_default());
+            }
+            vista_golden::selection::change(c, manifest, &files).is_some()
+        });
+        why.push("--changed".into());
+    }
+    if pick.failed {
+        let failures = vista_golden::selection::last_failures(report_dir)?;
+        picked.retain(|c| failures.contains(&c.id));
+        why.push("--failed".into());
+    }
+    if let Some(part) = pick.partition {
+        picked.retain(|c| vista_golden::selection::in_partition(&c.id, part));
+        why.push(format!("--partition {}/{}", part.0, part.1));
+    }
+    let line = (!why.is_empty()).then(|| format!("selected {} of {all} cases ({})", picked.len(), why.join(", ")));
+    Ok((picked, line))
+}
+
+/// The one render-twice rule: the in-process determinism check (two
+/// renders, bit-identical) runs on the default backend, lavapipe, where
+/// goldens are blessed (and only where the render is not the bless-time
+/// bits: `CheckOptions::twice`); other backends render once.
+pub fn options(ctx: &Renderer) -> CheckOptions {
+    CheckOptions { twice: ctx.backend() == "lavapipe" }
+}
+
+/// One case checked and filed in the report folder.
+#[derive(Debug, Clone)]
+pub struct Filed {
+    /// The verdict as the report has it.
+    pub outcome: Outcome,
+    /// For a failing or missing case, the manifest entry `vista bless
+    /// --from-report` would write from the render the report keeps.
+    pub pending: Option<ManifestEntry>,
+    /// Rendering, reading and judging.
+    pub check_time: Duration,
+    /// Writing the case's report folder.
+    pub report_time: Duration,
+}
+
+/// What checking a case reads and where it files it.
+pub struct Checker<'a> {
+    /// The device and the project's shaders.
+    pub ctx: &'a Renderer<'a>,
+    /// The goldens.
+    pub store: &'a Store,
+    /// Their provenance.
+    pub manifest: &'a Manifest,
+    /// The report folder each case is filed in.
+    pub report_dir: &'a Path,
+    /// Which cases get 16-bit images and the pixel viewer.
+    pub detail: Detail,
+}
+
+impl Checker<'_> {
+    /// Checks `case` (render, goldens, verdict) and writes its report folder.
+    pub fn check(&self, case: &Case) -> Filed {
+        let started = Instant::now();
+        let mut checked = vista_golden::check_case(self.ctx, self.store, self.manifest, case, &options(self.ctx));
+        let check_time = started.elapsed();
+        let entry = checked.pending.take();
+        let started = Instant::now();
+        let outcome = vista_report::file_case(self.report_dir, checked, self.detail);
+        let report_time = started.elapsed();
+        // A failing or missing case's render, as bless --from-report may take it.
+        let pending = match entry {
+            Some(mut entry) if matches!(outcome.verdict, Verdict::Fail | Verdict::Missing) => {
+                // A graph whose first output is a buffer has no main PNG.
+                let png = match outcome.files.actual {
+                    Some(_) => std::fs::read(vista_golden::pending::pending_png(self.report_dir, &outcome.id))
+                        .ok()
+                        .map(|bytes| vista_golden::short_hash_bytes(&bytes)),
+                    None => Some(String::new()),
+                };
+                png.map(|hash| {
+                    entry.golden_hash = hash;
+                    entry
+                })
+            }
+            _ => None,
+        };
+        Filed { outcome, pending, check_time, report_time }
+    }
+
+    /// Checks and files every case of `picked` with `jobs` workers (1 under
+    /// the validation layer, whose messages are process-wide, so each is
+    /// attributed to the dispatch that caused it), handing each to `each` in
+    /// case order as soon as it and every earlier one are done.
+    pub fn check_all(&self, picked: &[&Case], jobs: usize, mut each: impl FnMut(&Filed)) -> Vec<Filed> {
+        let jobs = if self.ctx.validating() { 1 } else { jobs.clamp(1, picked.len().max(1)) };
+        let mut out = Vec::with_capacity(picked.len());
+        // The device serialises the workers' GPU runs while the others plan,
+        // judge and write their report folder.
+        vista_golden::in_order(
+            picked,
+            jobs,
+            |case| self.check(case),
+            |_, filed| {
+                each(&filed);
+                out.push(filed);
+            },
+        );
+        out
+    }
+}
+
+/// Files a run writes beside its report, if asked.
+#[derive(Debug, Clone, Default)]
+pub struct Results {
+    /// A JUnit XML file.
+    pub junit: Option<PathBuf>,
+    /// A copy of `results.json`.
+    pub json: Option<PathBuf>,
+}
+
+/// What a run leaves: the report (`index.html`, whose path is returned),
+/// `pending.toml` (the pending renders of `filed`), `results.json` beside
+/// them (what `check --failed` reads next time) and `results`' files.
+pub fn finish(report_dir: &Path, run: &RunSummary, filed: &[Filed], results: &Results) -> Result<PathBuf, GoldenError> {
+    let mut run = run.clone();
+    let pending: BTreeMap<String, ManifestEntry> =
+        filed.iter().filter_map(|f| Some((f.outcome.id.clone(), f.pending.clone()?))).collect();
+    run.pending = pending.keys().cloned().collect();
+    if run.accept_from.is_empty() {
+        run.accept_from = report_dir.display().to_string();
+    }
+    let outcomes: Vec<Outcome> = filed.iter().map(|f| f.outcome.clone()).collect();
+    let index = vista_report::write_report(report_dir, &run, &outcomes)?;
+    vista_golden::pending::write_pending(report_dir, pending)?;
+    let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
+    vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;
+    if let Some(p) = &results.junit {
+        vista_image::atomic_write(p, vista_report::junit_xml(&run, &outcomes, report_dir)?.as_bytes())?;
+    }
+    if let Some(p) = &results.json {
+        vista_image::atomic_write(p, json_text.as_bytes())?;
+    }
+    Ok(index)
+}
+
+/// `vista bless --from-report <dir>`, where a run left pending renders.
+pub fn accept_command(report_dir: &Path, filed: &[Filed]) -> Option<String> {
+    filed.iter().any(|f| f.pending.is_some()).then(|| format!("vista bless --from-report {}", report_dir.display()))
+}
+
+/// Goldens no case refers to (a renamed or deleted case left them behind).
+pub fn orphans(store: &Store, cases: &[Case]) -> Vec<PathBuf> {
+    store.orphans(cases)
+}
