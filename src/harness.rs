@@ -86,15 +86,11 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
     let store = Store::of_project(project, "the golden tests").unwrap_or_else(|e| fail(&e.to_string()));
     let cases = store.load_cases().unwrap_or_else(|e| fail(&format!("cannot load golden cases: {e}")));
     let manifest = Arc::new(store.manifest().unwrap_or_else(|e| fail(&format!("cannot load the manifest: {e}"))));
-    let root = project.root().expect("a store has a root");
     // One report per implementation (VISTA_BACKEND) and for the validation
     // layer, so runs (side by side in `make test`) do not overwrite each other.
     let backend = config.gpu.adapter.backend_name();
-    let report_dir = match (backend, config.gpu.validate) {
-        ("lavapipe", false) => project.report_dir().expect("a root"),
-        (b, false) => root.join(format!("target/vista-report-{b}")),
-        (b, true) => root.join(format!("target/vista-report-{b}-validation")),
-    };
+    let report_dir =
+        vista_check::default_report_dir(project, backend, config.gpu.validate).expect("a store has a root");
     let filed: Arc<Mutex<Vec<Filed>>> = Arc::new(Mutex::new(Vec::new()));
     // Listing needs no device (nextest lists before it runs). One renderer
     // per process, shared by every case.

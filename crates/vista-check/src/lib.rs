@@ -75,6 +75,20 @@ pub fn select<'c>(
     Ok((picked, line))
 }
 
+/// Where a run on `backend` writes its report unless told otherwise: the
+/// project's `target/vista-report/` on lavapipe, `target/vista-report-<backend>/`
+/// on another backend, with `-validation` under the validation layer, so
+/// that checking a second backend (or the same one validated) does not
+/// overwrite the first's report.
+pub fn default_report_dir(project: &Project, backend: &str, validate: bool) -> Option<PathBuf> {
+    let root = project.root()?;
+    Some(match (backend, validate) {
+        ("lavapipe", false) => project.report_dir()?,
+        (b, false) => root.join(format!("target/vista-report-{b}")),
+        (b, true) => root.join(format!("target/vista-report-{b}-validation")),
+    })
+}
+
 /// The one render-twice rule: the in-process determinism check (two
 /// renders, bit-identical) runs on the default backend, lavapipe, where
 /// goldens are blessed (and only where the render is not the bless-time

@@ -83,7 +83,8 @@ pub fn check(
     let manifest = store.manifest()?;
     let report_dir = match report_dir {
         Some(d) => d,
-        None => project.report_dir().expect("a store implies a root"),
+        None => vista_check::default_report_dir(project, config.gpu.adapter.backend_name(), config.gpu.validate)
+            .expect("a store implies a root"),
     };
     let (picked, narrowed) = vista_check::select(project, &cases, &manifest, &pick.selection, &report_dir)?;
     if let Some(line) = narrowed {

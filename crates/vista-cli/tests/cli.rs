@@ -4265,6 +4265,28 @@ fn mutate_judges_each_case_against_its_backends_own_golden() {
     assert_eq!(v["mutants"].as_array().map(Vec::len), Some(2), "{v}");
 }
 
+/// `vista check --backend B` writes `target/vista-report-B/` unless
+/// `--report-dir` says otherwise: checking a second backend leaves the
+/// first's report (and what `--failed` reads there) as it was.
+fn each_backend_checks_into_its_own_report() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0);
+    let lavapipe = d.path().join("target/vista-report/results.json");
+    let before = std::fs::read_to_string(&lavapipe).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check", "--backend", "swiftshader", "--case", "a"]);
+    assert_eq!(c.code, 0, "{}", c.stdout);
+    let own = d.path().join("target/vista-report-swiftshader");
+    assert!(c.stdout.contains(&format!("report: {}", own.join("index.html").display())), "{}", c.stdout);
+    let results = std::fs::read_to_string(own.join("results.json")).unwrap();
+    assert!(results.contains("\"swiftshader\"") && !results.contains("\"b\""), "{results}");
+    assert_eq!(std::fs::read_to_string(&lavapipe).unwrap(), before, "the lavapipe report is untouched");
+    let elsewhere = d.path().join("elsewhere");
+    let r = vista_in(Some(d.path()), &[], &["check", "--backend", "swiftshader", "--report-dir", "elsewhere"]);
+    assert_eq!(r.code, 0, "{}", r.stdout);
+    assert!(elsewhere.join("results.json").exists());
+}
+
 fn mutate_bad_input_is_refused() {
     let d = golden_dir(CASES);
     for (args, needle) in [
@@ -4372,6 +4394,7 @@ fn main() {
         Gpu cube_textures_are_written_as_layers_and_sampled_as_cubes,
         Gpu a_group_of_passes_repeats_as_one_step,
         Gpu limits_are_reported_unsupported_by_name,
+        Gpu each_backend_checks_into_its_own_report,
         Gpu per_backend_goldens_cover_every_output_of_a_graph,
         Gpu bless_from_report_accepts_what_another_clone_rendered,
         Gpu check_writes_junit_json_and_github_annotations,
