@@ -42,6 +42,7 @@ fn nan_case() -> Case {
         ignore: vec![],
         expect_fail: vec![],
         inputs: vec![],
+        tolerances: vec![],
         doc: String::new(),
     }
 }

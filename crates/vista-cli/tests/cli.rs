@@ -4287,6 +4287,53 @@ fn each_backend_checks_into_its_own_report() {
     assert!(elsewhere.join("results.json").exists());
 }
 
+/// `tolerances = { out = { ... } }` in golden/cases.toml replaces an
+/// output's tolerance for that case alone: blessed at level 0.3 and now
+/// rendered at 0.5, the output passes its manifest's max_abs 0.5 and fails
+/// the case's 0.1; a name that is no output is refused.
+fn a_case_may_give_an_output_its_own_tolerance() {
+    let manifest = r#"summary = "a constant level"
+[[resource]]
+name = "out"
+kind = "texture"
+format = "r32float"
+[[pass]]
+entry = "main"
+[[output]]
+resource = "out"
+tolerance = { max_abs = 0.5 }
+[[param]]
+name = "level"
+type = "f32"
+range = [0.0, 1.0]
+default = 0.3
+"#;
+    let shader = "struct Params { width: u32, height: u32, level: f32 }
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var out: texture_storage_2d<r32float, write>;
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= vec2(params.width, params.height)) { return; }
+    textureStore(out, id.xy, vec4(params.level, 0.0, 0.0, 1.0));
+}
+";
+    let d = kernel_project(manifest, shader);
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    let case = "[[case]]\nid = \"flat\"\nkernel = \"k\"\nsize = \"8x8\"\n";
+    std::fs::write(cases_path(d.path()), case).unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let moved = format!("{case}set = {{ level = 0.5 }}\n");
+    std::fs::write(cases_path(d.path()), &moved).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 0, "within the manifest's max_abs 0.5: {}", c.stdout);
+    std::fs::write(cases_path(d.path()), format!("{moved}tolerances = {{ out = {{ max_abs = 0.1 }} }}\n")).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("max_abs 2.000e-1 is above 1.000e-1"), "the case's tolerance: {}", c.stdout);
+    std::fs::write(cases_path(d.path()), format!("{moved}tolerances = {{ nope = {{ max_abs = 0.1 }} }}\n")).unwrap();
+    assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["tolerances: nope names no output; outputs: out"]);
+}
+
 fn mutate_bad_input_is_refused() {
     let d = golden_dir(CASES);
     for (args, needle) in [
@@ -4395,6 +4442,7 @@ fn main() {
         Gpu a_group_of_passes_repeats_as_one_step,
         Gpu limits_are_reported_unsupported_by_name,
         Gpu each_backend_checks_into_its_own_report,
+        Gpu a_case_may_give_an_output_its_own_tolerance,
         Gpu per_backend_goldens_cover_every_output_of_a_graph,
         Gpu bless_from_report_accepts_what_another_clone_rendered,
         Gpu check_writes_junit_json_and_github_annotations,

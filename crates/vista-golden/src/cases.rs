@@ -61,6 +61,8 @@ struct RawCase {
     #[serde(default)]
     inputs: BTreeMap<String, String>,
     #[serde(default)]
+    tolerances: BTreeMap<String, toml::Value>,
+    #[serde(default)]
     doc: String,
 }
 
@@ -136,6 +138,9 @@ pub struct Case {
     /// A pass graph's resource files this case replaces: (resource, file
     /// under the project root).
     pub inputs: Vec<(String, String)>,
+    /// Tolerances this case gives some outputs instead of their manifest's
+    /// (`tolerances = { heights = { rmse = 0.002 } }`), by output name.
+    pub tolerances: Vec<(String, vista_kernels::graph::Tolerance)>,
     /// What the case covers, in a few words (`doc` in cases.toml).
     pub doc: String,
 }
@@ -240,6 +245,22 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
                 }
             }
         }
+        let mut tolerances = Vec::new();
+        for (name, v) in &raw.tolerances {
+            let outputs: Vec<&str> =
+                kernel.graph().map(|g| g.outputs.iter().map(|o| o.resource.as_str()).collect()).unwrap_or_default();
+            if outputs.is_empty() {
+                return Err(bad(format!(
+                    "tolerances: kernel {} has no [[output]] tables; a case's tolerance overrides one of theirs",
+                    kernel.name()
+                )));
+            }
+            if !outputs.contains(&name.as_str()) {
+                return Err(bad(format!("tolerances: {name} names no output; outputs: {}", outputs.join(", "))));
+            }
+            let t = vista_kernels::graph::parse_tolerance(v).map_err(|e| bad(format!("tolerances: {name}: {e}")))?;
+            tolerances.push((name.clone(), t));
+        }
         for x in &raw.expect_fail {
             if !EXPECTATION_BACKENDS.contains(&x.backend.as_str()) {
                 return Err(bad(format!(
@@ -269,6 +290,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             ignore: raw.ignore,
             expect_fail: raw.expect_fail,
             inputs: raw.inputs.into_iter().collect(),
+            tolerances,
             doc: raw.doc,
         });
     }

@@ -687,23 +687,26 @@ fn parse_outputs(
             Some(toml::Value::Boolean(b)) => *b,
             Some(other) => return Err(at(format!("partial = {other} is not valid; expected true or false"))),
         };
-        let tolerance = match t.get("tolerance") {
-            None => None,
-            Some(toml::Value::String(s)) if s == "exact" => Some(Tolerance::Exact),
-            Some(toml::Value::Table(tt)) => Some(tolerance(tt).map_err(at)?),
-            Some(other) => {
-                return Err(at(format!(
-                    "tolerance = {other} is not valid; expected \"exact\" or a table with one of {}",
-                    Tolerance::KEYS.join(", ")
-                )));
-            }
-        };
+        let tolerance = t.get("tolerance").map(parse_tolerance).transpose().map_err(at)?;
         if outs.iter().any(|o: &OutputSpec| o.resource == resource) {
             return Err(at("is listed twice".into()));
         }
         outs.push(OutputSpec { resource: resource.to_string(), view, partial, tolerance, exposure });
     }
     Ok(outs)
+}
+
+/// A tolerance as a manifest's `[[output]]` or a case's `tolerances` gives
+/// it: `"exact"`, or a table with one of [`Tolerance::KEYS`].
+pub fn parse_tolerance(v: &toml::Value) -> Result<Tolerance, String> {
+    match v {
+        toml::Value::String(s) if s == "exact" => Ok(Tolerance::Exact),
+        toml::Value::Table(t) => tolerance(t),
+        other => Err(format!(
+            "tolerance = {other} is not valid; expected \"exact\" or a table with one of {}",
+            Tolerance::KEYS.join(", ")
+        )),
+    }
 }
 
 fn tolerance(t: &toml::Table) -> Result<Tolerance, String> {
