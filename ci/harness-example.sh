@@ -31,4 +31,11 @@ echo "$out" | grep -q "golden::orphans.*FAILED\|---- golden::orphans" ||
     { echo "$out"; echo "harness-example: the orphaned golden did not fail golden::orphans"; exit 1; }
 echo "$out" | grep -q "gone.png" || { echo "$out"; echo "harness-example: golden::orphans did not name the file"; exit 1; }
 rm -f "$orphan"
+# A driver crash (injected) fails its case's test alone: the worker dies, the next case gets a new one.
+if out=$(VISTA_WORKER_FAULT=segv:glow "$cargo" test -q --test golden 2>&1); then
+    echo "$out"; echo "harness-example: a crashed case did not fail the run"; exit 1
+fi
+echo "$out" | grep -q "crashed (signal 11, SIGSEGV) in pass 1" ||
+    { echo "$out"; echo "harness-example: the crash was not named"; exit 1; }
+echo "$out" | grep -q "1 passed; 1 failed" || { echo "$out"; echo "harness-example: the other case did not pass"; exit 1; }
 echo "harness-example: the crate's own cargo test ran its 2 golden cases through vista::harness::main()"

@@ -34,6 +34,12 @@ pub struct Config {
     pub crate_dir: Option<PathBuf>,
     /// `VISTA_FAULT`: fault-injection plan for the write-path tests.
     pub fault: Option<String>,
+    /// `VISTA_WORKER_FAULT=<segv|abort|hang>:<case id>`: the worker
+    /// raises that fault on that case (tests of the crash path).
+    pub worker_fault: Option<(vista_render::worker::Fault, String)>,
+    /// GPU work in worker processes (`VISTA_WORKERS`, default 1; 0 runs it
+    /// in this process, where a driver crash ends the run).
+    pub workers: bool,
     /// `GITHUB_ACTIONS=true`: check also prints `::error` annotations.
     pub github_actions: bool,
     /// `MESA_SHADER_CACHE_DIR` is set: the user placed Mesa's shader cache,
@@ -75,7 +81,25 @@ fn truthy(name: &str, v: Option<String>) -> Result<bool, GoldenError> {
     vista_project::truthy(name, v.as_deref()).map_err(GoldenError::BadInput)
 }
 
+/// Serves as a GPU worker and exits, when another vista process started
+/// this one as one (`VISTA_WORKER`); call it first in `main`, before
+/// anything prints or reads arguments.
+pub fn serve_worker_if_asked() {
+    if std::env::var_os(vista_render::worker::WORKER_VAR).is_some() {
+        std::process::exit(vista_render::worker::serve_and_exit_code());
+    }
+}
+
 impl Config {
+    /// Runs this process's GPU work in workers re-executed from this very
+    /// binary (which calls `vista_render::worker::serve_if_asked` first),
+    /// unless `VISTA_WORKERS=0`.
+    pub fn start_workers(&self) {
+        if let (true, Ok(exe)) = (self.workers, std::env::current_exe()) {
+            vista_render::worker::enable(exe, self.worker_fault.clone());
+        }
+    }
+
     /// The configuration of `flags` over settings looked up by name: flags
     /// first, then the variables. A value that does not parse is bad input
     /// naming the variable and what is allowed.
@@ -125,6 +149,17 @@ impl Config {
             crate_dir: get("CARGO_MANIFEST_DIR").filter(|v| !v.is_empty()).map(PathBuf::from),
             github_actions: text("GITHUB_ACTIONS").is_some_and(|v| v.eq_ignore_ascii_case("true")),
             fault: text("VISTA_FAULT"),
+            worker_fault: match text("VISTA_WORKER_FAULT").filter(|v| !v.is_empty()) {
+                None => None,
+                Some(v) => Some(
+                    vista_render::worker::Fault::parse(&v)
+                        .map_err(|e| GoldenError::BadInput(format!("VISTA_WORKER_FAULT={v}: {e}")))?,
+                ),
+            },
+            workers: match text("VISTA_WORKERS").filter(|v| !v.is_empty()) {
+                None => true,
+                v => truthy("VISTA_WORKERS", v)?,
+            },
             mesa_cache_placed: get("MESA_SHADER_CACHE_DIR").is_some_and(|v| !v.is_empty()),
             vulkan_layers_chosen: ["VK_INSTANCE_LAYERS", "VK_LOADER_LAYERS_ENABLE", "VK_LOADER_LAYERS_DISABLE"]
                 .iter()

@@ -46,6 +46,8 @@ use vista_render::Renderer;
 
 /// Runs the project's golden cases as libtest tests and exits.
 pub fn main() -> ! {
+    // Started as a GPU worker by this very test binary: serve it, then exit.
+    crate::config::serve_worker_if_asked();
     let args = Arguments::from_args();
     let config = crate::Config::from_env(&crate::Flags::default()).unwrap_or_else(|e| fail(&e.to_string()));
     let cwd = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
@@ -83,6 +85,7 @@ fn fail(message: &str) -> ! {
 /// names the run in the report.
 pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
     let config = crate::Config::from_env(&crate::Flags::default()).unwrap_or_else(|e| fail(&e.to_string()));
+    config.start_workers();
     let store = Store::of_project(project, "the golden tests").unwrap_or_else(|e| fail(&e.to_string()));
     let cases = store.load_cases().unwrap_or_else(|e| fail(&format!("cannot load golden cases: {e}")));
     let manifest = Arc::new(store.manifest().unwrap_or_else(|e| fail(&format!("cannot load the manifest: {e}"))));

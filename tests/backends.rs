@@ -69,7 +69,7 @@ fn backends_agree(contexts: &[Context]) -> Result<(), String> {
     let shaders = vista_render::shader_set(&project).map_err(|e| e.to_string())?;
     let renderers: Vec<Renderer> = contexts
         .iter()
-        .map(|ctx| Renderer { ctx, shaders: shaders.clone(), limits: common::config().limits, root: None })
+        .map(|ctx| Renderer::with_shaders(ctx, shaders.clone(), common::config().limits, None))
         .collect();
     let pairs = [(0usize, 1usize), (0, 2), (1, 2)];
     let mut worst: std::collections::BTreeMap<(&str, usize), Worst> = Default::default();

@@ -91,7 +91,8 @@ pub fn with_edit(gpu: &Renderer<'static>, file: &str, from: &str, to: &str) -> R
         false => text,
     })
     .expect("the checkout's shaders");
-    Renderer { ctx: gpu.ctx, shaders, limits: gpu.limits, root: gpu.root.clone() }
+    // In this process: the edit is not a file a worker could rebuild.
+    Renderer { ctx: gpu.ctx, worker: None, edit: None, shaders, limits: gpu.limits, root: gpu.root.clone() }
 }
 
 /// Runs a file's GPU test functions, each named by itself (see

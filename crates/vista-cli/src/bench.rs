@@ -43,12 +43,8 @@ pub fn bench(
             None => format!("--cpu: kernel {kernel} has no CPU reference (only built-in kernels have one)"),
         }));
     }
-    let ctx = &Renderer {
-        ctx: Context::shared(&config.gpu)?,
-        shaders,
-        limits: config.limits,
-        root: project.root().map(Into::into),
-    };
+    let ctx =
+        &Renderer::with_shaders(Context::shared(&config.gpu)?, shaders, config.limits, project.root().map(Into::into));
     // GPU timestamps around each graph pass, where the device has them.
     ctx.time_passes(true);
     // Warm-up: compiles the pipeline and touches every allocation path once.

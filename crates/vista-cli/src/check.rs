@@ -42,6 +42,11 @@ fn print_case(o: &vista_golden::Outcome, report_dir: &Path) {
         Some((_, b)) => format!("  [golden @{}]", b.trim_end_matches(".png")),
         None => String::new(),
     };
+    if o.crashed {
+        // One block: what crashed, where, and that the run went on.
+        println!("CRASH {}: {}", o.id, o.problems.first().map(String::as_str).unwrap_or("the worker died"));
+        return;
+    }
     println!("{label:<6} {:<40} {:<17} {:>8.1} ms{per_backend}", o.id, o.headline(), o.gpu_ms);
     if !o.passed() {
         print!("{}", o.explain(report_dir));
@@ -135,6 +140,12 @@ pub fn check(
             if orphans.len() == 1 { "" } else { "s" }
         );
     }
+    // A crash is the driver's: bless cannot fix it.
+    let crashed: Vec<&str> = outcomes.iter().filter(|o| o.crashed).map(|o| o.id.as_str()).collect();
+    if !crashed.is_empty() {
+        println!("crashed: {} (the driver, not the kernel's output: see CRASH above)", crashed.join(", "));
+    }
+    let failing: Vec<&str> = failing.into_iter().filter(|id| !crashed.contains(id)).collect();
     if let Some(cmd) = vista_golden::bless_all_command(&failing) {
         println!("failed: {}", failing.join(", "));
         println!("if every change is intended, after reviewing the report: {cmd}");

@@ -256,6 +256,8 @@ fn die_quietly_on_closed_pipe() {
 }
 
 fn main() -> ExitCode {
+    // Started as a GPU worker by another vista process: serve it, then exit.
+    vista::config::serve_worker_if_asked();
     #[cfg(unix)]
     die_quietly_on_closed_pipe();
     let cli = Cli::parse();
@@ -341,6 +343,8 @@ fn main() -> ExitCode {
         // the instance, later.
         unsafe { std::env::set_var(name, value) };
     }
+    // Workers inherit the environment set above.
+    config.start_workers();
     match run(&project, &config, cli.command) {
         Ok(code) => ExitCode::from(code as u8),
         Err(e) => {

@@ -38,12 +38,7 @@ pub fn matrix(
                 continue;
             }
         };
-        let gpu = Renderer {
-            ctx: &ctx,
-            shaders: shaders.clone(),
-            limits: config.limits,
-            root: project.root().map(Into::into),
-        };
+        let gpu = Renderer::with_shaders(&ctx, shaders.clone(), config.limits, project.root().map(Into::into));
         let dir = report_dir.join(b);
         let checker =
             Checker { ctx: &gpu, store: &store, manifest: &manifest, report_dir: &dir, detail: Default::default() };

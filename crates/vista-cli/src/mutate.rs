@@ -107,12 +107,8 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
         ProgressStyle::with_template("{bar:40} {pos}/{len} mutants, {elapsed} elapsed, ETA {eta}")
             .expect("valid template"),
     );
-    let base = vista_render::Renderer {
-        ctx: &ctx,
-        shaders: shaders.clone(),
-        limits: config.limits,
-        root: project.root().map(Into::into),
-    };
+    let base =
+        vista_render::Renderer::with_shaders(&ctx, shaders.clone(), config.limits, project.root().map(Into::into));
     let results =
         vista_mutate::run(&base, project, &store, &cases, &planned, a.jobs, &|done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();

@@ -4334,6 +4334,62 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["tolerances: nope names no output; outputs: out"]);
 }
 
+/// GPU work runs in a worker process: a driver that dies by a signal, or
+/// hangs, fails the case it was running with one block and the next case
+/// gets a new worker (faults injected with VISTA_WORKER_FAULT, test-only).
+fn a_driver_crash_fails_one_case_not_the_run() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let goldens: Vec<Vec<u8>> = [("fbm", "a"), ("fbm", "b"), ("ridged", "c")]
+        .iter()
+        .map(|(k, c)| std::fs::read(golden(d.path(), k, c)).unwrap())
+        .collect();
+    let fault = |f: &str| vec![("VISTA_WORKER_FAULT", f.to_string())];
+    let with = |env: &[(&str, String)], args: &[&str]| {
+        let env: Vec<(&str, &str)> = env.iter().map(|(k, v)| (*k, v.as_str())).collect();
+        vista_in(Some(d.path()), &env, args)
+    };
+    let c = with(&fault("segv:a"), &["check", "--junit", "j.xml"]);
+    assert_eq!(c.code, 1, "{}{}", c.stdout, c.stderr);
+    let block = c.stdout.lines().find(|l| l.starts_with("CRASH a: ")).unwrap_or_else(|| panic!("{}", c.stdout));
+    for want in
+        ["the lavapipe driver (llvmpipe", "crashed (signal 11, SIGSEGV) in pass 1 (main, fbm.wgsl", "of kernel fbm"]
+    {
+        assert!(block.contains(want), "{want}: {block}");
+    }
+    assert!(c.stdout.contains("ok     b") && c.stdout.contains("ok     c"), "the others pass: {}", c.stdout);
+    assert!(c.stdout.contains("crashed: a") && !c.stdout.contains("vista bless --case 'a'"), "{}", c.stdout);
+    let junit = std::fs::read_to_string(d.path().join("j.xml")).unwrap();
+    let results = std::fs::read_to_string(d.path().join("target/vista-report/results.json")).unwrap();
+    for (name, text) in [("JUnit", &junit), ("results.json", &results)] {
+        assert!(text.contains("crashed (signal 11, SIGSEGV)"), "{name}: {text}");
+    }
+    let c = with(&fault("abort:b"), &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("CRASH b: ") && c.stdout.contains("(signal 6, SIGABRT)"), "{}", c.stdout);
+    assert!(c.stdout.contains("ok     a") && c.stdout.contains("ok     c"), "{}", c.stdout);
+    // A hung driver: killed after the watchdog, and replaced.
+    let env = [("VISTA_WORKER_FAULT", "hang:c".to_string()), ("VISTA_GPU_TIMEOUT_S", "1".to_string())];
+    let c = with(&env, &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("FAIL   c") && c.stdout.contains("GPU wait exceeded"), "{}", c.stdout);
+    assert!(c.stdout.contains("ok     a") && c.stdout.contains("ok     b"), "{}", c.stdout);
+    // bless refuses the crashed case and writes nothing.
+    let b = with(&fault("segv:b"), &["bless"]);
+    assert_eq!(b.code, 1, "{}{}", b.stdout, b.stderr);
+    assert!(format!("{}{}", b.stdout, b.stderr).contains("crashed (signal 11, SIGSEGV)"), "{}{}", b.stdout, b.stderr);
+    for ((k, c), bytes) in [("fbm", "a"), ("fbm", "b"), ("ridged", "c")].iter().zip(&goldens) {
+        assert_eq!(&std::fs::read(golden(d.path(), k, c)).unwrap(), bytes, "{c}.png unchanged");
+    }
+    // mutate checks the unmutated suite first: the crash is named.
+    let m = with(&fault("segv:a"), &["mutate", "--kernel", "fbm", "--sample", "1"]);
+    assert_rejected(&m, 2, &["case a fails before any mutation", "crashed (signal 11, SIGSEGV)"]);
+    // The matrix goes on past the crashed cell.
+    let x = with(&fault("segv:a"), &["check", "--matrix", "--case", "a"]);
+    assert_eq!(x.code, 1, "{}", x.stdout);
+    assert!(x.stdout.contains("matrix: 1 cases x 3 backends"), "{}", x.stdout);
+}
+
 fn mutate_bad_input_is_refused() {
     let d = golden_dir(CASES);
     for (args, needle) in [
@@ -4443,6 +4499,7 @@ fn main() {
         Gpu limits_are_reported_unsupported_by_name,
         Gpu each_backend_checks_into_its_own_report,
         Gpu a_case_may_give_an_output_its_own_tolerance,
+        Gpu a_driver_crash_fails_one_case_not_the_run,
         Gpu per_backend_goldens_cover_every_output_of_a_graph,
         Gpu bless_from_report_accepts_what_another_clone_rendered,
         Gpu check_writes_junit_json_and_github_annotations,

@@ -98,6 +98,9 @@ pub struct Outcome {
     /// Remarks that do not fail the case (another adapter, parameters changed
     /// since bless, an expected failure).
     pub notes: Vec<String>,
+    /// The render's worker process died: the driver crashed (the problem
+    /// says how and where). `vista check` prints it as a `CRASH` block.
+    pub crashed: bool,
     /// The report's images of the case; filled in by the caller (`vista-report`).
     pub files: ReportFiles,
     /// GPU wall time of the render in milliseconds; filled in by the caller.
@@ -219,6 +222,19 @@ impl Outcome {
                 self.run.backend, self.run.backend
             );
         }
+        if self.crashed {
+            return format!(
+                "the driver crashed, not the kernel's output (bless cannot fix it): report it to the driver's \
+                 makers; if {} cannot run the case, expect it in golden/cases.toml: expect_fail = [{{ backend = \
+                 \"{}\", reason = \"...\" }}]",
+                self.run.backend, self.run.backend
+            );
+        }
+        if text.contains("GPU wait exceeded") {
+            return "the kernel did not finish within the watchdog (bless cannot fix it): lower its size or step \
+                    counts, or raise VISTA_GPU_TIMEOUT_S"
+                .into();
+        }
         if self.verdict == Verdict::Error
             && ["WGSL error", "WESL error", "naga validation failed", "#include"].iter().any(|w| text.contains(w))
         {
@@ -329,6 +345,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
         max_flip: case.max_flip,
         problems: Vec::new(),
         notes: Vec::new(),
+        crashed: false,
         files: ReportFiles::default(),
         gpu_ms: 0.0,
         bless_command: case.bless_command(),

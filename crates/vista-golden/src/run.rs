@@ -146,9 +146,11 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     let r = match render_case(ctx, case) {
         Ok(r) => r,
         Err(e) => {
+            let mut outcome = judge(case, entry, run, Err(e.to_string()));
+            outcome.crashed = matches!(e, vista_render::RenderError::Crashed(_));
             return Checked {
                 timed_out: e.is_timeout(),
-                outcome: judge(case, entry, run, Err(e.to_string())),
+                outcome,
                 actual: None,
                 expected: None,
                 pending: None,
@@ -331,7 +333,9 @@ pub fn in_order<T: Sync, R: Send>(
 
 /// Renders a case: its kernel, params, size and replacement inputs.
 pub fn render_case(ctx: &Renderer, case: &Case) -> Result<Rendered, vista_render::RenderError> {
-    render_with(ctx, &case.kernel, &case.params, &case.inputs, case.width, case.height)
+    vista_render::for_case(&case.id, || {
+        render_with(ctx, &case.kernel, &case.params, &case.inputs, case.width, case.height)
+    })
 }
 
 /// Whether two renders are bit-identical in every output.

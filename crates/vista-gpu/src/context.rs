@@ -12,7 +12,7 @@ use vista_texel::Format;
 
 /// Which adapter to ask for. Software adapters are chosen by name, never
 /// by whichever CPU driver the Vulkan loader lists first.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum AdapterChoice {
     /// Mesa's lavapipe (device "llvmpipe"). Reproducible; the default.
     Lavapipe,
@@ -159,7 +159,7 @@ pub const SWIFTSHADER_HINT: &str = "install Google's SwiftShader Vulkan ICD with
 (it extracts libvk_swiftshader.so from Debian's chromium-common); set VISTA_ALLOW_NO_GPU=1 to skip GPU tests loudly";
 
 /// Timing of one run, excluding device creation and shader compilation.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct RunStats {
     /// Submit to completion of the compute pass and readback copy.
     pub gpu_wall: Duration,
@@ -189,9 +189,14 @@ pub struct Context {
     pub creation_time: Duration,
     /// Whether the Khronos validation layer is on.
     pub(crate) validate: bool,
+    /// What it was made from.
+    config: GpuConfig,
     /// Whether graph passes read GPU timestamps (`vista bench` turns it
     /// on): a readback per pass run, which checks need not pay.
     pub(crate) time_passes: std::sync::atomic::AtomicBool,
+    /// Called with each pass's label just before it is submitted (a worker
+    /// process reports it, so a driver crash names the pass it died in).
+    pub(crate) on_pass: Mutex<Option<PassHook>>,
     /// Nanoseconds spent creating shader modules and pipelines (the
     /// driver's compile; a warm Mesa shader cache makes it short).
     pub(crate) compile_nanos: std::sync::atomic::AtomicU64,
@@ -206,6 +211,9 @@ impl Drop for CountInto<'_> {
         self.0.fetch_add(self.1.elapsed().as_nanos() as u64, std::sync::atomic::Ordering::Relaxed);
     }
 }
+
+/// See [`Context::on_pass`].
+pub type PassHook = Arc<dyn Fn(&str) + Send + Sync>;
 
 pub(crate) enum Engine {
     Wgpu(Box<WgpuEngine>),
@@ -352,7 +360,9 @@ impl Context {
             submit_lock: Mutex::new(()),
             creation_time: start.elapsed(),
             validate,
+            config: config.clone(),
             time_passes: Default::default(),
+            on_pass: Mutex::new(None),
             compile_nanos: Default::default(),
         })
     }
@@ -385,7 +395,14 @@ impl Context {
             submit_lock: Mutex::new(()),
             creation_time: start.elapsed(),
             validate: false,
+            config: GpuConfig {
+                adapter: AdapterChoice::Browser,
+                timeout,
+                browser: config.clone(),
+                ..Default::default()
+            },
             time_passes: Default::default(),
+            on_pass: Mutex::new(None),
             compile_nanos: Default::default(),
         })
     }
@@ -397,10 +414,28 @@ impl Context {
         self.time_passes.store(on, std::sync::atomic::Ordering::Relaxed);
     }
 
+    /// The configuration it was made from (with the watchdog
+    /// [`Context::with_timeout`] set).
+    pub fn config(&self) -> &GpuConfig {
+        &self.config
+    }
+
+    /// Whether [`Context::time_passes`] is on.
+    pub fn timing_passes(&self) -> bool {
+        self.time_passes.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Calls `hook` with each pass's label just before the pass is
+    /// submitted (wgpu engines), or stops calling one (`None`).
+    pub fn on_pass(&self, hook: Option<PassHook>) {
+        *self.on_pass.lock().expect("pass hook") = hook;
+    }
+
     /// The same context with another GPU watchdog (mutation runs use a short
     /// one: a mutant can loop for ever).
     pub fn with_timeout(mut self, timeout: Duration) -> Context {
         self.timeout = timeout;
+        self.config.timeout = timeout;
         if let Engine::Browser(b) = &mut self.engine {
             b.browser.set_timeout(timeout);
         }

@@ -16,7 +16,7 @@ use crate::context::{Context, Engine, RunStats};
 use crate::shaders::ShaderSet;
 
 /// What a texture holds before the first pass.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Contents {
     /// Zeros (a resource with no file).
     Zeros,
@@ -29,9 +29,9 @@ pub enum Contents {
 }
 
 /// A texture resource.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TextureDesc {
-    /// The storage format's WGSL name (one of [`crate::format_names`]).
+    /// The storage format's WGSL name (one of `vista_texel::format_names`).
     pub format: &'static str,
     /// The texture's dimension.
     pub dimension: Dimension,
@@ -46,7 +46,7 @@ pub struct TextureDesc {
 }
 
 /// A sampler's address mode along one axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Address {
     /// Coordinates outside [0, 1] clamp to the edge texel (`clamp-to-edge`).
     ClampToEdge,
@@ -93,7 +93,7 @@ pub(crate) fn compare_fn(name: &str) -> Option<wgpu::CompareFunction> {
 }
 
 /// A sampler resource.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize)]
 pub struct SamplerDesc {
     /// Linear filtering (else nearest), for magnification, minification
     /// and mips alike.
@@ -104,8 +104,52 @@ pub struct SamplerDesc {
     pub compare: Option<&'static str>,
 }
 
+// Names as the tables' own `&'static str`s (what plans hold): read as
+// strings and looked up, so a worker's graph is the plan's.
+#[derive(serde::Deserialize)]
+struct TextureWire {
+    format: String,
+    dimension: Dimension,
+    width: u32,
+    height: u32,
+    layers: u32,
+    contents: Contents,
+}
+
+impl<'de> serde::Deserialize<'de> for TextureDesc {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<TextureDesc, D::Error> {
+        let w = TextureWire::deserialize(d)?;
+        let format = vista_texel::Format::parse(&w.format).map_err(serde::de::Error::custom)?.name;
+        let TextureWire { dimension, width, height, layers, contents, .. } = w;
+        Ok(TextureDesc { format, dimension, width, height, layers, contents })
+    }
+}
+
+#[derive(serde::Deserialize)]
+struct SamplerWire {
+    linear: bool,
+    address: [Address; 3],
+    compare: Option<String>,
+}
+
+impl<'de> serde::Deserialize<'de> for SamplerDesc {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<SamplerDesc, D::Error> {
+        let w = SamplerWire::deserialize(d)?;
+        let compare = match &w.compare {
+            None => None,
+            Some(name) => Some(
+                *COMPARE_NAMES
+                    .iter()
+                    .find(|n| *n == name)
+                    .ok_or_else(|| serde::de::Error::custom(format!("unknown compare function {name}")))?,
+            ),
+        };
+        Ok(SamplerDesc { linear: w.linear, address: w.address, compare })
+    }
+}
+
 /// A resource of the graph.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Resource {
     /// A texture.
     Texture(TextureDesc),
@@ -116,7 +160,7 @@ pub enum Resource {
 }
 
 /// What feeds one binding of a pass.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Bind {
     /// A uniform block's bytes, packed for this pass.
     Uniform(Vec<u8>),
@@ -167,7 +211,7 @@ impl Bind {
 }
 
 /// One binding of a pass.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GraphSlot {
     /// The WGSL `@group` index.
     pub group: u32,
@@ -182,7 +226,7 @@ pub struct GraphSlot {
 /// runs itself and the n - 1 passes after it, in order, `repeat` times (a
 /// group; its later passes have span 0 and are run by it); span 1 is a
 /// pass alone.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GraphPass {
     /// Names the pass in errors and timings (e.g. `flux (pass 2)`).
     pub label: String,

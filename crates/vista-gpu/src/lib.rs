@@ -18,8 +18,8 @@ pub mod validation;
 mod wgpu_run;
 
 pub use context::{
-    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, GpuConfig, RunStats, SWIFTSHADER_HINT,
-    VALIDATION_LAYER_JSON,
+    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, GpuConfig, PassHook, RunStats,
+    SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
 };
 pub use graph::{
     Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Readback, Resource, SamplerDesc,

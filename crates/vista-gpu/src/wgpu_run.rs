@@ -171,6 +171,7 @@ impl Context {
         .then(|| Stamps::new(w));
         let mut gpu_times = vec![Duration::ZERO; g.passes.len()];
         let _serial = self.submit_lock.lock().expect("submit lock");
+        let hook = self.on_pass.lock().expect("pass hook").clone();
         for (pi, pass, compiled) in run_order(&g.passes).into_iter().map(|i| (i, &g.passes[i], &pipelines[i])) {
             let pass_start = Instant::now();
             {
@@ -183,6 +184,9 @@ impl Context {
                 }
                 if let Some(e) = pollster::block_on(scope.pop()) {
                     return Err(GpuError::Validation { what: pass.label.clone(), message: e.to_string() });
+                }
+                if let Some(hook) = &hook {
+                    hook(&pass.label);
                 }
                 let index = w.queue.submit([encoder.finish()]);
                 self.wait(w, index, &pass.label)?;

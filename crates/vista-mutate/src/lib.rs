@@ -500,6 +500,8 @@ pub fn run(
             let text = texts.get(&m.file).map(|t| m.apply(t)).unwrap_or_default();
             let gpu = Renderer {
                 ctx: base.ctx,
+                worker: base.worker.clone(),
+                edit: Some((m.file.clone(), text.clone())),
                 shaders: sources.with_file("mutant", &m.file, text),
                 limits: base.limits,
                 root: base.root.clone(),

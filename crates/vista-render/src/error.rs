@@ -16,6 +16,9 @@ pub enum RenderError {
     /// An image could not be read, written or compared.
     #[error(transparent)]
     Image(#[from] vista_image::ImageError),
+    /// The worker process running the graph died: the driver crashed.
+    #[error("{0}")]
+    Crashed(Box<Crash>),
     /// A file or directory could not be used.
     #[error("{path}: {message}")]
     Io {
@@ -24,6 +27,22 @@ pub enum RenderError {
         /// What went wrong.
         message: String,
     },
+}
+
+/// A worker that died while running a graph.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("the {backend} driver ({adapter}) crashed ({how}) in {pass} of kernel {kernel}")]
+pub struct Crash {
+    /// lavapipe | swiftshader | gpu.
+    pub backend: String,
+    /// The adapter's description (name, driver and version).
+    pub adapter: String,
+    /// `signal 11, SIGSEGV` and the like.
+    pub how: String,
+    /// The pass it was running (`pass 1 (main, fbm.wgsl)`).
+    pub pass: String,
+    /// The kernel.
+    pub kernel: String,
 }
 
 impl RenderError {
@@ -37,7 +56,7 @@ impl RenderError {
         match self {
             RenderError::BadInput(_) | RenderError::Project(_) | RenderError::Image(_) | RenderError::Io { .. } => 2,
             RenderError::Gpu(vista_gpu::GpuError::Request(_)) => 2,
-            RenderError::Gpu(_) => 1,
+            RenderError::Gpu(_) | RenderError::Crashed(_) => 1,
         }
     }
 }

@@ -15,8 +15,9 @@ mod error;
 pub mod graph;
 mod one_pass;
 mod reflect;
+pub mod worker;
 
-pub use error::RenderError;
+pub use error::{Crash, RenderError};
 pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
@@ -112,6 +113,12 @@ pub fn check_request(
 pub struct Renderer<'a> {
     /// The process's device (or browser).
     pub ctx: &'a Context,
+    /// Where its graphs run instead, when GPU work runs in a worker process
+    /// ([`worker`]); the context then only describes the device.
+    pub worker: Option<std::sync::Arc<worker::Worker>>,
+    /// The one file of the project `shaders` replaces (a mutant), so a
+    /// worker can compose the same set.
+    pub edit: Option<(String, String)>,
     /// The project's WGSL over the built-ins.
     pub shaders: ShaderSet,
     /// Bounds every render is held to.
@@ -135,7 +142,25 @@ impl<'a> Renderer<'a> {
         project: &vista_project::Project,
         limits: RenderLimits,
     ) -> Result<Renderer<'a>, RenderError> {
-        Ok(Renderer { ctx, shaders: shader_set(project)?, limits, root: project.root().map(Into::into) })
+        Ok(Renderer {
+            ctx,
+            worker: worker::Worker::for_config(ctx.config()),
+            edit: None,
+            shaders: shader_set(project)?,
+            limits,
+            root: project.root().map(Into::into),
+        })
+    }
+
+    /// A renderer over `shaders` (with a worker for the context's
+    /// configuration when GPU work runs in worker processes).
+    pub fn with_shaders(
+        ctx: &'a Context,
+        shaders: ShaderSet,
+        limits: RenderLimits,
+        root: Option<std::path::PathBuf>,
+    ) -> Renderer<'a> {
+        Renderer { ctx, worker: worker::Worker::for_config(ctx.config()), edit: None, shaders, limits, root }
     }
 
     /// A renderer on the process's shared context (made from `gpu` on
@@ -146,6 +171,11 @@ impl<'a> Renderer<'a> {
         limits: RenderLimits,
     ) -> Result<Renderer<'static>, RenderError> {
         Renderer::new(Context::shared(gpu)?, project, limits)
+    }
+
+    /// Time spent so far compiling pipelines, here or in workers.
+    pub fn compile_time(&self) -> Duration {
+        self.ctx.compile_time() + self.worker.as_ref().map_or(Duration::ZERO, |w| w.compile_time())
     }
 
     /// Provenance hash of a kernel file and its imports.
@@ -424,14 +454,35 @@ impl OutputRender {
     }
 }
 
-/// Runs a plan on the renderer's engine.
+thread_local! {
+    /// The case this thread renders (named in a crash, matched by a fault).
+    static CASE: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` with renders on this thread counted as case `id`'s.
+pub fn for_case<R>(id: &str, f: impl FnOnce() -> R) -> R {
+    let before = CASE.with(|c| c.replace(Some(id.to_string())));
+    let out = f();
+    CASE.with(|c| *c.borrow_mut() = before);
+    out
+}
+
+/// Runs a plan on the renderer's engine (in its worker process, if it has one).
 pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
-    let out = gpu.ctx.run(&vista_gpu::Graph {
+    let graph = vista_gpu::Graph {
         shaders: &gpu.shaders,
         resources: plan.resources.clone(),
         passes: plan.passes.clone(),
         outputs: plan.output_ids.clone(),
-    })?;
+    };
+    let out = match &gpu.worker {
+        Some(w) => {
+            let source = worker::ShaderSource { root: gpu.root.clone(), edit: gpu.edit.clone() };
+            let case = CASE.with(|c| c.borrow().clone());
+            w.run(gpu.ctx, &graph, &source, &plan.kernel, case.as_deref())?
+        }
+        None => gpu.ctx.run(&graph)?,
+    };
     let outputs: Vec<OutputRender> = plan
         .outputs
         .iter()

@@ -18,7 +18,7 @@ pub use format::{Format, SampleKind, format_names};
 pub const UNWRITTEN: u32 = 0x7FC0_DEAD;
 
 /// A texture's dimension, as manifests and WebGPU's view dimensions spell it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Dimension {
     /// `1d`.
     D1,
@@ -102,7 +102,7 @@ impl Dimension {
 }
 
 /// How a pass may use a storage texture.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Access {
     /// WGSL `write` (WebGPU `write-only`).
     Write,

@@ -1,0 +1,558 @@
+//! GPU work in a worker process (SPEC 14 "Crashes", SPEC 16): a driver that
+//! crashes (lavapipe segfaults in its queue thread on some kernels) or hangs
+//! takes down the worker, not the run. The binary (and `vista::harness`'s
+//! test binary) re-executes itself with `VISTA_WORKER=1`; that process owns
+//! a device and runs the graphs the parent plans ([`Worker::run`]), one at
+//! a time, reporting each pass before it is submitted. When it dies by a
+//! signal the case it was running fails with [`RenderError::Crashed`]
+//! (naming the signal and the pass), when it stops answering it is killed
+//! ([`vista_gpu::GpuError::Timeout`]), and the next run starts a new one.
+//!
+//! The wire: each message is a little-endian u32 length and that much JSON,
+//! then a little-endian u64 length and that many bytes (a run's outputs,
+//! raw: texels as f32 RGBA, buffers as they are).
+
+use std::io::{BufReader, Read, Write};
+use std::path::PathBuf;
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
+use vista_gpu::{Context, GpuConfig, GpuError, OutputData, Readback, RunStats};
+use vista_image::Image;
+
+use crate::RenderError;
+
+/// The variable that makes the binary a worker.
+pub const WORKER_VAR: &str = "VISTA_WORKER";
+
+/// A fault a worker raises on purpose (tests of the crash path), set by
+/// `VISTA_WORKER_FAULT=<segv|abort|hang>:<case id>` through `vista::Config`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Fault {
+    /// `raise(SIGSEGV)`, as a driver's bad pointer would.
+    Segv,
+    /// `abort()` (SIGABRT), as a driver's failed assertion would.
+    Abort,
+    /// Never answers, as a hung driver would.
+    Hang,
+}
+
+impl Fault {
+    /// `segv:<case>` and the like, or the error naming what is allowed.
+    pub fn parse(text: &str) -> Result<(Fault, String), String> {
+        let (kind, case) = text.split_once(':').unwrap_or((text, ""));
+        let fault = match kind {
+            "segv" => Fault::Segv,
+            "abort" => Fault::Abort,
+            "hang" => Fault::Hang,
+            other => return Err(format!("'{other}' is not a fault; expected segv|abort|hang:<case id>")),
+        };
+        if case.is_empty() {
+            return Err(format!("'{text}' names no case; expected {kind}:<case id>"));
+        }
+        Ok((fault, case.to_string()))
+    }
+}
+
+/// How the worker rebuilds the parent's shaders: the project root (none:
+/// the built-ins alone) and the one file a mutant replaces.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ShaderSource {
+    /// The project root.
+    pub root: Option<PathBuf>,
+    /// A file's path (as `Sources::with_file` takes it) and its text.
+    pub edit: Option<(String, String)>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct WireConfig {
+    adapter: vista_gpu::AdapterChoice,
+    validate: bool,
+    timeout: Duration,
+    wgpu_backends: Option<String>,
+}
+
+#[derive(Serialize, Deserialize)]
+enum ToWorker {
+    Init(WireConfig),
+    Run {
+        source: ShaderSource,
+        resources: Vec<vista_gpu::Resource>,
+        passes: Vec<vista_gpu::GraphPass>,
+        outputs: Vec<usize>,
+        /// Each pass's source hash in the parent's set: a worker whose set
+        /// differs (a file saved since it read the project) reads it again.
+        hashes: Vec<String>,
+        time_passes: bool,
+        fault: Option<Fault>,
+    },
+}
+
+#[derive(Serialize, Deserialize)]
+enum FromWorker {
+    Ready,
+    Failed(String),
+    Pass(String),
+    Done(Result<ReadbackHead, WireError>),
+}
+
+/// A readback without its bytes (they follow the message).
+#[derive(Serialize, Deserialize)]
+struct ReadbackHead {
+    /// Per output: a texture's (width, height, unwritten), or a buffer's length.
+    outputs: Vec<Result<(u32, u32, u64), usize>>,
+    stats: RunStats,
+    pass_times: Vec<Duration>,
+    pass_gpu_times: Vec<Option<Duration>>,
+    compile: Duration,
+}
+
+/// A [`GpuError`] as it crosses the pipe (`NoAdapter`'s hint is static:
+/// it arrives as a device error with its text).
+#[derive(Serialize, Deserialize)]
+enum WireError {
+    Shader(String),
+    Validation { what: String, message: String },
+    Timeout { what: String, seconds: f64 },
+    Request(String),
+    Unsupported { adapter: String, what: String, feature: String },
+    Device { adapter: String, message: String },
+}
+
+impl From<GpuError> for WireError {
+    fn from(e: GpuError) -> WireError {
+        match e {
+            GpuError::Shader(m) => WireError::Shader(m),
+            GpuError::Validation { what, message } => WireError::Validation { what, message },
+            GpuError::Timeout { what, seconds } => WireError::Timeout { what, seconds },
+            GpuError::Request(m) => WireError::Request(m),
+            GpuError::Unsupported { adapter, what, feature } => WireError::Unsupported { adapter, what, feature },
+            GpuError::Device { adapter, message } => WireError::Device { adapter, message },
+            e @ GpuError::NoAdapter { .. } => WireError::Device { adapter: "worker".into(), message: e.to_string() },
+        }
+    }
+}
+
+impl From<WireError> for GpuError {
+    fn from(e: WireError) -> GpuError {
+        match e {
+            WireError::Shader(m) => GpuError::Shader(m),
+            WireError::Validation { what, message } => GpuError::Validation { what, message },
+            WireError::Timeout { what, seconds } => GpuError::Timeout { what, seconds },
+            WireError::Request(m) => GpuError::Request(m),
+            WireError::Unsupported { adapter, what, feature } => GpuError::Unsupported { adapter, what, feature },
+            WireError::Device { adapter, message } => GpuError::Device { adapter, message },
+        }
+    }
+}
+
+fn send<T: Serialize>(w: &mut impl Write, msg: &T, bytes: &[u8]) -> std::io::Result<()> {
+    let head = serde_json::to_vec(msg).expect("wire messages serialize");
+    w.write_all(&(head.len() as u32).to_le_bytes())?;
+    w.write_all(&head)?;
+    w.write_all(&(bytes.len() as u64).to_le_bytes())?;
+    w.write_all(bytes)?;
+    w.flush()
+}
+
+fn receive<T: for<'de> Deserialize<'de>>(r: &mut impl Read) -> std::io::Result<(T, Vec<u8>)> {
+    let mut n = [0u8; 4];
+    r.read_exact(&mut n)?;
+    let mut head = vec![0u8; u32::from_le_bytes(n) as usize];
+    r.read_exact(&mut head)?;
+    let mut m = [0u8; 8];
+    r.read_exact(&mut m)?;
+    let mut bytes = vec![0u8; u64::from_le_bytes(m) as usize];
+    r.read_exact(&mut bytes)?;
+    let msg = serde_json::from_slice(&head).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
+    Ok((msg, bytes))
+}
+
+/// Serves as a worker (the edge calls it when [`WORKER_VAR`] is set, first
+/// in `main`): reads requests on stdin until it closes; the exit code.
+pub fn serve_and_exit_code() -> i32 {
+    match serve() {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("vista worker: {e}");
+            3
+        }
+    }
+}
+
+fn serve() -> std::io::Result<()> {
+    let mut input = BufReader::new(std::io::stdin().lock());
+    let out = Arc::new(Mutex::new(std::io::stdout()));
+    let (first, _) = receive::<ToWorker>(&mut input)?;
+    let ToWorker::Init(c) = first else {
+        return Err(std::io::Error::other("the first request must be Init"));
+    };
+    let config = GpuConfig {
+        adapter: c.adapter,
+        validate: c.validate,
+        timeout: c.timeout,
+        wgpu_backends: c.wgpu_backends,
+        ..Default::default()
+    };
+    let ctx = match Context::new(&config) {
+        Ok(ctx) => ctx,
+        Err(e) => return send(&mut *out.lock().expect("stdout"), &FromWorker::Failed(e.to_string()), &[]),
+    };
+    send(&mut *out.lock().expect("stdout"), &FromWorker::Ready, &[])?;
+    let mut sets: Option<(ShaderSource, vista_gpu::ShaderSet)> = None;
+    let mut sources: Option<(Option<PathBuf>, crate::Sources)> = None;
+    loop {
+        let request = match receive::<ToWorker>(&mut input) {
+            Ok((r, _)) => r,
+            // The parent closed the pipe: the run is over.
+            Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Ok(()),
+            Err(e) => return Err(e),
+        };
+        let ToWorker::Run { source, resources, passes, outputs, hashes, time_passes, fault } = request else {
+            return Err(std::io::Error::other("Init twice"));
+        };
+        let same = |set: &vista_gpu::ShaderSet| {
+            passes.iter().zip(&hashes).all(|(p, h)| set.source_hash(&p.shader).is_ok_and(|mine| mine == *h))
+        };
+        let kept = sets.as_ref().filter(|(s, set)| *s == source && same(set)).map(|(_, set)| set.clone());
+        let shaders = match kept {
+            Some(set) => set,
+            None => {
+                // From the project as read, else as it is now on disk.
+                let mut built = shader_set(&source, &mut sources).map_err(|e| WireError::Shader(e.to_string()));
+                if built.as_ref().is_ok_and(|set| !same(set)) {
+                    sources = None;
+                    built = shader_set(&source, &mut sources).map_err(|e| WireError::Shader(e.to_string()));
+                }
+                let built = built.and_then(|set| match same(&set) {
+                    true => Ok(set),
+                    false => Err(WireError::Request(
+                        "the worker's shaders differ from the parent's (a file changed during the run?)".into(),
+                    )),
+                });
+                match built {
+                    Ok(set) => {
+                        sets = Some((source.clone(), set.clone()));
+                        set
+                    }
+                    Err(err) => {
+                        send(&mut *out.lock().expect("stdout"), &FromWorker::Done(Err(err)), &[])?;
+                        continue;
+                    }
+                }
+            }
+        };
+        let reporter = out.clone();
+        ctx.on_pass(Some(Arc::new(move |label: &str| {
+            let _ = send(&mut *reporter.lock().expect("stdout"), &FromWorker::Pass(label.to_string()), &[]);
+            match fault {
+                Some(Fault::Segv) => {
+                    // SAFETY: the default action (a handler a library
+                    // installed could return), then the signal: what the
+                    // fault asks for.
+                    unsafe {
+                        libc::signal(libc::SIGSEGV, libc::SIG_DFL);
+                        libc::raise(libc::SIGSEGV);
+                    }
+                }
+                Some(Fault::Abort) => std::process::abort(),
+                Some(Fault::Hang) => loop {
+                    std::thread::sleep(Duration::from_secs(3600));
+                },
+                None => {}
+            }
+        })));
+        ctx.time_passes(time_passes);
+        let before = ctx.compile_time();
+        let result = ctx.run(&vista_gpu::Graph { shaders: &shaders, resources, passes, outputs });
+        let compile = ctx.compile_time().saturating_sub(before);
+        let mut out = out.lock().expect("stdout");
+        match result {
+            Err(e) => send(&mut *out, &FromWorker::Done(Err(e.into())), &[])?,
+            Ok(r) => {
+                let mut bytes = Vec::new();
+                let mut heads = Vec::new();
+                for o in &r.outputs {
+                    match o {
+                        OutputData::Texture { image, unwritten } => {
+                            heads.push(Ok((image.width, image.height, *unwritten)));
+                            bytes.extend(image.data.iter().flat_map(|px| px.iter().flat_map(|c| c.to_le_bytes())));
+                        }
+                        OutputData::Buffer(b) => {
+                            heads.push(Err(b.len()));
+                            bytes.extend_from_slice(b);
+                        }
+                    }
+                }
+                let head = ReadbackHead {
+                    outputs: heads,
+                    stats: r.stats,
+                    pass_times: r.pass_times,
+                    pass_gpu_times: r.pass_gpu_times,
+                    compile,
+                };
+                send(&mut *out, &FromWorker::Done(Ok(head)), &bytes)?
+            }
+        }
+    }
+}
+
+/// The worker's shader set for `source`, reading the project once.
+fn shader_set(
+    source: &ShaderSource,
+    cache: &mut Option<(Option<PathBuf>, crate::Sources)>,
+) -> Result<vista_gpu::ShaderSet, RenderError> {
+    if cache.as_ref().is_none_or(|(root, _)| *root != source.root) {
+        let project = match &source.root {
+            Some(root) => vista_project::Project::at(root)?,
+            None => vista_project::Project::builtin_only(),
+        };
+        *cache = Some((source.root.clone(), crate::Sources::of(&project)?));
+    }
+    let sources = &cache.as_ref().expect("just filled").1;
+    Ok(match &source.edit {
+        None => sources.shader_set(),
+        Some((rel, text)) => sources.with_file("mutant", rel, text.clone()),
+    })
+}
+
+enum Heard {
+    Message(FromWorker, Vec<u8>),
+    Gone,
+}
+
+struct Proc {
+    child: Child,
+    stdin: ChildStdin,
+    heard: Receiver<Heard>,
+}
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The parent's side: worker processes started on first use, one per
+/// thread rendering at once (`check --jobs`: each job its own, as each had
+/// its own share of one device before), kept idle between runs, and
+/// replaced after one died.
+pub struct Worker {
+    exe: PathBuf,
+    config: GpuConfig,
+    /// The case whose run raises this fault (tests).
+    fault: Option<(Fault, String)>,
+    idle: Mutex<Vec<Proc>>,
+    compile: Mutex<Duration>,
+}
+
+/// What started the worker mode: this binary, and a fault to inject.
+struct Mode {
+    exe: PathBuf,
+    fault: Option<(Fault, String)>,
+}
+
+static MODE: OnceLock<Mode> = OnceLock::new();
+static WORKERS: Mutex<Vec<Arc<Worker>>> = Mutex::new(Vec::new());
+
+/// Runs GPU work of this process in workers started from `exe` (this
+/// binary, which calls [`serve_if_asked`] first), raising `fault` on a
+/// named case. Renderers made after this get a worker for wgpu backends.
+pub fn enable(exe: PathBuf, fault: Option<(Fault, String)>) {
+    let _ = MODE.set(Mode { exe, fault });
+}
+
+impl Worker {
+    /// The worker for `config`, when worker mode is on and the backend runs
+    /// in this process (the browser backend is Chromium, already a process
+    /// of its own): one per configuration, for the process's life.
+    pub fn for_config(config: &GpuConfig) -> Option<Arc<Worker>> {
+        let mode = MODE.get()?;
+        if config.adapter == vista_gpu::AdapterChoice::Browser {
+            return None;
+        }
+        let mut all = WORKERS.lock().expect("workers");
+        if let Some(w) = all.iter().find(|w| w.config == *config) {
+            return Some(w.clone());
+        }
+        let w = Arc::new(Worker {
+            exe: mode.exe.clone(),
+            config: config.clone(),
+            fault: mode.fault.clone(),
+            idle: Mutex::new(Vec::new()),
+            compile: Mutex::new(Duration::ZERO),
+        });
+        all.push(w.clone());
+        Some(w)
+    }
+
+    /// Time the workers spent compiling pipelines so far.
+    pub fn compile_time(&self) -> Duration {
+        *self.compile.lock().expect("compile time")
+    }
+
+    fn start(&self) -> Result<Proc, RenderError> {
+        let failed = |m: String| RenderError::Gpu(GpuError::Device { adapter: "vista worker".into(), message: m });
+        let mut child = Command::new(&self.exe)
+            .env(WORKER_VAR, "1")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .map_err(|e| failed(format!("cannot start {}: {e}", self.exe.display())))?;
+        let mut stdin = child.stdin.take().expect("piped");
+        let mut stdout = BufReader::new(child.stdout.take().expect("piped"));
+        let (tx, heard) = channel();
+        std::thread::spawn(move || {
+            loop {
+                match receive::<FromWorker>(&mut stdout) {
+                    Ok((m, bytes)) => {
+                        if tx.send(Heard::Message(m, bytes)).is_err() {
+                            return;
+                        }
+                    }
+                    Err(_) => {
+                        let _ = tx.send(Heard::Gone);
+                        return;
+                    }
+                }
+            }
+        });
+        let c = &self.config;
+        let init = ToWorker::Init(WireConfig {
+            adapter: c.adapter.clone(),
+            validate: c.validate,
+            timeout: c.timeout,
+            wgpu_backends: c.wgpu_backends.clone(),
+        });
+        send(&mut stdin, &init, &[]).map_err(|e| failed(format!("cannot talk to the worker: {e}")))?;
+        let mut proc = Proc { child, stdin, heard };
+        // Device creation: the watchdog's time, and then some.
+        match proc.heard.recv_timeout(c.timeout + Duration::from_secs(30)) {
+            Ok(Heard::Message(FromWorker::Ready, _)) => Ok(proc),
+            Ok(Heard::Message(FromWorker::Failed(m), _)) => Err(failed(m)),
+            _ => {
+                let status = proc.child.try_wait().ok().flatten();
+                Err(failed(format!("the worker did not start ({})", describe_exit(status))))
+            }
+        }
+    }
+
+    /// Runs `graph` in the worker; `kernel` and `case` name it in a crash.
+    pub fn run(
+        &self,
+        ctx: &Context,
+        graph: &vista_gpu::Graph<'_>,
+        source: &ShaderSource,
+        kernel: &str,
+        case: Option<&str>,
+    ) -> Result<Readback, RenderError> {
+        let taken = self.idle.lock().expect("workers").pop();
+        let mut proc = match taken {
+            Some(p) => p,
+            None => self.start()?,
+        };
+        let fault = self.fault.as_ref().filter(|(_, c)| Some(c.as_str()) == case).map(|(f, _)| f.clone());
+        let hashes = graph.passes.iter().map(|p| graph.shaders.source_hash(&p.shader)).collect::<Result<_, _>>()?;
+        let request = ToWorker::Run {
+            source: source.clone(),
+            resources: graph.resources.clone(),
+            passes: graph.passes.clone(),
+            outputs: graph.outputs.clone(),
+            hashes,
+            time_passes: ctx.timing_passes(),
+            fault,
+        };
+        if send(&mut proc.stdin, &request, &[]).is_err() {
+            // It died between runs: start another and try once more.
+            proc = self.start()?;
+            send(&mut proc.stdin, &request, &[]).map_err(|e| {
+                RenderError::Gpu(GpuError::Device { adapter: ctx.adapter_description(), message: e.to_string() })
+            })?;
+        }
+        let mut pass = String::from("its setup");
+        // The worker's own watchdog covers every GPU wait, and it reports
+        // each pass; this one covers a driver stuck outside them.
+        let patience = self.config.timeout + Duration::from_secs(10);
+        loop {
+            match proc.heard.recv_timeout(patience) {
+                Ok(Heard::Message(FromWorker::Pass(label), _)) => pass = label,
+                Ok(Heard::Message(FromWorker::Done(result), bytes)) => {
+                    self.idle.lock().expect("workers").push(proc);
+                    return match result {
+                        Err(e) => Err(RenderError::Gpu(e.into())),
+                        Ok(head) => {
+                            *self.compile.lock().expect("compile time") += head.compile;
+                            Ok(readback(head, &bytes))
+                        }
+                    };
+                }
+                Ok(Heard::Message(_, _)) => {}
+                Ok(Heard::Gone) | Err(RecvTimeoutError::Disconnected) => {
+                    let status = proc.child.wait().ok();
+                    return Err(RenderError::Crashed(Box::new(crate::error::Crash {
+                        backend: ctx.backend().to_string(),
+                        adapter: ctx.adapter_description(),
+                        how: describe_exit(status),
+                        pass,
+                        kernel: kernel.to_string(),
+                    })));
+                }
+                // Dropping `proc` kills the worker.
+                Err(RecvTimeoutError::Timeout) => {
+                    return Err(RenderError::Gpu(GpuError::Timeout { what: pass, seconds: patience.as_secs_f64() }));
+                }
+            }
+        }
+    }
+}
+
+/// The outputs a [`ReadbackHead`] describes, from the bytes after it.
+fn readback(head: ReadbackHead, bytes: &[u8]) -> Readback {
+    let mut at = 0;
+    let outputs = head
+        .outputs
+        .iter()
+        .map(|o| match *o {
+            Ok((width, height, unwritten)) => {
+                let n = width as usize * height as usize;
+                let data = bytes[at..at + n * 16]
+                    .chunks_exact(16)
+                    .map(|t| std::array::from_fn(|c| f32::from_le_bytes(t[c * 4..c * 4 + 4].try_into().expect("4"))))
+                    .collect();
+                at += n * 16;
+                OutputData::Texture { image: Image::from_raw(width, height, data).expect("sized"), unwritten }
+            }
+            Err(len) => {
+                at += len;
+                OutputData::Buffer(bytes[at - len..at].to_vec())
+            }
+        })
+        .collect();
+    Readback { outputs, stats: head.stats, pass_times: head.pass_times, pass_gpu_times: head.pass_gpu_times }
+}
+
+/// `signal 11, SIGSEGV`, `exit status 3` or the like.
+fn describe_exit(status: Option<std::process::ExitStatus>) -> String {
+    use std::os::unix::process::ExitStatusExt;
+    let Some(status) = status else { return "no exit status".into() };
+    match status.signal() {
+        Some(s) => {
+            let name = match s {
+                libc::SIGSEGV => "SIGSEGV",
+                libc::SIGABRT => "SIGABRT",
+                libc::SIGBUS => "SIGBUS",
+                libc::SIGILL => "SIGILL",
+                libc::SIGFPE => "SIGFPE",
+                libc::SIGKILL => "SIGKILL",
+                _ => "a signal",
+            };
+            format!("signal {s}, {name}")
+        }
+        None => format!("exit status {}", status.code().unwrap_or(-1)),
+    }
+}
