@@ -74,33 +74,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
     let picked = select(&cases, opts.glob.as_deref())?;
     let mut manifest = store.manifest()?;
     let adapter = ctx.adapter_description();
-    let mut rendered: Vec<(&crate::Case, Rendered)> = Vec::new();
-    for case in &picked {
-        let r = crate::run::render_case(ctx, case)?;
-        if opts.per_backend && r.raw.width == 0 {
-            return Err(GoldenError::BadInput(format!(
-                "--per-backend: case {}'s first output is a buffer; a per-backend golden is found by its main PNG \
-                 (<case>@<backend>.png), so its first output must be a texture; nothing was written",
-                case.id
-            )));
-        }
-        // The checks of `vista check` that need no golden, with the same
-        // words: a golden is never blessed from output check would fail.
-        let identical = match case.kernel.graph().is_none_or(|g| g.deterministic) {
-            true => Some(crate::run::same_render(&crate::run::render_case(ctx, case)?, &r)),
-            false => None,
-        };
-        let (mut problems, _) = crate::guards(case, &r.raw, r.format, r.unwritten, identical);
-        problems.extend(crate::outputs::output_guards(&r.outputs));
-        if !problems.is_empty() {
-            return Err(GoldenError::Rejected(format!(
-                "case {}: {}; refusing to bless it (vista check would fail it); nothing was written",
-                case.id,
-                problems.join("; ")
-            )));
-        }
-        rendered.push((case, r));
-    }
+    let rendered = render_checked(ctx, &picked, opts.per_backend)?;
 
     // Temp files of a writer that was killed earlier are never read; clear them.
     vista_image::remove_stale_temps(&store.dir);
@@ -118,21 +92,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         };
         // A pass graph's other files first: each atomic, named in the entry.
         let extra = crate::outputs::golden_bytes(&store.dir, case, &key, crate::outputs::outputs_of(case, &r))?;
-        let mut extra_hashes = std::collections::BTreeMap::new();
-        let mut extra_changed = false;
-        for (file, bytes) in &extra {
-            if let Some(parent) = file.parent() {
-                std::fs::create_dir_all(parent)
-                    .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
-            }
-            let hash = crate::short_hash_bytes(bytes);
-            if std::fs::read(file).ok().map(|b| crate::short_hash_bytes(&b)).as_deref() != Some(hash.as_str()) {
-                extra_changed = true;
-                vista_image::atomic_write(file, bytes)?;
-            }
-            let name = file.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
-            extra_hashes.insert(name, hash);
-        }
+        let (extra_hashes, extra_changed) = write_extra_files(&extra)?;
         let run = crate::RunInfo {
             backend: ctx.backend().to_string(),
             adapter: adapter.clone(),
@@ -157,75 +117,18 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             rows.push(BlessRow { id: case.id.clone(), status, psnr_vs_previous: status.into(), path: shown });
             continue;
         }
-        let new = quantize16(r.display());
-        // Read once: decoded for the PSNR against the new golden, hashed below.
-        let old_bytes = std::fs::read(&path).ok();
-        let old = old_bytes.as_deref().map(|b| vista_image::decode_png16(&path, b));
-        let (status, psnr) = match old {
-            Some(Ok(old)) if (old.width, old.height) == (new.width, new.height) => {
-                let p = metrics::psnr(&old, &new);
-                (if p.is_infinite() { "unchanged" } else { "changed" }, metrics::format_psnr(p))
-            }
-            Some(Ok(_)) => ("changed", "size changed".to_string()),
-            Some(Err(_)) => ("changed", "old golden unreadable".to_string()),
-            None if path.exists() => ("changed", "old golden unreadable".to_string()),
-            None => ("new", "new".to_string()),
-        };
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent)
-                .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
-        }
-        // Goldens live in a repository: the smallest lossless encoding, and
-        // a golden whose pixels did not change keeps its bytes (another
-        // encoder version must not churn the history).
-        let bytes = match (status, &old_bytes) {
-            ("unchanged", Some(old)) => old.clone(),
-            _ => vista_image::encode_png16_small(&path, &new)?,
-        };
-        if bytes.len() > GOLDEN_WARN_BYTES {
-            warnings.push(format!(
-                "golden {} is {:.1} MiB (over 1 MiB): a smaller case size, or Git LFS for golden/ (see the README)",
-                path.display(),
-                bytes.len() as f64 / (1 << 20) as f64
-            ));
-        }
-        let new_hash = crate::short_hash_bytes(&bytes);
-        let old_hash = old_bytes.as_deref().map(crate::short_hash_bytes);
-        let mut entry =
-            ManifestEntry::of_render(case, &run, files, r.raw.content_hash(), psnr.clone(), new_hash.clone());
-        entry.outputs = extra_hashes;
-        let status = if status == "unchanged" && extra_changed { "changed" } else { status };
-        let same_render = |e: &ManifestEntry| {
-            (&e.params_hash, &e.shader_hash, &e.adapter, &e.raw_hash)
-                == (&entry.params_hash, &entry.shader_hash, &entry.adapter, &entry.raw_hash)
-        };
-        if old_hash.as_deref() == Some(new_hash.as_str())
-            && let Some(previous) = manifest.case.get(&key).filter(|e| same_render(e))
-        {
-            // Nothing changed: keep the entry's date and PSNR-vs-previous (the
-            // provenance of the last real change), only completing its hashes
-            // (per-file shader hashes too: equal shader_hash, equal files).
-            let (shader_files, backend) = (entry.shader_files.clone(), entry.backend.clone());
-            entry = ManifestEntry {
-                golden_hash: new_hash.clone(),
-                replacing: None,
-                shader_files,
-                backend,
-                outputs: entry.outputs.clone(),
-                ..previous.clone()
-            };
-        } else if old_hash.as_deref() != Some(new_hash.as_str()) {
-            // Two-phase per case: the manifest first accepts both files, then
-            // the golden is replaced, then the manifest names only the new one.
-            // A stop anywhere leaves a golden that its entry describes.
-            entry.replacing = Some(old_hash.unwrap_or_else(|| "none".into()));
-            manifest.case.insert(key.clone(), entry.clone());
-            store.write_manifest(&manifest)?;
-            vista_image::atomic_write(&path, &bytes)?;
-            entry.replacing = None;
-        }
-        manifest.case.insert(key.clone(), entry);
-        store.write_manifest(&manifest)?;
+        let entry = ManifestEntry::of_render(case, &run, files, r.raw.content_hash(), String::new(), String::new());
+        let (status, psnr) = write_main_image(
+            store,
+            &mut manifest,
+            &key,
+            &path,
+            r.display(),
+            entry,
+            extra_hashes,
+            extra_changed,
+            &mut warnings,
+        )?;
         rows.push(BlessRow { id: case.id.clone(), status, psnr_vs_previous: psnr, path });
     }
 
@@ -241,4 +144,154 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         store.write_manifest(&manifest)?;
     }
     Ok(BlessSummary { rows, orphans, pruned: opts.prune, warnings })
+}
+
+/// Renders every picked case (twice where it is deterministic) and refuses
+/// the whole bless, writing nothing, if any fails a check `vista check`
+/// would fail it by without a golden, with the same words.
+fn render_checked<'c>(
+    ctx: &Renderer,
+    picked: &[&'c crate::Case],
+    per_backend: bool,
+) -> Result<Vec<(&'c crate::Case, Rendered)>, GoldenError> {
+    let mut rendered: Vec<(&crate::Case, Rendered)> = Vec::new();
+    for case in picked {
+        let r = crate::run::render_case(ctx, case)?;
+        if per_backend && r.raw.width == 0 {
+            return Err(GoldenError::BadInput(format!(
+                "--per-backend: case {}'s first output is a buffer; a per-backend golden is found by its main PNG \
+                 (<case>@<backend>.png), so its first output must be a texture; nothing was written",
+                case.id
+            )));
+        }
+        // The checks of `vista check` that need no golden, with the same
+        // words: a golden is never blessed from output check would fail.
+        let identical = match case.kernel.graph().is_none_or(|g| g.deterministic) {
+            true => Some(crate::run::same_render(&crate::run::render_case(ctx, case)?, &r)),
+            false => None,
+        };
+        let (mut problems, _) = crate::guards(case, &r.raw, r.format, r.unwritten, identical);
+        problems.extend(crate::outputs::output_guards(&r.outputs));
+        if !problems.is_empty() {
+            return Err(GoldenError::Rejected(format!(
+                "case {}: {}; refusing to bless it (vista check would fail it); nothing was written",
+                case.id,
+                problems.join("; ")
+            )));
+        }
+        rendered.push((case, r));
+    }
+
+    Ok(rendered)
+}
+
+/// Writes the golden files a case keeps besides its main image (each only
+/// if its bytes changed); their hashes by file name, and whether any changed.
+fn write_extra_files(
+    extra: &[(std::path::PathBuf, Vec<u8>)],
+) -> Result<(std::collections::BTreeMap<String, String>, bool), GoldenError> {
+    let mut extra_hashes = std::collections::BTreeMap::new();
+    let mut extra_changed = false;
+    for (file, bytes) in extra {
+        if let Some(parent) = file.parent() {
+            std::fs::create_dir_all(parent)
+                .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+        }
+        let hash = crate::short_hash_bytes(bytes);
+        if std::fs::read(file).ok().map(|b| crate::short_hash_bytes(&b)).as_deref() != Some(hash.as_str()) {
+            extra_changed = true;
+            vista_image::atomic_write(file, bytes)?;
+        }
+        let name = file.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        extra_hashes.insert(name, hash);
+    }
+    Ok((extra_hashes, extra_changed))
+}
+
+/// Writes a case's main golden PNG from its display values and its
+/// manifest entry (`entry`, completed here), two-phase, keeping the old
+/// bytes where the pixels did not change; its status and PSNR against the
+/// previous golden.
+#[allow(clippy::too_many_arguments)]
+fn write_main_image(
+    store: &Store,
+    manifest: &mut crate::Manifest,
+    key: &str,
+    path: &std::path::Path,
+    display: &vista_image::Image,
+    mut entry: ManifestEntry,
+    extra_hashes: std::collections::BTreeMap<String, String>,
+    extra_changed: bool,
+    warnings: &mut Vec<String>,
+) -> Result<(&'static str, String), GoldenError> {
+    let new = quantize16(display);
+    // Read once: decoded for the PSNR against the new golden, hashed below.
+    let old_bytes = std::fs::read(path).ok();
+    let old = old_bytes.as_deref().map(|b| vista_image::decode_png16(path, b));
+    let (status, psnr) = match old {
+        Some(Ok(old)) if (old.width, old.height) == (new.width, new.height) => {
+            let p = metrics::psnr(&old, &new);
+            (if p.is_infinite() { "unchanged" } else { "changed" }, metrics::format_psnr(p))
+        }
+        Some(Ok(_)) => ("changed", "size changed".to_string()),
+        Some(Err(_)) => ("changed", "old golden unreadable".to_string()),
+        None if path.exists() => ("changed", "old golden unreadable".to_string()),
+        None => ("new", "new".to_string()),
+    };
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent)
+            .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+    }
+    // Goldens live in a repository: the smallest lossless encoding, and
+    // a golden whose pixels did not change keeps its bytes (another
+    // encoder version must not churn the history).
+    let bytes = match (status, &old_bytes) {
+        ("unchanged", Some(old)) => old.clone(),
+        _ => vista_image::encode_png16_small(path, &new)?,
+    };
+    if bytes.len() > GOLDEN_WARN_BYTES {
+        warnings.push(format!(
+            "golden {} is {:.1} MiB (over 1 MiB): a smaller case size, or Git LFS for golden/ (see the README)",
+            path.display(),
+            bytes.len() as f64 / (1 << 20) as f64
+        ));
+    }
+    let new_hash = crate::short_hash_bytes(&bytes);
+    let old_hash = old_bytes.as_deref().map(crate::short_hash_bytes);
+    entry.psnr_vs_previous = psnr.clone();
+    entry.golden_hash = new_hash.clone();
+    entry.outputs = extra_hashes;
+    let status = if status == "unchanged" && extra_changed { "changed" } else { status };
+    let same_render = |e: &ManifestEntry| {
+        (&e.params_hash, &e.shader_hash, &e.adapter, &e.raw_hash)
+            == (&entry.params_hash, &entry.shader_hash, &entry.adapter, &entry.raw_hash)
+    };
+    if old_hash.as_deref() == Some(new_hash.as_str())
+        && let Some(previous) = manifest.case.get(key).filter(|e| same_render(e))
+    {
+        // Nothing changed: keep the entry's date and PSNR-vs-previous (the
+        // provenance of the last real change), only completing its hashes
+        // (per-file shader hashes too: equal shader_hash, equal files).
+        let (shader_files, backend) = (entry.shader_files.clone(), entry.backend.clone());
+        entry = ManifestEntry {
+            golden_hash: new_hash.clone(),
+            replacing: None,
+            shader_files,
+            backend,
+            outputs: entry.outputs.clone(),
+            ..previous.clone()
+        };
+    } else if old_hash.as_deref() != Some(new_hash.as_str()) {
+        // Two-phase per case: the manifest first accepts both files, then
+        // the golden is replaced, then the manifest names only the new one.
+        // A stop anywhere leaves a golden that its entry describes.
+        entry.replacing = Some(old_hash.unwrap_or_else(|| "none".into()));
+        manifest.case.insert(key.to_string(), entry.clone());
+        store.write_manifest(manifest)?;
+        vista_image::atomic_write(path, &bytes)?;
+        entry.replacing = None;
+    }
+    manifest.case.insert(key.to_string(), entry);
+    store.write_manifest(manifest)?;
+    Ok((status, psnr))
 }

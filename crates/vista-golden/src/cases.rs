@@ -178,7 +178,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         }
         let kernel = kernels.find(&raw.kernel).map_err(|e| bad(e.to_string()))?;
         let overrides: Vec<(String, String)> =
-            raw.set.iter().map(|(k, v)| (k.clone(), vista_kernels::manifest::value_text(v))).collect();
+            raw.set.iter().map(|(k, v)| (k.clone(), vista_kernels::values::value_text(v))).collect();
         let params = kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?;
         let (width, height) = match &raw.size {
             Some(s) => vista_kernels::parse_size(s).map_err(|e| bad(e.to_string()))?,

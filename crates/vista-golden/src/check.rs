@@ -409,43 +409,7 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
     let (problems, first_bad) = guards(case, obs.raw, obs.format, obs.unwritten, obs.repeat_identical);
     out.problems.extend(problems);
     out.first_bad = first_bad;
-    let run = out.run.clone();
-    match entry {
-        Some(e) => {
-            let threshold = crate::DriverThreshold::of(case, Some(e), &run.adapter);
-            (out.same_driver, out.psnr_threshold) = (threshold.same_driver, threshold.psnr);
-            if !out.same_driver {
-                out.notes.push(format!("golden blessed on '{}', running on '{}'", e.adapter, run.adapter));
-            }
-            if e.shader_hash != run.shader_hash {
-                // Named files are reported from `changed_files` (terminal
-                // block, report); only an old manifest needs the note.
-                if e.shader_files.is_empty() {
-                    out.notes.push(format!(
-                        "shader changed since the last bless (manifest {}, now {}); the manifest predates per-file \
-                         hashes, so the files are not named",
-                        e.shader_hash, run.shader_hash
-                    ));
-                } else {
-                    out.changed_files = changed_files(&e.shader_files, obs.shader_files);
-                }
-            }
-            // Integer outputs compare exactly in `outputs` (their EXR golden).
-            if e.params_hash != run.params_hash {
-                out.notes.push("case parameters changed since the last bless".into());
-            } else if obs.deterministic && e.same_inputs(&run) {
-                let raw_hash = obs.raw.content_hash();
-                if e.raw_hash != raw_hash {
-                    out.problems.push(format!(
-                        "not bit-identical with the bless-time render on the same adapter, shader and params \
-                         (raw hash {raw_hash} vs manifest {})",
-                        e.raw_hash
-                    ));
-                }
-            }
-        }
-        None => out.notes.push("no manifest entry for this case".into()),
-    }
+    provenance(case, entry, obs, out);
     outputs_verdict(case, obs.outputs, out);
     let (path, hash, expected) = match obs.golden {
         GoldenRead::NoImage => return,
@@ -537,6 +501,64 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
         out.metrics = Some(m);
         return;
     }
+    thresholds(case, obs, &mut m, expected, actual, out);
+    out.metrics = Some(m);
+}
+
+/// The run against the case's manifest entry: the driver (same or other
+/// threshold), the changed files, and bit-identity where the adapter,
+/// shader and params are the bless-time ones.
+fn provenance(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut Outcome) {
+    let run = out.run.clone();
+    match entry {
+        Some(e) => {
+            let threshold = crate::DriverThreshold::of(case, Some(e), &run.adapter);
+            (out.same_driver, out.psnr_threshold) = (threshold.same_driver, threshold.psnr);
+            if !out.same_driver {
+                out.notes.push(format!("golden blessed on '{}', running on '{}'", e.adapter, run.adapter));
+            }
+            if e.shader_hash != run.shader_hash {
+                // Named files are reported from `changed_files` (terminal
+                // block, report); only an old manifest needs the note.
+                if e.shader_files.is_empty() {
+                    out.notes.push(format!(
+                        "shader changed since the last bless (manifest {}, now {}); the manifest predates per-file \
+                         hashes, so the files are not named",
+                        e.shader_hash, run.shader_hash
+                    ));
+                } else {
+                    out.changed_files = changed_files(&e.shader_files, obs.shader_files);
+                }
+            }
+            // Integer outputs compare exactly in `outputs` (their EXR golden).
+            if e.params_hash != run.params_hash {
+                out.notes.push("case parameters changed since the last bless".into());
+            } else if obs.deterministic && e.same_inputs(&run) {
+                let raw_hash = obs.raw.content_hash();
+                if e.raw_hash != raw_hash {
+                    out.problems.push(format!(
+                        "not bit-identical with the bless-time render on the same adapter, shader and params \
+                         (raw hash {raw_hash} vs manifest {})",
+                        e.raw_hash
+                    ));
+                }
+            }
+        }
+        None => out.notes.push("no manifest entry for this case".into()),
+    }
+}
+
+/// The main image's metrics against the case's thresholds: its bad-pixel
+/// budget or PSNR (of its raw values where they carry the verdict), the
+/// alpha a view keeps, SSIM and FLIP.
+fn thresholds(
+    case: &Case,
+    obs: &Observed,
+    m: &mut metrics::Metrics,
+    expected: &Image,
+    actual: &Image,
+    out: &mut Outcome,
+) {
     // A case with a bad-pixel budget is judged by it instead of PSNR: a few
     // pixels that flip far (a crest across drivers) pass, more do not.
     let by_bad_pixels = case.max_bad_pixels.is_some() || case.max_bad_ratio.is_some();
@@ -578,7 +600,7 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
         out.problems.push(format!("FLIP mean {f:.5} is above the threshold {t}"));
     }
     if let Some(t) = case.max_bad_pixels
-        && m.bad_pixels as u64 > t
+        && m.bad_pixels > t
     {
         out.problems.push(format!("{} bad pixels (> {BAD_PIXEL_LIMIT}) is above max_bad_pixels {t}", m.bad_pixels));
     }
@@ -593,7 +615,6 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
             m.bad_pixels as f64 / pixels
         ));
     }
-    out.metrics = Some(m);
 }
 
 /// PSNR (peak 1) of two views' alpha channels.

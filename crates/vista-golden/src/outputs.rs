@@ -188,23 +188,7 @@ pub fn compare_output(
         ..Default::default()
     };
     v.problems = guard_one(index, out);
-    // Each file is the one its manifest entry describes: a file changed
-    // outside vista bless, or left by an interrupted one, is named.
-    if let Some(entry) = blessed {
-        for path in files.all() {
-            let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
-            let (Some(want), Ok(bytes)) = (entry.outputs.get(&name), std::fs::read(path)) else { continue };
-            let hash = crate::short_hash_bytes(&bytes);
-            if &hash != want {
-                v.problems.push(format!(
-                    "golden {} (hash {hash}) is not the file its manifest entry describes ({want}): it was changed \
-                     outside vista bless or by an interrupted one; review it and re-bless: {}",
-                    path.display(),
-                    case.bless_command()
-                ));
-            }
-        }
-    }
+    v.problems.extend(changed_outside_bless(case, &files, blessed));
     match &out.value {
         OutputValue::Buffer { .. } => {
             let path = files.npy.expect("a buffer's npy");
@@ -288,38 +272,67 @@ pub fn compare_output(
             let png = files.png.expect("a texture's png");
             if index > 0 && tolerance.is_none() && files.exr.is_none() {
                 // A float texture without a tolerance or raw golden: its view by PSNR.
-                match png.exists() {
-                    false => v.missing.push(png),
-                    true => match vista_image::read_png16(&png) {
-                        Err(e) => v.errors.push(e.to_string()),
-                        Ok(g) => {
-                            let actual = quantize16(&out.display().expect("a texture"));
-                            match vista_image::metrics::compare(&g, &actual) {
-                                Err(e) => v.problems.push(format!("output {}: {e}", out.name)),
-                                Ok(m) => {
-                                    v.summary = format!(
-                                        "output {}: PSNR {} (>= {psnr_threshold:.1} dB)",
-                                        out.name,
-                                        vista_image::metrics::format_psnr(m.psnr)
-                                    );
-                                    if m.psnr < psnr_threshold {
-                                        v.problems.push(format!(
-                                            "output {}: PSNR {} is below the threshold {psnr_threshold:.1} dB",
-                                            out.name,
-                                            vista_image::metrics::format_psnr(m.psnr)
-                                        ));
-                                    }
-                                }
-                            }
-                        }
-                    },
-                }
+                judge_view(&mut v, out, png, psnr_threshold);
             } else if index > 0 && !png.exists() {
                 v.missing.push(png);
             }
         }
     }
     v
+}
+
+/// Each golden file of an output that its manifest entry names but whose
+/// bytes are not the ones it describes (changed outside vista bless, or
+/// left by an interrupted one).
+fn changed_outside_bless(case: &Case, files: &OutputFiles, blessed: Option<&crate::ManifestEntry>) -> Vec<String> {
+    let mut problems = Vec::new();
+    if let Some(entry) = blessed {
+        for path in files.all() {
+            let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+            let (Some(want), Ok(bytes)) = (entry.outputs.get(&name), std::fs::read(path)) else { continue };
+            let hash = crate::short_hash_bytes(&bytes);
+            if &hash != want {
+                problems.push(format!(
+                    "golden {} (hash {hash}) is not the file its manifest entry describes ({want}): it was changed \
+                     outside vista bless or by an interrupted one; review it and re-bless: {}",
+                    path.display(),
+                    case.bless_command()
+                ));
+            }
+        }
+    }
+    problems
+}
+
+/// A float texture output without a tolerance or raw golden: the PSNR of
+/// its view against its golden PNG.
+fn judge_view(v: &mut OutputVerdict, out: &OutputRender, png: PathBuf, psnr_threshold: f64) {
+    match png.exists() {
+        false => v.missing.push(png),
+        true => match vista_image::read_png16(&png) {
+            Err(e) => v.errors.push(e.to_string()),
+            Ok(g) => {
+                let actual = quantize16(&out.display().expect("a texture"));
+                match vista_image::metrics::compare(&g, &actual) {
+                    Err(e) => v.problems.push(format!("output {}: {e}", out.name)),
+                    Ok(m) => {
+                        v.summary = format!(
+                            "output {}: PSNR {} (>= {psnr_threshold:.1} dB)",
+                            out.name,
+                            vista_image::metrics::format_psnr(m.psnr)
+                        );
+                        if m.psnr < psnr_threshold {
+                            v.problems.push(format!(
+                                "output {}: PSNR {} is below the threshold {psnr_threshold:.1} dB",
+                                out.name,
+                                vista_image::metrics::format_psnr(m.psnr)
+                            ));
+                        }
+                    }
+                }
+            }
+        },
+    }
 }
 
 /// "N of M texels never written": a workgroup size, dispatch or bounds check

@@ -171,25 +171,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         };
         let files = ctx.kernel_file_hashes(&case.kernel).map_err(|e| e.to_string())?;
         let path = golden_path.clone();
-        let golden = match path.exists() {
-            false => None,
-            // Read once: hashed against the manifest, then decoded.
-            true => {
-                let bytes = std::fs::read(&path)
-                    .map_err(|source| vista_image::ImageError::Io { path: path.clone(), source }.to_string())?;
-                let hash = crate::short_hash_bytes(&bytes);
-                let image = match bytes.starts_with(b"version https://git-lfs.github.com/spec/") {
-                    // A Git LFS pointer where the PNG should be: the clone lacks the file.
-                    true => Err(format!(
-                        "{} is a Git LFS pointer, not a PNG: run `git lfs pull` (and `git lfs install` once) to fetch \
-                         the goldens",
-                        path.display()
-                    )),
-                    false => vista_image::decode_png16(&path, &bytes).map_err(|e| e.to_string()),
-                };
-                Some((hash, image))
-            }
-        };
+        let golden = read_golden(&path)?;
         Ok((repeat_identical, files, path, golden))
     })();
     let mut out = match &gathered {
@@ -288,6 +270,30 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         raw_hash: Some(r.raw.content_hash()),
         timed_out: false,
     }
+}
+
+/// A golden PNG read once (hashed against the manifest, then decoded):
+/// `None` where there is no file; its hash and image, or why it cannot be
+/// decoded (a Git LFS pointer where the PNG should be is named as one).
+type GoldenFile = Option<(String, Result<Image, String>)>;
+
+fn read_golden(path: &std::path::Path) -> Result<GoldenFile, String> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let bytes =
+        std::fs::read(path).map_err(|source| vista_image::ImageError::Io { path: path.into(), source }.to_string())?;
+    let hash = crate::short_hash_bytes(&bytes);
+    let image = match bytes.starts_with(b"version https://git-lfs.github.com/spec/") {
+        // A Git LFS pointer where the PNG should be: the clone lacks the file.
+        true => Err(format!(
+            "{} is a Git LFS pointer, not a PNG: run `git lfs pull` (and `git lfs install` once) to fetch the \
+             goldens",
+            path.display()
+        )),
+        false => vista_image::decode_png16(path, &bytes).map_err(|e| e.to_string()),
+    };
+    Ok(Some((hash, image)))
 }
 
 /// Runs `work` on every item with `jobs` threads (at least one, at most

@@ -226,8 +226,8 @@ pub(crate) struct WgpuEngine {
     /// Pipelines with their bind group layouts (one per group up to the
     /// highest the kernel binds), by shader hash, entry, slots and format.
     pub(crate) pipelines: Mutex<HashMap<String, Arc<Compiled>>>,
-    /// What the last runs left for the next to take (see [`crate::wgpu_run::Spares`]).
-    pub(crate) spares: Mutex<crate::wgpu_run::Spares>,
+    /// What the last runs left for the next to take (see [`crate::spares::Spares`]).
+    pub(crate) spares: Mutex<crate::spares::Spares>,
     /// Storage formats this device binds `read_write`.
     read_write: Vec<&'static str>,
 }

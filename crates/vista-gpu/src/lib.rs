@@ -14,6 +14,7 @@ mod format;
 mod graph;
 mod limits;
 mod shaders;
+mod spares;
 pub mod validation;
 mod wgpu_run;
 

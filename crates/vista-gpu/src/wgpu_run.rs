@@ -15,27 +15,11 @@ use crate::graph::{
     Bind, Contents, Graph, GraphPass, OutputData, Readback, Resource, TextureDesc, compare_fn, run_order,
     view_dimension,
 };
+use crate::spares::{Spares, TextureKey};
 use vista_texel::{Access, Format, SampleKind};
-
-/// Textures, sentinel fills and readback buffers a run leaves for the next
-/// run to take instead of allocating its own: fresh ones cost a page fault
-/// per 4 KiB as they are first written (filling a fresh 16 MiB image, 1024
-/// x 1024, took 10-12 ms here). Only sentinel-filled textures are kept:
-/// every run copies the sentinel over them first, so a texel a pass leaves
-/// unwritten is counted and never shows an earlier run's value. A
-/// concurrent run finds the pool empty and allocates.
-#[derive(Default)]
-pub(crate) struct Spares {
-    textures: Vec<(TextureKey, wgpu::Texture)>,
-    /// Sentinel `which` of a format, as many bytes as a padded copy needs.
-    fills: Vec<((&'static str, usize, u64), wgpu::Buffer)>,
-    staging: Vec<(u64, wgpu::Buffer)>,
-}
 
 /// Kept at most per kind: a graph's outputs, and a little more.
 const SPARES: usize = 8;
-
-type TextureKey = (&'static str, vista_texel::Dimension, u32, u32, u32);
 
 fn texture_key(t: &TextureDesc) -> TextureKey {
     (t.format, t.dimension, t.width, t.height, t.layers)

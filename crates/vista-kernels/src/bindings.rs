@@ -10,6 +10,7 @@
 use naga::{AddressSpace, Handle, ImageClass, ImageDimension, ScalarKind, StorageAccess, TypeInner};
 
 use crate::ParamError;
+use vista_texel::{Access, Dimension};
 
 /// What feeds a binding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -19,9 +20,9 @@ pub enum Feed {
     /// The u32 table (`var<storage, read>` of `array<u32>`).
     Table,
     /// The output: a write or read_write storage texture.
-    Output(crate::resources::Storage),
+    Output(Storage),
     /// A read-only storage texture (pass graphs only).
-    StorageRead(crate::resources::Storage),
+    StorageRead(Storage),
     /// A storage buffer other than the table (pass graphs only).
     Buffer {
         /// `var<storage, read>` (else `read_write`).
@@ -32,7 +33,7 @@ pub enum Feed {
         /// The texture's dimension.
         dim: vista_texel::Dimension,
         /// What sampling it returns.
-        kind: crate::graph::SampledKind,
+        kind: SampledKind,
     },
     /// A sampler (pass graphs only).
     Sampler {
@@ -53,6 +54,30 @@ pub struct Binding {
     /// What feeds it.
     pub feed: Feed,
     pub(crate) global: Handle<naga::GlobalVariable>,
+}
+
+/// A storage texture binding as WGSL declares it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Storage {
+    /// Its texel format, one of [`vista_texel::format_names`].
+    pub format: &'static str,
+    /// Its dimension.
+    pub dimension: Dimension,
+    /// How the pass may use it.
+    pub access: Access,
+}
+
+/// What a sampled texture binding returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampledKind {
+    /// `texture_*<f32>`: sampling returns floats.
+    Float,
+    /// `texture_*<u32>`: sampling returns unsigned integers.
+    Uint,
+    /// `texture_*<i32>`: sampling returns signed integers.
+    Sint,
+    /// `texture_depth_*`: a depth texture.
+    Depth,
 }
 
 /// `name` as one of vista-texel's formats, or the error listing them.
@@ -97,7 +122,7 @@ pub fn undecorate(name: &str) -> (String, Option<String>) {
 
 /// The storage texture a pass writes, as [`reflect`] found it (it refuses
 /// a pass without one).
-pub fn output(bindings: &[Binding]) -> (&Binding, crate::resources::Storage) {
+pub fn output(bindings: &[Binding]) -> (&Binding, Storage) {
     bindings
         .iter()
         .find_map(|b| match b.feed {
@@ -239,7 +264,6 @@ pub fn reflect_all(kernel: &str, shader: &str, entry: &str, module: &naga::Modul
                 wgsl_type(module, var)
             ))
         };
-        use crate::graph::SampledKind;
         use vista_texel::{Access, Dimension};
         let feed = match (&var.space, &module.types[var.ty].inner) {
             (AddressSpace::Uniform, _) => Feed::Uniform,
@@ -261,7 +285,7 @@ pub fn reflect_all(kernel: &str, shader: &str, entry: &str, module: &naga::Modul
                 let Some(format) = format_name(*format) else {
                     return Err(unfed("a storage texture of a supported format (not bgra8unorm or a packed one)"));
                 };
-                let storage = crate::resources::Storage { format, dimension, access };
+                let storage = Storage { format, dimension, access };
                 if access == Access::Read { Feed::StorageRead(storage) } else { Feed::Output(storage) }
             }
             (_, TypeInner::Image { dim, arrayed, class }) => {

@@ -11,24 +11,14 @@
 //! each pass against naga's reflection of its composed module and says what
 //! feeds every binding.
 
+use crate::bindings::Storage;
 use crate::bindings::{Binding, Feed};
 use crate::expr::Expr;
 use crate::params::ParamSpec;
-use crate::resources::{Access, Dimension, Storage};
 use crate::{Output, ParamError};
+use vista_texel::{Access, Dimension};
 
-/// What a sampled texture binding returns.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SampledKind {
-    /// `texture_*<f32>`: sampling returns floats.
-    Float,
-    /// `texture_*<u32>`: sampling returns unsigned integers.
-    Uint,
-    /// `texture_*<i32>`: sampling returns signed integers.
-    Sint,
-    /// `texture_depth_*`: a depth texture.
-    Depth,
-}
+pub use crate::bindings::SampledKind;
 
 /// The sampler address modes a manifest may name.
 pub const ADDRESS_MODES: [&str; 3] = ["clamp-to-edge", "repeat", "mirror-repeat"];
@@ -527,7 +517,7 @@ fn parse_passes(
         let shader = text("shader")?;
         let defs = match t.get("defs") {
             None => Vec::new(),
-            Some(toml::Value::Table(d)) => crate::manifest::parse_defs(d).map_err(at)?,
+            Some(toml::Value::Table(d)) => crate::values::parse_defs(d).map_err(at)?,
             Some(other) => return Err(at(format!("defs = {other} is not valid; expected a table {{ NAME = value }}"))),
         };
         let source = match t.get("source") {
@@ -581,7 +571,7 @@ fn parse_passes(
                         let all: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
                         return Err(at(format!("set: {k} is not a param; params: {}", all.join(", "))));
                     };
-                    let text = crate::manifest::value_text(v);
+                    let text = crate::values::value_text(v);
                     crate::params::parse_value(spec, &text).map_err(|e| at(format!("set: {e}")))?;
                     set.push((spec.name.clone(), text));
                 }

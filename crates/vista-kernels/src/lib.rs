@@ -85,6 +85,7 @@ pub mod params;
 pub mod phase;
 pub mod resources;
 pub mod ridged;
+pub mod values;
 
 use std::sync::{Arc, OnceLock};
 
@@ -795,7 +796,15 @@ impl Kernel {
         layout::check_groups(self, &[&l])?;
         layout::name_leaves(self, &mut l);
         layout::check(self, &l)?;
-        l.output = Some(resources::resolve(&self.manifest, &l.bindings, module)?);
+        let m = &self.manifest;
+        let declared = resources::Declared {
+            name: &m.name,
+            entry: &m.entry,
+            resources: &m.resources,
+            bind: &m.bind,
+            output_resource: m.output_resource.as_deref(),
+        };
+        l.output = Some(resources::resolve(&declared, &l.bindings, module)?);
         Ok(l)
     }
 

@@ -10,16 +10,7 @@ use crate::{ParamError, ParamSet};
 
 pub use vista_texel::{Access, Dimension};
 
-/// A storage texture binding as WGSL declares it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Storage {
-    /// Its texel format, one of [`vista_texel::format_names`].
-    pub format: &'static str,
-    /// Its dimension.
-    pub dimension: Dimension,
-    /// How the pass may use it.
-    pub access: Access,
-}
+pub use crate::bindings::Storage;
 
 /// A `[[resource]]` table of kind `texture`.
 #[derive(Debug, Clone, PartialEq)]
@@ -162,17 +153,31 @@ pub(crate) fn parse(
     Ok((out, binds))
 }
 
+/// What a one-pass manifest declares about its output, for [`resolve`].
+pub(crate) struct Declared<'a> {
+    /// The kernel's name.
+    pub name: &'a str,
+    /// Its entry point.
+    pub entry: &'a str,
+    /// Its `[[resource]]` textures.
+    pub resources: &'a [TextureResource],
+    /// Its pass's `bind` (variable, resource).
+    pub bind: &'a [(String, String)],
+    /// Its `[[output]] resource`.
+    pub output_resource: Option<&'a str>,
+}
+
 /// The output target of a pass: the storage texture it writes, checked
 /// against the resource `bind` gives it (format, dimension) and the
 /// `[[output]] resource`. Every other `bind` must name a storage texture
 /// the pass reaches.
 pub(crate) fn resolve(
-    kernel: &crate::manifest::Manifest,
+    kernel: &Declared<'_>,
     bindings: &[Binding],
     module: &naga::Module,
 ) -> Result<Target, ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.name.to_string(), message };
-    let entry = kernel.entry.as_str();
+    let entry = kernel.entry;
     let describe = |b: &Binding| {
         format!(
             "{} (@group({}) @binding({}), {})",
@@ -183,7 +188,7 @@ pub(crate) fn resolve(
         )
     };
     let mut resource = None;
-    for (var, res) in &kernel.bind {
+    for (var, res) in kernel.bind {
         let Some(b) = bindings.iter().find(|b| &b.name == var) else {
             let reached: Vec<&str> = bindings.iter().map(|b| b.name.as_str()).collect();
             return Err(bad(format!(
@@ -235,7 +240,7 @@ pub(crate) fn resolve(
         resource = Some(r.clone());
     }
     let (out, storage) = crate::bindings::output(bindings);
-    if let Some(named) = kernel.output_resource.as_deref() {
+    if let Some(named) = kernel.output_resource {
         let fits = resource.as_ref().map(|r| r.name == named).unwrap_or(named == out.name);
         if !fits {
             return Err(bad(format!(

@@ -213,52 +213,7 @@ pub fn mutants(file: &str, text: &str) -> Vec<Mutant> {
     let toks = lex(text);
     let s = |t: &Token| &text[t.start..t.end];
     // Tokens inside function bodies; template brackets excluded.
-    let mut in_body = vec![false; toks.len()];
-    let mut template = vec![false; toks.len()];
-    let mut i = 0;
-    while i < toks.len() {
-        if toks[i].kind == Kind::Ident && s(&toks[i]) == "fn" {
-            let mut j = i;
-            while j < toks.len() && s(&toks[j]) != "{" {
-                j += 1;
-            }
-            let mut depth = 0;
-            let mut k = j;
-            while k < toks.len() {
-                match s(&toks[k]) {
-                    "{" => depth += 1,
-                    "}" => {
-                        depth -= 1;
-                        if depth == 0 {
-                            break;
-                        }
-                    }
-                    _ => {}
-                }
-                in_body[k] = true;
-                k += 1;
-            }
-            i = k;
-        }
-        i += 1;
-    }
-    for i in 1..toks.len() {
-        if s(&toks[i]) == "<" && toks[i - 1].kind == Kind::Ident && TEMPLATED.contains(&s(&toks[i - 1])) {
-            let mut depth = 0i32;
-            for (k, t) in toks.iter().enumerate().skip(i) {
-                match s(t) {
-                    "<" => depth += 1,
-                    ">" => depth -= 1,
-                    ">>" => depth -= 2,
-                    _ => {}
-                }
-                template[k] = true;
-                if depth <= 0 {
-                    break;
-                }
-            }
-        }
-    }
+    let (in_body, template) = body_and_template_tokens(&toks, text);
     let operand_before = |i: usize| {
         i > 0 && (matches!(toks[i - 1].kind, Kind::Ident | Kind::Number) || matches!(s(&toks[i - 1]), ")" | "]"))
     };
@@ -372,6 +327,59 @@ pub fn mutants(file: &str, text: &str) -> Vec<Mutant> {
         }
     }
     out
+}
+
+/// Which tokens lie inside a function body, and which inside a template's
+/// angle brackets (`array<f32, 4>`: not comparisons to mutate).
+fn body_and_template_tokens(toks: &[Token], text: &str) -> (Vec<bool>, Vec<bool>) {
+    let s = |t: &Token| &text[t.start..t.end];
+    let mut in_body = vec![false; toks.len()];
+    let mut template = vec![false; toks.len()];
+    let mut i = 0;
+    while i < toks.len() {
+        if toks[i].kind == Kind::Ident && s(&toks[i]) == "fn" {
+            let mut j = i;
+            while j < toks.len() && s(&toks[j]) != "{" {
+                j += 1;
+            }
+            let mut depth = 0;
+            let mut k = j;
+            while k < toks.len() {
+                match s(&toks[k]) {
+                    "{" => depth += 1,
+                    "}" => {
+                        depth -= 1;
+                        if depth == 0 {
+                            break;
+                        }
+                    }
+                    _ => {}
+                }
+                in_body[k] = true;
+                k += 1;
+            }
+            i = k;
+        }
+        i += 1;
+    }
+    for i in 1..toks.len() {
+        if s(&toks[i]) == "<" && toks[i - 1].kind == Kind::Ident && TEMPLATED.contains(&s(&toks[i - 1])) {
+            let mut depth = 0i32;
+            for (k, t) in toks.iter().enumerate().skip(i) {
+                match s(t) {
+                    "<" => depth += 1,
+                    ">" => depth -= 1,
+                    ">>" => depth -= 2,
+                    _ => {}
+                }
+                template[k] = true;
+                if depth <= 0 {
+                    break;
+                }
+            }
+        }
+    }
+    (in_body, template)
 }
 
 #[cfg(test)]
