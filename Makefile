@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves seed-study bench mutants device-figures lavapipe swiftshader validation browser build
+.PHONY: demo test golden curves seed-study bench fuzz mutants device-figures lavapipe swiftshader validation browser build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -75,6 +75,12 @@ device-figures: build
 # Mutation score of every kernel's suite into docs/mutants (not part of make test).
 mutants: lavapipe build
 	bash ci/mutants.sh $(VISTA) docs/mutants
+
+# The fuzz test of make test (200 rounds from a fixed seed), 20,000 rounds
+# from a new seed; an input that fails is kept in tests/fuzz/ and replayed
+# by every later run.
+fuzz:
+	VISTA_FUZZ_ITERATIONS=20000 VISTA_FUZZ_SEED=$$(date +%s) $(CARGO) test -p vista-cli --test fuzz -- --nocapture
 
 bench: lavapipe
 	$(CARGO) bench -p vista --features bench
