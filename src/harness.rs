@@ -143,7 +143,14 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
                 };
                 let f = checker.check(&case);
                 let o = &f.outcome;
-                let result = if o.passed() { Ok(()) } else { Err(Failed::from(o.explain(&report_dir))) };
+                let result = match (o.passed(), f.report_errors.is_empty()) {
+                    (true, true) => Ok(()),
+                    (false, _) => Err(Failed::from(o.explain(&report_dir))),
+                    (true, false) => Err(Failed::from(format!(
+                        "passed, but its report folder could not be written: {}",
+                        f.report_errors.join("; ")
+                    ))),
+                };
                 filed.lock().expect("filed").push(f);
                 result
             })

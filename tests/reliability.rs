@@ -57,7 +57,8 @@ fn injected_nan_fails_the_case_naming_count_and_first_pixel(ctx: &vista_render::
     let report_dir = dir.path().join("report");
     let checked =
         vista_golden::check_case(ctx, &store, &Default::default(), &nan_case(), &CheckOptions { twice: false });
-    let o = vista_report::file_case(&report_dir, checked, vista_report::Detail::Failing);
+    let (o, unwritten) = vista_report::file_case(&report_dir, checked, vista_report::Detail::Failing);
+    assert!(unwritten.is_empty(), "{unwritten:?}");
     assert!(!o.passed(), "a NaN render passed: {o:?}");
     let text = o.explain(&report_dir);
     assert!(text.contains("2 pixels contain NaN/Inf; first at (5, 3)"), "{text}");

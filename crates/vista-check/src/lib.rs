@@ -109,6 +109,9 @@ pub struct Filed {
     pub check_time: Duration,
     /// Writing the case's report folder.
     pub report_time: Duration,
+    /// What of the case's report folder could not be written: the run
+    /// fails (exit 2), the verdict stays as judged.
+    pub report_errors: Vec<String>,
 }
 
 /// What checking a case reads and where it files it.
@@ -133,7 +136,7 @@ impl Checker<'_> {
         let check_time = started.elapsed();
         let entry = checked.pending.take();
         let started = Instant::now();
-        let outcome = vista_report::file_case(self.report_dir, checked, self.detail);
+        let (outcome, report_errors) = vista_report::file_case(self.report_dir, checked, self.detail);
         let report_time = started.elapsed();
         // A failing or missing case's render, as bless --from-report may take it.
         let pending = match entry {
@@ -152,7 +155,7 @@ impl Checker<'_> {
             }
             _ => None,
         };
-        Filed { outcome, pending, check_time, report_time }
+        Filed { outcome, pending, check_time, report_time, report_errors }
     }
 
     /// Checks and files every case of `picked` with `jobs` workers (1 under

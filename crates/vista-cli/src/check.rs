@@ -105,7 +105,11 @@ pub fn check(
         time.report += f.report_time;
         time.gpu += std::time::Duration::from_secs_f64(f.outcome.gpu_ms / 1000.0);
         print_case(&f.outcome, &report_dir);
+        for e in &f.report_errors {
+            println!("error: {}: its report folder could not be written: {e}", f.outcome.id);
+        }
     });
+    let report_failed = filed.iter().any(|f| !f.report_errors.is_empty());
     let run = vista_report::RunSummary {
         command: command_line(),
         backend: ctx.backend().to_string(),
@@ -157,7 +161,7 @@ pub fn check(
     }
     println!("{}", time.summary(ctx, outcomes.len()));
     println!("report: {}", index.display());
-    Ok(if failed == 0 && !orphans_fail { 0 } else { 1 })
+    Ok(if failed == 0 && !orphans_fail && !report_failed { 0 } else { 1 })
 }
 
 /// Where a check's wall time went: compiling (composing WGSL, creating

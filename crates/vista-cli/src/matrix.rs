@@ -42,7 +42,15 @@ pub fn matrix(
         let dir = report_dir.join(b);
         let checker =
             Checker { ctx: &gpu, store: &store, manifest: &manifest, report_dir: &dir, detail: Default::default() };
-        let outcomes: Vec<Outcome> = checker.check_all(&picked, 1, |_| {}).into_iter().map(|f| f.outcome).collect();
+        let outcomes: Vec<Outcome> = checker
+            .check_all(&picked, 1, |f| {
+                for e in &f.report_errors {
+                    println!("error: {} on {b}: its report folder could not be written: {e}", f.outcome.id);
+                }
+            })
+            .into_iter()
+            .map(|f| f.outcome)
+            .collect();
         columns.push((b.to_string(), Ok((ctx.adapter_description(), outcomes))));
     }
 

@@ -119,6 +119,9 @@ pub fn watch(
             if !o.passed() {
                 print!("{}", o.explain(&report_dir));
             }
+            for e in &f.report_errors {
+                println!("error: {}: its report folder could not be written: {e}", o.id);
+            }
             filed.insert(o.id.clone(), f);
         }
         // Cases no longer selected (renamed, deleted) leave the report, in case order.

@@ -4390,6 +4390,21 @@ fn a_driver_crash_fails_one_case_not_the_run() {
     assert!(x.stdout.contains("matrix: 1 cases x 3 backends"), "{}", x.stdout);
 }
 
+/// Writing the report never changes a verdict: a case folder that cannot
+/// be made (a file stands in its place) fails the run, naming it, while the
+/// case is still reported as judged.
+fn a_report_that_cannot_be_written_fails_the_run_not_the_verdict() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    std::fs::create_dir_all(d.path().join("r")).unwrap();
+    std::fs::write(d.path().join("r/a"), "not a folder").unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check", "--report-dir", "r", "--full-report"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("ok     a"), "the verdict as judged: {}", c.stdout);
+    assert!(c.stdout.contains("error: a: its report folder could not be written"), "{}", c.stdout);
+    assert!(c.stdout.contains("3 passed, 0 failed"), "{}", c.stdout);
+}
+
 fn mutate_bad_input_is_refused() {
     let d = golden_dir(CASES);
     for (args, needle) in [
@@ -4500,6 +4515,7 @@ fn main() {
         Gpu each_backend_checks_into_its_own_report,
         Gpu a_case_may_give_an_output_its_own_tolerance,
         Gpu a_driver_crash_fails_one_case_not_the_run,
+        Gpu a_report_that_cannot_be_written_fails_the_run_not_the_verdict,
         Gpu per_backend_goldens_cover_every_output_of_a_graph,
         Gpu bless_from_report_accepts_what_another_clone_rendered,
         Gpu check_writes_junit_json_and_github_annotations,

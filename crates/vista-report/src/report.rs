@@ -40,12 +40,13 @@ pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
 }
 
 /// A checked case with its images written into `dir`: the outcome with
-/// `files` filled in (a failure to write them makes the case an error).
-pub fn file_case(dir: &Path, checked: vista_golden::Checked, detail: Detail) -> Outcome {
+/// `files` filled in, its verdict as judged (never changed here), and what
+/// could not be written (the run's failure, not the case's).
+pub fn file_case(dir: &Path, checked: vista_golden::Checked, detail: Detail) -> (Outcome, Vec<String>) {
     let vista_golden::Checked { mut outcome, actual, expected, output_images, pending_files, inputs, .. } = checked;
+    let mut unwritten = Vec::new();
     if let Err(e) = write_inputs(dir, &mut outcome, &inputs) {
-        outcome.verdict = Verdict::Error;
-        outcome.problems.push(e.to_string());
+        unwritten.push(e.to_string());
     }
     // What bless --from-report accepts besides the main PNG.
     let kept = (|| -> Result<(), GoldenError> {
@@ -61,20 +62,17 @@ pub fn file_case(dir: &Path, checked: vista_golden::Checked, detail: Detail) -> 
         Ok(())
     })();
     if let Err(e) = kept {
-        outcome.verdict = Verdict::Error;
-        outcome.problems.push(e.to_string());
+        unwritten.push(e.to_string());
     }
     if let Some(actual) = &actual
         && let Err(e) = write_case_files(dir, &mut outcome, actual, expected.as_ref(), detail)
     {
-        outcome.verdict = Verdict::Error;
-        outcome.problems.push(e.to_string());
+        unwritten.push(e.to_string());
     }
     if let Err(e) = write_output_images(dir, &mut outcome, &output_images) {
-        outcome.verdict = Verdict::Error;
-        outcome.problems.push(e.to_string());
+        unwritten.push(e.to_string());
     }
-    outcome
+    (outcome, unwritten)
 }
 
 /// `<dir>/<id>/`, created and marked as vista's (so a later run may clear
