@@ -158,12 +158,18 @@ impl Checker<'_> {
         Filed { outcome, pending, check_time, report_time, report_errors }
     }
 
-    /// Checks and files every case of `picked` with `jobs` workers (1 under
+    /// How many of `requested` workers check `cases` cases at once: 1 under
     /// the validation layer, whose messages are process-wide, so each is
-    /// attributed to the dispatch that caused it), handing each to `each` in
-    /// case order as soon as it and every earlier one are done.
+    /// attributed to the dispatch that caused it; never more than the cases.
+    pub fn jobs(&self, requested: usize, cases: usize) -> usize {
+        if self.ctx.validating() { 1 } else { requested.clamp(1, cases.max(1)) }
+    }
+
+    /// Checks and files every case of `picked` with [`Checker::jobs`]
+    /// workers, handing each to `each` in case order as soon as it and every
+    /// earlier one are done.
     pub fn check_all(&self, picked: &[&Case], jobs: usize, mut each: impl FnMut(&Filed)) -> Vec<Filed> {
-        let jobs = if self.ctx.validating() { 1 } else { jobs.clamp(1, picked.len().max(1)) };
+        let jobs = self.jobs(jobs, picked.len());
         let mut out = Vec::with_capacity(picked.len());
         // The device serialises the workers' GPU runs while the others plan,
         // judge and write their report folder.

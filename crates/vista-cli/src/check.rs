@@ -99,7 +99,7 @@ pub fn check(
     vista_report::clear_case_folders(&report_dir)?;
     let mut time = Phases::start(ctx);
     let checker = Checker { ctx, store: &store, manifest: &manifest, report_dir: &report_dir, detail: viewers };
-    time.jobs = if ctx.validating() { 1 } else { pick.jobs.clamp(1, picked.len().max(1)) };
+    time.jobs = checker.jobs(pick.jobs, picked.len());
     let filed = checker.check_all(&picked, pick.jobs, |f| {
         time.cases += f.check_time;
         time.report += f.report_time;

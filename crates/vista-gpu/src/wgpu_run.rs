@@ -118,9 +118,7 @@ struct Made {
     textures: HashMap<usize, wgpu::Texture>,
     buffers: HashMap<usize, wgpu::Buffer>,
     samplers: HashMap<usize, wgpu::Sampler>,
-    /// Copies of the sentinel over sentinel-filled textures, and the fill
-    /// buffers they read (spares again after the run).
-    fill: wgpu::CommandEncoder,
+    /// The fill buffers the sentinel copies read (spares again after the run).
     fills: Vec<((&'static str, usize, u64), wgpu::Buffer)>,
 }
 
@@ -137,10 +135,9 @@ impl Context {
         let d = &w.device;
         let start = Instant::now();
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut made = self.make_resources(w, g, which)?;
+        let (made, fill) = self.make_resources(w, g, which)?;
         let pipelines: Vec<Arc<Compiled>> =
             g.passes.iter().map(|p| self.pipeline(w, g, p)).collect::<Result<_, _>>()?;
-        let fill = std::mem::replace(&mut made.fill, d.create_command_encoder(&Default::default()));
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Validation { what: "the pass graph's resources".into(), message: e.to_string() });
         }
@@ -218,16 +215,18 @@ impl Context {
     }
 
     /// Creates every resource with its initial contents (`which` picks the
-    /// sentinel of sentinel-filled textures).
-    fn make_resources(&self, w: &WgpuEngine, g: &Graph<'_>, which: usize) -> Result<Made, GpuError> {
+    /// sentinel of sentinel-filled textures), and the copies of the sentinel
+    /// over them, to submit before the first pass.
+    fn make_resources(
+        &self,
+        w: &WgpuEngine,
+        g: &Graph<'_>,
+        which: usize,
+    ) -> Result<(Made, wgpu::CommandEncoder), GpuError> {
         let d = &w.device;
-        let mut made = Made {
-            textures: HashMap::new(),
-            buffers: HashMap::new(),
-            samplers: HashMap::new(),
-            fill: d.create_command_encoder(&Default::default()),
-            fills: Vec::new(),
-        };
+        let mut made =
+            Made { textures: HashMap::new(), buffers: HashMap::new(), samplers: HashMap::new(), fills: Vec::new() };
+        let mut fill = d.create_command_encoder(&Default::default());
         for (i, r) in g.resources.iter().enumerate() {
             match r {
                 Resource::Texture(t) => {
@@ -289,7 +288,7 @@ impl Context {
                                     usage: wgpu::BufferUsages::COPY_SRC,
                                 })
                             });
-                            made.fill.copy_buffer_to_texture(
+                            fill.copy_buffer_to_texture(
                                 wgpu::TexelCopyBufferInfo {
                                     buffer: &buffer,
                                     layout: wgpu::TexelCopyBufferLayout {
@@ -342,7 +341,7 @@ impl Context {
                 }
             }
         }
-        Ok(made)
+        Ok((made, fill))
     }
 
     /// The pipeline of one pass, with bind group layouts from its slots

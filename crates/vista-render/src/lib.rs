@@ -142,14 +142,7 @@ impl<'a> Renderer<'a> {
         project: &vista_project::Project,
         limits: RenderLimits,
     ) -> Result<Renderer<'a>, RenderError> {
-        Ok(Renderer {
-            ctx,
-            worker: worker::Worker::for_config(ctx.config()),
-            edit: None,
-            shaders: shader_set(project)?,
-            limits,
-            root: project.root().map(Into::into),
-        })
+        Ok(Renderer::with_shaders(ctx, shader_set(project)?, limits, project.root().map(Into::into)))
     }
 
     /// A renderer over `shaders` (with a worker for the context's
