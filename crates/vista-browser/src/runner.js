@@ -68,8 +68,8 @@ function vistaChunk(offset, length) {
 
 // A pass graph (SPEC 14; a one-pass kernel is a graph of one pass): job = { resources: [texture | buffer |
 // sampler], passes: [{ key, wgsl, entry, workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding,
-// layout, owned (base64) | resource }] }], outputs: [resource index] }. A texture: { kind, format, dimension,
-// width, height, layers, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
+// layout, owned (base64) | resource, level (a texture's one mip level, or null: all) }] }], outputs: [resource
+// index] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
 // the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64) }; a sampler: { kind,
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility); a texture slot's view dimension is its layout's. Outputs are read back one
@@ -126,7 +126,7 @@ async function vistaRun(job) {
       if (r.kind === "texture") {
         const size = { width: r.width, height: r.height, depthOrArrayLayers: r.layers };
         const usage = T.STORAGE_BINDING | T.TEXTURE_BINDING | T.COPY_SRC | T.COPY_DST;
-        const texture = d.createTexture({ size, dimension: r.dimension, format: r.format, usage });
+        const texture = d.createTexture({ size, dimension: r.dimension, format: r.format, usage, mipLevelCount: r.mip_levels });
         const rowBytes = r.width * r.texel_bytes;
         if (r.contents) {
           d.queue.writeTexture({ texture }, fromBase64(r.contents), { bytesPerRow: rowBytes, rowsPerImage: r.height }, size);
@@ -188,7 +188,9 @@ async function vistaRun(job) {
           if (s.layout.buffer) return { buffer: r };
           if (s.layout.sampler) return r;
           const dim = (s.layout.texture || s.layout.storageTexture).viewDimension;
-          return r.createView({ dimension: dim });
+          // One level (a storage binding's, or `name@level`), else all of them.
+          const level = s.level === null || s.level === undefined ? {} : { baseMipLevel: s.level, mipLevelCount: 1 };
+          return r.createView({ dimension: dim, ...level });
         };
         const bindGroups = compiled[p].groups.map((layout, g) =>
           d.createBindGroup({

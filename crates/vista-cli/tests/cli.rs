@@ -2064,6 +2064,114 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_rejected(&r, 2, &["resource env", "a cube's faces are square but the case is 16x8", "size = [N]"]);
 }
 
+/// `mip_levels` and `bind = { v = "t@level" }`: one texture's levels
+/// written pass by pass (each the 2x2 mean of the level above, dispatched
+/// over its own size by `dispatch = "t@level"`), then read through one view
+/// of every level, on every backend; a level the texture lacks, more levels
+/// than its size has, and a pass reading a level it writes are refused
+/// before any GPU work.
+fn mip_levels_are_written_one_by_one_and_read_together() {
+    let mut manifest = String::from(
+        r#"summary = "a mip pyramid built level by level"
+[[resource]]
+name = "pyramid"
+kind = "texture"
+format = "rgba32float"
+size = [16, 16]
+mip_levels = 5
+[[resource]]
+name = "probe"
+kind = "texture"
+format = "rgba32float"
+size = [6, 2]
+[[pass]]
+entry = "base"
+bind = { dst = "pyramid@0" }
+"#,
+    );
+    for k in 1..5 {
+        manifest += &format!(
+            "[[pass]]\nentry = \"down\"\nbind = {{ src = \"pyramid@{}\", dst = \"pyramid@{k}\" }}\ndispatch = \"pyramid@{k}\"\n",
+            k - 1
+        );
+    }
+    manifest += "[[pass]]\nentry = \"look\"\nbind = { all = \"pyramid\", probe_out = \"probe\" }\n[[output]]\nresource = \"probe\"\n[[output]]\nresource = \"pyramid\"\n";
+    let shader = "@group(0) @binding(0) var dst: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(1) var src: texture_2d<f32>;
+@group(1) @binding(0) var all: texture_2d<f32>;
+@group(1) @binding(1) var probe_out: texture_storage_2d<rgba32float, write>;
+
+@compute @workgroup_size(4, 4, 1)
+fn base(@builtin(global_invocation_id) id: vec3<u32>) {
+    let d = textureDimensions(dst);
+    if any(id.xy >= d) { return; }
+    textureStore(dst, id.xy, vec4(f32(id.x), f32(id.y), f32(id.x * id.y), f32(d.x)));
+}
+
+@compute @workgroup_size(4, 4, 1)
+fn down(@builtin(global_invocation_id) id: vec3<u32>) {
+    let d = textureDimensions(dst);
+    if any(id.xy >= d) { return; }
+    let p = 2u * id.xy;
+    let sum = textureLoad(src, p, 0) + textureLoad(src, p + vec2(1u, 0u), 0)
+        + textureLoad(src, p + vec2(0u, 1u), 0) + textureLoad(src, p + vec2(1u, 1u), 0);
+    textureStore(dst, id.xy, vec4(0.25 * sum.xyz, f32(d.x)));
+}
+
+@compute @workgroup_size(8, 2, 1)
+fn look(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= 6u || id.y >= 2u { return; }
+    if id.x == 5u {
+        textureStore(probe_out, id.xy, vec4(f32(textureNumLevels(all)), 0.0, 0.0, 1.0));
+        return;
+    }
+    // Row 0: each level's first texel; row 1: its last. (Not from
+    // textureDimensions(all, level): lavapipe 22.3.6 answers level 0's size.)
+    let last = vec2((16u >> id.x) - 1u);
+    textureStore(probe_out, id.xy, textureLoad(all, select(vec2(0u), last, id.y == 1u), id.x));
+}
+";
+    let d = kernel_project(&manifest, shader);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("probe-{backend}.exr"));
+        let r = vista_in(
+            Some(d.path()),
+            &[],
+            &["render", "k", "--size", "16x16", "--backend", backend, "-o", out.to_str().unwrap()],
+        );
+        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
+        let probe = vista_image::load(&out).unwrap();
+        assert_eq!(probe.get(5, 0)[0], 5.0, "{backend}: the whole view sees 5 levels");
+        for level in 0..5u32 {
+            // Level k's texel averages a 2^k block of level 0, whose x, y and
+            // x*y means are exact in f32.
+            let block = (1u32 << level) as f32;
+            let mean = |first: f32| first + (block - 1.0) / 2.0;
+            for (row, first) in [(0, 0.0), (1, 16.0 - block)] {
+                let want = [mean(first), mean(first), mean(first) * mean(first), 16.0 / block];
+                assert_eq!(probe.get(level, row), want, "{backend}: level {level}, row {row}");
+            }
+        }
+        // The pyramid as an output is its level 0.
+        let base = vista_image::load(&d.path().join(format!("probe-{backend}.pyramid.exr"))).unwrap();
+        assert_eq!((base.width, base.height, base.get(15, 3)), (16, 16, [15.0, 3.0, 45.0, 16.0]), "{backend}");
+    }
+    let write = |m: &str| std::fs::write(d.path().join("kernels/k.toml"), m).unwrap();
+    let render = || vista_in(Some(d.path()), &[], &["render", "k", "--size", "16x16", "-o", "x.exr"]);
+    write(&manifest.replace("dst = \"pyramid@4\"", "dst = \"pyramid@5\""));
+    assert_rejected(&render(), 2, &["[[pass]] 5", "bind: dst = \"pyramid@5\"", "allowed: pyramid@0 .. pyramid@4"]);
+    write(&manifest.replace("probe_out = \"probe\"", "probe_out = \"probe@1\""));
+    assert_rejected(&render(), 2, &["\"probe@1\"", "probe has 1 mip level", "mip_levels = N"]);
+    write(&manifest.replace("mip_levels = 5", "mip_levels = 6"));
+    assert_rejected(&render(), 2, &["resource pyramid", "mip_levels = 6", "at most 5 levels; allowed: [1, 5]"]);
+    write(&manifest.replace("src = \"pyramid@0\"", "src = \"pyramid\""));
+    assert_rejected(&render(), 2, &["pass 2 (down)", "dst writes pyramid@1 and src binds all of pyramid's levels"]);
+    write(&manifest.replace("src = \"pyramid@0\"", "src = \"pyramid@1\""));
+    assert_rejected(&render(), 2, &["pass 2 (down)", "dst writes pyramid@1 and src binds pyramid@1 too"]);
+    write(&manifest.replace("mip_levels = 5", "mip_levels = 0"));
+    assert_rejected(&render(), 2, &["mip_levels = 0 is not valid; expected an integer in [1, 15]"]);
+}
+
 /// Passes of one `group` repeat together: a counter pass and a pass that
 /// appends the counter's digit run in turn, so 3 steps give 123 (one pass
 /// repeated after the other would give 333), on every backend; a group
@@ -4510,6 +4618,7 @@ fn main() {
         Gpu a_read_write_run_does_not_hide_the_next_runs_unwritten_texels,
         Gpu float_outputs_keep_raw_values_beside_their_view,
         Gpu cube_textures_are_written_as_layers_and_sampled_as_cubes,
+        Gpu mip_levels_are_written_one_by_one_and_read_together,
         Gpu a_group_of_passes_repeats_as_one_step,
         Gpu limits_are_reported_unsupported_by_name,
         Gpu each_backend_checks_into_its_own_report,

@@ -36,7 +36,7 @@ impl Context {
                     };
                     json!({
                         "kind": "texture", "format": t.format, "dimension": t.dimension.texture_name(),
-                        "width": t.width, "height": t.height, "layers": t.layers,
+                        "width": t.width, "height": t.height, "layers": t.layers, "mip_levels": t.mip_levels,
                         "texel_bytes": format.texel_bytes(), "contents": contents, "fill": fill,
                     })
                 }
@@ -128,7 +128,7 @@ impl Context {
                 json!({ "buffer": { "type": if *read_only { "read-only-storage" } else { "storage" } } }),
                 json!({ "resource": resource }),
             ),
-            Bind::StorageTexture { resource, access } => {
+            Bind::StorageTexture { resource, access, level } => {
                 let t = texture(*resource)?;
                 let format = crate::format::parse(t.format)?;
                 if *access == Access::ReadWrite && !self.binds_read_write(&format) {
@@ -141,10 +141,10 @@ impl Context {
                 let access = access.web();
                 (
                     json!({ "storageTexture": { "access": access, "format": t.format, "viewDimension": t.dimension.name() } }),
-                    json!({ "resource": resource }),
+                    json!({ "resource": resource, "level": level }),
                 )
             }
-            Bind::Sampled { resource, depth, cube } => {
+            Bind::Sampled { resource, depth, cube, level } => {
                 let t = texture(*resource)?;
                 let format = crate::format::parse(t.format)?;
                 let sample = match (depth, format.sample_kind()) {
@@ -159,7 +159,7 @@ impl Context {
                         true => "cube",
                         false => t.dimension.name(),
                     } } }),
-                    json!({ "resource": resource }),
+                    json!({ "resource": resource, "level": level }),
                 )
             }
             Bind::Sampler(r) => {

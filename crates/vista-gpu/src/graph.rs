@@ -41,6 +41,8 @@ pub struct TextureDesc {
     pub height: u32,
     /// Array layers or depth (1 for 1d and 2d).
     pub layers: u32,
+    /// Mip levels (1: none); `contents` fills level 0, outputs read level 0.
+    pub mip_levels: u32,
     /// What the texture holds before the first pass.
     pub contents: Contents,
 }
@@ -113,6 +115,7 @@ struct TextureWire {
     width: u32,
     height: u32,
     layers: u32,
+    mip_levels: u32,
     contents: Contents,
 }
 
@@ -120,8 +123,8 @@ impl<'de> serde::Deserialize<'de> for TextureDesc {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<TextureDesc, D::Error> {
         let w = TextureWire::deserialize(d)?;
         let format = vista_texel::Format::parse(&w.format).map_err(serde::de::Error::custom)?.name;
-        let TextureWire { dimension, width, height, layers, contents, .. } = w;
-        Ok(TextureDesc { format, dimension, width, height, layers, contents })
+        let TextureWire { dimension, width, height, layers, mip_levels, contents, .. } = w;
+        Ok(TextureDesc { format, dimension, width, height, layers, mip_levels, contents })
     }
 }
 
@@ -181,6 +184,8 @@ pub enum Bind {
         resource: usize,
         /// The storage texture's access mode.
         access: Access,
+        /// The one mip level it sees.
+        level: u32,
     },
     /// A texture resource bound for sampling or loads; `depth` for
     /// `texture_depth_2d`, `cube` for `texture_cube` over six layers.
@@ -191,6 +196,8 @@ pub enum Bind {
         depth: bool,
         /// Viewed as a cube rather than by its own dimension.
         cube: bool,
+        /// The one mip level it sees; `None`: all of them.
+        level: Option<u32>,
     },
     /// A sampler resource.
     Sampler(usize),

@@ -232,15 +232,18 @@ impl Context {
                 Resource::Texture(t) => {
                     let format = crate::format::parse(t.format)?;
                     let size = wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: t.layers };
+                    // Only single-level textures are kept (the key has no levels).
                     let spare = match t.contents {
-                        Contents::Sentinel => take(&w.spares, |s| &mut s.textures, &texture_key(t)),
+                        Contents::Sentinel if t.mip_levels == 1 => {
+                            take(&w.spares, |s| &mut s.textures, &texture_key(t))
+                        }
                         _ => None,
                     };
                     let texture = spare.unwrap_or_else(|| {
                         d.create_texture(&wgpu::TextureDescriptor {
                             label: Some("resource"),
                             size,
-                            mip_level_count: 1,
+                            mip_level_count: t.mip_levels,
                             sample_count: 1,
                             dimension: crate::format::texture_dimension(t.dimension),
                             format: crate::format::wgpu_format(&format),
@@ -366,7 +369,7 @@ impl Context {
                     has_dynamic_offset: false,
                     min_binding_size: None,
                 },
-                Bind::StorageTexture { resource, access } => {
+                Bind::StorageTexture { resource, access, .. } => {
                     let Resource::Texture(t) = &g.resources[resource] else {
                         return Err(GpuError::Request(format!(
                             "{}: a storage texture bound to a non-texture",
@@ -393,7 +396,7 @@ impl Context {
                         view_dimension: crate::format::view_dimension(t.dimension),
                     }
                 }
-                Bind::Sampled { resource, depth, cube } => {
+                Bind::Sampled { resource, depth, cube, .. } => {
                     let Resource::Texture(t) = &g.resources[resource] else {
                         return Err(GpuError::Request(format!("{}: a texture bound to a non-texture", pass.label)));
                     };
@@ -581,8 +584,15 @@ fn bind_groups(
             Bind::StorageTexture { resource, .. } | Bind::Sampled { resource, .. } => {
                 let Resource::Texture(t) = &g.resources[resource] else { return None };
                 let cube = matches!(s.bind, Bind::Sampled { cube: true, .. });
+                // A storage view sees one level; a sampled one, its level or all.
+                let level = match s.bind {
+                    Bind::StorageTexture { level, .. } | Bind::Sampled { level: Some(level), .. } => Some(level),
+                    _ => None,
+                };
                 Some(made.textures[&current[resource]].create_view(&wgpu::TextureViewDescriptor {
                     dimension: Some(view_dimension(t, cube)),
+                    base_mip_level: level.unwrap_or(0),
+                    mip_level_count: level.map(|_| 1),
                     ..Default::default()
                 }))
             }

@@ -42,6 +42,9 @@ pub enum ResourceKind {
         size: Option<Vec<Expr>>,
         /// A `.png` or `.exr` file under the project root holding its contents.
         file: Option<String>,
+        /// Mip levels (`mip_levels`, default 1): a `bind` or `dispatch` names
+        /// one as `name@level`; a file or the sentinel fills level 0.
+        mip_levels: u32,
     },
     /// A storage or uniform buffer (`kind = "buffer"`).
     Buffer {
@@ -87,6 +90,53 @@ impl ResourceSpec {
     }
 }
 
+/// A resource a pass names, with one of its mip levels (`pyramid@3`);
+/// `level: None` is the whole texture (or a buffer or sampler).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Level {
+    /// The resource's name.
+    pub resource: String,
+    /// The mip level, below the texture's `mip_levels`.
+    pub level: Option<u32>,
+}
+
+impl Level {
+    /// Reads `name` or `name@level` against the resources; the error says
+    /// what is allowed.
+    fn parse(text: &str, res: &[ResourceSpec]) -> Result<Level, String> {
+        let names = || {
+            let n: Vec<&str> = res.iter().map(|r| r.name.as_str()).collect();
+            if n.is_empty() { "none".to_string() } else { n.join(", ") }
+        };
+        let (name, level) = match text.split_once('@') {
+            Some((n, l)) => (n, Some(l)),
+            None => (text, None),
+        };
+        let Some(r) = res.iter().find(|r| r.name == name) else {
+            return Err(format!("\"{text}\" names no resource; resources: {}", names()));
+        };
+        let Some(level) = level else { return Ok(Level { resource: name.to_string(), level: None }) };
+        let levels = match r.kind {
+            ResourceKind::Texture { mip_levels, .. } => mip_levels,
+            _ => {
+                return Err(format!(
+                    "\"{text}\" names a level of {name}, a {}; only textures have levels",
+                    r.kind_name()
+                ));
+            }
+        };
+        match level.parse::<u32>() {
+            Ok(l) if l < levels => Ok(Level { resource: name.to_string(), level: Some(l) }),
+            _ => Err(format!(
+                "\"{text}\": {name} has {levels} mip level{}; allowed: {name}@0 .. {name}@{}{}",
+                if levels == 1 { "" } else { "s" },
+                levels - 1,
+                if levels == 1 { " (give the resource mip_levels = N for more)" } else { "" }
+            )),
+        }
+    }
+}
+
 /// How often a pass runs.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Repeat {
@@ -110,10 +160,10 @@ pub struct PassSpec {
     /// The pass's `source` keys (merged over the kernel's `[source]` by
     /// [`crate::Kernel::source_for`]).
     pub source: vista_source::SourceSpec,
-    /// WGSL variable name -> resource name.
-    pub bind: Vec<(String, String)>,
-    /// Cover this resource with the reflected workgroup size.
-    pub dispatch: Option<String>,
+    /// WGSL variable name -> resource (and mip level, `name@level`).
+    pub bind: Vec<(String, Level)>,
+    /// Cover this resource (at this mip level) with the reflected workgroup size.
+    pub dispatch: Option<Level>,
     /// Explicit workgroup counts `[x, y, z]` as expressions of the params and the
     /// case size (exclusive with `dispatch`).
     pub workgroups: Option<[Expr; 3]>,
@@ -223,8 +273,21 @@ pub struct GraphSpec {
 }
 
 /// Resource keys by kind, for messages and the README's table.
-pub const RESOURCE_KEYS: [&str; 12] =
-    ["name", "kind", "format", "dimension", "size", "file", "data", "fill", "length", "filter", "address", "compare"];
+pub const RESOURCE_KEYS: [&str; 13] = [
+    "name",
+    "kind",
+    "format",
+    "dimension",
+    "size",
+    "file",
+    "mip_levels",
+    "data",
+    "fill",
+    "length",
+    "filter",
+    "address",
+    "compare",
+];
 /// The keys of a `[[pass]]` table.
 pub const PASS_KEYS: [&str; 11] =
     ["entry", "shader", "defs", "source", "bind", "dispatch", "workgroups", "set", "repeat", "swap", "group"];
@@ -245,7 +308,7 @@ pub(crate) fn is_graph(
         || outputs.len() > 1
         || deterministic == Some(false)
         || resources.iter().any(|r| {
-            has(r, &["file", "data", "fill", "length", "filter", "address", "compare"])
+            has(r, &["file", "mip_levels", "data", "fill", "length", "filter", "address", "compare"])
                 || r.get("kind").and_then(|k| k.as_str()).is_some_and(|k| k != "texture")
                 || r.get("dimension").and_then(|k| k.as_str()) == Some("cube")
         })
@@ -314,7 +377,7 @@ fn parse_resources(
         let text = |k: &str| string_key(t, k, &at);
         let kind = text("kind")?.ok_or_else(|| at("needs kind = \"texture\", \"buffer\" or \"sampler\"".into()))?;
         let allowed: &[&str] = match kind.as_str() {
-            "texture" => &["name", "kind", "format", "dimension", "size", "file"],
+            "texture" => &["name", "kind", "format", "dimension", "size", "file", "mip_levels"],
             "buffer" => &["name", "kind", "file", "data", "fill", "length"],
             "sampler" => &["name", "kind", "filter", "address", "compare"],
             other => return Err(at(format!("kind = \"{other}\" is not valid; expected texture|buffer|sampler"))),
@@ -378,7 +441,15 @@ fn texture_kind(
         }
         Some(other) => return Err(at(format!("size = {other} is not valid; expected a list"))),
     };
-    Ok(ResourceKind::Texture { format, dimension, size, file })
+    let mip_levels = match t.get("mip_levels") {
+        None => 1,
+        Some(toml::Value::Integer(n)) if (1..=15).contains(n) => *n as u32,
+        Some(other) => return Err(at(format!("mip_levels = {other} is not valid; expected an integer in [1, 15]"))),
+    };
+    if mip_levels > 1 && dimension == Some(Dimension::D1) {
+        return Err(at(format!("mip_levels = {mip_levels}: a 1d texture has one level (WebGPU)")));
+    }
+    Ok(ResourceKind::Texture { format, dimension, size, file, mip_levels })
 }
 
 /// A buffer resource's keys: its file, inline data, or fill and length.
@@ -533,20 +604,15 @@ fn parse_passes(
                     let Some(r) = r.as_str() else {
                         return Err(at(format!("bind: {var} = {r} is not valid; expected a resource name")));
                     };
-                    if !named(r) {
-                        return Err(at(format!("bind: {var} = \"{r}\" names no resource; resources: {}", names())));
-                    }
-                    bind.push((var.clone(), r.to_string()));
+                    bind.push((var.clone(), Level::parse(r, res).map_err(|m| at(format!("bind: {var} = {m}")))?));
                 }
             }
             Some(other) => return Err(at(format!("bind = {other} is not valid; expected a table"))),
         }
-        let dispatch = text("dispatch")?;
-        if let Some(d) = &dispatch
-            && !named(d)
-        {
-            return Err(at(format!("dispatch = \"{d}\" names no resource; resources: {}", names())));
-        }
+        let dispatch = match text("dispatch")? {
+            None => None,
+            Some(d) => Some(Level::parse(&d, res).map_err(|m| at(format!("dispatch = {m}")))?),
+        };
         let workgroups = match t.get("workgroups") {
             None => None,
             Some(toml::Value::Array(list)) if list.len() == 3 => {
@@ -794,6 +860,55 @@ pub struct PassSlot {
     /// For a storage buffer: its element layout (stride, fixed header
     /// bytes before a runtime-sized array, leaf scalars of one element).
     pub element: Option<Element>,
+    /// The texture's mip level the binding sees (`bind = { v = "t@2" }`);
+    /// `None`: every level for a sampled binding, level 0 for storage.
+    pub level: Option<u32>,
+}
+
+impl PassSlot {
+    /// The mip levels of its texture this binding touches: one for a
+    /// storage binding, all (`None`) for a sampled one without a level.
+    fn levels(&self) -> Option<u32> {
+        match self.feed {
+            SlotFeed::Resource(_, Usage::StorageTexture(_)) => Some(self.level.unwrap_or(0)),
+            _ => self.level,
+        }
+    }
+}
+
+/// A texture level a pass writes is bound nowhere else in that pass
+/// (WebGPU forbids it; the message says which bindings clash).
+fn check_levels(
+    slots: &[PassSlot],
+    resources: &[ResolvedResource],
+    label: &str,
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<(), ParamError> {
+    for (i, w) in slots.iter().enumerate() {
+        let SlotFeed::Resource(r, Usage::StorageTexture(st)) = w.feed else { continue };
+        if st.access == Access::Read {
+            continue;
+        }
+        let level = w.levels().expect("storage binds one level");
+        for (j, o) in slots.iter().enumerate() {
+            let same = matches!(o.feed, SlotFeed::Resource(q, _) if q == r);
+            if j == i || !same || o.levels().is_some_and(|l| l != level) {
+                continue;
+            }
+            let name = &resources[r].spec.name;
+            return Err(bad(format!(
+                "{label}: {} writes {name}@{level} and {} binds {}; a pass cannot read or write a level it writes through another binding (bind one a different level, e.g. {name}@{})",
+                w.var,
+                o.var,
+                match o.levels() {
+                    Some(l) => format!("{name}@{l} too"),
+                    None => format!("all of {name}'s levels"),
+                },
+                level.saturating_sub(1)
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// A buffer binding's element: what one entry of its runtime-sized array
@@ -894,11 +1009,10 @@ pub fn resolve(
         let mut blocks = 0usize;
         for b in bindings.iter() {
             // Bound by the pass's bind, else to the resource of its own name.
-            let bound = pass
-                .bind
-                .iter()
-                .find(|(v, _)| *v == b.name)
-                .map(|(_, r)| r.clone())
+            let given = pass.bind.iter().find(|(v, _)| *v == b.name).map(|(_, r)| r);
+            let level = given.and_then(|r| r.level);
+            let bound = given
+                .map(|r| r.resource.clone())
                 .or_else(|| graph.resources.iter().find(|r| r.name == b.name).map(|r| r.name.clone()));
             let bound = bound.as_deref();
             let feed = match (b.feed, bound) {
@@ -985,8 +1099,9 @@ pub fn resolve(
                 }
                 _ => None,
             };
-            slots.push(PassSlot { group: b.group, binding: b.binding, var: b.name.clone(), feed, element });
+            slots.push(PassSlot { group: b.group, binding: b.binding, var: b.name.clone(), feed, element, level });
         }
+        check_levels(&slots, &resources, &label, &bad)?;
         all_slots.push(slots);
     }
     check_swaps_and_outputs(graph, &resources, &bad)?;
@@ -1015,7 +1130,13 @@ fn storage_slot(
                     resources.push(ResolvedResource {
                         spec: ResourceSpec {
                             name: b.name.clone(),
-                            kind: ResourceKind::Texture { format: None, dimension: None, size: None, file: None },
+                            kind: ResourceKind::Texture {
+                                format: None,
+                                dimension: None,
+                                size: None,
+                                file: None,
+                                mip_levels: 1,
+                            },
                         },
                         format: None,
                         dimension: None,

@@ -136,8 +136,8 @@ pub(crate) fn plan_graph(
         .resources
         .iter()
         .map(|r| match &r.spec.kind {
-            ResourceKind::Texture { size, file, .. } => {
-                at.texture(r, size.as_deref(), file.as_ref(), outputs_named.contains(&r.spec.name))
+            ResourceKind::Texture { size, file, mip_levels, .. } => {
+                at.texture(r, size.as_deref(), file.as_ref(), *mip_levels, outputs_named.contains(&r.spec.name))
             }
             ResourceKind::Buffer { file, data, fill, length } => {
                 at.buffer(r, file.as_ref(), data.as_deref(), *fill, length.as_ref())
@@ -196,6 +196,7 @@ impl Planning<'_> {
         r: &vista_kernels::graph::ResolvedResource,
         size: Option<&[vista_kernels::expr::Expr]>,
         file: Option<&String>,
+        mip_levels: u32,
         is_output: bool,
     ) -> Result<vista_gpu::Resource, RenderError> {
         let (root, p, width, height) = (self.root, self.p, self.width, self.height);
@@ -277,12 +278,25 @@ impl Planning<'_> {
             }
             (None, _) => [width, height, 1],
         };
+        // Each level halves every side (depth too for 3d), down to 1x1.
+        let deepest = match dimension {
+            Dimension::D3 => w.max(h).max(l),
+            _ => w.max(h),
+        };
+        let most = u32::BITS - deepest.leading_zeros();
+        if mip_levels > most {
+            return Err(at(format!(
+                "mip_levels = {mip_levels} but a {w}x{h}{} texture has at most {most} levels; allowed: [1, {most}]",
+                if dimension == Dimension::D3 { format!("x{l}") } else { String::new() }
+            )));
+        }
         Ok(vista_gpu::Resource::Texture(vista_gpu::TextureDesc {
             format,
             dimension,
             width: w,
             height: h,
             layers: l,
+            mip_levels,
             contents,
         }))
     }
@@ -379,20 +393,26 @@ impl Planning<'_> {
                 SlotFeed::Resource(r, usage) => match usage {
                     Usage::UniformBuffer => Bind::UniformBuffer(*r),
                     Usage::StorageBuffer { read_only } => Bind::Storage { resource: *r, read_only: *read_only },
-                    Usage::StorageTexture(st) => Bind::StorageTexture { resource: *r, access: st.access },
+                    Usage::StorageTexture(st) => {
+                        Bind::StorageTexture { resource: *r, access: st.access, level: s.level.unwrap_or(0) }
+                    }
                     Usage::Sampled { kind, dim } => Bind::Sampled {
                         resource: *r,
                         depth: *kind == vista_kernels::graph::SampledKind::Depth,
                         cube: *dim == Dimension::Cube,
+                        level: s.level,
                     },
                     Usage::Sampler { .. } => Bind::Sampler(*r),
                 },
             };
             gslots.push(GraphSlot { group: s.group, binding: s.binding, bind });
         }
-        let cover = |r: usize| -> [u32; 3] {
+        let cover = |r: usize, level: u32| -> [u32; 3] {
             match &resources[r] {
-                vista_gpu::Resource::Texture(t) => [t.width, t.height, t.layers],
+                vista_gpu::Resource::Texture(t) => {
+                    let depth = if t.dimension == Dimension::D3 { (t.layers >> level).max(1) } else { t.layers };
+                    [(t.width >> level).max(1), (t.height >> level).max(1), depth]
+                }
                 vista_gpu::Resource::Buffer(b) => {
                     let e = resolved.resources[r].element.as_ref().expect("a bound buffer");
                     [((b.len() as u32 - e.header) / e.stride.max(1)).max(1), 1, 1]
@@ -413,21 +433,21 @@ impl Planning<'_> {
             }
             (None, target) => {
                 let extent = match target {
-                    Some(name) => cover(index(name)),
+                    Some(l) => cover(index(&l.resource), l.level.unwrap_or(0)),
                     None => {
-                        let written: Vec<usize> = slots
+                        let written: Vec<(usize, u32)> = slots
                             .iter()
                             .filter_map(|s| match s.feed {
                                 SlotFeed::Resource(r, Usage::StorageTexture(st))
                                     if st.access != vista_texel::Access::Read =>
                                 {
-                                    Some(r)
+                                    Some((r, s.level.unwrap_or(0)))
                                 }
                                 _ => None,
                             })
                             .collect();
                         match written[..] {
-                            [one] => cover(one),
+                            [(one, level)] => cover(one, level),
                             _ => [width, height, 1],
                         }
                     }

@@ -57,6 +57,7 @@ pub(crate) fn plan(
                 Feed::Output(_) => Bind::StorageTexture {
                     resource: 0,
                     access: if read_write { vista_texel::Access::ReadWrite } else { vista_texel::Access::Write },
+                    level: 0,
                 },
                 _ => unreachable!("bindings::reflect refuses the graph feeds"),
             },
@@ -78,6 +79,7 @@ pub(crate) fn plan(
         width: extent.width,
         height: extent.height,
         layers: extent.layers,
+        mip_levels: 1,
         // A read_write output starts as zeros (the kernel may read a texel
         // before writing it); texels left as they were are not unwritten.
         contents: if read_write { Contents::Zeros } else { Contents::Sentinel },
