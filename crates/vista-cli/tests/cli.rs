@@ -4496,6 +4496,21 @@ fn a_driver_crash_fails_one_case_not_the_run() {
     let x = with(&fault("segv:a"), &["check", "--matrix", "--case", "a"]);
     assert_eq!(x.code, 1, "{}", x.stdout);
     assert!(x.stdout.contains("matrix: 1 cases x 3 backends"), "{}", x.stdout);
+    // A sweep names the crashed point, measures and writes the others, exits 1.
+    let out = d.path().join("sw");
+    let sweep = ["sweep", "fbm", "--param", "octaves", "--values", "1,2,4", "--size", "16x16", "--runs", "1"];
+    let args: Vec<&str> = sweep.iter().copied().chain(["--out", out.to_str().unwrap()]).collect();
+    let s = with(&fault("segv:octaves=2"), &args);
+    assert_eq!(s.code, 1, "{}{}", s.stdout, s.stderr);
+    let block = s.stdout.lines().find(|l| l.starts_with("CRASH octaves=2: ")).unwrap_or_else(|| panic!("{}", s.stdout));
+    assert!(block.contains("the lavapipe driver (llvmpipe") && block.contains("(signal 11, SIGSEGV)"), "{block}");
+    let csv = std::fs::read_to_string(out.join("curve.csv")).unwrap();
+    let settings: Vec<&str> = csv.lines().skip(1).map(|l| l.split(',').next().unwrap()).collect();
+    assert_eq!(settings, ["1", "4"], "{csv}");
+    // Without its reference a sweep has nothing to measure against: it stops.
+    let s = with(&fault("segv:reference"), &args);
+    assert_eq!(s.code, 1, "{}{}", s.stdout, s.stderr);
+    assert!(s.stderr.contains("crashed (signal 11, SIGSEGV)"), "{}", s.stderr);
 }
 
 /// Writing the report never changes a verdict: a case folder that cannot

@@ -29,7 +29,9 @@ use crate::RenderError;
 pub const WORKER_VAR: &str = "VISTA_WORKER";
 
 /// A fault a worker raises on purpose (tests of the crash path), set by
-/// `VISTA_WORKER_FAULT=<segv|abort|hang>:<case id>` through `vista::Config`.
+/// `VISTA_WORKER_FAULT=<segv|abort|hang>:<case>` through `vista::Config`
+/// (a case id; for `vista sweep`, a point's setting such as `octaves=4`, or
+/// `reference`).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Fault {
     /// `raise(SIGSEGV)`, as a driver's bad pointer would.

@@ -134,6 +134,10 @@ pub struct Sweep {
     pub reference_params: String,
     /// Every measured point: x values inner, y values outer.
     pub points: Vec<Point>,
+    /// Points whose render crashed the driver (the worker died): the
+    /// setting (`octaves=4`) and the crash, in sweep order. The sweep goes
+    /// on past them; `vista sweep` exits 1.
+    pub crashed: Vec<(String, String)>,
 }
 
 fn bad(e: impl std::fmt::Display) -> RenderError {
@@ -220,21 +224,32 @@ pub fn run(
     let (k, w, h) = (&spec.kernel, spec.width, spec.height);
     let total = points.len() + 1;
     progress(0, total, "reference");
-    // Warm-up: pipeline compilation is not part of any timing.
-    vista_render::render(ctx, k, &points[0].2, 8, 8)?;
-    let (reference, reference_time) = vista_render::render_median(ctx, k, &reference_params, w, h, spec.runs)?;
+    // Warm-up: pipeline compilation is not part of any timing. Renders are
+    // named (as cases are) so that a crash says which point it was.
+    let (reference, reference_time) = vista_render::for_case("reference", || {
+        vista_render::render(ctx, k, &reference_params, 8, 8)?;
+        vista_render::render_median(ctx, k, &reference_params, w, h, spec.runs)
+    })?;
     let reference_ms = reference_time.as_secs_f64() * 1e3;
     if let Some((x, y)) = reference.raw.first_nonfinite() {
         return Err(RenderError::BadInput(format!("the reference render has NaN/Inf, first at ({x}, {y})")));
     }
     let mut out = Vec::with_capacity(points.len());
+    let mut crashed = Vec::new();
     for (i, (xv, yv, p)) in points.iter().enumerate() {
         let label = match yv {
             Some(y) => format!("{}={xv} {}={y}", spec.x.name, spec.y.as_ref().map(|a| a.name.as_str()).unwrap_or("")),
             None => format!("{}={xv}", spec.x.name),
         };
         progress(i + 1, total, &label);
-        let (r, time) = vista_render::render_median(ctx, k, p, w, h, spec.runs)?;
+        let (r, time) = match vista_render::for_case(&label, || vista_render::render_median(ctx, k, p, w, h, spec.runs))
+        {
+            Err(RenderError::Crashed(c)) => {
+                crashed.push((label, c.to_string()));
+                continue;
+            }
+            other => other?,
+        };
         let gpu_ms = time.as_secs_f64() * 1e3;
         let m = match spec.metric {
             Metric::Display => metrics::compare(reference.display(), r.display())?,
@@ -256,6 +271,7 @@ pub fn run(
         reference_ms,
         reference_params: reference_params.canonical(),
         points: out,
+        crashed,
     })
 }
 
@@ -343,6 +359,9 @@ impl Sweep {
                 p.metrics.max_abs,
                 p.gpu_ms
             );
+        }
+        for (setting, crash) in &self.crashed {
+            let _ = writeln!(s, "CRASH {setting}: {crash}");
         }
         match self.cheapest() {
             Some(p) => {

@@ -22,7 +22,7 @@ fn sweep(y: Option<Axis>, points: Vec<Point>) -> Sweep {
         runs: 1,
         metric: Metric::Display,
     };
-    Sweep { spec, adapter: "test".into(), reference_ms: 1.0, reference_params: String::new(), points }
+    Sweep { spec, adapter: "test".into(), reference_ms: 1.0, reference_params: String::new(), points, crashed: vec![] }
 }
 
 #[test]
@@ -54,6 +54,18 @@ fn the_reference_itself_is_never_the_cheapest() {
     );
     let s = sweep(None, vec![point("1", None, 45.0, 2.0, 4.0), same]);
     assert_eq!(s.cheapest().unwrap().x, "1");
+}
+
+/// A point whose render crashed is named under the table with its crash
+/// and is never the cheapest; the CSV has the measured points only.
+#[test]
+fn crashed_points_are_listed_apart() {
+    let mut s = sweep(None, vec![point("16", None, 45.0, 1.0, 16.0), point("64", None, 50.0, 4.0, 64.0)]);
+    s.crashed.push(("steps=32".into(), "the lavapipe driver (x) crashed (signal 11, SIGSEGV) in pass 1".into()));
+    let t = s.table();
+    assert!(t.contains("\nCRASH steps=32: the lavapipe driver (x) crashed (signal 11, SIGSEGV) in pass 1\n"), "{t}");
+    assert_eq!(s.cheapest().unwrap().x, "16");
+    assert_eq!(s.csv().lines().count(), 3, "{}", s.csv());
 }
 
 #[test]
