@@ -2,7 +2,6 @@
 //! beside the f32 CPU reference on all cores.
 
 use vista_golden::GoldenError;
-use vista_gpu::Context;
 use vista_project::Project;
 use vista_render::Renderer;
 
@@ -43,8 +42,7 @@ pub fn bench(
             None => format!("--cpu: kernel {kernel} has no CPU reference (only built-in kernels have one)"),
         }));
     }
-    let ctx =
-        &Renderer::with_shaders(Context::shared(&config.gpu)?, shaders, config.limits, project.root().map(Into::into));
+    let ctx = &Renderer::shared_with_shaders(&config.gpu, shaders, config.limits, project.root().map(Into::into))?;
     // GPU timestamps around each graph pass, where the device has them.
     ctx.time_passes(true);
     // Warm-up: compiles the pipeline and touches every allocation path once.
@@ -76,7 +74,7 @@ pub fn bench(
             gpu_median_ms: (!gpu.is_empty()).then(|| vista_render::median(gpu).as_secs_f64() * 1e3),
         })
         .collect();
-    let med = |f: fn(&vista_gpu::RunStats) -> std::time::Duration| {
+    let med = |f: fn(&vista_render::RunStats) -> std::time::Duration| {
         vista_render::median(stats.iter().map(f).collect()).as_secs_f64()
     };
     let (median, kernel_s, readback_s) = (med(|s| s.gpu_wall), med(|s| s.kernel), med(|s| s.readback));

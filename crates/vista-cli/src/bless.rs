@@ -5,7 +5,6 @@ use std::path::Path;
 
 use vista::Config;
 use vista_golden::{BlessOptions, GoldenError, Store};
-use vista_gpu::Context;
 use vista_project::Project;
 use vista_render::Renderer;
 
@@ -45,7 +44,7 @@ pub fn from_report(
 /// Renders the selected cases and writes their goldens.
 pub fn bless(project: &Project, config: &Config, opts: BlessOptions) -> Result<i32, GoldenError> {
     let store = Store::of_project(project, "vista bless")?;
-    let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
+    let ctx = &Renderer::shared(&config.gpu, project, config.limits)?;
     let summary = vista_golden::bless(ctx, &store, &opts)?;
     println!("{:<40} {:<10} PSNR new vs old", "case", "status");
     for r in &summary.rows {

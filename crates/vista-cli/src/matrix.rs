@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use vista_check::Checker;
 use vista_golden::{GoldenError, Outcome, Store};
-use vista_gpu::{AdapterChoice, Context};
 use vista_project::Project;
 use vista_render::Renderer;
 
@@ -30,8 +29,7 @@ pub fn matrix(
     }
     let mut columns: Vec<vista_report::MatrixColumn> = Vec::new();
     for &b in BACKENDS {
-        let gpu_config = vista_gpu::GpuConfig { adapter: AdapterChoice::of_backend(b)?, ..config.gpu.clone() };
-        let ctx = match Context::new(&gpu_config) {
+        let ctx = match vista_render::own_device(&config.gpu, Some(b), None) {
             Ok(c) => c,
             Err(e) => {
                 columns.push((b.to_string(), Err(e.to_string())));

@@ -5,7 +5,6 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use vista_golden::{GoldenError, Store};
-use vista_gpu::Context;
 use vista_mutate::{Options, Report};
 use vista_project::Project;
 
@@ -101,7 +100,7 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
         partition.0,
         partition.1
     );
-    let ctx = Context::new(&config.gpu)?.with_timeout(MUTANT_TIMEOUT);
+    let ctx = vista_render::own_device(&config.gpu, None, Some(MUTANT_TIMEOUT))?;
     let bar = ProgressBar::new(planned.len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} mutants, {elapsed} elapsed, ETA {eta}")

@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 
 use vista::Config;
 use vista_golden::GoldenError;
-use vista_gpu::Context;
 use vista_project::Project;
 use vista_render::Renderer;
 
@@ -40,12 +39,7 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
         let shaders = vista_render::shader_set(project)?;
         // Every check that needs no device (bindings, input files) before one is made.
         let plan = vista_render::plan(&shaders, project.root(), &k, &p, &[], w, h, &config.limits)?;
-        let ctx = &Renderer::with_shaders(
-            Context::shared(&config.gpu)?,
-            shaders,
-            config.limits,
-            project.root().map(Into::into),
-        );
+        let ctx = &Renderer::shared_with_shaders(&config.gpu, shaders, config.limits, project.root().map(Into::into))?;
         return graph_render::render(ctx, &k, &plan, &out);
     }
     check_output_path(&out)?;
@@ -54,8 +48,7 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
     let t = plan.main_texture().cloned().expect("a one-pass kernel writes a texture");
     // Layers and slices are stacked top to bottom: crop that image.
     let rect = crop.as_deref().map(|c| parse_crop(c, t.width, t.height * t.layers)).transpose()?;
-    let ctx =
-        &Renderer::with_shaders(Context::shared(&config.gpu)?, shaders, config.limits, project.root().map(Into::into));
+    let ctx = &Renderer::shared_with_shaders(&config.gpu, shaders, config.limits, project.root().map(Into::into))?;
     let r = vista_render::run(ctx, &plan)?;
     let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     let mut img = if is_exr { r.raw.clone() } else { r.display().clone() };

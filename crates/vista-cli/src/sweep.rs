@@ -5,7 +5,6 @@ use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use vista_golden::GoldenError;
-use vista_gpu::Context;
 use vista_project::Project;
 use vista_render::Renderer;
 use vista_sweep::{Axis, Metric, SweepSpec};
@@ -76,7 +75,7 @@ pub fn sweep(project: &Project, config: &vista::Config, a: Args) -> Result<i32, 
     // Every value is checked before the device is touched.
     spec.resolve(&config.limits)?;
     crate::render::check_output_dir(&a.out)?;
-    let ctx = &Renderer::new(Context::shared(&config.gpu)?, project, config.limits)?;
+    let ctx = &Renderer::shared(&config.gpu, project, config.limits)?;
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{bar:30}] {pos}/{len} {msg} ({elapsed})")

@@ -4720,7 +4720,7 @@ fn main() {
     } else {
         vista::Config::from_env(&vista::Flags::default())
             .map_err(|e| e.to_string())
-            .and_then(|c| vista_gpu::Context::new(&c.gpu).map(|_| ()).map_err(|e| e.to_string()))
+            .and_then(|c| vista_render::own_device(&c.gpu, None, None).map(|_| ()).map_err(|e| e.to_string()))
             .err()
     };
     if let Some(e) = &missing {

@@ -22,8 +22,8 @@ pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-pub use vista_gpu::ShaderSet;
-use vista_gpu::{Context, RunStats};
+use vista_gpu::Context;
+pub use vista_gpu::{RunStats, ShaderSet};
 use vista_image::Image;
 use vista_kernels::{DisplayMap, Kernel, ParamSet};
 
@@ -108,6 +108,25 @@ pub fn check_request(
     Ok(())
 }
 
+/// A device of its own instead of the process's shared one: on another
+/// backend than `gpu` names (`vista check --matrix`), or with a watchdog of
+/// its own (`vista mutate`). A [`Renderer`] borrows it.
+pub fn own_device(
+    gpu: &vista_gpu::GpuConfig,
+    backend: Option<&str>,
+    timeout: Option<Duration>,
+) -> Result<Context, RenderError> {
+    let mut config = gpu.clone();
+    if let Some(b) = backend {
+        config.adapter = vista_gpu::AdapterChoice::of_backend(b)?;
+    }
+    let ctx = Context::new(&config)?;
+    Ok(match timeout {
+        Some(t) => ctx.with_timeout(t),
+        None => ctx,
+    })
+}
+
 /// The GPU context and the WGSL of one project: everything a render needs
 /// besides the kernel and its params. Derefs to the [`Context`].
 pub struct Renderer<'a> {
@@ -164,6 +183,18 @@ impl<'a> Renderer<'a> {
         limits: RenderLimits,
     ) -> Result<Renderer<'static>, RenderError> {
         Renderer::new(Context::shared(gpu)?, project, limits)
+    }
+
+    /// A renderer over `shaders` on the process's shared device (made
+    /// from `gpu` on first use): for commands that read and plan their
+    /// shaders before touching a device.
+    pub fn shared_with_shaders(
+        gpu: &vista_gpu::GpuConfig,
+        shaders: ShaderSet,
+        limits: RenderLimits,
+        root: Option<std::path::PathBuf>,
+    ) -> Result<Renderer<'static>, RenderError> {
+        Ok(Renderer::with_shaders(Context::shared(gpu)?, shaders, limits, root))
     }
 
     /// Time spent so far compiling pipelines, here or in workers.
