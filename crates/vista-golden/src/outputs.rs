@@ -42,6 +42,67 @@ impl OutputFiles {
     }
 }
 
+/// What the case runner found at a golden file's path.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Found {
+    /// No file there.
+    Missing,
+    /// The file's bytes.
+    Bytes(Vec<u8>),
+    /// Something there that could not be read (the error, naming the path).
+    Unreadable(String),
+}
+
+/// One output's golden files and what the case runner found at each: all
+/// that [`compare_output`] judges against, so the verdict reads no file.
+#[derive(Debug, Clone, Default)]
+pub struct GoldenFiles {
+    /// Where each file is.
+    pub paths: OutputFiles,
+    /// What was found at each of `paths.all()`.
+    pub found: Vec<(PathBuf, Found)>,
+}
+
+impl GoldenFiles {
+    /// Reads every file of `paths` (the case runner's part).
+    pub fn read(paths: OutputFiles) -> GoldenFiles {
+        let found = paths
+            .all()
+            .into_iter()
+            .map(|p| {
+                let found = match std::fs::read(p) {
+                    Ok(bytes) => Found::Bytes(bytes),
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => Found::Missing,
+                    Err(source) => {
+                        Found::Unreadable(vista_image::ImageError::Io { path: p.clone(), source }.to_string())
+                    }
+                };
+                (p.clone(), found)
+            })
+            .collect();
+        GoldenFiles { paths, found }
+    }
+
+    /// What was found at `path` (missing if it is not one of these files).
+    pub fn at(&self, path: &Path) -> &Found {
+        self.found.iter().find(|(p, _)| p == path).map_or(&Found::Missing, |(_, f)| f)
+    }
+
+    /// The decoded file at `path`: `Ok(None)` when missing, `Err` naming the
+    /// path when it cannot be read or decoded.
+    fn decode<T>(
+        &self,
+        path: &Path,
+        decode: impl Fn(&Path, &[u8]) -> Result<T, vista_image::ImageError>,
+    ) -> Result<Option<T>, String> {
+        match self.at(path) {
+            Found::Missing => Ok(None),
+            Found::Unreadable(e) => Err(e.clone()),
+            Found::Bytes(bytes) => decode(path, bytes).map(Some).map_err(|e| e.to_string()),
+        }
+    }
+}
+
 /// The allowance a float buffer without a tolerance gets on a driver other
 /// than the one that blessed it (SPEC 16): each value within this many f32
 /// units in the last place of the golden's...
@@ -147,19 +208,20 @@ pub struct OutputVerdict {
     pub summary: String,
 }
 
-/// Compares output `index` with its goldens. The first texture output's PNG
-/// is the case's main image, judged by the case's verdict (`check::judge`) itself; here it only
-/// gets its raw comparison, if it has one.
+/// Compares output `index` with its goldens as the case runner read them
+/// ([`GoldenFiles::read`]); pure: it reads and writes nothing. The first
+/// texture output's PNG is the case's main image, judged by the case's
+/// verdict (`check::judge`) itself; here it only gets its raw comparison,
+/// if it has one.
 pub fn compare_output(
     case: &Case,
-    golden_dir: &Path,
-    key: &str,
+    golden: &GoldenFiles,
     index: usize,
     out: &OutputRender,
     threshold: crate::DriverThreshold,
     blessed: Option<&crate::ManifestEntry>,
 ) -> OutputVerdict {
-    let files = output_files(golden_dir, case, key, index, out);
+    let files = golden.paths.clone();
     // A case's own tolerance for this output replaces the manifest's; which
     // golden files the output has stays the manifest's (`output_files`).
     let own = case.tolerances.iter().find(|(n, _)| *n == out.name).map(|(_, t)| *t);
@@ -188,18 +250,18 @@ pub fn compare_output(
         ..Default::default()
     };
     v.problems = guard_one(index, out);
-    v.problems.extend(changed_outside_bless(case, &files, blessed));
+    v.problems.extend(changed_outside_bless(case, golden, blessed));
     match &out.value {
         OutputValue::Buffer { .. } => {
             let path = files.npy.expect("a buffer's npy");
-            if !path.exists() {
-                v.missing.push(path);
-                return v;
-            }
-            let golden = match vista_image::npy::read_npy(&path) {
-                Ok(n) => n,
+            let golden = match golden.decode(&path, vista_image::npy::decode_npy) {
+                Ok(Some(n)) => n,
+                Ok(None) => {
+                    v.missing.push(path);
+                    return v;
+                }
                 Err(e) => {
-                    v.errors.push(e.to_string());
+                    v.errors.push(e);
                     return v;
                 }
             };
@@ -239,41 +301,39 @@ pub fn compare_output(
                 v.summary = format!("output {}: the main image (metrics above)", out.name);
             }
             if let Some(exr) = &files.exr {
-                match exr.exists() {
-                    false => v.missing.push(exr.clone()),
-                    true => match vista_image::read_exr(exr) {
-                        Err(e) => v.errors.push(e.to_string()),
-                        Ok(g) if (g.width, g.height) != (raw.width, raw.height) => v.problems.push(format!(
-                            "output {}: golden {} is {}x{} but the render is {}x{}",
-                            out.name,
-                            exr.display(),
-                            g.width,
-                            g.height,
-                            raw.width,
-                            raw.height
-                        )),
-                        Ok(g) => match tolerance {
-                            Some(t) => {
-                                let w = raw.width as usize;
-                                let locate = |i: usize| {
-                                    let t = i / 4;
-                                    format!("({}, {}).{}", t % w, t / w, ["r", "g", "b", "a"][i % 4])
-                                };
-                                judge_values(&mut v, &out.name, t, &flat(&g), &flat(raw), true, &locate)
-                            }
-                            None => judge_raw(&mut v, case, index, format, &g, raw, psnr_threshold),
-                        },
+                match golden.decode(exr, vista_image::decode_exr) {
+                    Ok(None) => v.missing.push(exr.clone()),
+                    Err(e) => v.errors.push(e),
+                    Ok(Some(g)) if (g.width, g.height) != (raw.width, raw.height) => v.problems.push(format!(
+                        "output {}: golden {} is {}x{} but the render is {}x{}",
+                        out.name,
+                        exr.display(),
+                        g.width,
+                        g.height,
+                        raw.width,
+                        raw.height
+                    )),
+                    Ok(Some(g)) => match tolerance {
+                        Some(t) => {
+                            let w = raw.width as usize;
+                            let locate = |i: usize| {
+                                let t = i / 4;
+                                format!("({}, {}).{}", t % w, t / w, ["r", "g", "b", "a"][i % 4])
+                            };
+                            judge_values(&mut v, &out.name, t, &flat(&g), &flat(raw), true, &locate)
+                        }
+                        None => judge_raw(&mut v, case, index, format, &g, raw, psnr_threshold),
                     },
                 }
             }
             if let Some(alpha) = &files.alpha {
-                judge_alpha(&mut v, case, alpha, raw, psnr_threshold);
+                judge_alpha(&mut v, case, alpha, golden, raw, psnr_threshold);
             }
             let png = files.png.expect("a texture's png");
             if index > 0 && tolerance.is_none() && files.exr.is_none() {
                 // A float texture without a tolerance or raw golden: its view by PSNR.
-                judge_view(&mut v, out, png, psnr_threshold);
-            } else if index > 0 && !png.exists() {
+                judge_view(&mut v, out, png, golden, psnr_threshold);
+            } else if index > 0 && *golden.at(&png) == Found::Missing {
                 v.missing.push(png);
             }
         }
@@ -284,13 +344,13 @@ pub fn compare_output(
 /// Each golden file of an output that its manifest entry names but whose
 /// bytes are not the ones it describes (changed outside vista bless, or
 /// left by an interrupted one).
-fn changed_outside_bless(case: &Case, files: &OutputFiles, blessed: Option<&crate::ManifestEntry>) -> Vec<String> {
+fn changed_outside_bless(case: &Case, golden: &GoldenFiles, blessed: Option<&crate::ManifestEntry>) -> Vec<String> {
     let mut problems = Vec::new();
     if let Some(entry) = blessed {
-        for path in files.all() {
+        for (path, found) in &golden.found {
             let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
-            let (Some(want), Ok(bytes)) = (entry.outputs.get(&name), std::fs::read(path)) else { continue };
-            let hash = crate::short_hash_bytes(&bytes);
+            let (Some(want), Found::Bytes(bytes)) = (entry.outputs.get(&name), found) else { continue };
+            let hash = crate::short_hash_bytes(bytes);
             if &hash != want {
                 problems.push(format!(
                     "golden {} (hash {hash}) is not the file its manifest entry describes ({want}): it was changed \
@@ -306,32 +366,30 @@ fn changed_outside_bless(case: &Case, files: &OutputFiles, blessed: Option<&crat
 
 /// A float texture output without a tolerance or raw golden: the PSNR of
 /// its view against its golden PNG.
-fn judge_view(v: &mut OutputVerdict, out: &OutputRender, png: PathBuf, psnr_threshold: f64) {
-    match png.exists() {
-        false => v.missing.push(png),
-        true => match vista_image::read_png16(&png) {
-            Err(e) => v.errors.push(e.to_string()),
-            Ok(g) => {
-                let actual = quantize16(&out.display().expect("a texture"));
-                match vista_image::metrics::compare(&g, &actual) {
-                    Err(e) => v.problems.push(format!("output {}: {e}", out.name)),
-                    Ok(m) => {
-                        v.summary = format!(
-                            "output {}: PSNR {} (>= {psnr_threshold:.1} dB)",
+fn judge_view(v: &mut OutputVerdict, out: &OutputRender, png: PathBuf, golden: &GoldenFiles, psnr_threshold: f64) {
+    match golden.decode(&png, vista_image::decode_png16) {
+        Ok(None) => v.missing.push(png),
+        Err(e) => v.errors.push(e),
+        Ok(Some(g)) => {
+            let actual = quantize16(&out.display().expect("a texture"));
+            match vista_image::metrics::compare(&g, &actual) {
+                Err(e) => v.problems.push(format!("output {}: {e}", out.name)),
+                Ok(m) => {
+                    v.summary = format!(
+                        "output {}: PSNR {} (>= {psnr_threshold:.1} dB)",
+                        out.name,
+                        vista_image::metrics::format_psnr(m.psnr)
+                    );
+                    if m.psnr < psnr_threshold {
+                        v.problems.push(format!(
+                            "output {}: PSNR {} is below the threshold {psnr_threshold:.1} dB",
                             out.name,
                             vista_image::metrics::format_psnr(m.psnr)
-                        );
-                        if m.psnr < psnr_threshold {
-                            v.problems.push(format!(
-                                "output {}: PSNR {} is below the threshold {psnr_threshold:.1} dB",
-                                out.name,
-                                vista_image::metrics::format_psnr(m.psnr)
-                            ));
-                        }
+                        ));
                     }
                 }
             }
-        },
+        }
     }
 }
 
@@ -418,15 +476,15 @@ pub fn golden_bytes(
 /// PSNR (peak 1) of the raw alpha, clamped and quantized as the golden was,
 /// against the case's threshold; the main image's ignore rectangles are
 /// left out.
-fn judge_alpha(v: &mut OutputVerdict, case: &Case, path: &Path, raw: &Image, threshold: f64) {
-    if !path.exists() {
-        v.missing.push(path.to_path_buf());
-        return;
-    }
-    let golden = match vista_image::read_png16(path) {
-        Ok(g) => g,
+fn judge_alpha(v: &mut OutputVerdict, case: &Case, path: &Path, files: &GoldenFiles, raw: &Image, threshold: f64) {
+    let golden = match files.decode(path, vista_image::decode_png16) {
+        Ok(Some(g)) => g,
+        Ok(None) => {
+            v.missing.push(path.to_path_buf());
+            return;
+        }
         Err(e) => {
-            v.errors.push(e.to_string());
+            v.errors.push(e);
             return;
         }
     };
@@ -801,6 +859,49 @@ mod tests {
         let t = Tolerance::HistogramEmd { max: 0.1, bins: 10 };
         assert!(within(t, &[0.0, 0.0], &[1.0, 1.0], true).is_err());
         assert!(within(Tolerance::MaxAbs(1.0), &g, &[1.0, f64::NAN, 3.0, 4.0], true).unwrap_err().contains("NaN"));
+    }
+
+    /// The verdict judges the golden files as the runner read them and
+    /// reads nothing itself: golden bytes held in memory, at a path with no
+    /// file behind it, decide it (equal values pass, one changed value
+    /// fails, no bytes is a missing golden).
+    #[test]
+    fn compare_output_judges_what_the_runner_read_and_reads_nothing() {
+        let text = "[[case]]\nid = \"a\"\nkernel = \"fbm\"\n";
+        let case = crate::cases::parse_cases(Path::new("cases.toml"), text, vista_kernels::Registry::builtin())
+            .unwrap()
+            .remove(0);
+        let element = vista_kernels::graph::Element {
+            stride: 4,
+            header: 0,
+            fixed: None,
+            leaves: vec![(0, 'u', String::new())],
+            wgsl: "array<u32>".into(),
+        };
+        let words = |w: &[u32]| w.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>();
+        let out = OutputRender {
+            name: "counts".into(),
+            tolerance: None,
+            partial: false,
+            value: OutputValue::Buffer { bytes: words(&[1, 2, 3]), element, count: 3 },
+        };
+        let npy = PathBuf::from("/nonexistent/golden/fbm/a.counts.npy");
+        let golden = |found: Found| GoldenFiles {
+            paths: OutputFiles { npy: Some(npy.clone()), ..Default::default() },
+            found: vec![(npy.clone(), found)],
+        };
+        let (descr, shape) = out.npy().unwrap();
+        let judge = |g: &GoldenFiles| {
+            let threshold = crate::DriverThreshold { psnr: 60.0, same_driver: true };
+            compare_output(&case, g, 1, &out, threshold, None)
+        };
+        let same = judge(&golden(Found::Bytes(vista_image::npy::encode_npy(&descr, &shape, &words(&[1, 2, 3])))));
+        assert!(same.problems.is_empty() && same.missing.is_empty() && same.errors.is_empty(), "{same:?}");
+        let changed = judge(&golden(Found::Bytes(vista_image::npy::encode_npy(&descr, &shape, &words(&[1, 5, 3])))));
+        assert!(changed.problems.iter().any(|p| p.contains("[1] 2 vs golden 5")), "{:?}", changed.problems);
+        assert_eq!(judge(&golden(Found::Missing)).missing, vec![npy.clone()]);
+        let unreadable = judge(&golden(Found::Unreadable("I/O error on x: denied".into())));
+        assert_eq!(unreadable.errors, ["I/O error on x: denied"]);
     }
 
     /// A float buffer compares exactly on the blessing driver and within

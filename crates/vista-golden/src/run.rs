@@ -7,6 +7,7 @@ use vista_render::{Rendered, Renderer, quantize16, render_with};
 
 use crate::Case;
 use crate::check::{GoldenRead, Observed, Outcome, RunInfo, judge};
+use crate::outputs::GoldenFiles;
 use crate::store::{Manifest, Store, params_hash};
 
 /// Options for checking.
@@ -188,7 +189,11 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
             let outputs: Vec<crate::outputs::OutputVerdict> = crate::outputs::outputs_of(case, &r)
                 .iter()
                 .enumerate()
-                .map(|(i, o)| crate::outputs::compare_output(case, &store.dir, &golden_key, i, o, threshold, entry))
+                .map(|(i, o)| {
+                    // The runner reads; the verdict only judges what it read.
+                    let files = crate::outputs::output_files(&store.dir, case, &golden_key, i, o);
+                    crate::outputs::compare_output(case, &GoldenFiles::read(files), i, o, threshold, entry)
+                })
                 .collect();
             let observed = Observed {
                 unwritten: r.unwritten,

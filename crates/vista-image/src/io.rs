@@ -115,9 +115,13 @@ pub fn encode_exr(path: &Path, img: &Image) -> Result<Vec<u8>, ImageError> {
 /// Reads an OpenEXR file with R, G, B (and optionally A) channels as f32
 /// RGBA; missing alpha becomes 1, half-float channels are widened exactly.
 pub fn read_exr(path: &Path) -> Result<Image, ImageError> {
-    let bytes = read_file(path)?;
+    decode_exr(path, &read_file(path)?)
+}
+
+/// [`read_exr`] of bytes already read from `path` (which errors name).
+pub fn decode_exr(path: &Path, bytes: &[u8]) -> Result<Image, ImageError> {
     let decoded =
-        image::load_from_memory_with_format(&bytes, ImageFormat::OpenExr).map_err(|e| decode_error(path, "EXR", e))?;
+        image::load_from_memory_with_format(bytes, ImageFormat::OpenExr).map_err(|e| decode_error(path, "EXR", e))?;
     Ok(from_rgba32f(decoded.into_rgba32f()))
 }
 
