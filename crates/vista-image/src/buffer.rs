@@ -118,12 +118,34 @@ impl Image {
         let mut h = Fnv1a64::new();
         h.write(&self.width.to_le_bytes());
         h.write(&self.height.to_le_bytes());
-        for p in &self.data {
-            for c in p {
-                h.write(&c.to_bits().to_le_bytes());
-            }
-        }
+        h.write(&self.le_bytes());
         format!("{:016x}", h.finish())
+    }
+
+    /// The texels' f32 bit patterns, little-endian, RGBA, row after row
+    /// (16 bytes a texel): borrowed on a little-endian machine, where that
+    /// is how they lie in memory.
+    pub fn le_bytes(&self) -> std::borrow::Cow<'_, [u8]> {
+        if cfg!(target_endian = "little") {
+            std::borrow::Cow::Borrowed(bytemuck::cast_slice(&self.data))
+        } else {
+            std::borrow::Cow::Owned(self.data.iter().flatten().flat_map(|c| c.to_le_bytes()).collect())
+        }
+    }
+
+    /// The image [`Image::le_bytes`] gave, or `None` when `bytes` is not
+    /// `width * height` texels.
+    pub fn from_le_bytes(width: u32, height: u32, bytes: &[u8]) -> Option<Image> {
+        if bytes.len() != width as usize * height as usize * 16 {
+            return None;
+        }
+        let data: Vec<[f32; 4]> = if cfg!(target_endian = "little") {
+            bytemuck::pod_collect_to_vec(bytes)
+        } else {
+            let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+            bytes.chunks_exact(16).map(|t| [f(&t[0..4]), f(&t[4..8]), f(&t[8..12]), f(&t[12..16])]).collect()
+        };
+        Some(Image { width, height, data })
     }
 
     /// True if both images have the same size and every channel has the same

@@ -83,13 +83,39 @@ pub fn flip_mean(reference: &Image, actual: &Image) -> f64 {
 /// All metrics with a PSNR peak of 1 (LDR data in `[0, 1]`).
 pub fn compare(reference: &Image, actual: &Image) -> Result<Metrics, ImageError> {
     check_same_size(reference, actual)?;
+    if let Some(m) = identical(reference, actual, true) {
+        return Ok(m);
+    }
     Ok(Metrics { flip_mean: Some(flip_mean(reference, actual)), ..all_metrics(reference, actual, 1.0) })
+}
+
+/// The metrics of two images with the same bits, all finite, without the
+/// passes that compute them (a passing check's render is usually its
+/// golden bit for bit, and SSIM and FLIP cost most of a check): PSNR +inf,
+/// SSIM 1, no difference, FLIP 0 where asked. `None` where any bit differs
+/// or a value is not finite.
+fn identical(reference: &Image, actual: &Image, flip: bool) -> Option<Metrics> {
+    let bits = |p: &[f32; 4]| p.map(f32::to_bits);
+    let same = reference.data.len() == actual.data.len()
+        && reference.data.iter().zip(&actual.data).all(|(r, a)| bits(r) == bits(a) && a.iter().all(|v| v.is_finite()));
+    same.then_some(Metrics {
+        psnr: f64::INFINITY,
+        ssim: 1.0,
+        max_abs: 0.0,
+        bad_pixels: 0,
+        nan: 0,
+        mse: 0.0,
+        flip_mean: flip.then_some(0.0),
+    })
 }
 
 /// All metrics for HDR data: PSNR uses peak = [`hdr_peak`] of the reference.
 /// SSIM is still computed on the raw values with dynamic range 1.
 pub fn compare_hdr(reference: &Image, actual: &Image) -> Result<Metrics, ImageError> {
     check_same_size(reference, actual)?;
+    if let Some(m) = identical(reference, actual, false) {
+        return Ok(m);
+    }
     Ok(all_metrics(reference, actual, hdr_peak(reference)))
 }
 
@@ -269,5 +295,46 @@ mod float_repr {
                 .map_err(|_| D::Error::custom(format!("expected a number, \"inf\", \"-inf\" or \"nan\", got {t:?}"))),
             Repr::Null(()) => Ok(f64::NAN),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shortcut for identical images says what the full passes say
+    /// (SSIM to rounding: the passes give 1 - 2e-16 where the formula is 1
+    /// exactly), on a pattern, a constant image (SSIM's degenerate case), an
+    /// image below SSIM's window and a wide one; and it is not taken for
+    /// one changed bit or a NaN.
+    #[test]
+    fn identical_images_skip_the_passes_and_agree_with_them() {
+        let pattern = |w: u32, h: u32| {
+            Image::from_fn(w, h, |x, y| {
+                let t = (x as f32 * 0.7).sin() * (y as f32 * 0.3).cos();
+                [0.5 + 0.4 * t, x as f32 / w as f32, y as f32 / h as f32, 1.0]
+            })
+        };
+        let constant = Image::from_fn(24, 24, |_, _| [0.25, 0.25, 0.25, 1.0]);
+        for img in [pattern(32, 24), constant, pattern(5, 7), pattern(97, 13)] {
+            let fast = identical(&img, &img, true).expect("identical");
+            let full = Metrics { flip_mean: Some(flip_mean(&img, &img)), ..all_metrics(&img, &img, 1.0) };
+            assert_eq!(
+                (fast.psnr, fast.max_abs, fast.bad_pixels, fast.nan, fast.mse),
+                (full.psnr, full.max_abs, full.bad_pixels, full.nan, full.mse)
+            );
+            assert_eq!(fast.flip_mean, full.flip_mean);
+            assert!((fast.ssim - full.ssim).abs() < 1e-12, "{} vs {}", fast.ssim, full.ssim);
+            let hdr = all_metrics(&img, &img, hdr_peak(&img));
+            assert_eq!(identical(&img, &img, false).unwrap().flip_mean, hdr.flip_mean);
+        }
+        let a = pattern(8, 8);
+        let mut b = a.clone();
+        b.data[5][1] = f32::from_bits(b.data[5][1].to_bits() + 1);
+        assert!(identical(&a, &b, true).is_none(), "one bit differs");
+        assert!(compare(&a, &b).unwrap().psnr.is_finite());
+        let mut n = a.clone();
+        n.data[3][0] = f32::NAN;
+        assert!(identical(&n, &n, true).is_none(), "NaN is never identical");
     }
 }

@@ -71,6 +71,22 @@ fn content_hash_is_stable_fnv1a() {
     assert_eq!(Image::new(0, 0).content_hash(), "a8c7f832281a39c5");
 }
 
+/// The bytes the worker sends over its pipe: each f32's little-endian
+/// bits, RGBA, row after row; back into the same bits (NaN payloads and
+/// -0.0 included), and refused at any other length.
+#[test]
+fn le_bytes_round_trip_bit_for_bit() {
+    let nan = f32::from_bits(0x7fc0_1234);
+    let a = Image::from_raw(2, 1, vec![[0.0, 0.5, 1.0, -0.0], [nan, -2.0, f32::INFINITY, 1.0]]).unwrap();
+    let bytes = a.le_bytes().into_owned();
+    assert_eq!(&bytes[4..8], &0.5f32.to_le_bytes());
+    assert_eq!(&bytes[16..20], &0x7fc0_1234u32.to_le_bytes());
+    let b = Image::from_le_bytes(2, 1, &bytes).unwrap();
+    assert!(a.bit_identical(&b));
+    assert!(Image::from_le_bytes(2, 2, &bytes).is_none());
+    assert!(Image::from_le_bytes(1, 1, &bytes[..15]).is_none());
+}
+
 #[test]
 fn content_hash_sees_bit_level_changes() {
     let a = Image::from_fn(8, 8, |x, y| [x as f32 / 8.0, y as f32 / 8.0, 0.0, 1.0]);

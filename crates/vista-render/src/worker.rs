@@ -281,7 +281,7 @@ fn serve() -> std::io::Result<()> {
                     match o {
                         OutputData::Texture { image, unwritten } => {
                             heads.push(Ok((image.width, image.height, *unwritten)));
-                            bytes.extend(image.data.iter().flat_map(|px| px.iter().flat_map(|c| c.to_le_bytes())));
+                            bytes.extend_from_slice(&image.le_bytes());
                         }
                         OutputData::Buffer(b) => {
                             heads.push(Err(b.len()));
@@ -521,13 +521,10 @@ fn readback(head: ReadbackHead, bytes: &[u8]) -> Readback {
         .iter()
         .map(|o| match *o {
             Ok((width, height, unwritten)) => {
-                let n = width as usize * height as usize;
-                let data = bytes[at..at + n * 16]
-                    .chunks_exact(16)
-                    .map(|t| std::array::from_fn(|c| f32::from_le_bytes(t[c * 4..c * 4 + 4].try_into().expect("4"))))
-                    .collect();
-                at += n * 16;
-                OutputData::Texture { image: Image::from_raw(width, height, data).expect("sized"), unwritten }
+                let n = width as usize * height as usize * 16;
+                let image = Image::from_le_bytes(width, height, &bytes[at..at + n]).expect("sized");
+                at += n;
+                OutputData::Texture { image, unwritten }
             }
             Err(len) => {
                 at += len;
