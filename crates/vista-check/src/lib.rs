@@ -134,6 +134,8 @@ impl Checker<'_> {
         let started = Instant::now();
         let mut checked = vista_golden::check_case(self.ctx, self.store, self.manifest, case, &options(self.ctx));
         let check_time = started.elapsed();
+        let golden = self.store.dir.join(&checked.outcome.golden_file);
+        checked.outcome.files.golden_href = Some(vista_report::href(self.report_dir, &golden));
         let entry = checked.pending.take();
         let started = Instant::now();
         let (outcome, report_errors) = vista_report::file_case(self.report_dir, checked, self.detail);

@@ -532,14 +532,24 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
     for f in ["expected.png", "actual.png", "diff.png", "expected8.png", "actual8.png", "diff8.png", "view.js"] {
         assert!(report(d.path()).join("b").join(f).exists(), "report file b/{f}");
     }
-    // A passing case keeps its 8-bit images only, unless --full-report:
-    // the 16-bit copies and the viewer's data were most of a report.
+    // A passing case keeps one thumbnail of its render, linked to its
+    // golden, unless --full-report: its full-size copies, heat map and the
+    // viewer's data were most of a report.
     assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 1);
     let a = report(d.path()).join("a");
-    assert!(a.join("actual8.png").exists() && a.join("expected8.png").exists(), "passing case a's images");
-    assert!(!a.join("actual.png").exists() && !a.join("view.js").exists(), "passing case a has only 8-bit images");
+    let thumb = vista_image::load(&a.join("thumb.png")).unwrap();
+    assert!(thumb.width.max(thumb.height) <= vista_report::THUMB_EDGE, "{}x{}", thumb.width, thumb.height);
+    for f in ["actual.png", "actual8.png", "expected8.png", "diff8.png", "view.js"] {
+        assert!(!a.join(f).exists(), "passing case a has only its thumbnail, not {f}");
+    }
     let index = std::fs::read_to_string(report(d.path()).join("index.html")).unwrap();
     assert!(index.contains("vista check --case 'a' --full-report"), "the passing case says how to get its viewer");
+    assert!(
+        index.contains(
+            "<a href=\"../../golden/fbm/a.png\" title=\"the golden file\"><img class=\"thumb\" src=\"a/thumb.png\""
+        ),
+        "the thumbnail links to the golden"
+    );
     let r = vista_in(Some(d.path()), &[], &["check", "--full-report"]);
     assert_eq!(r.code, 1, "{}", r.stdout);
     for f in ["actual.png", "expected.png", "view.js"] {

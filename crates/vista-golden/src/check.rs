@@ -47,6 +47,12 @@ pub struct ReportFiles {
     pub diff8: Option<String>,
     /// `view.js`: both images' 16-bit values for the viewer's readout.
     pub view: Option<String>,
+    /// A passing case's one image: its render, at most
+    /// `vista_report::THUMB_EDGE` texels across (`<id>/thumb.png`).
+    pub thumb: Option<String>,
+    /// The golden file as a link from the report folder (set by the check
+    /// driver, which knows both folders).
+    pub golden_href: Option<String>,
     /// A pass graph's other texture outputs: (name, expected 8-bit, actual
     /// 8-bit).
     pub outputs: Vec<(String, Option<String>, Option<String>)>,

@@ -33,6 +33,32 @@ impl Image {
         Image { width, height, data }
     }
 
+    /// A copy at most `edge` texels on its longer side, each texel the mean
+    /// of the block it covers (the image itself when it fits): what a
+    /// report shows of a passing case, whose golden holds the full image.
+    pub fn thumbnail(&self, edge: u32) -> Image {
+        let long = self.width.max(self.height);
+        if edge == 0 || long <= edge {
+            return self.clone();
+        }
+        let f = long.div_ceil(edge);
+        Image::from_fn(self.width.div_ceil(f), self.height.div_ceil(f), |x, y| {
+            let (x0, y0) = (x * f, y * f);
+            let (x1, y1) = ((x0 + f).min(self.width), (y0 + f).min(self.height));
+            let mut sum = [0f64; 4];
+            for yy in y0..y1 {
+                for xx in x0..x1 {
+                    let p = self.data[yy as usize * self.width as usize + xx as usize];
+                    for c in 0..4 {
+                        sum[c] += f64::from(p[c]);
+                    }
+                }
+            }
+            let n = f64::from((x1 - x0) * (y1 - y0));
+            sum.map(|v| (v / n) as f32)
+        })
+    }
+
     /// Wraps an existing pixel buffer, checking that its length is `width * height`.
     pub fn from_raw(width: u32, height: u32, data: Vec<[f32; 4]>) -> Result<Image, ImageError> {
         let expected = u64::from(width) * u64::from(height);

@@ -144,3 +144,18 @@ fn box_blur_removes_pixel_noise_and_keeps_steps() {
     // Edge windows are clipped, not zero-padded.
     assert_eq!(s.get(15, 0)[0], 1.0);
 }
+
+/// A thumbnail fits the edge on its longer side, keeps the aspect (sides
+/// rounded up), and each texel is the mean of its block (a partial block
+/// at the edge included); an image that fits is returned whole.
+#[test]
+fn thumbnails_average_blocks_and_fit_the_edge() {
+    let img = Image::from_fn(10, 4, |x, y| [x as f32, y as f32, 1.0, 1.0]);
+    let t = img.thumbnail(4);
+    assert_eq!((t.width, t.height), (4, 2), "factor 3: 10 -> 4, 4 -> 2");
+    assert_eq!(t.get(0, 0), [1.0, 1.0, 1.0, 1.0], "x 0..3, y 0..3");
+    assert_eq!(t.get(3, 1), [9.0, 3.0, 1.0, 1.0], "the last column alone, the last row alone");
+    assert!(img.thumbnail(10).bit_identical(&img));
+    let wide = Image::new(1920, 1080).thumbnail(128);
+    assert_eq!((wide.width, wide.height), (128, 72));
+}

@@ -226,6 +226,24 @@ fn outputs_table(o: &Outcome) -> String {
     t + "</table>"
 }
 
+/// `to` as a link from a page in `from_dir`: relative where both lie on
+/// one filesystem root (a report that moves with its checkout keeps its
+/// links), with `/` separators.
+pub fn href(from_dir: &Path, to: &Path) -> String {
+    let (Ok(from), Ok(to)) = (std::path::absolute(from_dir), std::path::absolute(to)) else {
+        return to.display().to_string();
+    };
+    let (from, to): (Vec<_>, Vec<_>) = (from.components().collect(), to.components().collect());
+    let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
+    let mut parts: Vec<String> = vec!["..".to_string(); from.len() - common];
+    parts.extend(to[common..].iter().map(|c| c.as_os_str().to_string_lossy().to_string()));
+    parts.join("/")
+}
+
+/// The longer side of a passing case's thumbnail, in texels (the index
+/// shows it 32 pixels high).
+pub const THUMB_EDGE: u32 = 128;
+
 /// Writes one case's report images into `<dir>/<id>/` and records their
 /// relative paths in `out.files`: the actual display values (16-bit and an
 /// 8-bit copy), the golden's when there is one, and where both have the
@@ -239,9 +257,16 @@ pub fn write_case_files(
 ) -> Result<(), GoldenError> {
     let id = out.id.clone();
     let case_dir = case_folder(dir, &id)?;
-    // A case that passed gets 8-bit images only (what a browser shows);
-    // one that did not, or a full report, the 16-bit values too.
+    // A case that passed gets one thumbnail of its render, linked to its
+    // golden (which holds the full image): at 1920 x 1080 its 8-bit copies
+    // and heat map were most of a passing case's cost. One that did not,
+    // or a full report, gets every image at full size.
     let full = detail == Detail::All || !out.passed();
+    if !full {
+        vista_image::write_png8(&case_dir.join("thumb.png"), &actual.thumbnail(THUMB_EDGE))?;
+        out.files.thumb = Some(format!("{id}/thumb.png"));
+        return Ok(());
+    }
     let write = |name: &str, img: &Image, bits16: bool| -> Result<Option<String>, GoldenError> {
         if bits16 && !full {
             return Ok(None);
@@ -501,7 +526,7 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
             html_escape(&o.id),
             html_escape(v)
         ),
-        None if o.files.actual8.is_some() => format!(
+        None if o.files.thumb.is_some() => format!(
             "<p class=\"note\">The pixel viewer and 16-bit images are written for cases that do not pass; for \
              this one: <code class=\"cmd\">vista check --case '{}' --full-report</code></p>",
             html_escape(&o.id)
@@ -523,6 +548,15 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
         kernel = html_escape(&o.kernel),
         gpu = o.gpu_ms,
         thumbs = match (&o.files.actual8, o.outputs.is_empty()) {
+            // A passing case: its render's thumbnail, linked to its golden.
+            _ if o.files.thumb.is_some() => {
+                let src = html_escape(o.files.thumb.as_deref().unwrap_or_default());
+                let href = o.files.golden_href.as_deref().map_or(src.clone(), html_escape);
+                format!(
+                    "<a href=\"{href}\" title=\"the golden file\"><img class=\"thumb\" src=\"{src}\" alt=\"render\" \
+                     loading=\"lazy\"></a>"
+                )
+            }
             // A graph whose first output is a buffer has no main image.
             (None, false) => format!(
                 "<span class=\"none\">outputs: {}</span>",
@@ -654,4 +688,17 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
     let index = dir.join("index.html");
     vista_image::atomic_write(&index, html.as_bytes())?;
     Ok(index)
+}
+
+#[cfg(test)]
+mod href_tests {
+    use super::*;
+
+    #[test]
+    fn links_are_relative_to_the_report_folder() {
+        let h = |a: &str, b: &str| href(Path::new(a), Path::new(b));
+        assert_eq!(h("/p/target/vista-report", "/p/golden/fbm/a.png"), "../../golden/fbm/a.png");
+        assert_eq!(h("/p/r", "/p/r/a/thumb.png"), "a/thumb.png");
+        assert_eq!(h("/tmp/x", "/p/golden/fbm/a@swiftshader.png"), "../../p/golden/fbm/a@swiftshader.png");
+    }
 }

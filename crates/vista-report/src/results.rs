@@ -97,7 +97,7 @@ pub fn json_results(run: &RunSummary, outcomes: &[Outcome]) -> serde_json::Value
                 "changed_files": o.changed_files,
                 "report_anchor": format!("index.html#{}", crate::report::anchor(&o.id)),
                 "golden": o.golden.as_ref().map(|g| serde_json::json!({
-                    "path": o.files.expected8.as_ref().map(|_| format!("golden/{}", o.golden_file)),
+                    "path": (o.files.expected8.is_some() || o.files.thumb.is_some()).then(|| format!("golden/{}", o.golden_file)),
                     "backend": g.backend,
                     "adapter": g.adapter,
                     "date": g.date,
