@@ -6,12 +6,17 @@
 //! the one render-twice rule, [`options`]; `vista_report::file_case`
 //! writes its folder), then what a run
 //! leaves ([`finish`]: the report, `pending.toml`, `results.json`, JUnit)
-//! and the goldens no case refers to ([`orphans`]). `vista mutate` judges
+//! and the goldens no case refers to ([`orphans`]); and the shards of a
+//! split suite joined into one report ([`merge`]). `vista mutate` judges
 //! every mutant with the same `vista_golden::check_case`.
 //!
 //! Not for: rendering or judging themselves (`vista-render`,
 //! `vista-golden`), page layout (`vista-report`), or flags and printing
 //! (the binary and the harness).
+
+mod merge;
+
+pub use merge::{OUTCOMES_FILE, merge};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -210,6 +215,7 @@ pub fn finish(report_dir: &Path, run: &RunSummary, filed: &[Filed], results: &Re
     }
     let outcomes: Vec<Outcome> = filed.iter().map(|f| f.outcome.clone()).collect();
     let index = vista_report::write_report(report_dir, &run, &outcomes)?;
+    merge::save(report_dir, &run, &outcomes)?;
     vista_golden::pending::write_pending(report_dir, pending)?;
     let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
     vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;

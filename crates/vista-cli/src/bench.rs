@@ -7,18 +7,35 @@ use vista_render::Renderer;
 
 use crate::{bad, parse_sets};
 
-#[allow(clippy::too_many_arguments)]
-pub fn bench(
-    project: &Project,
-    config: &vista::Config,
-    kernel: &str,
-    preset: Option<&str>,
-    set: &[String],
-    size: &str,
-    runs: u32,
-    json: bool,
-    cpu: bool,
-) -> Result<i32, GoldenError> {
+/// `vista bench`'s arguments.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The kernel's name.
+    pub kernel: String,
+    /// A preset of the kernel.
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// Parameter override NAME=VALUE (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x1024")]
+    pub size: String,
+    /// Timed runs after the warm-up (the median is reported).
+    #[arg(long, default_value_t = 7)]
+    pub runs: u32,
+    /// Print the result as one JSON object (field mpix_per_s among them).
+    #[arg(long)]
+    pub json: bool,
+    /// Also time the kernel's CPU reference built in f32 on all cores
+    /// (median of up to 3 runs) and print the CPU / GPU ratio.
+    #[arg(long)]
+    pub cpu: bool,
+}
+
+pub fn bench(project: &Project, config: &vista::Config, a: Args) -> Result<i32, GoldenError> {
+    let Args { kernel, preset, set, size, runs, json, cpu } = a;
+    let (kernel, preset, set, size) = (kernel.as_str(), preset.as_deref(), set.as_slice(), size.as_str());
     if !(1..=1000).contains(&runs) {
         return Err(bad(format!("--runs {runs} is out of range; allowed: [1, 1000]")));
     }

@@ -32,7 +32,7 @@ fn check_results_path(flag: &str, path: &Path) -> Result<(), GoldenError> {
 
 /// A case's status line (`ok`, `xfail`, `FAIL`; the value it was judged
 /// by; a per-backend golden named), and for a failure its explanation.
-fn print_case(o: &vista_golden::Outcome, report_dir: &Path) {
+pub(crate) fn print_case(o: &vista_golden::Outcome, report_dir: &Path) {
     let label = match o.verdict {
         vista_golden::Verdict::Pass => "ok",
         vista_golden::Verdict::ExpectedFail => "xfail",
@@ -114,6 +114,7 @@ pub fn check(
         command: command_line(),
         backend: ctx.backend().to_string(),
         adapter: ctx.adapter_description(),
+        partition: pick.selection.partition,
         ..Default::default()
     };
     let started = std::time::Instant::now();
@@ -225,7 +226,7 @@ impl Phases {
 
 /// This process's command line as a user would type it again (`vista` and
 /// its arguments, quoted where the shell would need it), for reports.
-fn command_line() -> String {
+pub(crate) fn command_line() -> String {
     let quote = |a: String| {
         if !a.is_empty() && a.chars().all(|c| c.is_ascii_alphanumeric() || "-_=./:,@+".contains(c)) {
             a
@@ -234,4 +235,40 @@ fn command_line() -> String {
         }
     };
     std::iter::once("vista".to_string()).chain(std::env::args().skip(1).map(quote)).collect::<Vec<_>>().join(" ")
+}
+
+/// `vista merge`: the shards' report folders joined into `out`; prints each
+/// case that did not pass as `check` does, then the totals; exit 1 if any
+/// failed, 2 for bad input (a shard missing, given twice, of another split).
+pub fn merge(dirs: &[PathBuf], out: &Path, results: Results) -> std::process::ExitCode {
+    match merged(dirs, out, results) {
+        Ok(code) => std::process::ExitCode::from(code),
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}
+
+fn merged(dirs: &[PathBuf], out: &Path, results: Results) -> Result<u8, GoldenError> {
+    if let Some(p) = &results.junit {
+        check_results_path("--junit", p)?;
+    }
+    if let Some(p) = &results.json {
+        check_results_path("--json", p)?;
+    }
+    let (index, outcomes) = vista_check::merge(dirs, out, &results, command_line())?;
+    for o in outcomes.iter().filter(|o| !o.passed()) {
+        print_case(o, out);
+    }
+    let failing: Vec<&str> = outcomes.iter().filter(|o| !o.passed()).map(|o| o.id.as_str()).collect();
+    println!("merged {} shards: {} passed, {} failed", dirs.len(), outcomes.len() - failing.len(), failing.len());
+    if !failing.is_empty() {
+        println!("failed: {}", failing.join(", "));
+    }
+    if out.join(vista_golden::pending::PENDING_FILE).exists() {
+        println!("accept exactly what the shards rendered: vista bless --from-report {}", out.display());
+    }
+    println!("report: {}", index.display());
+    Ok(if failing.is_empty() { 0 } else { 1 })
 }

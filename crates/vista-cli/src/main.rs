@@ -158,6 +158,22 @@ enum Command {
         #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=64))]
         jobs: u16,
     },
+    /// Join the report folders of `check --partition K/N --report-dir DIR`
+    /// runs into one report, results.json, JUnit and pending.toml.
+    Merge {
+        /// Each shard's report folder; every K of one N, once.
+        #[arg(required = true, value_name = "DIR")]
+        dirs: Vec<PathBuf>,
+        /// Where the joined report goes.
+        #[arg(long, value_name = "DIR")]
+        report_dir: PathBuf,
+        /// Also write JUnit XML here (as `check --junit`).
+        #[arg(long, value_name = "FILE")]
+        junit: Option<PathBuf>,
+        /// Also write the results as JSON here (as `check --json`).
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+    },
     /// Re-render cases and write their goldens (refused under CI=true without --force).
     Bless {
         /// Only the cases whose id matches this glob.
@@ -218,29 +234,7 @@ enum Command {
         equivalent: Option<PathBuf>,
     },
     /// Median kernel throughput after a warm-up (excludes device creation and compilation).
-    Bench {
-        /// The kernel's name.
-        kernel: String,
-        /// A preset of the kernel.
-        #[arg(long)]
-        preset: Option<String>,
-        /// Parameter override NAME=VALUE (repeatable).
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
-        /// Image size, WIDTHxHEIGHT.
-        #[arg(long, default_value = "1024x1024")]
-        size: String,
-        /// Timed runs after the warm-up (the median is reported).
-        #[arg(long, default_value_t = 7)]
-        runs: u32,
-        /// Print the result as one JSON object (field mpix_per_s among them).
-        #[arg(long)]
-        json: bool,
-        /// Also time the kernel's CPU reference built in f32 on all cores
-        /// (median of up to 3 runs) and print the CPU / GPU ratio.
-        #[arg(long)]
-        cpu: bool,
-    },
+    Bench(bench::Args),
 }
 
 /// A closed stdout (`vista list | head -1`) ends vista quietly like other
@@ -305,6 +299,10 @@ fn main() -> ExitCode {
                 ExitCode::from(e.exit_code() as u8)
             }
         };
+    }
+    // merge joins report folders: it needs no project either.
+    if let Command::Merge { dirs, report_dir, junit, json } = &cli.command {
+        return check::merge(dirs, report_dir, vista_check::Results { junit: junit.clone(), json: json.clone() });
     }
     let project = match std::env::current_dir()
         .map_err(|e| GoldenError::BadInput(format!("cannot read the current directory: {e}")))
@@ -372,6 +370,7 @@ fn bad(e: impl std::fmt::Display) -> GoldenError {
 fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenError> {
     match cmd {
         Command::Init { .. } => unreachable!("init runs before a project is found"),
+        Command::Merge { .. } => unreachable!("merge runs before a project is found"),
         Command::Watch { case, interval, timeout } => {
             let timeout = match timeout {
                 Some(t) if !(t > 0.0 && t <= 86400.0) => {
@@ -428,9 +427,7 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             config,
             mutate::Args { kernel, case, sample, seed, jobs, partition, json, merge, equivalent },
         ),
-        Command::Bench { kernel, preset, set, size, runs, json, cpu } => {
-            bench::bench(project, config, &kernel, preset.as_deref(), &set, &size, runs, json, cpu)
-        }
+        Command::Bench(args) => bench::bench(project, config, args),
     }
 }
 

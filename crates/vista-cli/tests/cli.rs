@@ -3891,10 +3891,13 @@ fn watch_rechecks_what_a_saved_file_reaches() {
 
 /// The README's CI recipe, run as written where it can be: every `vista`
 /// line of the GitHub and GitLab jobs in a copy of examples/project after an
-/// intended change (the check fails and writes JUnit XML, GitHub
-/// annotations under GITHUB_ACTIONS=true), then the developer's bless from
-/// the report as CI would upload it, after which the check passes. The
-/// clone, install and cargo install lines are the README's install steps.
+/// intended change. GitHub's three shards check (GitHub annotations under
+/// GITHUB_ACTIONS=true); their report folders travel as artifacts do
+/// (hidden files left out) to a merge job outside any project, which
+/// writes one report and JUnit file; GitLab's one job checks and writes
+/// JUnit XML; then the developer blesses from the merged report as CI
+/// uploads it, after which the check passes. The clone, install and cargo
+/// install lines are the README's install steps.
 fn the_ci_recipe_runs_as_written() {
     let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
     let section = readme.split("## Use vista in your CI").nth(1).unwrap().split("\n## ").next().unwrap();
@@ -3904,38 +3907,137 @@ fn the_ci_recipe_runs_as_written() {
         .filter(|l| l.starts_with("vista "))
         .map(|l| l.split(" #").next().unwrap().trim().to_string())
         .collect();
-    assert_eq!(lines.len(), 3, "{lines:?}");
+    assert_eq!(lines.len(), 4, "{lines:?}");
     let t = tmp();
-    let (bin, root) = (t.path().join("vista"), t.path().join("project"));
+    let (bin, root, merge_job) = (t.path().join("vista"), t.path().join("project"), t.path().join("merge-job"));
     std::fs::copy(env!("CARGO_BIN_EXE_vista"), &bin).unwrap();
     copy_tree(&repo().join("examples/project"), &root);
+    std::fs::create_dir(&merge_job).unwrap();
     // The intended change: sharper veins.
     let shader = root.join("shaders/marble.wgsl");
     let text = std::fs::read_to_string(&shader).unwrap();
     std::fs::write(&shader, text.replace("0.5 + 0.5 * sin(", "0.5 + 0.45 * sin(")).unwrap();
-    for (i, line) in lines.iter().enumerate() {
-        let args: Vec<&str> = line.split_whitespace().skip(1).collect();
-        let env: &[(&str, &str)] = if i == 0 { &[("GITHUB_ACTIONS", "true")] } else { &[] };
-        if args[0] == "bless" {
-            // The artifact as CI uploads it: the report folder.
-            copy_tree(&root.join("target/vista-report"), &root.join("vista-report"));
-        }
-        let r = run_in(&bin, &root, env, &args);
-        match args[0] {
-            "check" => {
-                assert_eq!(r.code, 1, "{line}: {}{}", r.stdout, r.stderr);
-                let junit = root.join(args[2]);
-                let xml = std::fs::read_to_string(&junit).unwrap_or_else(|e| panic!("{line}: {e}"));
-                assert!(xml.contains("<testsuites") && xml.contains("golden::marble::marble-default"), "{xml}");
-                if i == 0 {
-                    assert!(r.stdout.contains("::error file=golden/cases.toml,line="), "{}", r.stdout);
+    let args_of = |line: &str| line.split_whitespace().skip(1).map(String::from).collect::<Vec<String>>();
+    for line in &lines {
+        let args = args_of(line);
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        match argv[0] {
+            "check" if line.contains("${{ matrix.shard }}") => {
+                let mut failed = 0;
+                for k in 1..=3 {
+                    let shard = args_of(&line.replace("${{ matrix.shard }}", &k.to_string()));
+                    let argv: Vec<&str> = shard.iter().map(String::as_str).collect();
+                    let r = run_in(&bin, &root, &[("GITHUB_ACTIONS", "true")], &argv);
+                    assert!(r.code <= 1, "{line} (shard {k}): {}{}", r.stdout, r.stderr);
+                    if r.code == 1 {
+                        failed += 1;
+                        assert!(r.stdout.contains("::error file=golden/cases.toml,line="), "{}", r.stdout);
+                    }
+                    // upload-artifact leaves hidden files out.
+                    copy_visible(&root.join(format!("shard-{k}")), &merge_job.join(format!("shard-{k}")));
                 }
+                assert!(failed >= 1, "the changed shader fails its shard");
             }
-            _ => assert_eq!(r.code, 0, "{line}: {}{}", r.stdout, r.stderr),
+            "merge" => {
+                let r = run_in(&bin, &merge_job, &[], &argv);
+                assert_eq!(r.code, 1, "{line}: {}{}", r.stdout, r.stderr);
+                assert!(r.stdout.contains("merged 3 shards: 0 passed, 2 failed"), "{}", r.stdout);
+                let xml = std::fs::read_to_string(merge_job.join("vista-junit.xml")).unwrap();
+                assert!(
+                    xml.contains("golden::marble::marble-default") && xml.contains("golden::marble::marble-calm"),
+                    "{xml}"
+                );
+                // The merge job's artifact, unpacked on the developer's machine.
+                copy_visible(&merge_job.join("vista-report"), &root.join("vista-report"));
+            }
+            "check" => {
+                let r = run_in(&bin, &root, &[], &argv);
+                assert_eq!(r.code, 1, "{line}: {}{}", r.stdout, r.stderr);
+                let xml = std::fs::read_to_string(root.join(argv[2])).unwrap_or_else(|e| panic!("{line}: {e}"));
+                assert!(xml.contains("<testsuites") && xml.contains("golden::marble::marble-default"), "{xml}");
+            }
+            _ => {
+                let r = run_in(&bin, &root, &[], &argv);
+                assert_eq!(r.code, 0, "{line}: {}{}", r.stdout, r.stderr);
+            }
         }
     }
     let after = run_in(&bin, &root, &[], &["check"]);
     assert_eq!(after.code, 0, "after blessing what CI rendered: {}", after.stdout);
+}
+
+/// `from` copied to `to` without its hidden files, as CI artifacts travel.
+fn copy_visible(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let (src, dst) = (e.path(), to.join(e.file_name()));
+        if e.file_name().to_string_lossy().starts_with('.') {
+            continue;
+        }
+        if src.is_dir() {
+            copy_visible(&src, &dst);
+        } else {
+            std::fs::copy(&src, &dst).unwrap();
+        }
+    }
+}
+
+/// `vista merge` joins only a whole split: a shard missing, given twice, of
+/// another N, or from a check without --partition is named (exit 2) and
+/// nothing is written; one merged into its own folder is refused too. The
+/// merged report keeps every verdict and metric as its shard wrote it.
+fn merge_refuses_anything_but_a_whole_split() {
+    let d = golden_dir(CASES);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let p = |s: &str| d.path().join(s).to_str().unwrap().to_string();
+    for (k, n) in [(1, 2), (2, 2), (1, 3)] {
+        let r = vista_in(
+            Some(d.path()),
+            &[],
+            &["check", "--partition", &format!("{k}/{n}"), "--report-dir", &p(&format!("s{k}of{n}"))],
+        );
+        assert_eq!(r.code, 0, "{}", r.stdout);
+    }
+    assert_eq!(vista_in(Some(d.path()), &[], &["check", "--report-dir", &p("whole")]).code, 0);
+    let merge = |dirs: &[&str]| {
+        let mut args = vec!["merge".to_string()];
+        args.extend(dirs.iter().map(|s| p(s)));
+        args.extend(["--report-dir".to_string(), p("out")]);
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        vista_in(None, &[], &argv)
+    };
+    assert_rejected(&merge(&["s1of2"]), 2, &["shard 2/2 is missing (given: 1/2)"]);
+    assert_rejected(&merge(&["s1of2", "s1of2", "s2of2"]), 2, &["shard 1/2 is given twice"]);
+    assert_rejected(&merge(&["s1of2", "s1of3"]), 2, &["is shard 1/3 but", "is shard 1/2"]);
+    assert_rejected(&merge(&["whole"]), 2, &["a check without --partition"]);
+    assert_rejected(&merge(&["nowhere"]), 2, &["is not a check's report folder"]);
+    assert!(!d.path().join("out").exists(), "nothing is written");
+    let r = merge(&["s2of2", "s1of2"]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("merged 2 shards: 3 passed, 0 failed"), "{}", r.stdout);
+    let json = |dir: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(d.path().join(dir).join("results.json")).unwrap()).unwrap()
+    };
+    let cases = |v: &serde_json::Value| {
+        let mut c: Vec<serde_json::Value> = v["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                let mut c = c.clone();
+                c.as_object_mut().unwrap().remove("report_anchor");
+                c
+            })
+            .collect();
+        c.sort_by_key(|c| c["id"].as_str().unwrap().to_string());
+        c
+    };
+    let mut shards = cases(&json("s1of2"));
+    shards.extend(cases(&json("s2of2")));
+    shards.sort_by_key(|c| c["id"].as_str().unwrap().to_string());
+    assert_eq!(cases(&json("out")), shards, "verdicts and metrics as the shards gave them");
+    let into_shard = vista_in(None, &[], &["merge", &p("s1of2"), &p("s2of2"), "--report-dir", &p("s1of2")]);
+    assert_rejected(&into_shard, 2, &["merge into a folder of its own"]);
 }
 
 // ---- examples/project: a project outside the built-ins ---------------------
@@ -4681,6 +4783,7 @@ fn main() {
         Gpu per_backend_goldens_are_used_on_their_backend,
         Gpu watch_rechecks_what_a_saved_file_reaches,
         Gpu the_ci_recipe_runs_as_written,
+        Gpu merge_refuses_anything_but_a_whole_split,
         Gpu the_seed_study_generator_runs_on_the_shell_scene,
         Gpu matrices_integer_vectors_arrays_and_padding_are_packed,
         Gpu a_foreign_import_path_composes_and_is_named_when_edited,

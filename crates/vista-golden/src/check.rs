@@ -14,7 +14,7 @@ use crate::Case;
 use crate::store::ManifestEntry;
 
 /// How a case came out of [`judge`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Verdict {
     /// No problem: every guard, provenance check and threshold holds.
     Pass,
@@ -30,7 +30,7 @@ pub enum Verdict {
 
 /// Images written for the report (paths relative to the report dir): the
 /// 16-bit files, their 8-bit display copies, and the viewer's data.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct ReportFiles {
     /// The golden's values as a 16-bit PNG (`<id>/expected.png`), when the
     /// golden could be read.
@@ -61,7 +61,7 @@ pub struct ReportFiles {
 }
 
 /// The run's side of the provenance, beside the golden's manifest entry.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct RunInfo {
     /// The backend name this run renders on, as reports and manifests name it
     /// (`lavapipe`, `swiftshader`, `gpu`, ...).
@@ -78,7 +78,7 @@ pub struct RunInfo {
 
 /// What happened to one case. `#[must_use]`: callers decide pass/fail.
 #[must_use]
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Outcome {
     /// The case id.
     pub id: String,

@@ -174,7 +174,7 @@ pub fn output_files(golden_dir: &Path, case: &Case, key: &str, index: usize, out
 }
 
 /// One output's verdict.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct OutputVerdict {
     /// The output's name (`image` for a one-pass kernel's main image).
     pub name: String,

@@ -35,6 +35,22 @@ pub fn write_pending(report_dir: &Path, entries: BTreeMap<String, ManifestEntry>
     Ok(())
 }
 
+/// The pending renders `pending.toml` in `report_dir` lists (none where
+/// there is no such file).
+pub fn read_pending(report_dir: &Path) -> Result<BTreeMap<String, ManifestEntry>, GoldenError> {
+    let path = report_dir.join(PENDING_FILE);
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(BTreeMap::new()),
+        Err(e) => return Err(GoldenError::Io { path: path.display().to_string(), message: e.to_string() }),
+    };
+    let pending: Manifest = toml::from_str(&text).map_err(|e| GoldenError::Cases {
+        path: path.display().to_string(),
+        message: format!("malformed pending file: {}", crate::cases::one_line_toml_error(&text, &e)),
+    })?;
+    Ok(pending.case)
+}
+
 /// The hash of every WGSL file a kernel file reaches in this checkout.
 pub type FileHashes<'a> = &'a dyn Fn(&str) -> Result<BTreeMap<String, String>, String>;
 

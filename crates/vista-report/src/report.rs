@@ -333,7 +333,7 @@ pub enum Detail {
 }
 
 /// What a report says about the run that made it.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct RunSummary {
     /// The command line, as a user would type it again.
     pub command: String,
@@ -345,6 +345,10 @@ pub struct RunSummary {
     pub pending: Vec<String>,
     /// The report folder as that command names it.
     pub accept_from: String,
+    /// `--partition K/N`: the shard of a suite this run checked (what
+    /// `vista merge` joins).
+    #[serde(default)]
+    pub partition: Option<(u64, u64)>,
 }
 
 /// The viewer's data for one case: both images' 16-bit display values

@@ -1,0 +1,186 @@
+//! `vista merge`: the report folders of `vista check --partition K/N` runs
+//! (CI shards) joined into one report, `results.json`, JUnit file and
+//! `pending.toml`, with every verdict and metric as its shard gave it. A
+//! shard missing or given twice is named and nothing is written: a merge
+//! never passes as a smaller suite.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use vista_golden::{GoldenError, ManifestEntry, Outcome};
+use vista_report::RunSummary;
+
+use crate::Results;
+
+/// The file a check leaves beside `results.json`: its run and every
+/// outcome, losslessly (CBOR keeps PSNR +inf and NaN), for `vista merge`.
+pub const OUTCOMES_FILE: &str = "outcomes.cbor";
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Saved {
+    run: RunSummary,
+    outcomes: Vec<Outcome>,
+}
+
+/// Writes `outcomes.cbor` into `report_dir`.
+pub(crate) fn save(report_dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result<(), GoldenError> {
+    let mut bytes = Vec::new();
+    ciborium::into_writer(&Saved { run: run.clone(), outcomes: outcomes.to_vec() }, &mut bytes).map_err(|e| {
+        GoldenError::Io { path: report_dir.join(OUTCOMES_FILE).display().to_string(), message: e.to_string() }
+    })?;
+    vista_image::atomic_write(&report_dir.join(OUTCOMES_FILE), &bytes)?;
+    Ok(())
+}
+
+/// One shard as read back.
+struct Shard {
+    dir: PathBuf,
+    run: RunSummary,
+    outcomes: Vec<Outcome>,
+}
+
+fn read(dir: &Path) -> Result<Shard, GoldenError> {
+    let path = dir.join(OUTCOMES_FILE);
+    let bytes = std::fs::read(&path).map_err(|e| {
+        GoldenError::BadInput(format!(
+            "{} is not a check's report folder ({OUTCOMES_FILE}: {e}); merge takes the --report-dir of each \
+             `vista check --partition K/N` run",
+            dir.display()
+        ))
+    })?;
+    let saved: Saved = ciborium::from_reader(bytes.as_slice())
+        .map_err(|e| GoldenError::BadInput(format!("{}: not a report this vista wrote: {e}", path.display())))?;
+    Ok(Shard { dir: dir.to_path_buf(), run: saved.run, outcomes: saved.outcomes })
+}
+
+/// Every shard's K of one N, each once, on one backend; else the error
+/// naming the shard missing, given twice, or out of place.
+fn check_shards(shards: &[Shard]) -> Result<u64, GoldenError> {
+    let bad = |m: String| Err(GoldenError::BadInput(m));
+    let mut n = None;
+    let mut seen: BTreeMap<u64, &Path> = BTreeMap::new();
+    for s in shards {
+        let Some((k, sn)) = s.run.partition else {
+            return bad(format!(
+                "{} is the report of a check without --partition; merge joins the shards of `vista check \
+                 --partition K/N` runs",
+                s.dir.display()
+            ));
+        };
+        match n {
+            Some(first) if first != sn => {
+                return bad(format!(
+                    "{} is shard {k}/{sn} but {} is shard {}/{first}: the shards of one split have one N",
+                    s.dir.display(),
+                    shards[0].dir.display(),
+                    shards[0].run.partition.map_or(0, |p| p.0)
+                ));
+            }
+            _ => n = Some(sn),
+        }
+        if let Some(other) = seen.insert(k, &s.dir) {
+            return bad(format!("shard {k}/{sn} is given twice: {} and {}", other.display(), s.dir.display()));
+        }
+        if s.run.backend != shards[0].run.backend {
+            return bad(format!(
+                "{} ran on {} but {} on {}: merge the shards of one backend",
+                s.dir.display(),
+                s.run.backend,
+                shards[0].dir.display(),
+                shards[0].run.backend
+            ));
+        }
+    }
+    let n = n.expect("at least one shard");
+    let missing: Vec<String> = (1..=n).filter(|k| !seen.contains_key(k)).map(|k| format!("{k}/{n}")).collect();
+    if !missing.is_empty() {
+        let given: Vec<String> = seen.keys().map(|k| format!("{k}/{n}")).collect();
+        return bad(format!(
+            "shard{} {} {} missing (given: {}); a merge of fewer shards would pass as a smaller suite",
+            if missing.len() == 1 { "" } else { "s" },
+            missing.join(", "),
+            if missing.len() == 1 { "is" } else { "are" },
+            given.join(", ")
+        ));
+    }
+    Ok(n)
+}
+
+fn copy_dir(from: &Path, to: &Path) -> Result<(), GoldenError> {
+    let io = |p: &Path, e: std::io::Error| GoldenError::Io { path: p.display().to_string(), message: e.to_string() };
+    std::fs::create_dir_all(to).map_err(|e| io(to, e))?;
+    for entry in std::fs::read_dir(from).map_err(|e| io(from, e))? {
+        let entry = entry.map_err(|e| io(from, e))?;
+        let (src, dst) = (entry.path(), to.join(entry.file_name()));
+        if src.is_dir() {
+            copy_dir(&src, &dst)?;
+        } else {
+            std::fs::copy(&src, &dst).map_err(|e| io(&src, e))?;
+        }
+    }
+    Ok(())
+}
+
+/// Joins the shards in `dirs` into `out`: checks them first (nothing is
+/// written if one is missing, given twice or of another split), then
+/// copies each case's folder, and writes the report, `pending.toml`
+/// (every shard's pending renders), `results.json`, `outcomes.cbor` and
+/// what `results` asks for. Returns the index path and the outcomes, by id.
+pub fn merge(
+    dirs: &[PathBuf],
+    out: &Path,
+    results: &Results,
+    command: String,
+) -> Result<(PathBuf, Vec<Outcome>), GoldenError> {
+    if dirs.is_empty() {
+        return Err(GoldenError::BadInput("merge needs the report folders of the shards".into()));
+    }
+    let shards = dirs.iter().map(|d| read(d)).collect::<Result<Vec<_>, _>>()?;
+    let n = check_shards(&shards)?;
+    let out_abs = std::path::absolute(out).unwrap_or_else(|_| out.to_path_buf());
+    if let Some(s) = shards.iter().find(|s| std::path::absolute(&s.dir).is_ok_and(|d| d == out_abs)) {
+        return Err(GoldenError::BadInput(format!(
+            "--report-dir {} is shard {}: merge into a folder of its own",
+            out.display(),
+            s.dir.display()
+        )));
+    }
+    let mut pending: BTreeMap<String, ManifestEntry> = BTreeMap::new();
+    for s in &shards {
+        pending.extend(vista_golden::pending::read_pending(&s.dir)?);
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| GoldenError::Io { path: out.display().to_string(), message: e.to_string() })?;
+    vista_report::clear_case_folders(out)?;
+    for s in &shards {
+        for o in &s.outcomes {
+            let case = s.dir.join(&o.id);
+            if case.is_dir() {
+                copy_dir(&case, &out.join(&o.id))?;
+            }
+        }
+    }
+    let mut outcomes: Vec<Outcome> = shards.iter().flat_map(|s| s.outcomes.iter().cloned()).collect();
+    outcomes.sort_by(|a, b| a.id.cmp(&b.id));
+    let first = &shards[0].run;
+    let run = RunSummary {
+        command: format!("{command} (the {n} shards of: {})", first.command),
+        backend: first.backend.clone(),
+        adapter: first.adapter.clone(),
+        pending: pending.keys().cloned().collect(),
+        accept_from: out.display().to_string(),
+        partition: None,
+    };
+    let index = vista_report::write_report(out, &run, &outcomes)?;
+    vista_golden::pending::write_pending(out, pending)?;
+    let json = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
+    vista_image::atomic_write(&out.join("results.json"), json.as_bytes())?;
+    save(out, &run, &outcomes)?;
+    if let Some(p) = &results.junit {
+        vista_image::atomic_write(p, vista_report::junit_xml(&run, &outcomes, out)?.as_bytes())?;
+    }
+    if let Some(p) = &results.json {
+        vista_image::atomic_write(p, json.as_bytes())?;
+    }
+    Ok((index, outcomes))
+}
