@@ -1999,6 +1999,22 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     assert_rejected(&stale, 2, &["case sky", "is stale", "sky.exr is not the file the check wrote"]);
 }
 
+/// `vista render k` of the project in `dir` on lavapipe, SwiftShader and
+/// the browser, each to `probe-<backend>.exr` (its other outputs beside
+/// it): each backend with its first output's raw values.
+fn probe_on_every_backend(dir: &Path, size: &str) -> Vec<(&'static str, vista_image::Image)> {
+    ["lavapipe", "swiftshader", "browser"]
+        .into_iter()
+        .map(|backend| {
+            let out = dir.join(format!("probe-{backend}.exr"));
+            let args = ["render", "k", "--size", size, "--backend", backend, "-o", out.to_str().unwrap()];
+            let r = vista_in(Some(dir), &[], &args);
+            assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
+            (backend, vista_image::load(&out).unwrap())
+        })
+        .collect()
+}
+
 /// A `dimension = "cube"` resource: six square layers written through a
 /// 2d-array storage view, then sampled through a `texture_cube` view. Each
 /// axis direction finds its face (WebGPU's order +X, -X, +Y, -Y, +Z, -Z)
@@ -2051,15 +2067,7 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 ";
     let d = kernel_project(manifest, shader);
-    for backend in ["lavapipe", "swiftshader", "browser"] {
-        let out = d.path().join(format!("probe-{backend}.exr"));
-        let r = vista_in(
-            Some(d.path()),
-            &[],
-            &["render", "k", "--size", "16x16", "--backend", backend, "-o", out.to_str().unwrap()],
-        );
-        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
-        let probe = vista_image::load(&out).unwrap();
+    for (backend, probe) in probe_on_every_backend(d.path(), "16x16") {
         let faces: Vec<f32> = (0..6).map(|x| probe.get(x, 0)[0] * 8.0 - 1.0).collect();
         assert_eq!(faces, [0.0, 1.0, 2.0, 3.0, 4.0, 5.0], "{backend}: the face each axis finds");
         // +Z: u grows with x, v with -y (WebGPU's cube coordinates).
@@ -2142,15 +2150,7 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 ";
     let d = kernel_project(&manifest, shader);
-    for backend in ["lavapipe", "swiftshader", "browser"] {
-        let out = d.path().join(format!("probe-{backend}.exr"));
-        let r = vista_in(
-            Some(d.path()),
-            &[],
-            &["render", "k", "--size", "16x16", "--backend", backend, "-o", out.to_str().unwrap()],
-        );
-        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
-        let probe = vista_image::load(&out).unwrap();
+    for (backend, probe) in probe_on_every_backend(d.path(), "16x16") {
         assert_eq!(probe.get(5, 0)[0], 5.0, "{backend}: the whole view sees 5 levels");
         for level in 0..5u32 {
             // Level k's texel averages a 2^k block of level 0, whose x, y and
