@@ -215,7 +215,12 @@ pub fn finish(report_dir: &Path, run: &RunSummary, filed: &[Filed], results: &Re
     }
     let outcomes: Vec<Outcome> = filed.iter().map(|f| f.outcome.clone()).collect();
     let index = vista_report::write_report(report_dir, &run, &outcomes)?;
-    merge::save(report_dir, &run, &outcomes)?;
+    // Only a shard is merged: a whole run's report keeps no second copy of its outcomes.
+    if run.partition.is_some() {
+        merge::save(report_dir, &run, &outcomes)?;
+    } else {
+        merge::remove(report_dir)?;
+    }
     vista_golden::pending::write_pending(report_dir, pending)?;
     let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
     vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;

@@ -12,8 +12,9 @@ use vista_report::RunSummary;
 
 use crate::Results;
 
-/// The file a check leaves beside `results.json`: its run and every
-/// outcome, losslessly (CBOR keeps PSNR +inf and NaN), for `vista merge`.
+/// The file a `--partition` check leaves beside `results.json`: its run
+/// and every outcome, losslessly (CBOR keeps PSNR +inf and NaN), for
+/// `vista merge`.
 pub const OUTCOMES_FILE: &str = "outcomes.cbor";
 
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -32,6 +33,18 @@ pub(crate) fn save(report_dir: &Path, run: &RunSummary, outcomes: &[Outcome]) ->
     Ok(())
 }
 
+/// Removes an earlier shard's `outcomes.cbor` from a folder a whole run now
+/// reports into, so it is never merged as that run's.
+pub(crate) fn remove(report_dir: &Path) -> Result<(), GoldenError> {
+    let path = report_dir.join(OUTCOMES_FILE);
+    match std::fs::remove_file(&path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(GoldenError::Io { path: path.display().to_string(), message: e.to_string() })
+        }
+        _ => Ok(()),
+    }
+}
+
 /// One shard as read back.
 struct Shard {
     dir: PathBuf,
@@ -42,11 +55,18 @@ struct Shard {
 fn read(dir: &Path) -> Result<Shard, GoldenError> {
     let path = dir.join(OUTCOMES_FILE);
     let bytes = std::fs::read(&path).map_err(|e| {
-        GoldenError::BadInput(format!(
-            "{} is not a check's report folder ({OUTCOMES_FILE}: {e}); merge takes the --report-dir of each \
-             `vista check --partition K/N` run",
-            dir.display()
-        ))
+        GoldenError::BadInput(match dir.join("results.json").is_file() {
+            true => format!(
+                "{} is the report of a check without --partition; merge joins the shards of `vista check \
+                 --partition K/N` runs",
+                dir.display()
+            ),
+            false => format!(
+                "{} is not a check's report folder ({OUTCOMES_FILE}: {e}); merge takes the --report-dir of each \
+                 `vista check --partition K/N` run",
+                dir.display()
+            ),
+        })
     })?;
     let saved: Saved = ciborium::from_reader(bytes.as_slice())
         .map_err(|e| GoldenError::BadInput(format!("{}: not a report this vista wrote: {e}", path.display())))?;
@@ -124,8 +144,8 @@ fn copy_dir(from: &Path, to: &Path) -> Result<(), GoldenError> {
 /// Joins the shards in `dirs` into `out`: checks them first (nothing is
 /// written if one is missing, given twice or of another split), then
 /// copies each case's folder, and writes the report, `pending.toml`
-/// (every shard's pending renders), `results.json`, `outcomes.cbor` and
-/// what `results` asks for. Returns the index path and the outcomes, by id.
+/// (every shard's pending renders), `results.json` and what `results`
+/// asks for. Returns the index path and the outcomes, by id.
 pub fn merge(
     dirs: &[PathBuf],
     out: &Path,
@@ -175,7 +195,6 @@ pub fn merge(
     vista_golden::pending::write_pending(out, pending)?;
     let json = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
     vista_image::atomic_write(&out.join("results.json"), json.as_bytes())?;
-    save(out, &run, &outcomes)?;
     if let Some(p) = &results.junit {
         vista_image::atomic_write(p, vista_report::junit_xml(&run, &outcomes, out)?.as_bytes())?;
     }
