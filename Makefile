@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves seed-study bench fuzz mutants device-figures lavapipe swiftshader validation browser build
+.PHONY: demo test golden curves seed-study bench fuzz mutants scaling device-figures lavapipe swiftshader validation browser build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -84,3 +84,9 @@ fuzz:
 
 bench: lavapipe
 	$(CARGO) bench -p vista --features bench
+
+# vista check's time, memory and report size per case against image size
+# (64^2 .. 2048^2) and case count (COUNTS, default 100 1000), passing and
+# failing: a markdown table for docs/performance.md (not part of make test).
+scaling: lavapipe build
+	bash ci/scaling.sh $(VISTA) $(or $(COUNTS),100 1000)
