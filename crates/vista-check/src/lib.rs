@@ -206,26 +206,40 @@ pub struct Results {
 /// `pending.toml` (the pending renders of `filed`), `results.json` beside
 /// them (what `check --failed` reads next time) and `results`' files.
 pub fn finish(report_dir: &Path, run: &RunSummary, filed: &[Filed], results: &Results) -> Result<PathBuf, GoldenError> {
-    let mut run = run.clone();
     let pending: BTreeMap<String, ManifestEntry> =
         filed.iter().filter_map(|f| Some((f.outcome.id.clone(), f.pending.clone()?))).collect();
+    let outcomes: Vec<Outcome> = filed.iter().map(|f| f.outcome.clone()).collect();
+    write_run(report_dir, run, &outcomes, pending, results)
+}
+
+/// The files a run's outcomes make, for `finish` and `merge` alike: the
+/// report, `outcomes.cbor` for a shard, `pending.toml`, `results.json` and
+/// `results`' files. `run` gets the pending ids and, unless it names one,
+/// `report_dir` as the folder `bless --from-report` takes.
+pub(crate) fn write_run(
+    report_dir: &Path,
+    run: &RunSummary,
+    outcomes: &[Outcome],
+    pending: BTreeMap<String, ManifestEntry>,
+    results: &Results,
+) -> Result<PathBuf, GoldenError> {
+    let mut run = run.clone();
     run.pending = pending.keys().cloned().collect();
     if run.accept_from.is_empty() {
         run.accept_from = report_dir.display().to_string();
     }
-    let outcomes: Vec<Outcome> = filed.iter().map(|f| f.outcome.clone()).collect();
-    let index = vista_report::write_report(report_dir, &run, &outcomes)?;
+    let index = vista_report::write_report(report_dir, &run, outcomes)?;
     // Only a shard is merged: a whole run's report keeps no second copy of its outcomes.
     if run.partition.is_some() {
-        merge::save(report_dir, &run, &outcomes)?;
+        merge::save(report_dir, &run, outcomes)?;
     } else {
         merge::remove(report_dir)?;
     }
     vista_golden::pending::write_pending(report_dir, pending)?;
-    let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
+    let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, outcomes)).expect("JSON values");
     vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;
     if let Some(p) = &results.junit {
-        vista_image::atomic_write(p, vista_report::junit_xml(&run, &outcomes, report_dir)?.as_bytes())?;
+        vista_image::atomic_write(p, vista_report::junit_xml(&run, outcomes, report_dir)?.as_bytes())?;
     }
     if let Some(p) = &results.json {
         vista_image::atomic_write(p, json_text.as_bytes())?;

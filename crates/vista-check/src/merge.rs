@@ -52,15 +52,20 @@ struct Shard {
     outcomes: Vec<Outcome>,
 }
 
+/// Why a whole run's report is not a shard.
+fn unpartitioned(dir: &Path) -> String {
+    format!(
+        "{} is the report of a check without --partition; merge joins the shards of `vista check --partition K/N` \
+         runs",
+        dir.display()
+    )
+}
+
 fn read(dir: &Path) -> Result<Shard, GoldenError> {
     let path = dir.join(OUTCOMES_FILE);
     let bytes = std::fs::read(&path).map_err(|e| {
         GoldenError::BadInput(match dir.join("results.json").is_file() {
-            true => format!(
-                "{} is the report of a check without --partition; merge joins the shards of `vista check \
-                 --partition K/N` runs",
-                dir.display()
-            ),
+            true => unpartitioned(dir),
             false => format!(
                 "{} is not a check's report folder ({OUTCOMES_FILE}: {e}); merge takes the --report-dir of each \
                  `vista check --partition K/N` run",
@@ -80,13 +85,7 @@ fn check_shards(shards: &[Shard]) -> Result<u64, GoldenError> {
     let mut n = None;
     let mut seen: BTreeMap<u64, &Path> = BTreeMap::new();
     for s in shards {
-        let Some((k, sn)) = s.run.partition else {
-            return bad(format!(
-                "{} is the report of a check without --partition; merge joins the shards of `vista check \
-                 --partition K/N` runs",
-                s.dir.display()
-            ));
-        };
+        let Some((k, sn)) = s.run.partition else { return bad(unpartitioned(&s.dir)) };
         match n {
             Some(first) if first != sn => {
                 return bad(format!(
@@ -187,19 +186,8 @@ pub fn merge(
         command: format!("{command} (the {n} shards of: {})", first.command),
         backend: first.backend.clone(),
         adapter: first.adapter.clone(),
-        pending: pending.keys().cloned().collect(),
-        accept_from: out.display().to_string(),
-        partition: None,
+        ..Default::default()
     };
-    let index = vista_report::write_report(out, &run, &outcomes)?;
-    vista_golden::pending::write_pending(out, pending)?;
-    let json = serde_json::to_string_pretty(&vista_report::json_results(&run, &outcomes)).expect("JSON values");
-    vista_image::atomic_write(&out.join("results.json"), json.as_bytes())?;
-    if let Some(p) = &results.junit {
-        vista_image::atomic_write(p, vista_report::junit_xml(&run, &outcomes, out)?.as_bytes())?;
-    }
-    if let Some(p) = &results.json {
-        vista_image::atomic_write(p, json.as_bytes())?;
-    }
+    let index = crate::write_run(out, &run, &outcomes, pending, results)?;
     Ok((index, outcomes))
 }
