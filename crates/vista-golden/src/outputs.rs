@@ -88,6 +88,12 @@ impl GoldenFiles {
         self.found.iter().find(|(p, _)| p == path).map_or(&Found::Missing, |(_, f)| f)
     }
 
+    /// The PNG view's values, where there is one that decodes (the
+    /// report shows it beside the render's).
+    pub fn view(&self) -> Option<Image> {
+        self.decode(self.paths.png.as_deref()?, vista_image::decode_png16).ok().flatten()
+    }
+
     /// The decoded file at `path`: `Ok(None)` when missing, `Err` naming the
     /// path when it cannot be read or decoded.
     fn decode<T>(

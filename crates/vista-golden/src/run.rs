@@ -177,6 +177,16 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         let golden = read_golden(&path)?;
         Ok((repeat_identical, files, path, golden))
     })();
+    // Each output's golden files, read once: the verdict judges them and
+    // the report shows their PNG.
+    let golden_files: Vec<GoldenFiles> = match &gathered {
+        Ok(_) => crate::outputs::outputs_of(case, &r)
+            .iter()
+            .enumerate()
+            .map(|(i, o)| GoldenFiles::read(crate::outputs::output_files(&store.dir, case, &golden_key, i, o)))
+            .collect(),
+        Err(_) => Vec::new(),
+    };
     let mut out = match &gathered {
         Err(e) => judge(case, entry, run, Err(e.clone())),
         Ok((repeat_identical, files, path, golden)) => {
@@ -190,12 +200,9 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
             let threshold = crate::DriverThreshold::of(case, entry, &run.adapter);
             let outputs: Vec<crate::outputs::OutputVerdict> = crate::outputs::outputs_of(case, &r)
                 .iter()
+                .zip(&golden_files)
                 .enumerate()
-                .map(|(i, o)| {
-                    // The runner reads; the verdict only judges what it read.
-                    let files = crate::outputs::output_files(&store.dir, case, &golden_key, i, o);
-                    crate::outputs::compare_output(case, &GoldenFiles::read(files), i, o, threshold, entry)
-                })
+                .map(|(i, (o, golden))| crate::outputs::compare_output(case, golden, i, o, threshold, entry))
                 .collect();
             let observed = Observed {
                 raw_hash: &raw_hash,
@@ -261,8 +268,12 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         .skip(1)
         .filter_map(|(i, o)| {
             let shown = quantize16(&o.display()?);
-            let files = crate::outputs::output_files(&store.dir, case, &golden_key, i, o);
-            let golden = files.png.and_then(|p| vista_image::read_png16(&p).ok());
+            let golden = match golden_files.get(i) {
+                Some(g) => g.view(),
+                None => crate::outputs::output_files(&store.dir, case, &golden_key, i, o)
+                    .png
+                    .and_then(|p| vista_image::read_png16(&p).ok()),
+            };
             Some((o.name.clone(), shown, golden))
         })
         .collect();
