@@ -96,7 +96,8 @@ fn uniform_blocks_are_packed_by_name_at_naga_offsets() {
     let set = repo_shaders();
     for k in vista_kernels::registry() {
         let module = set.compose(k.shader()).unwrap();
-        let layout = k.layout(&module).unwrap_or_else(|e| panic!("{e}"));
+        let (_, mut layouts) = k.graph_layouts(&[(k.shader(), &module)]).unwrap_or_else(|e| panic!("{e}"));
+        let layout = layouts.remove(0);
         let p = k.resolve(k.presets().last().map(|p| p.name.as_str()), &[]).unwrap();
         let bytes = k.uniforms(&layout, &p, 64, 32).remove(0);
         assert_eq!(bytes.len() % 16, 0);

@@ -45,10 +45,7 @@ pub fn bench(project: &Project, config: &vista::Config, a: Args) -> Result<i32, 
     let shaders = vista_render::shader_set(project)?;
     // Every check that needs no device, before it is made.
     let plan = vista_render::plan(&shaders, project.root(), &k, &p, &[], w, h, &config.limits)?;
-    let graph_passes: Vec<String> = match k.graph() {
-        Some(_) => plan.passes.iter().map(|p| p.label.clone()).collect(),
-        None => Vec::new(),
-    };
+    let graph_passes: Vec<String> = plan.passes.iter().map(|p| p.label.clone()).collect();
     if cpu && !k.has_reference() {
         return Err(bad(match k.reference_mismatch() {
             Some(how) => format!(

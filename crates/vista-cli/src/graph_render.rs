@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use vista_golden::GoldenError;
+use vista_image::Image;
 use vista_kernels::Kernel;
 use vista_render::{OutputValue, Plan, Renderer};
 
@@ -25,9 +26,9 @@ pub fn output_path(out: &Path, first: bool, name: &str, buffer: bool) -> PathBuf
     out.with_file_name(format!("{stem}.{name}.{ext}"))
 }
 
-/// Renders a graph kernel and writes its outputs; exit 1 on NaN or
-/// unwritten texels in any output, as for one-pass kernels.
-pub fn render(ctx: &Renderer, k: &Kernel, plan: &Plan, out: &Path) -> Result<i32, GoldenError> {
+/// `-o`'s extension fits the kernel's first output: `.png` or `.exr` for a
+/// texture, `.npy` for a buffer; and its folder is writable.
+pub fn check_output_path(k: &Kernel, plan: &Plan, out: &Path) -> Result<(), GoldenError> {
     let first_is_buffer =
         matches!(plan.outputs.first().map(|o| &o.kind), Some(vista_render::PlannedKind::Buffer { .. }));
     let ext = out.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
@@ -42,6 +43,20 @@ pub fn render(ctx: &Renderer, k: &Kernel, plan: &Plan, out: &Path) -> Result<i32
             if first_is_buffer { "buffer" } else { "texture" }
         )));
     }
+    crate::render::check_parent_writable(out)
+}
+
+/// Renders a kernel and writes its outputs, the first through `frame`
+/// (`--crop`, `--zoom`); exit 1 on NaN or unwritten texels in any output.
+/// `shape` describes the first output where it is a texture.
+pub fn render(
+    ctx: &Renderer,
+    k: &Kernel,
+    plan: &Plan,
+    out: &Path,
+    shape: Option<String>,
+    frame: impl Fn(Image) -> Image,
+) -> Result<i32, GoldenError> {
     let r = vista_render::run(ctx, plan)?;
     let mut code = 0;
     for (i, o) in r.outputs.iter().enumerate() {
@@ -51,7 +66,7 @@ pub fn render(ctx: &Renderer, k: &Kernel, plan: &Plan, out: &Path) -> Result<i32
             OutputValue::Texture { raw, unwritten, .. } => {
                 let raw_values = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
                 let img = if raw_values { raw.clone() } else { o.display().expect("a texture") };
-                vista_image::save(&path, &img)?;
+                vista_image::save(&path, &if i == 0 { frame(img) } else { img })?;
                 if let Some((x, y)) = raw.first_nonfinite() {
                     eprintln!(
                         "error: output {} has {} NaN/Inf texels, first at ({x}, {y})",
@@ -75,14 +90,19 @@ pub fn render(ctx: &Renderer, k: &Kernel, plan: &Plan, out: &Path) -> Result<i32
                 vista_image::npy::write_npy(&path, &descr, &shape, o.buffer_body().expect("a buffer"))?;
             }
         }
-        eprintln!("  output {} -> {}", o.name, path.display());
+        if r.outputs.len() > 1 {
+            eprintln!("  output {} -> {}", o.name, path.display());
+        }
     }
     let passes: Vec<String> = r.pass_times.iter().map(|t| format!("{:.1}", t.as_secs_f64() * 1e3)).collect();
+    let passes = match passes.len() {
+        1 => String::new(),
+        n => format!(" ({n} passes: {} ms)", passes.join(" + ")),
+    };
     eprintln!(
-        "rendered {} ({} passes: {} ms) on {} in {:.1} ms -> {}",
+        "rendered {}{}{passes} on {} in {:.1} ms -> {}",
         k.name(),
-        r.pass_times.len(),
-        passes.join(" + "),
+        shape.map(|s| format!(" {s}")).unwrap_or_default(),
         ctx.adapter_description(),
         r.stats.gpu_wall.as_secs_f64() * 1e3,
         out.display()

@@ -31,35 +31,24 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
     if !(1..=16).contains(&zoom) {
         return Err(bad(format!("--zoom {zoom} is out of range; allowed: 1 to 16")));
     }
-    if k.graph().is_some() {
-        if crop.is_some() || zoom > 1 {
-            return Err(bad("--crop and --zoom apply to one-pass kernels; a pass graph writes every output whole"));
-        }
-        check_parent_writable(&out)?;
-        let shaders = vista_render::shader_set(project)?;
-        // Every check that needs no device (bindings, input files) before one is made.
-        let plan = vista_render::plan(&shaders, project.root(), &k, &p, &[], w, h, &config.limits)?;
-        let ctx = &Renderer::shared_with_shaders(&config.gpu, shaders, config.limits, project.root().map(Into::into))?;
-        return graph_render::render(ctx, &k, &plan, &out);
-    }
-    check_output_path(&out)?;
     let shaders = vista_render::shader_set(project)?;
+    // Every check that needs no device (bindings, input files) before one is made.
     let plan = vista_render::plan(&shaders, project.root(), &k, &p, &[], w, h, &config.limits)?;
-    let t = plan.main_texture().cloned().expect("a one-pass kernel writes a texture");
-    // Layers and slices are stacked top to bottom: crop that image.
-    let rect = crop.as_deref().map(|c| parse_crop(c, t.width, t.height * t.layers)).transpose()?;
+    graph_render::check_output_path(&k, &plan, &out)?;
+    // --crop and --zoom apply to the first output, a texture whose layers
+    // and slices are stacked top to bottom.
+    let rect = match (plan.main_texture(), crop.as_deref()) {
+        (None, _) if crop.is_some() || zoom > 1 => {
+            return Err(bad(format!(
+                "--crop and --zoom apply to a texture; kernel {kernel}'s first output, {}, is a buffer",
+                plan.outputs[0].name
+            )));
+        }
+        (Some(t), Some(c)) => Some(parse_crop(c, t.width, t.height * t.layers)?),
+        _ => None,
+    };
     let ctx = &Renderer::shared_with_shaders(&config.gpu, shaders, config.limits, project.root().map(Into::into))?;
-    let r = vista_render::run(ctx, &plan)?;
-    let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    let mut img = if is_exr { r.raw.clone() } else { r.display().clone() };
-    if let Some((x, y, cw, ch)) = rect {
-        img = img.crop(x, y, cw, ch).expect("the crop was checked against the size");
-    }
-    if zoom > 1 {
-        img = img.zoom(zoom);
-    }
-    vista_image::save(&out, &img)?;
-    let shape = match t.dimension {
+    let shape = plan.main_texture().map(|t| match t.dimension {
         vista_texel::Dimension::D2 if t.layers == 1 && (t.width, t.height) == (w, h) => format!("{w}x{h}"),
         d => format!(
             "{}x{}x{} ({} output, stacked {}x{})",
@@ -70,22 +59,15 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
             t.width,
             t.height * t.layers
         ),
+    });
+    let frame = |img: vista_image::Image| {
+        let img = match rect {
+            Some((x, y, cw, ch)) => img.crop(x, y, cw, ch).expect("the crop was checked against the size"),
+            None => img,
+        };
+        if zoom > 1 { img.zoom(zoom) } else { img }
     };
-    eprintln!(
-        "rendered {kernel} {shape} on {} in {:.1} ms -> {}",
-        ctx.adapter_description(),
-        r.stats.gpu_wall.as_secs_f64() * 1e3,
-        out.display()
-    );
-    if let Some((x, y)) = r.raw.first_nonfinite() {
-        eprintln!("error: output has {} NaN/Inf pixels, first at ({x}, {y})", r.raw.nonfinite_count());
-        return Ok(1);
-    }
-    if r.unwritten > 0 && !k.partial() {
-        eprintln!("error: kernel {kernel}: {}", vista_golden::unwritten_problem(r.unwritten, &r.raw));
-        return Ok(1);
-    }
-    Ok(0)
+    graph_render::render(ctx, &k, &plan, &out, shape, frame)
 }
 
 /// `X,Y,W,H` inside a `width` x `height` frame.
@@ -104,17 +86,6 @@ pub fn parse_crop(text: &str, width: u32, height: u32) -> Result<(u32, u32, u32,
         }
         _ => Err(bad(format!("--crop {text} does not fit; expected {allowed}"))),
     }
-}
-
-fn check_output_path(out: &Path) -> Result<(), GoldenError> {
-    let ext_ok = out
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("png") || e.eq_ignore_ascii_case("exr"));
-    if !ext_ok {
-        return Err(bad(format!("output {} must end in .png or .exr", out.display())));
-    }
-    check_parent_writable(out)
 }
 
 /// The directory a file will be written into exists, is one, and is writable.

@@ -191,6 +191,24 @@ fn a_crop_is_the_rectangle_of_the_frame() {
             assert_eq!(c.get(x, y), f.get(10 + x / 3, 4 + y / 3), "crop pixel ({x}, {y})");
         }
     }
+    // A graph's first output is cropped and zoomed, its other outputs
+    // written whole; a first output that is a buffer cannot be.
+    let graphs = repo().join("examples/graphs");
+    let luts = d.path().join("luts.png");
+    let args =
+        ["render", "sky_luts", "--size", "16x8", "--crop", "2,1,4,3", "--zoom", "2", "-o", luts.to_str().unwrap()];
+    let r = vista_in(Some(&graphs), &[], &args);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(vista_image::load(&luts).unwrap().dimensions(), (8, 6));
+    let other = vista_image::load(&d.path().join("luts.transmittance.png")).unwrap();
+    assert!(other.width > 8, "the second output is whole: {:?}", other.dimensions());
+    let npy = d.path().join("scan.npy");
+    let r = vista_in(Some(&graphs), &[], &["render", "scan", "--zoom", "2", "-o", npy.to_str().unwrap()]);
+    assert_rejected(
+        &r,
+        2,
+        &["--crop and --zoom apply to a texture", "kernel scan's first output, prefix, is a buffer"],
+    );
 }
 
 fn absurd_work_is_refused_with_the_cap() {
@@ -1413,7 +1431,7 @@ fn resources_that_do_not_fit_their_binding_are_refused() {
     ] {
         let manifest = VOLUME_MANIFEST.replace(from, to);
         let r = render_k(&manifest, &volume_shader("8, 8, 1", "d.z"));
-        assert_rejected(&r, 2, &["kernel k", "pass fill", "resource volume", ty, named]);
+        assert_rejected(&r, 2, &["kernel k", "pass 1 (fill)", "resource volume", ty, named]);
     }
     // A texture bound to a uniform: the kind does not fit.
     let shader = K_SHADER.replace("fn main", "fn fill");
@@ -1423,14 +1441,17 @@ fn resources_that_do_not_fit_their_binding_are_refused() {
     assert_rejected(
         &render_k(&manifest, &shader),
         2,
-        &["pass fill", "resource t (a texture) is bound to params (@group(0) @binding(0), var<uniform> Params)"],
+        &[
+            "pass 1 (fill)",
+            "params (@group(0) @binding(0), var<uniform> Params) is bound to t, a texture; it needs a buffer",
+        ],
     );
     // bind naming a variable the pass does not reach, or no resource.
     let manifest = VOLUME_MANIFEST.replace("bind = { vol = \"volume\" }", "bind = { volume = \"volume\" }");
     assert_rejected(
         &render_k(&manifest, &volume_shader("8, 8, 1", "d.z")),
         2,
-        &["bind names volume, which the pass does not reach; it reaches: vol"],
+        &["bind names volume, which k.wgsl does not declare; fill reaches: vol"],
     );
     let manifest = VOLUME_MANIFEST.replace("bind = { vol = \"volume\" }", "bind = { vol = \"vlume\" }");
     assert_rejected(
@@ -1493,7 +1514,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     let c = vista_in(Some(d.path()), &[], &["check"]);
     assert_eq!(c.code, 1, "{}", c.stdout);
     assert!(
-        c.stdout.contains("output image: not exact: 1 differ; worst: (3, 4).r 4010 vs golden 4009"),
+        c.stdout.contains("output counts: not exact: 1 differ; worst: (3, 4).r 4010 vs golden 4009"),
         "{}",
         c.stdout
     );
@@ -1654,7 +1675,7 @@ fn readme_schemas_match_the_parsers() {
     let resource = err(
         K_MANIFEST,
         "kernels/x.toml",
-        "summary = \"x\"\n[[resource]]\nname = \"r\"\nzzz = 1\n",
+        "summary = \"x\"\n[[resource]]\nname = \"r\"\nkind = \"texture\"\nzzz = 1\n",
         &["render", "x", "-o", "x.png"],
     );
     let allowed: std::collections::BTreeSet<String> =
@@ -2598,7 +2619,7 @@ fn unfed_globals_are_refused() {
             .replace("@compute", &format!("{decl}\n@compute"))
             .replace("    textureStore(output", &format!("    {use_it}\n    textureStore(output"));
         let r = render_k(K_MANIFEST, &shader);
-        assert_rejected(&r, 2, &["kernel k", "pass main", named, feed]);
+        assert_rejected(&r, 2, &["kernel k", "pass 1 (main)", named, feed]);
     }
 }
 
@@ -2953,7 +2974,7 @@ fn an_opaque_views_alpha_is_kept_and_judged() {
     let c = vista_in(Some(d.path()), &[], &["check"]);
     assert_eq!(c.code, 1, "{}", c.stdout);
     assert!(c.stdout.contains("PSNR identical"), "the view did not change: {}", c.stdout);
-    assert!(c.stdout.contains("output image: alpha PSNR") && c.stdout.contains("c.alpha.png"), "{}", c.stdout);
+    assert!(c.stdout.contains("output output: alpha PSNR") && c.stdout.contains("c.alpha.png"), "{}", c.stdout);
     // Missing, it is named with the bless command.
     std::fs::remove_file(d.path().join("shaders/clouds.wgsl")).unwrap();
     std::fs::remove_file(d.path().join("golden/clouds/c.alpha.png")).unwrap();

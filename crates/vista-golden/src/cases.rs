@@ -217,12 +217,13 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             }
         }
         if !raw.inputs.is_empty() {
-            let Some(g) = kernel.graph() else {
+            let g = kernel.graph();
+            if g.resources.is_empty() {
                 return Err(bad(format!(
                     "inputs: kernel {} has no [[resource]] files to replace (a pass graph's inputs)",
                     kernel.name()
                 )));
-            };
+            }
             for (name, file) in &raw.inputs {
                 let Some(r) = g.resources.iter().find(|r| &r.name == name) else {
                     let names: Vec<&str> = g.resources.iter().map(|r| r.name.as_str()).collect();
@@ -247,8 +248,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         }
         let mut tolerances = Vec::new();
         for (name, v) in &raw.tolerances {
-            let outputs: Vec<&str> =
-                kernel.graph().map(|g| g.outputs.iter().map(|o| o.resource.as_str()).collect()).unwrap_or_default();
+            let outputs: Vec<&str> = kernel.graph().outputs.iter().filter_map(|o| o.resource.as_deref()).collect();
             if outputs.is_empty() {
                 return Err(bad(format!(
                     "tolerances: kernel {} has no [[output]] tables; a case's tolerance overrides one of theirs",

@@ -145,14 +145,11 @@ pub fn keeps_raw(kernel: &Kernel, format: &str) -> bool {
     kernel.describes_resources() || format != "rgba32float"
 }
 
-pub use vista_render::MAIN_OUTPUT;
-
-/// A render's outputs as goldens see them: a graph's own, or a one-pass
-/// kernel's image as its one output where it keeps raw goldens or its
-/// alpha; none for the seed's contract (judged by its PNG alone).
+/// A render's outputs as goldens see them: every one, except under the
+/// seed's contract (no tables, one rgba32float image whose view keeps its
+/// alpha), judged by its PNG alone.
 pub fn outputs_of<'a>(case: &Case, r: &'a Rendered) -> &'a [OutputRender] {
-    let seed_contract =
-        case.kernel.graph().is_none() && !(keeps_raw(&case.kernel, r.format) || case.kernel.opaque_display());
+    let seed_contract = !(keeps_raw(&case.kernel, r.format) || case.kernel.opaque_display());
     match seed_contract {
         true => &[],
         false => &r.outputs,

@@ -56,7 +56,7 @@ pub struct Checked {
 /// read says so (the render refuses it before this is asked).
 pub fn inputs_of(case: &Case, root: Option<&std::path::Path>) -> Vec<(String, String, Option<Image>)> {
     use vista_kernels::graph::ResourceKind;
-    let Some(g) = case.kernel.graph() else { return Vec::new() };
+    let g = case.kernel.graph();
     let mut out = Vec::new();
     for r in &g.resources {
         let replaced = case.inputs.iter().find(|(n, _)| *n == r.name).map(|(_, f)| f.clone());
@@ -166,7 +166,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     // Hashed once: at 1920 x 1080 each pass over the raw bits costs ~0.1 s.
     let raw_hash = r.raw.content_hash();
     let actual = quantize16(r.display());
-    let deterministic = case.kernel.graph().is_none_or(|g| g.deterministic);
+    let deterministic = case.kernel.graph().deterministic;
     let gathered = (|| -> Result<_, String> {
         let repeat_identical = match opts.twice && deterministic && !as_blessed(entry, &run, &raw_hash) {
             true => Some(same_render(&render_case(ctx, case).map_err(|e| e.to_string())?, &r)),

@@ -120,18 +120,6 @@ pub fn undecorate(name: &str) -> (String, Option<String>) {
     }
 }
 
-/// The storage texture a pass writes, as [`reflect`] found it (it refuses
-/// a pass without one).
-pub fn output(bindings: &[Binding]) -> (&Binding, Storage) {
-    bindings
-        .iter()
-        .find_map(|b| match b.feed {
-            Feed::Output(storage) => Some((b, storage)),
-            _ => None,
-        })
-        .expect("bindings::reflect refuses a pass without an output")
-}
-
 /// A WGSL spelling of a global's type, for messages.
 pub fn wgsl_type(module: &naga::Module, var: &naga::GlobalVariable) -> String {
     let ty = &module.types[var.ty];
@@ -310,45 +298,5 @@ pub fn reflect_all(kernel: &str, shader: &str, entry: &str, module: &naga::Modul
         out.push(Binding { group: rb.group, binding: rb.binding, name, feed, global: g });
     }
     out.sort_by_key(|b| (b.group, b.binding));
-    Ok(out)
-}
-
-/// Every binding `entry` of `module` reaches on the one-pass path (SPEC
-/// 10): uniforms, the table and one written storage texture; any other
-/// reached global, a second output or none is refused, naming what would
-/// feed it.
-pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<Vec<Binding>, ParamError> {
-    let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
-    let out = reflect_all(kernel, shader, entry, module)?;
-    for b in &out {
-        let var = &module.global_variables[b.global];
-        let needs = match b.feed {
-            Feed::Uniform | Feed::Table | Feed::Output(_) => continue,
-            Feed::Buffer { .. } => "a buffer resource ([[resource]] kind = \"buffer\")",
-            Feed::StorageRead(_) | Feed::Sampled { .. } => "a texture resource ([[resource]] kind = \"texture\")",
-            Feed::Sampler { .. } => "a sampler resource ([[resource]] kind = \"sampler\")",
-        };
-        return Err(bad(format!(
-            "pass {entry}: {} (@group({}) @binding({}), {}) is fed by nothing; it needs {needs}, named in the pass's bind",
-            b.name,
-            b.group,
-            b.binding,
-            wgsl_type(module, var)
-        )));
-    }
-    let outputs: Vec<&Binding> = out.iter().filter(|b| matches!(b.feed, Feed::Output(_))).collect();
-    if let [first, second, ..] = outputs[..] {
-        return Err(bad(format!(
-            "pass {entry}: {} (@group({}) @binding({})) is a second output texture after {}; list both as \
-             [[output]] tables (a pass graph)",
-            second.name, second.group, second.binding, first.name
-        )));
-    }
-    if outputs.is_empty() {
-        return Err(bad(format!(
-            "pass {entry} of {shader} writes no storage texture (texture_storage_{{1d,2d,2d_array,3d}} with write or \
-             read_write access)"
-        )));
-    }
     Ok(out)
 }

@@ -2,10 +2,9 @@
 //! (with their files, inline data, fill and length), `[[pass]]` tables
 //! (entry, shader, bind, dispatch or workgroups, set, repeat, swap) and
 //! `[[output]]` tables (any texture or buffer a pass writes, with a view,
-//! `partial` and a tolerance). A manifest that uses any of these beyond a
-//! single pass writing one storage texture is a graph; the others keep the
-//! one-pass path of [`crate::resources`] (SPEC 14: "for today's kernels that
-//! equals section 10").
+//! `partial` and a tolerance). Every manifest is a graph: one without these
+//! tables is one pass (`main`) whose written storage texture is its one
+//! output (SPEC 14: "for today's kernels that equals section 10").
 //!
 //! Parsing checks everything that needs no shader; [`resolve`] then checks
 //! each pass against naga's reflection of its composed module and says what
@@ -246,8 +245,10 @@ impl Tolerance {
 /// One `[[output]]` table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputSpec {
-    /// The texture or buffer resource (one a pass writes) compared with its golden.
-    pub resource: String,
+    /// The texture or buffer resource (one a pass writes) compared with its
+    /// golden; `None` (a lone `[[output]]` without `resource`): the first
+    /// texture a pass writes, as without `[[output]]` tables.
+    pub resource: Option<String>,
     /// The PNG view of a texture (`view`; default: the manifest's `output`).
     pub view: Option<Output>,
     /// Whether texels no pass writes are allowed.
@@ -294,28 +295,6 @@ pub const PASS_KEYS: [&str; 11] =
 /// The keys of an `[[output]]` table.
 pub const OUTPUT_KEYS: [&str; 5] = ["resource", "view", "partial", "tolerance", "exposure"];
 
-/// Whether these tables need the graph path: more than one pass or output,
-/// a buffer or sampler, an input file or contents, or any part-2 key of a
-/// pass or output.
-pub(crate) fn is_graph(
-    resources: &[toml::Value],
-    passes: &[toml::Value],
-    outputs: &[toml::Value],
-    deterministic: Option<bool>,
-) -> bool {
-    let has = |t: &toml::Value, keys: &[&str]| t.as_table().is_some_and(|t| keys.iter().any(|k| t.contains_key(*k)));
-    passes.len() > 1
-        || outputs.len() > 1
-        || deterministic == Some(false)
-        || resources.iter().any(|r| {
-            has(r, &["file", "mip_levels", "data", "fill", "length", "filter", "address", "compare"])
-                || r.get("kind").and_then(|k| k.as_str()).is_some_and(|k| k != "texture")
-                || r.get("dimension").and_then(|k| k.as_str()) == Some("cube")
-        })
-        || passes.iter().any(|p| has(p, &["shader", "defs", "source", "dispatch", "set", "repeat", "swap", "group"]))
-        || outputs.iter().any(|o| has(o, &["tolerance"]))
-}
-
 fn valid_name(name: &str) -> bool {
     !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
@@ -346,7 +325,7 @@ pub(crate) fn parse(
         if let Some(o) = outs.iter().find(|o| o.tolerance.is_none()) {
             return Err(fail(format!(
                 "[[output]] {}: deterministic = false needs a tolerance on every output ({})",
-                o.resource,
+                o.resource.as_deref().unwrap_or("(the written texture)"),
                 Tolerance::KEYS[1..6].join(", ")
             )));
         }
@@ -717,10 +696,22 @@ fn parse_outputs(
                 return Err(fail(format!("[[output]]: unknown key {k}; allowed: {}", OUTPUT_KEYS.join(", "))));
             }
         }
-        let Some(resource) = t.get("resource").and_then(|v| v.as_str()) else {
-            return Err(fail("[[output]] needs resource = \"...\" (a texture or buffer a pass writes)".into()));
+        let resource = match t.get("resource") {
+            Some(toml::Value::String(r)) if !r.is_empty() => Some(r.as_str()),
+            // One output may leave it to the texture its pass writes.
+            None if outputs.len() == 1 => None,
+            _ => {
+                return Err(fail(
+                    "[[output]] needs resource = \"...\" (a texture or buffer a pass writes; only a lone [[output]] may \
+                     leave it out)"
+                        .into(),
+                ));
+            }
         };
-        let at = |m: String| fail(format!("[[output]] {resource}: {m}"));
+        let at = |m: String| match resource {
+            Some(r) => fail(format!("[[output]] {r}: {m}")),
+            None => fail(format!("[[output]]: {m}")),
+        };
         let view = match t.get("view") {
             None => default_view,
             Some(toml::Value::String(v)) => Some(match v.as_str() {
@@ -744,10 +735,10 @@ fn parse_outputs(
             Some(other) => return Err(at(format!("partial = {other} is not valid; expected true or false"))),
         };
         let tolerance = t.get("tolerance").map(parse_tolerance).transpose().map_err(at)?;
-        if outs.iter().any(|o: &OutputSpec| o.resource == resource) {
+        if outs.iter().any(|o: &OutputSpec| o.resource.as_deref() == resource) {
             return Err(at("is listed twice".into()));
         }
-        outs.push(OutputSpec { resource: resource.to_string(), view, partial, tolerance, exposure });
+        outs.push(OutputSpec { resource: resource.map(str::to_string), view, partial, tolerance, exposure });
     }
     Ok(outs)
 }
@@ -929,7 +920,7 @@ pub struct Element {
 }
 
 /// The graph's resources after reflection: the manifest's, then one
-/// implicit texture per write-only storage texture no `bind` names.
+/// implicit texture per written storage texture no `bind` names.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Resolved {
     /// The manifest's resources, then the implicit textures; [`SlotFeed::Resource`]
@@ -937,6 +928,10 @@ pub struct Resolved {
     pub resources: Vec<ResolvedResource>,
     /// Per pass, its slots (sorted by group and binding).
     pub slots: Vec<Vec<PassSlot>>,
+    /// The outputs' resources (indexes into `resources`), in `[[output]]`
+    /// order; without tables, or for a lone one without `resource`, the
+    /// first texture a pass writes.
+    pub outputs: Vec<usize>,
 }
 
 /// One resource with what reflection adds to its table.
@@ -1008,12 +1003,18 @@ pub fn resolve(
         let mut slots = Vec::new();
         let mut blocks = 0usize;
         for b in bindings.iter() {
-            // Bound by the pass's bind, else to the resource of its own name.
+            // Bound by the pass's bind, else to the resource of its own name
+            // unless the bind gives that resource to another variable (a
+            // uniform `sky` beside `bind = { sky_faces = "sky" }`).
             let given = pass.bind.iter().find(|(v, _)| *v == b.name).map(|(_, r)| r);
             let level = given.and_then(|r| r.level);
-            let bound = given
-                .map(|r| r.resource.clone())
-                .or_else(|| graph.resources.iter().find(|r| r.name == b.name).map(|r| r.name.clone()));
+            let bound = given.map(|r| r.resource.clone()).or_else(|| {
+                graph
+                    .resources
+                    .iter()
+                    .find(|r| r.name == b.name && !pass.bind.iter().any(|(_, l)| l.resource == r.name))
+                    .map(|r| r.name.clone())
+            });
             let bound = bound.as_deref();
             let feed = match (b.feed, bound) {
                 (Feed::Uniform, None) => {
@@ -1104,13 +1105,38 @@ pub fn resolve(
         check_levels(&slots, &resources, &label, &bad)?;
         all_slots.push(slots);
     }
-    check_swaps_and_outputs(graph, &resources, &bad)?;
-    Ok(Resolved { resources, slots: all_slots })
+    let outputs = check_swaps_and_outputs(graph, &resources, &bad)?;
+    if graph.outputs.iter().all(|o| o.resource.is_none()) {
+        // Two textures written and never read: which one is the output?
+        let mut only_written = (0..resources.len())
+            .filter(|&r| resources[r].written && !resources[r].read && kind_of(&resources, r) == "texture");
+        if let (Some(first), Some(second)) = (only_written.next(), only_written.next()) {
+            let (i, slot) = all_slots
+                .iter()
+                .enumerate()
+                .find_map(|(i, slots)| {
+                    slots.iter().find(|s| matches!(s.feed, SlotFeed::Resource(r, _) if r == second)).map(|s| (i, s))
+                })
+                .expect("a written resource has a slot");
+            return Err(bad(format!(
+                "pass {} ({}): {} (@group({}) @binding({})) is a second output texture after {}; list both as \
+                 [[output]] tables",
+                i + 1,
+                graph.passes[i].entry,
+                slot.var,
+                slot.group,
+                slot.binding,
+                resources[first].spec.name
+            )));
+        }
+    }
+    Ok(Resolved { resources, slots: all_slots, outputs })
 }
 
 /// A storage texture binding's feed: the resource bound to it (an unbound
-/// written variable gets an implicit texture of its own name), whose format
-/// and dimension it fixes and which it marks written or read.
+/// written or read_write variable gets an implicit texture of its own name,
+/// which a read_write one finds as zeros), whose format and dimension it
+/// fixes and which it marks written or read.
 fn storage_slot(
     resources: &mut Vec<ResolvedResource>,
     storage: Storage,
@@ -1122,7 +1148,7 @@ fn storage_slot(
 ) -> Result<SlotFeed, ParamError> {
     let ri = match bound {
         Some(r) => find(resources, r),
-        None if storage.access == Access::Write => {
+        None if storage.access != Access::Read => {
             // Implicit: one resource per unbound written variable.
             match resources.iter().position(|r| r.spec.name == b.name) {
                 Some(ri) => ri,
@@ -1248,12 +1274,12 @@ fn needs_kind(
 }
 
 /// Swapped resources are alike; every output names a resource some pass
-/// writes (or swaps).
+/// writes (or swaps). Returns the outputs' resources ([`Resolved::outputs`]).
 fn check_swaps_and_outputs(
     graph: &GraphSpec,
     resources: &[ResolvedResource],
     bad: &dyn Fn(String) -> ParamError,
-) -> Result<(), ParamError> {
+) -> Result<Vec<usize>, ParamError> {
     for (i, pass) in graph.passes.iter().enumerate() {
         for (a, b) in &pass.swap {
             let (ra, rb) = (
@@ -1269,25 +1295,33 @@ fn check_swaps_and_outputs(
             }
         }
     }
+    let mut outputs = Vec::new();
     for o in &graph.outputs {
-        let Some(r) = resources.iter().find(|r| r.spec.name == o.resource) else {
+        let Some(name) = &o.resource else { continue };
+        let Some(ri) = resources.iter().position(|r| &r.spec.name == name) else {
             let n: Vec<&str> = resources.iter().map(|r| r.spec.name.as_str()).collect();
             return Err(bad(format!(
-                "[[output]] resource = \"{}\" names no resource; resources: {}",
-                o.resource,
+                "[[output]] resource = \"{name}\" names no resource; resources: {}",
                 n.join(", ")
             )));
         };
-        let swapped = graph.passes.iter().any(|p| p.swap.iter().any(|(a, b)| *a == o.resource || *b == o.resource));
+        let r = &resources[ri];
+        let swapped = graph.passes.iter().any(|p| p.swap.iter().any(|(a, b)| a == name || b == name));
         if r.spec.kind_name() == "sampler" || !(r.written || swapped) {
             return Err(bad(format!(
-                "[[output]] resource = \"{}\" is not written by any pass (a {}); an output is a texture or buffer a pass writes",
-                o.resource,
+                "[[output]] resource = \"{name}\" is not written by any pass (a {}); an output is a texture or buffer a pass writes",
                 r.spec.kind_name()
             )));
         }
+        outputs.push(ri);
     }
-    Ok(())
+    if graph.outputs.iter().all(|o| o.resource.is_none()) {
+        // No [[output]] tables, or a lone one without `resource`.
+        let first = resources.iter().position(|r| r.written && r.spec.kind_name() == "texture");
+        outputs
+            .push(first.ok_or_else(|| bad("no pass writes a texture; name the outputs in [[output]] tables".into()))?);
+    }
+    Ok(outputs)
 }
 
 fn find(resources: &[ResolvedResource], name: &str) -> usize {

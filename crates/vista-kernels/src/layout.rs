@@ -86,19 +86,6 @@ pub struct UniformLayout {
     pub bindings: Vec<crate::bindings::Binding>,
     /// The module's `override` constants by name (a param may feed one).
     pub overrides: Vec<String>,
-    /// The storage texture the pass writes, and its resource
-    /// ([`Kernel::layout`] applies the manifest's `bind`); none for a pass
-    /// of a graph (its resources are resolved by `graph::resolve`).
-    pub output: Option<crate::resources::Target>,
-}
-
-/// Reflects the uniform block of `module` for `kernel` (named in errors).
-pub fn reflect(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<UniformLayout, ParamError> {
-    let bindings = crate::bindings::reflect(kernel, shader, entry, module)?;
-    let mut l = blocks_of(kernel, shader, module, bindings)?;
-    let (out, storage) = crate::bindings::output(&l.bindings);
-    l.output = Some(crate::resources::Target { var: out.name.clone(), storage, resource: None });
-    Ok(l)
 }
 
 /// The uniform blocks among `bindings` (those fed by params), walked into
@@ -146,7 +133,7 @@ pub fn blocks_of(
         }
         blocks.push(Block { group: uniform.group, binding: uniform.binding, var: name, size });
     }
-    Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module), output: None })
+    Ok(UniformLayout { blocks, fields, uses_table, bindings, overrides: override_names(module) })
 }
 
 /// Names each leaf by the param that feeds it: a leaf inside a
@@ -359,14 +346,12 @@ fn leaf_type(module: &naga::Module, inner: &TypeInner) -> Result<FieldType, &'st
 /// `exposure`, or a name a `workgroups` or `size` expression reads.
 fn host_only(kernel: &Kernel, name: &str) -> bool {
     let m = &kernel.manifest;
-    let hdr = kernel.output() == crate::Output::Hdr
-        || m.graph.as_ref().is_some_and(|g| g.outputs.iter().any(|o| o.view == Some(crate::Output::Hdr)));
+    let hdr =
+        kernel.output() == crate::Output::Hdr || m.graph.outputs.iter().any(|o| o.view == Some(crate::Output::Hdr));
     (hdr && name == "exposure")
-        || m.workgroups.iter().flatten().any(|e| e.mentions(name))
-        || m.resources.iter().filter_map(|r| r.size.as_ref()).flatten().any(|e| e.mentions(name))
-        || m.graph.as_ref().is_some_and(|g| crate::graph::host_params(g).contains(&name))
+        || crate::graph::host_params(&m.graph).contains(&name)
         || m.source.params().contains(&name)
-        || m.graph.iter().flat_map(|g| &g.passes).any(|p| p.source.params().contains(&name))
+        || m.graph.passes.iter().any(|p| p.source.params().contains(&name))
 }
 
 /// The param feeding `f`, if any: one named by its `variable.path`, else
@@ -378,14 +363,6 @@ fn param_of<'k>(kernel: &'k Kernel, f: &Field) -> Option<&'k crate::ParamSpec> {
         .find(|s| s.name == f.qualified)
         .or_else(|| params.iter().find(|s| s.name == f.key))
         .or_else(|| params.iter().find(|s| s.name == f.name))
-}
-
-/// Refuses a layout that does not match the manifest: a field with no
-/// param, a param with no field, a bare param name that leaves of two
-/// uniforms share, or a type mismatch.
-pub fn check(kernel: &Kernel, layout: &UniformLayout) -> Result<(), ParamError> {
-    check_fields(kernel, layout)?;
-    check_params(kernel, &[layout])
 }
 
 /// Every leaf of `layout` has a param of its type (or is padding).
@@ -537,6 +514,11 @@ pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, h
 mod tests {
     use super::*;
 
+    /// The checked uniform layout of a one-pass kernel's module.
+    fn one_pass(k: &Kernel, m: &naga::Module) -> Result<UniformLayout, ParamError> {
+        k.graph_layouts(&[(k.shader(), m)]).map(|(_, mut l)| l.remove(0))
+    }
+
     const MANIFEST: &str = r#"summary = "nested"
 [[param]]
 name = "pos"
@@ -580,7 +562,7 @@ default = -3
             "struct Camera { pos: vec3<f32>, fov: f32 }\n\
              struct Params { width: u32, height: u32, camera: Camera, mode: u32, flip: u32, shift: i32 }",
         );
-        let layout = k.layout(&m).unwrap();
+        let layout = one_pass(&k, &m).unwrap();
         let at = |n: &str| layout.fields.iter().find(|f| f.name == n).map(|f| (f.path.clone(), f.offset)).unwrap();
         // vec3 aligns to 16: camera starts at 16, fov packs into pos's padding.
         assert_eq!(at("pos"), ("camera.pos".to_string(), 16));
@@ -601,17 +583,17 @@ default = -3
     fn duplicate_leaf_names_and_unsupported_types_are_refused() {
         let k = Kernel::from_manifest("nested", "nested.toml", MANIFEST).unwrap();
         let m = module("struct A { fov: f32 }\nstruct Params { width: u32, height: u32, a: A, fov: f32 }");
-        let e = k.layout(&m).unwrap_err().to_string();
+        let e = one_pass(&k, &m).unwrap_err().to_string();
         assert!(
             e.contains("param fov is ambiguous: 2 leaves share the name (params.a.fov, params.fov); name each by its full path: \
                         params.a.fov or params.fov"),
             "{e}"
         );
         let m = module("struct Params { width: u32, height: u32, m: array<array<f32, 2>, 2> }");
-        let e = k.layout(&m).unwrap_err().to_string();
+        let e = one_pass(&k, &m).unwrap_err().to_string();
         assert!(e.contains("Params field m is an array of arrays"), "{e}");
         let m = module("struct Params { width: u32, height: f32 }");
-        let e = k.layout(&m).unwrap_err().to_string();
+        let e = one_pass(&k, &m).unwrap_err().to_string();
         assert!(e.contains("Params field height is WGSL f32 but the image size is u32"), "{e}");
     }
 
@@ -636,13 +618,13 @@ default = -2.5
         let structs = "struct Cam { inv_proj: f32 }\nstruct View { cam: Cam }\nstruct Ocean { view: View }\n\
                        struct Params { width: u32, height: u32, camera: Cam, ocean: Ocean }";
         let k = Kernel::from_manifest("twins", "twins.toml", TWINS).unwrap();
-        let layout = k.layout(&module(structs)).unwrap();
+        let layout = one_pass(&k, &module(structs)).unwrap();
         let b = k.uniforms(&layout, &k.resolve(None, &[]).unwrap(), 1, 1).remove(0);
         let f = |o: usize| f32::from_le_bytes(b[o..o + 4].try_into().unwrap());
         assert_eq!((f(8), f(12)), (1.5, -2.5), "each leaf its own param");
         let bare = TWINS.replace("params.camera.inv_proj", "inv_proj");
         let k = Kernel::from_manifest("twins", "twins.toml", &bare).unwrap();
-        let e = k.layout(&module(structs)).unwrap_err().to_string();
+        let e = one_pass(&k, &module(structs)).unwrap_err().to_string();
         assert!(
             e.contains(
                 "param inv_proj is ambiguous: 2 leaves share the name (params.camera.inv_proj, \
@@ -688,7 +670,7 @@ default = [1, 0, 0, 0, 1, 0, 0, 0, -1]
             "struct Params { width: u32, height: u32, view: mat4x4<f32>, res: vec2<u32>, _pad0: u32, \
              weights: array<vec4<f32>, 2>, offs: vec3<i32>, rot: mat3x3<f32>, _pad1: vec4<f32> }",
         );
-        let layout = k.layout(&m).unwrap();
+        let layout = one_pass(&k, &m).unwrap();
         let p = k.resolve(None, &[("res".into(), "1920,1080".into())]).unwrap();
         let b = k.uniforms(&layout, &p, 3, 2).remove(0);
         let word = |o: u32| u32::from_le_bytes(b[o as usize..o as usize + 4].try_into().unwrap());
@@ -706,7 +688,7 @@ default = [1, 0, 0, 0, 1, 0, 0, 0, -1]
             "struct Params { width: u32, height: u32, view: mat4x4<f32>, res: vec2<i32>, \
                         weights: array<vec4<f32>, 2>, offs: vec3<i32>, rot: mat3x3<f32> }",
         );
-        let e = k.layout(&m).unwrap_err().to_string();
+        let e = one_pass(&k, &m).unwrap_err().to_string();
         assert!(
             e.contains("Params field res is WGSL vec2<i32> but leaves.toml declares param res as vec2<u32>"),
             "{e}"
@@ -737,7 +719,7 @@ default = [7, 8]
             "struct Light { pos: vec3<f32>, power: f32 }\n\
              struct Params { width: u32, height: u32, lights: array<Light, 2> }",
         );
-        let layout = k.layout(&m).unwrap();
+        let layout = one_pass(&k, &m).unwrap();
         let b = k.uniforms(&layout, &k.resolve(None, &[]).unwrap(), 3, 2).remove(0);
         let f = |o: usize| f32::from_le_bytes(b[o..o + 4].try_into().unwrap());
         // The array starts at 16; each Light is 16 bytes: pos, then power in its padding.

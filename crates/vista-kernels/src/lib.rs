@@ -83,7 +83,6 @@ pub mod manifest;
 pub mod noise;
 pub mod params;
 pub mod phase;
-pub mod resources;
 pub mod ridged;
 pub mod values;
 
@@ -353,35 +352,9 @@ impl Kernel {
     pub fn shader(&self) -> &str {
         &self.manifest.shader
     }
-    /// The compute entry point (`[[pass]] entry`, default `main`).
-    pub fn entry(&self) -> &str {
-        &self.manifest.entry
-    }
     /// Whether texels the kernel leaves unwritten are allowed (`[[output]] partial`).
     pub fn partial(&self) -> bool {
-        match self.graph() {
-            Some(g) => g.outputs.first().is_some_and(|o| o.partial),
-            None => self.manifest.partial,
-        }
-    }
-    /// The manifest's explicit workgroup count for these params and size
-    /// (`[[pass]] workgroups`), or `None`: cover the output with the
-    /// shader's own workgroup size. Each count must be in [1, 65535].
-    pub fn workgroups(&self, p: &ParamSet, width: u32, height: u32) -> Result<Option<[u32; 3]>, ParamError> {
-        let Some(exprs) = &self.manifest.workgroups else { return Ok(None) };
-        let mut out = [0u32; 3];
-        for (i, e) in exprs.iter().enumerate() {
-            let fail = |message: String| ParamError::Manifest {
-                file: self.origin.to_string(),
-                message: format!("kernel {}: [[pass]] workgroups[{i}] {message}", self.name()),
-            };
-            let v = e.eval(p, width, height).map_err(&fail)?;
-            out[i] = u32::try_from(v)
-                .ok()
-                .filter(|v| (1..=65535).contains(v))
-                .ok_or_else(|| fail(format!("is {v} for these params; allowed: [1, 65535]")))?;
-        }
-        Ok(Some(out))
+        self.graph().outputs.first().is_some_and(|o| o.partial)
     }
     /// The PNG view the manifest gives (default display).
     pub fn output(&self) -> Output {
@@ -391,7 +364,7 @@ impl Kernel {
     /// normalize for an integer format and display otherwise.
     pub fn view(&self, format: &str) -> Output {
         // A graph's first output may say its own view.
-        match self.graph().and_then(|g| g.outputs.first()).and_then(|o| o.view) {
+        match self.graph().outputs.first().and_then(|o| o.view) {
             Some(v) => v,
             None => self.default_view(format),
         }
@@ -432,7 +405,7 @@ impl Kernel {
 
     /// The display map of an output of `format` (see [`Kernel::view`]).
     pub fn display_map_of(&self, p: &ParamSet, format: &str) -> DisplayMap {
-        self.display_map_with(p, self.view(format), format, self.manifest.output_exposure)
+        self.display_map_with(p, self.view(format), format, self.graph().outputs.first().and_then(|o| o.exposure))
     }
 
     /// The display map of an output of `format` shown with `view` (a graph
@@ -552,16 +525,13 @@ impl Kernel {
     /// How pass `i`'s text is assembled: the kernel's `[source]` with the
     /// pass's `source` keys over it.
     pub fn source_for(&self, i: usize) -> vista_source::SourceSpec {
-        match self.graph() {
-            Some(g) => self.manifest.source.merged(&g.passes[i].source),
-            None => self.manifest.source.clone(),
-        }
+        self.manifest.source.merged(&self.graph().passes[i].source)
     }
 
     /// Every distinct assembly the kernel's passes use, by
     /// [`vista_source::SourceSpec::id`] (none without `[source]`).
     pub fn source_specs(&self) -> Vec<(String, vista_source::SourceSpec)> {
-        let n = self.graph().map_or(1, |g| g.passes.len());
+        let n = self.graph().passes.len();
         let mut out: Vec<(String, vista_source::SourceSpec)> = Vec::new();
         for spec in (0..n).map(|i| self.source_for(i)).filter(|s| !s.is_empty()) {
             let id = spec.id();
@@ -576,10 +546,9 @@ impl Kernel {
     /// a `[source]` assembles it ([`Kernel::source_specs`]). The shader
     /// hash and per-file hashes are taken over these.
     pub fn shader_units(&self) -> Vec<String> {
-        let n = self.graph().map_or(1, |g| g.passes.len());
         let mut out: Vec<String> = Vec::new();
-        for i in 0..n {
-            let file = self.graph().and_then(|g| g.passes[i].shader.as_deref()).unwrap_or(self.shader());
+        for (i, pass) in self.graph().passes.iter().enumerate() {
+            let file = pass.shader.as_deref().unwrap_or(self.shader());
             let spec = self.source_for(i);
             let unit = if spec.is_empty() { file.to_string() } else { format!("{file}|{}", spec.id()) };
             if !out.contains(&unit) {
@@ -654,9 +623,8 @@ impl Kernel {
     /// Every kernel file the kernel's passes use (without defs), the
     /// manifest's first.
     pub fn shader_files(&self) -> Vec<&str> {
-        let Some(g) = self.graph() else { return vec![self.shader()] };
         let mut out: Vec<&str> = Vec::new();
-        for p in &g.passes {
+        for p in &self.graph().passes {
             let s = p.shader.as_deref().unwrap_or(self.shader());
             if !out.contains(&s) {
                 out.push(s);
@@ -670,9 +638,11 @@ impl Kernel {
         &self.manifest.overrides
     }
 
-    /// The pass graph, for a manifest that has one (SPEC 14 part 2).
-    pub fn graph(&self) -> Option<&graph::GraphSpec> {
-        self.manifest.graph.as_ref()
+    /// The pass graph (SPEC 14): a manifest without `[[pass]]`,
+    /// `[[resource]]` or `[[output]]` tables is one pass (`main`) whose
+    /// written storage texture is its one output.
+    pub fn graph(&self) -> &graph::GraphSpec {
+        &self.manifest.graph
     }
 
     /// Whether the manifest describes its own resources, passes or outputs
@@ -685,9 +655,9 @@ impl Kernel {
     /// The file of graph pass `i` as composed for `p`: its `shader` (else
     /// the manifest's) with the defs of [`Kernel::shader_for`].
     pub fn pass_shader_for(&self, i: usize, p: &ParamSet) -> String {
-        let pass = self.graph().map(|g| &g.passes[i]);
-        let file = pass.and_then(|s| s.shader.as_deref()).unwrap_or(self.shader());
-        self.with_defs(file, pass.map_or(&[], |s| s.defs.as_slice()), &self.source_for(i), p)
+        let pass = &self.graph().passes[i];
+        let file = pass.shader.as_deref().unwrap_or(self.shader());
+        self.with_defs(file, &pass.defs, &self.source_for(i), p)
     }
 
     /// Reflects every pass of the graph (`modules[i]`: pass i's composed
@@ -698,7 +668,7 @@ impl Kernel {
         &self,
         modules: &[(&str, &naga::Module)],
     ) -> Result<(graph::Resolved, Vec<UniformLayout>), ParamError> {
-        let g = self.graph().expect("a graph kernel");
+        let g = self.graph();
         let mut reflected = Vec::new();
         for ((shader, module), pass) in modules.iter().zip(&g.passes) {
             reflected.push(bindings::reflect_all(self.name(), shader, &pass.entry, module)?);
@@ -707,14 +677,15 @@ impl Kernel {
             modules.iter().zip(&reflected).map(|((s, m), b)| (*s, b.as_slice(), *m)).collect();
         let resolved = graph::resolve(self.name(), g, &passes)?;
         let mut layouts = Vec::new();
-        for (((shader, module), bindings), pass) in modules.iter().zip(reflected).zip(&g.passes) {
-            // Params feed the uniforms no `bind` names, and the table.
+        for (((shader, module), bindings), slots) in modules.iter().zip(reflected).zip(&resolved.slots) {
+            // Params feed the uniforms and the table that no resource feeds.
             let fed: Vec<bindings::Binding> = bindings
                 .into_iter()
                 .filter(|b| {
-                    matches!(b.feed, bindings::Feed::Uniform | bindings::Feed::Table)
-                        && !pass.bind.iter().any(|(v, _)| *v == b.name)
-                        && !g.resources.iter().any(|r| r.name == b.name)
+                    slots.iter().any(|s| {
+                        (s.group, s.binding) == (b.group, b.binding)
+                            && matches!(s.feed, graph::SlotFeed::Uniform(_) | graph::SlotFeed::Table)
+                    })
                 })
                 .collect();
             layouts.push((*shader, layout::blocks_of(self.name(), shader, module, fed)?));
@@ -786,26 +757,6 @@ impl Kernel {
             }
         }
         Ok(out)
-    }
-
-    /// Reflects and checks the uniform layout of this kernel's composed module.
-    pub fn layout(&self, module: &naga::Module) -> Result<UniformLayout, ParamError> {
-        let mut l = layout::reflect(self.name(), self.shader(), self.entry(), module)?;
-        // A group that names no struct field first: its leaves would
-        // otherwise look like ungrouped leaves sharing names.
-        layout::check_groups(self, &[&l])?;
-        layout::name_leaves(self, &mut l);
-        layout::check(self, &l)?;
-        let m = &self.manifest;
-        let declared = resources::Declared {
-            name: &m.name,
-            entry: &m.entry,
-            resources: &m.resources,
-            bind: &m.bind,
-            output_resource: m.output_resource.as_deref(),
-        };
-        l.output = Some(resources::resolve(&declared, &l.bindings, module)?);
-        Ok(l)
     }
 
     /// Each uniform block's bytes for `p` at `width` x `height`, in

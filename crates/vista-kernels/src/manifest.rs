@@ -16,17 +16,17 @@
 //!                                  # or an integer: every such call samples that fixed z
 //! specialize = ["basis"]           # optional: enum params fixed when the shader is composed
 //!                                  # (naga_oil def BASIS_IS_PERLIN etc.; one pipeline per value)
-//! [[resource]]                     # SPEC 14, so far the output texture (resources.rs)
+//! [[resource]]                     # SPEC 14 (graph.rs): textures, buffers, samplers
 //! name = "sky"
 //! kind = "texture"
 //! format = "rgba16float"           # optional; must match the binding
 //! dimension = "2d-array"           # 1d | 2d | 2d-array | 3d; must match the binding
 //! size = ["width", "width", 6]     # numbers, params, width, height, + - * /, ceil_div(a, b)
-//! [[pass]]                         # one so far
+//! [[pass]]                         # any number; none: one pass, entry main
 //! entry = "bake_faces"             # default main
 //! workgroups = [1, 1, 6]           # optional: else the output covered with the reflected size
 //! bind = { sky_faces = "sky" }     # WGSL variable -> resource
-//! [[output]]                       # one so far
+//! [[output]]                       # any number; none: the texture the pass writes
 //! resource = "sky"                 # a resource, or the WGSL variable of the written texture
 //! view = "hdr"                     # as output = "..."
 //! partial = false                  # true: unwritten texels allowed
@@ -68,9 +68,11 @@ struct RawManifest {
     shader: Option<String>,
     /// `output = "display" | "hdr"` (SPEC 10), or `[[output]]` tables (SPEC 14).
     output: Option<toml::Value>,
+    /// Deserialized for its keys only; graph.rs reads the values.
     #[serde(default, rename = "pass")]
+    #[allow(dead_code)]
     passes: Vec<RawPass>,
-    /// `[[resource]]` tables (SPEC 14): so far the output texture.
+    /// `[[resource]]` tables (SPEC 14), read by graph.rs.
     #[serde(default, rename = "resource")]
     resources: Vec<toml::Value>,
     /// `false`: no render-twice check; every output needs a tolerance.
@@ -102,12 +104,11 @@ struct RawManifest {
     preset: toml::Table,
 }
 
-/// A `[[pass]]` table. One pass with `entry`, `workgroups` and `bind`
-/// only is the one-pass path; the other keys make a graph (`graph.rs`,
-/// which checks their values).
+/// A `[[pass]]` table: its keys checked here, their values by graph.rs,
+/// which reads them from the TOML.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[allow(dead_code)] // the graph keys are read by graph.rs from the TOML
+#[allow(dead_code)]
 struct RawPass {
     entry: Option<String>,
     workgroups: Option<Vec<toml::Value>>,
@@ -127,7 +128,7 @@ struct RawPass {
 /// An `[[output]]` table.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[allow(dead_code)] // tolerance is read by graph.rs
+#[allow(dead_code)] // the values are read by graph.rs
 struct RawOutput {
     resource: Option<String>,
     view: Option<String>,
@@ -227,23 +228,9 @@ pub struct Manifest {
     pub output: Option<Output>,
     /// `display_alpha = "opaque"`: display alpha is forced to 1 (the RGB is already composited).
     pub opaque_display: bool,
-    /// The compute entry point (`[[pass]] entry`, default `main`).
-    pub entry: String,
-    /// An explicit workgroup count (`[[pass]] workgroups`), else the plan
-    /// covers the output with the reflected workgroup size.
-    pub workgroups: Option<[crate::expr::Expr; 3]>,
-    /// Texels the kernel leaves unwritten are allowed (`[[output]] partial`).
-    pub partial: bool,
-    /// `[[resource]]` tables: so far textures, the output among them.
-    pub resources: Vec<crate::resources::TextureResource>,
-    /// The pass's `bind`: WGSL variable name -> resource name.
-    pub bind: Vec<(String, String)>,
-    /// `[[output]] resource`: a resource's name or the WGSL variable.
-    pub output_resource: Option<String>,
-    /// A pass graph (SPEC 14 part 2), where the manifest has one; then
-    /// `entry`, `workgroups`, `resources`, `bind` and `output_resource`
-    /// are unused (the first pass's entry is kept for messages).
-    pub graph: Option<crate::graph::GraphSpec>,
+    /// The pass graph (SPEC 14): resources, passes, outputs. A manifest
+    /// without those tables is one pass (`main`) writing one texture.
+    pub graph: crate::graph::GraphSpec,
     /// The manifest has `[[pass]]`, `[[resource]]` or `[[output]]` tables
     /// (SPEC 14): it describes its own resources instead of following the
     /// seed's contract.
@@ -251,9 +238,6 @@ pub struct Manifest {
     /// naga_oil shader defs (`defs = { MAX_LIGHTS = 10, FIRST_PASS = true }`),
     /// as `NAME=value` in declaration order.
     pub defs: Vec<String>,
-    /// The hdr view's exposure from the one-pass kernel's `[[output]]`
-    /// table (default 1; an `exposure` param wins).
-    pub output_exposure: Option<f64>,
     /// The kernel's `[source]`: how its shaders' text is assembled (a
     /// pass's `source` merges over it).
     pub source: vista_source::SourceSpec,
@@ -308,11 +292,8 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let doc: toml::Table = toml::from_str(text).map_err(|e| fail(vista_project::one_line_toml_error(text, &e)))?;
     let tables = |k: &str| doc.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
     let (pass_tables, output_tables) = (tables("pass"), tables("output"));
-    let is_graph = crate::graph::is_graph(&raw.resources, &pass_tables, &output_tables, raw.deterministic);
     let describes_resources = !pass_tables.is_empty() || !raw.resources.is_empty() || !output_tables.is_empty();
-
-    let OneOutput { view: output, partial, resource: output_resource, exposure: output_exposure } =
-        parse_output(raw.output.as_ref(), is_graph, &kfail)?;
+    let output = parse_view(raw.output.as_ref(), &kfail)?;
     let opaque_display = match raw.display_alpha.as_deref() {
         None | Some("keep") => false,
         Some("opaque") => true,
@@ -354,57 +335,8 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
             _ => return Err(kfail(format!("specialize = [\"{n}\"]: \"{n}\" must name an enum param"))),
         }
     }
-    let graph = match is_graph {
-        true => Some(crate::graph::parse(
-            &raw.resources,
-            &pass_tables,
-            &output_tables,
-            raw.deterministic,
-            output,
-            &params,
-            &kfail,
-        )?),
-        false => None,
-    };
-    let pass = if is_graph { None } else { raw.passes.first() };
-    let entry = match &graph {
-        Some(g) => g.passes[0].entry.clone(),
-        None => pass.and_then(|p| p.entry.clone()).unwrap_or_else(|| "main".into()),
-    };
-    if entry.is_empty() || !entry.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-        return Err(kfail(format!("[[pass]] entry = \"{entry}\" is not a WGSL function name")));
-    }
-    let workgroups = match pass.and_then(|p| p.workgroups.as_ref()) {
-        None => None,
-        Some(list) if list.len() == 3 => {
-            let mut out = Vec::new();
-            for v in list {
-                out.push(
-                    crate::expr::Expr::parse_entry(v, &params)
-                        .map_err(|e| kfail(format!("[[pass]] workgroups {e}")))?,
-                );
-            }
-            let [x, y, z]: [crate::expr::Expr; 3] = out.try_into().expect("three entries");
-            Some([x, y, z])
-        }
-        Some(list) => {
-            return Err(kfail(format!("[[pass]] workgroups has {} entries; expected [x, y, z]", list.len())));
-        }
-    };
-    let (resources, bind) = match is_graph {
-        true => (Vec::new(), Vec::new()),
-        false => crate::resources::parse(&raw.resources, pass.and_then(|p| p.bind.as_ref()), &params, &kfail)?,
-    };
-    if let Some(named) = &output_resource
-        && !resources.is_empty()
-        && !resources.iter().any(|r| &r.name == named)
-    {
-        let names: Vec<&str> = resources.iter().map(|r| r.name.as_str()).collect();
-        return Err(kfail(format!(
-            "[[output]] resource = \"{named}\" names no resource; resources: {}",
-            names.join(", ")
-        )));
-    }
+    let graph =
+        crate::graph::parse(&raw.resources, &pass_tables, &output_tables, raw.deterministic, output, &params, &kfail)?;
     let defs = parse_defs(&raw.defs).map_err(kfail)?;
     let source = match &raw.source {
         Some(t) => vista_source::SourceSpec::parse(t).map_err(kfail)?,
@@ -412,7 +344,7 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     };
     let overrides = parse_overrides(&raw.overrides).map_err(kfail)?;
     let groups = parse_groups(&raw.groups, &kfail)?;
-    let pass_sources = graph.iter().flat_map(|g| g.passes.iter().map(|p| &p.source));
+    let pass_sources = graph.passes.iter().map(|p| &p.source);
     check_replacements(std::iter::once(&source).chain(pass_sources), &params).map_err(kfail)?;
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
     Ok(Manifest {
@@ -421,16 +353,9 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
         shader,
         output,
         opaque_display,
-        entry,
-        workgroups,
-        partial,
-        resources,
-        bind,
-        output_resource,
         graph,
         describes_resources,
         defs,
-        output_exposure,
         source,
         overrides,
         work,
@@ -445,67 +370,31 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     })
 }
 
-/// The one-pass kernel's output: `output = "display"|"hdr"|"normalize"`,
-/// or its one `[[output]]` table (a graph's are `graph.rs`'s).
-#[derive(Default)]
-struct OneOutput {
-    view: Option<Output>,
-    partial: bool,
-    resource: Option<String>,
-    exposure: Option<f64>,
-}
-
-fn parse_output(
+/// The manifest's view: `output = "display"|"hdr"|"normalize"`; `None`
+/// for `[[output]]` tables (their keys checked here, their values by
+/// `graph.rs`) or no `output`.
+fn parse_view(
     output: Option<&toml::Value>,
-    is_graph: bool,
     kfail: &dyn Fn(String) -> ParamError,
-) -> Result<OneOutput, ParamError> {
-    let view = |v: &str| match v {
-        "display" => Ok(Output::Display),
-        "hdr" => Ok(Output::Hdr),
-        "normalize" => Ok(Output::Normalize),
-        other => Err(kfail(format!("output view \"{other}\" is not valid; expected display|hdr|normalize"))),
-    };
-    Ok(match output {
-        None => OneOutput::default(),
-        Some(toml::Value::String(s)) => OneOutput { view: Some(view(s)?), ..Default::default() },
-        Some(toml::Value::Array(tables)) if is_graph => {
+) -> Result<Option<Output>, ParamError> {
+    match output {
+        None => Ok(None),
+        Some(toml::Value::Array(tables)) => {
             for t in tables {
                 RawOutput::deserialize(t.clone()).map_err(|e| kfail(format!("[[output]]: {e}")))?;
             }
-            OneOutput::default()
+            Ok(None)
         }
-        Some(toml::Value::Array(tables)) => {
-            if tables.len() != 1 {
-                return Err(kfail(format!(
-                    "{} [[output]] tables: one output (the kernel's storage texture) is supported so far",
-                    tables.len()
-                )));
-            }
-            let o = RawOutput::deserialize(tables[0].clone()).map_err(|e| kfail(format!("[[output]]: {e}")))?;
-            if let Some(r) = &o.resource
-                && r.is_empty()
-            {
-                return Err(kfail("[[output]] resource must name the kernel's storage texture".into()));
-            }
-            if let Some(e) = o.exposure
-                && !(e.is_finite() && e > 0.0)
-            {
-                return Err(kfail(format!("[[output]] exposure = {e} is not valid; expected a number > 0")));
-            }
-            OneOutput {
-                view: o.view.as_deref().map(view).transpose()?,
-                partial: o.partial,
-                resource: o.resource,
-                exposure: o.exposure,
-            }
-        }
+        Some(toml::Value::String(s)) => match s.as_str() {
+            "display" => Ok(Some(Output::Display)),
+            "hdr" => Ok(Some(Output::Hdr)),
+            "normalize" => Ok(Some(Output::Normalize)),
+            other => Err(kfail(format!("output view \"{other}\" is not valid; expected display|hdr|normalize"))),
+        },
         Some(other) => {
-            return Err(kfail(format!(
-                "output = {other} is not valid; expected \"display\", \"hdr\" or [[output]] tables"
-            )));
+            Err(kfail(format!("output = {other} is not valid; expected \"display\", \"hdr\" or [[output]] tables")))
         }
-    })
+    }
 }
 
 /// Each enum value's WGSL constant name and index.

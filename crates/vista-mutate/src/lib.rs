@@ -300,10 +300,8 @@ pub fn plan(
                 }
             }
         }
-        let roots: Vec<(&str, &str)> = match k.graph() {
-            Some(g) => g.passes.iter().map(|p| (p.shader.as_deref().unwrap_or(k.shader()), p.entry.as_str())).collect(),
-            None => vec![(k.shader(), k.entry())],
-        };
+        let roots: Vec<(&str, &str)> =
+            k.graph().passes.iter().map(|p| (p.shader.as_deref().unwrap_or(k.shader()), p.entry.as_str())).collect();
         let fns: Vec<(&str, mutants::Function)> = closure
             .iter()
             .flat_map(|f| mutants::functions(&f.text).into_iter().map(move |g| (f.rel.as_str(), g)))

@@ -94,7 +94,7 @@ pub(crate) fn plan_graph(
     width: u32,
     height: u32,
 ) -> Result<Plan, RenderError> {
-    let g = kernel.graph().expect("a graph kernel");
+    let g = kernel.graph();
     let bad = |m: String| RenderError::BadInput(format!("kernel {}: {m}", kernel.name()));
     let mut files = Vec::new();
     let mut modules = Vec::new();
@@ -112,7 +112,13 @@ pub(crate) fn plan_graph(
     let (resolved, layouts) = kernel.graph_layouts(&pairs).map_err(|e| RenderError::BadInput(e.to_string()))?;
     for (k, _) in kernel.manifest_overrides() {
         if !modules.iter().any(|m| m.overrides.iter().any(|(_, o)| o.name.as_deref() == Some(k))) {
-            return Err(bad(format!("overrides: {k} is an override of no pass's shader")));
+            let names: Vec<&str> =
+                modules.iter().flat_map(|m| m.overrides.iter().filter_map(|(_, o)| o.name.as_deref())).collect();
+            return Err(bad(format!(
+                "overrides: {k} is not an override of {}; their overrides: {}",
+                kernel.shader_files().join(" or "),
+                if names.is_empty() { "none".to_string() } else { names.join(", ") }
+            )));
         }
     }
     for (name, _) in inputs {
@@ -121,23 +127,14 @@ pub(crate) fn plan_graph(
             return Err(bad(format!("case inputs: {name} names no resource; resources: {}", names.join(", "))));
         }
     }
-    let outputs_named: Vec<String> = match g.outputs.is_empty() {
-        false => g.outputs.iter().map(|o| o.resource.clone()).collect(),
-        // No [[output]] tables: the first texture some pass writes.
-        true => resolved
-            .resources
-            .iter()
-            .find(|r| r.written && r.spec.kind_name() == "texture")
-            .map(|r| vec![r.spec.name.clone()])
-            .ok_or_else(|| bad("no pass writes a texture; name the outputs in [[output]] tables".into()))?,
-    };
     let at = Planning { root, kernel, p, inputs, width, height };
     let resources = resolved
         .resources
         .iter()
-        .map(|r| match &r.spec.kind {
+        .enumerate()
+        .map(|(ri, r)| match &r.spec.kind {
             ResourceKind::Texture { size, file, mip_levels, .. } => {
-                at.texture(r, size.as_deref(), file.as_ref(), *mip_levels, outputs_named.contains(&r.spec.name))
+                at.texture(r, size.as_deref(), file.as_ref(), *mip_levels, resolved.outputs.contains(&ri))
             }
             ResourceKind::Buffer { file, data, fill, length } => {
                 at.buffer(r, file.as_ref(), data.as_deref(), *fill, length.as_ref())
@@ -156,7 +153,7 @@ pub(crate) fn plan_graph(
     for (i, ((pass, slots), layout)) in g.passes.iter().zip(&resolved.slots).zip(&layouts).enumerate() {
         passes.push(at.pass(i, pass, slots, layout, &modules[i], &files[i], &resources, &resolved)?);
     }
-    let (outputs, output_ids) = at.outputs(&outputs_named, &resources, &resolved);
+    let (outputs, output_ids) = at.outputs(&resources, &resolved);
     Ok(Plan {
         kernel: kernel.name().to_string(),
         resources,
@@ -372,7 +369,7 @@ impl Planning<'_> {
         resolved: &vista_kernels::graph::Resolved,
     ) -> Result<vista_gpu::GraphPass, RenderError> {
         let (kernel, p, width, height) = (self.kernel, self.p, self.width, self.height);
-        let g = kernel.graph().expect("a graph kernel");
+        let g = kernel.graph();
         let bad = |m: String| self.bad(m);
         let index = |name: &str| resolved.resources.iter().position(|r| r.spec.name == name).expect("resolved");
         let label = format!("pass {} ({}, {})", i + 1, pass.entry, file);
@@ -487,19 +484,16 @@ impl Planning<'_> {
     /// The outputs as planned, and the resource each reads.
     fn outputs(
         &self,
-        named: &[String],
         resources: &[vista_gpu::Resource],
         resolved: &vista_kernels::graph::Resolved,
     ) -> (Vec<PlannedOutput>, Vec<usize>) {
         let (kernel, p) = (self.kernel, self.p);
-        let g = kernel.graph().expect("a graph kernel");
-        let outputs_named = named;
-        let index = |name: &str| resolved.resources.iter().position(|r| r.spec.name == name).expect("resolved");
+        let g = kernel.graph();
         let mut outputs = Vec::new();
-        let mut output_ids = Vec::new();
-        for name in outputs_named {
-            let r = index(name);
-            let spec = g.outputs.iter().find(|o| &o.resource == name);
+        for (i, &r) in resolved.outputs.iter().enumerate() {
+            // The i-th [[output]] table (a lone one may leave `resource` out).
+            let spec = g.outputs.get(i);
+            let name = resolved.resources[r].spec.name.clone();
             let kind = match &resources[r] {
                 vista_gpu::Resource::Texture(t) => {
                     let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.default_view(t.format));
@@ -514,14 +508,13 @@ impl Planning<'_> {
                 vista_gpu::Resource::Sampler(_) => unreachable!("resolve refuses a sampler output"),
             };
             outputs.push(PlannedOutput {
-                name: name.clone(),
+                name,
                 tolerance: spec.and_then(|o| o.tolerance),
                 partial: spec.is_some_and(|o| o.partial),
                 kind,
             });
-            output_ids.push(r);
         }
-        (outputs, output_ids)
+        (outputs, resolved.outputs.clone())
     }
 }
 

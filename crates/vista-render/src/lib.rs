@@ -13,7 +13,6 @@
 
 mod error;
 pub mod graph;
-mod one_pass;
 mod reflect;
 pub mod worker;
 
@@ -58,8 +57,8 @@ pub struct Rendered {
     pub unwritten: u64,
     /// The output's storage format (an integer one compares exactly).
     pub format: &'static str,
-    /// Every output, the first (the main image, [`MAIN_OUTPUT`] of a
-    /// one-pass kernel) included. A graph whose first output is a buffer
+    /// Every output, the first (the main image: for a manifest without
+    /// tables, the texture its pass writes) included. A graph whose first output is a buffer
     /// has an empty `raw` (0 x 0): its outputs say everything.
     pub outputs: Vec<OutputRender>,
     /// Wall time of each graph pass (all its repeats).
@@ -80,9 +79,6 @@ impl Rendered {
         self.display.get_or_init(|| self.to_display.apply(&self.raw)).as_ref().unwrap_or(&self.raw)
     }
 }
-
-/// The name a one-pass kernel's image has as an output.
-pub const MAIN_OUTPUT: &str = "image";
 
 /// Checks size and work bounds before any GPU work.
 pub fn check_request(
@@ -319,11 +315,7 @@ impl Sources {
 /// `vista list`.
 pub fn composes(shaders: &ShaderSet, kernel: &Kernel) -> Result<(), String> {
     let p = kernel.resolve(None, &[]).map_err(|e| e.to_string())?;
-    let names: Vec<String> = match kernel.graph() {
-        Some(g) => (0..g.passes.len()).map(|i| kernel.pass_shader_for(i, &p)).collect(),
-        None => vec![kernel.shader_for(&p)],
-    };
-    for name in names {
+    for name in (0..kernel.graph().passes.len()).map(|i| kernel.pass_shader_for(i, &p)) {
         if let Err(e) = shaders.compose(&name) {
             let text = e.to_string();
             let at = text.lines().find_map(|l| l.trim().strip_prefix("┌─ ")).map(str::trim);
@@ -390,7 +382,7 @@ pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, Str
 /// after every check that needs no device: size and work bounds, every
 /// pass's composition and reflection, its uniforms against the manifest,
 /// every input file (`inputs` replaces resource files for a case). A
-/// one-pass kernel is planned as a graph of one pass writing one texture.
+/// manifest without tables is a graph of one pass writing one texture.
 #[allow(clippy::too_many_arguments)]
 pub fn plan(
     shaders: &ShaderSet,
@@ -403,10 +395,7 @@ pub fn plan(
     limits: &RenderLimits,
 ) -> Result<Plan, RenderError> {
     check_request(kernel, p, width, height, limits)?;
-    match kernel.graph() {
-        Some(_) => graph::plan_graph(shaders, root, kernel, p, inputs, width, height),
-        None => one_pass::plan(shaders, kernel, p, width, height),
-    }
+    graph::plan_graph(shaders, root, kernel, p, inputs, width, height)
 }
 
 /// One output of a pass graph as read back.
