@@ -91,7 +91,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
             false => (store.golden_path(case), case.id.clone()),
         };
         // A pass graph's other files first: each atomic, named in the entry.
-        let extra = crate::outputs::golden_bytes(&store.dir, case, &key, crate::outputs::outputs_of(case, &r))?;
+        let extra = crate::outputs::golden_bytes(&store.dir, case, &key, &r.outputs)?;
         let (extra_hashes, extra_changed) = write_extra_files(&extra)?;
         let run = crate::RunInfo {
             backend: ctx.backend().to_string(),

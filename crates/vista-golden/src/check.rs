@@ -5,7 +5,6 @@
 //! `vista mutate` all judge with it.
 
 use std::collections::BTreeMap;
-use std::path::Path;
 
 use vista_image::Image;
 use vista_image::metrics::{self, Metrics};
@@ -250,30 +249,6 @@ impl Outcome {
     }
 }
 
-/// The golden as the caller read it.
-#[derive(Debug, Clone, Copy)]
-pub enum GoldenRead<'a> {
-    /// No file at `path`.
-    Missing {
-        /// Where the golden was looked for.
-        path: &'a Path,
-    },
-    /// The file, the short hash of its bytes and its decoded values, or
-    /// why they could not be decoded.
-    Present {
-        /// The golden file.
-        path: &'a Path,
-        /// Short hash of its bytes ([`short_hash_bytes`](crate::short_hash_bytes)).
-        hash: &'a str,
-        /// Its decoded values, or why they could not be decoded (a Git LFS
-        /// pointer, a bad PNG).
-        image: Result<&'a Image, &'a str>,
-    },
-    /// The case has no main image: a pass graph whose first output is a
-    /// buffer, judged by its outputs alone.
-    NoImage,
-}
-
 /// What a check observed of one case, gathered by the caller.
 #[derive(Debug, Clone, Copy)]
 pub struct Observed<'a> {
@@ -285,17 +260,13 @@ pub struct Observed<'a> {
     pub unwritten: u64,
     /// The output's storage format: an integer one compares exactly.
     pub format: &'a str,
-    /// Display values as a 16-bit PNG holds them (`vista_render::quantize16`).
-    pub actual: &'a Image,
     /// Whether a second render in this process was bit-identical; `None`
     /// when the case was rendered once.
     pub repeat_identical: Option<bool>,
     /// Hash of each WGSL file the kernel reaches now, by path.
     pub shader_files: &'a BTreeMap<String, String>,
-    /// The case's golden as the caller read it.
-    pub golden: GoldenRead<'a>,
-    /// A pass graph's outputs as compared with their goldens
-    /// (`outputs::compare_output`); empty for a one-pass kernel.
+    /// Every output as compared with its goldens
+    /// (`outputs::compare_output`), the main image first.
     pub outputs: &'a [crate::outputs::OutputVerdict],
     /// False for a kernel whose manifest says `deterministic = false`: no
     /// bit-identity with the bless-time render is asked.
@@ -419,98 +390,8 @@ fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut
     out.first_bad = first_bad;
     provenance(case, entry, obs, out);
     outputs_verdict(case, obs.outputs, out);
-    let (path, hash, expected) = match obs.golden {
-        GoldenRead::NoImage => return,
-        GoldenRead::Missing { path } => {
-            out.verdict = Verdict::Missing;
-            out.problems.push(format!(
-                "golden {} does not exist; render and review it, then create it with: {}",
-                path.display(),
-                case.bless_command()
-            ));
-            return;
-        }
-        GoldenRead::Present { path, hash, image } => (path, hash, image),
-    };
-    if let Some(e) = entry
-        && !e.golden_hash.is_empty()
-    {
-        if e.replacing.as_deref() == Some(hash) {
-            out.problems.push(format!(
-                "golden {} is the file an interrupted bless was replacing; finish it with: {}",
-                path.display(),
-                case.bless_command()
-            ));
-        } else if hash != e.golden_hash {
-            out.problems.push(format!(
-                "golden {} (hash {hash}) is not the file its manifest entry describes ({}): it was changed \
-                 outside vista bless; review it and re-bless: {}",
-                path.display(),
-                e.golden_hash,
-                case.bless_command()
-            ));
-        }
-    }
-    let expected = match expected {
-        Ok(image) => image,
-        Err(e) => {
-            out.verdict = Verdict::Error;
-            out.problems.push(e.to_string());
-            return;
-        }
-    };
-    let actual = obs.actual;
-    if (expected.width, expected.height) != (actual.width, actual.height) {
-        out.problems.push(format!(
-            "golden {} is {}x{} but the case renders {}x{}; re-bless if the size change is intended",
-            path.display(),
-            expected.width,
-            expected.height,
-            actual.width,
-            actual.height
-        ));
-        return;
-    }
-    // Ignored rectangles hold the golden's values on both sides, so they
-    // count as equal in every metric.
-    let masked;
-    let actual = match case.ignore.is_empty() {
-        true => actual,
-        false => {
-            let mut a = actual.clone();
-            let mut n = 0u64;
-            for &[x, y, w, h] in &case.ignore {
-                for yy in y..(y + h).min(a.height) {
-                    for xx in x..(x + w).min(a.width) {
-                        a.set(xx, yy, expected.get(xx, yy));
-                        n += 1;
-                    }
-                }
-            }
-            out.notes.push(format!("{n} pixels in {} ignore rectangles left out of the comparison", case.ignore.len()));
-            masked = a;
-            &masked
-        }
-    };
-    let mut m = match metrics::compare(expected, actual) {
-        Ok(m) => m,
-        Err(e) => {
-            out.verdict = Verdict::Error;
-            out.problems.push(e.to_string());
-            return;
-        }
-    };
-    m.nan = obs.raw.nonfinite_count();
-    // A graph's main image with a tolerance (its own, or exact for an
-    // integer format) is judged by it alone, in `outputs`; the metrics stay
-    // for the reader.
-    if obs.outputs.first().is_some_and(|o| o.by_tolerance) {
-        out.notes.push("the main image is judged by its output's tolerance instead of PSNR".into());
-        out.metrics = Some(m);
-        return;
-    }
-    thresholds(case, obs, &mut m, expected, actual, out);
-    out.metrics = Some(m);
+    // The main image's metrics are the case's.
+    out.metrics = obs.outputs.first().and_then(|o| o.metrics);
 }
 
 /// The run against the case's manifest entry: the driver (same or other
@@ -556,85 +437,9 @@ fn provenance(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &
     }
 }
 
-/// The main image's metrics against the case's thresholds: its bad-pixel
-/// budget or PSNR (of its raw values where they carry the verdict), the
-/// alpha a view keeps, SSIM and FLIP.
-fn thresholds(
-    case: &Case,
-    obs: &Observed,
-    m: &mut metrics::Metrics,
-    expected: &Image,
-    actual: &Image,
-    out: &mut Outcome,
-) {
-    // A case with a bad-pixel budget is judged by it instead of PSNR: a few
-    // pixels that flip far (a crest across drivers) pass, more do not.
-    let by_bad_pixels = case.max_bad_pixels.is_some() || case.max_bad_ratio.is_some();
-    if by_bad_pixels {
-        out.notes.push("judged by its bad-pixel budget (max_bad_pixels / max_bad_ratio) instead of PSNR".into());
-    } else if let Some(raw) = obs.outputs.first().filter(|o| o.by_raw).and_then(|o| o.raw_psnr) {
-        // Its raw values (the EXR golden) carry the PSNR verdict (a failure
-        // is the output's problem); the view's other metrics stay.
-        m.psnr = raw;
-    } else if m.psnr < out.psnr_threshold {
-        out.problems.push(format!(
-            "PSNR {} is below the threshold {:.1} dB",
-            metrics::format_psnr(m.psnr),
-            out.psnr_threshold
-        ));
-    }
-    // PSNR, SSIM and FLIP see RGB; a view that keeps the kernel's alpha
-    // (display_alpha = "keep") has it compared here, by the same threshold.
-    // An opaque view's alpha is the `alpha` output's (outputs.rs).
-    if !case.kernel.opaque_display() && !by_bad_pixels {
-        let alpha = alpha_psnr(expected, actual);
-        if alpha < out.psnr_threshold {
-            out.problems.push(format!(
-                "alpha PSNR {} is below the threshold {:.1} dB (the view's RGB: PSNR {})",
-                metrics::format_psnr(alpha),
-                out.psnr_threshold,
-                metrics::format_psnr(m.psnr)
-            ));
-        }
-    }
-    if let Some(t) = case.min_ssim
-        && m.ssim < t
-    {
-        out.problems.push(format!("SSIM {:.5} is below the threshold {t}", m.ssim));
-    }
-    if let (Some(t), Some(f)) = (case.max_flip, m.flip_mean)
-        && f > t
-    {
-        out.problems.push(format!("FLIP mean {f:.5} is above the threshold {t}"));
-    }
-    if let Some(t) = case.max_bad_pixels
-        && m.bad_pixels > t
-    {
-        out.problems.push(format!("{} bad pixels (> {BAD_PIXEL_LIMIT}) is above max_bad_pixels {t}", m.bad_pixels));
-    }
-    let pixels = obs.raw.width as f64 * obs.raw.height as f64;
-    if let Some(t) = case.max_bad_ratio
-        && pixels > 0.0
-        && m.bad_pixels as f64 / pixels > t
-    {
-        out.problems.push(format!(
-            "{} bad pixels are {:.5} of the image, above max_bad_ratio {t}",
-            m.bad_pixels,
-            m.bad_pixels as f64 / pixels
-        ));
-    }
-}
-
-/// PSNR (peak 1) of two views' alpha channels.
-fn alpha_psnr(a: &Image, b: &Image) -> f64 {
-    let n = a.data.len().max(1) as f64;
-    let mse: f64 = a.data.iter().zip(&b.data).map(|(x, y)| (x[3] as f64 - y[3] as f64).powi(2)).sum::<f64>() / n;
-    metrics::psnr_from_mse(mse, 1.0)
-}
-
-/// Folds a graph's output verdicts into the case's: a missing golden file
-/// makes the case missing, an unreadable one an error, a difference a
-/// failure; each output's summary is a note.
+/// Folds the output verdicts into the case's: a missing golden file makes
+/// the case missing, an unreadable one an error, a difference a failure;
+/// each output's notes, and the summary of one that passed, are notes.
 fn outputs_verdict(case: &Case, outputs: &[crate::outputs::OutputVerdict], out: &mut Outcome) {
     out.outputs = outputs.to_vec();
     for o in outputs {
@@ -647,6 +452,7 @@ fn outputs_verdict(case: &Case, outputs: &[crate::outputs::OutputVerdict], out: 
                 case.bless_command()
             ));
         }
+        out.notes.extend(o.notes.iter().cloned());
         if !o.errors.is_empty() {
             out.verdict = Verdict::Error;
             out.problems.extend(o.errors.iter().cloned());

@@ -3,21 +3,22 @@
 //! `<case>.npy`), the others add their name (`<case>.<output>.png`, ...).
 //! Textures keep their PNG view (what the report shows) and, beside it, raw
 //! values in EXR ([`keeps_raw`]); buffers are NumPy files. Each output is
-//! judged by its tolerance: exact (the default for integer formats and
-//! buffers), max_abs, max_rel, max_ulp, rmse or histogram_emd; a float
-//! texture without one by the case's PSNR thresholds on its raw values
-//! (on its view where it keeps no EXR). A one-pass kernel that keeps raw
-//! goldens is treated as a graph of one output ([`outputs_of`]), and so is
-//! one whose view is opaque while its alpha means something
-//! (`display_alpha = "opaque"`): its alpha is kept in `<case>.alpha.png`
-//! (16-bit gray) and judged by the case's PSNR threshold.
+//! judged by one procedure ([`compare_output`]): by its tolerance (exact,
+//! the default for integer formats and buffers, max_abs, max_rel,
+//! max_ulp, rmse or histogram_emd), else a float texture by the case's
+//! PSNR threshold on its raw values (on its view where it keeps no EXR),
+//! and every texture's view by the case's other thresholds. The first
+//! output is the case's main image. A view that is opaque while its alpha
+//! means something (`display_alpha = "opaque"`) keeps that alpha in
+//! `<case>.alpha.png` (16-bit gray), judged by the case's PSNR threshold.
 
 use std::path::{Path, PathBuf};
 
 use vista_image::Image;
+use vista_image::metrics::format_psnr;
 use vista_kernels::Kernel;
 use vista_kernels::graph::Tolerance;
-use vista_render::{OutputRender, OutputValue, Rendered, quantize16};
+use vista_render::{OutputRender, OutputValue, quantize16};
 
 use crate::Case;
 
@@ -61,6 +62,8 @@ pub struct GoldenFiles {
     pub paths: OutputFiles,
     /// What was found at each of `paths.all()`.
     pub found: Vec<(PathBuf, Found)>,
+    /// The PNG view decoded, once: the verdict and the report both read it.
+    decoded_view: std::sync::OnceLock<Result<Option<Image>, String>>,
 }
 
 impl GoldenFiles {
@@ -80,7 +83,12 @@ impl GoldenFiles {
                 (p.clone(), found)
             })
             .collect();
-        GoldenFiles { paths, found }
+        GoldenFiles { paths, found, decoded_view: Default::default() }
+    }
+
+    /// Golden files already read (tests hold them in memory).
+    pub fn of(paths: OutputFiles, found: Vec<(PathBuf, Found)>) -> GoldenFiles {
+        GoldenFiles { paths, found, decoded_view: Default::default() }
     }
 
     /// What was found at `path` (missing if it is not one of these files).
@@ -90,8 +98,18 @@ impl GoldenFiles {
 
     /// The PNG view's values, where there is one that decodes (the
     /// report shows it beside the render's).
-    pub fn view(&self) -> Option<Image> {
-        self.decode(self.paths.png.as_deref()?, vista_image::decode_png16).ok().flatten()
+    pub fn view(&self) -> Option<&Image> {
+        self.view_decoded().ok().flatten()
+    }
+
+    /// The PNG view decoded (once): `Ok(None)` when missing or when the
+    /// output has none.
+    fn view_decoded(&self) -> Result<Option<&Image>, String> {
+        let decoded = self.decoded_view.get_or_init(|| match self.paths.png.as_deref() {
+            Some(png) => self.decode(png, vista_image::decode_png16),
+            None => Ok(None),
+        });
+        decoded.as_ref().map(Option::as_ref).map_err(Clone::clone)
     }
 
     /// The decoded file at `path`: `Ok(None)` when missing, `Err` naming the
@@ -104,6 +122,13 @@ impl GoldenFiles {
         match self.at(path) {
             Found::Missing => Ok(None),
             Found::Unreadable(e) => Err(e.clone()),
+            // A Git LFS pointer where the golden should be: the clone lacks the file.
+            Found::Bytes(bytes) if bytes.starts_with(b"version https://git-lfs.github.com/spec/") => Err(format!(
+                "{} is a Git LFS pointer, not a {}: run `git lfs pull` (and `git lfs install` once) to fetch the \
+                 goldens",
+                path.display(),
+                path.extension().and_then(|e| e.to_str()).unwrap_or("golden file").to_ascii_uppercase()
+            )),
             Found::Bytes(bytes) => decode(path, bytes).map(Some).map_err(|e| e.to_string()),
         }
     }
@@ -145,17 +170,6 @@ pub fn keeps_raw(kernel: &Kernel, format: &str) -> bool {
     kernel.describes_resources() || format != "rgba32float"
 }
 
-/// A render's outputs as goldens see them: every one, except under the
-/// seed's contract (no tables, one rgba32float image whose view keeps its
-/// alpha), judged by its PNG alone.
-pub fn outputs_of<'a>(case: &Case, r: &'a Rendered) -> &'a [OutputRender] {
-    let seed_contract = !(keeps_raw(&case.kernel, r.format) || case.kernel.opaque_display());
-    match seed_contract {
-        true => &[],
-        false => &r.outputs,
-    }
-}
-
 /// The golden files of output `index` of `case` under `golden_dir`, for
 /// golden `key` (the case's id, or `<id>@<backend>` for a per-backend
 /// golden).
@@ -179,7 +193,8 @@ pub fn output_files(golden_dir: &Path, case: &Case, key: &str, index: usize, out
 /// One output's verdict.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct OutputVerdict {
-    /// The output's name (`image` for a one-pass kernel's main image).
+    /// The output's name: its resource's (the WGSL variable of an implicit
+    /// texture).
     pub name: String,
     /// What it is: `texture rgba16float 64x32`, `buffer <u4 [65536]`.
     pub kind: String,
@@ -209,18 +224,28 @@ pub struct OutputVerdict {
     pub problems: Vec<String>,
     /// One line: what was compared and how it came out.
     pub summary: String,
+    /// A texture's view against its golden PNG (the main image's are the
+    /// case's metrics; `psnr` is its raw values' where an EXR judged them).
+    pub metrics: Option<vista_image::metrics::Metrics>,
+    /// How it was judged, where that is not the plain rule (a bad-pixel
+    /// budget, ignore rectangles, a tolerance instead of PSNR).
+    pub notes: Vec<String>,
 }
 
 /// Compares output `index` with its goldens as the case runner read them
-/// ([`GoldenFiles::read`]); pure: it reads and writes nothing. The first
-/// texture output's PNG is the case's main image, judged by the case's
-/// verdict (`check::judge`) itself; here it only gets its raw comparison,
-/// if it has one.
+/// ([`GoldenFiles::read`]); pure: it reads and writes nothing. Every output
+/// goes through the same steps: guards, golden files against the manifest
+/// entry, raw values (EXR, NumPy) by its tolerance or PSNR, an opaque
+/// view's alpha, and a texture's view (`view`: its display values as a
+/// 16-bit PNG holds them) against its golden PNG with the case's
+/// thresholds. Output 0 is the case's main image: its view's metrics are
+/// the case's, and the case's `ignore` rectangles are its.
 pub fn compare_output(
     case: &Case,
     golden: &GoldenFiles,
     index: usize,
     out: &OutputRender,
+    view: Option<&Image>,
     threshold: crate::DriverThreshold,
     blessed: Option<&crate::ManifestEntry>,
 ) -> OutputVerdict {
@@ -253,7 +278,7 @@ pub fn compare_output(
         ..Default::default()
     };
     v.problems = guard_one(index, out);
-    v.problems.extend(changed_outside_bless(case, golden, blessed));
+    v.problems.extend(changed_outside_bless(case, golden, index, blessed));
     match &out.value {
         OutputValue::Buffer { .. } => {
             let path = files.npy.expect("a buffer's npy");
@@ -300,9 +325,6 @@ pub fn compare_output(
             );
         }
         OutputValue::Texture { raw, format, .. } => {
-            if index == 0 && tolerance.is_none() && files.exr.is_none() {
-                v.summary = format!("output {}: the main image (metrics above)", out.name);
-            }
             if let Some(exr) = &files.exr {
                 match golden.decode(exr, vista_image::decode_exr) {
                     Ok(None) => v.missing.push(exr.clone()),
@@ -333,12 +355,8 @@ pub fn compare_output(
                 judge_alpha(&mut v, case, alpha, golden, raw, psnr_threshold);
             }
             let png = files.png.expect("a texture's png");
-            if index > 0 && tolerance.is_none() && files.exr.is_none() {
-                // A float texture without a tolerance or raw golden: its view by PSNR.
-                judge_view(&mut v, out, png, golden, psnr_threshold);
-            } else if index > 0 && *golden.at(&png) == Found::Missing {
-                v.missing.push(png);
-            }
+            let view = view.expect("a texture's view");
+            judge_view(&mut v, case, index, raw, view, &png, golden, tolerance.is_some(), psnr_threshold);
         }
     }
     v
@@ -346,54 +364,204 @@ pub fn compare_output(
 
 /// Each golden file of an output that its manifest entry names but whose
 /// bytes are not the ones it describes (changed outside vista bless, or
-/// left by an interrupted one).
-fn changed_outside_bless(case: &Case, golden: &GoldenFiles, blessed: Option<&crate::ManifestEntry>) -> Vec<String> {
+/// left by an interrupted one). The main image's PNG (output 0's) is the
+/// entry's `golden_hash`; the other files are its `outputs`.
+fn changed_outside_bless(
+    case: &Case,
+    golden: &GoldenFiles,
+    index: usize,
+    blessed: Option<&crate::ManifestEntry>,
+) -> Vec<String> {
     let mut problems = Vec::new();
-    if let Some(entry) = blessed {
-        for (path, found) in &golden.found {
-            let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
-            let (Some(want), Found::Bytes(bytes)) = (entry.outputs.get(&name), found) else { continue };
-            let hash = crate::short_hash_bytes(bytes);
-            if &hash != want {
+    let Some(entry) = blessed else { return problems };
+    for (path, found) in &golden.found {
+        let Found::Bytes(bytes) = found else { continue };
+        let hash = crate::short_hash_bytes(bytes);
+        if index == 0 && golden.paths.png.as_ref() == Some(path) {
+            if entry.golden_hash.is_empty() {
+                continue;
+            }
+            if entry.replacing.as_deref() == Some(hash.as_str()) {
                 problems.push(format!(
-                    "golden {} (hash {hash}) is not the file its manifest entry describes ({want}): it was changed \
-                     outside vista bless or by an interrupted one; review it and re-bless: {}",
+                    "golden {} is the file an interrupted bless was replacing; finish it with: {}",
                     path.display(),
                     case.bless_command()
                 ));
+            } else if hash != entry.golden_hash {
+                problems.push(format!(
+                    "golden {} (hash {hash}) is not the file its manifest entry describes ({}): it was changed \
+                     outside vista bless; review it and re-bless: {}",
+                    path.display(),
+                    entry.golden_hash,
+                    case.bless_command()
+                ));
             }
+            continue;
+        }
+        let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        let Some(want) = entry.outputs.get(&name) else { continue };
+        if &hash != want {
+            problems.push(format!(
+                "golden {} (hash {hash}) is not the file its manifest entry describes ({want}): it was changed \
+                 outside vista bless or by an interrupted one; review it and re-bless: {}",
+                path.display(),
+                case.bless_command()
+            ));
         }
     }
     problems
 }
 
-/// A float texture output without a tolerance or raw golden: the PSNR of
-/// its view against its golden PNG.
-fn judge_view(v: &mut OutputVerdict, out: &OutputRender, png: PathBuf, golden: &GoldenFiles, psnr_threshold: f64) {
-    match golden.decode(&png, vista_image::decode_png16) {
-        Ok(None) => v.missing.push(png),
-        Err(e) => v.errors.push(e),
-        Ok(Some(g)) => {
-            let actual = quantize16(&out.display().expect("a texture"));
-            match vista_image::metrics::compare(&g, &actual) {
-                Err(e) => v.problems.push(format!("output {}: {e}", out.name)),
-                Ok(m) => {
-                    v.summary = format!(
-                        "output {}: PSNR {} (>= {psnr_threshold:.1} dB)",
-                        out.name,
-                        vista_image::metrics::format_psnr(m.psnr)
-                    );
-                    if m.psnr < psnr_threshold {
-                        v.problems.push(format!(
-                            "output {}: PSNR {} is below the threshold {psnr_threshold:.1} dB",
-                            out.name,
-                            vista_image::metrics::format_psnr(m.psnr)
-                        ));
+/// A texture's view against its golden PNG, the same for every output: the
+/// case's ignore rectangles (output 0, the case's image, only) hold the
+/// golden's values on both sides; then the case's thresholds: a bad-pixel
+/// budget instead of PSNR where the case has one, else PSNR (of the raw
+/// values where an EXR golden judged them; none where a tolerance judges
+/// the output), the alpha a view keeps, SSIM and FLIP. Problems of outputs
+/// after the first name the output.
+#[allow(clippy::too_many_arguments)]
+fn judge_view(
+    v: &mut OutputVerdict,
+    case: &Case,
+    index: usize,
+    raw: &Image,
+    actual: &Image,
+    png: &Path,
+    golden: &GoldenFiles,
+    by_tolerance: bool,
+    psnr_threshold: f64,
+) {
+    let expected = match golden.view_decoded() {
+        Ok(Some(g)) => g,
+        Ok(None) => return v.missing.push(png.to_path_buf()),
+        Err(e) => return v.errors.push(e),
+    };
+    let named = if index == 0 { String::new() } else { format!("output {}: ", v.name) };
+    if (expected.width, expected.height) != (actual.width, actual.height) {
+        let what = if index == 0 { "the case renders" } else { "the render is" };
+        return v.problems.push(format!(
+            "{named}golden {} is {}x{} but {what} {}x{}; re-bless if the size change is intended",
+            png.display(),
+            expected.width,
+            expected.height,
+            actual.width,
+            actual.height
+        ));
+    }
+    let masked;
+    let actual = match index == 0 && !case.ignore.is_empty() {
+        false => actual,
+        true => {
+            let mut a = actual.clone();
+            let mut n = 0u64;
+            for &[x, y, w, h] in &case.ignore {
+                for yy in y..(y + h).min(a.height) {
+                    for xx in x..(x + w).min(a.width) {
+                        a.set(xx, yy, expected.get(xx, yy));
+                        n += 1;
                     }
                 }
             }
+            v.notes.push(format!("{n} pixels in {} ignore rectangles left out of the comparison", case.ignore.len()));
+            masked = a;
+            &masked
+        }
+    };
+    let mut m = match vista_image::metrics::compare(expected, actual) {
+        Ok(m) => m,
+        Err(e) => return v.errors.push(format!("{named}{e}")),
+    };
+    m.nan = raw.nonfinite_count();
+    if by_tolerance {
+        // Judged by the tolerance alone; the metrics stay for the reader.
+        if index == 0 {
+            v.notes.push("the main image is judged by its output's tolerance instead of PSNR".into());
+        }
+    } else {
+        thresholds(v, case, &named, &mut m, expected, actual, raw, psnr_threshold);
+    }
+    if index > 0 && v.summary.is_empty() {
+        v.summary = format!("output {}: PSNR {} (>= {psnr_threshold:.1} dB)", v.name, format_psnr(m.psnr));
+    }
+    v.metrics = Some(m);
+}
+
+/// A view's metrics against the case's thresholds: its bad-pixel budget or
+/// PSNR (its raw values' where they carried the verdict), the alpha a view
+/// keeps, SSIM and FLIP.
+#[allow(clippy::too_many_arguments)]
+fn thresholds(
+    v: &mut OutputVerdict,
+    case: &Case,
+    named: &str,
+    m: &mut vista_image::metrics::Metrics,
+    expected: &Image,
+    actual: &Image,
+    raw: &Image,
+    psnr_threshold: f64,
+) {
+    // A case with a bad-pixel budget is judged by it instead of PSNR: a few
+    // pixels that flip far (a crest across drivers) pass, more do not.
+    let by_bad_pixels = case.max_bad_pixels.is_some() || case.max_bad_ratio.is_some();
+    if by_bad_pixels {
+        v.notes.push(format!("{named}judged by its bad-pixel budget (max_bad_pixels / max_bad_ratio) instead of PSNR"));
+    } else if let Some(raw_psnr) = v.raw_psnr.filter(|_| v.by_raw) {
+        // Its raw values (the EXR golden) carried the PSNR verdict; the
+        // view's other metrics stay.
+        m.psnr = raw_psnr;
+    } else if m.psnr < psnr_threshold {
+        v.problems.push(format!("{named}PSNR {} is below the threshold {psnr_threshold:.1} dB", format_psnr(m.psnr)));
+    }
+    // PSNR, SSIM and FLIP see RGB; a view that keeps the kernel's alpha
+    // (display_alpha = "keep") has it compared here, by the same threshold.
+    // An opaque view's alpha is judged from its own golden (`judge_alpha`).
+    if !case.kernel.opaque_display() && !by_bad_pixels {
+        let alpha = alpha_psnr(expected, actual);
+        if alpha < psnr_threshold {
+            v.problems.push(format!(
+                "{named}alpha PSNR {} is below the threshold {psnr_threshold:.1} dB (the view's RGB: PSNR {})",
+                format_psnr(alpha),
+                format_psnr(m.psnr)
+            ));
         }
     }
+    if let Some(t) = case.min_ssim
+        && m.ssim < t
+    {
+        v.problems.push(format!("{named}SSIM {:.5} is below the threshold {t}", m.ssim));
+    }
+    if let (Some(t), Some(f)) = (case.max_flip, m.flip_mean)
+        && f > t
+    {
+        v.problems.push(format!("{named}FLIP mean {f:.5} is above the threshold {t}"));
+    }
+    if let Some(t) = case.max_bad_pixels
+        && m.bad_pixels > t
+    {
+        v.problems.push(format!(
+            "{named}{} bad pixels (> {}) is above max_bad_pixels {t}",
+            m.bad_pixels,
+            crate::BAD_PIXEL_LIMIT
+        ));
+    }
+    let pixels = raw.width as f64 * raw.height as f64;
+    if let Some(t) = case.max_bad_ratio
+        && pixels > 0.0
+        && m.bad_pixels as f64 / pixels > t
+    {
+        v.problems.push(format!(
+            "{named}{} bad pixels are {:.5} of the image, above max_bad_ratio {t}",
+            m.bad_pixels,
+            m.bad_pixels as f64 / pixels
+        ));
+    }
+}
+
+/// PSNR (peak 1) of two views' alpha channels.
+fn alpha_psnr(a: &Image, b: &Image) -> f64 {
+    let n = a.data.len().max(1) as f64;
+    let mse: f64 = a.data.iter().zip(&b.data).map(|(x, y)| (x[3] as f64 - y[3] as f64).powi(2)).sum::<f64>() / n;
+    vista_image::metrics::psnr_from_mse(mse, 1.0)
 }
 
 /// "N of M texels never written": a workgroup size, dispatch or bounds check
@@ -864,6 +1032,71 @@ mod tests {
         assert!(within(Tolerance::MaxAbs(1.0), &g, &[1.0, f64::NAN, 3.0, 4.0], true).unwrap_err().contains("NaN"));
     }
 
+    /// One procedure for every texture's view: the main image (output 0)
+    /// and a later output are judged by the same thresholds (alpha, the
+    /// case's min_ssim), the later one's problems naming it; the view's
+    /// metrics come back with the verdict.
+    #[test]
+    fn every_texture_view_is_judged_by_one_procedure() {
+        let text = "[[case]]\nid = \"a\"\nkernel = \"fbm\"\nmin_ssim = 0.99\n";
+        let case = crate::cases::parse_cases(Path::new("cases.toml"), text, vista_kernels::Registry::builtin())
+            .unwrap()
+            .remove(0);
+        let image = |f: &dyn Fn(u32, u32) -> [f32; 4]| {
+            Image::from_raw(16, 16, (0..256).map(|i| f(i % 16, i / 16)).collect()).unwrap()
+        };
+        let raw = image(&|x, y| [x as f32 / 15.0, y as f32 / 15.0, 0.5, 1.0]);
+        let out = OutputRender {
+            name: "t".into(),
+            tolerance: None,
+            partial: false,
+            value: OutputValue::Texture {
+                raw: raw.clone(),
+                format: "rgba32float",
+                view: vista_kernels::Output::Display,
+                unwritten: 0,
+                display: vista_kernels::DisplayMap::identity(),
+            },
+        };
+        let view = quantize16(&raw);
+        let png = PathBuf::from("/nonexistent/golden/fbm/a.t.png");
+        let judge = |golden: &Image, index: usize| {
+            let bytes = vista_image::encode_png16_small(&png, golden).unwrap();
+            let files = GoldenFiles::of(
+                OutputFiles { png: Some(png.clone()), ..Default::default() },
+                vec![(png.clone(), Found::Bytes(bytes))],
+            );
+            let threshold = crate::DriverThreshold { psnr: 60.0, same_driver: true };
+            compare_output(&case, &files, index, &out, Some(&view), threshold, None)
+        };
+        for index in [0, 1] {
+            let same = judge(&view, index);
+            assert!(same.problems.is_empty(), "{index}: {:?}", same.problems);
+            assert_eq!(same.metrics.map(|m| m.psnr), Some(f64::INFINITY), "{index}");
+            let named = if index == 0 { "" } else { "output t: " };
+            // Alpha halved, RGB the same.
+            let alpha = judge(&image(&|x, y| [x as f32 / 15.0, y as f32 / 15.0, 0.5, 0.5]), index);
+            assert!(
+                alpha.problems.iter().any(|p| p.starts_with(&format!("{named}alpha PSNR"))),
+                "{index}: {:?}",
+                alpha.problems
+            );
+            // A checkerboard of +-0.2 over the ramp: PSNR and SSIM fall.
+            let noisy = image(&|x, y| {
+                let d = if (x + y) % 2 == 0 { 0.2 } else { -0.2 };
+                [(x as f32 / 15.0 * 0.5 + 0.25 + d), y as f32 / 15.0, 0.5, 1.0]
+            });
+            let v = judge(&noisy, index);
+            for what in ["PSNR", "SSIM"] {
+                assert!(
+                    v.problems.iter().any(|p| p.starts_with(&format!("{named}{what}"))),
+                    "{index} {what}: {:?}",
+                    v.problems
+                );
+            }
+        }
+    }
+
     /// The verdict judges the golden files as the runner read them and
     /// reads nothing itself: golden bytes held in memory, at a path with no
     /// file behind it, decide it (equal values pass, one changed value
@@ -889,14 +1122,13 @@ mod tests {
             value: OutputValue::Buffer { bytes: words(&[1, 2, 3]), element, count: 3 },
         };
         let npy = PathBuf::from("/nonexistent/golden/fbm/a.counts.npy");
-        let golden = |found: Found| GoldenFiles {
-            paths: OutputFiles { npy: Some(npy.clone()), ..Default::default() },
-            found: vec![(npy.clone(), found)],
+        let golden = |found: Found| {
+            GoldenFiles::of(OutputFiles { npy: Some(npy.clone()), ..Default::default() }, vec![(npy.clone(), found)])
         };
         let (descr, shape) = out.npy().unwrap();
         let judge = |g: &GoldenFiles| {
             let threshold = crate::DriverThreshold { psnr: 60.0, same_driver: true };
-            compare_output(&case, g, 1, &out, threshold, None)
+            compare_output(&case, g, 1, &out, None, threshold, None)
         };
         let same = judge(&golden(Found::Bytes(vista_image::npy::encode_npy(&descr, &shape, &words(&[1, 2, 3])))));
         assert!(same.problems.is_empty() && same.missing.is_empty() && same.errors.is_empty(), "{same:?}");

@@ -6,7 +6,7 @@ use vista_image::Image;
 use vista_render::{Rendered, Renderer, quantize16, render_with};
 
 use crate::Case;
-use crate::check::{GoldenRead, Observed, Outcome, RunInfo, judge};
+use crate::check::{Observed, Outcome, RunInfo, judge};
 use crate::outputs::GoldenFiles;
 use crate::store::{Manifest, Store, params_hash};
 
@@ -165,7 +165,17 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     let has_image = r.raw.width > 0;
     // Hashed once: at 1920 x 1080 each pass over the raw bits costs ~0.1 s.
     let raw_hash = r.raw.content_hash();
-    let actual = quantize16(r.display());
+    // Each texture output's display values as a 16-bit PNG holds them,
+    // made once: the verdict compares them and the report shows them.
+    let mut views: Vec<Option<Image>> = r
+        .outputs
+        .iter()
+        .enumerate()
+        .map(|(i, o)| match i {
+            0 => has_image.then(|| quantize16(r.display())),
+            _ => o.display().map(|d| quantize16(&d)),
+        })
+        .collect();
     let deterministic = case.kernel.graph().deterministic;
     let gathered = (|| -> Result<_, String> {
         let repeat_identical = match opts.twice && deterministic && !as_blessed(entry, &run, &raw_hash) {
@@ -173,14 +183,13 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
             false => None,
         };
         let files = ctx.kernel_file_hashes(&case.kernel).map_err(|e| e.to_string())?;
-        let path = golden_path.clone();
-        let golden = read_golden(&path)?;
-        Ok((repeat_identical, files, path, golden))
+        Ok((repeat_identical, files))
     })();
     // Each output's golden files, read once: the verdict judges them and
     // the report shows their PNG.
     let golden_files: Vec<GoldenFiles> = match &gathered {
-        Ok(_) => crate::outputs::outputs_of(case, &r)
+        Ok(_) => r
+            .outputs
             .iter()
             .enumerate()
             .map(|(i, o)| GoldenFiles::read(crate::outputs::output_files(&store.dir, case, &golden_key, i, o)))
@@ -189,30 +198,25 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     };
     let mut out = match &gathered {
         Err(e) => judge(case, entry, run, Err(e.clone())),
-        Ok((repeat_identical, files, path, golden)) => {
-            let golden_read = match golden {
-                _ if !has_image => GoldenRead::NoImage,
-                None => GoldenRead::Missing { path },
-                Some((hash, image)) => {
-                    GoldenRead::Present { path, hash, image: image.as_ref().map_err(|e| e.as_str()) }
-                }
-            };
+        Ok((repeat_identical, files)) => {
             let threshold = crate::DriverThreshold::of(case, entry, &run.adapter);
-            let outputs: Vec<crate::outputs::OutputVerdict> = crate::outputs::outputs_of(case, &r)
+            let outputs: Vec<crate::outputs::OutputVerdict> = r
+                .outputs
                 .iter()
                 .zip(&golden_files)
+                .zip(&views)
                 .enumerate()
-                .map(|(i, (o, golden))| crate::outputs::compare_output(case, golden, i, o, threshold, entry))
+                .map(|(i, ((o, golden), view))| {
+                    crate::outputs::compare_output(case, golden, i, o, view.as_ref(), threshold, entry)
+                })
                 .collect();
             let observed = Observed {
                 raw_hash: &raw_hash,
                 unwritten: r.unwritten,
                 format: r.format,
                 raw: &r.raw,
-                actual: &actual,
                 repeat_identical: *repeat_identical,
                 shader_files: files,
-                golden: golden_read,
                 outputs: &outputs,
                 deterministic,
             };
@@ -227,7 +231,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     }
     let pending = match &gathered {
         // golden_hash is set once the report has written the PNG.
-        Ok((_, files, _, _)) => Some(crate::ManifestEntry::of_render(
+        Ok((_, files)) => Some(crate::ManifestEntry::of_render(
             case,
             &out.run,
             files.clone(),
@@ -243,7 +247,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     let (pending, pending_files) = match pending {
         Some(mut e) if matches!(out.verdict, crate::Verdict::Fail | crate::Verdict::Missing) => {
             // Accepted as the case's own golden (bless --from-report writes no per-backend one).
-            match crate::outputs::golden_bytes(&store.dir, case, &case.id, crate::outputs::outputs_of(case, &r)) {
+            match crate::outputs::golden_bytes(&store.dir, case, &case.id, &r.outputs) {
                 Ok(files) => {
                     let named: Vec<(String, Vec<u8>)> = files
                         .into_iter()
@@ -257,30 +261,27 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         }
         p => (p, Vec::new()),
     };
-    let expected = match gathered {
-        Ok((_, _, _, Some((_, Ok(image))))) => Some(image),
-        _ => None,
-    };
+    let expected = golden_files.first().and_then(|g| g.view()).cloned();
     let output_images = r
         .outputs
         .iter()
+        .zip(views.iter_mut())
         .enumerate()
         .skip(1)
-        .filter_map(|(i, o)| {
-            let shown = quantize16(&o.display()?);
+        .filter_map(|(i, (o, view))| {
             let golden = match golden_files.get(i) {
-                Some(g) => g.view(),
+                Some(g) => g.view().cloned(),
                 None => crate::outputs::output_files(&store.dir, case, &golden_key, i, o)
                     .png
                     .and_then(|p| vista_image::read_png16(&p).ok()),
             };
-            Some((o.name.clone(), shown, golden))
+            Some((o.name.clone(), view.take()?, golden))
         })
         .collect();
     let inputs = inputs_of(case, ctx.root.as_deref());
     Checked {
         outcome: out,
-        actual: has_image.then_some(actual),
+        actual: views.into_iter().next().flatten(),
         expected,
         pending,
         pending_files,
@@ -289,30 +290,6 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         raw_hash: Some(raw_hash),
         timed_out: false,
     }
-}
-
-/// A golden PNG read once (hashed against the manifest, then decoded):
-/// `None` where there is no file; its hash and image, or why it cannot be
-/// decoded (a Git LFS pointer where the PNG should be is named as one).
-type GoldenFile = Option<(String, Result<Image, String>)>;
-
-fn read_golden(path: &std::path::Path) -> Result<GoldenFile, String> {
-    if !path.exists() {
-        return Ok(None);
-    }
-    let bytes =
-        std::fs::read(path).map_err(|source| vista_image::ImageError::Io { path: path.into(), source }.to_string())?;
-    let hash = crate::short_hash_bytes(&bytes);
-    let image = match bytes.starts_with(b"version https://git-lfs.github.com/spec/") {
-        // A Git LFS pointer where the PNG should be: the clone lacks the file.
-        true => Err(format!(
-            "{} is a Git LFS pointer, not a PNG: run `git lfs pull` (and `git lfs install` once) to fetch the \
-             goldens",
-            path.display()
-        )),
-        false => vista_image::decode_png16(path, &bytes).map_err(|e| e.to_string()),
-    };
-    Ok(Some((hash, image)))
 }
 
 /// Runs `work` on every item with `jobs` threads (at least one, at most
