@@ -170,7 +170,7 @@ fn render_checked<'c>(
             true => Some(crate::run::same_render(&crate::run::render_case(ctx, case)?, &r)),
             false => None,
         };
-        let (mut problems, _) = crate::guards(case, &r.raw, r.format, r.unwritten, identical);
+        let (mut problems, _) = crate::guards(case, &r.raw, r.format, identical);
         problems.extend(crate::outputs::output_guards(&r.outputs));
         if !problems.is_empty() {
             return Err(GoldenError::Rejected(format!(

@@ -273,28 +273,21 @@ pub struct Observed<'a> {
     pub deterministic: bool,
 }
 
-/// The checks that need no golden, and so also gate `vista bless`: every
-/// texel written (unless the kernel's output is `partial`), finite output,
-/// within the kernel's documented range, deterministic in one process.
-/// Returns each problem (the text check prints) and the first bad raw pixel.
+/// The checks of the case as a whole that need no golden, and so also
+/// gate `vista bless` (beside each output's own, written and finite:
+/// [`crate::outputs::output_guards`]): the main image within the kernel's
+/// documented range, deterministic in one process. Returns each problem
+/// (the text check prints) and the main image's first bad raw pixel (NaN
+/// or out of range), which the report marks.
 pub fn guards(
     case: &Case,
     raw: &Image,
     format: &str,
-    unwritten: u64,
     repeat_identical: Option<bool>,
 ) -> (Vec<String>, Option<(u32, u32, String)>) {
     let (mut problems, mut first_bad) = (Vec::new(), None);
-    if unwritten > 0 && !case.kernel.partial() {
-        problems.push(crate::outputs::unwritten_problem(unwritten, raw));
-    }
     if let Some((x, y)) = raw.first_nonfinite() {
         first_bad = Some((x, y, format!("NaN/Inf {:?}", raw.get(x, y))));
-        problems.push(format!(
-            "{} pixels contain NaN/Inf; first at ({x}, {y}) = {:?}",
-            raw.nonfinite_count(),
-            raw.get(x, y)
-        ));
     }
     let (lo, hi) = case.kernel.output_bounds_of(&case.params, format);
     if let Some((x, y, v)) = first_out_of_bounds(raw, lo, hi) {
@@ -385,7 +378,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
 }
 
 fn compare(case: &Case, entry: Option<&ManifestEntry>, obs: &Observed, out: &mut Outcome) {
-    let (problems, first_bad) = guards(case, obs.raw, obs.format, obs.unwritten, obs.repeat_identical);
+    let (problems, first_bad) = guards(case, obs.raw, obs.format, obs.repeat_identical);
     out.problems.extend(problems);
     out.first_bad = first_bad;
     provenance(case, entry, obs, out);

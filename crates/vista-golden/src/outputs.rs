@@ -574,9 +574,9 @@ pub fn unwritten_problem(unwritten: u64, raw: &vista_image::Image) -> String {
     )
 }
 
-/// The checks of a graph's outputs that need no golden (the main image's
-/// are `check::guards`): every texel of each other texture written unless
-/// it is `partial`, finite textures and float buffers.
+/// The checks of each output that need no golden: every texel of a
+/// texture written unless it is `partial`, finite textures and float
+/// buffers (the case's range and determinism are `check::guards`).
 pub fn output_guards(outputs: &[OutputRender]) -> Vec<String> {
     outputs.iter().enumerate().flat_map(|(i, o)| guard_one(i, o)).collect()
 }
@@ -584,28 +584,27 @@ pub fn output_guards(outputs: &[OutputRender]) -> Vec<String> {
 /// [`output_guards`] of output `i`.
 fn guard_one(i: usize, o: &OutputRender) -> Vec<String> {
     let mut problems = Vec::new();
-    {
-        match &o.value {
-            OutputValue::Texture { raw, unwritten, .. } if i > 0 => {
-                if *unwritten > 0 && !o.partial {
-                    problems.push(format!("output {}: {}", o.name, unwritten_problem(*unwritten, raw)));
-                }
-                if let Some((x, y)) = raw.first_nonfinite() {
-                    problems.push(format!(
-                        "output {}: {} texels contain NaN/Inf; first at ({x}, {y})",
-                        o.name,
-                        raw.nonfinite_count()
-                    ));
-                }
+    match &o.value {
+        OutputValue::Texture { raw, unwritten, .. } => {
+            // The main image's problems are the case's; the others name their output.
+            let named = if i == 0 { String::new() } else { format!("output {}: ", o.name) };
+            if *unwritten > 0 && !o.partial {
+                problems.push(format!("{named}{}", unwritten_problem(*unwritten, raw)));
             }
-            OutputValue::Buffer { element, .. } => {
-                let values = vista_render::graph::leaf_values(o.buffer_body().expect("a buffer"), element);
-                if let Some(at) = values.iter().position(|v| !v.is_finite()) {
-                    let n = values.iter().filter(|v| !v.is_finite()).count();
-                    problems.push(format!("output {}: {n} values are NaN/Inf; first at value {at}", o.name));
-                }
+            if let Some((x, y)) = raw.first_nonfinite() {
+                problems.push(format!(
+                    "{named}{} pixels contain NaN/Inf; first at ({x}, {y}) = {:?}",
+                    raw.nonfinite_count(),
+                    raw.get(x, y)
+                ));
             }
-            _ => {}
+        }
+        OutputValue::Buffer { element, .. } => {
+            let values = vista_render::graph::leaf_values(o.buffer_body().expect("a buffer"), element);
+            if let Some(at) = values.iter().position(|v| !v.is_finite()) {
+                let n = values.iter().filter(|v| !v.is_finite()).count();
+                problems.push(format!("output {}: {n} values are NaN/Inf; first at value {at}", o.name));
+            }
         }
     }
     problems

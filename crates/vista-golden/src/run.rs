@@ -229,37 +229,9 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         out.notes.push(format!("judged against the per-backend golden {}", golden_path.display()));
         out.bless_command = format!("{} --backend {} --per-backend", out.bless_command, ctx.backend());
     }
-    let pending = match &gathered {
-        // golden_hash is set once the report has written the PNG.
-        Ok((_, files)) => Some(crate::ManifestEntry::of_render(
-            case,
-            &out.run,
-            files.clone(),
-            raw_hash.clone(),
-            out.metrics.map(|m| vista_image::metrics::format_psnr(m.psnr)).unwrap_or_else(|| "new".into()),
-            String::new(),
-        )),
-        Err(_) => None,
-    };
-    // A failing or missing case's other golden files (raw EXR, other
-    // outputs, buffers), kept in the report with their hashes in the entry,
-    // so bless --from-report accepts the render whole.
-    let (pending, pending_files) = match pending {
-        Some(mut e) if matches!(out.verdict, crate::Verdict::Fail | crate::Verdict::Missing) => {
-            // Accepted as the case's own golden (bless --from-report writes no per-backend one).
-            match crate::outputs::golden_bytes(&store.dir, case, &case.id, &r.outputs) {
-                Ok(files) => {
-                    let named: Vec<(String, Vec<u8>)> = files
-                        .into_iter()
-                        .map(|(p, b)| (p.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default(), b))
-                        .collect();
-                    e.outputs = named.iter().map(|(n, b)| (n.clone(), crate::short_hash_bytes(b))).collect();
-                    (Some(e), named)
-                }
-                Err(_) => (None, Vec::new()),
-            }
-        }
-        p => (p, Vec::new()),
+    let (pending, pending_files) = match &gathered {
+        Ok((_, files)) => pending(store, case, &out, files, &raw_hash, &r),
+        Err(_) => (None, Vec::new()),
     };
     let expected = golden_files.first().and_then(|g| g.view()).cloned();
     let output_images = r
@@ -289,6 +261,44 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         inputs,
         raw_hash: Some(raw_hash),
         timed_out: false,
+    }
+}
+
+/// The manifest entry a bless of this render would write (its
+/// `golden_hash` is set once the report has written the PNG) and, for a
+/// failing or missing case, its other golden files (raw EXR, other outputs,
+/// buffers) with their hashes in the entry, which the report keeps so
+/// `bless --from-report` accepts the render whole.
+fn pending(
+    store: &Store,
+    case: &Case,
+    out: &Outcome,
+    files: &std::collections::BTreeMap<String, String>,
+    raw_hash: &str,
+    r: &Rendered,
+) -> (Option<crate::ManifestEntry>, Vec<(String, Vec<u8>)>) {
+    let mut e = crate::ManifestEntry::of_render(
+        case,
+        &out.run,
+        files.clone(),
+        raw_hash.to_string(),
+        out.metrics.map(|m| vista_image::metrics::format_psnr(m.psnr)).unwrap_or_else(|| "new".into()),
+        String::new(),
+    );
+    if !matches!(out.verdict, crate::Verdict::Fail | crate::Verdict::Missing) {
+        return (Some(e), Vec::new());
+    }
+    // Accepted as the case's own golden (bless --from-report writes no per-backend one).
+    match crate::outputs::golden_bytes(&store.dir, case, &case.id, &r.outputs) {
+        Ok(files) => {
+            let named: Vec<(String, Vec<u8>)> = files
+                .into_iter()
+                .map(|(p, b)| (p.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default(), b))
+                .collect();
+            e.outputs = named.iter().map(|(n, b)| (n.clone(), crate::short_hash_bytes(b))).collect();
+            (Some(e), named)
+        }
+        Err(_) => (None, Vec::new()),
     }
 }
 

@@ -983,23 +983,7 @@ pub fn resolve(
                 crate::bindings::wgsl_type(module, &module.global_variables[b.global])
             )
         };
-        // A bind may name a global this entry point does not reach (one
-        // bind table for several entry points of a file), not one the
-        // module lacks.
-        for (var, _) in &pass.bind {
-            let declared = module
-                .global_variables
-                .iter()
-                .any(|(_, g)| g.name.as_deref().map(|n| crate::bindings::undecorate(n).0).as_deref() == Some(var));
-            if !declared {
-                let reached: Vec<&str> = bindings.iter().map(|b| b.name.as_str()).collect();
-                return Err(bad(format!(
-                    "{label}: bind names {var}, which {shader} does not declare; {} reaches: {}",
-                    pass.entry,
-                    reached.join(", ")
-                )));
-            }
-        }
+        check_bind_declared(pass, shader, bindings, module, &label, &bad)?;
         let mut slots = Vec::new();
         let mut blocks = 0usize;
         for b in bindings.iter() {
@@ -1106,31 +1090,70 @@ pub fn resolve(
         all_slots.push(slots);
     }
     let outputs = check_swaps_and_outputs(graph, &resources, &bad)?;
-    if graph.outputs.iter().all(|o| o.resource.is_none()) {
-        // Two textures written and never read: which one is the output?
-        let mut only_written = (0..resources.len())
-            .filter(|&r| resources[r].written && !resources[r].read && kind_of(&resources, r) == "texture");
-        if let (Some(first), Some(second)) = (only_written.next(), only_written.next()) {
-            let (i, slot) = all_slots
-                .iter()
-                .enumerate()
-                .find_map(|(i, slots)| {
-                    slots.iter().find(|s| matches!(s.feed, SlotFeed::Resource(r, _) if r == second)).map(|s| (i, s))
-                })
-                .expect("a written resource has a slot");
+    check_default_output(graph, &resources, &all_slots, &bad)?;
+    Ok(Resolved { resources, slots: all_slots, outputs })
+}
+
+/// A pass's `bind` may name a global its entry point does not reach (one
+/// bind table for several entry points of a file), not one the module
+/// lacks.
+fn check_bind_declared(
+    pass: &PassSpec,
+    shader: &str,
+    bindings: &[Binding],
+    module: &naga::Module,
+    label: &str,
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<(), ParamError> {
+    for (var, _) in &pass.bind {
+        let declared = module
+            .global_variables
+            .iter()
+            .any(|(_, g)| g.name.as_deref().map(|n| crate::bindings::undecorate(n).0).as_deref() == Some(var));
+        if !declared {
+            let reached: Vec<&str> = bindings.iter().map(|b| b.name.as_str()).collect();
             return Err(bad(format!(
-                "pass {} ({}): {} (@group({}) @binding({})) is a second output texture after {}; list both as \
-                 [[output]] tables",
-                i + 1,
-                graph.passes[i].entry,
-                slot.var,
-                slot.group,
-                slot.binding,
-                resources[first].spec.name
+                "{label}: bind names {var}, which {shader} does not declare; {} reaches: {}",
+                pass.entry,
+                reached.join(", ")
             )));
         }
     }
-    Ok(Resolved { resources, slots: all_slots, outputs })
+    Ok(())
+}
+
+/// Without `[[output]]` tables naming resources the output is the first
+/// texture a pass writes; a second texture written and never read makes
+/// that a guess, refused naming both.
+fn check_default_output(
+    graph: &GraphSpec,
+    resources: &[ResolvedResource],
+    all_slots: &[Vec<PassSlot>],
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<(), ParamError> {
+    if graph.outputs.iter().any(|o| o.resource.is_some()) {
+        return Ok(());
+    }
+    let mut only_written = (0..resources.len())
+        .filter(|&r| resources[r].written && !resources[r].read && kind_of(resources, r) == "texture");
+    let (Some(first), Some(second)) = (only_written.next(), only_written.next()) else { return Ok(()) };
+    let (i, slot) = all_slots
+        .iter()
+        .enumerate()
+        .find_map(|(i, slots)| {
+            slots.iter().find(|s| matches!(s.feed, SlotFeed::Resource(r, _) if r == second)).map(|s| (i, s))
+        })
+        .expect("a written resource has a slot");
+    Err(bad(format!(
+        "pass {} ({}): {} (@group({}) @binding({})) is a second output texture after {}; list both as [[output]] \
+         tables",
+        i + 1,
+        graph.passes[i].entry,
+        slot.var,
+        slot.group,
+        slot.binding,
+        resources[first].spec.name
+    )))
 }
 
 /// A storage texture binding's feed: the resource bound to it (an unbound
