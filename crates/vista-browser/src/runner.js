@@ -74,8 +74,22 @@ function vistaChunk(offset, length) {
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility); a texture slot's view dimension is its layout's. Outputs are read back one
 // after another into vista.out: textures unpadded, layers stacked; buffers whole.
-async function pipeline(pass) {
-  const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout]))}`;
+// WebGPU's blend state for a target's `blend` (replace: none).
+const BLENDS = {
+  replace: undefined,
+  alpha: {
+    color: { srcFactor: "src-alpha", dstFactor: "one-minus-src-alpha", operation: "add" },
+    alpha: { srcFactor: "one", dstFactor: "one-minus-src-alpha", operation: "add" },
+  },
+  additive: {
+    color: { srcFactor: "one", dstFactor: "one", operation: "add" },
+    alpha: { srcFactor: "one", dstFactor: "one", operation: "add" },
+  },
+};
+
+async function pipeline(pass, resources) {
+  const targets = pass.raster ? pass.raster.targets.map((t) => [resources[t.resource].format, t.blend]) : null;
+  const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout]))}${JSON.stringify(targets)}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
   const d = vista.device;
@@ -93,13 +107,23 @@ async function pipeline(pass) {
   for (let g = 0; g < count; g++) {
     const entries = pass.slots
       .filter((s) => s.group === g)
-      .map((s) => Object.assign({ binding: s.binding, visibility: GPUShaderStage.COMPUTE }, s.layout));
+      .map((s) => Object.assign({ binding: s.binding, visibility: pass.raster ? GPUShaderStage.FRAGMENT : GPUShaderStage.COMPUTE }, s.layout));
     groups.push(d.createBindGroupLayout({ entries }));
   }
   let p;
   try {
     const layout = d.createPipelineLayout({ bindGroupLayouts: groups });
-    p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: pass.entry } });
+    if (pass.raster) {
+      const vertex = d.createShaderModule({ code: pass.raster.vertex, label: "vista full-screen triangle" });
+      p = await d.createRenderPipelineAsync({
+        layout,
+        vertex: { module: vertex, entryPoint: pass.raster.vertex_entry },
+        fragment: { module, entryPoint: pass.entry, targets: targets.map(([format, blend]) => ({ format, blend: BLENDS[blend] })) },
+        primitive: { topology: "triangle-list" },
+      });
+    } else {
+      p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: pass.entry } });
+    }
   } finally {
     const e = await d.popErrorScope();
     if (e) throw new Error(`pipeline of ${pass.key}: ${e.message}`);
@@ -116,16 +140,18 @@ async function vistaRun(job) {
     const d = vista.device;
     if (!d) throw new Error(`the WebGPU device is gone (${vista.lost || "never created"})`);
     const compiled = [];
-    for (const pass of job.passes) compiled.push(await pipeline(pass));
+    for (const pass of job.passes) compiled.push(await pipeline(pass, job.resources));
+    // Textures some render pass draws into.
+    const drawn = new Set(job.passes.flatMap((p) => (p.raster ? p.raster.targets.map((t) => t.resource) : [])));
     const start = performance.now();
     d.pushErrorScope("out-of-memory");
     d.pushErrorScope("validation");
     const B = GPUBufferUsage;
     const T = GPUTextureUsage;
-    for (const r of job.resources) {
+    for (const [ri, r] of job.resources.entries()) {
       if (r.kind === "texture") {
         const size = { width: r.width, height: r.height, depthOrArrayLayers: r.layers };
-        const usage = T.STORAGE_BINDING | T.TEXTURE_BINDING | T.COPY_SRC | T.COPY_DST;
+        const usage = T.STORAGE_BINDING | T.TEXTURE_BINDING | T.COPY_SRC | T.COPY_DST | (drawn.has(ri) ? T.RENDER_ATTACHMENT : 0);
         const texture = d.createTexture({ size, dimension: r.dimension, format: r.format, usage, mipLevelCount: r.mip_levels });
         const rowBytes = r.width * r.texel_bytes;
         if (r.contents) {
@@ -199,11 +225,26 @@ async function vistaRun(job) {
           }),
         );
         const encoder = d.createCommandEncoder();
-        const cp = encoder.beginComputePass();
-        cp.setPipeline(compiled[p].pipeline);
-        bindGroups.forEach((group, g) => cp.setBindGroup(g, group));
-        cp.dispatchWorkgroups(pass.workgroups[0], pass.workgroups[1], pass.workgroups[2]);
-        cp.end();
+        if (pass.raster) {
+          // Each target's level, cleared where it says so, else drawn over.
+          const colorAttachments = pass.raster.targets.map((t) => {
+            const view = made[current[t.resource]].createView({ dimension: "2d", baseMipLevel: t.level, mipLevelCount: 1, baseArrayLayer: 0, arrayLayerCount: 1 });
+            return t.clear
+              ? { view, loadOp: "clear", clearValue: t.clear, storeOp: "store" }
+              : { view, loadOp: "load", storeOp: "store" };
+          });
+          const rp = encoder.beginRenderPass({ colorAttachments });
+          rp.setPipeline(compiled[p].pipeline);
+          bindGroups.forEach((group, g) => rp.setBindGroup(g, group));
+          rp.draw(3);
+          rp.end();
+        } else {
+          const cp = encoder.beginComputePass();
+          cp.setPipeline(compiled[p].pipeline);
+          bindGroups.forEach((group, g) => cp.setBindGroup(g, group));
+          cp.dispatchWorkgroups(pass.workgroups[0], pass.workgroups[1], pass.workgroups[2]);
+          cp.end();
+        }
         const e = await d.popErrorScope();
         if (e) throw new Error(`WebGPU validation (${pass.label}): ${e.message}`);
         d.queue.submit([encoder.finish()]);

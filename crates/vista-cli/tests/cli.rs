@@ -4721,6 +4721,108 @@ use Needs::{Cpu, Gpu};
 /// The harness: libtest-mimic, so that without an adapter and with
 /// VISTA_ALLOW_NO_GPU=1 the tests that render are reported ignored (never
 /// "ok"), while the bad-input tests, which stop before any GPU work, still run.
+/// A render pass (SPEC 17, `vertex = "fullscreen"`): vista's full-screen
+/// triangle covers every texel, `uv` is (0, 0) at the top left, and the
+/// fragment entry's `@location(0)` lands in `targets[0]` the same on
+/// lavapipe, SwiftShader and Chromium; a fragment that discards leaves
+/// texels unwritten; `clear` and `blend = "additive"` accumulate over two
+/// passes; goldens bless and check; what cannot be drawn is refused
+/// before GPU work.
+fn a_fullscreen_render_pass_draws_every_texel() {
+    const SHADER: &str = "struct Params { width: u32, height: u32, gain: f32 }
+@group(0) @binding(0) var<uniform> params: Params;
+
+@fragment
+fn shade(@builtin(position) pos: vec4<f32>, @location(0) uv: vec2<f32>) -> @location(0) vec4<f32> {
+    return vec4(pos.x / f32(params.width), pos.y / f32(params.height), uv.x * params.gain, uv.y);
+}
+
+@fragment
+fn half(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    if pos.x > f32(params.width) * 0.5 { discard; }
+    return vec4(params.gain);
+}
+
+@fragment
+fn add(@location(0) uv: vec2<f32>) -> @location(0) vec4<f32> {
+    return vec4(0.5 * params.gain);
+}
+";
+    let manifest = |body: &str| {
+        format!(
+            "summary = \"full-screen\"\n[[param]]\nname = \"gain\"\ntype = \"f32\"\nrange = [0, 4]\ndefault = 1.0\n\
+             doc = \"gain\"\n[[resource]]\nname = \"image\"\nkind = \"texture\"\nformat = \"rgba32float\"\n\
+             [[resource]]\nname = \"acc\"\nkind = \"texture\"\nformat = \"rgba16float\"\n{body}"
+        )
+    };
+    let shade = "[[pass]]\nkind = \"render\"\nfragment = \"shade\"\ntargets = [{ resource = \"image\" }]\n";
+    let d = kernel_project(&manifest(shade), SHADER);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("{backend}.exr"));
+        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        let img = vista_image::load(&out).unwrap();
+        for (x, y) in [(0, 0), (7, 0), (3, 2), (7, 3)] {
+            let (u, v) = ((x as f32 + 0.5) / 8.0, (y as f32 + 0.5) / 4.0);
+            assert_eq!(img.get(x, y), [u, v, u, v], "{backend}: texel ({x}, {y}) is its own centre");
+        }
+    }
+    // Discarding the right half leaves it unwritten.
+    let half = "[[pass]]\nkind = \"render\"\nfragment = \"half\"\ntargets = [{ resource = \"image\" }]\n";
+    let d = kernel_project(&manifest(half), SHADER);
+    let out = d.path().join("h.exr");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x4", "-o", out.to_str().unwrap()]);
+    assert_rejected(&r, 1, &["16 of 32 texels never written"]);
+    // Cleared to 0.25, then 0.5 added twice: 1.25.
+    let add = "[[pass]]\nkind = \"render\"\nfragment = \"add\"\n\
+               targets = [{ resource = \"acc\", clear = [0.25, 0.25, 0.25, 0.25], blend = \"additive\" }]\n\
+               [[pass]]\nkind = \"render\"\nfragment = \"add\"\ntargets = [{ resource = \"acc\", blend = \"additive\" }]\n";
+    let d = kernel_project(&manifest(add), SHADER);
+    for backend in ["lavapipe", "browser"] {
+        let out = d.path().join(format!("a-{backend}.exr"));
+        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        assert_eq!(vista_image::load(&out).unwrap().get(5, 1), [1.25; 4], "{backend}");
+    }
+    // Goldens: bless, check, and a changed fragment fails.
+    let d = kernel_project(&manifest(shade), SHADER);
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    std::fs::write(cases_path(d.path()), "[[case]]\nid = \"c\"\nkernel = \"k\"\nsize = \"16x8\"\n").unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 0);
+    std::fs::write(d.path().join("shaders/k.wgsl"), SHADER.replace("uv.x * params.gain", "uv.x * 0.9")).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    // Refused before GPU work, one line each.
+    for (body, needles) in [
+        (
+            "[[pass]]\nkind = \"render\"\nentry = \"shade\"\ntargets = [{ resource = \"image\" }]\n",
+            &["a render pass names its fragment entry as fragment"][..],
+        ),
+        (
+            "[[pass]]\nkind = \"render\"\nfragment = \"shade\"\ntargets = [{ resource = \"image\" }, { resource = \"acc\" }]\n",
+            &["pass 1 (shade)", "targets[1] (acc) has no @location(1) output in shade"][..],
+        ),
+        (
+            "[[pass]]\nkind = \"render\"\nfragment = \"add\"\ntargets = [{ resource = \"image\", blend = \"additive\" }]\n",
+            &["targets[0] image is rgba32float, which does not blend"][..],
+        ),
+        (
+            "[[pass]]\nkind = \"render\"\nfragment = \"shade\"\nworkgroups = [1, 1, 1]\ntargets = [{ resource = \"image\" }]\n",
+            &["dispatch and workgroups are for compute passes"][..],
+        ),
+        (
+            "[[pass]]\nkind = \"render\"\nfragment = \"nope\"\ntargets = [{ resource = \"image\" }]\n",
+            &["has no fragment entry point 'nope'; its fragment entry points: shade, half, add"][..],
+        ),
+    ] {
+        let r = render_k(&manifest(body), SHADER);
+        assert_rejected(&r, 2, needles);
+    }
+}
+
 fn main() {
     // Each test's name is its function's name, written once.
     macro_rules! tests {
@@ -4757,6 +4859,7 @@ fn main() {
         Gpu workgroup_size_comes_from_reflection_not_8x8,
         Gpu the_manifest_names_the_entry_point,
         Gpu layered_outputs_stack_and_follow_reflection,
+        Gpu a_fullscreen_render_pass_draws_every_texel,
         Gpu a_broken_manifest_breaks_only_its_kernel,
         Cpu adapter_is_a_hidden_alias_of_backend,
         Cpu readme_schemas_match_the_parsers,

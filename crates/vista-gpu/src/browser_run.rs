@@ -63,11 +63,21 @@ impl Context {
                 }
             };
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
+            // A render pass: vista's full-screen triangle, then the entry
+            // as its fragment stage into these targets.
+            let raster = pass.raster.as_ref().map(|r| {
+                json!({
+                    "vertex": crate::FULLSCREEN_WGSL, "vertex_entry": crate::FULLSCREEN_ENTRY,
+                    "targets": r.targets.iter().map(|t| json!({
+                        "resource": t.resource, "level": t.level, "clear": t.clear, "blend": t.blend,
+                    })).collect::<Vec<_>>(),
+                })
+            });
             passes.push(json!({
                 "key": key, "label": pass.label, "wgsl": *wgsl, "entry": pass.entry,
                 "workgroups": pass.workgroups, "repeat": pass.repeat, "span": pass.span,
                 "swap": pass.swap.iter().map(|(a, b)| [a, b]).collect::<Vec<_>>(),
-                "slots": slots,
+                "slots": slots, "raster": raster,
             }));
         }
         let job = json!({ "resources": resources, "passes": passes, "outputs": g.outputs });

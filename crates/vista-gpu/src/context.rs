@@ -233,8 +233,14 @@ pub(crate) struct WgpuEngine {
 }
 
 pub(crate) struct Compiled {
-    pub(crate) pipeline: wgpu::ComputePipeline,
+    pub(crate) pipeline: Pipeline,
     pub(crate) groups: Vec<wgpu::BindGroupLayout>,
+}
+
+/// A compute pass's pipeline or a render pass's.
+pub(crate) enum Pipeline {
+    Compute(wgpu::ComputePipeline),
+    Render(wgpu::RenderPipeline),
 }
 
 pub(crate) struct BrowserEngine {
@@ -504,7 +510,10 @@ impl Context {
     }
 
     /// Compiles a kernel file's entry point with one bind group layout per
-    /// group (entries given per group, groups 0..n).
+    /// group (entries given per group, groups 0..n): a compute pipeline, or
+    /// with `targets` a render pipeline of vista's full-screen triangle and
+    /// the entry as its fragment stage.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn compile(
         &self,
         w: &WgpuEngine,
@@ -513,6 +522,7 @@ impl Context {
         entry: &str,
         constants: &[(String, f64)],
         layouts: &[Vec<wgpu::BindGroupLayoutEntry>],
+        targets: Option<&[Option<wgpu::ColorTargetState>]>,
     ) -> Result<Arc<Compiled>, GpuError> {
         let module = shaders.compose(shader)?;
         let started = std::time::Instant::now();
@@ -535,17 +545,45 @@ impl Context {
             bind_group_layouts: &layout_refs,
             immediate_size: 0,
         });
-        let pipeline = w.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(shader),
-            layout: Some(&pipeline_layout),
-            module: &sm,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &constants.iter().map(|(k, v)| (k.as_str(), *v)).collect::<Vec<_>>(),
-                ..Default::default()
-            },
-            cache: None,
-        });
+        let constants: Vec<(&str, f64)> = constants.iter().map(|(k, v)| (k.as_str(), *v)).collect();
+        let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+        let pipeline = match targets {
+            None => Pipeline::Compute(w.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(shader),
+                layout: Some(&pipeline_layout),
+                module: &sm,
+                entry_point: Some(entry),
+                compilation_options: options(),
+                cache: None,
+            })),
+            Some(targets) => {
+                let vertex = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("vista full-screen triangle"),
+                    source: wgpu::ShaderSource::Wgsl(crate::FULLSCREEN_WGSL.into()),
+                });
+                Pipeline::Render(w.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(shader),
+                    layout: Some(&pipeline_layout),
+                    vertex: wgpu::VertexState {
+                        module: &vertex,
+                        entry_point: Some(crate::FULLSCREEN_ENTRY),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: wgpu::PrimitiveState::default(),
+                    depth_stencil: None,
+                    multisample: wgpu::MultisampleState::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &sm,
+                        entry_point: Some(entry),
+                        compilation_options: options(),
+                        targets,
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                }))
+            }
+        };
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Validation { what: shader.to_string(), message: e.to_string() });
         }

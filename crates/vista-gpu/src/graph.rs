@@ -266,6 +266,63 @@ pub struct GraphSlot {
     pub bind: Bind,
 }
 
+/// How a render pass's fragment output meets what its target holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Blend {
+    /// The output replaces the texel.
+    Replace,
+    /// `src * src.a + dst * (1 - src.a)`, alpha `src.a + dst.a * (1 - src.a)`.
+    Alpha,
+    /// `src + dst`, colour and alpha.
+    Additive,
+}
+
+/// One colour target of a render pass: `@location(n)` of its fragment
+/// entry goes to `targets[n]`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RasterTarget {
+    /// Index of the texture in [`Graph::resources`].
+    pub resource: usize,
+    /// The mip level drawn into.
+    pub level: u32,
+    /// Cleared to this before the draw; `None`: drawn over what the
+    /// texture holds (a sentinel-filled output keeps its sentinel where the
+    /// fragment entry discards: unwritten).
+    pub clear: Option<[f64; 4]>,
+    /// How the output meets the texel.
+    pub blend: Blend,
+}
+
+/// What makes a pass a render pass (SPEC 17): vista's full-screen triangle
+/// ([`FULLSCREEN_WGSL`]), then the pass's entry as the fragment stage.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Raster {
+    /// The colour targets, in `@location` order.
+    pub targets: Vec<RasterTarget>,
+}
+
+/// The vertex stage of `vertex = "fullscreen"`: one triangle over the
+/// viewport, `@location(0) uv` from (0, 0) at the top left to (1, 1) at the
+/// bottom right, as engines' full-screen vertex shaders have it.
+pub const FULLSCREEN_WGSL: &str = "struct VistaFullscreen {
+    @builtin(position) position: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+}
+
+@vertex
+fn vista_fullscreen(@builtin(vertex_index) i: u32) -> VistaFullscreen {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    var out: VistaFullscreen;
+    out.position = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 0.0, 1.0);
+    out.uv = uv;
+    return out;
+}
+";
+
+/// The vertex entry of [`FULLSCREEN_WGSL`].
+pub const FULLSCREEN_ENTRY: &str = "vista_fullscreen";
+
 /// One pass: a dispatch of an entry point; after every run the `swap`
 /// pairs exchange which resource each name binds. A pass with `span` n
 /// runs itself and the n - 1 passes after it, in order, `repeat` times (a
@@ -296,6 +353,10 @@ pub struct GraphPass {
     /// The entry point's reflected workgroup size (checked against the
     /// device's limits before any work).
     pub workgroup_size: [u32; 3],
+    /// A render pass: `entry` is its fragment stage, drawn into these
+    /// targets (no dispatch: `workgroups` and `workgroup_size` are 1).
+    #[serde(default)]
+    pub raster: Option<Raster>,
 }
 
 impl GraphPass {

@@ -23,8 +23,8 @@ pub use context::{
     SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
 };
 pub use graph::{
-    Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Readback, Resource, SamplerDesc,
-    TextureDesc, run_order,
+    Address, Bind, Blend, COMPARE_NAMES, Contents, FULLSCREEN_ENTRY, FULLSCREEN_WGSL, Graph, GraphPass, GraphSlot,
+    OutputData, Raster, RasterTarget, Readback, Resource, SamplerDesc, TextureDesc, run_order,
 };
 pub use limits::Needs;
 pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};

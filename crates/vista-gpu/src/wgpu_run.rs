@@ -10,10 +10,10 @@ use std::time::{Duration, Instant};
 use wgpu::util::DeviceExt;
 
 use crate::GpuError;
-use crate::context::{Compiled, Context, RunStats, WgpuEngine, read_texels};
+use crate::context::{Compiled, Context, Pipeline, RunStats, WgpuEngine, read_texels};
 use crate::graph::{
-    Bind, Contents, Graph, GraphPass, OutputData, Readback, Resource, TextureDesc, compare_fn, run_order,
-    view_dimension,
+    Bind, Blend, Contents, Graph, GraphPass, OutputData, Raster, Readback, Resource, TextureDesc, compare_fn,
+    run_order, view_dimension,
 };
 use crate::spares::{Spares, TextureKey};
 use vista_texel::{Access, Format, SampleKind};
@@ -159,7 +159,14 @@ impl Context {
                 let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
                 let groups = bind_groups(d, g, pass, compiled, &made, &current);
                 let mut encoder = d.create_command_encoder(&Default::default());
-                encode_dispatch(&mut encoder, compiled, &groups, pass.workgroups, stamps.as_ref().map(|s| &s.set));
+                let stamp_set = stamps.as_ref().map(|s| &s.set);
+                match (&compiled.pipeline, &pass.raster) {
+                    (Pipeline::Render(p), Some(raster)) => {
+                        encode_draw(&mut encoder, p, &groups, raster, &made, &current, stamp_set)
+                    }
+                    (Pipeline::Compute(p), _) => encode_dispatch(&mut encoder, p, &groups, pass.workgroups, stamp_set),
+                    (Pipeline::Render(_), None) => unreachable!("render pipelines are made for render passes"),
+                }
                 if let Some(s) = &stamps {
                     s.resolve(&mut encoder);
                 }
@@ -203,8 +210,13 @@ impl Context {
         let stats = RunStats { gpu_wall: kernel + readback, kernel, readback, total: start.elapsed() };
         let pass_gpu_times = gpu_times.into_iter().map(|t| stamps.as_ref().map(|_| t)).collect();
         let mut spares = w.spares.lock().expect("spares");
+        let targets: Vec<usize> =
+            g.passes.iter().flat_map(|p| p.raster.iter().flat_map(|r| r.targets.iter().map(|t| t.resource))).collect();
         for (i, texture) in made.textures {
-            if let Resource::Texture(t @ TextureDesc { contents: Contents::Sentinel, .. }) = &g.resources[i] {
+            if let Resource::Texture(t @ TextureDesc { contents: Contents::Sentinel, mip_levels: 1, .. }) =
+                &g.resources[i]
+                && !targets.contains(&i)
+            {
                 keep(&mut spares.textures, texture_key(t), texture);
             }
         }
@@ -227,14 +239,18 @@ impl Context {
         let mut made =
             Made { textures: HashMap::new(), buffers: HashMap::new(), samplers: HashMap::new(), fills: Vec::new() };
         let mut fill = d.create_command_encoder(&Default::default());
+        let targets: Vec<usize> =
+            g.passes.iter().flat_map(|p| p.raster.iter().flat_map(|r| r.targets.iter().map(|t| t.resource))).collect();
         for (i, r) in g.resources.iter().enumerate() {
             match r {
                 Resource::Texture(t) => {
                     let format = crate::format::parse(t.format)?;
                     let size = wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: t.layers };
-                    // Only single-level textures are kept (the key has no levels).
+                    let target = targets.contains(&i);
+                    // Only single-level textures that no pass draws into are
+                    // kept (the key has no levels or usages).
                     let spare = match t.contents {
-                        Contents::Sentinel if t.mip_levels == 1 => {
+                        Contents::Sentinel if t.mip_levels == 1 && !target => {
                             take(&w.spares, |s| &mut s.textures, &texture_key(t))
                         }
                         _ => None,
@@ -250,7 +266,12 @@ impl Context {
                             usage: wgpu::TextureUsages::STORAGE_BINDING
                                 | wgpu::TextureUsages::TEXTURE_BINDING
                                 | wgpu::TextureUsages::COPY_SRC
-                                | wgpu::TextureUsages::COPY_DST,
+                                | wgpu::TextureUsages::COPY_DST
+                                | if target {
+                                    wgpu::TextureUsages::RENDER_ATTACHMENT
+                                } else {
+                                    wgpu::TextureUsages::empty()
+                                },
                             view_formats: &[],
                         })
                     });
@@ -429,7 +450,10 @@ impl Context {
                 s.group,
                 wgpu::BindGroupLayoutEntry {
                     binding: s.binding,
-                    visibility: wgpu::ShaderStages::COMPUTE,
+                    visibility: match pass.raster {
+                        Some(_) => wgpu::ShaderStages::FRAGMENT,
+                        None => wgpu::ShaderStages::COMPUTE,
+                    },
                     ty,
                     count: None,
                 },
@@ -450,7 +474,42 @@ impl Context {
         let layouts: Vec<Vec<wgpu::BindGroupLayoutEntry>> = (0..last.map_or(0, |g| g + 1))
             .map(|gi| entries.iter().filter(|(g, _)| *g == gi).map(|(_, e)| *e).collect())
             .collect();
-        let compiled = self.compile(w, g.shaders, &pass.shader, &pass.entry, &pass.constants, &layouts)?;
+        let targets: Option<Vec<Option<wgpu::ColorTargetState>>> = match &pass.raster {
+            None => None,
+            Some(raster) => Some(
+                raster
+                    .targets
+                    .iter()
+                    .map(|t| {
+                        let Resource::Texture(desc) = &g.resources[t.resource] else {
+                            return Err(GpuError::Request(format!("{}: a target that is not a texture", pass.label)));
+                        };
+                        Ok(Some(wgpu::ColorTargetState {
+                            format: crate::format::wgpu_format(&crate::format::parse(desc.format)?),
+                            blend: match t.blend {
+                                Blend::Replace => None,
+                                Blend::Alpha => Some(wgpu::BlendState::ALPHA_BLENDING),
+                                Blend::Additive => Some(wgpu::BlendState {
+                                    color: wgpu::BlendComponent {
+                                        src_factor: wgpu::BlendFactor::One,
+                                        dst_factor: wgpu::BlendFactor::One,
+                                        operation: wgpu::BlendOperation::Add,
+                                    },
+                                    alpha: wgpu::BlendComponent {
+                                        src_factor: wgpu::BlendFactor::One,
+                                        dst_factor: wgpu::BlendFactor::One,
+                                        operation: wgpu::BlendOperation::Add,
+                                    },
+                                }),
+                            },
+                            write_mask: wgpu::ColorWrites::ALL,
+                        }))
+                    })
+                    .collect::<Result<_, GpuError>>()?,
+            ),
+        };
+        let compiled =
+            self.compile(w, g.shaders, &pass.shader, &pass.entry, &pass.constants, &layouts, targets.as_deref())?;
         w.pipelines.lock().expect("pipeline cache").insert(key, compiled.clone());
         Ok(compiled)
     }
@@ -630,10 +689,74 @@ fn bind_groups(
         .collect()
 }
 
+/// One render pass: each target's view (its level; cleared where it says
+/// so, else drawn over), the pipeline, its bind groups, the full-screen
+/// triangle.
+fn encode_draw(
+    encoder: &mut wgpu::CommandEncoder,
+    pipeline: &wgpu::RenderPipeline,
+    groups: &[wgpu::BindGroup],
+    raster: &Raster,
+    made: &Made,
+    current: &[usize],
+    stamps: Option<&wgpu::QuerySet>,
+) {
+    let views: Vec<wgpu::TextureView> = raster
+        .targets
+        .iter()
+        .map(|t| {
+            made.textures[&current[t.resource]].create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_mip_level: t.level,
+                mip_level_count: Some(1),
+                base_array_layer: 0,
+                array_layer_count: Some(1),
+                ..Default::default()
+            })
+        })
+        .collect();
+    let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = raster
+        .targets
+        .iter()
+        .zip(&views)
+        .map(|(t, view)| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: match t.clear {
+                        Some([r, g, b, a]) => wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
+                        None => wgpu::LoadOp::Load,
+                    },
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        })
+        .collect();
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: None,
+        color_attachments: &attachments,
+        depth_stencil_attachment: None,
+        timestamp_writes: stamps.map(|query_set| wgpu::RenderPassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: Some(0),
+            end_of_pass_write_index: Some(1),
+        }),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    for (g, group) in groups.iter().enumerate() {
+        pass.set_bind_group(g as u32, group, &[]);
+    }
+    pass.draw(0..3, 0..1);
+}
+
 /// One compute pass: the pipeline, its bind groups in order, the dispatch.
 fn encode_dispatch(
     encoder: &mut wgpu::CommandEncoder,
-    compiled: &Compiled,
+    pipeline: &wgpu::ComputePipeline,
     groups: &[wgpu::BindGroup],
     workgroups: [u32; 3],
     stamps: Option<&wgpu::QuerySet>,
@@ -647,7 +770,7 @@ fn encode_dispatch(
             end_of_pass_write_index: Some(1),
         }),
     });
-    pass.set_pipeline(&compiled.pipeline);
+    pass.set_pipeline(pipeline);
     for (g, group) in groups.iter().enumerate() {
         pass.set_bind_group(g as u32, group, &[]);
     }

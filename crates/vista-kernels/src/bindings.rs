@@ -120,6 +120,40 @@ pub fn undecorate(name: &str) -> (String, Option<String>) {
     }
 }
 
+/// The entry point `entry` of `stage` in `module`.
+fn entry_point<'m>(module: &'m naga::Module, entry: &str, stage: naga::ShaderStage) -> Option<&'m naga::EntryPoint> {
+    module.entry_points.iter().find(|e| e.name == entry && e.stage == stage)
+}
+
+/// WGSL's word for a stage.
+fn stage_name(stage: naga::ShaderStage) -> &'static str {
+    match stage {
+        naga::ShaderStage::Fragment => "fragment",
+        naga::ShaderStage::Vertex => "vertex",
+        _ => "compute",
+    }
+}
+
+/// The `@location(n)` outputs of fragment entry `entry`, ascending (a
+/// struct's members or a single result).
+pub fn fragment_outputs(module: &naga::Module, entry: &str) -> Vec<u32> {
+    let Some(ep) = entry_point(module, entry, naga::ShaderStage::Fragment) else { return Vec::new() };
+    let Some(result) = &ep.function.result else { return Vec::new() };
+    let location = |b: &Option<naga::Binding>| match b {
+        Some(naga::Binding::Location { location, .. }) => Some(*location),
+        _ => None,
+    };
+    let mut out: Vec<u32> = match (&result.binding, &module.types[result.ty].inner) {
+        (Some(_), _) => location(&result.binding).into_iter().collect(),
+        (None, naga::TypeInner::Struct { members, .. }) => {
+            members.iter().filter_map(|m| location(&m.binding)).collect()
+        }
+        _ => Vec::new(),
+    };
+    out.sort_unstable();
+    out
+}
+
 /// A WGSL spelling of a global's type, for messages.
 pub fn wgsl_type(module: &naga::Module, var: &naga::GlobalVariable) -> String {
     let ty = &module.types[var.ty];
@@ -220,22 +254,23 @@ fn reached(module: &naga::Module, entry: &naga::Function) -> Vec<Handle<naga::Gl
 /// Every binding `entry` of `module` reaches, each with what feeds it
 /// (any kind SPEC 14 names); only a type no resource can feed, or an
 /// unknown entry point, is refused.
-pub fn reflect_all(kernel: &str, shader: &str, entry: &str, module: &naga::Module) -> Result<Vec<Binding>, ParamError> {
+pub fn reflect_all(
+    kernel: &str,
+    shader: &str,
+    entry: &str,
+    stage: naga::ShaderStage,
+    module: &naga::Module,
+) -> Result<Vec<Binding>, ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
-    let ep = module.entry_points.iter().find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute).ok_or_else(
-        || {
-            let compute: Vec<&str> = module
-                .entry_points
-                .iter()
-                .filter(|e| e.stage == naga::ShaderStage::Compute)
-                .map(|e| e.name.as_str())
-                .collect();
-            bad(format!(
-                "{shader} has no compute entry point '{entry}'; its compute entry points: {}",
-                if compute.is_empty() { "none".to_string() } else { compute.join(", ") }
-            ))
-        },
-    )?;
+    let ep = entry_point(module, entry, stage).ok_or_else(|| {
+        let kind = stage_name(stage);
+        let named: Vec<&str> =
+            module.entry_points.iter().filter(|e| e.stage == stage).map(|e| e.name.as_str()).collect();
+        bad(format!(
+            "{shader} has no {kind} entry point '{entry}'; its {kind} entry points: {}",
+            if named.is_empty() { "none".to_string() } else { named.join(", ") }
+        ))
+    })?;
     let mut out: Vec<Binding> = Vec::new();
     // In binding order, so that every message names the same variable first.
     let mut globals = reached(module, &ep.function);

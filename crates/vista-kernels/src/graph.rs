@@ -145,11 +145,49 @@ pub enum Repeat {
     Param(String),
 }
 
+/// How a render pass's output meets its target (`blend`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Blend {
+    /// `replace` (the default).
+    Replace,
+    /// `alpha`: over, by the output's alpha.
+    Alpha,
+    /// `additive`: added.
+    Additive,
+}
+
+/// One of a render pass's `targets`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetSpec {
+    /// The texture (and mip level) drawn into.
+    pub texture: Level,
+    /// `clear = [r, g, b, a]`: cleared before the draw; without, drawn
+    /// over what the texture holds (texels a full-screen pass leaves keep
+    /// the unwritten sentinel).
+    pub clear: Option<[f64; 4]>,
+    /// `blend`.
+    pub blend: Blend,
+}
+
+/// What makes a pass a render pass (`kind = "render"`, SPEC 17): so far
+/// `vertex = "fullscreen"`, vista's full-screen triangle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RasterSpec {
+    /// `@location(n)` of the fragment entry goes to `targets[n]`.
+    pub targets: Vec<TargetSpec>,
+}
+
+/// The keys of a render pass's target table.
+pub const TARGET_KEYS: [&str; 3] = ["resource", "clear", "blend"];
+
 /// One `[[pass]]` table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PassSpec {
-    /// The compute entry point (default `main`).
+    /// The compute entry point (default `main`), or a render pass's
+    /// `fragment` entry.
     pub entry: String,
+    /// A render pass's vertex stage and targets; `None`: a compute pass.
+    pub raster: Option<RasterSpec>,
     /// Default: the manifest's shader.
     pub shader: Option<String>,
     /// Shader defs (`NAME=value`) merged over the kernel's `defs` for this
@@ -290,8 +328,23 @@ pub const RESOURCE_KEYS: [&str; 13] = [
     "compare",
 ];
 /// The keys of a `[[pass]]` table.
-pub const PASS_KEYS: [&str; 11] =
-    ["entry", "shader", "defs", "source", "bind", "dispatch", "workgroups", "set", "repeat", "swap", "group"];
+pub const PASS_KEYS: [&str; 15] = [
+    "kind",
+    "entry",
+    "vertex",
+    "fragment",
+    "targets",
+    "shader",
+    "defs",
+    "source",
+    "bind",
+    "dispatch",
+    "workgroups",
+    "set",
+    "repeat",
+    "swap",
+    "group",
+];
 /// The keys of an `[[output]]` table.
 pub const OUTPUT_KEYS: [&str; 5] = ["resource", "view", "partial", "tolerance", "exposure"];
 
@@ -560,7 +613,11 @@ fn parse_passes(
             }
         }
         let text = |k: &str| string_key(t, k, &at);
-        let entry = text("entry")?.unwrap_or_else(|| "main".into());
+        let raster = parse_raster(t, res, &at)?;
+        let entry = match &raster {
+            Some(_) => text("fragment")?.ok_or_else(|| at("a render pass needs fragment = \"<entry>\"".into()))?,
+            None => text("entry")?.unwrap_or_else(|| "main".into()),
+        };
         if entry.is_empty() || !entry.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
             return Err(at(format!("entry = \"{entry}\" is not a WGSL function name")));
         }
@@ -677,9 +734,95 @@ fn parse_passes(
                 _ => {}
             }
         }
-        out_passes.push(PassSpec { entry, shader, defs, source, bind, dispatch, workgroups, set, repeat, swap, group });
+        if raster.is_some() && (dispatch.is_some() || workgroups.is_some()) {
+            return Err(at("a render pass draws its targets; dispatch and workgroups are for compute passes".into()));
+        }
+        out_passes.push(PassSpec {
+            entry,
+            raster,
+            shader,
+            defs,
+            source,
+            bind,
+            dispatch,
+            workgroups,
+            set,
+            repeat,
+            swap,
+            group,
+        });
     }
     Ok(out_passes)
+}
+
+/// A pass's `kind` and, for `kind = "render"`, its `vertex` and `targets`
+/// (the `fragment` entry is read with `entry`); the keys of one kind on
+/// the other are refused.
+fn parse_raster(
+    t: &toml::Table,
+    res: &[ResourceSpec],
+    at: &dyn Fn(String) -> ParamError,
+) -> Result<Option<RasterSpec>, ParamError> {
+    let kind = string_key(t, "kind", at)?;
+    match kind.as_deref() {
+        None | Some("compute") => {
+            if let Some(k) = ["vertex", "fragment", "targets"].into_iter().find(|k| t.contains_key(*k)) {
+                return Err(at(format!("{k} is a render pass's key; add kind = \"render\"")));
+            }
+            return Ok(None);
+        }
+        Some("render") => {}
+        Some(other) => return Err(at(format!("kind = \"{other}\" is not valid; expected compute|render"))),
+    }
+    if t.contains_key("entry") {
+        return Err(at("a render pass names its fragment entry as fragment = \"...\", not entry".into()));
+    }
+    match string_key(t, "vertex", at)?.as_deref() {
+        None | Some("fullscreen") => {}
+        Some(other) => {
+            return Err(at(format!(
+                "vertex = \"{other}\" is not supported yet; expected \"fullscreen\" (vista's full-screen triangle)"
+            )));
+        }
+    }
+    let Some(toml::Value::Array(list)) = t.get("targets") else {
+        return Err(at("a render pass needs targets = [{ resource = \"...\" }, ...]".into()));
+    };
+    let mut targets = Vec::new();
+    for (n, v) in list.iter().enumerate() {
+        let tat = |m: String| at(format!("targets[{n}]: {m}"));
+        let Some(tt) = v.as_table() else { return Err(tat("must be a table { resource = \"...\" }".into())) };
+        if let Some(k) = tt.keys().find(|k| !TARGET_KEYS.contains(&k.as_str())) {
+            return Err(tat(format!("unknown key {k}; allowed: {}", TARGET_KEYS.join(", "))));
+        }
+        let name = string_key(tt, "resource", &tat)?.ok_or_else(|| tat("needs resource = \"...\"".into()))?;
+        let texture = Level::parse(&name, res).map_err(|m| tat(format!("resource = {m}")))?;
+        let clear = match tt.get("clear") {
+            None => None,
+            Some(toml::Value::Array(c)) if c.len() == 4 => {
+                let v: Vec<f64> =
+                    c.iter().filter_map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64))).collect();
+                match <[f64; 4]>::try_from(v) {
+                    Ok(c) if c.iter().all(|x| x.is_finite()) => Some(c),
+                    _ => return Err(tat("clear must be four finite numbers [r, g, b, a]".into())),
+                }
+            }
+            Some(other) => return Err(tat(format!("clear = {other} is not valid; expected [r, g, b, a]"))),
+        };
+        let blend = match string_key(tt, "blend", &tat)?.as_deref() {
+            None | Some("replace") => Blend::Replace,
+            Some("alpha") => Blend::Alpha,
+            Some("additive") => Blend::Additive,
+            Some(other) => {
+                return Err(tat(format!("blend = \"{other}\" is not valid; expected replace|alpha|additive")));
+            }
+        };
+        targets.push(TargetSpec { texture, clear, blend });
+    }
+    if targets.is_empty() {
+        return Err(at("targets is empty; a render pass draws into at least one texture".into()));
+    }
+    Ok(Some(RasterSpec { targets }))
 }
 
 /// The `[[output]]` tables: resource, view, exposure, partial, tolerance.
@@ -1087,11 +1230,70 @@ pub fn resolve(
             slots.push(PassSlot { group: b.group, binding: b.binding, var: b.name.clone(), feed, element, level });
         }
         check_levels(&slots, &resources, &label, &bad)?;
+        if let Some(raster) = &pass.raster {
+            check_targets(raster, &slots, &mut resources, module, &pass.entry, &label, &bad)?;
+        }
         all_slots.push(slots);
     }
     let outputs = check_swaps_and_outputs(graph, &resources, &bad)?;
     check_default_output(graph, &resources, &all_slots, &bad)?;
     Ok(Resolved { resources, slots: all_slots, outputs })
+}
+
+/// A render pass's targets: each a 2d texture (or one level of one) that
+/// the pass does not also bind, marked written; `@location(n)` of the
+/// fragment entry for each `targets[n]`, and no output without a target.
+fn check_targets(
+    raster: &RasterSpec,
+    slots: &[PassSlot],
+    resources: &mut [ResolvedResource],
+    module: &naga::Module,
+    entry: &str,
+    label: &str,
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<(), ParamError> {
+    for (n, t) in raster.targets.iter().enumerate() {
+        let ri = find(resources, &t.texture.resource);
+        let name = &t.texture.resource;
+        if kind_of(resources, ri) != "texture" {
+            return Err(bad(format!(
+                "{label}: targets[{n}] names {name}, a {}; a target is a texture",
+                kind_of(resources, ri)
+            )));
+        }
+        if let Some(s) = slots.iter().find(|s| matches!(s.feed, SlotFeed::Resource(r, _) if r == ri)) {
+            return Err(bad(format!(
+                "{label}: targets[{n}] {name} is also bound to {} in this pass; a pass cannot draw into what it reads",
+                s.var
+            )));
+        }
+        let r = &mut resources[ri];
+        match r.dimension {
+            None => r.dimension = Some(Dimension::D2),
+            Some(Dimension::D2) => {}
+            Some(d) => {
+                return Err(bad(format!(
+                    "{label}: targets[{n}] {name} is a {} texture; render targets are 2d so far",
+                    d.name()
+                )));
+            }
+        }
+        r.written = true;
+    }
+    let outputs = crate::bindings::fragment_outputs(module, entry);
+    if let Some(extra) = outputs.iter().find(|&&l| l as usize >= raster.targets.len()) {
+        return Err(bad(format!(
+            "{label}: {entry}'s output @location({extra}) has no target; targets has {} (targets[n] takes @location(n))",
+            raster.targets.len()
+        )));
+    }
+    if let Some(n) = (0..raster.targets.len()).find(|n| !outputs.contains(&(*n as u32))) {
+        return Err(bad(format!(
+            "{label}: targets[{n}] ({}) has no @location({n}) output in {entry}",
+            raster.targets[n].texture.resource
+        )));
+    }
+    Ok(())
 }
 
 /// A pass's `bind` may name a global its entry point does not reach (one

@@ -671,7 +671,11 @@ impl Kernel {
         let g = self.graph();
         let mut reflected = Vec::new();
         for ((shader, module), pass) in modules.iter().zip(&g.passes) {
-            reflected.push(bindings::reflect_all(self.name(), shader, &pass.entry, module)?);
+            let stage = match pass.raster {
+                Some(_) => naga::ShaderStage::Fragment,
+                None => naga::ShaderStage::Compute,
+            };
+            reflected.push(bindings::reflect_all(self.name(), shader, &pass.entry, stage, module)?);
         }
         let passes: Vec<(&str, &[bindings::Binding], &naga::Module)> =
             modules.iter().zip(&reflected).map(|((s, m), b)| (*s, b.as_slice(), *m)).collect();

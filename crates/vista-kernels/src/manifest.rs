@@ -110,7 +110,11 @@ struct RawManifest {
 #[serde(deny_unknown_fields)]
 #[allow(dead_code)]
 struct RawPass {
+    kind: Option<toml::Value>,
     entry: Option<String>,
+    vertex: Option<toml::Value>,
+    fragment: Option<toml::Value>,
+    targets: Option<toml::Value>,
     workgroups: Option<Vec<toml::Value>>,
     /// WGSL variable name -> resource name.
     bind: Option<toml::Table>,

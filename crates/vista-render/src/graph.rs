@@ -378,8 +378,6 @@ impl Planning<'_> {
             pp = pp.with(kernel.params(), k, v).map_err(|e| bad(format!("{label}: set: {e}")))?;
         }
         let constants = kernel.overrides_in(module, &pp, false).map_err(|e| RenderError::BadInput(e.to_string()))?;
-        let size = crate::reflect::workgroup_size(module, &pass.entry, &constants)
-            .map_err(|e| bad(format!("{label}: {e}")))?;
         let blocks = kernel.uniforms(layout, &pp, width, height);
         let table = kernel.table(layout, &pp);
         let mut gslots = Vec::new();
@@ -404,6 +402,58 @@ impl Planning<'_> {
             };
             gslots.push(GraphSlot { group: s.group, binding: s.binding, bind });
         }
+        let (size, workgroups, raster) = match &pass.raster {
+            // A render pass draws; it dispatches nothing.
+            Some(r) => ([1; 3], [1; 3], Some(self.raster(r, &label, resources, &index)?)),
+            None => {
+                let size = crate::reflect::workgroup_size(module, &pass.entry, &constants)
+                    .map_err(|e| bad(format!("{label}: {e}")))?;
+                (size, self.dispatch(pass, slots, resources, resolved, &pp, size, &label)?, None)
+            }
+        };
+        let repeat = match &pass.repeat {
+            vista_kernels::graph::Repeat::Count(n) => *n,
+            vista_kernels::graph::Repeat::Param(name) => {
+                let n = pp.int(name);
+                u32::try_from(n)
+                    .ok()
+                    .filter(|n| (1..=100_000).contains(n))
+                    .ok_or_else(|| bad(format!("{label}: repeat = {name} is {n}; allowed: [1, 100000]")))?
+            }
+        };
+        let swap = pass.swap.iter().map(|(a, b)| (index(a), index(b))).collect();
+        Ok(vista_gpu::GraphPass {
+            label,
+            shader: file.to_string(),
+            entry: pass.entry.clone(),
+            constants,
+            workgroups,
+            slots: gslots,
+            repeat,
+            swap,
+            span: g.span(i) as u32,
+            workgroup_size: size,
+            raster,
+        })
+    }
+
+    /// A compute pass's workgroup counts: its `workgroups`, else its
+    /// `dispatch` resource (or the one texture it writes, else the case
+    /// size) covered with the reflected workgroup size `size`.
+    #[allow(clippy::too_many_arguments)]
+    fn dispatch(
+        &self,
+        pass: &vista_kernels::graph::PassSpec,
+        slots: &[vista_kernels::graph::PassSlot],
+        resources: &[vista_gpu::Resource],
+        resolved: &vista_kernels::graph::Resolved,
+        pp: &ParamSet,
+        size: [u32; 3],
+        label: &str,
+    ) -> Result<[u32; 3], RenderError> {
+        let (width, height) = (self.width, self.height);
+        let bad = |m: String| self.bad(m);
+        let index = |name: &str| resolved.resources.iter().position(|r| r.spec.name == name).expect("resolved");
         let cover = |r: usize, level: u32| -> [u32; 3] {
             match &resources[r] {
                 vista_gpu::Resource::Texture(t) => {
@@ -417,11 +467,11 @@ impl Planning<'_> {
                 vista_gpu::Resource::Sampler(_) => [width, height, 1],
             }
         };
-        let workgroups = match (&pass.workgroups, &pass.dispatch) {
+        Ok(match (&pass.workgroups, &pass.dispatch) {
             (Some(exprs), _) => {
                 let mut out = [1u32; 3];
                 for (k, e) in exprs.iter().enumerate() {
-                    let v = e.eval(&pp, width, height).map_err(|m| bad(format!("{label}: workgroups[{k}] {m}")))?;
+                    let v = e.eval(pp, width, height).map_err(|m| bad(format!("{label}: workgroups[{k}] {m}")))?;
                     out[k] = u32::try_from(v).ok().filter(|v| (1..=65535).contains(v)).ok_or_else(|| {
                         bad(format!("{label}: workgroups[{k}] is {v} for these params; allowed: [1, 65535]"))
                     })?;
@@ -455,30 +505,59 @@ impl Planning<'_> {
                 }
                 wg
             }
-        };
-        let repeat = match &pass.repeat {
-            vista_kernels::graph::Repeat::Count(n) => *n,
-            vista_kernels::graph::Repeat::Param(name) => {
-                let n = pp.int(name);
-                u32::try_from(n)
-                    .ok()
-                    .filter(|n| (1..=100_000).contains(n))
-                    .ok_or_else(|| bad(format!("{label}: repeat = {name} is {n}; allowed: [1, 100000]")))?
-            }
-        };
-        let swap = pass.swap.iter().map(|(a, b)| (index(a), index(b))).collect();
-        Ok(vista_gpu::GraphPass {
-            label,
-            shader: file.to_string(),
-            entry: pass.entry.clone(),
-            constants,
-            workgroups,
-            slots: gslots,
-            repeat,
-            swap,
-            span: g.span(i) as u32,
-            workgroup_size: size,
         })
+    }
+
+    /// A render pass's targets as the engine draws them: each a
+    /// renderable format (blended only where the format allows), all of
+    /// one size.
+    fn raster(
+        &self,
+        r: &vista_kernels::graph::RasterSpec,
+        label: &str,
+        resources: &[vista_gpu::Resource],
+        index: &dyn Fn(&str) -> usize,
+    ) -> Result<vista_gpu::Raster, RenderError> {
+        let mut targets = Vec::new();
+        let mut size: Option<(u32, u32, String)> = None;
+        for (n, t) in r.targets.iter().enumerate() {
+            let ri = index(&t.texture.resource);
+            let name = &t.texture.resource;
+            let vista_gpu::Resource::Texture(desc) = &resources[ri] else { unreachable!("resolve checks targets") };
+            let level = t.texture.level.unwrap_or(0);
+            let format = vista_texel::Format::parse(desc.format).map_err(|m| self.bad(m))?;
+            if desc.format == "rgba8snorm" {
+                return Err(self.bad(format!(
+                    "{label}: targets[{n}] {name} is rgba8snorm, which WebGPU cannot render to; give it another format"
+                )));
+            }
+            let blend = match t.blend {
+                vista_kernels::graph::Blend::Replace => vista_gpu::Blend::Replace,
+                vista_kernels::graph::Blend::Alpha => vista_gpu::Blend::Alpha,
+                vista_kernels::graph::Blend::Additive => vista_gpu::Blend::Additive,
+            };
+            if blend != vista_gpu::Blend::Replace
+                && (format.sample_kind() != vista_texel::SampleKind::Float || format.is_float32())
+            {
+                return Err(self.bad(format!(
+                    "{label}: targets[{n}] {name} is {}, which does not blend (integer formats never; 32-bit floats \
+                     need float32-blendable, not requested yet); use blend = \"replace\"",
+                    desc.format
+                )));
+            }
+            let (w, h) = ((desc.width >> level).max(1), (desc.height >> level).max(1));
+            match &size {
+                Some((w0, h0, first)) if (*w0, *h0) != (w, h) => {
+                    return Err(self.bad(format!(
+                        "{label}: targets[{n}] {name} is {w}x{h} but {first} is {w0}x{h0}; a pass's targets share one size"
+                    )));
+                }
+                Some(_) => {}
+                None => size = Some((w, h, name.clone())),
+            }
+            targets.push(vista_gpu::RasterTarget { resource: ri, level, clear: t.clear, blend });
+        }
+        Ok(vista_gpu::Raster { targets })
     }
 
     /// The outputs as planned, and the resource each reads.
