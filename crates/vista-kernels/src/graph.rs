@@ -1237,11 +1237,12 @@ pub fn resolve(
     }
     let outputs = check_swaps_and_outputs(graph, &resources, &bad)?;
     check_default_output(graph, &resources, &all_slots, &bad)?;
+    check_read_before_written(graph, &resources, &bad)?;
     Ok(Resolved { resources, slots: all_slots, outputs })
 }
 
 /// A render pass's targets: each a 2d texture (or one level of one) that
-/// the pass does not also bind, marked written; `@location(n)` of the
+/// the pass does not also bind at that level, marked written; `@location(n)` of the
 /// fragment entry for each `targets[n]`, and no output without a target.
 fn check_targets(
     raster: &RasterSpec,
@@ -1261,9 +1262,14 @@ fn check_targets(
                 kind_of(resources, ri)
             )));
         }
-        if let Some(s) = slots.iter().find(|s| matches!(s.feed, SlotFeed::Resource(r, _) if r == ri)) {
+        // Another level of the same texture may be read (a mip chain).
+        let drawn = t.texture.level.unwrap_or(0);
+        let overlaps =
+            |s: &&PassSlot| matches!(s.feed, SlotFeed::Resource(r, _) if r == ri) && s.level.is_none_or(|l| l == drawn);
+        if let Some(s) = slots.iter().find(overlaps) {
             return Err(bad(format!(
-                "{label}: targets[{n}] {name} is also bound to {} in this pass; a pass cannot draw into what it reads",
+                "{label}: targets[{n}] {name} is also bound to {} in this pass; a pass cannot draw into what it \
+                 reads (another mip level of it, \"{name}@k\", it may)",
                 s.var
             )));
         }
@@ -1292,6 +1298,32 @@ fn check_targets(
             "{label}: targets[{n}] ({}) has no @location({n}) output in {entry}",
             raster.targets[n].texture.resource
         )));
+    }
+    Ok(())
+}
+
+/// A texture that passes read but none writes, no swap exchanges and no
+/// file fills holds only zeros: a `bind` left out (the writing pass's
+/// variable got an implicit texture of its own), refused naming the
+/// resource. (Swapped state starts as zeros on purpose.)
+fn check_read_before_written(
+    graph: &GraphSpec,
+    resources: &[ResolvedResource],
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<(), ParamError> {
+    let swapped = |name: &str| graph.passes.iter().any(|p| p.swap.iter().any(|(a, b)| a == name || b == name));
+    for r in resources {
+        if let ResourceKind::Texture { file: None, .. } = &r.spec.kind
+            && r.read
+            && !r.written
+            && !swapped(&r.spec.name)
+        {
+            let name = &r.spec.name;
+            return Err(bad(format!(
+                "resource {name} is read but no pass writes it and it has no file, so it would hold zeros; bind it \
+                 in the pass that writes it ({{ <variable> = \"{name}\" }}) or give it a file"
+            )));
+        }
     }
     Ok(())
 }
