@@ -9,8 +9,6 @@ use vista_image::Image;
 use vista_kernels::Kernel;
 use vista_render::{OutputValue, Plan, Renderer};
 
-use crate::bad;
-
 /// The file output `name` goes to, given `-o out` (the first output: `out`).
 pub fn output_path(out: &Path, first: bool, name: &str, buffer: bool) -> PathBuf {
     let ext = match (buffer, out.extension().and_then(|e| e.to_str())) {
@@ -24,26 +22,6 @@ pub fn output_path(out: &Path, first: bool, name: &str, buffer: bool) -> PathBuf
     }
     let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
     out.with_file_name(format!("{stem}.{name}.{ext}"))
-}
-
-/// `-o`'s extension fits the kernel's first output: `.png` or `.exr` for a
-/// texture, `.npy` for a buffer; and its folder is writable.
-pub fn check_output_path(k: &Kernel, plan: &Plan, out: &Path) -> Result<(), GoldenError> {
-    let first_is_buffer =
-        matches!(plan.outputs.first().map(|o| &o.kind), Some(vista_render::PlannedKind::Buffer { .. }));
-    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
-    let want: &[&str] = if first_is_buffer { &["npy"] } else { &["png", "exr"] };
-    if !want.contains(&ext.as_str()) {
-        return Err(bad(format!(
-            "output {} must end in .{} (kernel {}'s first output, {}, is a {})",
-            out.display(),
-            want.join(" or ."),
-            k.name(),
-            plan.outputs[0].name,
-            if first_is_buffer { "buffer" } else { "texture" }
-        )));
-    }
-    crate::render::check_parent_writable(out)
 }
 
 /// Renders a kernel and writes its outputs, the first through `frame`

@@ -34,7 +34,7 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
     let shaders = vista_render::shader_set(project)?;
     // Every check that needs no device (bindings, input files) before one is made.
     let plan = vista_render::plan(&shaders, project.root(), &k, &p, &[], w, h, &config.limits)?;
-    graph_render::check_output_path(&k, &plan, &out)?;
+    check_output_path(&k, &plan, &out)?;
     // --crop and --zoom apply to the first output, a texture whose layers
     // and slices are stacked top to bottom.
     let rect = match (plan.main_texture(), crop.as_deref()) {
@@ -68,6 +68,26 @@ pub fn render(project: &Project, config: &Config, a: Args) -> Result<i32, Golden
         if zoom > 1 { img.zoom(zoom) } else { img }
     };
     graph_render::render(ctx, &k, &plan, &out, shape, frame)
+}
+
+/// `-o`'s extension fits the kernel's first output: `.png` or `.exr` for a
+/// texture, `.npy` for a buffer; and its folder is writable.
+fn check_output_path(k: &vista_kernels::Kernel, plan: &vista_render::Plan, out: &Path) -> Result<(), GoldenError> {
+    let first_is_buffer =
+        matches!(plan.outputs.first().map(|o| &o.kind), Some(vista_render::PlannedKind::Buffer { .. }));
+    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+    let want: &[&str] = if first_is_buffer { &["npy"] } else { &["png", "exr"] };
+    if !want.contains(&ext.as_str()) {
+        return Err(bad(format!(
+            "output {} must end in .{} (kernel {}'s first output, {}, is a {})",
+            out.display(),
+            want.join(" or ."),
+            k.name(),
+            plan.outputs[0].name,
+            if first_is_buffer { "buffer" } else { "texture" }
+        )));
+    }
+    check_parent_writable(out)
 }
 
 /// `X,Y,W,H` inside a `width` x `height` frame.

@@ -10,7 +10,8 @@ use vista_image::Image;
 use vista_image::metrics::{self, Metrics};
 
 use crate::Case;
-use crate::store::ManifestEntry;
+use crate::outputs::BAD_PIXEL_LIMIT;
+use crate::store::{ManifestEntry, RunInfo};
 
 /// How a case came out of [`judge`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -57,22 +58,6 @@ pub struct ReportFiles {
     pub outputs: Vec<(String, Option<String>, Option<String>)>,
     /// A pass graph's inputs: (resource, where from, an 8-bit image).
     pub inputs: Vec<(String, String, Option<String>)>,
-}
-
-/// The run's side of the provenance, beside the golden's manifest entry.
-#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
-pub struct RunInfo {
-    /// The backend name this run renders on, as reports and manifests name it
-    /// (`lavapipe`, `swiftshader`, `gpu`, ...).
-    pub backend: String,
-    /// The adapter description (`name | driver driver_info | backend | device
-    /// type`), compared with the golden's to pick the PSNR threshold.
-    pub adapter: String,
-    /// Hash of the case's kernel, size and resolved parameters ([`params_hash`](crate::params_hash)).
-    pub params_hash: String,
-    /// Hash of the WGSL the kernel reaches now (`unavailable: ...` when it
-    /// cannot be computed).
-    pub shader_hash: String,
 }
 
 /// What happened to one case. `#[must_use]`: callers decide pass/fail.
@@ -136,9 +121,6 @@ pub struct Outcome {
     /// (`<kernel>/<case>.png`, or a per-backend `<kernel>/<case>@<backend>.png`).
     pub golden_file: String,
 }
-
-/// A pixel is "bad" when a display channel differs by more than this.
-pub const BAD_PIXEL_LIMIT: &str = "1/255";
 
 impl Outcome {
     /// Whether `metrics.psnr` is of the main image's raw values (its EXR

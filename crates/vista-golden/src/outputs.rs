@@ -22,6 +22,9 @@ use vista_render::{OutputRender, OutputValue, quantize16};
 
 use crate::Case;
 
+/// A pixel is "bad" when a display channel differs by more than this.
+pub const BAD_PIXEL_LIMIT: &str = "1/255";
+
 /// The golden files of one output.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct OutputFiles {
@@ -538,11 +541,8 @@ fn thresholds(
     if let Some(t) = case.max_bad_pixels
         && m.bad_pixels > t
     {
-        v.problems.push(format!(
-            "{named}{} bad pixels (> {}) is above max_bad_pixels {t}",
-            m.bad_pixels,
-            crate::BAD_PIXEL_LIMIT
-        ));
+        v.problems
+            .push(format!("{named}{} bad pixels (> {}) is above max_bad_pixels {t}", m.bad_pixels, BAD_PIXEL_LIMIT));
     }
     let pixels = raw.width as f64 * raw.height as f64;
     if let Some(t) = case.max_bad_ratio

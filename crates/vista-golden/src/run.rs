@@ -6,8 +6,9 @@ use vista_image::Image;
 use vista_render::{Rendered, Renderer, quantize16, render_with};
 
 use crate::Case;
-use crate::check::{Observed, Outcome, RunInfo, judge};
+use crate::check::{Observed, Outcome, judge};
 use crate::outputs::GoldenFiles;
+use crate::store::RunInfo;
 use crate::store::{Manifest, Store, params_hash};
 
 /// Options for checking.

@@ -8,6 +8,22 @@ use serde::{Deserialize, Serialize};
 
 use crate::{Case, GoldenError};
 
+/// The run's side of the provenance, beside the golden's manifest entry.
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+pub struct RunInfo {
+    /// The backend name this run renders on, as reports and manifests name it
+    /// (`lavapipe`, `swiftshader`, `gpu`, ...).
+    pub backend: String,
+    /// The adapter description (`name | driver driver_info | backend | device
+    /// type`), compared with the golden's to pick the PSNR threshold.
+    pub adapter: String,
+    /// Hash of the case's kernel, size and resolved parameters ([`params_hash`](crate::params_hash)).
+    pub params_hash: String,
+    /// Hash of the WGSL the kernel reaches now (`unavailable: ...` when it
+    /// cannot be computed).
+    pub shader_hash: String,
+}
+
 /// Provenance of one golden at bless time.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct ManifestEntry {
@@ -55,7 +71,7 @@ impl ManifestEntry {
     /// Whether `run` renders what this entry's bless rendered: the same
     /// adapter, shader and params, so a deterministic kernel must
     /// reproduce `raw_hash` bit for bit.
-    pub(crate) fn same_inputs(&self, run: &crate::RunInfo) -> bool {
+    pub(crate) fn same_inputs(&self, run: &RunInfo) -> bool {
         (&self.adapter, &self.shader_hash, &self.params_hash) == (&run.adapter, &run.shader_hash, &run.params_hash)
     }
 
@@ -65,7 +81,7 @@ impl ManifestEntry {
     /// hash of the PNG's bytes.
     pub fn of_render(
         case: &Case,
-        run: &crate::RunInfo,
+        run: &RunInfo,
         shader_files: BTreeMap<String, String>,
         raw_hash: String,
         psnr_vs_previous: String,

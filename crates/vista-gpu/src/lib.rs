@@ -11,6 +11,7 @@
 mod browser_run;
 mod context;
 mod format;
+mod fullscreen;
 mod graph;
 mod limits;
 mod shaders;
@@ -22,9 +23,10 @@ pub use context::{
     AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, GpuConfig, PassHook, RunStats,
     SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
 };
+pub use fullscreen::{FULLSCREEN_ENTRY, FULLSCREEN_WGSL};
 pub use graph::{
-    Address, Bind, Blend, COMPARE_NAMES, Contents, FULLSCREEN_ENTRY, FULLSCREEN_WGSL, Graph, GraphPass, GraphSlot,
-    OutputData, Raster, RasterTarget, Readback, Resource, SamplerDesc, TextureDesc, run_order,
+    Address, Bind, Blend, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Raster, RasterTarget,
+    Readback, Resource, SamplerDesc, TextureDesc, run_order,
 };
 pub use limits::Needs;
 pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};
