@@ -632,35 +632,12 @@ fn parse_passes(
             Some(toml::Value::Table(s)) => vista_source::SourceSpec::parse(s).map_err(at)?,
             Some(other) => return Err(at(format!("source = {other} is not valid; expected a table like [source]"))),
         };
-        let mut bind = Vec::new();
-        match t.get("bind") {
-            None => {}
-            Some(toml::Value::Table(b)) => {
-                for (var, r) in b {
-                    let Some(r) = r.as_str() else {
-                        return Err(at(format!("bind: {var} = {r} is not valid; expected a resource name")));
-                    };
-                    bind.push((var.clone(), Level::parse(r, res).map_err(|m| at(format!("bind: {var} = {m}")))?));
-                }
-            }
-            Some(other) => return Err(at(format!("bind = {other} is not valid; expected a table"))),
-        }
+        let bind = parse_bind(t, res, &at)?;
         let dispatch = match text("dispatch")? {
             None => None,
             Some(d) => Some(Level::parse(&d, res).map_err(|m| at(format!("dispatch = {m}")))?),
         };
-        let workgroups = match t.get("workgroups") {
-            None => None,
-            Some(toml::Value::Array(list)) if list.len() == 3 => {
-                let mut e = Vec::new();
-                for v in list {
-                    e.push(Expr::parse_entry(v, params).map_err(|m| at(format!("workgroups {m}")))?);
-                }
-                let [x, y, z]: [Expr; 3] = e.try_into().expect("three entries");
-                Some([x, y, z])
-            }
-            Some(other) => return Err(at(format!("workgroups = {other} is not valid; expected [x, y, z]"))),
-        };
+        let workgroups = parse_workgroups(t, params, &at)?;
         if workgroups.is_some() && dispatch.is_some() {
             return Err(at("dispatch and workgroups are exclusive; give one".into()));
         }
@@ -753,6 +730,49 @@ fn parse_passes(
         });
     }
     Ok(out_passes)
+}
+
+/// A pass's `bind`: WGSL variable -> resource (and mip level).
+fn parse_bind(
+    t: &toml::Table,
+    res: &[ResourceSpec],
+    at: &dyn Fn(String) -> ParamError,
+) -> Result<Vec<(String, Level)>, ParamError> {
+    let mut bind = Vec::new();
+    match t.get("bind") {
+        None => {}
+        Some(toml::Value::Table(b)) => {
+            for (var, r) in b {
+                let Some(r) = r.as_str() else {
+                    return Err(at(format!("bind: {var} = {r} is not valid; expected a resource name")));
+                };
+                bind.push((var.clone(), Level::parse(r, res).map_err(|m| at(format!("bind: {var} = {m}")))?));
+            }
+        }
+        Some(other) => return Err(at(format!("bind = {other} is not valid; expected a table"))),
+    }
+    Ok(bind)
+}
+
+/// A pass's explicit `workgroups = [x, y, z]`, expressions of the params
+/// and the case size.
+fn parse_workgroups(
+    t: &toml::Table,
+    params: &[ParamSpec],
+    at: &dyn Fn(String) -> ParamError,
+) -> Result<Option<[Expr; 3]>, ParamError> {
+    match t.get("workgroups") {
+        None => Ok(None),
+        Some(toml::Value::Array(list)) if list.len() == 3 => {
+            let mut e = Vec::new();
+            for v in list {
+                e.push(Expr::parse_entry(v, params).map_err(|m| at(format!("workgroups {m}")))?);
+            }
+            let [x, y, z]: [Expr; 3] = e.try_into().expect("three entries");
+            Ok(Some([x, y, z]))
+        }
+        Some(other) => Err(at(format!("workgroups = {other} is not valid; expected [x, y, z]"))),
+    }
 }
 
 /// A pass's `kind` and, for `kind = "render"`, its `vertex` and `targets`
