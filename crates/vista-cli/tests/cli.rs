@@ -568,6 +568,9 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
         ),
         "the thumbnail links to the golden"
     );
+    // fbm's one image judged by the case's thresholds: its metrics say it
+    // all, so no outputs table repeats it.
+    assert!(!index.contains("<table class=\"outputs\">"), "a lone plain main image gets no outputs table");
     let r = vista_in(Some(d.path()), &[], &["check", "--full-report"]);
     assert_eq!(r.code, 1, "{}", r.stdout);
     for f in ["actual.png", "expected.png", "view.js"] {
