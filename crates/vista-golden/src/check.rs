@@ -238,8 +238,6 @@ pub struct Observed<'a> {
     pub raw: &'a Image,
     /// Its [`Image::content_hash`], taken once by the caller.
     pub raw_hash: &'a str,
-    /// Texels of the output the kernel never wrote.
-    pub unwritten: u64,
     /// The output's storage format: an integer one compares exactly.
     pub format: &'a str,
     /// Whether a second render in this process was bit-identical; `None`

@@ -213,7 +213,6 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
                 .collect();
             let observed = Observed {
                 raw_hash: &raw_hash,
-                unwritten: r.unwritten,
                 format: r.format,
                 raw: &r.raw,
                 repeat_identical: *repeat_identical,

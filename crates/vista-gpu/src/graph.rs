@@ -266,18 +266,6 @@ pub struct GraphSlot {
     pub bind: Bind,
 }
 
-/// How a render pass's fragment output meets what its target holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Blend {
-    /// The output replaces the texel.
-    Replace,
-    /// `src * src.a + dst * (1 - src.a)`, alpha `src.a + dst.a * (1 - src.a)`.
-    Alpha,
-    /// `src + dst`, colour and alpha.
-    Additive,
-}
-
 /// One colour target of a render pass: `@location(n)` of its fragment
 /// entry goes to `targets[n]`.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -291,7 +279,7 @@ pub struct RasterTarget {
     /// fragment entry discards: unwritten).
     pub clear: Option<[f64; 4]>,
     /// How the output meets the texel.
-    pub blend: Blend,
+    pub blend: vista_texel::Blend,
 }
 
 /// What makes a pass a render pass (SPEC 17): vista's full-screen triangle

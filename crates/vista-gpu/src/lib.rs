@@ -25,8 +25,8 @@ pub use context::{
 };
 pub use fullscreen::{FULLSCREEN_ENTRY, FULLSCREEN_WGSL};
 pub use graph::{
-    Address, Bind, Blend, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Raster, RasterTarget,
-    Readback, Resource, SamplerDesc, TextureDesc, run_order,
+    Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Raster, RasterTarget, Readback,
+    Resource, SamplerDesc, TextureDesc, run_order,
 };
 pub use limits::Needs;
 pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};

@@ -12,11 +12,11 @@ use wgpu::util::DeviceExt;
 use crate::GpuError;
 use crate::context::{Compiled, Context, Pipeline, RunStats, WgpuEngine, read_texels};
 use crate::graph::{
-    Bind, Blend, Contents, Graph, GraphPass, OutputData, Raster, Readback, Resource, TextureDesc, compare_fn,
-    run_order, view_dimension,
+    Bind, Contents, Graph, GraphPass, OutputData, Raster, Readback, Resource, TextureDesc, compare_fn, run_order,
+    view_dimension,
 };
 use crate::spares::{Spares, TextureKey};
-use vista_texel::{Access, Format, SampleKind};
+use vista_texel::{Access, Blend, Format, SampleKind};
 
 /// Kept at most per kind: a graph's outputs, and a little more.
 const SPARES: usize = 8;
@@ -135,7 +135,10 @@ impl Context {
         let d = &w.device;
         let start = Instant::now();
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-        let (made, fill) = self.make_resources(w, g, which)?;
+        // Textures some render pass draws into: RENDER_ATTACHMENT, never pooled.
+        let targets: Vec<usize> =
+            g.passes.iter().flat_map(|p| p.raster.iter().flat_map(|r| r.targets.iter().map(|t| t.resource))).collect();
+        let (made, fill) = self.make_resources(w, g, which, &targets)?;
         let pipelines: Vec<Arc<Compiled>> =
             g.passes.iter().map(|p| self.pipeline(w, g, p)).collect::<Result<_, _>>()?;
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -210,8 +213,6 @@ impl Context {
         let stats = RunStats { gpu_wall: kernel + readback, kernel, readback, total: start.elapsed() };
         let pass_gpu_times = gpu_times.into_iter().map(|t| stamps.as_ref().map(|_| t)).collect();
         let mut spares = w.spares.lock().expect("spares");
-        let targets: Vec<usize> =
-            g.passes.iter().flat_map(|p| p.raster.iter().flat_map(|r| r.targets.iter().map(|t| t.resource))).collect();
         for (i, texture) in made.textures {
             if let Resource::Texture(t @ TextureDesc { contents: Contents::Sentinel, mip_levels: 1, .. }) =
                 &g.resources[i]
@@ -227,20 +228,19 @@ impl Context {
     }
 
     /// Creates every resource with its initial contents (`which` picks the
-    /// sentinel of sentinel-filled textures), and the copies of the sentinel
-    /// over them, to submit before the first pass.
+    /// sentinel of sentinel-filled textures; `targets` are drawn into), and
+    /// the copies of the sentinel over them, to submit before the first pass.
     fn make_resources(
         &self,
         w: &WgpuEngine,
         g: &Graph<'_>,
         which: usize,
+        targets: &[usize],
     ) -> Result<(Made, wgpu::CommandEncoder), GpuError> {
         let d = &w.device;
         let mut made =
             Made { textures: HashMap::new(), buffers: HashMap::new(), samplers: HashMap::new(), fills: Vec::new() };
         let mut fill = d.create_command_encoder(&Default::default());
-        let targets: Vec<usize> =
-            g.passes.iter().flat_map(|p| p.raster.iter().flat_map(|r| r.targets.iter().map(|t| t.resource))).collect();
         for (i, r) in g.resources.iter().enumerate() {
             match r {
                 Resource::Texture(t) => {

@@ -15,7 +15,7 @@ use crate::bindings::{Binding, Feed};
 use crate::expr::Expr;
 use crate::params::ParamSpec;
 use crate::{Output, ParamError};
-use vista_texel::{Access, Dimension};
+use vista_texel::{Access, Blend, Dimension};
 
 pub use crate::bindings::SampledKind;
 
@@ -143,17 +143,6 @@ pub enum Repeat {
     Count(u32),
     /// The value of this integer param.
     Param(String),
-}
-
-/// How a render pass's output meets its target (`blend`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Blend {
-    /// `replace` (the default).
-    Replace,
-    /// `alpha`: over, by the output's alpha.
-    Alpha,
-    /// `additive`: added.
-    Additive,
 }
 
 /// One of a render pass's `targets`.
@@ -829,13 +818,9 @@ fn parse_raster(
             }
             Some(other) => return Err(tat(format!("clear = {other} is not valid; expected [r, g, b, a]"))),
         };
-        let blend = match string_key(tt, "blend", &tat)?.as_deref() {
-            None | Some("replace") => Blend::Replace,
-            Some("alpha") => Blend::Alpha,
-            Some("additive") => Blend::Additive,
-            Some(other) => {
-                return Err(tat(format!("blend = \"{other}\" is not valid; expected replace|alpha|additive")));
-            }
+        let blend = match string_key(tt, "blend", &tat)? {
+            None => Blend::Replace,
+            Some(name) => Blend::parse(&name).map_err(tat)?,
         };
         targets.push(TargetSpec { texture, clear, blend });
     }

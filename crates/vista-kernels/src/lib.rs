@@ -352,10 +352,6 @@ impl Kernel {
     pub fn shader(&self) -> &str {
         &self.manifest.shader
     }
-    /// Whether texels the kernel leaves unwritten are allowed (`[[output]] partial`).
-    pub fn partial(&self) -> bool {
-        self.graph().outputs.first().is_some_and(|o| o.partial)
-    }
     /// The PNG view the manifest gives (default display).
     pub fn output(&self) -> Output {
         self.manifest.output.unwrap_or(Output::Display)

@@ -526,17 +526,14 @@ impl Planning<'_> {
             let vista_gpu::Resource::Texture(desc) = &resources[ri] else { unreachable!("resolve checks targets") };
             let level = t.texture.level.unwrap_or(0);
             let format = vista_texel::Format::parse(desc.format).map_err(|m| self.bad(m))?;
-            if desc.format == "rgba8snorm" {
+            if !format.is_renderable() {
                 return Err(self.bad(format!(
-                    "{label}: targets[{n}] {name} is rgba8snorm, which WebGPU cannot render to; give it another format"
+                    "{label}: targets[{n}] {name} is {}, which WebGPU cannot render to; give it another format",
+                    desc.format
                 )));
             }
-            let blend = match t.blend {
-                vista_kernels::graph::Blend::Replace => vista_gpu::Blend::Replace,
-                vista_kernels::graph::Blend::Alpha => vista_gpu::Blend::Alpha,
-                vista_kernels::graph::Blend::Additive => vista_gpu::Blend::Additive,
-            };
-            if blend != vista_gpu::Blend::Replace
+            let blend = t.blend;
+            if blend != vista_texel::Blend::Replace
                 && (format.sample_kind() != vista_texel::SampleKind::Float || format.is_float32())
             {
                 return Err(self.bad(format!(

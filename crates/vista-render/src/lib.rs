@@ -53,8 +53,6 @@ pub struct Rendered {
     pub raw: Image,
     /// Timing of the run.
     pub stats: RunStats,
-    /// Texels of the output the kernel never wrote (they read 0 in `raw`).
-    pub unwritten: u64,
     /// The output's storage format (an integer one compares exactly).
     pub format: &'static str,
     /// Every output, the first (the main image: for a manifest without
@@ -516,16 +514,13 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
             },
         })
         .collect();
-    let (raw, format, unwritten, display) = match outputs.first().map(|o| &o.value) {
-        Some(OutputValue::Texture { raw, format, unwritten, display, .. }) => {
-            (raw.clone(), *format, *unwritten, *display)
-        }
-        _ => (Image::new(0, 0), "rgba32float", 0, DisplayMap::identity()),
+    let (raw, format, display) = match outputs.first().map(|o| &o.value) {
+        Some(OutputValue::Texture { raw, format, display, .. }) => (raw.clone(), *format, *display),
+        _ => (Image::new(0, 0), "rgba32float", DisplayMap::identity()),
     };
     Ok(Rendered {
         raw,
         stats: out.stats,
-        unwritten,
         format,
         outputs,
         pass_times: out.pass_times,

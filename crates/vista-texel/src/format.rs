@@ -191,6 +191,12 @@ impl Format {
         self.channels[0] == Channel::Float32
     }
 
+    /// Whether a render pass may draw into it: every storage format but
+    /// the 8-bit snorm one (WebGPU's rgba8snorm is not renderable).
+    pub fn is_renderable(&self) -> bool {
+        self.channels[0] != Channel::Snorm8
+    }
+
     /// Whether the channels are unsigned or signed integers (sampled as
     /// `texture_2d<u32>` / `<i32>`), else floats (normalized ones included).
     pub fn sample_kind(&self) -> SampleKind {
@@ -221,6 +227,14 @@ impl Format {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Of the storage formats, only rgba8snorm cannot be a render target.
+    #[test]
+    fn every_storage_format_but_rgba8snorm_is_renderable() {
+        let not: Vec<&str> =
+            format_names().iter().filter(|n| !Format::parse(n).unwrap().is_renderable()).copied().collect();
+        assert_eq!(not, ["rgba8snorm"]);
+    }
 
     #[test]
     fn texels_decode_per_format() {
