@@ -72,24 +72,18 @@ function vistaChunk(offset, length) {
 // index] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
 // the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64) }; a sampler: { kind,
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
-// binding and visibility); a texture slot's view dimension is its layout's. Outputs are read back one
-// after another into vista.out: textures unpadded, layers stacked; buffers whole.
-// WebGPU's blend state for a target's `blend` (replace: none).
-const BLENDS = {
-  replace: undefined,
-  alpha: {
-    color: { srcFactor: "src-alpha", dstFactor: "one-minus-src-alpha", operation: "add" },
-    alpha: { srcFactor: "one", dstFactor: "one-minus-src-alpha", operation: "add" },
-  },
-  additive: {
-    color: { srcFactor: "one", dstFactor: "one", operation: "add" },
-    alpha: { srcFactor: "one", dstFactor: "one", operation: "add" },
-  },
-};
-
+// binding and visibility; `vertex`: the render pass's vertex entry reads it too); a texture slot's view
+// dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (vista's full-screen WGSL, or
+// null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, clear, blend
+// (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a u32
+// buffer or null), count, instances, topology, cull, depth ({ compare, write, clear } or null: the pass's own
+// depth32float texture), blend_constant }. Outputs are read back one after another into vista.out: textures
+// unpadded, layers stacked; buffers whole.
 async function pipeline(pass, resources) {
-  const targets = pass.raster ? pass.raster.targets.map((t) => [resources[t.resource].format, t.blend]) : null;
-  const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout]))}${JSON.stringify(targets)}`;
+  const targets = pass.raster ? pass.raster.targets.map((t) => ({ format: resources[t.resource].format, blend: t.blend || undefined })) : null;
+  const r = pass.raster;
+  const fixed = r ? [r.vertex_entry, r.buffers.map((b) => [b.arrayStride, b.stepMode, b.attributes]), r.topology, r.cull, r.depth, r.indices !== null] : null;
+  const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout, s.vertex]))}${JSON.stringify(targets)}${JSON.stringify(fixed)}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
   const d = vista.device;
@@ -107,19 +101,26 @@ async function pipeline(pass, resources) {
   for (let g = 0; g < count; g++) {
     const entries = pass.slots
       .filter((s) => s.group === g)
-      .map((s) => Object.assign({ binding: s.binding, visibility: pass.raster ? GPUShaderStage.FRAGMENT : GPUShaderStage.COMPUTE }, s.layout));
+      .map((s) => {
+        const S = GPUShaderStage;
+        const visibility = pass.raster ? S.FRAGMENT | (s.vertex ? S.VERTEX : 0) : S.COMPUTE;
+        return Object.assign({ binding: s.binding, visibility }, s.layout);
+      });
     groups.push(d.createBindGroupLayout({ entries }));
   }
   let p;
   try {
     const layout = d.createPipelineLayout({ bindGroupLayouts: groups });
-    if (pass.raster) {
-      const vertex = d.createShaderModule({ code: pass.raster.vertex, label: "vista full-screen triangle" });
+    if (r) {
+      // vista's full-screen triangle, or the pass's own vertex entry.
+      const vertex = r.vertex ? d.createShaderModule({ code: r.vertex, label: "vista full-screen triangle" }) : module;
+      const strip = r.indices !== null && (r.topology === "triangle-strip" || r.topology === "line-strip");
       p = await d.createRenderPipelineAsync({
         layout,
-        vertex: { module: vertex, entryPoint: pass.raster.vertex_entry },
-        fragment: { module, entryPoint: pass.entry, targets: targets.map(([format, blend]) => ({ format, blend: BLENDS[blend] })) },
-        primitive: { topology: "triangle-list" },
+        vertex: { module: vertex, entryPoint: r.vertex_entry, buffers: r.buffers.map((b) => ({ arrayStride: b.arrayStride, stepMode: b.stepMode, attributes: b.attributes })) },
+        fragment: { module, entryPoint: pass.entry, targets },
+        primitive: { topology: r.topology, cullMode: r.cull, frontFace: "ccw", ...(strip ? { stripIndexFormat: "uint32" } : {}) },
+        ...(r.depth ? { depthStencil: { format: "depth32float", depthWriteEnabled: r.depth.write, depthCompare: r.depth.compare } } : {}),
       });
     } else {
       p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: pass.entry } });
@@ -166,7 +167,7 @@ async function vistaRun(job) {
         made.push(texture);
       } else if (r.kind === "buffer") {
         const bytes = fromBase64(r.contents);
-        const buffer = d.createBuffer({ size: Math.max(4, Math.ceil(bytes.length / 4) * 4), usage: B.STORAGE | B.UNIFORM | B.COPY_SRC | B.COPY_DST, mappedAtCreation: true });
+        const buffer = d.createBuffer({ size: Math.max(4, Math.ceil(bytes.length / 4) * 4), usage: B.STORAGE | B.UNIFORM | B.VERTEX | B.INDEX | B.COPY_SRC | B.COPY_DST, mappedAtCreation: true });
         new Uint8Array(buffer.getMappedRange()).set(bytes);
         buffer.unmap();
         made.push(buffer);
@@ -233,10 +234,27 @@ async function vistaRun(job) {
               ? { view, loadOp: "clear", clearValue: t.clear, storeOp: "store" }
               : { view, loadOp: "load", storeOp: "store" };
           });
-          const rp = encoder.beginRenderPass({ colorAttachments });
+          const r = pass.raster;
+          // The pass's own depth buffer, the size of its first target's level.
+          let depthStencilAttachment;
+          if (r.depth) {
+            const t0 = r.targets[0];
+            const desc = job.resources[t0.resource];
+            const size = [Math.max(1, desc.width >> t0.level), Math.max(1, desc.height >> t0.level)];
+            const depth = d.createTexture({ size, format: "depth32float", usage: GPUTextureUsage.RENDER_ATTACHMENT });
+            depthStencilAttachment = { view: depth.createView(), depthClearValue: r.depth.clear, depthLoadOp: "clear", depthStoreOp: "store" };
+          }
+          const rp = encoder.beginRenderPass({ colorAttachments, ...(depthStencilAttachment ? { depthStencilAttachment } : {}) });
           rp.setPipeline(compiled[p].pipeline);
           bindGroups.forEach((group, g) => rp.setBindGroup(g, group));
-          rp.draw(3);
+          if (r.blend_constant) rp.setBlendConstant(r.blend_constant);
+          r.buffers.forEach((b, slot) => rp.setVertexBuffer(slot, made[current[b.resource]]));
+          if (r.indices !== null) {
+            rp.setIndexBuffer(made[current[r.indices]], "uint32");
+            rp.drawIndexed(r.count, r.instances);
+          } else {
+            rp.draw(r.count, r.instances);
+          }
           rp.end();
         } else {
           const cp = encoder.beginComputePass();

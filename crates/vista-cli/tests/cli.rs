@@ -4854,13 +4854,181 @@ fn copy(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     }
 }
 
+/// A draw (SPEC 17): a vertex entry of the pass's shader fed by vertex
+/// buffers (reflected and explicit, per vertex and per instance), an index
+/// buffer, a depth test, blend factors with a constant and culling, drawn
+/// alike on lavapipe, SwiftShader and Chromium; uncovered texels keep the
+/// clear value and are not unwritten; what a draw cannot feed is refused
+/// before GPU work, one line naming pass, entry and location.
+fn a_draw_reads_vertex_buffers_indices_and_depth() {
+    const SHADER: &str = "struct Params { width: u32, height: u32, gain: f32 }
+@group(0) @binding(0) var<uniform> params: Params;
+
+@vertex
+fn flat(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
+    return vec4(p * min(params.gain, 1.0), 0.5, 1.0);
+}
+
+@vertex
+fn placed(@location(0) p: vec2<f32>, @location(1) shift: vec2<f32>) -> @builtin(position) vec4<f32> {
+    return vec4(p + shift, 0.5, 1.0);
+}
+
+struct Lit { @builtin(position) pos: vec4<f32>, @location(0) color: vec4<f32> }
+
+@vertex
+fn layered(@location(0) p: vec3<f32>, @location(1) color: vec4<f32>) -> Lit {
+    return Lit(vec4(p.xy, p.z, 1.0), color * min(params.gain, 1.0));
+}
+
+@fragment
+fn fill() -> @location(0) vec4<f32> {
+    return vec4(params.gain);
+}
+
+@fragment
+fn colored(in: Lit) -> @location(0) vec4<f32> {
+    return in.color;
+}
+
+struct Corner { p: vec3<f32>, color: vec4<f32> }
+@group(0) @binding(1) var<storage, read_write> corners: array<Corner>;
+
+@compute @workgroup_size(6)
+fn build(@builtin(local_invocation_index) i: u32) {
+    var xy = array(vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, 1.0));
+    corners[i] = Corner(vec3(xy[i], 0.5), vec4(0.25, 0.5, 0.75, 1.0));
+}
+";
+    let manifest = |body: &str| {
+        format!(
+            "summary = \"draws\"\n[[param]]\nname = \"gain\"\ntype = \"f32\"\nrange = [0, 4]\ndefault = 1.0\n\
+             doc = \"gain\"\n[[resource]]\nname = \"image\"\nkind = \"texture\"\nformat = \"rgba32float\"\n{body}"
+        )
+    };
+    let render = |body: &str, backend: &str| {
+        let d = kernel_project(&manifest(body), SHADER);
+        let out = d.path().join("o.exr");
+        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}\n{body}", r.stderr);
+        vista_image::load(&out).unwrap()
+    };
+    // The left half as an indexed quad; the right half keeps the clear value (zeros).
+    let indexed = "[[resource]]\nname = \"quad\"\nkind = \"buffer\"\ndata = [-1, -1, 0, -1, 0, 1, -1, 1]\n\
+                   [[resource]]\nname = \"ix\"\nkind = \"buffer\"\ndata = [0, 1, 2, 0, 2, 3]\n\
+                   [[pass]]\nkind = \"render\"\nvertex = \"flat\"\nfragment = \"fill\"\nvertices = [\"quad\"]\n\
+                   indices = \"ix\"\ntargets = [{ resource = \"image\" }]\n";
+    // A quad over texels x 0-1, y 0-1, twice: the second instance 4 texels right.
+    let instanced = "[[resource]]\nname = \"tri\"\nkind = \"buffer\"\n\
+                     data = [-1, 1, -0.5, 1, -1, 0, -0.5, 1, -0.5, 0, -1, 0]\n\
+                     [[resource]]\nname = \"shifts\"\nkind = \"buffer\"\ndata = [0, 0, 1, 0]\n\
+                     [[pass]]\nkind = \"render\"\nvertex = \"placed\"\nfragment = \"fill\"\n\
+                     vertices = [\"tri\", { resource = \"shifts\", step = \"instance\", attributes = [{ location = 1, format = \"float32x2\" }] }]\n\
+                     targets = [{ resource = \"image\", clear = [0.25, 0.25, 0.25, 0.25] }]\n";
+    // Two full-screen quads: red at depth 0.2 first, green at 0.6 after it.
+    let quad = |z: f64, c: &str| {
+        [(-1, -1), (1, -1), (1, 1), (-1, -1), (1, 1), (-1, 1)].map(|(x, y)| format!("{x}, {y}, {z}, {c}")).join(", ")
+    };
+    let layers = format!(
+        "[[resource]]\nname = \"layers\"\nkind = \"buffer\"\ndata = [{}, {}]\n\
+         [[pass]]\nkind = \"render\"\nvertex = \"layered\"\nfragment = \"colored\"\nvertices = [\"layers\"]\n\
+         targets = [{{ resource = \"image\" }}]\n",
+        quad(0.2, "1, 0, 0, 1"),
+        quad(0.6, "0, 1, 0, 1")
+    );
+    let depth = layers.replace("vertices = [", "depth = { compare = \"less\" }\nvertices = [");
+    // A compute pass writes the vertices: read at its struct's offsets (vec3 then vec4 at 16, stride 32).
+    let computed = "[[resource]]\nname = \"corners\"\nkind = \"buffer\"\nlength = 6\n\
+                    [[pass]]\nentry = \"build\"\nworkgroups = [1, 1, 1]\n\
+                    [[pass]]\nkind = \"render\"\nvertex = \"layered\"\nfragment = \"colored\"\nvertices = [\"corners\"]\n\
+                    targets = [{ resource = \"image\" }]\n";
+    // Half-screen triangles: counter-clockwise on the left, clockwise on the right.
+    let winding = |cull: &str| {
+        format!(
+            "[[resource]]\nname = \"tris\"\nkind = \"buffer\"\ndata = [-1, -1, 0, -1, -1, 1, 0, -1, 1, 1, 1, -1]\n\
+             [[pass]]\nkind = \"render\"\nvertex = \"flat\"\nfragment = \"fill\"\nvertices = [\"tris\"]\ncull = \"{cull}\"\n\
+             targets = [{{ resource = \"image\" }}]\n"
+        )
+    };
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let img = render(indexed, backend);
+        assert_eq!(
+            (img.get(0, 0), img.get(3, 3), img.get(4, 0), img.get(7, 3)),
+            ([1.0; 4], [1.0; 4], [0.0; 4], [0.0; 4]),
+            "{backend}"
+        );
+        let img = render(instanced, backend);
+        for (x, y, v) in [(0, 0, 1.0), (1, 1, 1.0), (4, 0, 1.0), (5, 1, 1.0), (2, 0, 0.25), (6, 1, 0.25), (0, 2, 0.25)]
+        {
+            assert_eq!(img.get(x, y), [v; 4], "{backend}: instanced texel ({x}, {y})");
+        }
+        assert_eq!(render(&layers, backend).get(3, 2), [0.0, 1.0, 0.0, 1.0], "{backend}: drawn last without depth");
+        assert_eq!(render(&depth, backend).get(3, 2), [1.0, 0.0, 0.0, 1.0], "{backend}: nearer with depth");
+        assert_eq!(
+            render(computed, backend).get(5, 1),
+            [0.25, 0.5, 0.75, 1.0],
+            "{backend}: vertices a compute pass wrote"
+        );
+        let none = render(&winding("none"), backend);
+        assert_eq!((none.get(0, 3), none.get(7, 0)), ([1.0; 4], [1.0; 4]), "{backend}");
+        let back = render(&winding("back"), backend);
+        assert_eq!((back.get(0, 3), back.get(7, 0)), ([1.0; 4], [0.0; 4]), "{backend}: back faces (clockwise) culled");
+        let front = render(&winding("front"), backend);
+        assert_eq!((front.get(0, 3), front.get(7, 0)), ([0.0; 4], [1.0; 4]), "{backend}: front faces culled");
+    }
+    // Blend factors with a constant: 0.25 * 1 + 0.5 (the clear) = 0.75.
+    let constant = "[[resource]]\nname = \"acc\"\nkind = \"texture\"\nformat = \"rgba16float\"\n\
+                    [[pass]]\nkind = \"render\"\nfragment = \"fill\"\ntargets = [{ resource = \"acc\", clear = [0.5, 0.5, 0.5, 0.5], \
+                    blend = { color = [\"constant\", \"one\", \"add\"], constant = [0.25, 0.25, 0.25, 0.25] } }]\n\
+                    [[output]]\nresource = \"acc\"\n";
+    for backend in ["lavapipe", "browser"] {
+        assert_eq!(render(constant, backend).get(2, 2), [0.75; 4], "{backend}: constant blend");
+    }
+    // Refused before GPU work, one line each.
+    for (body, needles) in [
+        (
+            instanced
+                .replace(
+                    "vertices = [\"tri\", { resource = \"shifts\", step = \"instance\", attributes = [{ location = 1, format = \"float32x2\" }] }]",
+                    "vertices = [{ resource = \"tri\", attributes = [{ location = 0, format = \"float32x2\" }] }]",
+                )
+                .replace("[[resource]]\nname = \"shifts\"\nkind = \"buffer\"\ndata = [0, 0, 1, 0]\n", ""),
+            &[
+                "pass 1 (placed, fill)",
+                "placed's input @location(1) shift: vec2<f32> has no buffer attribute of its type",
+                "vertices give @location(0) float32x2",
+            ][..],
+        ),
+        (
+            instanced.replace("format = \"float32x2\"", "format = \"uint32x2\""),
+            &["placed's input @location(1) shift is vec2<f32> but shifts's attribute is uint32x2; allowed: float32x2"][..],
+        ),
+        (instanced.replace("vertex = \"placed\"", "vertex = \"placed\"\ncount = 99"), &["count = 99 but vertices tri holds 6"][..]),
+        (indexed.replace("vertex = \"flat\"", "vertex = \"fullscreen\""), &["vertices needs a vertex entry"][..]),
+        (indexed.replace("vertex = \"flat\"", "vertex = \"nope\""), &["has no vertex entry point 'nope'; its vertex entry points: flat, placed, layered"][..]),
+        (indexed.replace("vertex = \"flat\"", "vertex = { shader = \"v.wgsl\", entry = \"vs\" }"), &["is not supported yet"][..]),
+        (depth.replace("compare = \"less\"", "resource = \"image\""), &["depth: a depth texture resource shared between passes is not supported yet"][..]),
+        (indexed.replace("data = [0, 1, 2, 0, 2, 3]", "data = [0.5, 1, 2, 0, 2, 3]"), &["0.5 does not fit"][..]),
+        (indexed.replace("indices = \"ix\"", "indices = \"image\""), &["indices = image is a texture; expected a buffer resource"][..]),
+        (indexed.replace("indices = \"ix\"\n", "topology = \"quads\"\n"), &["topology = \"quads\" is not valid; expected triangle-list|"][..]),
+        (
+            constant.replace(", constant = [0.25, 0.25, 0.25, 0.25]", ""),
+            &["blend uses a constant factor; give constant = [r, g, b, a]"][..],
+        ),
+    ] {
+        let r = render_k(&manifest(&body), SHADER);
+        assert_rejected(&r, 2, needles);
+    }
+}
+
 /// examples/render (SPEC 17's examples a and b), copied with a copied
 /// binary: its goldens pass on lavapipe, SwiftShader and Chromium; the
 /// full-screen sky draws what the built-in compute sky dispatches (within
 /// 120 dB on lavapipe, the other-driver threshold elsewhere); the
 /// bloom's glow is its own output; a halved up-sample fails the check.
 fn the_render_example_passes_on_every_backend_with_a_copied_binary() {
-    let (_t, bin, root) = copied_example("render", 4);
+    let (_t, bin, root) = copied_example("render", 7);
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
     let sets = ["--preset", "sunset", "--set", "projection=fisheye", "--size", "48x40"];
     let reference = root.join("compute.exr");
@@ -4891,6 +5059,109 @@ fn the_render_example_passes_on_every_backend_with_a_copied_binary() {
     let c = run(&["check", "--case", "bloom"]);
     assert_eq!(c.code, 1, "{}", c.stdout);
     assert!(c.stdout.contains("output glow:"), "the glow's own verdict names it: {}", c.stdout);
+    grass_tips_follow_the_cpu_projection(&bin, &root);
+    // (d) A mutant of the wind's amplitude fails check at every time.
+    let shader = root.join("shaders/grass.wgsl");
+    let text = std::fs::read_to_string(&shader).unwrap();
+    let from = "return p + params.wind * vec3(cos(a), 0.0, sin(a));";
+    assert_eq!(text.matches(from).count(), 1, "grass.wgsl's sway changed");
+    std::fs::write(&shader, text.replace(from, "return p + 1.25 * params.wind * vec3(cos(a), 0.0, sin(a));")).unwrap();
+    let c = run(&["check", "--case", "grass-*"]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    assert!(c.stdout.contains("failed: grass-t0, grass-t1, grass-t2"), "{}", c.stdout);
+}
+
+/// The grass example's wind checked without the GPU's arithmetic (SPEC 17
+/// example c): single blades drawn alone (wide triangles whose two upper
+/// vertices meet at the tip, an opaque texture) put their topmost drawn
+/// pixel within one pixel of an f64 projection of the swayed tip, on every
+/// backend and at three times; the same projection without the wind misses.
+fn grass_tips_follow_the_cpu_projection(bin: &Path, root: &Path) {
+    let (w, h) = (160u32, 96u32);
+    // The example's camera and wind (kernels/grass.toml's defaults).
+    let (wind, eye, look, fov) = (0.06f64, [0.0, 0.55, -2.2], [0.0, 0.25, 1.0], 40f64);
+    let project = |p: [f64; 3]| {
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let unit = |a: [f64; 3]| {
+            let l = dot(a, a).sqrt();
+            [a[0] / l, a[1] / l, a[2] / l]
+        };
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        };
+        let forward = unit(sub(look, eye));
+        let right = unit(cross([0.0, 1.0, 0.0], forward));
+        let up = cross(forward, right);
+        let d = sub(p, eye);
+        let (x, y, z) = (dot(d, right), dot(d, up), dot(d, forward));
+        let t = (fov.to_radians() / 2.0).tan();
+        let (nx, ny) = (x / (z * t * w as f64 / h as f64), y / (z * t));
+        ((nx + 1.0) / 2.0 * w as f64, (1.0 - ny) / 2.0 * h as f64)
+    };
+    let sway = |p: [f64; 3], time: f64, wind: f64| {
+        let a = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() * time.sin() * 20.0;
+        [p[0] + wind * a.cos(), p[1], p[2] + wind * a.sin()]
+    };
+    let tips: Vec<[f64; 3]> = [-1.2, -0.6, 0.0, 0.6, 1.2].iter().map(|&x| [x, 0.2, 0.3]).collect();
+    let (mut verts, mut idx) = (Vec::<f32>::new(), Vec::<u32>::new());
+    for (i, t) in tips.iter().enumerate() {
+        for (x, y, u, v) in
+            [(t[0] - 0.2, 0.0, 0.0, 1.0), (t[0] + 0.2, 0.0, 1.0, 1.0), (t[0], t[1], 1.0, 0.0), (t[0], t[1], 0.0, 0.0)]
+        {
+            verts.extend([x as f32, y as f32, t[2] as f32, u, v]);
+        }
+        idx.extend([0, 1, 2, 0, 2, 3].map(|k| 4 * i as u32 + k));
+    }
+    let bytes = |v: Vec<[u8; 4]>| v.concat();
+    let inputs = root.join("inputs");
+    let npy = |name: &str, descr: &str, shape: &[u64], data: Vec<u8>| {
+        vista_image::npy::write_npy(&inputs.join(name), descr, shape, &data).unwrap();
+    };
+    npy("tips.npy", "<f4", &[tips.len() as u64 * 4, 5], bytes(verts.iter().map(|f| f.to_le_bytes()).collect()));
+    npy("tip_indices.npy", "<u4", &[idx.len() as u64], bytes(idx.iter().map(|i| i.to_le_bytes()).collect()));
+    vista_image::write_png8(&inputs.join("opaque.png"), &vista_image::Image::from_fn(4, 4, |_, _| [1.0; 4])).unwrap();
+    let manifest = std::fs::read_to_string(root.join("kernels/grass.toml")).unwrap();
+    let tips_manifest = manifest
+        .replace("inputs/grass_blades.npy", "inputs/tips.npy")
+        .replace("inputs/grass_indices.npy", "inputs/tip_indices.npy")
+        .replace("inputs/grass_blade.png", "inputs/opaque.png");
+    std::fs::write(root.join("kernels/grass_tips.toml"), tips_manifest).unwrap();
+    let sky = [0.55f32, 0.70, 0.90];
+    let mut missed_without_wind = 0;
+    for (backend, time) in
+        [("lavapipe", 0.0), ("lavapipe", 0.8), ("lavapipe", 2.1), ("swiftshader", 2.1), ("browser", 0.8)]
+    {
+        let out = root.join(format!("tips-{backend}-{time}.exr"));
+        let args = ["render", "grass_tips", "--size", "160x96", "--set", &format!("time={time}"), "--backend", backend];
+        let r = run_in(bin, root, &[], &[&args[..], &["-o", out.to_str().unwrap()]].concat());
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        let img = vista_image::load(&out).unwrap();
+        let drawn = |x: i64, y: i64| {
+            x >= 0 && y >= 0 && x < w as i64 && y < h as i64 && {
+                let p = img.get(x as u32, y as u32);
+                (0..3).any(|c| (p[c] - sky[c]).abs() > 0.05)
+            }
+        };
+        for tip in &tips {
+            let (px, py) = project(sway(*tip, time, wind));
+            // The topmost drawn row near the tip, and the middle of its drawn pixels.
+            let cols: Vec<i64> = (px as i64 - 12..=px as i64 + 12).collect();
+            let top = (0..h as i64).find(|&y| cols.iter().any(|&x| drawn(x, y))).expect("the blade is drawn");
+            let xs: Vec<i64> = cols.iter().copied().filter(|&x| drawn(x, top)).collect();
+            let mid = (xs[0] + xs[xs.len() - 1]) as f64 / 2.0;
+            eprintln!("{backend} t={time}: tip at ({px:.2}, {py:.2}) projected, drawn from ({mid:.1}, {top})");
+            assert!(
+                (mid.floor() - px.floor()).abs() <= 1.0 && (top as f64 - py.floor()).abs() <= 1.0,
+                "{backend} t={time}: the tip projects to ({px:.2}, {py:.2}) but the topmost drawn pixel is ({mid}, {top})"
+            );
+            let (qx, qy) = project(sway(*tip, time, 0.0));
+            if (mid.floor() - qx.floor()).abs() > 1.0 || (top as f64 - qy.floor()).abs() > 1.0 {
+                missed_without_wind += 1;
+            }
+        }
+    }
+    assert!(missed_without_wind >= 10, "without the wind only {missed_without_wind} of 25 tips move by > 1 px");
 }
 
 fn main() {
@@ -4930,6 +5201,7 @@ fn main() {
         Gpu the_manifest_names_the_entry_point,
         Gpu layered_outputs_stack_and_follow_reflection,
         Gpu a_fullscreen_render_pass_draws_every_texel,
+        Gpu a_draw_reads_vertex_buffers_indices_and_depth,
         Gpu the_render_example_passes_on_every_backend_with_a_copied_binary,
         Gpu a_broken_manifest_breaks_only_its_kernel,
         Cpu adapter_is_a_hidden_alias_of_backend,

@@ -63,16 +63,7 @@ impl Context {
                 }
             };
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
-            // A render pass: vista's full-screen triangle, then the entry
-            // as its fragment stage into these targets.
-            let raster = pass.raster.as_ref().map(|r| {
-                json!({
-                    "vertex": crate::FULLSCREEN_WGSL, "vertex_entry": crate::FULLSCREEN_ENTRY,
-                    "targets": r.targets.iter().map(|t| json!({
-                        "resource": t.resource, "level": t.level, "clear": t.clear, "blend": t.blend,
-                    })).collect::<Vec<_>>(),
-                })
-            });
+            let raster = pass.raster.as_ref().map(raster_json);
             passes.push(json!({
                 "key": key, "label": pass.label, "wgsl": *wgsl, "entry": pass.entry,
                 "workgroups": pass.workgroups, "repeat": pass.repeat, "span": pass.span,
@@ -184,8 +175,41 @@ impl Context {
                 (json!({ "sampler": { "type": ty } }), json!({ "resource": r }))
             }
         };
-        let mut slot = json!({ "group": s.group, "binding": s.binding, "layout": layout });
+        let mut slot = json!({ "group": s.group, "binding": s.binding, "layout": layout, "vertex": s.vertex });
         slot.as_object_mut().expect("an object").extend(source.as_object().expect("an object").clone());
         Ok(slot)
     }
+}
+
+/// A render pass as runner.js builds it: the vertex stage (vista's
+/// full-screen triangle, or `vertex_entry` of the pass's own module when
+/// `vertex` is null), WebGPU's blend states, buffers and fixed-function state.
+fn raster_json(r: &crate::graph::Raster) -> Value {
+    let blend = |b: vista_texel::Blend| {
+        b.components().map(|(c, a)| {
+            let part = |p: vista_texel::BlendComponent| {
+                json!({ "srcFactor": p.src.web(), "dstFactor": p.dst.web(), "operation": p.op.web() })
+            };
+            json!({ "color": part(c), "alpha": part(a) })
+        })
+    };
+    let (vertex, vertex_entry) = match &r.vertex {
+        None => (Some(crate::FULLSCREEN_WGSL), crate::FULLSCREEN_ENTRY),
+        Some(vs) => (None, vs.as_str()),
+    };
+    json!({
+        "vertex": vertex, "vertex_entry": vertex_entry,
+        "targets": r.targets.iter().map(|t| json!({
+            "resource": t.resource, "level": t.level, "clear": t.clear, "blend": blend(t.blend),
+        })).collect::<Vec<_>>(),
+        "buffers": r.buffers.iter().map(|b| json!({
+            "resource": b.resource, "arrayStride": b.stride, "stepMode": if b.instance { "instance" } else { "vertex" },
+            "attributes": b.attributes.iter().map(|(l, f, o)| json!({ "shaderLocation": l, "format": f, "offset": o }))
+                .collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "indices": r.indices, "count": r.count, "instances": r.instances,
+        "topology": r.topology.web(), "cull": r.cull.web(),
+        "depth": r.depth.as_ref().map(|d| json!({ "compare": d.compare, "write": d.write, "clear": d.clear })),
+        "blend_constant": r.blend_constant,
+    })
 }

@@ -232,6 +232,19 @@ pub(crate) struct WgpuEngine {
     read_write: Vec<&'static str>,
 }
 
+/// A render pipeline's stages and state beside the fragment entry, in
+/// wgpu's terms (made from a pass's `Raster` by `raster.rs`).
+pub(crate) struct RenderStages<'a> {
+    /// Each target's format and blend.
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
+    /// The pass's own vertex entry; `None`: vista's full-screen triangle.
+    pub vertex_entry: Option<&'a str>,
+    /// The vertex buffer layouts, one per slot.
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    pub primitive: wgpu::PrimitiveState,
+    pub depth_stencil: Option<wgpu::DepthStencilState>,
+}
+
 pub(crate) struct Compiled {
     pub(crate) pipeline: Pipeline,
     pub(crate) groups: Vec<wgpu::BindGroupLayout>,
@@ -522,7 +535,7 @@ impl Context {
         entry: &str,
         constants: &[(String, f64)],
         layouts: &[Vec<wgpu::BindGroupLayoutEntry>],
-        targets: Option<&[Option<wgpu::ColorTargetState>]>,
+        render: Option<RenderStages<'_>>,
     ) -> Result<Arc<Compiled>, GpuError> {
         let module = shaders.compose(shader)?;
         let started = std::time::Instant::now();
@@ -547,7 +560,7 @@ impl Context {
         });
         let constants: Vec<(&str, f64)> = constants.iter().map(|(k, v)| (k.as_str(), *v)).collect();
         let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
-        let pipeline = match targets {
+        let pipeline = match render {
             None => Pipeline::Compute(w.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(shader),
                 layout: Some(&pipeline_layout),
@@ -556,28 +569,36 @@ impl Context {
                 compilation_options: options(),
                 cache: None,
             })),
-            Some(targets) => {
-                let vertex = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some("vista full-screen triangle"),
-                    source: wgpu::ShaderSource::Wgsl(crate::FULLSCREEN_WGSL.into()),
-                });
+            Some(r) => {
+                // vista's full-screen triangle, or the pass's own vertex entry.
+                let fullscreen;
+                let (vertex, vertex_entry) = match r.vertex_entry {
+                    Some(vs) => (&sm, vs),
+                    None => {
+                        fullscreen = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                            label: Some("vista full-screen triangle"),
+                            source: wgpu::ShaderSource::Wgsl(crate::FULLSCREEN_WGSL.into()),
+                        });
+                        (&fullscreen, crate::FULLSCREEN_ENTRY)
+                    }
+                };
                 Pipeline::Render(w.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                     label: Some(shader),
                     layout: Some(&pipeline_layout),
                     vertex: wgpu::VertexState {
-                        module: &vertex,
-                        entry_point: Some(crate::FULLSCREEN_ENTRY),
-                        compilation_options: Default::default(),
-                        buffers: &[],
+                        module: vertex,
+                        entry_point: Some(vertex_entry),
+                        compilation_options: options(),
+                        buffers: r.buffers,
                     },
-                    primitive: wgpu::PrimitiveState::default(),
-                    depth_stencil: None,
+                    primitive: r.primitive,
+                    depth_stencil: r.depth_stencil,
                     multisample: wgpu::MultisampleState::default(),
                     fragment: Some(wgpu::FragmentState {
                         module: &sm,
                         entry_point: Some(entry),
                         compilation_options: options(),
-                        targets,
+                        targets: r.targets,
                     }),
                     multiview_mask: None,
                     cache: None,

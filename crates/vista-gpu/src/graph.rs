@@ -264,6 +264,9 @@ pub struct GraphSlot {
     pub binding: u32,
     /// What feeds the binding.
     pub bind: Bind,
+    /// A render pass's vertex entry reads it (visible to the vertex stage).
+    #[serde(default)]
+    pub vertex: bool,
 }
 
 /// One colour target of a render pass: `@location(n)` of its fragment
@@ -282,12 +285,57 @@ pub struct RasterTarget {
     pub blend: vista_texel::Blend,
 }
 
-/// What makes a pass a render pass (SPEC 17): vista's full-screen triangle
-/// ([`crate::FULLSCREEN_WGSL`]), then the pass's entry as the fragment stage.
+/// One vertex buffer of a draw.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct VertexBuffer {
+    /// Index of the buffer in [`Graph::resources`].
+    pub resource: usize,
+    /// Bytes from one element to the next.
+    pub stride: u32,
+    /// Advanced per instance rather than per vertex.
+    pub instance: bool,
+    /// (shader location, WebGPU vertex format name, byte offset).
+    pub attributes: Vec<(u32, String, u32)>,
+}
+
+/// A render pass's depth test, on a depth32float buffer of the targets'
+/// size that the pass owns (cleared every run).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Depth {
+    /// WebGPU's comparison name.
+    pub compare: String,
+    /// Whether passing fragments write their depth.
+    pub write: bool,
+    /// The value it is cleared to.
+    pub clear: f64,
+}
+
+/// What makes a pass a render pass (SPEC 17): a vertex stage (vista's
+/// full-screen triangle, [`crate::FULLSCREEN_WGSL`], or an entry of the
+/// pass's shader with its buffers), the pass's entry as the fragment
+/// stage, its targets and fixed-function state.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Raster {
     /// The colour targets, in `@location` order.
     pub targets: Vec<RasterTarget>,
+    /// The `@vertex` entry of the pass's shader; `None`: the full-screen triangle.
+    pub vertex: Option<String>,
+    /// The vertex buffers, one per slot.
+    pub buffers: Vec<VertexBuffer>,
+    /// A u32 index buffer.
+    pub indices: Option<usize>,
+    /// Vertices (or indices) drawn per instance.
+    pub count: u32,
+    /// Instances drawn.
+    pub instances: u32,
+    /// How vertices make primitives.
+    pub topology: vista_texel::Topology,
+    /// Which faces are discarded.
+    pub cull: vista_texel::Cull,
+    /// The depth test, if any.
+    pub depth: Option<Depth>,
+    /// The blend constant of the constant factors.
+    pub blend_constant: Option<[f64; 4]>,
 }
 
 /// One pass: a dispatch of an entry point; after every run the `swap`

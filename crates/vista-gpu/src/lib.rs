@@ -14,6 +14,7 @@ mod format;
 mod fullscreen;
 mod graph;
 mod limits;
+mod raster;
 mod shaders;
 mod spares;
 pub mod validation;
@@ -25,8 +26,8 @@ pub use context::{
 };
 pub use fullscreen::{FULLSCREEN_ENTRY, FULLSCREEN_WGSL};
 pub use graph::{
-    Address, Bind, COMPARE_NAMES, Contents, Graph, GraphPass, GraphSlot, OutputData, Raster, RasterTarget, Readback,
-    Resource, SamplerDesc, TextureDesc, run_order,
+    Address, Bind, COMPARE_NAMES, Contents, Depth, Graph, GraphPass, GraphSlot, OutputData, Raster, RasterTarget,
+    Readback, Resource, SamplerDesc, TextureDesc, VertexBuffer, run_order,
 };
 pub use limits::Needs;
 pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};

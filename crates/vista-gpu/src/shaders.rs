@@ -595,10 +595,12 @@ pub fn resolve_overrides(
         return Ok((module.clone(), info));
     }
     let map: naga::back::PipelineConstants = constants.iter().cloned().collect();
+    // A compute pass keeps its one entry; a render pass both its stages.
+    let compute = module.entry_points.iter().any(|e| e.name == entry && e.stage == naga::ShaderStage::Compute);
     let (resolved, resolved_info) = naga::back::pipeline_constants::process_overrides(
         module,
         &info,
-        Some((naga::ShaderStage::Compute, entry)),
+        compute.then_some((naga::ShaderStage::Compute, entry)),
         &map,
     )
     .map_err(|e| GpuError::Shader(format!("{name}: override values do not resolve: {e}")))?;

@@ -16,7 +16,7 @@ use crate::graph::{
     view_dimension,
 };
 use crate::spares::{Spares, TextureKey};
-use vista_texel::{Access, Blend, Format, SampleKind};
+use vista_texel::{Access, Format, SampleKind};
 
 /// Kept at most per kind: a graph's outputs, and a little more.
 const SPARES: usize = 8;
@@ -164,9 +164,17 @@ impl Context {
                 let mut encoder = d.create_command_encoder(&Default::default());
                 let stamp_set = stamps.as_ref().map(|s| &s.set);
                 match (&compiled.pipeline, &pass.raster) {
-                    (Pipeline::Render(p), Some(raster)) => {
-                        encode_draw(&mut encoder, p, &groups, raster, &made, &current, stamp_set)
-                    }
+                    (Pipeline::Render(p), Some(raster)) => encode_draw(
+                        &w.device,
+                        &mut encoder,
+                        p,
+                        &groups,
+                        raster,
+                        &g.resources,
+                        &made,
+                        &current,
+                        stamp_set,
+                    ),
                     (Pipeline::Compute(p), _) => encode_dispatch(&mut encoder, p, &groups, pass.workgroups, stamp_set),
                     (Pipeline::Render(_), None) => unreachable!("render pipelines are made for render passes"),
                 }
@@ -340,6 +348,8 @@ impl Context {
                             contents: &contents,
                             usage: wgpu::BufferUsages::STORAGE
                                 | wgpu::BufferUsages::UNIFORM
+                                | wgpu::BufferUsages::VERTEX
+                                | wgpu::BufferUsages::INDEX
                                 | wgpu::BufferUsages::COPY_SRC
                                 | wgpu::BufferUsages::COPY_DST,
                         }),
@@ -450,22 +460,30 @@ impl Context {
                 s.group,
                 wgpu::BindGroupLayoutEntry {
                     binding: s.binding,
-                    visibility: match pass.raster {
-                        Some(_) => wgpu::ShaderStages::FRAGMENT,
-                        None => wgpu::ShaderStages::COMPUTE,
+                    visibility: match (&pass.raster, s.vertex) {
+                        (Some(_), true) => wgpu::ShaderStages::VERTEX_FRAGMENT,
+                        (Some(_), false) => wgpu::ShaderStages::FRAGMENT,
+                        (None, _) => wgpu::ShaderStages::COMPUTE,
                     },
                     ty,
                     count: None,
                 },
             ));
         }
+        let targets = match &pass.raster {
+            Some(r) => Some(crate::raster::color_targets(r, &g.resources, &pass.label)?),
+            None => None,
+        };
+        // A render pipeline differs by its targets and fixed-function state too.
         let key = format!(
-            "graph {}#{}@{}{:?}{:?}",
+            "graph {}#{}@{}{:?}{:?}{:?}{:?}",
             pass.shader,
             g.shaders.source_hash(&pass.shader)?,
             pass.entry,
             entries,
-            pass.constants
+            pass.constants,
+            targets,
+            pass.raster.as_ref().map(|r| (&r.vertex, &r.buffers, r.topology, r.cull, &r.depth, r.indices.is_some()))
         );
         if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
@@ -474,42 +492,20 @@ impl Context {
         let layouts: Vec<Vec<wgpu::BindGroupLayoutEntry>> = (0..last.map_or(0, |g| g + 1))
             .map(|gi| entries.iter().filter(|(g, _)| *g == gi).map(|(_, e)| *e).collect())
             .collect();
-        let targets: Option<Vec<Option<wgpu::ColorTargetState>>> = match &pass.raster {
-            None => None,
-            Some(raster) => Some(
-                raster
-                    .targets
-                    .iter()
-                    .map(|t| {
-                        let Resource::Texture(desc) = &g.resources[t.resource] else {
-                            return Err(GpuError::Request(format!("{}: a target that is not a texture", pass.label)));
-                        };
-                        Ok(Some(wgpu::ColorTargetState {
-                            format: crate::format::wgpu_format(&crate::format::parse(desc.format)?),
-                            blend: match t.blend {
-                                Blend::Replace => None,
-                                Blend::Alpha => Some(wgpu::BlendState::ALPHA_BLENDING),
-                                Blend::Additive => Some(wgpu::BlendState {
-                                    color: wgpu::BlendComponent {
-                                        src_factor: wgpu::BlendFactor::One,
-                                        dst_factor: wgpu::BlendFactor::One,
-                                        operation: wgpu::BlendOperation::Add,
-                                    },
-                                    alpha: wgpu::BlendComponent {
-                                        src_factor: wgpu::BlendFactor::One,
-                                        dst_factor: wgpu::BlendFactor::One,
-                                        operation: wgpu::BlendOperation::Add,
-                                    },
-                                }),
-                            },
-                            write_mask: wgpu::ColorWrites::ALL,
-                        }))
-                    })
-                    .collect::<Result<_, GpuError>>()?,
-            ),
-        };
-        let compiled =
-            self.compile(w, g.shaders, &pass.shader, &pass.entry, &pass.constants, &layouts, targets.as_deref())?;
+        let attributes = pass.raster.as_ref().map(|r| crate::raster::attributes(&r.buffers));
+        let buffers =
+            pass.raster.as_ref().zip(attributes.as_ref()).map(|(r, a)| crate::raster::buffer_layouts(&r.buffers, a));
+        let render =
+            pass.raster.as_ref().zip(targets.as_deref()).zip(buffers.as_deref()).map(|((r, targets), buffers)| {
+                crate::context::RenderStages {
+                    targets,
+                    vertex_entry: r.vertex.as_deref(),
+                    buffers,
+                    primitive: crate::raster::primitive(r),
+                    depth_stencil: crate::raster::depth_stencil(r),
+                }
+            });
+        let compiled = self.compile(w, g.shaders, &pass.shader, &pass.entry, &pass.constants, &layouts, render)?;
         w.pipelines.lock().expect("pipeline cache").insert(key, compiled.clone());
         Ok(compiled)
     }
@@ -690,13 +686,16 @@ fn bind_groups(
 }
 
 /// One render pass: each target's view (its level; cleared where it says
-/// so, else drawn over), the pipeline, its bind groups, the full-screen
-/// triangle.
+/// so, else drawn over), the pass's own depth buffer, the pipeline, its
+/// bind groups, vertex and index buffers, the draw.
+#[allow(clippy::too_many_arguments)]
 fn encode_draw(
+    d: &wgpu::Device,
     encoder: &mut wgpu::CommandEncoder,
     pipeline: &wgpu::RenderPipeline,
     groups: &[wgpu::BindGroup],
     raster: &Raster,
+    resources: &[Resource],
     made: &Made,
     current: &[usize],
     stamps: Option<&wgpu::QuerySet>,
@@ -734,10 +733,39 @@ fn encode_draw(
             })
         })
         .collect();
+    let depth_view = raster.depth.as_ref().map(|_| {
+        let t = &raster.targets[0];
+        let Resource::Texture(desc) = &resources[t.resource] else { unreachable!("plans check targets") };
+        let size = wgpu::Extent3d {
+            width: (desc.width >> t.level).max(1),
+            height: (desc.height >> t.level).max(1),
+            depth_or_array_layers: 1,
+        };
+        d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("vista depth"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+    });
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: None,
         color_attachments: &attachments,
-        depth_stencil_attachment: None,
+        depth_stencil_attachment: raster.depth.as_ref().zip(depth_view.as_ref()).map(|(depth, view)| {
+            wgpu::RenderPassDepthStencilAttachment {
+                view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(depth.clear as f32),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }
+        }),
         timestamp_writes: stamps.map(|query_set| wgpu::RenderPassTimestampWrites {
             query_set,
             beginning_of_pass_write_index: Some(0),
@@ -750,7 +778,19 @@ fn encode_draw(
     for (g, group) in groups.iter().enumerate() {
         pass.set_bind_group(g as u32, group, &[]);
     }
-    pass.draw(0..3, 0..1);
+    if let Some([r, g, b, a]) = raster.blend_constant {
+        pass.set_blend_constant(wgpu::Color { r, g, b, a });
+    }
+    for (slot, v) in raster.buffers.iter().enumerate() {
+        pass.set_vertex_buffer(slot as u32, made.buffers[&current[v.resource]].slice(..));
+    }
+    match raster.indices {
+        Some(i) => {
+            pass.set_index_buffer(made.buffers[&current[i]].slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..raster.count, 0, 0..raster.instances);
+        }
+        None => pass.draw(0..raster.count, 0..raster.instances),
+    }
 }
 
 /// One compute pass: the pipeline, its bind groups in order, the dispatch.

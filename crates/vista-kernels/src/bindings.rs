@@ -53,6 +53,9 @@ pub struct Binding {
     pub name: String,
     /// What feeds it.
     pub feed: Feed,
+    /// A render pass's vertex entry reaches it (it is visible to the
+    /// vertex stage as well as the fragment stage).
+    pub vertex: bool,
     pub(crate) global: Handle<naga::GlobalVariable>,
 }
 
@@ -152,6 +155,106 @@ pub fn fragment_outputs(module: &naga::Module, entry: &str) -> Vec<u32> {
     };
     out.sort_unstable();
     out
+}
+
+/// One `@location` input of a vertex entry (an argument or a member of
+/// an argument struct), in location order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct VertexInput {
+    /// Its `@location`.
+    pub location: u32,
+    /// The argument or member name.
+    pub name: String,
+    /// Scalar kind: 'f', 'u' or 'i'.
+    pub kind: char,
+    /// 1 for a scalar, else the vector size.
+    pub components: u32,
+}
+
+impl VertexInput {
+    /// Its WGSL type, for messages.
+    pub fn wgsl(&self) -> String {
+        let s = match self.kind {
+            'f' => "f32",
+            'u' => "u32",
+            _ => "i32",
+        };
+        match self.components {
+            1 => s.to_string(),
+            n => format!("vec{n}<{s}>"),
+        }
+    }
+}
+
+/// The `@location` inputs of a vertex entry; a type a vertex buffer cannot
+/// feed (f16, a matrix) is refused naming it.
+pub fn vertex_inputs(module: &naga::Module, entry: &str) -> Result<Vec<VertexInput>, String> {
+    let Some(ep) = entry_point(module, entry, naga::ShaderStage::Vertex) else { return Ok(Vec::new()) };
+    let mut out = Vec::new();
+    let mut add = |name: &str, binding: &Option<naga::Binding>, ty: Handle<naga::Type>| -> Result<(), String> {
+        let Some(naga::Binding::Location { location, .. }) = binding else { return Ok(()) };
+        let (scalar, components) = match &module.types[ty].inner {
+            TypeInner::Scalar(s) => (*s, 1),
+            TypeInner::Vector { size, scalar } => (*scalar, *size as u32),
+            _ => return Err(format!("{entry}'s input @location({location}) {name} is not a scalar or vector")),
+        };
+        let kind = match (scalar.kind, scalar.width) {
+            (ScalarKind::Float, 4) => 'f',
+            (ScalarKind::Uint, 4) => 'u',
+            (ScalarKind::Sint, 4) => 'i',
+            _ => {
+                return Err(format!(
+                    "{entry}'s input @location({location}) {name} has a type vertex buffers do not feed yet \
+                     (32-bit scalars and vectors only)"
+                ));
+            }
+        };
+        out.push(VertexInput { location: *location, name: name.to_string(), kind, components });
+        Ok(())
+    };
+    for arg in &ep.function.arguments {
+        let name = arg.name.as_deref().unwrap_or("argument");
+        match (&arg.binding, &module.types[arg.ty].inner) {
+            (None, TypeInner::Struct { members, .. }) => {
+                for m in members {
+                    add(m.name.as_deref().unwrap_or("member"), &m.binding, m.ty)?;
+                }
+            }
+            _ => add(name, &arg.binding, arg.ty)?,
+        }
+    }
+    out.sort_by_key(|i| i.location);
+    Ok(out)
+}
+
+/// A render pass's bindings: its fragment entry's and its vertex entry's
+/// (one module), each global once; two globals at one group and binding
+/// are refused, since the stages share one pipeline layout.
+pub fn merge_stages(
+    kernel: &str,
+    mut fragment: Vec<Binding>,
+    vertex: Vec<Binding>,
+) -> Result<Vec<Binding>, ParamError> {
+    for mut v in vertex {
+        if let Some(f) = fragment.iter_mut().find(|f| (f.group, f.binding) == (v.group, v.binding)) {
+            if f.global != v.global {
+                return Err(ParamError::Layout {
+                    kernel: kernel.to_string(),
+                    message: format!(
+                        "@group({}) @binding({}) is {} in the fragment entry but {} in the vertex entry; one \
+                         render pipeline has one binding there",
+                        v.group, v.binding, f.name, v.name
+                    ),
+                });
+            }
+            f.vertex = true;
+            continue;
+        }
+        v.vertex = true;
+        fragment.push(v);
+    }
+    fragment.sort_by_key(|b| (b.group, b.binding));
+    Ok(fragment)
 }
 
 /// A WGSL spelling of a global's type, for messages.
@@ -330,7 +433,14 @@ pub fn reflect_all(
             (_, TypeInner::Sampler { comparison }) => Feed::Sampler { comparison: *comparison },
             _ => return Err(unfed("a resource")),
         };
-        out.push(Binding { group: rb.group, binding: rb.binding, name, feed, global: g });
+        out.push(Binding {
+            group: rb.group,
+            binding: rb.binding,
+            name,
+            feed,
+            vertex: stage == naga::ShaderStage::Vertex,
+            global: g,
+        });
     }
     out.sort_by_key(|b| (b.group, b.binding));
     Ok(out)

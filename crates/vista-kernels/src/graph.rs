@@ -15,9 +15,11 @@ use crate::bindings::{Binding, Feed};
 use crate::expr::Expr;
 use crate::params::ParamSpec;
 use crate::{Output, ParamError};
-use vista_texel::{Access, Blend, Dimension};
+use vista_texel::{Access, Blend, Cull, Dimension, Topology};
 
 pub use crate::bindings::SampledKind;
+pub use crate::element::Element;
+pub use crate::vertex::{Attribute, VertexBufferSpec, VertexLayout};
 
 /// The sampler address modes a manifest may name.
 pub const ADDRESS_MODES: [&str; 3] = ["clamp-to-edge", "repeat", "mirror-repeat"];
@@ -156,18 +158,62 @@ pub struct TargetSpec {
     pub clear: Option<[f64; 4]>,
     /// `blend`.
     pub blend: Blend,
+    /// The blend table's `constant`, for the constant factors.
+    pub constant: Option<[f64; 4]>,
 }
 
-/// What makes a pass a render pass (`kind = "render"`, SPEC 17): so far
-/// `vertex = "fullscreen"`, vista's full-screen triangle.
+/// A render pass's vertex stage.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VertexStage {
+    /// `vertex = "fullscreen"`: vista's full-screen triangle.
+    Fullscreen,
+    /// A `@vertex` entry of the pass's shader.
+    Entry(String),
+}
+
+/// A render pass's `depth` table: a depth32float buffer of the targets'
+/// size, owned by the pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DepthSpec {
+    /// The comparison (one of [`COMPARE_FUNCTIONS`]).
+    pub compare: &'static str,
+    /// Whether passing fragments write their depth.
+    pub write: bool,
+    /// Cleared to this before the draw (default 1).
+    pub clear: f64,
+}
+
+/// What makes a pass a render pass (`kind = "render"`, SPEC 17).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RasterSpec {
+    /// The vertex stage.
+    pub vertex: VertexStage,
     /// `@location(n)` of the fragment entry goes to `targets[n]`.
     pub targets: Vec<TargetSpec>,
+    /// The vertex buffers, one per slot.
+    pub vertices: Vec<VertexBufferSpec>,
+    /// A u32 index buffer resource.
+    pub indices: Option<String>,
+    /// Vertices (or indices) per instance; `None`: every one the buffer holds.
+    pub count: Option<Expr>,
+    /// Instances; `None`: the per-instance buffer's elements, else 1.
+    pub instances: Option<Expr>,
+    /// How vertices make primitives.
+    pub topology: Topology,
+    /// Which faces are discarded.
+    pub cull: Cull,
+    /// The pass's depth test.
+    pub depth: Option<DepthSpec>,
 }
 
 /// The keys of a render pass's target table.
 pub const TARGET_KEYS: [&str; 3] = ["resource", "clear", "blend"];
+/// The keys of a target's blend table.
+pub const BLEND_KEYS: [&str; 3] = ["color", "alpha", "constant"];
+/// The keys of a render pass's depth table.
+pub const DEPTH_KEYS: [&str; 4] = ["resource", "compare", "write", "clear"];
+/// A render pass's keys beyond `kind`, `vertex`, `fragment` and `targets`.
+const DRAW_KEYS: [&str; 6] = ["vertices", "indices", "count", "instances", "topology", "cull"];
 
 /// One `[[pass]]` table.
 #[derive(Debug, Clone, PartialEq)]
@@ -317,12 +363,19 @@ pub const RESOURCE_KEYS: [&str; 13] = [
     "compare",
 ];
 /// The keys of a `[[pass]]` table.
-pub const PASS_KEYS: [&str; 15] = [
+pub const PASS_KEYS: [&str; 22] = [
     "kind",
     "entry",
     "vertex",
     "fragment",
     "targets",
+    "vertices",
+    "indices",
+    "count",
+    "instances",
+    "topology",
+    "cull",
+    "depth",
     "shader",
     "defs",
     "source",
@@ -602,7 +655,7 @@ fn parse_passes(
             }
         }
         let text = |k: &str| string_key(t, k, &at);
-        let raster = parse_raster(t, res, &at)?;
+        let raster = parse_raster(t, res, params, &at)?;
         let entry = match &raster {
             Some(_) => text("fragment")?.ok_or_else(|| at("a render pass needs fragment = \"<entry>\"".into()))?,
             None => text("entry")?.unwrap_or_else(|| "main".into()),
@@ -764,18 +817,20 @@ fn parse_workgroups(
     }
 }
 
-/// A pass's `kind` and, for `kind = "render"`, its `vertex` and `targets`
-/// (the `fragment` entry is read with `entry`); the keys of one kind on
-/// the other are refused.
+/// A pass's `kind` and, for `kind = "render"`, its vertex stage, targets,
+/// buffers, draw counts and fixed-function state (the `fragment` entry is
+/// read with `entry`); the keys of one kind on the other are refused.
 fn parse_raster(
     t: &toml::Table,
     res: &[ResourceSpec],
+    params: &[ParamSpec],
     at: &dyn Fn(String) -> ParamError,
 ) -> Result<Option<RasterSpec>, ParamError> {
     let kind = string_key(t, "kind", at)?;
     match kind.as_deref() {
         None | Some("compute") => {
-            if let Some(k) = ["vertex", "fragment", "targets"].into_iter().find(|k| t.contains_key(*k)) {
+            let render_keys = ["vertex", "fragment", "targets", "depth"].into_iter().chain(DRAW_KEYS);
+            if let Some(k) = render_keys.into_iter().find(|k| t.contains_key(*k)) {
                 return Err(at(format!("{k} is a render pass's key; add kind = \"render\"")));
             }
             return Ok(None);
@@ -786,14 +841,78 @@ fn parse_raster(
     if t.contains_key("entry") {
         return Err(at("a render pass names its fragment entry as fragment = \"...\", not entry".into()));
     }
-    match string_key(t, "vertex", at)?.as_deref() {
-        None | Some("fullscreen") => {}
+    let vertex = match t.get("vertex") {
+        None => VertexStage::Fullscreen,
+        Some(toml::Value::String(v)) if v == "fullscreen" => VertexStage::Fullscreen,
+        Some(toml::Value::String(v)) if valid_name(v) => VertexStage::Entry(v.clone()),
+        Some(toml::Value::Table(_)) => {
+            return Err(at("vertex = { shader, entry } (an entry of another file) is not supported yet; put the \
+                 @vertex entry in the pass's shader and name it, vertex = \"<entry>\""
+                .into()));
+        }
         Some(other) => {
             return Err(at(format!(
-                "vertex = \"{other}\" is not supported yet; expected \"fullscreen\" (vista's full-screen triangle)"
+                "vertex = {other} is not valid; expected \"fullscreen\" or a @vertex entry of the pass's shader"
             )));
         }
+    };
+    if vertex == VertexStage::Fullscreen
+        && let Some(k) = DRAW_KEYS.into_iter().find(|k| t.contains_key(*k))
+    {
+        return Err(at(format!(
+            "{k} needs a vertex entry; vertex = \"fullscreen\" draws vista's own triangle (name a @vertex entry)"
+        )));
     }
+    let targets = parse_targets(t, res, at)?;
+    let buffer = |name: &str| match res.iter().find(|r| r.name == name) {
+        Some(r) if matches!(r.kind, ResourceKind::Buffer { .. }) => Ok(()),
+        Some(r) => Err(format!("{name} is a {}; expected a buffer resource", r.kind_name())),
+        None => Err(format!("{name} names no resource; resources: {}", names_of(res))),
+    };
+    let vertices = match t.get("vertices") {
+        None => Vec::new(),
+        Some(v) => crate::vertex::parse(v, &buffer).map_err(at)?,
+    };
+    let indices = string_key(t, "indices", at)?;
+    if let Some(i) = &indices {
+        buffer(i).map_err(|m| at(format!("indices = {m}")))?;
+    }
+    let expr = |k: &str| t.get(k).map(|v| Expr::parse_entry(v, params).map_err(|e| at(format!("{k} {e}")))).transpose();
+    let (count, instances) = (expr("count")?, expr("instances")?);
+    let topology = match string_key(t, "topology", at)? {
+        None => Topology::TriangleList,
+        Some(name) => Topology::parse(&name).map_err(at)?,
+    };
+    let cull = match string_key(t, "cull", at)? {
+        None => Cull::None,
+        Some(name) => Cull::parse(&name).map_err(at)?,
+    };
+    let depth = match t.get("depth") {
+        None => None,
+        Some(toml::Value::Table(d)) => Some(parse_depth(d, at)?),
+        Some(other) => return Err(at(format!("depth = {other} is not valid; expected {{ compare, write, clear }}"))),
+    };
+    Ok(Some(RasterSpec { vertex, targets, vertices, indices, count, instances, topology, cull, depth }))
+}
+
+fn names_of(res: &[ResourceSpec]) -> String {
+    let n: Vec<&str> = res.iter().map(|r| r.name.as_str()).collect();
+    if n.is_empty() { "none".to_string() } else { n.join(", ") }
+}
+
+/// Four finite numbers `[r, g, b, a]`.
+fn four(v: &toml::Value) -> Option<[f64; 4]> {
+    let c = v.as_array().filter(|c| c.len() == 4)?;
+    let v: Vec<f64> = c.iter().filter_map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64))).collect();
+    <[f64; 4]>::try_from(v).ok().filter(|c| c.iter().all(|x| x.is_finite()))
+}
+
+/// A render pass's `targets`: resource (and level), clear, blend.
+fn parse_targets(
+    t: &toml::Table,
+    res: &[ResourceSpec],
+    at: &dyn Fn(String) -> ParamError,
+) -> Result<Vec<TargetSpec>, ParamError> {
     let Some(toml::Value::Array(list)) = t.get("targets") else {
         return Err(at("a render pass needs targets = [{ resource = \"...\" }, ...]".into()));
     };
@@ -806,28 +925,99 @@ fn parse_raster(
         }
         let name = string_key(tt, "resource", &tat)?.ok_or_else(|| tat("needs resource = \"...\"".into()))?;
         let texture = Level::parse(&name, res).map_err(|m| tat(format!("resource = {m}")))?;
-        let clear = match tt.get("clear") {
-            None => None,
-            Some(toml::Value::Array(c)) if c.len() == 4 => {
-                let v: Vec<f64> =
-                    c.iter().filter_map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64))).collect();
-                match <[f64; 4]>::try_from(v) {
-                    Ok(c) if c.iter().all(|x| x.is_finite()) => Some(c),
-                    _ => return Err(tat("clear must be four finite numbers [r, g, b, a]".into())),
-                }
-            }
-            Some(other) => return Err(tat(format!("clear = {other} is not valid; expected [r, g, b, a]"))),
-        };
-        let blend = match string_key(tt, "blend", &tat)? {
-            None => Blend::Replace,
-            Some(name) => Blend::parse(&name).map_err(tat)?,
-        };
-        targets.push(TargetSpec { texture, clear, blend });
+        let clear =
+            match tt.get("clear") {
+                None => None,
+                Some(c) => Some(four(c).ok_or_else(|| {
+                    tat(format!("clear = {c} is not valid; expected four finite numbers [r, g, b, a]"))
+                })?),
+            };
+        let (blend, constant) = parse_blend(tt.get("blend"), &tat)?;
+        targets.push(TargetSpec { texture, clear, blend, constant });
     }
     if targets.is_empty() {
         return Err(at("targets is empty; a render pass draws into at least one texture".into()));
     }
-    Ok(Some(RasterSpec { targets }))
+    Ok(targets)
+}
+
+/// `blend = "replace" | "alpha" | "additive"` or `{ color = [src, dst,
+/// op], alpha = [...], constant = [r, g, b, a] }` (alpha defaults to color).
+fn parse_blend(
+    v: Option<&toml::Value>,
+    at: &dyn Fn(String) -> ParamError,
+) -> Result<(Blend, Option<[f64; 4]>), ParamError> {
+    let t = match v {
+        None => return Ok((Blend::Replace, None)),
+        Some(toml::Value::String(name)) => return Ok((Blend::parse(name).map_err(at)?, None)),
+        Some(toml::Value::Table(t)) => t,
+        Some(other) => {
+            return Err(at(format!("blend = {other} is not valid; expected a name or {{ color, alpha, constant }}")));
+        }
+    };
+    if let Some(k) = t.keys().find(|k| !BLEND_KEYS.contains(&k.as_str())) {
+        return Err(at(format!("blend: unknown key {k}; allowed: {}", BLEND_KEYS.join(", "))));
+    }
+    let component = |k: &str| -> Result<Option<vista_texel::BlendComponent>, ParamError> {
+        let Some(v) = t.get(k) else { return Ok(None) };
+        let words: Option<Vec<&str>> = v.as_array().map(|a| a.iter().filter_map(|w| w.as_str()).collect());
+        match words {
+            Some(w) if w.len() == v.as_array().map_or(0, |a| a.len()) => {
+                vista_texel::BlendComponent::parse(&w).map(Some).map_err(|m| at(format!("blend {k}: {m}")))
+            }
+            _ => Err(at(format!("blend {k} = {v} is not valid; expected [src factor, dst factor, operation]"))),
+        }
+    };
+    let color = component("color")?.ok_or_else(|| at("blend needs color = [src, dst, op]".into()))?;
+    let alpha = component("alpha")?.unwrap_or(color);
+    let blend = Blend::Factors { color, alpha };
+    let constant = match t.get("constant") {
+        None => None,
+        Some(c) => {
+            Some(four(c).ok_or_else(|| at(format!("blend constant = {c} is not valid; expected [r, g, b, a]")))?)
+        }
+    };
+    if blend.uses_constant() != constant.is_some() {
+        return Err(at(match constant {
+            None => "blend uses a constant factor; give constant = [r, g, b, a]".into(),
+            Some(_) => "blend constant is given but no factor is constant or one-minus-constant".into(),
+        }));
+    }
+    Ok((blend, constant))
+}
+
+/// A render pass's `depth` table.
+fn parse_depth(d: &toml::Table, at: &dyn Fn(String) -> ParamError) -> Result<DepthSpec, ParamError> {
+    let dat = |m: String| at(format!("depth: {m}"));
+    if let Some(k) = d.keys().find(|k| !DEPTH_KEYS.contains(&k.as_str())) {
+        return Err(dat(format!("unknown key {k}; allowed: {}", DEPTH_KEYS.join(", "))));
+    }
+    if d.contains_key("resource") {
+        return Err(dat("a depth texture resource shared between passes is not supported yet; leave resource out \
+             for the pass's own depth32float buffer"
+            .into()));
+    }
+    let compare =
+        match string_key(d, "compare", &dat)? {
+            None => "less",
+            Some(c) => COMPARE_FUNCTIONS.iter().copied().find(|f| *f == c).ok_or_else(|| {
+                dat(format!("compare = \"{c}\" is not valid; expected {}", COMPARE_FUNCTIONS.join("|")))
+            })?,
+        };
+    let write = match d.get("write") {
+        None => true,
+        Some(toml::Value::Boolean(b)) => *b,
+        Some(other) => return Err(dat(format!("write = {other} is not valid; expected true or false"))),
+    };
+    let clear = match d.get("clear") {
+        None => 1.0,
+        Some(v) => v
+            .as_float()
+            .or_else(|| v.as_integer().map(|i| i as f64))
+            .filter(|c| (0.0..=1.0).contains(c))
+            .ok_or_else(|| dat(format!("clear = {v} is not valid; expected a number in [0, 1]")))?,
+    };
+    Ok(DepthSpec { compare, write, clear })
 }
 
 /// The `[[output]]` tables: resource, view, exposure, partial, tolerance.
@@ -1002,6 +1192,18 @@ pub struct PassSlot {
     /// The texture's mip level the binding sees (`bind = { v = "t@2" }`);
     /// `None`: every level for a sampled binding, level 0 for storage.
     pub level: Option<u32>,
+    /// A render pass's vertex entry reaches it too.
+    pub vertex: bool,
+}
+
+/// A draw's buffers as resolved: each vertex buffer's resource and
+/// layout, and the index buffer's resource.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DrawLayout {
+    /// (resource index, layout), one per vertex-buffer slot.
+    pub buffers: Vec<(usize, VertexLayout)>,
+    /// The u32 index buffer.
+    pub indices: Option<usize>,
 }
 
 impl PassSlot {
@@ -1050,23 +1252,6 @@ fn check_levels(
     Ok(())
 }
 
-/// A buffer binding's element: what one entry of its runtime-sized array
-/// (or the whole binding, when fixed-size) holds.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Element {
-    /// Bytes from one element to the next.
-    pub stride: u32,
-    /// Bytes before the runtime-sized array (0 for a bare array).
-    pub header: u32,
-    /// Elements of a fixed-size binding (`None`: runtime-sized).
-    pub fixed: Option<u32>,
-    /// Every leaf scalar of one element: byte offset, kind ('f' 'u' 'i'),
-    /// and its field path (for NumPy's structured dtype).
-    pub leaves: Vec<(u32, char, String)>,
-    /// The WGSL type, for messages.
-    pub wgsl: String,
-}
-
 /// The graph's resources after reflection: the manifest's, then one
 /// implicit texture per written storage texture no `bind` names.
 #[derive(Debug, Clone, PartialEq)]
@@ -1076,6 +1261,8 @@ pub struct Resolved {
     pub resources: Vec<ResolvedResource>,
     /// Per pass, its slots (sorted by group and binding).
     pub slots: Vec<Vec<PassSlot>>,
+    /// Per pass, a draw's buffers (`None`: a compute or full-screen pass).
+    pub draws: Vec<Option<DrawLayout>>,
     /// The outputs' resources (indexes into `resources`), in `[[output]]`
     /// order; without tables, or for a lone one without `resource`, the
     /// first texture a pass writes.
@@ -1201,38 +1388,16 @@ pub fn resolve(
                     SlotFeed::Resource(ri, Usage::Sampler { comparison })
                 }
             };
-            let element = match feed {
-                SlotFeed::Resource(ri, Usage::StorageBuffer { read_only }) => {
-                    let e = element(module, &module.global_variables[b.global])
-                        .map_err(|m| bad(format!("{label}: {}: {m}", describe(b))))?;
-                    let r = &mut resources[ri];
-                    if let Some(prev) = &r.element
-                        && (prev.stride != e.stride || prev.header != e.header)
-                    {
-                        return Err(bad(format!(
-                            "{label}: resource {} is bound as {} here but as {} elsewhere",
-                            r.spec.name, e.wgsl, prev.wgsl
-                        )));
-                    }
-                    r.element.get_or_insert(e.clone());
-                    if read_only {
-                        r.read = true;
-                    } else {
-                        r.written = true;
-                        r.read = true;
-                    }
-                    Some(e)
-                }
-                SlotFeed::Resource(ri, Usage::UniformBuffer) => {
-                    let e = element(module, &module.global_variables[b.global])
-                        .map_err(|m| bad(format!("{label}: {}: {m}", describe(b))))?;
-                    resources[ri].element.get_or_insert(e.clone());
-                    resources[ri].read = true;
-                    Some(e)
-                }
-                _ => None,
-            };
-            slots.push(PassSlot { group: b.group, binding: b.binding, var: b.name.clone(), feed, element, level });
+            let element = buffer_element(&feed, module, b, &mut resources, &label, &describe(b), &bad)?;
+            slots.push(PassSlot {
+                group: b.group,
+                binding: b.binding,
+                var: b.name.clone(),
+                feed,
+                element,
+                level,
+                vertex: b.vertex,
+            });
         }
         check_levels(&slots, &resources, &label, &bad)?;
         if let Some(raster) = &pass.raster {
@@ -1240,10 +1405,125 @@ pub fn resolve(
         }
         all_slots.push(slots);
     }
+    let mut draws = Vec::new();
+    for (i, ((_, _, module), pass)) in passes.iter().zip(&graph.passes).enumerate() {
+        draws.push(match &pass.raster {
+            Some(raster @ RasterSpec { vertex: VertexStage::Entry(vs), .. }) => Some(
+                draw_layout(raster, vs, module, &mut resources)
+                    .map_err(|m| bad(format!("pass {} ({vs}, {}): {m}", i + 1, pass.entry)))?,
+            ),
+            _ => None,
+        });
+    }
     let outputs = check_swaps_and_outputs(graph, &resources, &bad)?;
     check_default_output(graph, &resources, &all_slots, &bad)?;
     check_read_before_written(graph, &resources, &bad)?;
-    Ok(Resolved { resources, slots: all_slots, outputs })
+    Ok(Resolved { resources, slots: all_slots, outputs, draws })
+}
+
+/// A buffer binding's element (its WGSL type's stride, header and
+/// leaves), recorded on the resource it binds, which is marked read (and
+/// written, for a read_write storage buffer); `None` for other bindings.
+fn buffer_element(
+    feed: &SlotFeed,
+    module: &naga::Module,
+    b: &Binding,
+    resources: &mut [ResolvedResource],
+    label: &str,
+    describe: &str,
+    bad: &dyn Fn(String) -> ParamError,
+) -> Result<Option<Element>, ParamError> {
+    Ok(match *feed {
+        SlotFeed::Resource(ri, Usage::StorageBuffer { read_only }) => {
+            let e = element(module, &module.global_variables[b.global])
+                .map_err(|m| bad(format!("{label}: {describe}: {m}")))?;
+            let r = &mut resources[ri];
+            if let Some(prev) = &r.element
+                && (prev.stride != e.stride || prev.header != e.header)
+            {
+                return Err(bad(format!(
+                    "{label}: resource {} is bound as {} here but as {} elsewhere",
+                    r.spec.name, e.wgsl, prev.wgsl
+                )));
+            }
+            r.element.get_or_insert(e.clone());
+            if read_only {
+                r.read = true;
+            } else {
+                r.written = true;
+                r.read = true;
+            }
+            Some(e)
+        }
+        SlotFeed::Resource(ri, Usage::UniformBuffer) => {
+            let e = element(module, &module.global_variables[b.global])
+                .map_err(|m| bad(format!("{label}: {describe}: {m}")))?;
+            resources[ri].element.get_or_insert(e.clone());
+            resources[ri].read = true;
+            Some(e)
+        }
+        _ => None,
+    })
+}
+
+/// A draw's vertex and index buffers against its vertex entry's inputs,
+/// after every pass's bindings (a compute pass may give a buffer its
+/// element): each buffer read, and given the vertex layout's element where
+/// no binding gives one.
+fn draw_layout(
+    raster: &RasterSpec,
+    vs: &str,
+    module: &naga::Module,
+    resources: &mut [ResolvedResource],
+) -> Result<DrawLayout, String> {
+    let inputs = crate::bindings::vertex_inputs(module, vs)?;
+    let ids: Vec<usize> = raster.vertices.iter().map(|v| find(resources, &v.resource)).collect();
+    let elements: Vec<Option<&Element>> = ids.iter().map(|&r| resources[r].element.as_ref()).collect();
+    let laid = crate::vertex::layouts(vs, &inputs, &raster.vertices, &elements)?;
+    let mut buffers = Vec::new();
+    for (&r, (layout, synth)) in ids.iter().zip(laid) {
+        if let Some(e) = synth {
+            match &resources[r].element {
+                Some(prev) if prev.stride != e.stride => {
+                    return Err(format!(
+                        "vertices {}: read with stride {} here but {} elsewhere",
+                        resources[r].spec.name, e.stride, prev.stride
+                    ));
+                }
+                Some(_) => {}
+                None => resources[r].element = Some(e),
+            }
+        }
+        resources[r].read = true;
+        buffers.push((r, layout));
+    }
+    let indices = match &raster.indices {
+        None => None,
+        Some(name) => {
+            let r = find(resources, name);
+            let res = &mut resources[r];
+            let u32_index = Element {
+                stride: 4,
+                header: 0,
+                fixed: None,
+                leaves: vec![(0, 'u', String::new())],
+                wgsl: "u32".into(),
+            };
+            match &res.element {
+                Some(e) if (e.stride, e.header, e.leaves.len(), e.leaves[0].1) != (4, 0, 1, 'u') => {
+                    return Err(format!(
+                        "indices {name} holds {}; indices are u32 (uint16 is not supported yet)",
+                        e.wgsl
+                    ));
+                }
+                Some(_) => {}
+                None => res.element = Some(u32_index),
+            }
+            res.read = true;
+            Some(r)
+        }
+    };
+    Ok(DrawLayout { buffers, indices })
 }
 
 /// A render pass's targets: each a 2d texture (or one level of one) that

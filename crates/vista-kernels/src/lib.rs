@@ -73,6 +73,7 @@ pub mod atmosphere;
 pub mod bindings;
 pub mod cloudmap;
 pub mod clouds;
+pub mod element;
 pub mod expr;
 pub mod fbm;
 pub mod graph;
@@ -85,6 +86,7 @@ pub mod params;
 pub mod phase;
 pub mod ridged;
 pub mod values;
+pub mod vertex;
 
 use std::sync::{Arc, OnceLock};
 
@@ -671,7 +673,12 @@ impl Kernel {
                 Some(_) => naga::ShaderStage::Fragment,
                 None => naga::ShaderStage::Compute,
             };
-            reflected.push(bindings::reflect_all(self.name(), shader, &pass.entry, stage, module)?);
+            let mut b = bindings::reflect_all(self.name(), shader, &pass.entry, stage, module)?;
+            if let Some(graph::RasterSpec { vertex: graph::VertexStage::Entry(vs), .. }) = &pass.raster {
+                let v = bindings::reflect_all(self.name(), shader, vs, naga::ShaderStage::Vertex, module)?;
+                b = bindings::merge_stages(self.name(), b, v)?;
+            }
+            reflected.push(b);
         }
         let passes: Vec<(&str, &[bindings::Binding], &naga::Module)> =
             modules.iter().zip(&reflected).map(|((s, m), b)| (*s, b.as_slice(), *m)).collect();

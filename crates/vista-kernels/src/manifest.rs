@@ -115,6 +115,13 @@ struct RawPass {
     vertex: Option<toml::Value>,
     fragment: Option<toml::Value>,
     targets: Option<toml::Value>,
+    vertices: Option<toml::Value>,
+    indices: Option<toml::Value>,
+    count: Option<toml::Value>,
+    instances: Option<toml::Value>,
+    topology: Option<toml::Value>,
+    cull: Option<toml::Value>,
+    depth: Option<toml::Value>,
     workgroups: Option<Vec<toml::Value>>,
     /// WGSL variable name -> resource name.
     bind: Option<toml::Table>,

@@ -400,11 +400,11 @@ impl Planning<'_> {
                     Usage::Sampler { .. } => Bind::Sampler(*r),
                 },
             };
-            gslots.push(GraphSlot { group: s.group, binding: s.binding, bind });
+            gslots.push(GraphSlot { group: s.group, binding: s.binding, bind, vertex: s.vertex });
         }
         let (size, workgroups, raster) = match &pass.raster {
             // A render pass draws; it dispatches nothing.
-            Some(r) => ([1; 3], [1; 3], Some(self.raster(r, &label, resources, &index)?)),
+            Some(r) => ([1; 3], [1; 3], Some(self.raster(i, r, &label, resources, resolved, &pp)?)),
             None => {
                 let size = crate::reflect::workgroup_size(module, &pass.entry, &constants)
                     .map_err(|e| bad(format!("{label}: {e}")))?;
@@ -508,18 +508,23 @@ impl Planning<'_> {
         })
     }
 
-    /// A render pass's targets as the engine draws them: each a
-    /// renderable format (blended only where the format allows), all of
-    /// one size.
+    /// A render pass as the engine draws it: its targets (each a
+    /// renderable format, blended only where the format allows, all of one
+    /// size), its vertex stage, buffers and counts, and its fixed-function state.
     fn raster(
         &self,
+        i: usize,
         r: &vista_kernels::graph::RasterSpec,
         label: &str,
         resources: &[vista_gpu::Resource],
-        index: &dyn Fn(&str) -> usize,
+        resolved: &vista_kernels::graph::Resolved,
+        pp: &ParamSet,
     ) -> Result<vista_gpu::Raster, RenderError> {
+        use vista_kernels::graph::VertexStage;
+        let index = |name: &str| resolved.resources.iter().position(|x| x.spec.name == name).expect("resolved");
         let mut targets = Vec::new();
         let mut size: Option<(u32, u32, String)> = None;
+        let mut blend_constant: Option<[f64; 4]> = None;
         for (n, t) in r.targets.iter().enumerate() {
             let ri = index(&t.texture.resource);
             let name = &t.texture.resource;
@@ -542,6 +547,14 @@ impl Planning<'_> {
                     desc.format
                 )));
             }
+            if let (Some(c), Some(prev)) = (t.constant, blend_constant)
+                && c != prev
+            {
+                return Err(self.bad(format!(
+                    "{label}: targets[{n}] has blend constant {c:?} but an earlier target {prev:?}; a pass has one"
+                )));
+            }
+            blend_constant = blend_constant.or(t.constant);
             let (w, h) = ((desc.width >> level).max(1), (desc.height >> level).max(1));
             match &size {
                 Some((w0, h0, first)) if (*w0, *h0) != (w, h) => {
@@ -552,9 +565,141 @@ impl Planning<'_> {
                 Some(_) => {}
                 None => size = Some((w, h, name.clone())),
             }
-            targets.push(vista_gpu::RasterTarget { resource: ri, level, clear: t.clear, blend });
+            // A draw leaves uncovered texels at the clear value: zeros on a
+            // texture no earlier pass wrote, so they are not "unwritten".
+            let clear = match (&r.vertex, t.clear) {
+                (VertexStage::Entry(_), None) if !self.written_before(i, ri, resolved) => Some([0.0; 4]),
+                (_, c) => c,
+            };
+            targets.push(vista_gpu::RasterTarget { resource: ri, level, clear, blend });
         }
-        Ok(vista_gpu::Raster { targets })
+        let vertex = match &r.vertex {
+            VertexStage::Fullscreen => None,
+            VertexStage::Entry(vs) => Some(vs.clone()),
+        };
+        let draw = resolved.draws[i].as_ref();
+        let buffers: Vec<vista_gpu::VertexBuffer> = draw
+            .map(|d| {
+                d.buffers
+                    .iter()
+                    .map(|(ri, l)| vista_gpu::VertexBuffer {
+                        resource: *ri,
+                        stride: l.stride,
+                        instance: l.instance,
+                        attributes: l
+                            .attributes
+                            .iter()
+                            .map(|a| (a.location, a.format.name.to_string(), a.offset))
+                            .collect(),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let indices = draw.and_then(|d| d.indices);
+        let (count, instances) = self.draw_counts(r, label, resources, &buffers, indices, pp)?;
+        Ok(vista_gpu::Raster {
+            targets,
+            vertex,
+            buffers,
+            indices,
+            count,
+            instances,
+            topology: r.topology,
+            cull: r.cull,
+            depth: r.depth.as_ref().map(|d| vista_gpu::Depth {
+                compare: d.compare.to_string(),
+                write: d.write,
+                clear: d.clear,
+            }),
+            blend_constant,
+        })
+    }
+
+    /// Whether a pass before pass `i` writes resource `ri` (a storage
+    /// texture written, or a render target).
+    fn written_before(&self, i: usize, ri: usize, resolved: &vista_kernels::graph::Resolved) -> bool {
+        let g = self.kernel.graph();
+        (0..i).any(|j| {
+            let stored = resolved.slots[j].iter().any(|s| {
+                matches!(&s.feed, SlotFeed::Resource(r, Usage::StorageTexture(st))
+                    if *r == ri && st.access != vista_texel::Access::Read)
+            });
+            let drawn = g.passes[j]
+                .raster
+                .as_ref()
+                .is_some_and(|r| r.targets.iter().any(|t| resolved.resources[ri].spec.name == t.texture.resource));
+            stored || drawn
+        })
+    }
+
+    /// A draw's vertex (or index) count and instance count: as written, else
+    /// every index, every vertex of the per-vertex buffers, every element
+    /// of the per-instance ones; never more than the buffers hold.
+    fn draw_counts(
+        &self,
+        r: &vista_kernels::graph::RasterSpec,
+        label: &str,
+        resources: &[vista_gpu::Resource],
+        buffers: &[vista_gpu::VertexBuffer],
+        indices: Option<usize>,
+        pp: &ParamSet,
+    ) -> Result<(u32, u32), RenderError> {
+        if r.vertex == vista_kernels::graph::VertexStage::Fullscreen {
+            return Ok((3, 1));
+        }
+        let len = |ri: usize| match &resources[ri] {
+            vista_gpu::Resource::Buffer(b) => b.len() as u64,
+            _ => 0,
+        };
+        let held = |instance: bool| {
+            buffers
+                .iter()
+                .filter(|b| b.instance == instance)
+                .map(|b| (len(b.resource) / b.stride.max(1) as u64, b.resource))
+                .min()
+        };
+        let eval = |k: &str, e: &vista_kernels::expr::Expr| -> Result<u32, RenderError> {
+            let n = e.eval(pp, self.width, self.height).map_err(|m| self.bad(format!("{label}: {k} {m}")))?;
+            u32::try_from(n)
+                .ok()
+                .filter(|n| (1..=1 << 26).contains(n))
+                .ok_or_else(|| self.bad(format!("{label}: {k} is {n}; allowed: [1, 67108864]")))
+        };
+        let name = |ri: usize| self.kernel.graph().resources.get(ri).map_or("?".to_string(), |x| x.name.clone());
+        let (available, what) = match (indices, held(false)) {
+            (Some(ix), _) => (Some(len(ix) / 4), format!("indices {}", name(ix))),
+            (None, Some((n, ri))) => (Some(n), format!("vertices {}", name(ri))),
+            (None, None) => (None, String::new()),
+        };
+        let count = match (&r.count, available) {
+            (Some(e), _) => eval("count", e)?,
+            (None, Some(n)) => n.min(u32::MAX as u64) as u32,
+            (None, None) => {
+                return Err(self.bad(format!(
+                    "{label}: no vertex buffer or index buffer says how many vertices to draw; give count = N"
+                )));
+            }
+        };
+        if let Some(n) = available
+            && count as u64 > n
+        {
+            return Err(self.bad(format!("{label}: count = {count} but {what} holds {n}")));
+        }
+        let per_instance = held(true);
+        let instances = match (&r.instances, per_instance) {
+            (Some(e), _) => eval("instances", e)?,
+            (None, Some((n, _))) => n.min(u32::MAX as u64) as u32,
+            (None, None) => 1,
+        };
+        if let Some((n, ri)) = per_instance
+            && instances as u64 > n
+        {
+            return Err(self.bad(format!("{label}: instances = {instances} but vertices {} holds {n}", name(ri))));
+        }
+        if count == 0 || instances == 0 {
+            return Err(self.bad(format!("{label}: the draw has no vertices (count {count}, instances {instances})")));
+        }
+        Ok((count, instances))
     }
 
     /// The outputs as planned, and the resource each reads.

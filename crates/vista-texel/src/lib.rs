@@ -8,8 +8,10 @@
 //! `vista-gpu`) or what a kernel means.
 
 mod format;
+mod raster;
 
 pub use format::{Format, SampleKind, format_names};
+pub use raster::{Blend, BlendComponent, BlendFactor, BlendOp, Cull, Topology, VertexFormat};
 
 /// What each 32-bit channel of a sentinel-filled texture holds before the
 /// passes run (sentinel 0 of the 32-bit formats): a NaN with a payload no
@@ -98,33 +100,6 @@ impl Dimension {
             Dimension::Cube => Dimension::D2Array,
             d => d,
         }
-    }
-}
-
-/// How a render pass's fragment output meets what its target holds
-/// (`blend` of a target; SPEC 17).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Blend {
-    /// `replace`: the output replaces the texel.
-    Replace,
-    /// `alpha`: `src * src.a + dst * (1 - src.a)`, alpha `src.a + dst.a * (1 - src.a)`.
-    Alpha,
-    /// `additive`: `src + dst`, colour and alpha.
-    Additive,
-}
-
-impl Blend {
-    /// Every blend by its manifest name.
-    pub const ALL: [(&'static str, Blend); 3] =
-        [("replace", Blend::Replace), ("alpha", Blend::Alpha), ("additive", Blend::Additive)];
-
-    /// The blend a manifest names; the error lists the names allowed.
-    pub fn parse(name: &str) -> Result<Blend, String> {
-        Blend::ALL.iter().find(|(n, _)| *n == name).map(|(_, b)| *b).ok_or_else(|| {
-            let names: Vec<&str> = Blend::ALL.iter().map(|(n, _)| *n).collect();
-            format!("blend = \"{name}\" is not valid; expected {}", names.join("|"))
-        })
     }
 }
 

@@ -1,0 +1,152 @@
+//! A render pass's fixed-function state in wgpu's terms: blend equations,
+//! vertex buffer layouts, primitive and depth state (SPEC 17). The plan
+//! holds WebGPU's names; this maps them once.
+
+use vista_texel::{BlendComponent, BlendFactor, BlendOp, Cull, Topology};
+
+use crate::GpuError;
+use crate::graph::{Raster, Resource, VertexBuffer};
+
+fn blend_component(c: BlendComponent) -> wgpu::BlendComponent {
+    use wgpu::BlendFactor as W;
+    let factor = |f: BlendFactor| match f {
+        BlendFactor::Zero => W::Zero,
+        BlendFactor::One => W::One,
+        BlendFactor::Src => W::Src,
+        BlendFactor::OneMinusSrc => W::OneMinusSrc,
+        BlendFactor::SrcAlpha => W::SrcAlpha,
+        BlendFactor::OneMinusSrcAlpha => W::OneMinusSrcAlpha,
+        BlendFactor::Dst => W::Dst,
+        BlendFactor::OneMinusDst => W::OneMinusDst,
+        BlendFactor::DstAlpha => W::DstAlpha,
+        BlendFactor::OneMinusDstAlpha => W::OneMinusDstAlpha,
+        BlendFactor::SrcAlphaSaturated => W::SrcAlphaSaturated,
+        BlendFactor::Constant => W::Constant,
+        BlendFactor::OneMinusConstant => W::OneMinusConstant,
+    };
+    let operation = match c.op {
+        BlendOp::Add => wgpu::BlendOperation::Add,
+        BlendOp::Subtract => wgpu::BlendOperation::Subtract,
+        BlendOp::ReverseSubtract => wgpu::BlendOperation::ReverseSubtract,
+        BlendOp::Min => wgpu::BlendOperation::Min,
+        BlendOp::Max => wgpu::BlendOperation::Max,
+    };
+    wgpu::BlendComponent { src_factor: factor(c.src), dst_factor: factor(c.dst), operation }
+}
+
+/// Each target's format and blend state.
+pub(crate) fn color_targets(
+    r: &Raster,
+    resources: &[Resource],
+    label: &str,
+) -> Result<Vec<Option<wgpu::ColorTargetState>>, GpuError> {
+    r.targets
+        .iter()
+        .map(|t| {
+            let Resource::Texture(desc) = &resources[t.resource] else {
+                return Err(GpuError::Request(format!("{label}: a target that is not a texture")));
+            };
+            Ok(Some(wgpu::ColorTargetState {
+                format: crate::format::wgpu_format(&crate::format::parse(desc.format)?),
+                blend: t.blend.components().map(|(color, alpha)| wgpu::BlendState {
+                    color: blend_component(color),
+                    alpha: blend_component(alpha),
+                }),
+                write_mask: wgpu::ColorWrites::ALL,
+            }))
+        })
+        .collect()
+}
+
+fn vertex_format(name: &str) -> wgpu::VertexFormat {
+    use wgpu::VertexFormat as F;
+    match name {
+        "float32" => F::Float32,
+        "float32x2" => F::Float32x2,
+        "float32x3" => F::Float32x3,
+        "float32x4" => F::Float32x4,
+        "uint32" => F::Uint32,
+        "uint32x2" => F::Uint32x2,
+        "uint32x3" => F::Uint32x3,
+        "uint32x4" => F::Uint32x4,
+        "sint32" => F::Sint32,
+        "sint32x2" => F::Sint32x2,
+        "sint32x3" => F::Sint32x3,
+        "sint32x4" => F::Sint32x4,
+        "unorm8x4" => F::Unorm8x4,
+        "snorm8x4" => F::Snorm8x4,
+        "uint8x4" => F::Uint8x4,
+        "sint8x4" => F::Sint8x4,
+        other => unreachable!("vista_texel::VertexFormat has no {other}"),
+    }
+}
+
+/// Each buffer's attributes in wgpu's terms (kept alive for the layouts).
+pub(crate) fn attributes(buffers: &[VertexBuffer]) -> Vec<Vec<wgpu::VertexAttribute>> {
+    buffers
+        .iter()
+        .map(|b| {
+            b.attributes
+                .iter()
+                .map(|(location, format, offset)| wgpu::VertexAttribute {
+                    format: vertex_format(format),
+                    offset: *offset as u64,
+                    shader_location: *location,
+                })
+                .collect()
+        })
+        .collect()
+}
+
+pub(crate) fn buffer_layouts<'a>(
+    buffers: &[VertexBuffer],
+    attributes: &'a [Vec<wgpu::VertexAttribute>],
+) -> Vec<Option<wgpu::VertexBufferLayout<'a>>> {
+    buffers
+        .iter()
+        .zip(attributes)
+        .map(|(b, a)| {
+            Some(wgpu::VertexBufferLayout {
+                array_stride: b.stride as u64,
+                step_mode: if b.instance { wgpu::VertexStepMode::Instance } else { wgpu::VertexStepMode::Vertex },
+                attributes: a,
+            })
+        })
+        .collect()
+}
+
+pub(crate) fn primitive(r: &Raster) -> wgpu::PrimitiveState {
+    use wgpu::PrimitiveTopology as P;
+    wgpu::PrimitiveState {
+        topology: match r.topology {
+            Topology::TriangleList => P::TriangleList,
+            Topology::TriangleStrip => P::TriangleStrip,
+            Topology::LineList => P::LineList,
+            Topology::LineStrip => P::LineStrip,
+            Topology::PointList => P::PointList,
+        },
+        // WebGPU wants the strip's index format in the pipeline when indexed.
+        strip_index_format: match (r.topology, r.indices) {
+            (Topology::TriangleStrip | Topology::LineStrip, Some(_)) => Some(wgpu::IndexFormat::Uint32),
+            _ => None,
+        },
+        front_face: wgpu::FrontFace::Ccw,
+        cull_mode: match r.cull {
+            Cull::None => None,
+            Cull::Back => Some(wgpu::Face::Back),
+            Cull::Front => Some(wgpu::Face::Front),
+        },
+        ..Default::default()
+    }
+}
+
+pub(crate) fn depth_stencil(r: &Raster) -> Option<wgpu::DepthStencilState> {
+    let d = r.depth.as_ref()?;
+    Some(wgpu::DepthStencilState {
+        format: wgpu::TextureFormat::Depth32Float,
+        depth_write_enabled: Some(d.write),
+        depth_compare: Some(crate::graph::compare_fn(&d.compare).expect("plans name WebGPU's comparisons")),
+        stencil: Default::default(),
+        bias: Default::default(),
+    })
+}
