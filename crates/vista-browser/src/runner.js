@@ -74,8 +74,8 @@ function vistaChunk(offset, length) {
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility; `vertex`: the render pass's vertex entry reads it too); a texture slot's view
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (vista's full-screen WGSL, or
-// null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, clear, blend
-// (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a u32
+// null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear,
+// blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a u32
 // buffer or null), count, instances, topology, cull, depth ({ compare, write, clear } or null: the pass's own
 // depth32float texture), blend_constant }. Outputs are read back one after another into vista.out: textures
 // unpadded, layers stacked; buffers whole.
@@ -229,7 +229,7 @@ async function vistaRun(job) {
         if (pass.raster) {
           // Each target's level, cleared where it says so, else drawn over.
           const colorAttachments = pass.raster.targets.map((t) => {
-            const view = made[current[t.resource]].createView({ dimension: "2d", baseMipLevel: t.level, mipLevelCount: 1, baseArrayLayer: 0, arrayLayerCount: 1 });
+            const view = made[current[t.resource]].createView({ dimension: "2d", baseMipLevel: t.level, mipLevelCount: 1, baseArrayLayer: t.layer, arrayLayerCount: 1 });
             return t.clear
               ? { view, loadOp: "clear", clearValue: t.clear, storeOp: "store" }
               : { view, loadOp: "load", storeOp: "store" };

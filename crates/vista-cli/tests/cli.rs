@@ -4796,6 +4796,15 @@ fn copy(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
         assert_eq!(vista_image::load(&out).unwrap().get(5, 1), [1.25; 4], "{backend}");
     }
+    // 32-bit floats blend where the backend has float32-blendable (all three here).
+    let d = kernel_project(&manifest(&add.replace("\"acc\"", "\"image\"")), SHADER);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("f-{backend}.exr"));
+        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        assert_eq!(vista_image::load(&out).unwrap().get(2, 3), [1.25; 4], "{backend}: rgba32float blended");
+    }
     // One mip level drawn while another of the same texture is read.
     let chain = "[[resource]]\nname = \"pyr\"\nkind = \"texture\"\nformat = \"rgba16float\"\nmip_levels = 2\n\
                  [[pass]]\nkind = \"render\"\nfragment = \"add\"\ntargets = [{ resource = \"pyr@0\", clear = [0.0, 0.0, 0.0, 0.0] }]\n\
@@ -4808,6 +4817,48 @@ fn copy(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
         let r = vista_in(Some(d.path()), &[], &args);
         assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+    }
+    // A cube drawn face by face ("cube@layerK"); a face left out stays unwritten.
+    let faces = |n: usize| -> String {
+        (0..n)
+            .map(|k| {
+                format!(
+                    "[[pass]]\nkind = \"render\"\nfragment = \"add\"\nset = {{ gain = {} }}\n\
+                     targets = [{{ resource = \"cube@layer{k}\" }}]\n",
+                    k as f64 * 0.5
+                )
+            })
+            .collect()
+    };
+    let cube = |n: usize| {
+        format!(
+            "[[resource]]\nname = \"cube\"\nkind = \"texture\"\nformat = \"rgba16float\"\ndimension = \"cube\"\n{}\
+             [[output]]\nresource = \"cube\"\n",
+            faces(n)
+        )
+    };
+    let d = kernel_project(&manifest(&cube(6)), SHADER);
+    for backend in ["lavapipe", "browser"] {
+        let out = d.path().join(format!("c-{backend}.exr"));
+        let args = ["render", "k", "--size", "8x8", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        let img = vista_image::load(&out).unwrap();
+        for k in 0..6u32 {
+            assert_eq!(img.get(3, 8 * k + 5), [0.25 * k as f32; 4], "{backend}: face {k}");
+        }
+    }
+    let d = kernel_project(&manifest(&cube(5)), SHADER);
+    let out = d.path().join("c5.exr");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    assert_rejected(&r, 1, &["64 of 384 texels never written"]);
+    for (from, to, needle) in [
+        ("cube@layer0", "cube", "cube is a cube texture, drawn one layer at a time: \"cube@layer0\""),
+        ("cube@layer0", "image@layer0", "image@layer.. needs a 2d-array or cube texture"),
+        ("cube@layer5", "cube@layer6", "cube has 6 layers; allowed: cube@layer0 .. cube@layer5"),
+        ("cube@layer5", "cube@layerx", "@layer needs a layer number, e.g. cube@layer0"),
+    ] {
+        assert_rejected(&render_k(&manifest(&cube(6).replace(from, to)), SHADER), 2, &[needle]);
     }
     // Goldens: bless, check, and a changed fragment fails.
     let d = kernel_project(&manifest(shade), SHADER);
@@ -4829,8 +4880,9 @@ fn copy(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
             &["pass 1 (shade)", "targets[1] (acc) has no @location(1) output in shade"][..],
         ),
         (
-            "[[pass]]\nkind = \"render\"\nfragment = \"add\"\ntargets = [{ resource = \"image\", blend = \"additive\" }]\n",
-            &["targets[0] image is rgba32float, which does not blend"][..],
+            "[[resource]]\nname = \"counts\"\nkind = \"texture\"\nformat = \"r32uint\"\n\
+             [[pass]]\nkind = \"render\"\nfragment = \"add\"\ntargets = [{ resource = \"counts\", blend = \"additive\" }]\n",
+            &["targets[0] counts is r32uint, an integer format, which does not blend"][..],
         ),
         (
             "[[pass]]\nkind = \"render\"\nfragment = \"shade\"\nworkgroups = [1, 1, 1]\ntargets = [{ resource = \"image\" }]\n",
@@ -5060,6 +5112,17 @@ fn the_render_example_passes_on_every_backend_with_a_copied_binary() {
     assert_eq!(c.code, 1, "{}", c.stdout);
     assert!(c.stdout.contains("output glow:"), "the glow's own verdict names it: {}", c.stdout);
     grass_tips_follow_the_cpu_projection(&bin, &root);
+    // mutate reaches a draw's vertex entry: the sway's mutants are run, and killed.
+    let json = root.join("mutants.json");
+    let m = run(&["mutate", "--kernel", "grass", "--json", json.to_str().unwrap()]);
+    assert_eq!(m.code, 0, "{}{}", m.stdout, m.stderr);
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let text = std::fs::read_to_string(root.join("shaders/grass.wgsl")).unwrap();
+    let sway_line = text.lines().position(|l| l.contains("sin(params.time) * 20.0")).unwrap() as u64 + 1;
+    let sway: Vec<&serde_json::Value> =
+        report["mutants"].as_array().unwrap().iter().filter(|m| m["line"].as_u64() == Some(sway_line)).collect();
+    assert!(!sway.is_empty(), "no mutant of the vertex entry's sway: {report}");
+    assert!(sway.iter().all(|m| m["outcome"] == "killed"), "a sway mutant survived: {sway:?}");
     // (d) A mutant of the wind's amplitude fails check at every time.
     let shader = root.join("shaders/grass.wgsl");
     let text = std::fs::read_to_string(&shader).unwrap();

@@ -63,6 +63,10 @@ impl Context {
                 }
             };
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
+            if let Some(r) = &pass.raster {
+                let adapter = || self.adapter_description();
+                crate::raster::check_blendable(r, &g.resources, &pass.label, self.blends_float32(), &adapter)?;
+            }
             let raster = pass.raster.as_ref().map(raster_json);
             passes.push(json!({
                 "key": key, "label": pass.label, "wgsl": *wgsl, "entry": pass.entry,
@@ -200,7 +204,7 @@ fn raster_json(r: &crate::graph::Raster) -> Value {
     json!({
         "vertex": vertex, "vertex_entry": vertex_entry,
         "targets": r.targets.iter().map(|t| json!({
-            "resource": t.resource, "level": t.level, "clear": t.clear, "blend": blend(t.blend),
+            "resource": t.resource, "level": t.level, "layer": t.layer, "clear": t.clear, "blend": blend(t.blend),
         })).collect::<Vec<_>>(),
         "buffers": r.buffers.iter().map(|b| json!({
             "resource": b.resource, "arrayStride": b.stride, "stepMode": if b.instance { "instance" } else { "vertex" },

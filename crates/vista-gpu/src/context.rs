@@ -343,7 +343,11 @@ impl Context {
         // Linear sampling of r32float/rg32float/rgba32float inputs, where
         // the driver has it (SPEC 14, features and limits).
         // GPU timestamps around each graph pass, where the driver has them.
-        let wanted = specific | wgpu::Features::FLOAT32_FILTERABLE | wgpu::Features::TIMESTAMP_QUERY;
+        // Blending into 32-bit float render targets, where the driver has it.
+        let wanted = specific
+            | wgpu::Features::FLOAT32_FILTERABLE
+            | wgpu::Features::FLOAT32_BLENDABLE
+            | wgpu::Features::TIMESTAMP_QUERY;
         let required_features = adapter.features() & wanted;
         let read_write = vista_texel::format_names()
             .into_iter()
@@ -620,6 +624,15 @@ impl Context {
                 Engine::Wgpu(w) => w.read_write.contains(&format.name),
                 Engine::Browser(b) => b.features.iter().any(|f| f == "texture-formats-tier2"),
             }
+    }
+
+    /// Whether this device blends into 32-bit float render targets
+    /// (wgpu's FLOAT32_BLENDABLE, WebGPU's `float32-blendable`).
+    pub(crate) fn blends_float32(&self) -> bool {
+        match &self.engine {
+            Engine::Wgpu(w) => w.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE),
+            Engine::Browser(b) => b.features.iter().any(|f| f == "float32-blendable"),
+        }
     }
 
     /// The feature that [`Context::binds_read_write`] depends on here.

@@ -277,6 +277,9 @@ pub struct RasterTarget {
     pub resource: usize,
     /// The mip level drawn into.
     pub level: u32,
+    /// The array layer drawn into (0 for a 2d texture).
+    #[serde(default)]
+    pub layer: u32,
     /// Cleared to this before the draw; `None`: drawn over what the
     /// texture holds (a sentinel-filled output keeps its sentinel where the
     /// fragment entry discards: unwritten).

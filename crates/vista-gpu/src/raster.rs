@@ -34,6 +34,28 @@ fn blend_component(c: BlendComponent) -> wgpu::BlendComponent {
     wgpu::BlendComponent { src_factor: factor(c.src), dst_factor: factor(c.dst), operation }
 }
 
+/// A blended 32-bit float target where the backend lacks float32-blendable
+/// (`blendable`): the case is unsupported here, naming the feature.
+pub(crate) fn check_blendable(
+    r: &Raster,
+    resources: &[Resource],
+    label: &str,
+    blendable: bool,
+    adapter: &dyn Fn() -> String,
+) -> Result<(), GpuError> {
+    for t in &r.targets {
+        let Resource::Texture(desc) = &resources[t.resource] else { continue };
+        if t.blend != vista_texel::Blend::Replace && !blendable && crate::format::parse(desc.format)?.is_float32() {
+            return Err(GpuError::Unsupported {
+                adapter: adapter(),
+                what: format!("{label}: a blended {} target", desc.format),
+                feature: "float32-blendable".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Each target's format and blend state.
 pub(crate) fn color_targets(
     r: &Raster,
@@ -149,4 +171,46 @@ pub(crate) fn depth_stencil(r: &Raster) -> Option<wgpu::DepthStencilState> {
         stencil: Default::default(),
         bias: Default::default(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::{Contents, RasterTarget, TextureDesc};
+
+    #[test]
+    fn a_blended_float32_target_needs_float32_blendable() {
+        let texture = |format| {
+            Resource::Texture(TextureDesc {
+                format,
+                dimension: vista_texel::Dimension::D2,
+                width: 4,
+                height: 4,
+                layers: 1,
+                mip_levels: 1,
+                contents: Contents::Sentinel,
+            })
+        };
+        let raster = |blend| Raster {
+            targets: vec![RasterTarget { resource: 0, level: 0, layer: 0, clear: None, blend }],
+            vertex: None,
+            buffers: Vec::new(),
+            indices: None,
+            count: 3,
+            instances: 1,
+            topology: Topology::TriangleList,
+            cull: Cull::None,
+            depth: None,
+            blend_constant: None,
+        };
+        let adapter = || "test adapter".to_string();
+        let f32s = [texture("rgba32float")];
+        let e = check_blendable(&raster(vista_texel::Blend::Additive), &f32s, "pass 1 (add)", false, &adapter);
+        let message = e.unwrap_err().to_string();
+        assert!(message.contains("pass 1 (add): a blended rgba32float target needs float32-blendable"), "{message}");
+        assert!(check_blendable(&raster(vista_texel::Blend::Additive), &f32s, "p", true, &adapter).is_ok());
+        assert!(check_blendable(&raster(vista_texel::Blend::Replace), &f32s, "p", false, &adapter).is_ok());
+        let f16s = [texture("rgba16float")];
+        assert!(check_blendable(&raster(vista_texel::Blend::Alpha), &f16s, "p", false, &adapter).is_ok());
+    }
 }

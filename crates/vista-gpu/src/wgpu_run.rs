@@ -471,7 +471,11 @@ impl Context {
             ));
         }
         let targets = match &pass.raster {
-            Some(r) => Some(crate::raster::color_targets(r, &g.resources, &pass.label)?),
+            Some(r) => {
+                let adapter = || self.adapter_description();
+                crate::raster::check_blendable(r, &g.resources, &pass.label, self.blends_float32(), &adapter)?;
+                Some(crate::raster::color_targets(r, &g.resources, &pass.label)?)
+            }
             None => None,
         };
         // A render pipeline differs by its targets and fixed-function state too.
@@ -708,7 +712,7 @@ fn encode_draw(
                 dimension: Some(wgpu::TextureViewDimension::D2),
                 base_mip_level: t.level,
                 mip_level_count: Some(1),
-                base_array_layer: 0,
+                base_array_layer: t.layer,
                 array_layer_count: Some(1),
                 ..Default::default()
             })

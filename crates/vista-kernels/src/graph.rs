@@ -152,6 +152,8 @@ pub enum Repeat {
 pub struct TargetSpec {
     /// The texture (and mip level) drawn into.
     pub texture: Level,
+    /// The one layer of a 2d-array or cube texture drawn into (`"cube@layer3"`).
+    pub layer: Option<u32>,
     /// `clear = [r, g, b, a]`: cleared before the draw; without, drawn
     /// over what the texture holds (texels a full-screen pass leaves keep
     /// the unwritten sentinel).
@@ -248,6 +250,18 @@ pub struct PassSpec {
     /// Consecutive passes with one `group` run together, in order, the
     /// group's `repeat` times (given on its first pass).
     pub group: Option<String>,
+}
+
+impl PassSpec {
+    /// The entry points the pass runs: its compute or fragment entry, and a
+    /// draw's vertex entry.
+    pub fn entries(&self) -> Vec<&str> {
+        let mut out = vec![self.entry.as_str()];
+        if let Some(RasterSpec { vertex: VertexStage::Entry(vs), .. }) = &self.raster {
+            out.push(vs);
+        }
+        out
+    }
 }
 
 impl GraphSpec {
@@ -924,6 +938,16 @@ fn parse_targets(
             return Err(tat(format!("unknown key {k}; allowed: {}", TARGET_KEYS.join(", "))));
         }
         let name = string_key(tt, "resource", &tat)?.ok_or_else(|| tat("needs resource = \"...\"".into()))?;
+        // "cube@layer3", "arr@2@layer1": one layer (of one level).
+        let (name, layer) = match name.rsplit_once("@layer") {
+            None => (name.clone(), None),
+            Some((n, l)) => match l.parse::<u32>() {
+                Ok(l) => (n.to_string(), Some(l)),
+                Err(_) => {
+                    return Err(tat(format!("resource = \"{name}\": @layer needs a layer number, e.g. {n}@layer0")));
+                }
+            },
+        };
         let texture = Level::parse(&name, res).map_err(|m| tat(format!("resource = {m}")))?;
         let clear =
             match tt.get("clear") {
@@ -933,7 +957,7 @@ fn parse_targets(
                 })?),
             };
         let (blend, constant) = parse_blend(tt.get("blend"), &tat)?;
-        targets.push(TargetSpec { texture, clear, blend, constant });
+        targets.push(TargetSpec { texture, layer, clear, blend, constant });
     }
     if targets.is_empty() {
         return Err(at("targets is empty; a render pass draws into at least one texture".into()));
@@ -1559,12 +1583,26 @@ fn check_targets(
             )));
         }
         let r = &mut resources[ri];
-        match r.dimension {
-            None => r.dimension = Some(Dimension::D2),
-            Some(Dimension::D2) => {}
-            Some(d) => {
+        match (r.dimension, t.layer) {
+            (None, None) => r.dimension = Some(Dimension::D2),
+            (Some(Dimension::D2), None) | (Some(Dimension::D2Array | Dimension::Cube), Some(_)) => {}
+            (Some(d @ (Dimension::D2Array | Dimension::Cube)), None) => {
                 return Err(bad(format!(
-                    "{label}: targets[{n}] {name} is a {} texture; render targets are 2d so far",
+                    "{label}: targets[{n}] {name} is a {} texture, drawn one layer at a time: \"{name}@layer0\" ..",
+                    d.name()
+                )));
+            }
+            (d, Some(_)) => {
+                return Err(bad(format!(
+                    "{label}: targets[{n}] {name}@layer.. needs a 2d-array or cube texture (dimension = \"cube\"); \
+                     {name} is {}",
+                    d.map_or("2d".to_string(), |d| d.name().to_string())
+                )));
+            }
+            (Some(d), None) => {
+                return Err(bad(format!(
+                    "{label}: targets[{n}] {name} is a {} texture; a render target is 2d, or one layer of a \
+                     2d-array or cube",
                     d.name()
                 )));
             }

@@ -277,7 +277,7 @@ pub fn outside_files(project: &Project) -> Result<Vec<SourceFile>, GoldenError> 
 /// The deterministic plan: per kernel (sorted by name), every mutant of its
 /// import closure in source order, shuffled by `seed` and cut to `sample`;
 /// then this partition's slice (every n-th from the k-th). Only functions
-/// the kernel's entry point (`main` unless the manifest names another) reaches (by name, through calls, across the closure)
+/// the kernel's entry points (each pass's, a draw's vertex entry too) reach (by name, through calls, across the closure)
 /// are mutated: a function it never calls cannot change its output, so its
 /// mutants would only be `equivalent?` noise.
 pub fn plan(
@@ -300,8 +300,14 @@ pub fn plan(
                 }
             }
         }
-        let roots: Vec<(&str, &str)> =
-            k.graph().passes.iter().map(|p| (p.shader.as_deref().unwrap_or(k.shader()), p.entry.as_str())).collect();
+        // A draw's vertex entry is a root too.
+        let own = k.shader();
+        let roots: Vec<(&str, &str)> = k
+            .graph()
+            .passes
+            .iter()
+            .flat_map(|p| p.entries().into_iter().map(move |e| (p.shader.as_deref().unwrap_or(own), e)))
+            .collect();
         let fns: Vec<(&str, mutants::Function)> = closure
             .iter()
             .flat_map(|f| mutants::functions(&f.text).into_iter().map(move |g| (f.rel.as_str(), g)))

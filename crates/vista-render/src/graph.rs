@@ -530,6 +530,14 @@ impl Planning<'_> {
             let name = &t.texture.resource;
             let vista_gpu::Resource::Texture(desc) = &resources[ri] else { unreachable!("resolve checks targets") };
             let level = t.texture.level.unwrap_or(0);
+            let layer = t.layer.unwrap_or(0);
+            if layer >= desc.layers {
+                return Err(self.bad(format!(
+                    "{label}: targets[{n}] {name}@layer{layer}: {name} has {} layers; allowed: {name}@layer0 .. {name}@layer{}",
+                    desc.layers,
+                    desc.layers - 1
+                )));
+            }
             let format = vista_texel::Format::parse(desc.format).map_err(|m| self.bad(m))?;
             if !format.is_renderable() {
                 return Err(self.bad(format!(
@@ -537,13 +545,12 @@ impl Planning<'_> {
                     desc.format
                 )));
             }
+            // 32-bit floats blend where the backend has float32-blendable
+            // (the engine reports the case unsupported where not).
             let blend = t.blend;
-            if blend != vista_texel::Blend::Replace
-                && (format.sample_kind() != vista_texel::SampleKind::Float || format.is_float32())
-            {
+            if blend != vista_texel::Blend::Replace && format.sample_kind() != vista_texel::SampleKind::Float {
                 return Err(self.bad(format!(
-                    "{label}: targets[{n}] {name} is {}, which does not blend (integer formats never; 32-bit floats \
-                     need float32-blendable, not requested yet); use blend = \"replace\"",
+                    "{label}: targets[{n}] {name} is {}, an integer format, which does not blend; use blend = \"replace\"",
                     desc.format
                 )));
             }
@@ -571,7 +578,7 @@ impl Planning<'_> {
                 (VertexStage::Entry(_), None) if !self.written_before(i, ri, resolved) => Some([0.0; 4]),
                 (_, c) => c,
             };
-            targets.push(vista_gpu::RasterTarget { resource: ri, level, clear, blend });
+            targets.push(vista_gpu::RasterTarget { resource: ri, level, layer, clear, blend });
         }
         let vertex = match &r.vertex {
             VertexStage::Fullscreen => None,
