@@ -73,8 +73,8 @@ function vistaChunk(offset, length) {
 // the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64) }; a sampler: { kind,
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility; `vertex`: the render pass's vertex entry reads it too); a texture slot's view
-// dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (vista's full-screen WGSL, or
-// null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear,
+// dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
+// another file's; null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear,
 // blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a u32
 // buffer or null), count, instances, topology, cull, depth ({ compare, write, clear } or null: the pass's own
 // depth32float texture), blend_constant }. Outputs are read back one after another into vista.out: textures
@@ -82,7 +82,7 @@ function vistaChunk(offset, length) {
 async function pipeline(pass, resources) {
   const targets = pass.raster ? pass.raster.targets.map((t) => ({ format: resources[t.resource].format, blend: t.blend || undefined })) : null;
   const r = pass.raster;
-  const fixed = r ? [r.vertex_entry, r.buffers.map((b) => [b.arrayStride, b.stepMode, b.attributes]), r.topology, r.cull, r.depth, r.indices !== null] : null;
+  const fixed = r ? [r.vertex_entry, r.vertex, r.buffers.map((b) => [b.arrayStride, b.stepMode, b.attributes]), r.topology, r.cull, r.depth, r.indices !== null] : null;
   const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout, s.vertex]))}${JSON.stringify(targets)}${JSON.stringify(fixed)}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
@@ -113,7 +113,7 @@ async function pipeline(pass, resources) {
     const layout = d.createPipelineLayout({ bindGroupLayouts: groups });
     if (r) {
       // vista's full-screen triangle, or the pass's own vertex entry.
-      const vertex = r.vertex ? d.createShaderModule({ code: r.vertex, label: "vista full-screen triangle" }) : module;
+      const vertex = r.vertex ? d.createShaderModule({ code: r.vertex, label: `${pass.key} vertex` }) : module;
       const strip = r.indices !== null && (r.topology === "triangle-strip" || r.topology === "line-strip");
       p = await d.createRenderPipelineAsync({
         layout,

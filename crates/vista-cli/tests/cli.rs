@@ -5029,6 +5029,41 @@ fn build(@builtin(local_invocation_index) i: u32) {
         let front = render(&winding("front"), backend);
         assert_eq!((front.get(0, 3), front.get(7, 0)), ([0.0; 4], [1.0; 4]), "{backend}: front faces culled");
     }
+    // A vertex entry of another file, binding only what the fragment entry binds.
+    const OTHER: &str = "struct Params { width: u32, height: u32, gain: f32 }
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(3) var<uniform> extra: vec4<f32>;
+
+@vertex
+fn lifted(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
+    return vec4(p * min(params.gain, 1.0), 0.5, 1.0);
+}
+
+@vertex
+fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
+    return vec4(p * min(params.gain, 1.0) + extra.xy, 0.5, 1.0);
+}
+";
+    let other = indexed.replace("vertex = \"flat\"", "vertex = { shader = \"v.wgsl\", entry = \"lifted\" }");
+    let d = kernel_project(&manifest(&other), SHADER);
+    std::fs::write(d.path().join("shaders/v.wgsl"), OTHER).unwrap();
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("v-{backend}.exr"));
+        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        let img = vista_image::load(&out).unwrap();
+        assert_eq!((img.get(1, 2), img.get(6, 2)), ([1.0; 4], [0.0; 4]), "{backend}: another file's vertex entry");
+    }
+    let manifest_path = d.path().join("kernels/k.toml");
+    std::fs::write(&manifest_path, manifest(&other.replace("lifted", "greedy"))).unwrap();
+    let out = d.path().join("g.exr");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x4", "-o", out.to_str().unwrap()]);
+    assert_rejected(
+        &r,
+        2,
+        &["the vertex entry in v.wgsl binds extra (@group(0) @binding(3)", "which the fragment entry does not"],
+    );
     // Blend factors with a constant: 0.25 * 1 + 0.5 (the clear) = 0.75.
     let constant = "[[resource]]\nname = \"acc\"\nkind = \"texture\"\nformat = \"rgba16float\"\n\
                     [[pass]]\nkind = \"render\"\nfragment = \"fill\"\ntargets = [{ resource = \"acc\", clear = [0.5, 0.5, 0.5, 0.5], \
@@ -5059,7 +5094,8 @@ fn build(@builtin(local_invocation_index) i: u32) {
         (instanced.replace("vertex = \"placed\"", "vertex = \"placed\"\ncount = 99"), &["count = 99 but vertices tri holds 6"][..]),
         (indexed.replace("vertex = \"flat\"", "vertex = \"fullscreen\""), &["vertices needs a vertex entry"][..]),
         (indexed.replace("vertex = \"flat\"", "vertex = \"nope\""), &["has no vertex entry point 'nope'; its vertex entry points: flat, placed, layered"][..]),
-        (indexed.replace("vertex = \"flat\"", "vertex = { shader = \"v.wgsl\", entry = \"vs\" }"), &["is not supported yet"][..]),
+        (indexed.replace("vertex = \"flat\"", "vertex = { shader = \"nowhere.wgsl\", entry = \"vs\" }"), &["nowhere.wgsl"][..]),
+        (indexed.replace("vertex = \"flat\"", "vertex = { shader = \"k.wgsl\", entry = \"vs\", stage = 1 }"), &["vertex: unknown key stage; allowed: shader, entry"][..]),
         (depth.replace("compare = \"less\"", "resource = \"image\""), &["depth: a depth texture resource shared between passes is not supported yet"][..]),
         (indexed.replace("data = [0, 1, 2, 0, 2, 3]", "data = [0.5, 1, 2, 0, 2, 3]"), &["0.5 does not fit"][..]),
         (indexed.replace("indices = \"ix\"", "indices = \"image\""), &["indices = image is a texture; expected a buffer resource"][..]),
@@ -5071,6 +5107,41 @@ fn build(@builtin(local_invocation_index) i: u32) {
     ] {
         let r = render_k(&manifest(&body), SHADER);
         assert_rejected(&r, 2, needles);
+    }
+}
+
+/// `enable f16;` (SPEC 17, features requested from the shader): naga
+/// validates it, the device is asked for shader-f16, and a backend without
+/// it reports the kernel unsupported, naming the feature (lavapipe has it;
+/// SwiftShader and Chromium's SwiftShader adapter do not).
+fn f16_kernels_run_where_the_backend_has_shader_f16() {
+    const SHADER: &str = "enable f16;
+struct Params { width: u32, height: u32, gain: f32 }
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var out: texture_storage_2d<rgba16float, write>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let half_gain = f16(params.gain) * 0.5h;
+    textureStore(out, id.xy, vec4(f32(half_gain)));
+}
+";
+    let manifest = "summary = \"f16\"\n[[param]]\nname = \"gain\"\ntype = \"f32\"\nrange = [0, 4]\ndefault = 3.0\ndoc = \"gain\"\n";
+    let d = kernel_project(manifest, SHADER);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("{backend}.exr"));
+        let args = ["render", "k", "--size", "8x8", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        match backend {
+            "lavapipe" => {
+                assert_eq!(r.code, 0, "{}", r.stderr);
+                assert_eq!(vista_image::load(&out).unwrap().get(5, 6), [1.5; 4]);
+            }
+            _ => {
+                assert_rejected(&r, 1, &["unsupported on", "k.wgsl: f16 (enable f16;) needs shader-f16"]);
+                assert!(!out.exists(), "{backend}: an unsupported render wrote its output");
+            }
+        }
     }
 }
 
@@ -5101,6 +5172,9 @@ fn the_render_example_passes_on_every_backend_with_a_copied_binary() {
         eprintln!("{backend}: fragment sky vs compute sky: PSNR {:.2} dB, max abs {:.3e}", m.psnr, m.max_abs);
         assert!(m.psnr >= bound, "{backend}: PSNR {} against the compute sky; bound {bound}", m.psnr);
     }
+    // Full-screen passes and draws alike pass the Khronos validation layer.
+    let validated = run_in(&bin, &root, &[("VISTA_VALIDATION", "1")], &["check"]);
+    assert_eq!(validated.code, 0, "{}{}", validated.stdout, validated.stderr);
     let manifest = std::fs::read_to_string(root.join("golden/manifest.toml")).unwrap();
     assert!(manifest.contains("\"bloom.glow.png\" = "), "the glow has its own golden: {manifest}");
     let shader = root.join("shaders/bloom.wgsl");
@@ -5265,6 +5339,7 @@ fn main() {
         Gpu layered_outputs_stack_and_follow_reflection,
         Gpu a_fullscreen_render_pass_draws_every_texel,
         Gpu a_draw_reads_vertex_buffers_indices_and_depth,
+        Gpu f16_kernels_run_where_the_backend_has_shader_f16,
         Gpu the_render_example_passes_on_every_backend_with_a_copied_binary,
         Gpu a_broken_manifest_breaks_only_its_kernel,
         Cpu adapter_is_a_hidden_alias_of_backend,

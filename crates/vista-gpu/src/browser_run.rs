@@ -62,12 +62,25 @@ impl Context {
                     w
                 }
             };
+            let vertex_module = match pass.raster.as_ref().and_then(|r| r.vertex_shader.as_ref()) {
+                Some(f) => Some(g.shaders.compose(f)?),
+                None => None,
+            };
+            self.check_f16(&pass.shader, [Some(&*g.shaders.compose(&pass.shader)?), vertex_module.as_deref()])?;
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
             if let Some(r) = &pass.raster {
                 let adapter = || self.adapter_description();
                 crate::raster::check_blendable(r, &g.resources, &pass.label, self.blends_float32(), &adapter)?;
             }
-            let raster = pass.raster.as_ref().map(raster_json);
+            // A vertex entry of another file travels as its own WGSL.
+            let vertex_wgsl = match pass.raster.as_ref().and_then(|r| r.vertex_shader.as_ref().zip(r.vertex.as_ref())) {
+                Some((file, vs)) => {
+                    let r = pass.raster.as_ref().expect("a render pass");
+                    Some(Context::wgsl_source(g.shaders, file, vs, &r.vertex_constants)?)
+                }
+                None => None,
+            };
+            let raster = pass.raster.as_ref().map(|r| raster_json(r, vertex_wgsl.as_deref()));
             passes.push(json!({
                 "key": key, "label": pass.label, "wgsl": *wgsl, "entry": pass.entry,
                 "workgroups": pass.workgroups, "repeat": pass.repeat, "span": pass.span,
@@ -186,9 +199,10 @@ impl Context {
 }
 
 /// A render pass as runner.js builds it: the vertex stage (vista's
-/// full-screen triangle, or `vertex_entry` of the pass's own module when
-/// `vertex` is null), WebGPU's blend states, buffers and fixed-function state.
-fn raster_json(r: &crate::graph::Raster) -> Value {
+/// full-screen triangle or another file's WGSL, or `vertex_entry` of the
+/// pass's own module when `vertex` is null), WebGPU's blend states, buffers
+/// and fixed-function state.
+fn raster_json(r: &crate::graph::Raster, vertex_wgsl: Option<&str>) -> Value {
     let blend = |b: vista_texel::Blend| {
         b.components().map(|(c, a)| {
             let part = |p: vista_texel::BlendComponent| {
@@ -199,7 +213,7 @@ fn raster_json(r: &crate::graph::Raster) -> Value {
     };
     let (vertex, vertex_entry) = match &r.vertex {
         None => (Some(crate::FULLSCREEN_WGSL), crate::FULLSCREEN_ENTRY),
-        Some(vs) => (None, vs.as_str()),
+        Some(vs) => (vertex_wgsl, vs.as_str()),
     };
     json!({
         "vertex": vertex, "vertex_entry": vertex_entry,

@@ -239,6 +239,8 @@ pub(crate) struct RenderStages<'a> {
     pub targets: &'a [Option<wgpu::ColorTargetState>],
     /// The pass's own vertex entry; `None`: vista's full-screen triangle.
     pub vertex_entry: Option<&'a str>,
+    /// The module holding it when another file does, with its overrides.
+    pub vertex_module: Option<(&'a naga::Module, &'a [(String, f64)])>,
     /// The vertex buffer layouts, one per slot.
     pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
     pub primitive: wgpu::PrimitiveState,
@@ -344,9 +346,11 @@ impl Context {
         // the driver has it (SPEC 14, features and limits).
         // GPU timestamps around each graph pass, where the driver has them.
         // Blending into 32-bit float render targets, where the driver has it.
+        // 16-bit floats in shaders (`enable f16;`), where the driver has them.
         let wanted = specific
             | wgpu::Features::FLOAT32_FILTERABLE
             | wgpu::Features::FLOAT32_BLENDABLE
+            | wgpu::Features::SHADER_F16
             | wgpu::Features::TIMESTAMP_QUERY;
         let required_features = adapter.features() & wanted;
         let read_write = vista_texel::format_names()
@@ -542,6 +546,7 @@ impl Context {
         render: Option<RenderStages<'_>>,
     ) -> Result<Arc<Compiled>, GpuError> {
         let module = shaders.compose(shader)?;
+        self.check_f16(shader, [Some(&*module), render.as_ref().and_then(|r| r.vertex_module.map(|(m, _)| m))])?;
         let started = std::time::Instant::now();
         let _count = CountInto(&self.compile_nanos, started);
         let scope = w.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -575,13 +580,26 @@ impl Context {
             })),
             Some(r) => {
                 // vista's full-screen triangle, or the pass's own vertex entry.
-                let fullscreen;
-                let (vertex, vertex_entry) = match r.vertex_entry {
-                    Some(vs) => (&sm, vs),
-                    None => {
+                let (fullscreen, other);
+                let vertex_constants: Vec<(&str, f64)> =
+                    r.vertex_module.iter().flat_map(|(_, c)| c.iter().map(|(k, v)| (k.as_str(), *v))).collect();
+                let (vertex, vertex_entry) = match (r.vertex_entry, r.vertex_module) {
+                    (Some(vs), None) => (&sm, vs),
+                    (Some(vs), Some((module, _))) => {
+                        other = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                            label: Some(vs),
+                            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module.clone())),
+                        });
+                        (&other, vs)
+                    }
+                    (None, _) => {
+                        // As a naga module, like every kernel: the SPIR-V wgpu
+                        // writes for WGSL text names WGSL as its source
+                        // language, which Debian's validation layer rejects.
+                        let module = naga::front::wgsl::parse_str(crate::FULLSCREEN_WGSL).expect("vista's own WGSL");
                         fullscreen = w.device.create_shader_module(wgpu::ShaderModuleDescriptor {
                             label: Some("vista full-screen triangle"),
-                            source: wgpu::ShaderSource::Wgsl(crate::FULLSCREEN_WGSL.into()),
+                            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module)),
                         });
                         (&fullscreen, crate::FULLSCREEN_ENTRY)
                     }
@@ -592,7 +610,12 @@ impl Context {
                     vertex: wgpu::VertexState {
                         module: vertex,
                         entry_point: Some(vertex_entry),
-                        compilation_options: options(),
+                        compilation_options: match r.vertex_module {
+                            Some(_) => {
+                                wgpu::PipelineCompilationOptions { constants: &vertex_constants, ..Default::default() }
+                            }
+                            None => options(),
+                        },
                         buffers: r.buffers,
                     },
                     primitive: r.primitive,
@@ -624,6 +647,23 @@ impl Context {
                 Engine::Wgpu(w) => w.read_write.contains(&format.name),
                 Engine::Browser(b) => b.features.iter().any(|f| f == "texture-formats-tier2"),
             }
+    }
+
+    /// A module that uses f16 where the device lacks it: unsupported here,
+    /// naming the feature.
+    pub(crate) fn check_f16(&self, shader: &str, modules: [Option<&naga::Module>; 2]) -> Result<(), GpuError> {
+        let has = match &self.engine {
+            Engine::Wgpu(w) => w.device.features().contains(wgpu::Features::SHADER_F16),
+            Engine::Browser(b) => b.features.iter().any(|f| f == "shader-f16"),
+        };
+        match modules.into_iter().flatten().any(crate::shaders::uses_f16) && !has {
+            true => Err(GpuError::Unsupported {
+                adapter: self.adapter_description(),
+                what: format!("{shader}: f16 (enable f16;)"),
+                feature: "shader-f16".into(),
+            }),
+            false => Ok(()),
+        }
     }
 
     /// Whether this device blends into 32-bit float render targets

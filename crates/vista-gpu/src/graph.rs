@@ -321,8 +321,13 @@ pub struct Depth {
 pub struct Raster {
     /// The colour targets, in `@location` order.
     pub targets: Vec<RasterTarget>,
-    /// The `@vertex` entry of the pass's shader; `None`: the full-screen triangle.
+    /// The `@vertex` entry (of the pass's shader, or of `vertex_shader`);
+    /// `None`: the full-screen triangle.
     pub vertex: Option<String>,
+    /// The composed file holding `vertex` when it is not the pass's shader.
+    pub vertex_shader: Option<String>,
+    /// That file's override values.
+    pub vertex_constants: Vec<(String, f64)>,
     /// The vertex buffers, one per slot.
     pub buffers: Vec<VertexBuffer>,
     /// A u32 index buffer.

@@ -194,6 +194,8 @@ mod tests {
         let raster = |blend| Raster {
             targets: vec![RasterTarget { resource: 0, level: 0, layer: 0, clear: None, blend }],
             vertex: None,
+            vertex_shader: None,
+            vertex_constants: Vec::new(),
             buffers: Vec::new(),
             indices: None,
             count: 3,

@@ -616,6 +616,11 @@ pub fn resolve_overrides(
 /// offset)`; structs that already agree are left as written.
 pub fn keep_struct_layouts(name: &str, module: &naga::Module, text: String) -> Result<String, GpuError> {
     use naga::TypeInner;
+    // naga's writer leaves out the directive its own f16 needs.
+    let text = match !text.contains("enable f16;") && uses_f16(module) {
+        true => format!("enable f16;\n{text}"),
+        false => text,
+    };
     let written = naga::front::wgsl::parse_str(&text)
         .map_err(|e| GpuError::Shader(format!("{name}: naga cannot read back its own WGSL: {e}")))?;
     let layout = |m: &naga::Module, ty: &str| {
@@ -801,9 +806,12 @@ fn describe(composer: &Composer, label: &str, e: &ComposerError) -> String {
     format!("WGSL error ({label}):\n{}", e.emit_to_string(composer))
 }
 
-/// Validates a composed module with naga alone (no device needed).
+/// Validates a composed module with naga alone (no device needed). f16
+/// (`enable f16;`) is allowed here; a device without it reports the case
+/// unsupported ([`uses_f16`]).
 pub fn validate(name: &str, module: &naga::Module) -> Result<naga::valid::ModuleInfo, GpuError> {
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+    let capabilities = naga::valid::Capabilities::default() | naga::valid::Capabilities::SHADER_FLOAT16;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
         .validate(module)
         .map_err(|e| GpuError::Shader(format!("{name}: naga validation failed: {}", e.emit_to_string(""))))
 }
@@ -830,4 +838,15 @@ fn shader_defs(name: &str) -> HashMap<String, naga_oil::compose::ShaderDefValue>
             }
         })
         .collect()
+}
+
+/// Whether a module uses 16-bit floats (WGSL's `enable f16;`): the
+/// feature a device needs for it (wgpu's SHADER_F16, WebGPU's
+/// `shader-f16`). A literal or conversion needs no type of the module's
+/// own, so the question goes to naga's validator: the module is valid only
+/// with the f16 capability.
+pub fn uses_f16(module: &naga::Module) -> bool {
+    let mut plain =
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default());
+    plain.validate(module).is_err() && validate("", module).is_ok()
 }

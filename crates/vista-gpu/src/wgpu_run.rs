@@ -478,16 +478,22 @@ impl Context {
             }
             None => None,
         };
+        // A vertex entry of another file, composed.
+        let vertex_module = match pass.raster.as_ref().and_then(|r| r.vertex_shader.as_ref()) {
+            Some(file) => Some((g.shaders.compose(file)?, g.shaders.source_hash(file)?)),
+            None => None,
+        };
         // A render pipeline differs by its targets and fixed-function state too.
         let key = format!(
-            "graph {}#{}@{}{:?}{:?}{:?}{:?}",
+            "graph {}#{}@{}{:?}{:?}{:?}{:?}{:?}",
             pass.shader,
             g.shaders.source_hash(&pass.shader)?,
             pass.entry,
             entries,
             pass.constants,
             targets,
-            pass.raster.as_ref().map(|r| (&r.vertex, &r.buffers, r.topology, r.cull, &r.depth, r.indices.is_some()))
+            pass.raster.as_ref().map(|r| (&r.vertex, &r.buffers, r.topology, r.cull, &r.depth, r.indices.is_some())),
+            pass.raster.as_ref().map(|r| (&r.vertex_shader, &r.vertex_constants, vertex_module.as_ref().map(|v| &v.1)))
         );
         if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
             return Ok(p.clone());
@@ -504,6 +510,7 @@ impl Context {
                 crate::context::RenderStages {
                     targets,
                     vertex_entry: r.vertex.as_deref(),
+                    vertex_module: vertex_module.as_ref().map(|(m, _)| (&**m, r.vertex_constants.as_slice())),
                     buffers,
                     primitive: crate::raster::primitive(r),
                     depth_stencil: crate::raster::depth_stencil(r),

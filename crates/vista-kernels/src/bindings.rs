@@ -257,6 +257,43 @@ pub fn merge_stages(
     Ok(fragment)
 }
 
+/// A render pass's bindings when its vertex entry lives in another file
+/// (`file`, module `vmodule`): that entry may bind only what the fragment
+/// entry binds, the same name and type at the same group and binding (its
+/// own uniforms would need a layout of their own), which become visible to
+/// the vertex stage.
+pub fn match_vertex_file(
+    kernel: &str,
+    mut fragment: Vec<Binding>,
+    module: &naga::Module,
+    vertex: Vec<Binding>,
+    vmodule: &naga::Module,
+    file: &str,
+) -> Result<Vec<Binding>, ParamError> {
+    for v in vertex {
+        let vtype = wgsl_type(vmodule, &vmodule.global_variables[v.global]);
+        let same = fragment.iter_mut().find(|f| {
+            (f.group, f.binding, &f.name) == (v.group, v.binding, &v.name)
+                && wgsl_type(module, &module.global_variables[f.global]) == vtype
+        });
+        match same {
+            Some(f) => f.vertex = true,
+            None => {
+                return Err(ParamError::Layout {
+                    kernel: kernel.to_string(),
+                    message: format!(
+                        "the vertex entry in {file} binds {} (@group({}) @binding({}), {vtype}), which the fragment \
+                         entry does not; a vertex entry of another file may bind only what the fragment entry binds \
+                         (or move it into the pass's shader)",
+                        v.name, v.group, v.binding
+                    ),
+                });
+            }
+        }
+    }
+    Ok(fragment)
+}
+
 /// A WGSL spelling of a global's type, for messages.
 pub fn wgsl_type(module: &naga::Module, var: &naga::GlobalVariable) -> String {
     let ty = &module.types[var.ty];

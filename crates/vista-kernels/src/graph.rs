@@ -171,6 +171,25 @@ pub enum VertexStage {
     Fullscreen,
     /// A `@vertex` entry of the pass's shader.
     Entry(String),
+    /// `{ shader = "other.wgsl", entry = "vs" }`: an entry of another file,
+    /// composed with the pass's defs and source keys; it may bind only what
+    /// the fragment entry binds.
+    File {
+        /// The kernel file (relative to `shaders/`).
+        shader: String,
+        /// The `@vertex` entry.
+        entry: String,
+    },
+}
+
+impl VertexStage {
+    /// The vertex entry's name, if it is not vista's full-screen triangle.
+    pub fn entry(&self) -> Option<&str> {
+        match self {
+            VertexStage::Fullscreen => None,
+            VertexStage::Entry(e) | VertexStage::File { entry: e, .. } => Some(e),
+        }
+    }
 }
 
 /// A render pass's `depth` table: a depth32float buffer of the targets'
@@ -253,14 +272,26 @@ pub struct PassSpec {
 }
 
 impl PassSpec {
-    /// The entry points the pass runs: its compute or fragment entry, and a
-    /// draw's vertex entry.
-    pub fn entries(&self) -> Vec<&str> {
-        let mut out = vec![self.entry.as_str()];
-        if let Some(RasterSpec { vertex: VertexStage::Entry(vs), .. }) = &self.raster {
-            out.push(vs);
+    /// The entry points the pass runs, each with its file (`own`: the
+    /// manifest's shader): its compute or fragment entry, and a draw's
+    /// vertex entry.
+    pub fn entries<'a>(&'a self, own: &'a str) -> Vec<(&'a str, &'a str)> {
+        let file = self.shader.as_deref().unwrap_or(own);
+        let mut out = vec![(file, self.entry.as_str())];
+        match &self.raster {
+            Some(RasterSpec { vertex: VertexStage::Entry(vs), .. }) => out.push((file, vs)),
+            Some(RasterSpec { vertex: VertexStage::File { shader, entry }, .. }) => out.push((shader, entry)),
+            _ => {}
         }
         out
+    }
+
+    /// The vertex entry's file when it is another file than the pass's.
+    pub fn vertex_file(&self) -> Option<&str> {
+        match &self.raster {
+            Some(RasterSpec { vertex: VertexStage::File { shader, .. }, .. }) => Some(shader),
+            _ => None,
+        }
     }
 }
 
@@ -859,10 +890,17 @@ fn parse_raster(
         None => VertexStage::Fullscreen,
         Some(toml::Value::String(v)) if v == "fullscreen" => VertexStage::Fullscreen,
         Some(toml::Value::String(v)) if valid_name(v) => VertexStage::Entry(v.clone()),
-        Some(toml::Value::Table(_)) => {
-            return Err(at("vertex = { shader, entry } (an entry of another file) is not supported yet; put the \
-                 @vertex entry in the pass's shader and name it, vertex = \"<entry>\""
-                .into()));
+        Some(toml::Value::Table(v)) => {
+            if let Some(k) = v.keys().find(|k| !["shader", "entry"].contains(&k.as_str())) {
+                return Err(at(format!("vertex: unknown key {k}; allowed: shader, entry")));
+            }
+            let shader = string_key(v, "shader", at)?.ok_or_else(|| at("vertex needs shader = \"<file>\"".into()))?;
+            let entry =
+                string_key(v, "entry", at)?.ok_or_else(|| at("vertex needs entry = \"<@vertex entry>\"".into()))?;
+            if !valid_name(&entry) {
+                return Err(at(format!("vertex entry = \"{entry}\" is not a WGSL function name")));
+            }
+            VertexStage::File { shader, entry }
         }
         Some(other) => {
             return Err(at(format!(
@@ -1317,6 +1355,7 @@ pub fn resolve(
     kernel: &str,
     graph: &GraphSpec,
     passes: &[(&str, &[Binding], &naga::Module)],
+    vertex_modules: &[Option<&naga::Module>],
 ) -> Result<Resolved, ParamError> {
     let bad = |message: String| ParamError::Layout { kernel: kernel.to_string(), message };
     let mut resources: Vec<ResolvedResource> = graph
@@ -1431,12 +1470,16 @@ pub fn resolve(
     }
     let mut draws = Vec::new();
     for (i, ((_, _, module), pass)) in passes.iter().zip(&graph.passes).enumerate() {
-        draws.push(match &pass.raster {
-            Some(raster @ RasterSpec { vertex: VertexStage::Entry(vs), .. }) => Some(
-                draw_layout(raster, vs, module, &mut resources)
-                    .map_err(|m| bad(format!("pass {} ({vs}, {}): {m}", i + 1, pass.entry)))?,
-            ),
-            _ => None,
+        let vs = pass.raster.as_ref().and_then(|r| r.vertex.entry().map(|vs| (r, vs)));
+        draws.push(match vs {
+            Some((raster, vs)) => {
+                let module = vertex_modules.get(i).copied().flatten().unwrap_or(module);
+                Some(
+                    draw_layout(raster, vs, module, &mut resources)
+                        .map_err(|m| bad(format!("pass {} ({vs}, {}): {m}", i + 1, pass.entry)))?,
+                )
+            }
+            None => None,
         });
     }
     let outputs = check_swaps_and_outputs(graph, &resources, &bad)?;

@@ -548,9 +548,11 @@ impl Kernel {
         for (i, pass) in self.graph().passes.iter().enumerate() {
             let file = pass.shader.as_deref().unwrap_or(self.shader());
             let spec = self.source_for(i);
-            let unit = if spec.is_empty() { file.to_string() } else { format!("{file}|{}", spec.id()) };
-            if !out.contains(&unit) {
-                out.push(unit);
+            for file in std::iter::once(file).chain(pass.vertex_file()) {
+                let unit = if spec.is_empty() { file.to_string() } else { format!("{file}|{}", spec.id()) };
+                if !out.contains(&unit) {
+                    out.push(unit);
+                }
             }
         }
         out
@@ -624,8 +626,10 @@ impl Kernel {
         let mut out: Vec<&str> = Vec::new();
         for p in &self.graph().passes {
             let s = p.shader.as_deref().unwrap_or(self.shader());
-            if !out.contains(&s) {
-                out.push(s);
+            for s in std::iter::once(s).chain(p.vertex_file()) {
+                if !out.contains(&s) {
+                    out.push(s);
+                }
             }
         }
         out
@@ -658,6 +662,13 @@ impl Kernel {
         self.with_defs(file, &pass.defs, &self.source_for(i), p)
     }
 
+    /// The file of graph pass `i`'s vertex entry when another file holds
+    /// it, composed for `p` with the pass's defs and source keys.
+    pub fn vertex_shader_for(&self, i: usize, p: &ParamSet) -> Option<String> {
+        let pass = &self.graph().passes[i];
+        pass.vertex_file().map(|file| self.with_defs(file, &pass.defs, &self.source_for(i), p))
+    }
+
     /// Reflects every pass of the graph (`modules[i]`: pass i's composed
     /// file name and module), resolves what feeds each binding, and checks
     /// each pass's uniform blocks against the params: a leaf with no param,
@@ -666,23 +677,42 @@ impl Kernel {
         &self,
         modules: &[(&str, &naga::Module)],
     ) -> Result<(graph::Resolved, Vec<UniformLayout>), ParamError> {
+        self.graph_layouts_with(modules, &[])
+    }
+
+    /// [`Kernel::graph_layouts`], with the composed file and module of each
+    /// pass's vertex entry that lives in another file (`vertex[i]`).
+    pub fn graph_layouts_with(
+        &self,
+        modules: &[(&str, &naga::Module)],
+        vertex: &[Option<(&str, &naga::Module)>],
+    ) -> Result<(graph::Resolved, Vec<UniformLayout>), ParamError> {
         let g = self.graph();
         let mut reflected = Vec::new();
-        for ((shader, module), pass) in modules.iter().zip(&g.passes) {
+        for (i, ((shader, module), pass)) in modules.iter().zip(&g.passes).enumerate() {
             let stage = match pass.raster {
                 Some(_) => naga::ShaderStage::Fragment,
                 None => naga::ShaderStage::Compute,
             };
             let mut b = bindings::reflect_all(self.name(), shader, &pass.entry, stage, module)?;
-            if let Some(graph::RasterSpec { vertex: graph::VertexStage::Entry(vs), .. }) = &pass.raster {
-                let v = bindings::reflect_all(self.name(), shader, vs, naga::ShaderStage::Vertex, module)?;
-                b = bindings::merge_stages(self.name(), b, v)?;
+            let vs = pass.raster.as_ref().and_then(|r| r.vertex.entry());
+            match (vs, vertex.get(i).copied().flatten()) {
+                (Some(vs), None) => {
+                    let v = bindings::reflect_all(self.name(), shader, vs, naga::ShaderStage::Vertex, module)?;
+                    b = bindings::merge_stages(self.name(), b, v)?;
+                }
+                (Some(vs), Some((file, vmodule))) => {
+                    let v = bindings::reflect_all(self.name(), file, vs, naga::ShaderStage::Vertex, vmodule)?;
+                    b = bindings::match_vertex_file(self.name(), b, module, v, vmodule, file)?;
+                }
+                (None, _) => {}
             }
             reflected.push(b);
         }
         let passes: Vec<(&str, &[bindings::Binding], &naga::Module)> =
             modules.iter().zip(&reflected).map(|((s, m), b)| (*s, b.as_slice(), *m)).collect();
-        let resolved = graph::resolve(self.name(), g, &passes)?;
+        let vertex_modules: Vec<Option<&naga::Module>> = vertex.iter().map(|v| v.map(|(_, m)| m)).collect();
+        let resolved = graph::resolve(self.name(), g, &passes, &vertex_modules)?;
         let mut layouts = Vec::new();
         for (((shader, module), bindings), slots) in modules.iter().zip(reflected).zip(&resolved.slots) {
             // Params feed the uniforms and the table that no resource feeds.

@@ -301,13 +301,7 @@ pub fn plan(
             }
         }
         // A draw's vertex entry is a root too.
-        let own = k.shader();
-        let roots: Vec<(&str, &str)> = k
-            .graph()
-            .passes
-            .iter()
-            .flat_map(|p| p.entries().into_iter().map(move |e| (p.shader.as_deref().unwrap_or(own), e)))
-            .collect();
+        let roots: Vec<(&str, &str)> = k.graph().passes.iter().flat_map(|p| p.entries(k.shader())).collect();
         let fns: Vec<(&str, mutants::Function)> = closure
             .iter()
             .flat_map(|f| mutants::functions(&f.text).into_iter().map(move |g| (f.rel.as_str(), g)))

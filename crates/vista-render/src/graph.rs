@@ -96,20 +96,31 @@ pub(crate) fn plan_graph(
 ) -> Result<Plan, RenderError> {
     let g = kernel.graph();
     let bad = |m: String| RenderError::BadInput(format!("kernel {}: {m}", kernel.name()));
-    let mut files = Vec::new();
-    let mut modules = Vec::new();
-    for i in 0..g.passes.len() {
-        let file = kernel.pass_shader_for(i, p);
-        let module = shaders.compose(&file).map_err(|e| match e {
+    let compose = |file: &str| {
+        shaders.compose(file).map_err(|e| match e {
             vista_gpu::GpuError::Shader(m) => bad(m),
             other => RenderError::Gpu(other),
-        })?;
+        })
+    };
+    let mut files = Vec::new();
+    let mut modules = Vec::new();
+    // A draw's vertex entry in another file: its composed file and module.
+    let mut vertex = Vec::new();
+    for i in 0..g.passes.len() {
+        let file = kernel.pass_shader_for(i, p);
+        modules.push(compose(&file)?);
         files.push(file);
-        modules.push(module);
+        vertex.push(match kernel.vertex_shader_for(i, p) {
+            Some(v) => Some((compose(&v)?, v)),
+            None => None,
+        });
     }
     let pairs: Vec<(&str, &naga::Module)> =
         files.iter().map(|f| f.as_str()).zip(modules.iter().map(|m| &**m)).collect();
-    let (resolved, layouts) = kernel.graph_layouts(&pairs).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let vertex_pairs: Vec<Option<(&str, &naga::Module)>> =
+        vertex.iter().map(|v| v.as_ref().map(|(m, f)| (f.as_str(), &**m))).collect();
+    let (resolved, layouts) =
+        kernel.graph_layouts_with(&pairs, &vertex_pairs).map_err(|e| RenderError::BadInput(e.to_string()))?;
     for (k, _) in kernel.manifest_overrides() {
         if !modules.iter().any(|m| m.overrides.iter().any(|(_, o)| o.name.as_deref() == Some(k))) {
             let names: Vec<&str> =
@@ -151,7 +162,19 @@ pub(crate) fn plan_graph(
         .collect::<Result<Vec<_>, _>>()?;
     let mut passes = Vec::new();
     for (i, ((pass, slots), layout)) in g.passes.iter().zip(&resolved.slots).zip(&layouts).enumerate() {
-        passes.push(at.pass(i, pass, slots, layout, &modules[i], &files[i], &resources, &resolved)?);
+        let mut planned = at.pass(i, pass, slots, layout, &modules[i], &files[i], &resources, &resolved)?;
+        if let (Some(r), Some((vmodule, vfile))) = (planned.raster.as_mut(), &vertex[i]) {
+            // Its own overrides' values (the pass's, for the names it declares).
+            let constants = kernel.overrides_in(vmodule, &at.pass_params(pass)?, false);
+            r.vertex_shader = Some(vfile.clone());
+            r.vertex_constants = constants.map_err(|e| RenderError::BadInput(e.to_string()))?;
+        }
+        passes.push(planned);
+    }
+    for (_, vfile) in vertex.iter().flatten() {
+        if !files.contains(vfile) {
+            files.push(vfile.clone());
+        }
     }
     let (outputs, output_ids) = at.outputs(&resources, &resolved);
     Ok(Plan {
@@ -368,15 +391,15 @@ impl Planning<'_> {
         resources: &[vista_gpu::Resource],
         resolved: &vista_kernels::graph::Resolved,
     ) -> Result<vista_gpu::GraphPass, RenderError> {
-        let (kernel, p, width, height) = (self.kernel, self.p, self.width, self.height);
+        let (kernel, width, height) = (self.kernel, self.width, self.height);
         let g = kernel.graph();
         let bad = |m: String| self.bad(m);
         let index = |name: &str| resolved.resources.iter().position(|r| r.spec.name == name).expect("resolved");
         let label = format!("pass {} ({}, {})", i + 1, pass.entry, file);
-        let mut pp = p.clone();
-        for (k, v) in &pass.set {
-            pp = pp.with(kernel.params(), k, v).map_err(|e| bad(format!("{label}: set: {e}")))?;
-        }
+        let pp = self.pass_params(pass).map_err(|e| match e {
+            RenderError::BadInput(m) => bad(format!("{label}: {m}")),
+            other => other,
+        })?;
         let constants = kernel.overrides_in(module, &pp, false).map_err(|e| RenderError::BadInput(e.to_string()))?;
         let blocks = kernel.uniforms(layout, &pp, width, height);
         let table = kernel.table(layout, &pp);
@@ -508,6 +531,15 @@ impl Planning<'_> {
         })
     }
 
+    /// The case's params with the pass's `set` over them.
+    fn pass_params(&self, pass: &vista_kernels::graph::PassSpec) -> Result<ParamSet, RenderError> {
+        let mut pp = self.p.clone();
+        for (k, v) in &pass.set {
+            pp = pp.with(self.kernel.params(), k, v).map_err(|e| RenderError::BadInput(format!("set: {e}")))?;
+        }
+        Ok(pp)
+    }
+
     /// A render pass as the engine draws it: its targets (each a
     /// renderable format, blended only where the format allows, all of one
     /// size), its vertex stage, buffers and counts, and its fixed-function state.
@@ -574,16 +606,14 @@ impl Planning<'_> {
             }
             // A draw leaves uncovered texels at the clear value: zeros on a
             // texture no earlier pass wrote, so they are not "unwritten".
-            let clear = match (&r.vertex, t.clear) {
-                (VertexStage::Entry(_), None) if !self.written_before(i, ri, resolved) => Some([0.0; 4]),
-                (_, c) => c,
+            let draw = r.vertex != VertexStage::Fullscreen;
+            let clear = match t.clear {
+                None if draw && !self.written_before(i, ri, resolved) => Some([0.0; 4]),
+                c => c,
             };
             targets.push(vista_gpu::RasterTarget { resource: ri, level, layer, clear, blend });
         }
-        let vertex = match &r.vertex {
-            VertexStage::Fullscreen => None,
-            VertexStage::Entry(vs) => Some(vs.clone()),
-        };
+        let vertex = r.vertex.entry().map(str::to_string);
         let draw = resolved.draws[i].as_ref();
         let buffers: Vec<vista_gpu::VertexBuffer> = draw
             .map(|d| {
@@ -607,6 +637,8 @@ impl Planning<'_> {
         Ok(vista_gpu::Raster {
             targets,
             vertex,
+            vertex_shader: None,
+            vertex_constants: Vec::new(),
             buffers,
             indices,
             count,
