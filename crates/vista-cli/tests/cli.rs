@@ -5110,11 +5110,14 @@ fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
     }
 }
 
-/// `enable f16;` (SPEC 17, features requested from the shader): naga
-/// validates it, the device is asked for shader-f16, and a backend without
-/// it reports the kernel unsupported, naming the feature (lavapipe has it;
-/// SwiftShader and Chromium's SwiftShader adapter do not).
-fn f16_kernels_run_where_the_backend_has_shader_f16() {
+/// `enable f16;` and `enable dual_source_blending;` (SPEC 17, features
+/// requested from the shader): naga validates them, the device is asked
+/// for shader-f16 and dual-source-blending, and a backend without one
+/// reports the kernel unsupported, naming it (lavapipe has both; SwiftShader
+/// and Chromium's SwiftShader adapter neither).
+fn shader_features_run_where_the_backend_has_them() {
+    // The backends here with dual-source blending.
+    const DUAL_SOURCE: [&str; 1] = ["lavapipe"];
     const SHADER: &str = "enable f16;
 struct Params { width: u32, height: u32, gain: f32 }
 @group(0) @binding(0) var<uniform> params: Params;
@@ -5141,6 +5144,42 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 assert_rejected(&r, 1, &["unsupported on", "k.wgsl: f16 (enable f16;) needs shader-f16"]);
                 assert!(!out.exists(), "{backend}: an unsupported render wrote its output");
             }
+        }
+    }
+    // Dual-source blending: the second output weighs the texel, 0.5 + 1.0 * 0.25.
+    const TWO: &str = "enable dual_source_blending;
+struct Params { width: u32, height: u32, gain: f32 }
+@group(0) @binding(0) var<uniform> params: Params;
+
+struct Two {
+    @location(0) @blend_src(0) color: vec4<f32>,
+    @location(0) @blend_src(1) weight: vec4<f32>,
+}
+
+@fragment
+fn two() -> Two {
+    return Two(vec4(0.5 * params.gain), vec4(0.25));
+}
+";
+    let manifest = "summary = \"two\"\n[[param]]\nname = \"gain\"\ntype = \"f32\"\nrange = [0, 4]\ndefault = 1.0\ndoc = \"gain\"\n\
+                    [[resource]]\nname = \"image\"\nkind = \"texture\"\nformat = \"rgba16float\"\n\
+                    [[pass]]\nkind = \"render\"\nfragment = \"two\"\n\
+                    targets = [{ resource = \"image\", clear = [1.0, 1.0, 1.0, 1.0], blend = { color = [\"one\", \"src1\", \"add\"] } }]\n";
+    let d = kernel_project(manifest, TWO);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("two-{backend}.exr"));
+        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        match DUAL_SOURCE.contains(&backend) {
+            true => {
+                assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+                assert_eq!(vista_image::load(&out).unwrap().get(5, 2), [0.75; 4], "{backend}");
+            }
+            false => assert_rejected(
+                &r,
+                1,
+                &["dual_source_blending (enable dual_source_blending;) needs dual-source-blending"],
+            ),
         }
     }
 }
@@ -5197,6 +5236,16 @@ fn the_render_example_passes_on_every_backend_with_a_copied_binary() {
         report["mutants"].as_array().unwrap().iter().filter(|m| m["line"].as_u64() == Some(sway_line)).collect();
     assert!(!sway.is_empty(), "no mutant of the vertex entry's sway: {report}");
     assert!(sway.iter().all(|m| m["outcome"] == "killed"), "a sway mutant survived: {sway:?}");
+    // A wind sweep and a per-pass bench of the draw.
+    let sweep = root.join("sweep");
+    let args = ["sweep", "grass", "--param", "wind", "--values", "0,0.03,0.06", "--reference-set", "wind=0.06"];
+    let r = run(&[&args[..], &["--size", "80x48", "--runs", "1", "--out", sweep.to_str().unwrap()]].concat());
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    let csv = std::fs::read_to_string(sweep.join("curve.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "a header and three points: {csv}");
+    let b = run(&["bench", "grass", "--size", "80x48"]);
+    assert_eq!(b.code, 0, "{}", b.stderr);
+    assert!(b.stdout.contains("pass 1 (grass_fragment, grass.wgsl): median"), "{}", b.stdout);
     // (d) A mutant of the wind's amplitude fails check at every time.
     let shader = root.join("shaders/grass.wgsl");
     let text = std::fs::read_to_string(&shader).unwrap();
@@ -5339,7 +5388,7 @@ fn main() {
         Gpu layered_outputs_stack_and_follow_reflection,
         Gpu a_fullscreen_render_pass_draws_every_texel,
         Gpu a_draw_reads_vertex_buffers_indices_and_depth,
-        Gpu f16_kernels_run_where_the_backend_has_shader_f16,
+        Gpu shader_features_run_where_the_backend_has_them,
         Gpu the_render_example_passes_on_every_backend_with_a_copied_binary,
         Gpu a_broken_manifest_breaks_only_its_kernel,
         Cpu adapter_is_a_hidden_alias_of_backend,

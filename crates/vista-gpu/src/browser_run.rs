@@ -66,7 +66,7 @@ impl Context {
                 Some(f) => Some(g.shaders.compose(f)?),
                 None => None,
             };
-            self.check_f16(&pass.shader, [Some(&*g.shaders.compose(&pass.shader)?), vertex_module.as_deref()])?;
+            self.check_features(&pass.shader, [Some(&*g.shaders.compose(&pass.shader)?), vertex_module.as_deref()])?;
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
             if let Some(r) = &pass.raster {
                 let adapter = || self.adapter_description();

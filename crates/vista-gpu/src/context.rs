@@ -346,11 +346,13 @@ impl Context {
         // the driver has it (SPEC 14, features and limits).
         // GPU timestamps around each graph pass, where the driver has them.
         // Blending into 32-bit float render targets, where the driver has it.
-        // 16-bit floats in shaders (`enable f16;`), where the driver has them.
+        // 16-bit floats and dual-source blending in shaders (`enable f16;`,
+        // `enable dual_source_blending;`), where the driver has them.
         let wanted = specific
             | wgpu::Features::FLOAT32_FILTERABLE
             | wgpu::Features::FLOAT32_BLENDABLE
             | wgpu::Features::SHADER_F16
+            | wgpu::Features::DUAL_SOURCE_BLENDING
             | wgpu::Features::TIMESTAMP_QUERY;
         let required_features = adapter.features() & wanted;
         let read_write = vista_texel::format_names()
@@ -546,7 +548,7 @@ impl Context {
         render: Option<RenderStages<'_>>,
     ) -> Result<Arc<Compiled>, GpuError> {
         let module = shaders.compose(shader)?;
-        self.check_f16(shader, [Some(&*module), render.as_ref().and_then(|r| r.vertex_module.map(|(m, _)| m))])?;
+        self.check_features(shader, [Some(&*module), render.as_ref().and_then(|r| r.vertex_module.map(|(m, _)| m))])?;
         let started = std::time::Instant::now();
         let _count = CountInto(&self.compile_nanos, started);
         let scope = w.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -649,21 +651,26 @@ impl Context {
             }
     }
 
-    /// A module that uses f16 where the device lacks it: unsupported here,
-    /// naming the feature.
-    pub(crate) fn check_f16(&self, shader: &str, modules: [Option<&naga::Module>; 2]) -> Result<(), GpuError> {
-        let has = match &self.engine {
-            Engine::Wgpu(w) => w.device.features().contains(wgpu::Features::SHADER_F16),
-            Engine::Browser(b) => b.features.iter().any(|f| f == "shader-f16"),
-        };
-        match modules.into_iter().flatten().any(crate::shaders::uses_f16) && !has {
-            true => Err(GpuError::Unsupported {
-                adapter: self.adapter_description(),
-                what: format!("{shader}: f16 (enable f16;)"),
-                feature: "shader-f16".into(),
+    /// A module that needs a shader feature the device lacks (f16,
+    /// dual-source blending): unsupported here, naming the feature.
+    pub(crate) fn check_features(&self, shader: &str, modules: [Option<&naga::Module>; 2]) -> Result<(), GpuError> {
+        let has = |feature: &str| match &self.engine {
+            Engine::Wgpu(w) => w.device.features().contains(match feature {
+                "shader-f16" => wgpu::Features::SHADER_F16,
+                _ => wgpu::Features::DUAL_SOURCE_BLENDING,
             }),
-            false => Ok(()),
+            Engine::Browser(b) => b.features.iter().any(|f| f == feature),
+        };
+        for (feature, enable) in modules.into_iter().flatten().flat_map(crate::shaders::features_used) {
+            if !has(feature) {
+                return Err(GpuError::Unsupported {
+                    adapter: self.adapter_description(),
+                    what: format!("{shader}: {enable} (enable {enable};)"),
+                    feature: feature.into(),
+                });
+            }
         }
+        Ok(())
     }
 
     /// Whether this device blends into 32-bit float render targets

@@ -23,6 +23,10 @@ fn blend_component(c: BlendComponent) -> wgpu::BlendComponent {
         BlendFactor::SrcAlphaSaturated => W::SrcAlphaSaturated,
         BlendFactor::Constant => W::Constant,
         BlendFactor::OneMinusConstant => W::OneMinusConstant,
+        BlendFactor::Src1 => W::Src1,
+        BlendFactor::OneMinusSrc1 => W::OneMinusSrc1,
+        BlendFactor::Src1Alpha => W::Src1Alpha,
+        BlendFactor::OneMinusSrc1Alpha => W::OneMinusSrc1Alpha,
     };
     let operation = match c.op {
         BlendOp::Add => wgpu::BlendOperation::Add,

@@ -616,11 +616,13 @@ pub fn resolve_overrides(
 /// offset)`; structs that already agree are left as written.
 pub fn keep_struct_layouts(name: &str, module: &naga::Module, text: String) -> Result<String, GpuError> {
     use naga::TypeInner;
-    // naga's writer leaves out the directive its own f16 needs.
-    let text = match !text.contains("enable f16;") && uses_f16(module) {
-        true => format!("enable f16;\n{text}"),
-        false => text,
-    };
+    // naga's writer leaves out the enable directives its own output needs.
+    let enables: String = features_used(module)
+        .iter()
+        .filter(|(_, e)| !text.contains(&format!("enable {e};")))
+        .map(|(_, e)| format!("enable {e};\n"))
+        .collect();
+    let text = enables + &text;
     let written = naga::front::wgsl::parse_str(&text)
         .map_err(|e| GpuError::Shader(format!("{name}: naga cannot read back its own WGSL: {e}")))?;
     let layout = |m: &naga::Module, ty: &str| {
@@ -806,11 +808,20 @@ fn describe(composer: &Composer, label: &str, e: &ComposerError) -> String {
     format!("WGSL error ({label}):\n{}", e.emit_to_string(composer))
 }
 
-/// Validates a composed module with naga alone (no device needed). f16
-/// (`enable f16;`) is allowed here; a device without it reports the case
-/// unsupported ([`uses_f16`]).
+/// The optional shader capabilities vista validates with, each with the
+/// WebGPU feature a device needs for it and the `enable` directive WGSL
+/// names it by: a device without the feature reports the case unsupported
+/// ([`features_used`]).
+pub const OPTIONAL_CAPABILITIES: [(naga::valid::Capabilities, &str, &str); 2] = [
+    (naga::valid::Capabilities::SHADER_FLOAT16, "shader-f16", "f16"),
+    (naga::valid::Capabilities::DUAL_SOURCE_BLENDING, "dual-source-blending", "dual_source_blending"),
+];
+
+/// Validates a composed module with naga alone (no device needed), the
+/// [`OPTIONAL_CAPABILITIES`] allowed.
 pub fn validate(name: &str, module: &naga::Module) -> Result<naga::valid::ModuleInfo, GpuError> {
-    let capabilities = naga::valid::Capabilities::default() | naga::valid::Capabilities::SHADER_FLOAT16;
+    let capabilities =
+        OPTIONAL_CAPABILITIES.iter().fold(naga::valid::Capabilities::default(), |c, (cap, _, _)| c | *cap);
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
         .validate(module)
         .map_err(|e| GpuError::Shader(format!("{name}: naga validation failed: {}", e.emit_to_string(""))))
@@ -840,13 +851,15 @@ fn shader_defs(name: &str) -> HashMap<String, naga_oil::compose::ShaderDefValue>
         .collect()
 }
 
-/// Whether a module uses 16-bit floats (WGSL's `enable f16;`): the
-/// feature a device needs for it (wgpu's SHADER_F16, WebGPU's
-/// `shader-f16`). A literal or conversion needs no type of the module's
-/// own, so the question goes to naga's validator: the module is valid only
-/// with the f16 capability.
-pub fn uses_f16(module: &naga::Module) -> bool {
-    let mut plain =
-        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default());
-    plain.validate(module).is_err() && validate("", module).is_ok()
+/// The [`OPTIONAL_CAPABILITIES`] a module uses, as (WebGPU feature,
+/// `enable` name): f16 in a literal or conversion needs no type of the
+/// module's own, so the question goes to naga's validator: the module is
+/// valid only with that capability. Nothing for a module that needs none.
+pub fn features_used(module: &naga::Module) -> Vec<(&'static str, &'static str)> {
+    let all = OPTIONAL_CAPABILITIES.iter().fold(naga::valid::Capabilities::default(), |c, (cap, _, _)| c | *cap);
+    let valid = |caps| naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(module).is_ok();
+    if valid(naga::valid::Capabilities::default()) || !valid(all) {
+        return Vec::new();
+    }
+    OPTIONAL_CAPABILITIES.iter().filter(|(cap, _, _)| !valid(all - *cap)).map(|(_, f, e)| (*f, *e)).collect()
 }

@@ -153,7 +153,9 @@ pub fn fragment_outputs(module: &naga::Module, entry: &str) -> Vec<u32> {
         }
         _ => Vec::new(),
     };
+    // Dual-source blending's two outputs share @location(0).
     out.sort_unstable();
+    out.dedup();
     out
 }
 

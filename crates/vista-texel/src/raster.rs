@@ -15,7 +15,8 @@ fn name_of<T: Copy + PartialEq>(table: &[(&'static str, T)], v: T) -> &'static s
     table.iter().find(|(_, x)| *x == v).map(|(n, _)| *n).expect("every value is named")
 }
 
-/// A blend factor (WebGPU's `GPUBlendFactor`, dual-source ones aside).
+/// A blend factor (WebGPU's `GPUBlendFactor`; the `src1` ones need
+/// dual-source blending).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[allow(missing_docs)]
 pub enum BlendFactor {
@@ -32,11 +33,15 @@ pub enum BlendFactor {
     SrcAlphaSaturated,
     Constant,
     OneMinusConstant,
+    Src1,
+    OneMinusSrc1,
+    Src1Alpha,
+    OneMinusSrc1Alpha,
 }
 
 impl BlendFactor {
     /// Every factor by its WebGPU name.
-    pub const ALL: [(&'static str, BlendFactor); 13] = {
+    pub const ALL: [(&'static str, BlendFactor); 17] = {
         use BlendFactor::*;
         [
             ("zero", Zero),
@@ -52,8 +57,21 @@ impl BlendFactor {
             ("src-alpha-saturated", SrcAlphaSaturated),
             ("constant", Constant),
             ("one-minus-constant", OneMinusConstant),
+            ("src1", Src1),
+            ("one-minus-src1", OneMinusSrc1),
+            ("src1-alpha", Src1Alpha),
+            ("one-minus-src1-alpha", OneMinusSrc1Alpha),
         ]
     };
+
+    /// Whether the factor reads the fragment's second source
+    /// (`@blend_src(1)`, dual-source blending).
+    pub fn is_src1(self) -> bool {
+        matches!(
+            self,
+            BlendFactor::Src1 | BlendFactor::OneMinusSrc1 | BlendFactor::Src1Alpha | BlendFactor::OneMinusSrc1Alpha
+        )
+    }
 
     /// WebGPU's name.
     pub fn web(self) -> &'static str {
