@@ -75,14 +75,14 @@ function vistaChunk(offset, length) {
 // binding and visibility; `vertex`: the render pass's vertex entry reads it too); a texture slot's view
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
 // another file's; null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear,
-// blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a u32
-// buffer or null), count, instances, topology, cull, depth ({ compare, write, clear } or null: the pass's own
+// blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a
+// buffer or null), index_format (uint32 or uint16), count, instances, topology, cull, depth ({ compare, write, clear } or null: the pass's own
 // depth32float texture), blend_constant }. Outputs are read back one after another into vista.out: textures
 // unpadded, layers stacked; buffers whole.
 async function pipeline(pass, resources) {
   const targets = pass.raster ? pass.raster.targets.map((t) => ({ format: resources[t.resource].format, blend: t.blend || undefined })) : null;
   const r = pass.raster;
-  const fixed = r ? [r.vertex_entry, r.vertex, r.buffers.map((b) => [b.arrayStride, b.stepMode, b.attributes]), r.topology, r.cull, r.depth, r.indices !== null] : null;
+  const fixed = r ? [r.vertex_entry, r.vertex, r.buffers.map((b) => [b.arrayStride, b.stepMode, b.attributes]), r.topology, r.cull, r.depth, r.indices !== null && r.index_format] : null;
   const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout, s.vertex]))}${JSON.stringify(targets)}${JSON.stringify(fixed)}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
@@ -119,7 +119,7 @@ async function pipeline(pass, resources) {
         layout,
         vertex: { module: vertex, entryPoint: r.vertex_entry, buffers: r.buffers.map((b) => ({ arrayStride: b.arrayStride, stepMode: b.stepMode, attributes: b.attributes })) },
         fragment: { module, entryPoint: pass.entry, targets },
-        primitive: { topology: r.topology, cullMode: r.cull, frontFace: "ccw", ...(strip ? { stripIndexFormat: "uint32" } : {}) },
+        primitive: { topology: r.topology, cullMode: r.cull, frontFace: "ccw", ...(strip ? { stripIndexFormat: r.index_format } : {}) },
         ...(r.depth ? { depthStencil: { format: "depth32float", depthWriteEnabled: r.depth.write, depthCompare: r.depth.compare } } : {}),
       });
     } else {
@@ -250,7 +250,7 @@ async function vistaRun(job) {
           if (r.blend_constant) rp.setBlendConstant(r.blend_constant);
           r.buffers.forEach((b, slot) => rp.setVertexBuffer(slot, made[current[b.resource]]));
           if (r.indices !== null) {
-            rp.setIndexBuffer(made[current[r.indices]], "uint32");
+            rp.setIndexBuffer(made[current[r.indices]], r.index_format);
             rp.drawIndexed(r.count, r.instances);
           } else {
             rp.draw(r.count, r.instances);

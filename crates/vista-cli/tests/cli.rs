@@ -5003,7 +5003,11 @@ fn build(@builtin(local_invocation_index) i: u32) {
              targets = [{{ resource = \"image\" }}]\n"
         )
     };
+    // The same quad from u16 indices.
+    let indexed16 = indexed.replace("indices = \"ix\"", "indices = { resource = \"ix\", format = \"uint16\" }");
     for backend in ["lavapipe", "swiftshader", "browser"] {
+        let img = render(&indexed16, backend);
+        assert_eq!((img.get(1, 1), img.get(6, 2)), ([1.0; 4], [0.0; 4]), "{backend}: u16 indices");
         let img = render(indexed, backend);
         assert_eq!(
             (img.get(0, 0), img.get(3, 3), img.get(4, 0), img.get(7, 3)),
@@ -5099,6 +5103,8 @@ fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
         (depth.replace("compare = \"less\"", "resource = \"image\""), &["depth: a depth texture resource shared between passes is not supported yet"][..]),
         (indexed.replace("data = [0, 1, 2, 0, 2, 3]", "data = [0.5, 1, 2, 0, 2, 3]"), &["0.5 does not fit"][..]),
         (indexed.replace("indices = \"ix\"", "indices = \"image\""), &["indices = image is a texture; expected a buffer resource"][..]),
+        (indexed16.replace("uint16", "uint8"), &["indices format = \"uint8\" is not valid; expected uint32|uint16"][..]),
+        (indexed16.replace("data = [0, 1, 2, 0, 2, 3]", "data = [0, 1, 2, 0, 2, 70000]"), &["70000 does not fit u16 (u16)"][..]),
         (indexed.replace("indices = \"ix\"\n", "topology = \"quads\"\n"), &["topology = \"quads\" is not valid; expected triangle-list|"][..]),
         (
             constant.replace(", constant = [0.25, 0.25, 0.25, 0.25]", ""),
@@ -5305,7 +5311,8 @@ fn grass_tips_follow_the_cpu_projection(bin: &Path, root: &Path) {
         vista_image::npy::write_npy(&inputs.join(name), descr, shape, &data).unwrap();
     };
     npy("tips.npy", "<f4", &[tips.len() as u64 * 4, 5], bytes(verts.iter().map(|f| f.to_le_bytes()).collect()));
-    npy("tip_indices.npy", "<u4", &[idx.len() as u64], bytes(idx.iter().map(|i| i.to_le_bytes()).collect()));
+    let idx16: Vec<u8> = idx.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect();
+    npy("tip_indices.npy", "<u2", &[idx.len() as u64], idx16);
     vista_image::write_png8(&inputs.join("opaque.png"), &vista_image::Image::from_fn(4, 4, |_, _| [1.0; 4])).unwrap();
     let manifest = std::fs::read_to_string(root.join("kernels/grass.toml")).unwrap();
     let tips_manifest = manifest

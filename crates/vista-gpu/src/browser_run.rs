@@ -225,7 +225,8 @@ fn raster_json(r: &crate::graph::Raster, vertex_wgsl: Option<&str>) -> Value {
             "attributes": b.attributes.iter().map(|(l, f, o)| json!({ "shaderLocation": l, "format": f, "offset": o }))
                 .collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
-        "indices": r.indices, "count": r.count, "instances": r.instances,
+        "indices": r.indices, "index_format": if r.index_u16 { "uint16" } else { "uint32" },
+        "count": r.count, "instances": r.instances,
         "topology": r.topology.web(), "cull": r.cull.web(),
         "depth": r.depth.as_ref().map(|d| json!({ "compare": d.compare, "write": d.write, "clear": d.clear })),
         "blend_constant": r.blend_constant,

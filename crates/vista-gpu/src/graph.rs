@@ -330,8 +330,11 @@ pub struct Raster {
     pub vertex_constants: Vec<(String, f64)>,
     /// The vertex buffers, one per slot.
     pub buffers: Vec<VertexBuffer>,
-    /// A u32 index buffer.
+    /// The index buffer.
     pub indices: Option<usize>,
+    /// It holds u16 indices (else u32).
+    #[serde(default)]
+    pub index_u16: bool,
     /// Vertices (or indices) drawn per instance.
     pub count: u32,
     /// Instances drawn.

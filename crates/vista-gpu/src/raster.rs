@@ -153,7 +153,7 @@ pub(crate) fn primitive(r: &Raster) -> wgpu::PrimitiveState {
         },
         // WebGPU wants the strip's index format in the pipeline when indexed.
         strip_index_format: match (r.topology, r.indices) {
-            (Topology::TriangleStrip | Topology::LineStrip, Some(_)) => Some(wgpu::IndexFormat::Uint32),
+            (Topology::TriangleStrip | Topology::LineStrip, Some(_)) => Some(index_format(r)),
             _ => None,
         },
         front_face: wgpu::FrontFace::Ccw,
@@ -164,6 +164,10 @@ pub(crate) fn primitive(r: &Raster) -> wgpu::PrimitiveState {
         },
         ..Default::default()
     }
+}
+
+pub(crate) fn index_format(r: &Raster) -> wgpu::IndexFormat {
+    if r.index_u16 { wgpu::IndexFormat::Uint16 } else { wgpu::IndexFormat::Uint32 }
 }
 
 pub(crate) fn depth_stencil(r: &Raster) -> Option<wgpu::DepthStencilState> {
@@ -202,6 +206,7 @@ mod tests {
             vertex_constants: Vec::new(),
             buffers: Vec::new(),
             indices: None,
+            index_u16: false,
             count: 3,
             instances: 1,
             topology: Topology::TriangleList,

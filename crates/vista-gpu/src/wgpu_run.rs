@@ -492,7 +492,14 @@ impl Context {
             entries,
             pass.constants,
             targets,
-            pass.raster.as_ref().map(|r| (&r.vertex, &r.buffers, r.topology, r.cull, &r.depth, r.indices.is_some())),
+            pass.raster.as_ref().map(|r| (
+                &r.vertex,
+                &r.buffers,
+                r.topology,
+                r.cull,
+                &r.depth,
+                r.indices.map(|_| r.index_u16)
+            )),
             pass.raster.as_ref().map(|r| (&r.vertex_shader, &r.vertex_constants, vertex_module.as_ref().map(|v| &v.1)))
         );
         if let Some(p) = w.pipelines.lock().expect("pipeline cache").get(&key) {
@@ -797,7 +804,7 @@ fn encode_draw(
     }
     match raster.indices {
         Some(i) => {
-            pass.set_index_buffer(made.buffers[&current[i]].slice(..), wgpu::IndexFormat::Uint32);
+            pass.set_index_buffer(made.buffers[&current[i]].slice(..), crate::raster::index_format(raster));
             pass.draw_indexed(0..raster.count, 0, 0..raster.instances);
         }
         None => pass.draw(0..raster.count, 0..raster.instances),

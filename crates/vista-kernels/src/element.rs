@@ -11,9 +11,18 @@ pub struct Element {
     pub header: u32,
     /// Elements of a fixed-size binding (`None`: runtime-sized).
     pub fixed: Option<u32>,
-    /// Every leaf scalar of one element: byte offset, kind ('f' 'u' 'i'),
-    /// and its field path (for NumPy's structured dtype).
+    /// Every leaf scalar of one element: byte offset, kind ('f' 'u' 'i':
+    /// 32-bit; 'h': a u16, only a 16-bit index buffer's), and its field
+    /// path (for NumPy's structured dtype).
     pub leaves: Vec<(u32, char, String)>,
     /// The WGSL type, for messages.
     pub wgsl: String,
+}
+
+/// A leaf kind's NumPy kind and its size in bytes.
+pub fn leaf_numpy(kind: char) -> (char, u32) {
+    match kind {
+        'h' => ('u', 2),
+        k => (k, 4),
+    }
 }

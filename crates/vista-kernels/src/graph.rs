@@ -213,8 +213,8 @@ pub struct RasterSpec {
     pub targets: Vec<TargetSpec>,
     /// The vertex buffers, one per slot.
     pub vertices: Vec<VertexBufferSpec>,
-    /// A u32 index buffer resource.
-    pub indices: Option<String>,
+    /// The index buffer resource, and whether it holds u16 (else u32).
+    pub indices: Option<(String, bool)>,
     /// Vertices (or indices) per instance; `None`: every one the buffer holds.
     pub count: Option<Expr>,
     /// Instances; `None`: the per-instance buffer's elements, else 1.
@@ -925,8 +925,31 @@ fn parse_raster(
         None => Vec::new(),
         Some(v) => crate::vertex::parse(v, &buffer).map_err(at)?,
     };
-    let indices = string_key(t, "indices", at)?;
-    if let Some(i) = &indices {
+    let indices = match t.get("indices") {
+        None => None,
+        Some(toml::Value::String(name)) => Some((name.clone(), false)),
+        Some(toml::Value::Table(i)) => {
+            if let Some(k) = i.keys().find(|k| !["resource", "format"].contains(&k.as_str())) {
+                return Err(at(format!("indices: unknown key {k}; allowed: resource, format")));
+            }
+            let name =
+                string_key(i, "resource", at)?.ok_or_else(|| at("indices needs resource = \"<buffer>\"".into()))?;
+            let u16 = match string_key(i, "format", at)?.as_deref() {
+                None | Some("uint32") => false,
+                Some("uint16") => true,
+                Some(other) => {
+                    return Err(at(format!("indices format = \"{other}\" is not valid; expected uint32|uint16")));
+                }
+            };
+            Some((name, u16))
+        }
+        Some(other) => {
+            return Err(at(format!(
+                "indices = {other} is not valid; expected a buffer name or {{ resource, format }}"
+            )));
+        }
+    };
+    if let Some((i, _)) = &indices {
         buffer(i).map_err(|m| at(format!("indices = {m}")))?;
     }
     let expr = |k: &str| t.get(k).map(|v| Expr::parse_entry(v, params).map_err(|e| at(format!("{k} {e}")))).transpose();
@@ -1264,8 +1287,10 @@ pub struct PassSlot {
 pub struct DrawLayout {
     /// (resource index, layout), one per vertex-buffer slot.
     pub buffers: Vec<(usize, VertexLayout)>,
-    /// The u32 index buffer.
+    /// The index buffer.
     pub indices: Option<usize>,
+    /// It holds u16 indices (else u32).
+    pub index_u16: bool,
 }
 
 impl PassSlot {
@@ -1566,31 +1591,26 @@ fn draw_layout(
     }
     let indices = match &raster.indices {
         None => None,
-        Some(name) => {
+        Some((name, u16)) => {
             let r = find(resources, name);
             let res = &mut resources[r];
-            let u32_index = Element {
-                stride: 4,
-                header: 0,
-                fixed: None,
-                leaves: vec![(0, 'u', String::new())],
-                wgsl: "u32".into(),
-            };
+            // A u16 index is a 2-byte leaf ('h'), read from "<u2" or data.
+            let (stride, kind, wgsl) = if *u16 { (2, 'h', "u16") } else { (4, 'u', "u32") };
+            let index =
+                Element { stride, header: 0, fixed: None, leaves: vec![(0, kind, String::new())], wgsl: wgsl.into() };
             match &res.element {
-                Some(e) if (e.stride, e.header, e.leaves.len(), e.leaves[0].1) != (4, 0, 1, 'u') => {
-                    return Err(format!(
-                        "indices {name} holds {}; indices are u32 (uint16 is not supported yet)",
-                        e.wgsl
-                    ));
+                Some(e) if (e.stride, e.header, e.leaves.len(), e.leaves[0].1) != (stride, 0, 1, kind) => {
+                    return Err(format!("indices {name} holds {} but the draw reads {wgsl} indices", e.wgsl));
                 }
                 Some(_) => {}
-                None => res.element = Some(u32_index),
+                None => res.element = Some(index),
             }
             res.read = true;
             Some(r)
         }
     };
-    Ok(DrawLayout { buffers, indices })
+    let index_u16 = raster.indices.as_ref().is_some_and(|(_, u16)| *u16);
+    Ok(DrawLayout { buffers, indices, index_u16 })
 }
 
 /// A render pass's targets: each a 2d texture (or one level of one) that

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use vista_gpu::{Bind, Contents, GraphSlot};
 use vista_image::Image;
+use vista_kernels::element::leaf_numpy;
 use vista_kernels::graph::{Element, ResourceKind, SlotFeed, Tolerance, Usage};
 use vista_kernels::{DisplayMap, Kernel, ParamSet};
 use vista_texel::Dimension;
@@ -633,7 +634,9 @@ impl Planning<'_> {
             })
             .unwrap_or_default();
         let indices = draw.and_then(|d| d.indices);
-        let (count, instances) = self.draw_counts(r, label, resources, &buffers, indices, pp)?;
+        let index_u16 = draw.is_some_and(|d| d.index_u16);
+        let (count, instances) =
+            self.draw_counts(r, label, resources, &buffers, indices.map(|i| (i, index_u16)), pp)?;
         Ok(vista_gpu::Raster {
             targets,
             vertex,
@@ -641,6 +644,7 @@ impl Planning<'_> {
             vertex_constants: Vec::new(),
             buffers,
             indices,
+            index_u16,
             count,
             instances,
             topology: r.topology,
@@ -680,7 +684,7 @@ impl Planning<'_> {
         label: &str,
         resources: &[vista_gpu::Resource],
         buffers: &[vista_gpu::VertexBuffer],
-        indices: Option<usize>,
+        indices: Option<(usize, bool)>,
         pp: &ParamSet,
     ) -> Result<(u32, u32), RenderError> {
         if r.vertex == vista_kernels::graph::VertexStage::Fullscreen {
@@ -706,7 +710,7 @@ impl Planning<'_> {
         };
         let name = |ri: usize| self.kernel.graph().resources.get(ri).map_or("?".to_string(), |x| x.name.clone());
         let (available, what) = match (indices, held(false)) {
-            (Some(ix), _) => (Some(len(ix) / 4), format!("indices {}", name(ix))),
+            (Some((ix, u16)), _) => (Some(len(ix) / if u16 { 2 } else { 4 }), format!("indices {}", name(ix))),
             (None, Some((n, ri))) => (Some(n), format!("vertices {}", name(ri))),
             (None, None) => (None, String::new()),
         };
@@ -811,11 +815,12 @@ fn read_buffer(root: Option<&Path>, file: &str, e: &Element) -> Result<Vec<u8>, 
             let n = vista_image::npy::decode_npy(&path, &bytes).map_err(|err| format!("file {file}: {err}"))?;
             let (descr, _) = npy_dtype(e);
             let scalar_of = |d: &str| d.chars().nth(1);
-            let leaf_kind = e.leaves.first().map(|l| l.1);
+            let leaf_kind = e.leaves.first().map(|l| l.1).unwrap_or('u');
+            let (numpy_kind, size) = leaf_numpy(leaf_kind);
             let simple_ok = !n.descr.starts_with('[')
-                && scalar_of(&n.descr) == leaf_kind
-                && n.descr.ends_with('4')
-                && e.leaves.iter().all(|l| Some(l.1) == leaf_kind);
+                && scalar_of(&n.descr) == Some(numpy_kind)
+                && n.descr.ends_with(&size.to_string())
+                && e.leaves.iter().all(|l| l.1 == leaf_kind);
             if !(simple_ok || (n.descr.starts_with('[') && n.item_bytes == e.stride as u64)) {
                 return Err(format!(
                     "file {file} has dtype {} but {} needs {descr} (or any dtype of {} bytes per element)",
@@ -828,7 +833,7 @@ fn read_buffer(root: Option<&Path>, file: &str, e: &Element) -> Result<Vec<u8>, 
     };
     // A simple dtype of a padded element (vec3 at 16-byte stride) is packed:
     // spread it over the stride.
-    let packed = e.leaves.len() as u32 * 4;
+    let packed: u32 = e.leaves.iter().map(|l| leaf_numpy(l.1).1).sum();
     let data = if packed != e.stride
         && data.len().is_multiple_of(packed as usize)
         && !data.len().is_multiple_of(e.stride as usize)
@@ -836,8 +841,11 @@ fn read_buffer(root: Option<&Path>, file: &str, e: &Element) -> Result<Vec<u8>, 
         let mut out = Vec::new();
         for chunk in data.chunks(packed as usize) {
             let mut el = vec![0u8; e.stride as usize];
-            for (leaf, v) in e.leaves.iter().zip(chunk.chunks(4)) {
-                el[leaf.0 as usize..leaf.0 as usize + 4].copy_from_slice(v);
+            let mut at = 0;
+            for leaf in &e.leaves {
+                let size = leaf_numpy(leaf.1).1 as usize;
+                el[leaf.0 as usize..leaf.0 as usize + size].copy_from_slice(&chunk[at..at + size]);
+                at += size;
             }
             out.extend(el);
         }
@@ -874,13 +882,21 @@ fn encode_values(values: &[f64], e: &Element) -> Result<Vec<u8>, String> {
     for chunk in values.chunks(per) {
         let mut el = vec![0u8; e.stride as usize];
         for ((offset, kind, path), v) in e.leaves.iter().zip(chunk) {
+            let whole = v.fract() == 0.0;
             let word = match kind {
-                'f' => (*v as f32).to_le_bytes(),
-                'u' if *v >= 0.0 && *v <= u32::MAX as f64 && v.fract() == 0.0 => (*v as u32).to_le_bytes(),
-                'i' if *v >= i32::MIN as f64 && *v <= i32::MAX as f64 && v.fract() == 0.0 => (*v as i32).to_le_bytes(),
-                _ => return Err(format!("{v} does not fit {path} ({kind}32) of {}", e.wgsl)),
+                'f' => (*v as f32).to_le_bytes().to_vec(),
+                'u' if whole && *v >= 0.0 && *v <= u32::MAX as f64 => (*v as u32).to_le_bytes().to_vec(),
+                'i' if whole && *v >= i32::MIN as f64 && *v <= i32::MAX as f64 => (*v as i32).to_le_bytes().to_vec(),
+                'h' if whole && *v >= 0.0 && *v <= u16::MAX as f64 => (*v as u16).to_le_bytes().to_vec(),
+                _ => {
+                    let (k, bits) = (leaf_numpy(*kind).0, leaf_numpy(*kind).1 * 8);
+                    return Err(match path.is_empty() {
+                        true => format!("{v} does not fit {} ({k}{bits})", e.wgsl),
+                        false => format!("{v} does not fit {path} ({k}{bits}) of {}", e.wgsl),
+                    });
+                }
             };
-            el[*offset as usize..*offset as usize + 4].copy_from_slice(&word);
+            el[*offset as usize..*offset as usize + word.len()].copy_from_slice(&word);
         }
         out.extend(el);
     }
@@ -892,7 +908,11 @@ pub fn leaf_values(bytes: &[u8], e: &Element) -> Vec<f64> {
     let mut out = Vec::new();
     for el in bytes.chunks_exact(e.stride.max(1) as usize) {
         for (offset, kind, _) in &e.leaves {
-            let b = &el[*offset as usize..*offset as usize + 4];
+            let b = &el[*offset as usize..];
+            if *kind == 'h' {
+                out.push(u16::from_le_bytes([b[0], b[1]]) as f64);
+                continue;
+            }
             let w = [b[0], b[1], b[2], b[3]];
             out.push(match kind {
                 'f' => f32::from_le_bytes(w) as f64,
@@ -910,10 +930,11 @@ pub fn leaf_values(bytes: &[u8], e: &Element) -> Vec<f64> {
 /// padding as void fields.
 pub fn npy_dtype(e: &Element) -> (String, Vec<u64>) {
     let kind = e.leaves.first().map(|l| l.1).unwrap_or('u');
-    let packed = e.leaves.iter().enumerate().all(|(i, l)| l.0 == 4 * i as u32 && l.1 == kind);
-    if packed && e.stride == 4 * e.leaves.len() as u32 {
+    let (numpy, size) = leaf_numpy(kind);
+    let packed = e.leaves.iter().enumerate().all(|(i, l)| l.0 == size * i as u32 && l.1 == kind);
+    if packed && e.stride == size * e.leaves.len() as u32 {
         let tail = if e.leaves.len() == 1 { vec![] } else { vec![e.leaves.len() as u64] };
-        return (format!("<{kind}4"), tail);
+        return (format!("<{numpy}{size}"), tail);
     }
     let mut fields = Vec::new();
     let mut at = 0;
@@ -922,11 +943,31 @@ pub fn npy_dtype(e: &Element) -> (String, Vec<u64>) {
             fields.push(format!("('_pad{at}', '|V{}')", offset - at));
         }
         let name = if path.is_empty() { "value".to_string() } else { path.clone() };
-        fields.push(format!("('{name}', '<{kind}4')"));
-        at = offset + 4;
+        let (numpy, size) = leaf_numpy(*kind);
+        fields.push(format!("('{name}', '<{numpy}{size}')"));
+        at = offset + size;
     }
     if e.stride > at {
         fields.push(format!("('_pad{at}', '|V{}')", e.stride - at));
     }
     (format!("[{}]", fields.join(", ")), vec![])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn u16_indices_are_two_byte_leaves() {
+        let e =
+            Element { stride: 2, header: 0, fixed: None, leaves: vec![(0, 'h', String::new())], wgsl: "u16".into() };
+        let bytes = encode_values(&[0.0, 65535.0, 7.0], &e).unwrap();
+        assert_eq!(bytes, [0, 0, 255, 255, 7, 0]);
+        assert_eq!(leaf_values(&bytes, &e), [0.0, 65535.0, 7.0]);
+        assert_eq!(npy_dtype(&e), ("<u2".to_string(), vec![]));
+        assert_eq!(encode_values(&[65536.0], &e).unwrap_err(), "65536 does not fit u16 (u16)");
+        let u32s =
+            Element { stride: 4, header: 0, fixed: None, leaves: vec![(0, 'u', String::new())], wgsl: "u32".into() };
+        assert_eq!(npy_dtype(&u32s).0, "<u4");
+    }
 }

@@ -7,7 +7,7 @@ examples/render/README.md, with only Python's standard library:
                             in the bottom-right 8 x 8 corner
   inputs/grass_blades.npy   float32 (N, 5): position xyz, uv per vertex;
                             three aligned layers of 100 cards, then the ground
-  inputs/grass_indices.npy  uint32 (M,): two triangles per card
+  inputs/grass_indices.npy  uint16 (M,): two triangles per card
 
 Run from the repository root: python3 examples/render/tools/make_grass.py
 """
@@ -100,7 +100,7 @@ def main():
     png(os.path.join(HERE, "grass_blade.png"), w, h, px)
     verts, idx = cards()
     npy(os.path.join(HERE, "grass_blades.npy"), "<f4", (len(verts) // 5, 5), struct.pack("<%df" % len(verts), *verts))
-    npy(os.path.join(HERE, "grass_indices.npy"), "<u4", (len(idx),), struct.pack("<%dI" % len(idx), *idx))
+    npy(os.path.join(HERE, "grass_indices.npy"), "<u2", (len(idx),), struct.pack("<%dH" % len(idx), *idx))
     print("%d vertices, %d indices" % (len(verts) // 5, len(idx)))
 
 
