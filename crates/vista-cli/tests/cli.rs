@@ -5190,6 +5190,67 @@ fn two() -> Two {
     }
 }
 
+/// Integer textures load from raw data (SPEC 17): a `.npy` of the
+/// texture's shape and dtype, its bytes the texels unchanged (u32 ids in
+/// the millions, which no 8- or 16-bit image carries, arrive exact), on
+/// every backend; a dtype or channel count the format does not store is refused
+/// before GPU work naming both.
+fn integer_textures_load_from_npy() {
+    const SHADER: &str = "@group(0) @binding(0) var ids: texture_2d<u32>;
+@group(0) @binding(1) var colours: texture_2d<u32>;
+@group(0) @binding(2) var out: texture_storage_2d<rgba32uint, write>;
+
+@compute @workgroup_size(4, 4)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let c = textureLoad(colours, id.xy, 0);
+    textureStore(out, id.xy, vec4(textureLoad(ids, id.xy, 0).x, c.x, c.y, c.w));
+}
+";
+    let manifest = |ids: &str| {
+        format!(
+            "summary = \"ids\"\n[[resource]]\nname = \"ids\"\nkind = \"texture\"\n{ids}file = \"ids.npy\"\n\
+             [[resource]]\nname = \"colours\"\nkind = \"texture\"\nformat = \"rgba8uint\"\nfile = \"colours.npy\"\n"
+        )
+    };
+    let d = kernel_project(&manifest("format = \"r32uint\"\n"), SHADER);
+    // Past any 8- or 16-bit image, still exact in the f32 the EXR holds.
+    let id = |x: u32, y: u32| 16_000_000u32 + 1001 * (y * 8 + x);
+    let ids: Vec<u8> = (0..4).flat_map(|y| (0..8).flat_map(move |x| id(x, y).to_le_bytes())).collect();
+    vista_image::npy::write_npy(&d.path().join("ids.npy"), "<u4", &[4, 8], &ids).unwrap();
+    let colours: Vec<u8> = (0..4u8).flat_map(|y| (0..8u8).flat_map(move |x| [x, y, 0, 200 + x])).collect();
+    vista_image::npy::write_npy(&d.path().join("colours.npy"), "|u1", &[4, 8, 4], &colours).unwrap();
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("{backend}.exr"));
+        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        let img = vista_image::load(&out).unwrap();
+        for (x, y) in [(0u32, 0u32), (7, 3), (5, 2)] {
+            let want = [id(x, y) as f32, x as f32, y as f32, (200 + x) as f32];
+            assert_eq!(img.get(x, y), want, "{backend}: ({x}, {y})");
+        }
+    }
+    // The format from the dtype when the resource names none: <u4 (H, W) is r32uint.
+    std::fs::write(d.path().join("kernels/k.toml"), manifest("")).unwrap();
+    let out = d.path().join("natural.exr");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x4", "-o", out.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let bad = |descr: &str, shape: &[u64]| {
+        let d = kernel_project(&manifest("format = \"r32uint\"\n"), SHADER);
+        vista_image::npy::write_npy(&d.path().join("ids.npy"), descr, shape, &ids).unwrap();
+        vista_image::npy::write_npy(&d.path().join("colours.npy"), "|u1", &[4, 8, 4], &colours).unwrap();
+        let out = d.path().join("bad.exr");
+        vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x4", "-o", out.to_str().unwrap()])
+    };
+    assert_rejected(
+        &bad("<f4", &[4, 8]),
+        2,
+        &["resource ids: file ids.npy holds <f4 x 1 per texel but r32uint needs <u4 x 1"],
+    );
+    assert_rejected(&bad("<u4", &[4, 4, 2]), 2, &["holds <u4 x 2 per texel but r32uint needs <u4 x 1"]);
+    assert_rejected(&bad("<u4", &[32]), 2, &["has shape [32]; a texture is (H, W) or (H, W, channels)"]);
+}
+
 /// examples/render (SPEC 17's examples a and b), copied with a copied
 /// binary: its goldens pass on lavapipe, SwiftShader and Chromium; the
 /// full-screen sky draws what the built-in compute sky dispatches (within
@@ -5396,6 +5457,7 @@ fn main() {
         Gpu a_fullscreen_render_pass_draws_every_texel,
         Gpu a_draw_reads_vertex_buffers_indices_and_depth,
         Gpu shader_features_run_where_the_backend_has_them,
+        Gpu integer_textures_load_from_npy,
         Gpu the_render_example_passes_on_every_backend_with_a_copied_binary,
         Gpu a_broken_manifest_breaks_only_its_kernel,
         Cpu adapter_is_a_hidden_alias_of_backend,

@@ -541,9 +541,9 @@ fn texture_kind(
         ),
     };
     if let Some(f) = &file
-        && !(f.ends_with(".png") || f.ends_with(".exr"))
+        && !(f.ends_with(".png") || f.ends_with(".exr") || f.ends_with(".npy"))
     {
-        return Err(at(format!("file = \"{f}\" is not valid for a texture; expected a .png or .exr file")));
+        return Err(at(format!("file = \"{f}\" is not valid for a texture; expected a .png, .exr or .npy file")));
     }
     let size = match t.get("size") {
         None => None,

@@ -244,6 +244,24 @@ impl Planning<'_> {
             None => None,
         };
         let (format, contents) = match &file {
+            Some(f) if f.ends_with(".npy") => {
+                let (format, [fw, fh], bytes) = read_texture_npy(root, f, r.format).map_err(at)?;
+                let layers = extent.map(|e| e[2]).unwrap_or(1);
+                if let Some(e) = extent
+                    && (fw != e[0] || fh != e[1] * layers)
+                {
+                    return Err(at(format!(
+                        "file {f} is {fw}x{fh} but size says {}x{} ({layers} layers stacked)",
+                        e[0],
+                        e[1] * layers
+                    )));
+                }
+                if cube && extent.is_none() && fh == 6 * fw {
+                    extent = Some([fw, fw, 6]);
+                }
+                extent.get_or_insert([fw, fh, 1]);
+                (format, Contents::Bytes(bytes))
+            }
             Some(f) => {
                 let (natural, image) = read_texture(root, f).map_err(at)?;
                 let layers = extent.map(|e| e[2]).unwrap_or(1);
@@ -797,6 +815,51 @@ fn read_texture(root: Option<&Path>, file: &str) -> Result<(&'static str, Image)
     }
     let image = vista_image::decode_png16(&path, &bytes).map_err(|e| format!("file {file}: {e}"))?;
     Ok((if bytes[24] == 16 { "rgba32float" } else { "rgba8unorm" }, image))
+}
+
+/// A texture from a `.npy` (SPEC 17: integer textures from raw data): an
+/// (H, W) or (H, W, C) array whose dtype and C are the format's channels
+/// (layers stacked along H), its bytes the texels unchanged; the format is
+/// the resource's, else the first whose channels the dtype matches.
+fn read_texture_npy(
+    root: Option<&Path>,
+    file: &str,
+    declared: Option<&'static str>,
+) -> Result<(&'static str, [u32; 2], Vec<u8>), String> {
+    let path = under(root, file)?;
+    let n = vista_image::npy::read_npy(&path).map_err(|e| format!("file {file}: {e}"))?;
+    let (h, w, c) = match n.shape[..] {
+        [h, w] => (h, w, 1),
+        [h, w, c] => (h, w, c as usize),
+        _ => return Err(format!("file {file} has shape {:?}; a texture is (H, W) or (H, W, channels)", n.shape)),
+    };
+    let format = match declared {
+        Some(name) => vista_texel::Format::parse(name)?,
+        None => vista_texel::Format::of_numpy(&n.descr, c).ok_or_else(|| {
+            format!("file {file} holds {} x {c}, which no texture format stores; give the resource a format", n.descr)
+        })?,
+    };
+    let (dtype, channels) = format.numpy();
+    let same = |d: &str| d == dtype || (dtype.starts_with('|') && d.ends_with(&dtype[1..]));
+    if !same(&n.descr) || c != channels {
+        return Err(format!(
+            "file {file} holds {} x {c} per texel but {} needs {dtype} x {channels} (shape (H, W{}))",
+            n.descr,
+            format.name,
+            if channels == 1 { String::new() } else { format!(", {channels}") }
+        ));
+    }
+    let (w, h) = (u32::try_from(w).ok().filter(|w| (1..=16384).contains(w)), u32::try_from(h).ok().filter(|h| *h >= 1));
+    let (Some(w), Some(h)) = (w, h) else { return Err(format!("file {file}: shape {:?} is out of range", n.shape)) };
+    if !format.is_integer()
+        && let Some(i) = (0..(w * h) as usize).find(|i| {
+            let b = format.texel_bytes();
+            format.decode(&n.data[i * b..(i + 1) * b]).iter().any(|v| !v.is_finite())
+        })
+    {
+        return Err(format!("file {file} holds NaN/Inf at texel {i}; inputs must be finite"));
+    }
+    Ok((format.name, [w, h], n.data))
 }
 
 fn under(root: Option<&Path>, file: &str) -> Result<PathBuf, String> {

@@ -20,6 +20,20 @@ enum Channel {
 }
 
 impl Channel {
+    /// NumPy's dtype of one channel.
+    fn numpy(self) -> &'static str {
+        match self {
+            Channel::Unorm8 | Channel::Uint8 => "|u1",
+            Channel::Snorm8 | Channel::Sint8 => "|i1",
+            Channel::Float16 => "<f2",
+            Channel::Uint16 => "<u2",
+            Channel::Sint16 => "<i2",
+            Channel::Float32 => "<f4",
+            Channel::Uint32 => "<u4",
+            Channel::Sint32 => "<i4",
+        }
+    }
+
     fn bytes(self) -> usize {
         match self {
             Channel::Unorm8 | Channel::Snorm8 | Channel::Uint8 | Channel::Sint8 => 1,
@@ -168,6 +182,21 @@ impl Format {
     /// output compares exactly).
     pub fn is_integer(&self) -> bool {
         self.sample_kind() != SampleKind::Float
+    }
+
+    /// NumPy's dtype of one channel and the channel count: a `.npy` of
+    /// this texture holds an (H, W, channels) array of it (H, W for one).
+    pub fn numpy(&self) -> (&'static str, usize) {
+        (self.channels[0].numpy(), self.channels.len())
+    }
+
+    /// The first format whose texels a `.npy` of this dtype and channel
+    /// count holds, byte for byte.
+    pub fn of_numpy(descr: &str, channels: usize) -> Option<Format> {
+        format_names().into_iter().map(|n| Format::parse(n).expect("a listed name")).find(|f| {
+            let (d, c) = f.numpy();
+            (d, c) == (descr, channels) || (d.strip_prefix('|').is_some_and(|d| descr.ends_with(d)) && c == channels)
+        })
     }
 
     /// Bytes of one texel.
