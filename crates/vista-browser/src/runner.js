@@ -74,7 +74,7 @@ function vistaChunk(offset, length) {
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility; `vertex`: the render pass's vertex entry reads it too); a texture slot's view
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
-// another file's; null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear,
+// another file's; null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear, clear_once (the first run only),
 // blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a
 // buffer or null), index_format (uint32 or uint16), count, instances, topology, cull, depth ({ compare, write, clear } or null: the pass's own
 // depth32float texture), blend_constant }. Outputs are read back one after another into vista.out: textures
@@ -204,8 +204,11 @@ async function vistaRun(job) {
       first += span;
     }
     const passMs = job.passes.map(() => 0);
+    const ran = new Set();
     for (const p of order) {
       const pass = job.passes[p];
+      const firstRun = !ran.has(p);
+      ran.add(p);
       const passStart = performance.now();
       {
         d.pushErrorScope("validation");
@@ -230,7 +233,7 @@ async function vistaRun(job) {
           // Each target's level, cleared where it says so, else drawn over.
           const colorAttachments = pass.raster.targets.map((t) => {
             const view = made[current[t.resource]].createView({ dimension: "2d", baseMipLevel: t.level, mipLevelCount: 1, baseArrayLayer: t.layer, arrayLayerCount: 1 });
-            return t.clear
+            return t.clear && (firstRun || !t.clear_once)
               ? { view, loadOp: "clear", clearValue: t.clear, storeOp: "store" }
               : { view, loadOp: "load", storeOp: "store" };
           });

@@ -5003,9 +5003,19 @@ fn build(@builtin(local_invocation_index) i: u32) {
              targets = [{{ resource = \"image\" }}]\n"
         )
     };
+    // A repeated additive draw accumulates after vista's default clear (its first run only): 3 x 1.
+    let repeated = format!(
+        "[[resource]]\nname = \"acc\"\nkind = \"texture\"\nformat = \"rgba16float\"\n{}repeat = 3\n[[output]]\nresource = \"acc\"\n",
+        indexed.replace(
+            "targets = [{ resource = \"image\" }]",
+            "targets = [{ resource = \"acc\", blend = \"additive\" }]"
+        )
+    );
     // The same quad from u16 indices.
     let indexed16 = indexed.replace("indices = \"ix\"", "indices = { resource = \"ix\", format = \"uint16\" }");
     for backend in ["lavapipe", "swiftshader", "browser"] {
+        let img = render(&repeated, backend);
+        assert_eq!((img.get(1, 1), img.get(6, 2)), ([3.0; 4], [0.0; 4]), "{backend}: a repeated draw accumulates");
         let img = render(&indexed16, backend);
         assert_eq!((img.get(1, 1), img.get(6, 2)), ([1.0; 4], [0.0; 4]), "{backend}: u16 indices");
         let img = render(indexed, backend);

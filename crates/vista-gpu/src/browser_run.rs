@@ -218,7 +218,8 @@ fn raster_json(r: &crate::graph::Raster, vertex_wgsl: Option<&str>) -> Value {
     json!({
         "vertex": vertex, "vertex_entry": vertex_entry,
         "targets": r.targets.iter().map(|t| json!({
-            "resource": t.resource, "level": t.level, "layer": t.layer, "clear": t.clear, "blend": blend(t.blend),
+            "resource": t.resource, "level": t.level, "layer": t.layer, "clear": t.clear, "clear_once": t.clear_once,
+            "blend": blend(t.blend),
         })).collect::<Vec<_>>(),
         "buffers": r.buffers.iter().map(|b| json!({
             "resource": b.resource, "arrayStride": b.stride, "stepMode": if b.instance { "instance" } else { "vertex" },

@@ -284,6 +284,10 @@ pub struct RasterTarget {
     /// texture holds (a sentinel-filled output keeps its sentinel where the
     /// fragment entry discards: unwritten).
     pub clear: Option<[f64; 4]>,
+    /// `clear` applies to the pass's first run only, later runs draw over
+    /// (vista's default clear of a draw's target, not the manifest's).
+    #[serde(default)]
+    pub clear_once: bool,
     /// How the output meets the texel.
     pub blend: vista_texel::Blend,
 }

@@ -200,7 +200,7 @@ mod tests {
             })
         };
         let raster = |blend| Raster {
-            targets: vec![RasterTarget { resource: 0, level: 0, layer: 0, clear: None, blend }],
+            targets: vec![RasterTarget { resource: 0, level: 0, layer: 0, clear: None, clear_once: false, blend }],
             vertex: None,
             vertex_shader: None,
             vertex_constants: Vec::new(),

@@ -156,8 +156,10 @@ impl Context {
         let mut gpu_times = vec![Duration::ZERO; g.passes.len()];
         let _serial = self.submit_lock.lock().expect("submit lock");
         let hook = self.on_pass.lock().expect("pass hook").clone();
+        let mut ran = vec![false; g.passes.len()];
         for (pi, pass, compiled) in run_order(&g.passes).into_iter().map(|i| (i, &g.passes[i], &pipelines[i])) {
             let pass_start = Instant::now();
+            let first_run = !std::mem::replace(&mut ran[pi], true);
             {
                 let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
                 let groups = bind_groups(d, g, pass, compiled, &made, &current);
@@ -171,8 +173,8 @@ impl Context {
                         &groups,
                         raster,
                         &g.resources,
-                        &made,
-                        &current,
+                        (&made, &current),
+                        first_run,
                         stamp_set,
                     ),
                     (Pipeline::Compute(p), _) => encode_dispatch(&mut encoder, p, &groups, pass.workgroups, stamp_set),
@@ -704,7 +706,8 @@ fn bind_groups(
 }
 
 /// One render pass: each target's view (its level; cleared where it says
-/// so, else drawn over), the pass's own depth buffer, the pipeline, its
+/// so, on the first run only where `clear_once`, else drawn over), the
+/// pass's own depth buffer, the pipeline, its
 /// bind groups, vertex and index buffers, the draw.
 #[allow(clippy::too_many_arguments)]
 fn encode_draw(
@@ -714,8 +717,8 @@ fn encode_draw(
     groups: &[wgpu::BindGroup],
     raster: &Raster,
     resources: &[Resource],
-    made: &Made,
-    current: &[usize],
+    (made, current): (&Made, &[usize]),
+    first_run: bool,
     stamps: Option<&wgpu::QuerySet>,
 ) {
     let views: Vec<wgpu::TextureView> = raster
@@ -743,8 +746,10 @@ fn encode_draw(
                 resolve_target: None,
                 ops: wgpu::Operations {
                     load: match t.clear {
-                        Some([r, g, b, a]) => wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
-                        None => wgpu::LoadOp::Load,
+                        Some([r, g, b, a]) if first_run || !t.clear_once => {
+                            wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a })
+                        }
+                        _ => wgpu::LoadOp::Load,
                     },
                     store: wgpu::StoreOp::Store,
                 },

@@ -625,12 +625,11 @@ impl Planning<'_> {
             }
             // A draw leaves uncovered texels at the clear value: zeros on a
             // texture no earlier pass wrote, so they are not "unwritten".
+            // (On its first run: a repeated draw accumulates after it.)
             let draw = r.vertex != VertexStage::Fullscreen;
-            let clear = match t.clear {
-                None if draw && !self.written_before(i, ri, resolved) => Some([0.0; 4]),
-                c => c,
-            };
-            targets.push(vista_gpu::RasterTarget { resource: ri, level, layer, clear, blend });
+            let implicit = t.clear.is_none() && draw && !self.written_before(i, ri, resolved);
+            let clear = if implicit { Some([0.0; 4]) } else { t.clear };
+            targets.push(vista_gpu::RasterTarget { resource: ri, level, layer, clear, clear_once: implicit, blend });
         }
         let vertex = r.vertex.entry().map(str::to_string);
         let draw = resolved.draws[i].as_ref();
