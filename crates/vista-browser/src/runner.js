@@ -76,8 +76,8 @@ function vistaChunk(offset, length) {
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
 // another file's; null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear, clear_once (the first run only),
 // blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a
-// buffer or null), index_format (uint32 or uint16), count, instances, topology, cull, depth ({ compare, write, clear } or null: the pass's own
-// depth32float texture), blend_constant }. Outputs are read back one after another into vista.out: textures
+// buffer or null), index_format (uint32 or uint16), count, instances, topology, cull, depth ({ resource (a depth resource or null: the pass's own
+// depth32float texture), compare, write, clear } or null), blend_constant }. Outputs are read back one after another into vista.out: textures
 // unpadded, layers stacked; buffers whole.
 async function pipeline(pass, resources) {
   const targets = pass.raster ? pass.raster.targets.map((t) => ({ format: resources[t.resource].format, blend: t.blend || undefined })) : null;
@@ -165,6 +165,9 @@ async function vistaRun(job) {
           d.queue.writeTexture({ texture }, filled, { bytesPerRow: rowBytes, rowsPerImage: r.height }, size);
         }
         made.push(texture);
+      } else if (r.kind === "depth") {
+        // Cleared by the pass that tests against it; sampled as texture_depth_2d.
+        made.push(d.createTexture({ size: [r.width, r.height], format: "depth32float", usage: T.RENDER_ATTACHMENT | T.TEXTURE_BINDING }));
       } else if (r.kind === "buffer") {
         const bytes = fromBase64(r.contents);
         const buffer = d.createBuffer({ size: Math.max(4, Math.ceil(bytes.length / 4) * 4), usage: B.STORAGE | B.UNIFORM | B.VERTEX | B.INDEX | B.COPY_SRC | B.COPY_DST, mappedAtCreation: true });
@@ -238,13 +241,18 @@ async function vistaRun(job) {
               : { view, loadOp: "load", storeOp: "store" };
           });
           const r = pass.raster;
-          // The pass's own depth buffer, the size of its first target's level.
+          // A depth resource, or the pass's own buffer the size of its first target's level.
           let depthStencilAttachment;
           if (r.depth) {
-            const t0 = r.targets[0];
-            const desc = job.resources[t0.resource];
-            const size = [Math.max(1, desc.width >> t0.level), Math.max(1, desc.height >> t0.level)];
-            const depth = d.createTexture({ size, format: "depth32float", usage: GPUTextureUsage.RENDER_ATTACHMENT });
+            let depth;
+            if (r.depth.resource !== null && r.depth.resource !== undefined) {
+              depth = made[current[r.depth.resource]];
+            } else {
+              const t0 = r.targets[0];
+              const desc = job.resources[t0.resource];
+              const size = [Math.max(1, desc.width >> t0.level), Math.max(1, desc.height >> t0.level)];
+              depth = d.createTexture({ size, format: "depth32float", usage: GPUTextureUsage.RENDER_ATTACHMENT });
+            }
             depthStencilAttachment = { view: depth.createView(), depthClearValue: r.depth.clear, depthLoadOp: "clear", depthStoreOp: "store" };
           }
           const rp = encoder.beginRenderPass({ colorAttachments, ...(depthStencilAttachment ? { depthStencilAttachment } : {}) });

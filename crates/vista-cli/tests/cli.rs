@@ -4943,6 +4943,13 @@ fn colored(in: Lit) -> @location(0) vec4<f32> {
     return in.color;
 }
 
+@group(1) @binding(0) var scene_depth: texture_depth_2d;
+
+@fragment
+fn show_depth(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4(textureLoad(scene_depth, vec2<i32>(pos.xy), 0));
+}
+
 struct Corner { p: vec3<f32>, color: vec4<f32> }
 @group(0) @binding(1) var<storage, read_write> corners: array<Corner>;
 
@@ -4990,6 +4997,14 @@ fn build(@builtin(local_invocation_index) i: u32) {
         quad(0.6, "0, 1, 0, 1")
     );
     let depth = layers.replace("vertices = [", "depth = { compare = \"less\" }\nvertices = [");
+    // A depth resource: the draw tests against it, a later full-screen pass samples it.
+    let shared = format!(
+        "[[resource]]\nname = \"scene_depth\"\nkind = \"depth\"\n\
+         [[resource]]\nname = \"shown\"\nkind = \"texture\"\nformat = \"rgba32float\"\n{}\
+         [[pass]]\nkind = \"render\"\nfragment = \"show_depth\"\ntargets = [{{ resource = \"shown\" }}]\n\
+         [[output]]\nresource = \"shown\"\n",
+        layers.replace("vertices = [", "depth = { resource = \"scene_depth\" }\nvertices = [")
+    );
     // A compute pass writes the vertices: read at its struct's offsets (vec3 then vec4 at 16, stride 32).
     let computed = "[[resource]]\nname = \"corners\"\nkind = \"buffer\"\nlength = 6\n\
                     [[pass]]\nentry = \"build\"\nworkgroups = [1, 1, 1]\n\
@@ -5035,6 +5050,11 @@ fn build(@builtin(local_invocation_index) i: u32) {
             render(computed, backend).get(5, 1),
             [0.25, 0.5, 0.75, 1.0],
             "{backend}: vertices a compute pass wrote"
+        );
+        let depth = render(&shared, backend).get(3, 2);
+        assert!(
+            depth.iter().all(|d| (d - 0.2).abs() < 1e-6),
+            "{backend}: the nearer quad's depth sampled later: {depth:?}"
         );
         let none = render(&winding("none"), backend);
         assert_eq!((none.get(0, 3), none.get(7, 0)), ([1.0; 4], [1.0; 4]), "{backend}");
@@ -5110,7 +5130,10 @@ fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
         (indexed.replace("vertex = \"flat\"", "vertex = \"nope\""), &["has no vertex entry point 'nope'; its vertex entry points: flat, placed, layered"][..]),
         (indexed.replace("vertex = \"flat\"", "vertex = { shader = \"nowhere.wgsl\", entry = \"vs\" }"), &["nowhere.wgsl"][..]),
         (indexed.replace("vertex = \"flat\"", "vertex = { shader = \"k.wgsl\", entry = \"vs\", stage = 1 }"), &["vertex: unknown key stage; allowed: shader, entry"][..]),
-        (depth.replace("compare = \"less\"", "resource = \"image\""), &["depth: a depth texture resource shared between passes is not supported yet"][..]),
+        (shared.replace("resource = \"shown\"\n", "resource = \"scene_depth\"\n"), &["[[output]] resource = \"scene_depth\" is a depth texture, not an output yet"][..]),
+        (shared.replace("kind = \"depth\"\n", "kind = \"depth\"\nsize = [4, 4]\n"), &["depth resource scene_depth is 4x4 but image is 8x8"][..]),
+        (shared.replace("depth = { resource = \"scene_depth\" }", "depth = { resource = \"image\" }"), &["depth: resource image is a texture; it needs kind = \"depth\""][..]),
+        (shared.replace("depth = { resource = \"scene_depth\" }", "depth = { compare = \"less\" }"), &["resource scene_depth is read but no pass writes it"][..]),
         (indexed.replace("data = [0, 1, 2, 0, 2, 3]", "data = [0.5, 1, 2, 0, 2, 3]"), &["0.5 does not fit"][..]),
         (indexed.replace("indices = \"ix\"", "indices = \"image\""), &["indices = image is a texture; expected a buffer resource"][..]),
         (indexed16.replace("uint16", "uint8"), &["indices format = \"uint8\" is not valid; expected uint32|uint16"][..]),

@@ -89,7 +89,7 @@ pub fn inputs_of(case: &Case, root: Option<&std::path::Path>) -> Vec<(String, St
                 };
                 out.push((r.name.clone(), what, None));
             }
-            ResourceKind::Sampler { .. } => {}
+            ResourceKind::Sampler { .. } | ResourceKind::Depth { .. } => {}
         }
     }
     out

@@ -41,6 +41,7 @@ impl Context {
                     })
                 }
                 Resource::Buffer(bytes) => json!({ "kind": "buffer", "size": bytes.len(), "contents": b64(bytes) }),
+                Resource::Depth([w, h]) => json!({ "kind": "depth", "width": w, "height": h }),
                 Resource::Sampler(s) => json!({
                     "kind": "sampler",
                     "filter": if s.linear { "linear" } else { "nearest" },
@@ -162,6 +163,10 @@ impl Context {
                     json!({ "resource": resource, "level": level }),
                 )
             }
+            Bind::Sampled { resource, .. } if matches!(g.resources[*resource], Resource::Depth(_)) => (
+                json!({ "texture": { "sampleType": "depth", "viewDimension": "2d", "multisampled": false } }),
+                json!({ "resource": resource, "level": null }),
+            ),
             Bind::Sampled { resource, depth, cube, level } => {
                 let t = texture(*resource)?;
                 let format = crate::format::parse(t.format)?;
@@ -229,7 +234,9 @@ fn raster_json(r: &crate::graph::Raster, vertex_wgsl: Option<&str>) -> Value {
         "indices": r.indices, "index_format": if r.index_u16 { "uint16" } else { "uint32" },
         "count": r.count, "instances": r.instances,
         "topology": r.topology.web(), "cull": r.cull.web(),
-        "depth": r.depth.as_ref().map(|d| json!({ "compare": d.compare, "write": d.write, "clear": d.clear })),
+        "depth": r.depth.as_ref().map(|d| json!({
+            "resource": d.resource, "compare": d.compare, "write": d.write, "clear": d.clear,
+        })),
         "blend_constant": r.blend_constant,
     })
 }

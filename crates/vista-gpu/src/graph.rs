@@ -198,6 +198,9 @@ pub enum Resource {
     Buffer(#[serde(with = "wire::bytes")] Vec<u8>),
     /// A sampler.
     Sampler(SamplerDesc),
+    /// A depth32float texture of this width and height: a render pass's
+    /// depth attachment, sampled by later passes as `texture_depth_2d`.
+    Depth([u32; 2]),
 }
 
 /// What feeds one binding of a pass.
@@ -309,6 +312,9 @@ pub struct VertexBuffer {
 /// size that the pass owns (cleared every run).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Depth {
+    /// The depth resource tested against; `None`: the pass's own buffer.
+    #[serde(default)]
+    pub resource: Option<usize>,
     /// WebGPU's comparison name.
     pub compare: String,
     /// Whether passing fragments write their depth.

@@ -375,6 +375,9 @@ impl Context {
                     });
                     made.samplers.insert(i, sampler);
                 }
+                Resource::Depth(size) => {
+                    made.textures.insert(i, depth_texture(d, *size));
+                }
             }
         }
         Ok((made, fill))
@@ -429,6 +432,14 @@ impl Context {
                         view_dimension: crate::format::view_dimension(t.dimension),
                     }
                 }
+                // A depth resource: texture_depth_2d.
+                Bind::Sampled { resource, .. } if matches!(g.resources[resource], Resource::Depth(_)) => {
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    }
+                }
                 Bind::Sampled { resource, depth, cube, .. } => {
                     let Resource::Texture(t) = &g.resources[resource] else {
                         return Err(GpuError::Request(format!("{}: a texture bound to a non-texture", pass.label)));
@@ -460,16 +471,7 @@ impl Context {
             };
             entries.push((
                 s.group,
-                wgpu::BindGroupLayoutEntry {
-                    binding: s.binding,
-                    visibility: match (&pass.raster, s.vertex) {
-                        (Some(_), true) => wgpu::ShaderStages::VERTEX_FRAGMENT,
-                        (Some(_), false) => wgpu::ShaderStages::FRAGMENT,
-                        (None, _) => wgpu::ShaderStages::COMPUTE,
-                    },
-                    ty,
-                    count: None,
-                },
+                wgpu::BindGroupLayoutEntry { binding: s.binding, visibility: stages(pass, s), ty, count: None },
             ));
         }
         let targets = match &pass.raster {
@@ -579,7 +581,9 @@ impl Context {
                 encoder.copy_buffer_to_buffer(&made.buffers[&physical], 0, &staging, 0, size);
                 (staging, None)
             }
-            Resource::Sampler(_) => return Err(GpuError::Request("a sampler cannot be an output".into())),
+            Resource::Sampler(_) | Resource::Depth(_) => {
+                return Err(GpuError::Request("a sampler or depth texture cannot be an output".into()));
+            }
         };
         let index = w.queue.submit([encoder.finish()]);
         let (tx, rx) = mpsc::channel();
@@ -657,6 +661,9 @@ fn bind_groups(
         .iter()
         .map(|s| match s.bind {
             Bind::StorageTexture { resource, .. } | Bind::Sampled { resource, .. } => {
+                if let Resource::Depth(_) = &g.resources[resource] {
+                    return Some(made.textures[&current[resource]].create_view(&Default::default()));
+                }
                 let Resource::Texture(t) = &g.resources[resource] else { return None };
                 let cube = matches!(s.bind, Bind::Sampled { cube: true, .. });
                 // A storage view sees one level; a sampled one, its level or all.
@@ -703,6 +710,31 @@ fn bind_groups(
             d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(&pass.label), layout, entries: &entries })
         })
         .collect()
+}
+
+/// A depth resource's texture: cleared by the pass that tests against it,
+/// never filled.
+fn depth_texture(d: &wgpu::Device, [width, height]: [u32; 2]) -> wgpu::Texture {
+    d.create_texture(&wgpu::TextureDescriptor {
+        label: Some("depth resource"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Depth32Float,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
+}
+
+/// The stages that see a binding: a render pass's fragment stage (and its
+/// vertex stage where that reads it), else compute.
+fn stages(pass: &GraphPass, s: &crate::graph::GraphSlot) -> wgpu::ShaderStages {
+    match (&pass.raster, s.vertex) {
+        (Some(_), true) => wgpu::ShaderStages::VERTEX_FRAGMENT,
+        (Some(_), false) => wgpu::ShaderStages::FRAGMENT,
+        (None, _) => wgpu::ShaderStages::COMPUTE,
+    }
 }
 
 /// One render pass: each target's view (its level; cleared where it says
@@ -756,7 +788,10 @@ fn encode_draw(
             })
         })
         .collect();
-    let depth_view = raster.depth.as_ref().map(|_| {
+    let depth_view = raster.depth.as_ref().map(|depth| {
+        if let Some(r) = depth.resource {
+            return made.textures[&current[r]].create_view(&Default::default());
+        }
         let t = &raster.targets[0];
         let Resource::Texture(desc) = &resources[t.resource] else { unreachable!("plans check targets") };
         let size = wgpu::Extent3d {

@@ -59,6 +59,12 @@ pub enum ResourceKind {
         /// `fill` or alone (a runtime-sized array needs one).
         length: Option<Expr>,
     },
+    /// A depth texture (`kind = "depth"`, depth32float): a render pass's
+    /// `depth` attachment that later passes sample as `texture_depth_2d`.
+    Depth {
+        /// `[w, h]` as expressions; `None`: the case size.
+        size: Option<Vec<Expr>>,
+    },
     /// A sampler (`kind = "sampler"`).
     Sampler {
         /// `filter = "linear"`; false: nearest.
@@ -81,12 +87,13 @@ pub struct ResourceSpec {
 }
 
 impl ResourceSpec {
-    /// The manifest's `kind`: `texture`, `buffer` or `sampler`.
+    /// The manifest's `kind`: `texture`, `buffer`, `sampler` or `depth`.
     pub fn kind_name(&self) -> &'static str {
         match self.kind {
             ResourceKind::Texture { .. } => "texture",
             ResourceKind::Buffer { .. } => "buffer",
             ResourceKind::Sampler { .. } => "sampler",
+            ResourceKind::Depth { .. } => "depth",
         }
     }
 }
@@ -193,9 +200,12 @@ impl VertexStage {
 }
 
 /// A render pass's `depth` table: a depth32float buffer of the targets'
-/// size, owned by the pass.
+/// size, the pass's own or a depth resource.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DepthSpec {
+    /// A `kind = "depth"` resource later passes may sample; `None`: the
+    /// pass's own buffer.
+    pub resource: Option<String>,
     /// The comparison (one of [`COMPARE_FUNCTIONS`]).
     pub compare: &'static str,
     /// Whether passing fragments write their depth.
@@ -494,12 +504,16 @@ fn parse_resources(
         }
         let at = |m: String| fail(format!("[[resource]] {name}: {m}"));
         let text = |k: &str| string_key(t, k, &at);
-        let kind = text("kind")?.ok_or_else(|| at("needs kind = \"texture\", \"buffer\" or \"sampler\"".into()))?;
+        let kind =
+            text("kind")?.ok_or_else(|| at("needs kind = \"texture\", \"buffer\", \"sampler\" or \"depth\"".into()))?;
         let allowed: &[&str] = match kind.as_str() {
             "texture" => &["name", "kind", "format", "dimension", "size", "file", "mip_levels"],
             "buffer" => &["name", "kind", "file", "data", "fill", "length"],
             "sampler" => &["name", "kind", "filter", "address", "compare"],
-            other => return Err(at(format!("kind = \"{other}\" is not valid; expected texture|buffer|sampler"))),
+            "depth" => &["name", "kind", "size"],
+            other => {
+                return Err(at(format!("kind = \"{other}\" is not valid; expected texture|buffer|sampler|depth")));
+            }
         };
         for k in t.keys() {
             if !allowed.contains(&k.as_str()) {
@@ -515,11 +529,28 @@ fn parse_resources(
         let kind = match kind.as_str() {
             "texture" => texture_kind(t, file, params, &at)?,
             "buffer" => buffer_kind(t, file, params, &at)?,
+            "depth" => ResourceKind::Depth { size: depth_size(t, params, &at)? },
             _ => sampler_kind(t, &at)?,
         };
         res.push(ResourceSpec { name, kind });
     }
     Ok(res)
+}
+
+/// A depth resource's `size = [w, h]`.
+fn depth_size(
+    t: &toml::Table,
+    params: &[ParamSpec],
+    at: &dyn Fn(String) -> ParamError,
+) -> Result<Option<Vec<Expr>>, ParamError> {
+    match t.get("size") {
+        None => Ok(None),
+        Some(toml::Value::Array(list)) if list.len() == 2 => {
+            let e: Result<Vec<Expr>, _> = list.iter().map(|v| Expr::parse_entry(v, params)).collect();
+            Ok(Some(e.map_err(|e| at(format!("size {e}")))?))
+        }
+        Some(other) => Err(at(format!("size = {other} is not valid; a depth texture takes [w, h]"))),
+    }
 }
 
 /// A texture resource's keys: format, dimension, size (and its file).
@@ -964,7 +995,27 @@ fn parse_raster(
     };
     let depth = match t.get("depth") {
         None => None,
-        Some(toml::Value::Table(d)) => Some(parse_depth(d, at)?),
+        Some(toml::Value::Table(d)) => {
+            let depth = parse_depth(d, at)?;
+            if let Some(name) = &depth.resource {
+                match res.iter().find(|r| &r.name == name) {
+                    Some(r) if matches!(r.kind, ResourceKind::Depth { .. }) => {}
+                    Some(r) => {
+                        return Err(at(format!(
+                            "depth: resource {name} is a {}; it needs kind = \"depth\"",
+                            r.kind_name()
+                        )));
+                    }
+                    None => {
+                        return Err(at(format!(
+                            "depth: resource = \"{name}\" names no resource; resources: {}",
+                            names_of(res)
+                        )));
+                    }
+                }
+            }
+            Some(depth)
+        }
         Some(other) => return Err(at(format!("depth = {other} is not valid; expected {{ compare, write, clear }}"))),
     };
     Ok(Some(RasterSpec { vertex, targets, vertices, indices, count, instances, topology, cull, depth }))
@@ -1077,11 +1128,7 @@ fn parse_depth(d: &toml::Table, at: &dyn Fn(String) -> ParamError) -> Result<Dep
     if let Some(k) = d.keys().find(|k| !DEPTH_KEYS.contains(&k.as_str())) {
         return Err(dat(format!("unknown key {k}; allowed: {}", DEPTH_KEYS.join(", "))));
     }
-    if d.contains_key("resource") {
-        return Err(dat("a depth texture resource shared between passes is not supported yet; leave resource out \
-             for the pass's own depth32float buffer"
-            .into()));
-    }
+    let resource = string_key(d, "resource", &dat)?;
     let compare =
         match string_key(d, "compare", &dat)? {
             None => "less",
@@ -1102,7 +1149,7 @@ fn parse_depth(d: &toml::Table, at: &dyn Fn(String) -> ParamError) -> Result<Dep
             .filter(|c| (0.0..=1.0).contains(c))
             .ok_or_else(|| dat(format!("clear = {v} is not valid; expected a number in [0, 1]")))?,
     };
-    Ok(DepthSpec { compare, write, clear })
+    Ok(DepthSpec { resource, compare, write, clear })
 }
 
 /// The `[[output]]` tables: resource, view, exposure, partial, tolerance.
@@ -1672,6 +1719,16 @@ fn check_targets(
         }
         r.written = true;
     }
+    if let Some(d) = raster.depth.as_ref().and_then(|d| d.resource.as_ref()) {
+        let ri = find(resources, d);
+        if let Some(s) = slots.iter().find(|s| matches!(s.feed, SlotFeed::Resource(r, _) if r == ri)) {
+            return Err(bad(format!(
+                "{label}: depth resource {d} is also bound to {} in this pass; a pass cannot test against what it reads",
+                s.var
+            )));
+        }
+        resources[ri].written = true;
+    }
     let outputs = crate::bindings::fragment_outputs(module, entry);
     if let Some(extra) = outputs.iter().find(|&&l| l as usize >= raster.targets.len()) {
         return Err(bad(format!(
@@ -1699,7 +1756,7 @@ fn check_read_before_written(
 ) -> Result<(), ParamError> {
     let swapped = |name: &str| graph.passes.iter().any(|p| p.swap.iter().any(|(a, b)| a == name || b == name));
     for r in resources {
-        if let ResourceKind::Texture { file: None, .. } = &r.spec.kind
+        if matches!(&r.spec.kind, ResourceKind::Texture { file: None, .. } | ResourceKind::Depth { .. })
             && r.read
             && !r.written
             && !swapped(&r.spec.name)
@@ -1880,6 +1937,16 @@ fn sampled_slot(
         )));
     };
     let ri = find(resources, rn);
+    // A depth resource is sampled as texture_depth_2d, and only so.
+    if kind_of(resources, ri) == "depth" {
+        if (kind, dim) != (SampledKind::Depth, Dimension::D2) {
+            return Err(bad(format!(
+                "{label}: {described} is bound to {rn}, a depth texture; it is sampled as texture_depth_2d"
+            )));
+        }
+        resources[ri].read = true;
+        return Ok(SlotFeed::Resource(ri, Usage::Sampled { dim, kind }));
+    }
     needs_kind(resources, ri, "texture", label, described, bad)?;
     let r = &mut resources[ri];
     match r.dimension {
@@ -1950,6 +2017,11 @@ fn check_swaps_and_outputs(
         };
         let r = &resources[ri];
         let swapped = graph.passes.iter().any(|p| p.swap.iter().any(|(a, b)| a == name || b == name));
+        if r.spec.kind_name() == "depth" {
+            return Err(bad(format!(
+                "[[output]] resource = \"{name}\" is a depth texture, not an output yet; sample it in a pass that writes a texture"
+            )));
+        }
         if r.spec.kind_name() == "sampler" || !(r.written || swapped) {
             return Err(bad(format!(
                 "[[output]] resource = \"{name}\" is not written by any pass (a {}); an output is a texture or buffer a pass writes",

@@ -151,6 +151,7 @@ pub(crate) fn plan_graph(
             ResourceKind::Buffer { file, data, fill, length } => {
                 at.buffer(r, file.as_ref(), data.as_deref(), *fill, length.as_ref())
             }
+            ResourceKind::Depth { size } => at.depth(r, size.as_deref()),
             ResourceKind::Sampler { linear, address, compare } => {
                 let a = |s: &str| vista_gpu::Address::parse(s).expect("manifest checks address modes");
                 Ok(vista_gpu::Resource::Sampler(vista_gpu::SamplerDesc {
@@ -340,6 +341,24 @@ impl Planning<'_> {
         }))
     }
 
+    /// A depth resource: its size (default the case's).
+    fn depth(
+        &self,
+        r: &vista_kernels::graph::ResolvedResource,
+        size: Option<&[vista_kernels::expr::Expr]>,
+    ) -> Result<vista_gpu::Resource, RenderError> {
+        let at = |m: String| self.bad(format!("resource {}: {m}", r.spec.name));
+        let mut wh = [self.width, self.height];
+        for (i, e) in size.unwrap_or_default().iter().enumerate() {
+            let n = e.eval(self.p, self.width, self.height).map_err(|m| at(format!("size[{i}] {m}")))?;
+            wh[i] = u32::try_from(n)
+                .ok()
+                .filter(|n| (1..=16384).contains(n))
+                .ok_or_else(|| at(format!("size[{i}] is {n} for these params; allowed: [1, 16384]")))?;
+        }
+        Ok(vista_gpu::Resource::Depth(wh))
+    }
+
     /// A buffer resource: its header and elements from a file, inline
     /// `data`, or `length` copies of `fill`.
     fn buffer(
@@ -507,6 +526,7 @@ impl Planning<'_> {
                     [((b.len() as u32 - e.header) / e.stride.max(1)).max(1), 1, 1]
                 }
                 vista_gpu::Resource::Sampler(_) => [width, height, 1],
+                vista_gpu::Resource::Depth([w, h]) => [*w, *h, 1],
             }
         };
         Ok(match (&pass.workgroups, &pass.dispatch) {
@@ -631,6 +651,14 @@ impl Planning<'_> {
             let clear = if implicit { Some([0.0; 4]) } else { t.clear };
             targets.push(vista_gpu::RasterTarget { resource: ri, level, layer, clear, clear_once: implicit, blend });
         }
+        if let (Some(name), Some((w, h, first))) = (r.depth.as_ref().and_then(|d| d.resource.as_ref()), &size)
+            && let vista_gpu::Resource::Depth([dw, dh]) = &resources[index(name)]
+            && (dw, dh) != (w, h)
+        {
+            return Err(self.bad(format!(
+                "{label}: depth resource {name} is {dw}x{dh} but {first} is {w}x{h}; a pass's depth and targets share one size"
+            )));
+        }
         let vertex = r.vertex.entry().map(str::to_string);
         let draw = resolved.draws[i].as_ref();
         let buffers: Vec<vista_gpu::VertexBuffer> = draw
@@ -667,6 +695,7 @@ impl Planning<'_> {
             topology: r.topology,
             cull: r.cull,
             depth: r.depth.as_ref().map(|d| vista_gpu::Depth {
+                resource: d.resource.as_ref().map(|n| index(n)),
                 compare: d.compare.to_string(),
                 write: d.write,
                 clear: d.clear,
@@ -786,7 +815,9 @@ impl Planning<'_> {
                     let count = (b.len() as u64 - e.header as u64) / e.stride.max(1) as u64;
                     PlannedKind::Buffer { element: e, count }
                 }
-                vista_gpu::Resource::Sampler(_) => unreachable!("resolve refuses a sampler output"),
+                vista_gpu::Resource::Sampler(_) | vista_gpu::Resource::Depth(_) => {
+                    unreachable!("resolve refuses a sampler or depth output")
+                }
             };
             outputs.push(PlannedOutput {
                 name,
