@@ -1243,6 +1243,16 @@ fn render_k_on(d: &Path, backend: &str, size: &str, set: &str) -> vista_image::I
     vista_image::load(&out).unwrap()
 }
 
+/// Kernel `k` of project `d` rendered on `backend` at `size`, as raw
+/// values; the render must succeed.
+fn render_on(d: &Path, backend: &str, size: &str) -> vista_image::Image {
+    let out = d.join(format!("{backend}-{size}.exr"));
+    let args = ["render", "k", "--size", size, "--backend", backend, "-o", out.to_str().unwrap()];
+    let r = vista_in(Some(d), &[], &args);
+    assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+    vista_image::load(&out).unwrap()
+}
+
 fn render_exr(d: &Path, size: &str, name: &str) -> (Run, PathBuf) {
     let out = d.join(format!("{name}.exr"));
     (vista_in(Some(d), &[], &["render", "k", "--size", size, "-o", out.to_str().unwrap()]), out)
@@ -4799,11 +4809,7 @@ fn copy(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     // 32-bit floats blend where the backend has float32-blendable (all three here).
     let d = kernel_project(&manifest(&add.replace("\"acc\"", "\"image\"")), SHADER);
     for backend in ["lavapipe", "swiftshader", "browser"] {
-        let out = d.path().join(format!("f-{backend}.exr"));
-        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
-        let r = vista_in(Some(d.path()), &[], &args);
-        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
-        assert_eq!(vista_image::load(&out).unwrap().get(2, 3), [1.25; 4], "{backend}: rgba32float blended");
+        assert_eq!(render_on(d.path(), backend, "8x4").get(2, 3), [1.25; 4], "{backend}: rgba32float blended");
     }
     // One mip level drawn while another of the same texture is read.
     let chain = "[[resource]]\nname = \"pyr\"\nkind = \"texture\"\nformat = \"rgba16float\"\nmip_levels = 2\n\
@@ -4839,11 +4845,7 @@ fn copy(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     };
     let d = kernel_project(&manifest(&cube(6)), SHADER);
     for backend in ["lavapipe", "browser"] {
-        let out = d.path().join(format!("c-{backend}.exr"));
-        let args = ["render", "k", "--size", "8x8", "--backend", backend, "-o", out.to_str().unwrap()];
-        let r = vista_in(Some(d.path()), &[], &args);
-        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
-        let img = vista_image::load(&out).unwrap();
+        let img = render_on(d.path(), backend, "8x8");
         for k in 0..6u32 {
             assert_eq!(img.get(3, 8 * k + 5), [0.25 * k as f32; 4], "{backend}: face {k}");
         }
@@ -5082,11 +5084,7 @@ fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
     let d = kernel_project(&manifest(&other), SHADER);
     std::fs::write(d.path().join("shaders/v.wgsl"), OTHER).unwrap();
     for backend in ["lavapipe", "swiftshader", "browser"] {
-        let out = d.path().join(format!("v-{backend}.exr"));
-        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
-        let r = vista_in(Some(d.path()), &[], &args);
-        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
-        let img = vista_image::load(&out).unwrap();
+        let img = render_on(d.path(), backend, "8x4");
         assert_eq!((img.get(1, 2), img.get(6, 2)), ([1.0; 4], [0.0; 4]), "{backend}: another file's vertex entry");
     }
     let manifest_path = d.path().join("kernels/k.toml");
@@ -5253,11 +5251,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let colours: Vec<u8> = (0..4u8).flat_map(|y| (0..8u8).flat_map(move |x| [x, y, 0, 200 + x])).collect();
     vista_image::npy::write_npy(&d.path().join("colours.npy"), "|u1", &[4, 8, 4], &colours).unwrap();
     for backend in ["lavapipe", "swiftshader", "browser"] {
-        let out = d.path().join(format!("{backend}.exr"));
-        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
-        let r = vista_in(Some(d.path()), &[], &args);
-        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
-        let img = vista_image::load(&out).unwrap();
+        let img = render_on(d.path(), backend, "8x4");
         for (x, y) in [(0u32, 0u32), (7, 3), (5, 2)] {
             let want = [id(x, y) as f32, x as f32, y as f32, (200 + x) as f32];
             assert_eq!(img.get(x, y), want, "{backend}: ({x}, {y})");
@@ -5316,13 +5310,8 @@ fn the_render_example_passes_on_every_backend_with_a_copied_binary() {
     assert_eq!(validated.code, 0, "{}{}", validated.stdout, validated.stderr);
     let manifest = std::fs::read_to_string(root.join("golden/manifest.toml")).unwrap();
     assert!(manifest.contains("\"bloom.glow.png\" = "), "the glow has its own golden: {manifest}");
-    let shader = root.join("shaders/bloom.wgsl");
-    let text = std::fs::read_to_string(&shader).unwrap();
-    let from = "return vec4(0.25 * (a + b + c + d), 0.0);";
-    assert_eq!(text.matches(from).count(), 1, "bloom.wgsl's up-sample changed");
-    std::fs::write(&shader, text.replace(from, "return vec4(0.125 * (a + b + c + d), 0.0);")).unwrap();
-    let c = run(&["check", "--case", "bloom"]);
-    assert_eq!(c.code, 1, "{}", c.stdout);
+    let up = "return vec4(0.25 * (a + b + c + d), 0.0);";
+    let c = mutant_fails_check(&bin, &root, "bloom.wgsl", up, &up.replace("0.25", "0.125"), "bloom");
     assert!(c.stdout.contains("output glow:"), "the glow's own verdict names it: {}", c.stdout);
     grass_tips_follow_the_cpu_projection(&bin, &root);
     // mutate reaches a draw's vertex entry: the sway's mutants are run, and killed.
@@ -5347,14 +5336,21 @@ fn the_render_example_passes_on_every_backend_with_a_copied_binary() {
     assert_eq!(b.code, 0, "{}", b.stderr);
     assert!(b.stdout.contains("pass 1 (grass_fragment, grass.wgsl): median"), "{}", b.stdout);
     // (d) A mutant of the wind's amplitude fails check at every time.
-    let shader = root.join("shaders/grass.wgsl");
-    let text = std::fs::read_to_string(&shader).unwrap();
-    let from = "return p + params.wind * vec3(cos(a), 0.0, sin(a));";
-    assert_eq!(text.matches(from).count(), 1, "grass.wgsl's sway changed");
-    std::fs::write(&shader, text.replace(from, "return p + 1.25 * params.wind * vec3(cos(a), 0.0, sin(a));")).unwrap();
-    let c = run(&["check", "--case", "grass-*"]);
-    assert_eq!(c.code, 1, "{}", c.stdout);
+    let sway = "return p + params.wind * vec3(cos(a), 0.0, sin(a));";
+    let c = mutant_fails_check(&bin, &root, "grass.wgsl", sway, &sway.replace("p + ", "p + 1.25 * "), "grass-*");
     assert!(c.stdout.contains("failed: grass-t0, grass-t1, grass-t2"), "{}", c.stdout);
+}
+
+/// `from` (found once in `shaders/<file>`) replaced by `to`: `check --case
+/// <case>` exits 1.
+fn mutant_fails_check(bin: &Path, root: &Path, file: &str, from: &str, to: &str, case: &str) -> Run {
+    let shader = root.join("shaders").join(file);
+    let text = std::fs::read_to_string(&shader).unwrap();
+    assert_eq!(text.matches(from).count(), 1, "{file} changed: {from} is not there once");
+    std::fs::write(&shader, text.replace(from, to)).unwrap();
+    let c = run_in(bin, root, &[], &["check", "--case", case]);
+    assert_eq!(c.code, 1, "{}", c.stdout);
+    c
 }
 
 /// The grass example's wind checked without the GPU's arithmetic (SPEC 17
