@@ -52,36 +52,20 @@ impl Context {
         }
         let mut passes = Vec::new();
         for pass in &g.passes {
-            let key =
-                format!("{}#{}@{}{:?}", pass.shader, g.shaders.source_hash(&pass.shader)?, pass.entry, pass.constants);
-            let cached = b.sources.lock().expect("wgsl cache").get(&key).cloned();
-            let wgsl = match cached {
-                Some(w) => w,
-                None => {
-                    let w = Arc::new(Context::wgsl_source(g.shaders, &pass.shader, &pass.entry, &pass.constants)?);
-                    b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
-                    w
-                }
-            };
-            let vertex_module = match pass.raster.as_ref().and_then(|r| r.vertex_shader.as_ref()) {
-                Some(f) => Some(g.shaders.compose(f)?),
-                None => None,
-            };
-            self.check_features(&pass.shader, [Some(&*g.shaders.compose(&pass.shader)?), vertex_module.as_deref()])?;
+            let (key, wgsl) = self.browser_wgsl(b, g, &pass.shader, &pass.entry, &pass.constants)?;
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
             if let Some(r) = &pass.raster {
                 let adapter = || self.adapter_description();
                 crate::raster::check_blendable(r, &g.resources, &pass.label, self.blends_float32(), &adapter)?;
             }
             // A vertex entry of another file travels as its own WGSL.
-            let vertex_wgsl = match pass.raster.as_ref().and_then(|r| r.vertex_shader.as_ref().zip(r.vertex.as_ref())) {
-                Some((file, vs)) => {
-                    let r = pass.raster.as_ref().expect("a render pass");
-                    Some(Context::wgsl_source(g.shaders, file, vs, &r.vertex_constants)?)
+            let vertex_wgsl = match pass.raster.as_ref() {
+                Some(r @ crate::graph::Raster { vertex_shader: Some(file), vertex: Some(vs), .. }) => {
+                    Some(self.browser_wgsl(b, g, file, vs, &r.vertex_constants)?.1)
                 }
-                None => None,
+                _ => None,
             };
-            let raster = pass.raster.as_ref().map(|r| raster_json(r, vertex_wgsl.as_deref()));
+            let raster = pass.raster.as_ref().map(|r| raster_json(r, vertex_wgsl.as_deref().map(String::as_str)));
             passes.push(json!({
                 "key": key, "label": pass.label, "wgsl": *wgsl, "entry": pass.entry,
                 "workgroups": pass.workgroups, "repeat": pass.repeat, "span": pass.span,
@@ -128,6 +112,27 @@ impl Context {
 
     /// One binding as the page takes it: its bind group layout entry, and
     /// its source (a pass's own bytes, or a resource).
+    /// A composed file's WGSL for Tint, with its cache key: written once
+    /// per engine (a file that needs a feature the browser lacks is
+    /// unsupported, checked then).
+    fn browser_wgsl(
+        &self,
+        b: &BrowserEngine,
+        g: &Graph<'_>,
+        shader: &str,
+        entry: &str,
+        constants: &[(String, f64)],
+    ) -> Result<(String, Arc<String>), GpuError> {
+        let key = format!("{shader}#{}@{entry}{constants:?}", g.shaders.source_hash(shader)?);
+        if let Some(w) = b.sources.lock().expect("wgsl cache").get(&key).cloned() {
+            return Ok((key, w));
+        }
+        self.check_features(shader, [Some(&*g.shaders.compose(shader)?), None])?;
+        let w = Arc::new(Context::wgsl_source(g.shaders, shader, entry, constants)?);
+        b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
+        Ok((key, w))
+    }
+
     fn slot_json(&self, b: &BrowserEngine, g: &Graph<'_>, pass: &GraphPass, s: &GraphSlot) -> Result<Value, GpuError> {
         let b64 = vista_browser::base64;
         let filterable32 = b.features.iter().any(|f| f == "float32-filterable");
