@@ -76,8 +76,7 @@ function vistaChunk(offset, length) {
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
 // another file's; null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear, clear_once (the first run only),
 // blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a
-// buffer or null), index_format (uint32 or uint16), count, instances, topology, cull, depth ({ resource (a depth resource or null: the pass's own
-// depth32float texture), compare, write, clear } or null), blend_constant }. Outputs are read back one after another into vista.out: textures
+// buffer or null), index_format (uint32 or uint16), count, instances, topology, cull, depth ({ resource, compare, write, clear } or null), blend_constant }. Outputs are read back one after another into vista.out: textures
 // unpadded, layers stacked; buffers whole.
 async function pipeline(pass, resources) {
   const targets = pass.raster ? pass.raster.targets.map((t) => ({ format: resources[t.resource].format, blend: t.blend || undefined })) : null;
@@ -241,20 +240,10 @@ async function vistaRun(job) {
               : { view, loadOp: "load", storeOp: "store" };
           });
           const r = pass.raster;
-          // A depth resource, or the pass's own buffer the size of its first target's level.
-          let depthStencilAttachment;
-          if (r.depth) {
-            let depth;
-            if (r.depth.resource !== null && r.depth.resource !== undefined) {
-              depth = made[current[r.depth.resource]];
-            } else {
-              const t0 = r.targets[0];
-              const desc = job.resources[t0.resource];
-              const size = [Math.max(1, desc.width >> t0.level), Math.max(1, desc.height >> t0.level)];
-              depth = d.createTexture({ size, format: "depth32float", usage: GPUTextureUsage.RENDER_ATTACHMENT });
-            }
-            depthStencilAttachment = { view: depth.createView(), depthClearValue: r.depth.clear, depthLoadOp: "clear", depthStoreOp: "store" };
-          }
+          // The depth resource (a pass's own buffer is one the plan adds).
+          const depthStencilAttachment = r.depth && {
+            view: made[current[r.depth.resource]].createView(), depthClearValue: r.depth.clear, depthLoadOp: "clear", depthStoreOp: "store",
+          };
           const rp = encoder.beginRenderPass({ colorAttachments, ...(depthStencilAttachment ? { depthStencilAttachment } : {}) });
           rp.setPipeline(compiled[p].pipeline);
           bindGroups.forEach((group, g) => rp.setBindGroup(g, group));

@@ -308,13 +308,12 @@ pub struct VertexBuffer {
     pub attributes: Vec<(u32, String, u32)>,
 }
 
-/// A render pass's depth test, on a depth32float buffer of the targets'
-/// size that the pass owns (cleared every run).
+/// A render pass's depth test, on a depth resource (cleared every run).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Depth {
-    /// The depth resource tested against; `None`: the pass's own buffer.
-    #[serde(default)]
-    pub resource: Option<usize>,
+    /// The depth resource tested against (a pass's own buffer is one the
+    /// plan adds).
+    pub resource: usize,
     /// WebGPU's comparison name.
     pub compare: String,
     /// Whether passing fragments write their depth.

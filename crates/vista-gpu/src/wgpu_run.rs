@@ -166,17 +166,9 @@ impl Context {
                 let mut encoder = d.create_command_encoder(&Default::default());
                 let stamp_set = stamps.as_ref().map(|s| &s.set);
                 match (&compiled.pipeline, &pass.raster) {
-                    (Pipeline::Render(p), Some(raster)) => encode_draw(
-                        &w.device,
-                        &mut encoder,
-                        p,
-                        &groups,
-                        raster,
-                        &g.resources,
-                        (&made, &current),
-                        first_run,
-                        stamp_set,
-                    ),
+                    (Pipeline::Render(p), Some(raster)) => {
+                        encode_draw(&mut encoder, p, &groups, raster, (&made, &current), first_run, stamp_set)
+                    }
                     (Pipeline::Compute(p), _) => encode_dispatch(&mut encoder, p, &groups, pass.workgroups, stamp_set),
                     (Pipeline::Render(_), None) => unreachable!("render pipelines are made for render passes"),
                 }
@@ -712,8 +704,8 @@ fn bind_groups(
         .collect()
 }
 
-/// A depth resource's texture: cleared by the pass that tests against it,
-/// never filled.
+/// A depth resource's texture (a pass's own depth buffer is one too):
+/// cleared by the pass that tests against it, never filled.
 fn depth_texture(d: &wgpu::Device, [width, height]: [u32; 2]) -> wgpu::Texture {
     d.create_texture(&wgpu::TextureDescriptor {
         label: Some("depth resource"),
@@ -738,17 +730,14 @@ fn stages(pass: &GraphPass, s: &crate::graph::GraphSlot) -> wgpu::ShaderStages {
 }
 
 /// One render pass: each target's view (its level; cleared where it says
-/// so, on the first run only where `clear_once`, else drawn over), the
-/// pass's own depth buffer, the pipeline, its
-/// bind groups, vertex and index buffers, the draw.
-#[allow(clippy::too_many_arguments)]
+/// so, on the first run only where `clear_once`, else drawn over), its
+/// depth resource, the pipeline, its bind groups, vertex and index
+/// buffers, the draw.
 fn encode_draw(
-    d: &wgpu::Device,
     encoder: &mut wgpu::CommandEncoder,
     pipeline: &wgpu::RenderPipeline,
     groups: &[wgpu::BindGroup],
     raster: &Raster,
-    resources: &[Resource],
     (made, current): (&Made, &[usize]),
     first_run: bool,
     stamps: Option<&wgpu::QuerySet>,
@@ -788,29 +777,8 @@ fn encode_draw(
             })
         })
         .collect();
-    let depth_view = raster.depth.as_ref().map(|depth| {
-        if let Some(r) = depth.resource {
-            return made.textures[&current[r]].create_view(&Default::default());
-        }
-        let t = &raster.targets[0];
-        let Resource::Texture(desc) = &resources[t.resource] else { unreachable!("plans check targets") };
-        let size = wgpu::Extent3d {
-            width: (desc.width >> t.level).max(1),
-            height: (desc.height >> t.level).max(1),
-            depth_or_array_layers: 1,
-        };
-        d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("vista depth"),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        })
-        .create_view(&Default::default())
-    });
+    let depth_view =
+        raster.depth.as_ref().map(|d| made.textures[&current[d.resource]].create_view(&Default::default()));
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: None,
         color_attachments: &attachments,

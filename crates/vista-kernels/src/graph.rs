@@ -112,10 +112,7 @@ impl Level {
     /// Reads `name` or `name@level` against the resources; the error says
     /// what is allowed.
     fn parse(text: &str, res: &[ResourceSpec]) -> Result<Level, String> {
-        let names = || {
-            let n: Vec<&str> = res.iter().map(|r| r.name.as_str()).collect();
-            if n.is_empty() { "none".to_string() } else { n.join(", ") }
-        };
+        let names = || names_of(res);
         let (name, level) = match text.split_once('@') {
             Some((n, l)) => (n, Some(l)),
             None => (text, None),
@@ -715,10 +712,7 @@ fn parse_passes(
     fail: &dyn Fn(String) -> ParamError,
 ) -> Result<Vec<PassSpec>, ParamError> {
     let named = |r: &str| res.iter().any(|x| x.name == r);
-    let names = || {
-        let n: Vec<&str> = res.iter().map(|r| r.name.as_str()).collect();
-        if n.is_empty() { "none".to_string() } else { n.join(", ") }
-    };
+    let names = || names_of(res);
     let mut out_passes = Vec::new();
     let raw_passes: Vec<toml::Value> =
         if passes.is_empty() { vec![toml::Value::Table(Default::default())] } else { passes.to_vec() };
@@ -1021,6 +1015,7 @@ fn parse_raster(
     Ok(Some(RasterSpec { vertex, targets, vertices, indices, count, instances, topology, cull, depth }))
 }
 
+/// The resources' names for a message ("none" for none).
 fn names_of(res: &[ResourceSpec]) -> String {
     let n: Vec<&str> = res.iter().map(|r| r.name.as_str()).collect();
     if n.is_empty() { "none".to_string() } else { n.join(", ") }

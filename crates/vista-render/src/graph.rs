@@ -140,7 +140,7 @@ pub(crate) fn plan_graph(
         }
     }
     let at = Planning { root, kernel, p, inputs, width, height };
-    let resources = resolved
+    let mut resources = resolved
         .resources
         .iter()
         .enumerate()
@@ -164,7 +164,7 @@ pub(crate) fn plan_graph(
         .collect::<Result<Vec<_>, _>>()?;
     let mut passes = Vec::new();
     for (i, ((pass, slots), layout)) in g.passes.iter().zip(&resolved.slots).zip(&layouts).enumerate() {
-        let mut planned = at.pass(i, pass, slots, layout, &modules[i], &files[i], &resources, &resolved)?;
+        let mut planned = at.pass(i, pass, slots, layout, &modules[i], &files[i], &mut resources, &resolved)?;
         if let (Some(r), Some((vmodule, vfile))) = (planned.raster.as_mut(), &vertex[i]) {
             // Its own overrides' values (the pass's, for the names it declares).
             let constants = kernel.overrides_in(vmodule, &at.pass_params(pass)?, false);
@@ -221,7 +221,7 @@ impl Planning<'_> {
         mip_levels: u32,
         is_output: bool,
     ) -> Result<vista_gpu::Resource, RenderError> {
-        let (root, p, width, height) = (self.root, self.p, self.width, self.height);
+        let (root, width, height) = (self.root, self.width, self.height);
         let bad = |m: String| self.bad(m);
         let file = self.file_of(&r.spec.name, file);
         let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
@@ -233,11 +233,7 @@ impl Planning<'_> {
             Some(exprs) => {
                 let mut v = [1u32; 3];
                 for (i, e) in exprs.iter().enumerate() {
-                    let n = e.eval(p, width, height).map_err(|m| at(format!("size[{i}] {m}")))?;
-                    v[i] = u32::try_from(n)
-                        .ok()
-                        .filter(|n| (1..=16384).contains(n))
-                        .ok_or_else(|| at(format!("size[{i}] is {n} for these params; allowed: [1, 16384]")))?;
+                    v[i] = self.size_entry(i, e).map_err(at)?;
                 }
                 // A cube's size is its face's edge.
                 Some(if cube { [v[0], v[0], 6] } else { v })
@@ -341,6 +337,15 @@ impl Planning<'_> {
         }))
     }
 
+    /// Entry `i` of a resource's `size` for these params, in [1, 16384].
+    fn size_entry(&self, i: usize, e: &vista_kernels::expr::Expr) -> Result<u32, String> {
+        let n = e.eval(self.p, self.width, self.height).map_err(|m| format!("size[{i}] {m}"))?;
+        u32::try_from(n)
+            .ok()
+            .filter(|n| (1..=16384).contains(n))
+            .ok_or_else(|| format!("size[{i}] is {n} for these params; allowed: [1, 16384]"))
+    }
+
     /// A depth resource: its size (default the case's).
     fn depth(
         &self,
@@ -350,11 +355,7 @@ impl Planning<'_> {
         let at = |m: String| self.bad(format!("resource {}: {m}", r.spec.name));
         let mut wh = [self.width, self.height];
         for (i, e) in size.unwrap_or_default().iter().enumerate() {
-            let n = e.eval(self.p, self.width, self.height).map_err(|m| at(format!("size[{i}] {m}")))?;
-            wh[i] = u32::try_from(n)
-                .ok()
-                .filter(|n| (1..=16384).contains(n))
-                .ok_or_else(|| at(format!("size[{i}] is {n} for these params; allowed: [1, 16384]")))?;
+            wh[i] = self.size_entry(i, e).map_err(at)?;
         }
         Ok(vista_gpu::Resource::Depth(wh))
     }
@@ -426,7 +427,7 @@ impl Planning<'_> {
         layout: &vista_kernels::UniformLayout,
         module: &naga::Module,
         file: &str,
-        resources: &[vista_gpu::Resource],
+        resources: &mut Vec<vista_gpu::Resource>,
         resolved: &vista_kernels::graph::Resolved,
     ) -> Result<vista_gpu::GraphPass, RenderError> {
         let (kernel, width, height) = (self.kernel, self.width, self.height);
@@ -587,7 +588,7 @@ impl Planning<'_> {
         i: usize,
         r: &vista_kernels::graph::RasterSpec,
         label: &str,
-        resources: &[vista_gpu::Resource],
+        resources: &mut Vec<vista_gpu::Resource>,
         resolved: &vista_kernels::graph::Resolved,
         pp: &ParamSet,
     ) -> Result<vista_gpu::Raster, RenderError> {
@@ -682,6 +683,23 @@ impl Planning<'_> {
         let index_u16 = draw.is_some_and(|d| d.index_u16);
         let (count, instances) =
             self.draw_counts(r, label, resources, &buffers, indices.map(|i| (i, index_u16)), pp)?;
+        // The pass's own depth buffer is one more depth resource of its
+        // targets' size: the engines draw every depth test one way, and
+        // make it once per run, not once per draw.
+        let depth = match &r.depth {
+            None => None,
+            Some(d) => {
+                let resource = match &d.resource {
+                    Some(name) => index(name),
+                    None => {
+                        let (w, h, _) = size.clone().expect("a render pass has targets");
+                        resources.push(vista_gpu::Resource::Depth([w, h]));
+                        resources.len() - 1
+                    }
+                };
+                Some(vista_gpu::Depth { resource, compare: d.compare.to_string(), write: d.write, clear: d.clear })
+            }
+        };
         Ok(vista_gpu::Raster {
             targets,
             vertex,
@@ -694,12 +712,7 @@ impl Planning<'_> {
             instances,
             topology: r.topology,
             cull: r.cull,
-            depth: r.depth.as_ref().map(|d| vista_gpu::Depth {
-                resource: d.resource.as_ref().map(|n| index(n)),
-                compare: d.compare.to_string(),
-                write: d.write,
-                clear: d.clear,
-            }),
+            depth,
             blend_constant,
         })
     }
