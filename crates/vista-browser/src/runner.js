@@ -151,7 +151,7 @@ async function vistaRun(job) {
     for (const [ri, r] of job.resources.entries()) {
       if (r.kind === "texture") {
         const size = { width: r.width, height: r.height, depthOrArrayLayers: r.layers };
-        const usage = T.STORAGE_BINDING | T.TEXTURE_BINDING | T.COPY_SRC | T.COPY_DST | (drawn.has(ri) ? T.RENDER_ATTACHMENT : 0);
+        const usage = (r.storable ? T.STORAGE_BINDING : 0) | T.TEXTURE_BINDING | T.COPY_SRC | T.COPY_DST | (drawn.has(ri) ? T.RENDER_ATTACHMENT : 0);
         const texture = d.createTexture({ size, dimension: r.dimension, format: r.format, usage, mipLevelCount: r.mip_levels });
         const rowBytes = r.width * r.texel_bytes;
         if (r.contents) {

@@ -82,7 +82,7 @@ fn job(key: &str, wgsl: &str, u: &[u8], table: &[u32], w: u32, h: u32) -> Value 
     json!({
         "resources": [{
             "kind": "texture", "format": "rgba32float", "dimension": "2d", "width": w, "height": h, "layers": 1,
-            "texel_bytes": 16, "contents": null, "fill": base64(&[0; 16]),
+            "texel_bytes": 16, "storable": true, "contents": null, "fill": base64(&[0; 16]),
         }],
         "passes": [{
             "key": key, "label": "pass 1", "wgsl": wgsl, "entry": "main",

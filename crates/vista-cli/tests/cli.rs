@@ -5221,6 +5221,102 @@ fn two() -> Two {
     }
 }
 
+/// Render targets of the formats engines draw into but core WebGPU does
+/// not store to (SPEC 17, any renderable format): a fragment writes
+/// (0.2, 0.4, 0.8, 0.6) and each format gives back its own rounding of it,
+/// worked by hand from its bit layout, within one step of the channel
+/// (Vulkan lets a driver take either neighbour: lavapipe stores 0.2 as
+/// 204 / 1023, not the nearer 205), on every backend; a later pass
+/// samples the target. rg11b10ufloat asks for rg11b10ufloat-renderable and
+/// a backend without it names it. Bound as a storage texture, such a format
+/// is refused before GPU work.
+fn render_targets_of_packed_and_narrow_formats() {
+    const SHADER: &str = "struct Params { width: u32, height: u32, gain: f32 }
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var drawn: texture_2d<f32>;
+@group(0) @binding(2) var copy: texture_storage_2d<rgba32float, write>;
+
+@fragment
+fn shade() -> @location(0) vec4<f32> {
+    return vec4(0.2, 0.4, 0.8, 0.6) * params.gain;
+}
+
+@compute @workgroup_size(4, 4)
+fn copy_out(@builtin(global_invocation_id) id: vec3<u32>) {
+    textureStore(copy, id.xy, textureLoad(drawn, id.xy, 0));
+}
+";
+    let third = 2.0 / 3.0;
+    // (format, the nearest values, one step of each channel there)
+    let cases: [(&str, [f32; 4], [f32; 4]); 7] = [
+        ("r8unorm", [51.0 / 255.0, 0.0, 0.0, 1.0], [1e-6; 4]),
+        ("rg8unorm", [51.0 / 255.0, 102.0 / 255.0, 0.0, 1.0], [1e-6; 4]),
+        // binary16's nearest values to 0.2 and 0.4, ulps 2^-13 and 2^-12.
+        ("r16float", [0.199951171875, 0.0, 0.0, 1.0], [2f32.powi(-13), 0.0, 0.0, 0.0]),
+        ("rg16float", [0.199951171875, 0.39990234375, 0.0, 1.0], [2f32.powi(-13), 2f32.powi(-12), 0.0, 0.0]),
+        ("bgra8unorm", [51.0 / 255.0, 102.0 / 255.0, 204.0 / 255.0, 153.0 / 255.0], [1e-6; 4]),
+        // 0.2 * 1023 = 204.6, 0.4 * 1023 = 409.2, 0.8 * 1023 = 818.4; 0.6 * 3 = 1.8.
+        (
+            "rgb10a2unorm",
+            [205.0 / 1023.0, 409.0 / 1023.0, 818.0 / 1023.0, third],
+            [1.0 / 1023.0, 1.0 / 1023.0, 1.0 / 1023.0, 0.0],
+        ),
+        // 0.2 = 1.6 / 8: 0.6 * 64 = 38.4 -> 38; 0.4 likewise; 0.8 = 1.6 / 2 with
+        // a 5-bit mantissa: 0.6 * 32 = 19.2 -> 19.
+        (
+            "rg11b10ufloat",
+            [(1.0 + 38.0 / 64.0) / 8.0, (1.0 + 38.0 / 64.0) / 4.0, (1.0 + 19.0 / 32.0) / 2.0, 1.0],
+            [1.0 / 512.0, 1.0 / 256.0, 1.0 / 64.0, 0.0],
+        ),
+    ];
+    let manifest = |format: &str| {
+        format!(
+            "summary = \"formats\"\n[[param]]\nname = \"gain\"\ntype = \"f32\"\nrange = [0, 4]\ndefault = 1.0\n\
+             doc = \"gain\"\n[[resource]]\nname = \"drawn\"\nkind = \"texture\"\nformat = \"{format}\"\n\
+             [[resource]]\nname = \"copy\"\nkind = \"texture\"\nformat = \"rgba32float\"\n\
+             [[pass]]\nkind = \"render\"\nfragment = \"shade\"\ntargets = [{{ resource = \"drawn\" }}]\n\
+             [[pass]]\nentry = \"copy_out\"\n[[output]]\nresource = \"drawn\"\n[[output]]\nresource = \"copy\"\n"
+        )
+    };
+    let mut lacking = Vec::new();
+    for (format, want, step) in cases {
+        let d = kernel_project(&manifest(format), SHADER);
+        for backend in ["lavapipe", "swiftshader", "browser"] {
+            let out = d.path().join(format!("{format}-{backend}.exr"));
+            let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+            let r = vista_in(Some(d.path()), &[], &args);
+            if format == "rg11b10ufloat" && r.code == 1 {
+                assert_rejected(&r, 1, &["an rg11b10ufloat target needs rg11b10ufloat-renderable"]);
+                lacking.push(backend);
+                continue;
+            }
+            assert_eq!(r.code, 0, "{format} on {backend}: {}", r.stderr);
+            for (name, file) in
+                [("drawn", out.clone()), ("copy", d.path().join(format!("{format}-{backend}.copy.exr")))]
+            {
+                let got = vista_image::load(&file).unwrap_or_else(|e| panic!("{format}, {name}: {e}")).get(5, 2);
+                for c in 0..4 {
+                    let off = (got[c] - want[c]).abs();
+                    assert!(
+                        off < 1e-6 || off <= step[c] * 1.0001,
+                        "{format} on {backend}, {name}: {got:?}, want {want:?}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(!lacking.contains(&"lavapipe"), "lavapipe has rg11b10ufloat-renderable");
+    eprintln!("rg11b10ufloat-renderable lacking on: {lacking:?}");
+    // Storage textures keep to core WebGPU's storage formats.
+    let stored = SHADER.replace("texture_storage_2d<rgba32float, write>", "texture_storage_2d<r8unorm, write>");
+    let r = render_k(&manifest("r8unorm").replace("format = \"rgba32float\"", "format = \"r8unorm\""), &stored);
+    assert_rejected(
+        &r,
+        2,
+        &["copy (@group(0) @binding(2), texture_storage_2d<r8unorm, write>) cannot be fed", "core storage formats"],
+    );
+}
+
 /// Integer textures load from raw data (SPEC 17): a `.npy` of the
 /// texture's shape and dtype, its bytes the texels unchanged (u32 ids in
 /// the millions, which no 8- or 16-bit image carries, arrive exact), on
@@ -5487,6 +5583,7 @@ fn main() {
         Gpu a_draw_reads_vertex_buffers_indices_and_depth,
         Gpu shader_features_run_where_the_backend_has_them,
         Gpu integer_textures_load_from_npy,
+        Gpu render_targets_of_packed_and_narrow_formats,
         Gpu the_render_example_passes_on_every_backend_with_a_copied_binary,
         Gpu a_broken_manifest_breaks_only_its_kernel,
         Cpu adapter_is_a_hidden_alias_of_backend,

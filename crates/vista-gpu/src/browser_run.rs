@@ -37,7 +37,8 @@ impl Context {
                     json!({
                         "kind": "texture", "format": t.format, "dimension": t.dimension.texture_name(),
                         "width": t.width, "height": t.height, "layers": t.layers, "mip_levels": t.mip_levels,
-                        "texel_bytes": format.texel_bytes(), "contents": contents, "fill": fill,
+                        "texel_bytes": format.texel_bytes(), "storable": format.is_storable(),
+                        "contents": contents, "fill": fill,
                     })
                 }
                 Resource::Buffer(bytes) => json!({ "kind": "buffer", "size": bytes.len(), "contents": b64(bytes) }),
@@ -56,7 +57,7 @@ impl Context {
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
             if let Some(r) = &pass.raster {
                 let adapter = || self.adapter_description();
-                crate::raster::check_blendable(r, &g.resources, &pass.label, self.blends_float32(), &adapter)?;
+                crate::raster::check_targets(r, &g.resources, &pass.label, &|f| self.has_feature(f), &adapter)?;
             }
             // A vertex entry of another file travels as its own WGSL.
             let vertex_wgsl = match pass.raster.as_ref() {

@@ -351,12 +351,14 @@ impl Context {
         let wanted = specific
             | wgpu::Features::FLOAT32_FILTERABLE
             | wgpu::Features::FLOAT32_BLENDABLE
+            | wgpu::Features::RG11B10UFLOAT_RENDERABLE
             | wgpu::Features::SHADER_F16
             | wgpu::Features::DUAL_SOURCE_BLENDING
             | wgpu::Features::TIMESTAMP_QUERY;
         let required_features = adapter.features() & wanted;
         let read_write = vista_texel::format_names()
             .into_iter()
+            .filter(|name| vista_texel::Format::parse(name).is_ok_and(|f| f.is_storable()))
             .filter(|name| {
                 CORE_READ_WRITE.contains(name)
                     || (required_features.contains(specific)
@@ -654,15 +656,8 @@ impl Context {
     /// A module that needs a shader feature the device lacks (f16,
     /// dual-source blending): unsupported here, naming the feature.
     pub(crate) fn check_features(&self, shader: &str, modules: [Option<&naga::Module>; 2]) -> Result<(), GpuError> {
-        let has = |feature: &str| match &self.engine {
-            Engine::Wgpu(w) => w.device.features().contains(match feature {
-                "shader-f16" => wgpu::Features::SHADER_F16,
-                _ => wgpu::Features::DUAL_SOURCE_BLENDING,
-            }),
-            Engine::Browser(b) => b.features.iter().any(|f| f == feature),
-        };
         for (feature, enable) in modules.into_iter().flatten().flat_map(crate::shaders::features_used) {
-            if !has(feature) {
+            if !self.has_feature(feature) {
                 return Err(GpuError::Unsupported {
                     adapter: self.adapter_description(),
                     what: format!("{shader}: {enable} (enable {enable};)"),
@@ -673,12 +668,18 @@ impl Context {
         Ok(())
     }
 
-    /// Whether this device blends into 32-bit float render targets
-    /// (wgpu's FLOAT32_BLENDABLE, WebGPU's `float32-blendable`).
-    pub(crate) fn blends_float32(&self) -> bool {
+    /// Whether this device has one of the optional features vista asks
+    /// for, by its WebGPU name (`float32-blendable`, `shader-f16`, ...).
+    pub(crate) fn has_feature(&self, feature: &str) -> bool {
         match &self.engine {
-            Engine::Wgpu(w) => w.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE),
-            Engine::Browser(b) => b.features.iter().any(|f| f == "float32-blendable"),
+            Engine::Wgpu(w) => w.device.features().contains(match feature {
+                "shader-f16" => wgpu::Features::SHADER_F16,
+                "dual-source-blending" => wgpu::Features::DUAL_SOURCE_BLENDING,
+                "float32-blendable" => wgpu::Features::FLOAT32_BLENDABLE,
+                "rg11b10ufloat-renderable" => wgpu::Features::RG11B10UFLOAT_RENDERABLE,
+                other => unreachable!("vista asks for no feature {other}"),
+            }),
+            Engine::Browser(b) => b.features.iter().any(|f| f == feature),
         }
     }
 

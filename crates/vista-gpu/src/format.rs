@@ -31,6 +31,13 @@ pub(crate) fn wgpu_format(f: &Format) -> wgpu::TextureFormat {
         S::Rg32Float => T::Rg32Float,
         S::Rg32Uint => T::Rg32Uint,
         S::Rg32Sint => T::Rg32Sint,
+        S::R8Unorm => T::R8Unorm,
+        S::Rg8Unorm => T::Rg8Unorm,
+        S::R16Float => T::R16Float,
+        S::Rg16Float => T::Rg16Float,
+        S::Bgra8Unorm => T::Bgra8Unorm,
+        S::Rgb10a2Unorm => T::Rgb10a2Unorm,
+        S::Rg11b10Ufloat => T::Rg11b10Ufloat,
         other => unreachable!("vista_texel lists no {other:?}"),
     }
 }
@@ -63,6 +70,6 @@ mod tests {
             let w = super::wgpu_format(&super::parse(name).unwrap());
             assert_eq!(format!("{w:?}").to_lowercase(), name, "{name}");
         }
-        assert!(super::parse("bgra8unorm").unwrap_err().to_string().starts_with("output format bgra8unorm"));
+        assert!(super::parse("rgba8unorm-srgb").unwrap_err().to_string().starts_with("output format rgba8unorm-srgb"));
     }
 }

@@ -38,23 +38,28 @@ fn blend_component(c: BlendComponent) -> wgpu::BlendComponent {
     wgpu::BlendComponent { src_factor: factor(c.src), dst_factor: factor(c.dst), operation }
 }
 
-/// A blended 32-bit float target where the backend lacks float32-blendable
-/// (`blendable`): the case is unsupported here, naming the feature.
-pub(crate) fn check_blendable(
+/// Targets that need a feature the backend lacks (`has`, by WebGPU name):
+/// a blended 32-bit float target needs float32-blendable, an rg11b10ufloat
+/// one rg11b10ufloat-renderable. The case is unsupported here, naming it.
+pub(crate) fn check_targets(
     r: &Raster,
     resources: &[Resource],
     label: &str,
-    blendable: bool,
+    has: &dyn Fn(&str) -> bool,
     adapter: &dyn Fn() -> String,
 ) -> Result<(), GpuError> {
     for t in &r.targets {
         let Resource::Texture(desc) = &resources[t.resource] else { continue };
-        if t.blend != vista_texel::Blend::Replace && !blendable && crate::format::parse(desc.format)?.is_float32() {
-            return Err(GpuError::Unsupported {
-                adapter: adapter(),
-                what: format!("{label}: a blended {} target", desc.format),
-                feature: "float32-blendable".into(),
-            });
+        let format = crate::format::parse(desc.format)?;
+        let needs = if desc.format == "rg11b10ufloat" {
+            Some(("rg11b10ufloat-renderable", format!("{label}: an {} target", desc.format)))
+        } else if t.blend != vista_texel::Blend::Replace && format.is_float32() {
+            Some(("float32-blendable", format!("{label}: a blended {} target", desc.format)))
+        } else {
+            None
+        };
+        if let Some((feature, what)) = needs.filter(|(f, _)| !has(f)) {
+            return Err(GpuError::Unsupported { adapter: adapter(), what, feature: feature.into() });
         }
     }
     Ok(())
@@ -187,7 +192,7 @@ mod tests {
     use crate::graph::{Contents, RasterTarget, TextureDesc};
 
     #[test]
-    fn a_blended_float32_target_needs_float32_blendable() {
+    fn targets_name_the_features_they_need() {
         let texture = |format| {
             Resource::Texture(TextureDesc {
                 format,
@@ -215,13 +220,24 @@ mod tests {
             blend_constant: None,
         };
         let adapter = || "test adapter".to_string();
+        let (none, all) = (|_: &str| false, |_: &str| true);
         let f32s = [texture("rgba32float")];
-        let e = check_blendable(&raster(vista_texel::Blend::Additive), &f32s, "pass 1 (add)", false, &adapter);
+        let e = check_targets(&raster(vista_texel::Blend::Additive), &f32s, "pass 1 (add)", &none, &adapter);
         let message = e.unwrap_err().to_string();
         assert!(message.contains("pass 1 (add): a blended rgba32float target needs float32-blendable"), "{message}");
-        assert!(check_blendable(&raster(vista_texel::Blend::Additive), &f32s, "p", true, &adapter).is_ok());
-        assert!(check_blendable(&raster(vista_texel::Blend::Replace), &f32s, "p", false, &adapter).is_ok());
+        assert!(check_targets(&raster(vista_texel::Blend::Additive), &f32s, "p", &all, &adapter).is_ok());
+        assert!(check_targets(&raster(vista_texel::Blend::Replace), &f32s, "p", &none, &adapter).is_ok());
         let f16s = [texture("rgba16float")];
-        assert!(check_blendable(&raster(vista_texel::Blend::Alpha), &f16s, "p", false, &adapter).is_ok());
+        assert!(check_targets(&raster(vista_texel::Blend::Alpha), &f16s, "p", &none, &adapter).is_ok());
+        let packed = [texture("rg11b10ufloat")];
+        let e = check_targets(&raster(vista_texel::Blend::Replace), &packed, "pass 2 (bloom)", &none, &adapter);
+        let message = e.unwrap_err().to_string();
+        assert!(
+            message.contains("pass 2 (bloom): an rg11b10ufloat target needs rg11b10ufloat-renderable"),
+            "{message}"
+        );
+        let only_blendable = |f: &str| f == "float32-blendable";
+        assert!(check_targets(&raster(vista_texel::Blend::Replace), &packed, "p", &only_blendable, &adapter).is_err());
+        assert!(check_targets(&raster(vista_texel::Blend::Additive), &packed, "p", &all, &adapter).is_ok());
     }
 }

@@ -265,8 +265,11 @@ impl Context {
                             sample_count: 1,
                             dimension: crate::format::texture_dimension(t.dimension),
                             format: crate::format::wgpu_format(&format),
-                            usage: wgpu::TextureUsages::STORAGE_BINDING
-                                | wgpu::TextureUsages::TEXTURE_BINDING
+                            usage: if format.is_storable() {
+                                wgpu::TextureUsages::STORAGE_BINDING
+                            } else {
+                                wgpu::TextureUsages::empty()
+                            } | wgpu::TextureUsages::TEXTURE_BINDING
                                 | wgpu::TextureUsages::COPY_SRC
                                 | wgpu::TextureUsages::COPY_DST
                                 | if target {
@@ -469,7 +472,7 @@ impl Context {
         let targets = match &pass.raster {
             Some(r) => {
                 let adapter = || self.adapter_description();
-                crate::raster::check_blendable(r, &g.resources, &pass.label, self.blends_float32(), &adapter)?;
+                crate::raster::check_targets(r, &g.resources, &pass.label, &|f| self.has_feature(f), &adapter)?;
                 Some(crate::raster::color_targets(r, &g.resources, &pass.label)?)
             }
             None => None,

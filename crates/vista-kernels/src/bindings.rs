@@ -90,8 +90,9 @@ pub(crate) fn storage_format(name: &str) -> Result<&'static str, String> {
     })
 }
 
+/// A storage texture's format, where WebGPU's core lets one have it.
 fn format_name(f: naga::StorageFormat) -> Option<&'static str> {
-    vista_texel::Format::of_naga(f).map(|f| f.name)
+    vista_texel::Format::of_naga(f).filter(|f| f.is_storable()).map(|f| f.name)
 }
 
 /// A name as its declaring module spells it, and that module's import
@@ -448,7 +449,10 @@ pub fn reflect_all(
                 };
                 let access = Access::of_naga(*access);
                 let Some(format) = format_name(*format) else {
-                    return Err(unfed("a storage texture of a supported format (not bgra8unorm or a packed one)"));
+                    return Err(unfed(
+                        "a storage texture of one of WebGPU's core storage formats (rgba8unorm .. rg32sint; \
+                         r8unorm, rg11b10ufloat and the like are render targets and sampled textures only)",
+                    ));
                 };
                 let storage = Storage { format, dimension, access };
                 if access == Access::Read { Feed::StorageRead(storage) } else { Feed::Output(storage) }
