@@ -57,7 +57,7 @@ impl Channel {
     }
 
     fn is_packed(self) -> bool {
-        self.bits() % 8 != 0
+        !self.bits().is_multiple_of(8)
     }
 
     /// A packed channel's value from its bits.
