@@ -166,7 +166,7 @@ async function vistaRun(job) {
         made.push(texture);
       } else if (r.kind === "depth") {
         // Cleared by the pass that tests against it; sampled as texture_depth_2d.
-        made.push(d.createTexture({ size: [r.width, r.height], format: "depth32float", usage: T.RENDER_ATTACHMENT | T.TEXTURE_BINDING }));
+        made.push(d.createTexture({ size: [r.width, r.height], format: "depth32float", usage: T.RENDER_ATTACHMENT | T.TEXTURE_BINDING | T.COPY_SRC }));
       } else if (r.kind === "buffer") {
         const bytes = fromBase64(r.contents);
         const buffer = d.createBuffer({ size: Math.max(4, Math.ceil(bytes.length / 4) * 4), usage: B.STORAGE | B.UNIFORM | B.VERTEX | B.INDEX | B.COPY_SRC | B.COPY_DST, mappedAtCreation: true });
@@ -279,13 +279,16 @@ async function vistaRun(job) {
       const encoder = d.createCommandEncoder();
       let readback;
       let unpad = null;
-      if (r.kind === "texture") {
-        const rowBytes = r.width * r.texel_bytes;
+      if (r.kind === "texture" || r.kind === "depth") {
+        // A depth texture's depth aspect reads back as 4-byte floats.
+        const [texelBytes, layers] = r.kind === "depth" ? [4, 1] : [r.texel_bytes, r.layers];
+        const rowBytes = r.width * texelBytes;
         const paddedRow = Math.ceil(rowBytes / 256) * 256;
-        const rows = r.height * r.layers;
+        const rows = r.height * layers;
         readback = d.createBuffer({ size: paddedRow * rows, usage: B.COPY_DST | B.MAP_READ });
-        const size = { width: r.width, height: r.height, depthOrArrayLayers: r.layers };
-        encoder.copyTextureToBuffer({ texture: physical }, { buffer: readback, bytesPerRow: paddedRow, rowsPerImage: r.height }, size);
+        const size = { width: r.width, height: r.height, depthOrArrayLayers: layers };
+        const source = { texture: physical, aspect: r.kind === "depth" ? "depth-only" : "all" };
+        encoder.copyTextureToBuffer(source, { buffer: readback, bytesPerRow: paddedRow, rowsPerImage: r.height }, size);
         unpad = { rowBytes, paddedRow, rows };
       } else {
         const size = Math.max(4, Math.ceil(r.size / 4) * 4);

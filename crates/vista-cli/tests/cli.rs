@@ -5058,6 +5058,10 @@ fn build(@builtin(local_invocation_index) i: u32) {
             depth.iter().all(|d| (d - 0.2).abs() < 1e-6),
             "{backend}: the nearer quad's depth sampled later: {depth:?}"
         );
+        // The depth resource as an output: read back as r32float.
+        let depth_out = render(&shared.replace("resource = \"shown\"\n", "resource = \"scene_depth\"\n"), backend);
+        let d = depth_out.get(3, 2);
+        assert!((d[0] - 0.2).abs() < 1e-6 && d[1..] == [0.0, 0.0, 1.0], "{backend}: the depth output: {d:?}");
         let none = render(&winding("none"), backend);
         assert_eq!((none.get(0, 3), none.get(7, 0)), ([1.0; 4], [1.0; 4]), "{backend}");
         let back = render(&winding("back"), backend);
@@ -5128,7 +5132,6 @@ fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
         (indexed.replace("vertex = \"flat\"", "vertex = \"nope\""), &["has no vertex entry point 'nope'; its vertex entry points: flat, placed, layered"][..]),
         (indexed.replace("vertex = \"flat\"", "vertex = { shader = \"nowhere.wgsl\", entry = \"vs\" }"), &["nowhere.wgsl"][..]),
         (indexed.replace("vertex = \"flat\"", "vertex = { shader = \"k.wgsl\", entry = \"vs\", stage = 1 }"), &["vertex: unknown key stage; allowed: shader, entry"][..]),
-        (shared.replace("resource = \"shown\"\n", "resource = \"scene_depth\"\n"), &["[[output]] resource = \"scene_depth\" is a depth texture, not an output yet"][..]),
         (shared.replace("kind = \"depth\"\n", "kind = \"depth\"\nsize = [4, 4]\n"), &["depth resource scene_depth is 4x4 but image is 8x8"][..]),
         (shared.replace("depth = { resource = \"scene_depth\" }", "depth = { resource = \"image\" }"), &["depth: resource image is a texture; it needs kind = \"depth\""][..]),
         (shared.replace("depth = { resource = \"scene_depth\" }", "depth = { compare = \"less\" }"), &["resource scene_depth is read but no pass writes it"][..]),

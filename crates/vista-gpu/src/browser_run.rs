@@ -87,8 +87,8 @@ impl Context {
         let mut outputs = Vec::new();
         let mut sentinels = Vec::new();
         for (&o, bytes) in g.outputs.iter().zip(out.outputs) {
-            match &g.resources[o] {
-                Resource::Texture(t) => {
+            match g.resources[o].read_as() {
+                Some(t) => {
                     let format = crate::format::parse(t.format)?;
                     let row = t.width as usize * format.texel_bytes();
                     let texels =
@@ -99,7 +99,7 @@ impl Context {
                     });
                     outputs.push(OutputData::Texture { image: texels.image, unwritten: 0 });
                 }
-                _ => {
+                None => {
                     sentinels.push(Vec::new());
                     outputs.push(OutputData::Buffer(bytes));
                 }

@@ -203,6 +203,26 @@ pub enum Resource {
     Depth([u32; 2]),
 }
 
+impl Resource {
+    /// The texture an output of this resource reads back: a depth texture
+    /// is read as r32float (its depth aspect's bytes are those of one).
+    pub fn read_as(&self) -> Option<TextureDesc> {
+        match self {
+            Resource::Texture(t) => Some(t.clone()),
+            Resource::Depth([width, height]) => Some(TextureDesc {
+                format: "r32float",
+                dimension: Dimension::D2,
+                width: *width,
+                height: *height,
+                layers: 1,
+                mip_levels: 1,
+                contents: Contents::Zeros,
+            }),
+            Resource::Buffer(_) | Resource::Sampler(_) => None,
+        }
+    }
+}
+
 /// What feeds one binding of a pass.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Bind {

@@ -550,14 +550,19 @@ impl Context {
                 })
             })
         };
-        let (staging, texture) = match &g.resources[logical] {
-            Resource::Texture(t) => {
+        let read_as = g.resources[logical].read_as();
+        let (staging, texture) = match (&g.resources[logical], &read_as) {
+            (Resource::Texture(_) | Resource::Depth(_), Some(t)) => {
                 let format = crate::format::parse(t.format)?;
                 let padded = padded_row(t, &format);
                 let rows = t.height * t.layers;
                 let staging = staging_of(padded as u64 * rows as u64);
+                let depth = matches!(g.resources[logical], Resource::Depth(_));
                 encoder.copy_texture_to_buffer(
-                    made.textures[&physical].as_image_copy(),
+                    wgpu::TexelCopyTextureInfo {
+                        aspect: if depth { wgpu::TextureAspect::DepthOnly } else { wgpu::TextureAspect::All },
+                        ..made.textures[&physical].as_image_copy()
+                    },
                     wgpu::TexelCopyBufferInfo {
                         buffer: &staging,
                         layout: wgpu::TexelCopyBufferLayout {
@@ -570,15 +575,13 @@ impl Context {
                 );
                 (staging, Some((t, format, padded, rows)))
             }
-            Resource::Buffer(bytes) => {
+            (Resource::Buffer(bytes), _) => {
                 let size = bytes.len().max(4).next_multiple_of(4) as u64;
                 let staging = staging_of(size);
                 encoder.copy_buffer_to_buffer(&made.buffers[&physical], 0, &staging, 0, size);
                 (staging, None)
             }
-            Resource::Sampler(_) | Resource::Depth(_) => {
-                return Err(GpuError::Request("a sampler or depth texture cannot be an output".into()));
-            }
+            _ => return Err(GpuError::Request("a sampler cannot be an output".into())),
         };
         let index = w.queue.submit([encoder.finish()]);
         let (tx, rx) = mpsc::channel();
@@ -717,7 +720,9 @@ fn depth_texture(d: &wgpu::Device, [width, height]: [u32; 2]) -> wgpu::Texture {
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format: wgpu::TextureFormat::Depth32Float,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     })
 }

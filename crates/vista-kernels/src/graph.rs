@@ -2012,11 +2012,6 @@ fn check_swaps_and_outputs(
         };
         let r = &resources[ri];
         let swapped = graph.passes.iter().any(|p| p.swap.iter().any(|(a, b)| a == name || b == name));
-        if r.spec.kind_name() == "depth" {
-            return Err(bad(format!(
-                "[[output]] resource = \"{name}\" is a depth texture, not an output yet; sample it in a pass that writes a texture"
-            )));
-        }
         if r.spec.kind_name() == "sampler" || !(r.written || swapped) {
             return Err(bad(format!(
                 "[[output]] resource = \"{name}\" is not written by any pass (a {}); an output is a texture or buffer a pass writes",

@@ -411,11 +411,8 @@ impl Kernel {
     /// setting; default 1). A kernel's `exposure` param wins, so cases and
     /// sweeps can vary it.
     pub fn display_map_with(&self, p: &ParamSet, view: Output, format: &str, exposure: Option<f64>) -> DisplayMap {
-        let channels = match format {
-            f if f.starts_with("rg32") => 2,
-            f if f.starts_with("r32") => 1,
-            _ => 3,
-        };
+        // Normalized channels: one or two for r and rg formats, else RGB.
+        let channels = vista_texel::Format::parse(format).map_or(3, |f| f.channels().min(3) as u8);
         DisplayMap {
             channels,
             exposure: (view == Output::Hdr).then(|| match p.value("exposure") {

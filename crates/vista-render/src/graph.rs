@@ -71,12 +71,9 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The first output's texture, where it is one.
-    pub fn main_texture(&self) -> Option<&vista_gpu::TextureDesc> {
-        match self.resources.get(*self.output_ids.first()?) {
-            Some(vista_gpu::Resource::Texture(t)) => Some(t),
-            _ => None,
-        }
+    /// The first output's texture as it reads back, where it is one.
+    pub fn main_texture(&self) -> Option<vista_gpu::TextureDesc> {
+        self.resources.get(*self.output_ids.first()?)?.read_as()
     }
 }
 
@@ -818,7 +815,9 @@ impl Planning<'_> {
             let spec = g.outputs.get(i);
             let name = resolved.resources[r].spec.name.clone();
             let kind = match &resources[r] {
-                vista_gpu::Resource::Texture(t) => {
+                vista_gpu::Resource::Texture(_) | vista_gpu::Resource::Depth(_) => {
+                    // A depth output reads back as r32float.
+                    let t = resources[r].read_as().expect("a texture");
                     let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.default_view(t.format));
                     let display = kernel.display_map_with(p, view, t.format, spec.and_then(|o| o.exposure));
                     PlannedKind::Texture { format: t.format, view, display }
@@ -828,9 +827,7 @@ impl Planning<'_> {
                     let count = (b.len() as u64 - e.header as u64) / e.stride.max(1) as u64;
                     PlannedKind::Buffer { element: e, count }
                 }
-                vista_gpu::Resource::Sampler(_) | vista_gpu::Resource::Depth(_) => {
-                    unreachable!("resolve refuses a sampler or depth output")
-                }
+                vista_gpu::Resource::Sampler(_) => unreachable!("resolve refuses a sampler output"),
             };
             outputs.push(PlannedOutput {
                 name,
