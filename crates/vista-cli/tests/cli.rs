@@ -5069,10 +5069,13 @@ fn build(@builtin(local_invocation_index) i: u32) {
         let front = render(&winding("front"), backend);
         assert_eq!((front.get(0, 3), front.get(7, 0)), ([0.0; 4], [1.0; 4]), "{backend}: front faces culled");
     }
-    // A vertex entry of another file, binding only what the fragment entry binds.
+    // A vertex entry of another file: what both entries bind is shared; what
+    // only it binds (a storage buffer, a uniform buffer resource) is its own.
     const OTHER: &str = "struct Params { width: u32, height: u32, gain: f32 }
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(3) var<uniform> extra: vec4<f32>;
+@group(0) @binding(4) var<storage, read> offsets: array<vec2<f32>>;
+@group(2) @binding(0) var<uniform> nudge: vec4<f32>;
 
 @vertex
 fn lifted(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
@@ -5083,23 +5086,54 @@ fn lifted(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
 fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
     return vec4(p * min(params.gain, 1.0) + extra.xy, 0.5, 1.0);
 }
+
+@vertex
+fn shifted(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
+    return vec4(p * min(params.gain, 1.0) + offsets[0] + nudge.xy, 0.5, 1.0);
+}
 ";
     let other = indexed.replace("vertex = \"flat\"", "vertex = { shader = \"v.wgsl\", entry = \"lifted\" }");
+    // The quad moved right by 1 (offsets) and by 0 (nudge), both from resources.
+    let shifted = format!(
+        "[[resource]]\nname = \"offsets\"\nkind = \"buffer\"\ndata = [1, 0]\n\
+         [[resource]]\nname = \"zero\"\nkind = \"buffer\"\ndata = [0, 0, 0, 0]\n{}bind = {{ nudge = \"zero\" }}\n",
+        other.replace("lifted", "shifted")
+    );
     let d = kernel_project(&manifest(&other), SHADER);
     std::fs::write(d.path().join("shaders/v.wgsl"), OTHER).unwrap();
+    let manifest_path = d.path().join("kernels/k.toml");
     for backend in ["lavapipe", "swiftshader", "browser"] {
+        std::fs::write(&manifest_path, manifest(&other)).unwrap();
         let img = render_on(d.path(), backend, "8x4");
         assert_eq!((img.get(1, 2), img.get(6, 2)), ([1.0; 4], [0.0; 4]), "{backend}: another file's vertex entry");
+        std::fs::write(&manifest_path, manifest(&shifted)).unwrap();
+        let img = render_on(d.path(), backend, "8x4");
+        assert_eq!((img.get(1, 2), img.get(6, 2)), ([0.0; 4], [1.0; 4]), "{backend}: the vertex file's own buffers");
     }
-    let manifest_path = d.path().join("kernels/k.toml");
-    std::fs::write(&manifest_path, manifest(&other.replace("lifted", "greedy"))).unwrap();
-    let out = d.path().join("g.exr");
-    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x4", "-o", out.to_str().unwrap()]);
-    assert_rejected(
-        &r,
-        2,
-        &["the vertex entry in v.wgsl binds extra (@group(0) @binding(3)", "which the fragment entry does not"],
-    );
+    // Its own uniform would need params of a second layout: refused, as is
+    // a binding the fragment entry holds for another variable.
+    let clash = "@group(0) @binding(0) var<uniform> extra: vec4<f32>;
+@vertex
+fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
+    return vec4(p + extra.xy, 0.5, 1.0);
+}
+";
+    for (text, entry, needles) in [
+        (OTHER.to_string(), "greedy", &["binds extra (@group(0) @binding(3)), which params would fill"][..]),
+        (
+            clash.to_string(),
+            "greedy",
+            &[
+                "@group(0) @binding(0) is params (var<uniform> Params) in the fragment entry but extra (var<uniform> vec4<f32>)",
+            ][..],
+        ),
+    ] {
+        std::fs::write(d.path().join("shaders/v.wgsl"), text).unwrap();
+        std::fs::write(&manifest_path, manifest(&other.replace("lifted", entry))).unwrap();
+        let out = d.path().join("g.exr");
+        let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x4", "-o", out.to_str().unwrap()]);
+        assert_rejected(&r, 2, needles);
+    }
     // Blend factors with a constant: 0.25 * 1 + 0.5 (the clear) = 0.75.
     let constant = "[[resource]]\nname = \"acc\"\nkind = \"texture\"\nformat = \"rgba16float\"\n\
                     [[pass]]\nkind = \"render\"\nfragment = \"fill\"\ntargets = [{ resource = \"acc\", clear = [0.5, 0.5, 0.5, 0.5], \

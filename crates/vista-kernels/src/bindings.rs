@@ -57,6 +57,8 @@ pub struct Binding {
     /// vertex stage as well as the fragment stage).
     pub vertex: bool,
     pub(crate) global: Handle<naga::GlobalVariable>,
+    /// `global` is a variable of the pass's vertex file, not its shader.
+    pub(crate) in_vertex_file: bool,
 }
 
 /// A storage texture binding as WGSL declares it.
@@ -261,10 +263,11 @@ pub fn merge_stages(
 }
 
 /// A render pass's bindings when its vertex entry lives in another file
-/// (`file`, module `vmodule`): that entry may bind only what the fragment
-/// entry binds, the same name and type at the same group and binding (its
-/// own uniforms would need a layout of their own), which become visible to
-/// the vertex stage.
+/// (`file`, module `vmodule`): what both bind must be the same name and
+/// type at the same group and binding, and becomes visible to the vertex
+/// stage; what only the vertex entry binds joins the pass's bindings,
+/// read from its own module (a uniform that params would fill is refused
+/// later, since the pass's uniform layout is its shader's).
 pub fn match_vertex_file(
     kernel: &str,
     mut fragment: Vec<Binding>,
@@ -275,25 +278,25 @@ pub fn match_vertex_file(
 ) -> Result<Vec<Binding>, ParamError> {
     for v in vertex {
         let vtype = wgsl_type(vmodule, &vmodule.global_variables[v.global]);
-        let same = fragment.iter_mut().find(|f| {
-            (f.group, f.binding, &f.name) == (v.group, v.binding, &v.name)
-                && wgsl_type(module, &module.global_variables[f.global]) == vtype
-        });
-        match same {
-            Some(f) => f.vertex = true,
-            None => {
+        match fragment.iter_mut().find(|f| (f.group, f.binding) == (v.group, v.binding)) {
+            Some(f) if f.name == v.name && wgsl_type(module, &module.global_variables[f.global]) == vtype => {
+                f.vertex = true
+            }
+            Some(f) => {
+                let ftype = wgsl_type(module, &module.global_variables[f.global]);
                 return Err(ParamError::Layout {
                     kernel: kernel.to_string(),
                     message: format!(
-                        "the vertex entry in {file} binds {} (@group({}) @binding({}), {vtype}), which the fragment \
-                         entry does not; a vertex entry of another file may bind only what the fragment entry binds \
-                         (or move it into the pass's shader)",
-                        v.name, v.group, v.binding
+                        "@group({}) @binding({}) is {} ({ftype}) in the fragment entry but {} ({vtype}) in the vertex \
+                         entry in {file}; one render pipeline has one binding there",
+                        v.group, v.binding, f.name, v.name
                     ),
                 });
             }
+            None => fragment.push(Binding { vertex: true, in_vertex_file: true, ..v }),
         }
     }
+    fragment.sort_by_key(|b| (b.group, b.binding));
     Ok(fragment)
 }
 
@@ -336,10 +339,10 @@ pub fn wgsl_type(module: &naga::Module, var: &naga::GlobalVariable) -> String {
         }
         TypeInner::Sampler { comparison: true } => "sampler_comparison".into(),
         TypeInner::Sampler { comparison: false } => "sampler".into(),
-        _ => ty
-            .name
-            .clone()
-            .unwrap_or_else(|| format!("{:?}", ty.inner).split([' ', '{', '(']).next().unwrap_or("?").to_lowercase()),
+        _ => {
+            use naga::common::wgsl::TypeContext;
+            module.to_ctx().type_to_string(var.ty)
+        }
     };
     match var.space {
         AddressSpace::Uniform => format!("var<uniform> {inner}"),
@@ -483,6 +486,7 @@ pub fn reflect_all(
             feed,
             vertex: stage == naga::ShaderStage::Vertex,
             global: g,
+            in_vertex_file: false,
         });
     }
     out.sort_by_key(|b| (b.group, b.binding));

@@ -176,8 +176,8 @@ pub enum VertexStage {
     /// A `@vertex` entry of the pass's shader.
     Entry(String),
     /// `{ shader = "other.wgsl", entry = "vs" }`: an entry of another file,
-    /// composed with the pass's defs and source keys; it may bind only what
-    /// the fragment entry binds.
+    /// composed with the pass's defs and source keys; what both entries bind
+    /// must agree, and params fill only the pass shader's uniforms.
     File {
         /// The kernel file (relative to `shaders/`).
         shader: String,
@@ -1439,13 +1439,20 @@ pub fn resolve(
     let mut all_slots = Vec::new();
     for (i, ((shader, bindings, module), pass)) in passes.iter().zip(&graph.passes).enumerate() {
         let label = format!("pass {} ({})", i + 1, pass.entry);
+        // A binding only a vertex file declares is a variable of its module.
+        let vertex_module = vertex_modules.get(i).copied().flatten();
+        let module_of = |b: &Binding| match (b.in_vertex_file, vertex_module) {
+            (true, Some(v)) => v,
+            _ => *module,
+        };
         let describe = |b: &Binding| {
+            let m = module_of(b);
             format!(
                 "{} (@group({}) @binding({}), {})",
                 b.name,
                 b.group,
                 b.binding,
-                crate::bindings::wgsl_type(module, &module.global_variables[b.global])
+                crate::bindings::wgsl_type(m, &m.global_variables[b.global])
             )
         };
         check_bind_declared(pass, shader, bindings, module, &label, &bad)?;
@@ -1518,7 +1525,7 @@ pub fn resolve(
                     SlotFeed::Resource(ri, Usage::Sampler { comparison })
                 }
             };
-            let element = buffer_element(&feed, module, b, &mut resources, &label, &describe(b), &bad)?;
+            let element = buffer_element(&feed, module_of(b), b, &mut resources, &label, &describe(b), &bad)?;
             slots.push(PassSlot {
                 group: b.group,
                 binding: b.binding,
@@ -1778,10 +1785,11 @@ fn check_bind_declared(
     bad: &dyn Fn(String) -> ParamError,
 ) -> Result<(), ParamError> {
     for (var, _) in &pass.bind {
-        let declared = module
-            .global_variables
-            .iter()
-            .any(|(_, g)| g.name.as_deref().map(|n| crate::bindings::undecorate(n).0).as_deref() == Some(var));
+        let declared = bindings.iter().any(|b| &b.name == var)
+            || module
+                .global_variables
+                .iter()
+                .any(|(_, g)| g.name.as_deref().map(|n| crate::bindings::undecorate(n).0).as_deref() == Some(var));
         if !declared {
             let reached: Vec<&str> = bindings.iter().map(|b| b.name.as_str()).collect();
             return Err(bad(format!(

@@ -713,15 +713,26 @@ impl Kernel {
         let mut layouts = Vec::new();
         for (((shader, module), bindings), slots) in modules.iter().zip(reflected).zip(&resolved.slots) {
             // Params feed the uniforms and the table that no resource feeds.
-            let fed: Vec<bindings::Binding> = bindings
-                .into_iter()
-                .filter(|b| {
-                    slots.iter().any(|s| {
-                        (s.group, s.binding) == (b.group, b.binding)
-                            && matches!(s.feed, graph::SlotFeed::Uniform(_) | graph::SlotFeed::Table)
-                    })
+            let by_params = |b: &bindings::Binding| {
+                slots.iter().any(|s| {
+                    (s.group, s.binding) == (b.group, b.binding)
+                        && matches!(s.feed, graph::SlotFeed::Uniform(_) | graph::SlotFeed::Table)
                 })
-                .collect();
+            };
+            // The pass's uniform layout is its shader's: a vertex file's own
+            // uniform must come from a buffer resource.
+            if let Some(b) = bindings.iter().find(|b| b.in_vertex_file && by_params(b)) {
+                return Err(ParamError::Layout {
+                    kernel: self.name().to_string(),
+                    message: format!(
+                        "{shader}: the vertex entry's file binds {} (@group({}) @binding({})), which params would \
+                         fill, but the fragment entry does not; declare it in the pass's shader too, or bind it to \
+                         a buffer resource in the pass's bind",
+                        b.name, b.group, b.binding
+                    ),
+                });
+            }
+            let fed: Vec<bindings::Binding> = bindings.iter().filter(|b| by_params(b)).cloned().collect();
             layouts.push((*shader, layout::blocks_of(self.name(), shader, module, fed)?));
         }
         // As for one pass: a group that names no struct field first.

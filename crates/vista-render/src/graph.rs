@@ -77,6 +77,17 @@ impl Plan {
     }
 }
 
+/// What one pass is planned from: its resolved slots and uniform layout,
+/// its composed shader file and module, and its vertex entry's where that
+/// lives in another file.
+struct PassParts<'a> {
+    slots: &'a [vista_kernels::graph::PassSlot],
+    layout: &'a vista_kernels::UniformLayout,
+    module: &'a naga::Module,
+    file: &'a str,
+    vertex: Option<(&'a naga::Module, &'a str)>,
+}
+
 /// Case-level replacements of resource files (`inputs = { name = "file" }`).
 pub type Inputs = [(String, String)];
 
@@ -161,14 +172,14 @@ pub(crate) fn plan_graph(
         .collect::<Result<Vec<_>, _>>()?;
     let mut passes = Vec::new();
     for (i, ((pass, slots), layout)) in g.passes.iter().zip(&resolved.slots).zip(&layouts).enumerate() {
-        let mut planned = at.pass(i, pass, slots, layout, &modules[i], &files[i], &mut resources, &resolved)?;
-        if let (Some(r), Some((vmodule, vfile))) = (planned.raster.as_mut(), &vertex[i]) {
-            // Its own overrides' values (the pass's, for the names it declares).
-            let constants = kernel.overrides_in(vmodule, &at.pass_params(pass)?, false);
-            r.vertex_shader = Some(vfile.clone());
-            r.vertex_constants = constants.map_err(|e| RenderError::BadInput(e.to_string()))?;
-        }
-        passes.push(planned);
+        let parts = PassParts {
+            slots,
+            layout,
+            module: &modules[i],
+            file: &files[i],
+            vertex: vertex[i].as_ref().map(|(m, f)| (&**m, f.as_str())),
+        };
+        passes.push(at.pass(i, pass, parts, &mut resources, &resolved)?);
     }
     for (_, vfile) in vertex.iter().flatten() {
         if !files.contains(vfile) {
@@ -240,52 +251,12 @@ impl Planning<'_> {
         let (format, contents) = match &file {
             Some(f) if f.ends_with(".npy") => {
                 let (format, [fw, fh], bytes) = read_texture_npy(root, f, r.format).map_err(at)?;
-                let layers = extent.map(|e| e[2]).unwrap_or(1);
-                if let Some(e) = extent
-                    && (fw != e[0] || fh != e[1] * layers)
-                {
-                    return Err(at(format!(
-                        "file {f} is {fw}x{fh} but size says {}x{} ({layers} layers stacked)",
-                        e[0],
-                        e[1] * layers
-                    )));
-                }
-                if cube && extent.is_none() && fh == 6 * fw {
-                    extent = Some([fw, fw, 6]);
-                }
-                extent.get_or_insert([fw, fh, 1]);
+                extent = Some(file_extent(f, [fw, fh], extent, cube).map_err(at)?);
                 (format, Contents::Bytes(bytes))
             }
             Some(f) => {
                 let (natural, image) = read_texture(root, f).map_err(at)?;
-                let layers = extent.map(|e| e[2]).unwrap_or(1);
-                let want_h = extent.map(|e| e[1] * layers);
-                if let Some(e) = extent
-                    && (image.width != e[0] || Some(image.height) != want_h)
-                {
-                    return Err(at(format!(
-                        "file {f} is {}x{} but size says {}x{}{}",
-                        image.width,
-                        image.height,
-                        e[0],
-                        e[1],
-                        if layers > 1 {
-                            format!(" x {layers} layers stacked ({}x{})", e[0], e[1] * layers)
-                        } else {
-                            String::new()
-                        }
-                    )));
-                }
-                if cube && extent.is_none() {
-                    if image.height != 6 * image.width {
-                        return Err(at(format!(
-                            "file {f} is {}x{}; a cube's six square faces stack to W x 6W (or give size = [W])",
-                            image.width, image.height
-                        )));
-                    }
-                    extent = Some([image.width, image.width, 6]);
-                }
-                extent.get_or_insert([image.width, image.height, 1]);
+                extent = Some(file_extent(f, [image.width, image.height], extent, cube).map_err(at)?);
                 if let Some((x, y)) = image.first_nonfinite() {
                     return Err(at(format!("file {f} holds NaN/Inf at ({x}, {y}); inputs must be finite")));
                 }
@@ -415,18 +386,15 @@ impl Planning<'_> {
 
     /// Pass `i`: its constants, workgroup size and count, bindings (its
     /// own uniform blocks and table, or resources), repeats and swaps.
-    #[allow(clippy::too_many_arguments)]
     fn pass(
         &self,
         i: usize,
         pass: &vista_kernels::graph::PassSpec,
-        slots: &[vista_kernels::graph::PassSlot],
-        layout: &vista_kernels::UniformLayout,
-        module: &naga::Module,
-        file: &str,
+        parts: PassParts<'_>,
         resources: &mut Vec<vista_gpu::Resource>,
         resolved: &vista_kernels::graph::Resolved,
     ) -> Result<vista_gpu::GraphPass, RenderError> {
+        let PassParts { slots, layout, module, file, vertex } = parts;
         let (kernel, width, height) = (self.kernel, self.width, self.height);
         let g = kernel.graph();
         let bad = |m: String| self.bad(m);
@@ -463,7 +431,16 @@ impl Planning<'_> {
         }
         let (size, workgroups, raster) = match &pass.raster {
             // A render pass draws; it dispatches nothing.
-            Some(r) => ([1; 3], [1; 3], Some(self.raster(i, r, &label, resources, resolved, &pp)?)),
+            Some(r) => {
+                let mut raster = self.raster(i, r, &label, resources, resolved, &pp)?;
+                if let Some((vmodule, vfile)) = vertex {
+                    // Its own overrides' values (the pass's, for the names it declares).
+                    raster.vertex_shader = Some(vfile.to_string());
+                    raster.vertex_constants =
+                        kernel.overrides_in(vmodule, &pp, false).map_err(|e| RenderError::BadInput(e.to_string()))?;
+                }
+                ([1; 3], [1; 3], Some(raster))
+            }
             None => {
                 let size = crate::reflect::workgroup_size(module, &pass.entry, &constants)
                     .map_err(|e| bad(format!("{label}: {e}")))?;
@@ -902,6 +879,26 @@ fn read_texture_npy(
     Ok((format.name, [w, h], n.data))
 }
 
+/// A texture file's extent: the `size` given (which the file, its layers
+/// stacked top to bottom, must match), else a cube's six stacked faces
+/// (W x 6W), else the file's own width and height.
+fn file_extent(file: &str, [fw, fh]: [u32; 2], size: Option<[u32; 3]>, cube: bool) -> Result<[u32; 3], String> {
+    match size {
+        Some(e) if fw != e[0] || fh != e[1] * e[2] => Err(format!(
+            "file {file} is {fw}x{fh} but size says {}x{}{}",
+            e[0],
+            e[1],
+            if e[2] > 1 { format!(" x {} layers stacked ({}x{})", e[2], e[0], e[1] * e[2]) } else { String::new() }
+        )),
+        Some(e) => Ok(e),
+        None if cube && fh != 6 * fw => {
+            Err(format!("file {file} is {fw}x{fh}; a cube's six square faces stack to W x 6W (or give size = [W])"))
+        }
+        None if cube => Ok([fw, fw, 6]),
+        None => Ok([fw, fh, 1]),
+    }
+}
+
 fn under(root: Option<&Path>, file: &str) -> Result<PathBuf, String> {
     let root = root.ok_or_else(|| format!("file {file} needs a project root (vista.toml) to be found under"))?;
     Ok(root.join(file))
@@ -1059,6 +1056,20 @@ pub fn npy_dtype(e: &Element) -> (String, Vec<u64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// PNG, EXR and .npy files take one rule for their extent.
+    #[test]
+    fn a_files_extent_is_its_size_its_cube_or_its_own() {
+        assert_eq!(file_extent("a.npy", [4, 24], None, true), Ok([4, 4, 6]));
+        assert_eq!(file_extent("a.npy", [4, 24], None, false), Ok([4, 24, 1]));
+        assert_eq!(file_extent("a.npy", [4, 12], Some([4, 4, 3]), false), Ok([4, 4, 3]));
+        let e = file_extent("a.npy", [4, 20], None, true).unwrap_err();
+        assert!(e.contains("file a.npy is 4x20; a cube's six square faces stack to W x 6W"), "{e}");
+        let e = file_extent("a.png", [4, 12], Some([4, 4, 2]), false).unwrap_err();
+        assert_eq!(e, "file a.png is 4x12 but size says 4x4 x 2 layers stacked (4x8)");
+        let e = file_extent("a.png", [8, 8], Some([4, 4, 1]), false).unwrap_err();
+        assert_eq!(e, "file a.png is 8x8 but size says 4x4");
+    }
 
     #[test]
     fn u16_indices_are_two_byte_leaves() {
