@@ -1,5 +1,9 @@
 //! `vista bench`: median kernel throughput after a warm-up run, optionally
-//! beside the f32 CPU reference on all cores.
+//! beside the f32 CPU reference on all cores; or, with `--open-report`, how
+//! long a report's index.html takes to open in headless Chromium.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use vista_golden::GoldenError;
 use vista_project::Project;
@@ -11,7 +15,8 @@ use crate::{bad, parse_sets};
 #[derive(clap::Args)]
 pub struct Args {
     /// The kernel's name.
-    pub kernel: String,
+    #[arg(required_unless_present = "open_report")]
+    pub kernel: Option<String>,
     /// A preset of the kernel.
     #[arg(long)]
     pub preset: Option<String>,
@@ -31,14 +36,24 @@ pub struct Args {
     /// (median of up to 3 runs) and print the CPU / GPU ratio.
     #[arg(long)]
     pub cpu: bool,
+    /// Instead of a kernel: open DIR/index.html (a `check` report) in
+    /// headless Chromium `--runs` times and report the median time to its
+    /// load event, over the DevTools protocol.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["kernel", "preset", "set", "cpu"])]
+    pub open_report: Option<PathBuf>,
 }
 
 pub fn bench(project: &Project, config: &vista::Config, a: Args) -> Result<i32, GoldenError> {
-    let Args { kernel, preset, set, size, runs, json, cpu } = a;
-    let (kernel, preset, set, size) = (kernel.as_str(), preset.as_deref(), set.as_slice(), size.as_str());
+    let Args { kernel, preset, set, size, runs, json, cpu, open_report } = a;
     if !(1..=1000).contains(&runs) {
         return Err(bad(format!("--runs {runs} is out of range; allowed: [1, 1000]")));
     }
+    let kernel = match (open_report, kernel) {
+        (Some(dir), _) => return open_report_page(&dir, runs, json),
+        (None, Some(k)) => k,
+        (None, None) => return Err(bad("give a kernel to bench, or --open-report DIR")),
+    };
+    let (kernel, preset, set, size) = (kernel.as_str(), preset.as_deref(), set.as_slice(), size.as_str());
     let k = crate::registry(project)?.find(kernel).cloned().map_err(bad)?;
     let p = k.resolve(preset, &parse_sets(set)?).map_err(bad)?;
     let (w, h) = vista_kernels::parse_size(size).map_err(bad)?;
@@ -146,6 +161,63 @@ pub fn bench(project: &Project, config: &vista::Config, a: Args) -> Result<i32, 
         if let (Some(ms), Some(threads), Some(ratio)) = (r.cpu_f32_ms, r.cpu_threads, r.cpu_over_gpu) {
             println!("f32 CPU reference on {threads} threads: {ms:.2} ms = {ratio:.2}x the GPU time");
         }
+    }
+    Ok(0)
+}
+
+/// `--open-report DIR`: DIR/index.html opened `runs` times in headless
+/// Chromium (a blank page between), each timed from the navigation to the
+/// load event; then what the page holds, as the reader sees it.
+fn open_report_page(dir: &Path, runs: u32, json: bool) -> Result<i32, GoldenError> {
+    let index = dir.join("index.html");
+    let bytes = std::fs::metadata(&index).map(|m| m.len()).map_err(|e| {
+        bad(format!(
+            "--open-report {}: no index.html there ({e}); give a report folder (check --report-dir)",
+            dir.display()
+        ))
+    })?;
+    let url = format!("file://{}", std::path::absolute(&index).unwrap_or(index.clone()).display());
+    let config = vista_browser::BrowserConfig::from_lookup(&|k| std::env::var_os(k));
+    let failed = |e: String| GoldenError::Rejected(format!("--open-report: {e}"));
+    let chromium = vista_browser::find_chromium(&config).map_err(|e| failed(e.to_string()))?;
+    let wait = Duration::from_secs(120);
+    let page = vista_browser::cdp::Chromium::launch(&chromium, &["--window-size=1400,1000"], wait).map_err(failed)?;
+    let mut times = Vec::new();
+    for _ in 0..runs {
+        page.navigate("about:blank", wait).map_err(|e| failed(e.to_string()))?;
+        let start = Instant::now();
+        page.navigate(&url, wait).map_err(|e| failed(format!("{}: {e}", index.display())))?;
+        times.push(start.elapsed());
+    }
+    // Cases and images as loaded: lazy thumbnails below the fold wait.
+    let facts = page
+        .evaluate(
+            "(() => { const im = [...document.images]; return { cases: document.querySelectorAll('[id^=\"case-\"]').length, \
+             images: im.length, lazy: im.filter((i) => i.loading === 'lazy').length, \
+             loaded: im.filter((i) => i.complete && i.naturalWidth > 0).length }; })()",
+            wait,
+        )
+        .map_err(|e| failed(e.to_string()))?;
+    let median_ms = vista_render::median(times).as_secs_f64() * 1e3;
+    let version = page.version(wait).unwrap_or_default();
+    let n = |k: &str| facts[k].as_u64().unwrap_or(0);
+    if json {
+        let out = serde_json::json!({
+            "report": index, "bytes": bytes, "runs": runs, "load_median_ms": median_ms, "browser": version,
+            "cases": n("cases"), "images": n("images"), "lazy_images": n("lazy"), "images_loaded": n("loaded"),
+        });
+        println!("{out}");
+    } else {
+        println!(
+            "{} ({:.1} MB, {} cases, {} images of which {} lazy, {} loaded): load event after median {median_ms:.0} ms \
+             over {runs} runs in headless {version}",
+            index.display(),
+            bytes as f64 / 1e6,
+            n("cases"),
+            n("images"),
+            n("lazy"),
+            n("loaded")
+        );
     }
     Ok(0)
 }

@@ -3446,6 +3446,23 @@ fn the_report_works_in_a_real_browser() {
     shot("report-missing.png");
     let errors = page.errors();
     assert!(errors.is_empty(), "console errors: {errors:?}");
+    // `vista bench --open-report` times the same page over the DevTools
+    // protocol (issue 55's 2 s target for a large suite's index.html).
+    let report = root.join("target/vista-report");
+    let r = vista_in(Some(&root), &[], &["bench", "--open-report", report.to_str().unwrap(), "--runs", "2", "--json"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let got: serde_json::Value = serde_json::from_str(r.stdout.trim()).unwrap_or_else(|e| panic!("{e}: {}", r.stdout));
+    let cases = eval("document.querySelectorAll('[id^=\"case-\"]').length");
+    assert_eq!(got["cases"], cases, "{got}");
+    assert!(got["cases"].as_u64() >= Some(3) && got["images"].as_u64() >= Some(1), "{got}");
+    let ms = got["load_median_ms"].as_f64().unwrap();
+    assert!(ms > 0.0 && got["runs"] == 2 && got["bytes"].as_u64() > Some(1000), "{got}");
+    assert_rejected(
+        &vista_in(Some(&root), &[], &["bench", "--open-report", root.join("golden").to_str().unwrap()]),
+        2,
+        &["--open-report", "no index.html there"],
+    );
+    assert_rejected(&vista_in(Some(&root), &[], &["bench"]), 2, &["required arguments were not provided"]);
 }
 
 // ---- examples/graphs: pass graphs (SPEC 14 part 2) -------------------------

@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use vista_image::Image;
 
 use crate::GpuError;
+use crate::wire;
 use vista_texel::{Access, Dimension};
 
 use crate::context::{Context, Engine, RunStats};
@@ -26,44 +27,6 @@ pub enum Contents {
     /// The sentinel texel: an output no pass reads, so a texel still
     /// holding it afterwards was never written.
     Sentinel,
-}
-
-/// Byte and word lists cross a worker's pipe as base64 text: as JSON
-/// numbers, each pass's uniforms and noise table were a third of a small
-/// case's own time (printing and parsing integers).
-mod wire {
-    use base64::Engine;
-    use base64::engine::general_purpose::STANDARD;
-    use serde::{Deserialize, Deserializer, Serializer, de::Error};
-
-    pub mod bytes {
-        use super::*;
-
-        pub fn serialize<S: Serializer>(v: &[u8], s: S) -> Result<S::Ok, S::Error> {
-            s.serialize_str(&STANDARD.encode(v))
-        }
-
-        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
-            STANDARD.decode(String::deserialize(d)?).map_err(D::Error::custom)
-        }
-    }
-
-    pub mod words {
-        use super::*;
-
-        pub fn serialize<S: Serializer>(v: &[u32], s: S) -> Result<S::Ok, S::Error> {
-            let bytes: Vec<u8> = v.iter().flat_map(|w| w.to_le_bytes()).collect();
-            s.serialize_str(&STANDARD.encode(bytes))
-        }
-
-        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u32>, D::Error> {
-            let bytes = STANDARD.decode(String::deserialize(d)?).map_err(D::Error::custom)?;
-            if bytes.len() % 4 != 0 {
-                return Err(D::Error::custom(format!("{} bytes are not whole u32 words", bytes.len())));
-            }
-            Ok(bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect())
-        }
-    }
 }
 
 /// A texture resource.

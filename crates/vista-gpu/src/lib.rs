@@ -19,6 +19,7 @@ mod shaders;
 mod spares;
 pub mod validation;
 mod wgpu_run;
+pub mod wire;
 
 pub use context::{
     AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, GpuConfig, PassHook, RunStats,

@@ -151,8 +151,13 @@ impl From<WireError> for GpuError {
     }
 }
 
+/// One message: its JSON head, then `bytes` (a readback's outputs), or the
+/// byte lists the head refers to (a request's tables, uniforms, inputs:
+/// [`vista_gpu::wire`]) where `bytes` is empty.
 fn send<T: Serialize>(w: &mut impl Write, msg: &T, bytes: &[u8]) -> std::io::Result<()> {
-    let head = serde_json::to_vec(msg).expect("wire messages serialize");
+    let (head, attached) = vista_gpu::wire::attach(|| serde_json::to_vec(msg).expect("wire messages serialize"));
+    assert!(attached.is_empty() || bytes.is_empty(), "a message with byte lists carries no other bytes");
+    let bytes = if attached.is_empty() { bytes } else { &attached };
     w.write_all(&(head.len() as u32).to_le_bytes())?;
     w.write_all(&head)?;
     w.write_all(&(bytes.len() as u64).to_le_bytes())?;
@@ -169,7 +174,8 @@ fn receive<T: for<'de> Deserialize<'de>>(r: &mut impl Read) -> std::io::Result<(
     r.read_exact(&mut m)?;
     let mut bytes = vec![0u8; u64::from_le_bytes(m) as usize];
     r.read_exact(&mut bytes)?;
-    let msg = serde_json::from_slice(&head).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
+    let (msg, bytes) = vista_gpu::wire::read_attached(bytes, || serde_json::from_slice(&head));
+    let msg = msg.map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
     Ok((msg, bytes))
 }
 

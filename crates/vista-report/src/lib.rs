@@ -70,7 +70,7 @@ pub fn write_page(
     std::fs::create_dir_all(dir)
         .map_err(|e| vista_golden::GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;
     let path = dir.join(name);
-    vista_image::atomic_write(&path, html.as_bytes())?;
+    vista_image::atomic_replace(&path, html.as_bytes())?;
     Ok(path)
 }
 

@@ -57,7 +57,7 @@ pub fn file_case(dir: &Path, checked: vista_golden::Checked, detail: Detail) -> 
                 std::fs::create_dir_all(parent)
                     .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
             }
-            vista_image::atomic_write(&path, bytes)?;
+            vista_image::atomic_replace(&path, bytes)?;
         }
         Ok(())
     })();
@@ -276,7 +276,8 @@ pub fn write_case_files(
             return Ok(None);
         }
         if bits16 {
-            vista_image::write_png16(&case_dir.join(name), img)?;
+            let path = case_dir.join(name);
+            vista_image::atomic_replace(&path, &vista_image::encode_png16(&path, img)?)?;
         } else {
             vista_image::write_png8(&case_dir.join(name), img)?;
         }
@@ -318,7 +319,7 @@ pub fn write_case_files(
     // inspects pixels where a case did not pass.
     if full {
         let view = view_js(&id, comparable, actual, out.first_bad.as_ref().map(|b| (b.0, b.1)));
-        vista_image::atomic_write(&case_dir.join("view.js"), view.as_bytes())?;
+        vista_image::atomic_replace(&case_dir.join("view.js"), view.as_bytes())?;
         out.files.view = Some(format!("{id}/view.js"));
     }
     Ok(())
@@ -694,7 +695,7 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
     std::fs::create_dir_all(dir)
         .map_err(|e| GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;
     let index = dir.join("index.html");
-    vista_image::atomic_write(&index, html.as_bytes())?;
+    vista_image::atomic_replace(&index, html.as_bytes())?;
     Ok(index)
 }
 
