@@ -177,6 +177,16 @@ pub fn merge(
             if case.is_dir() {
                 copy_dir(&case, &out.join(&o.id))?;
             }
+            // A passing case's thumbnail lives in the shard's thumbnail folder.
+            if let Some(thumb) = o.files.thumb.as_deref().filter(|t| !t.starts_with(&format!("{}/", o.id))) {
+                let to = out.join(thumb);
+                if let Some(parent) = to.parent() {
+                    std::fs::create_dir_all(parent)
+                        .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+                }
+                std::fs::copy(s.dir.join(thumb), &to)
+                    .map_err(|e| GoldenError::Io { path: to.display().to_string(), message: e.to_string() })?;
+            }
         }
     }
     let mut outcomes: Vec<Outcome> = shards.iter().flat_map(|s| s.outcomes.iter().cloned()).collect();

@@ -555,16 +555,26 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
     // viewer's data were most of a report.
     assert_eq!(vista_in(Some(d.path()), &[], &["check"]).code, 1);
     let a = report(d.path()).join("a");
-    let thumb = vista_image::load(&a.join("thumb.png")).unwrap();
+    let thumb = vista_image::load(&report(d.path()).join("thumbs.d/a.png")).unwrap();
     assert!(thumb.width.max(thumb.height) <= vista_report::THUMB_EDGE, "{}x{}", thumb.width, thumb.height);
-    for f in ["actual.png", "actual8.png", "expected8.png", "diff8.png", "view.js"] {
-        assert!(!a.join(f).exists(), "passing case a has only its thumbnail, not {f}");
-    }
+    assert!(!a.exists(), "passing case a has only its thumbnail, in the thumbnails' folder, and no folder");
+    assert!(report(d.path()).join("b").is_dir(), "the failing case b keeps its folder");
     let index = std::fs::read_to_string(report(d.path()).join("index.html")).unwrap();
     assert!(index.contains("vista check --case 'a' --full-report"), "the passing case says how to get its viewer");
+    // Identical to its golden: one line, not the tables (most of a long
+    // suite's page); the failing case keeps them.
+    let section = |id: &str| {
+        let start = index.find(&format!("id=\"case-{id}\"")).unwrap();
+        index[start..].split("</details>").next().unwrap().to_string()
+    };
+    let a_section = section("a");
+    assert!(a_section.contains("identical to its golden <code>fbm/a.png</code>"), "{a_section}");
+    assert!(!a_section.contains("<table"), "{a_section}");
+    assert!(a_section.len() < 1000, "{} bytes: {a_section}", a_section.len());
+    assert!(section("b").contains("<table class=\"metrics\">") && section("b").contains("<table class=\"prov\">"));
     assert!(
         index.contains(
-            "<a href=\"../../golden/fbm/a.png\" title=\"the golden file\"><img class=\"thumb\" src=\"a/thumb.png\""
+            "<a href=\"../../golden/fbm/a.png\" title=\"the golden file\"><img class=\"thumb\" src=\"thumbs.d/a.png\""
         ),
         "the thumbnail links to the golden"
     );
@@ -576,6 +586,8 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
     for f in ["actual.png", "expected.png", "view.js"] {
         assert!(a.join(f).exists(), "--full-report: a/{f}");
     }
+    // No case shows a thumbnail now: the earlier run's is gone.
+    assert!(!report(d.path()).join("thumbs.d/a.png").exists(), "a stale thumbnail was kept");
 }
 
 /// `max_flip` in golden/cases.toml fails a case whose mean FLIP is above it,
@@ -4087,6 +4099,12 @@ fn merge_refuses_anything_but_a_whole_split() {
     shards.extend(cases(&json("s2of2")));
     shards.sort_by_key(|c| c["id"].as_str().unwrap().to_string());
     assert_eq!(cases(&json("out")), shards, "verdicts and metrics as the shards gave them");
+    // Every passing case's thumbnail travels with it.
+    let index = std::fs::read_to_string(d.path().join("out/index.html")).unwrap();
+    for id in ["a", "b", "c"] {
+        assert!(d.path().join(format!("out/thumbs.d/{id}.png")).is_file(), "thumbnail of {id}");
+        assert!(index.contains(&format!("src=\"thumbs.d/{id}.png\"")), "{id}'s thumbnail shown");
+    }
     let into_shard = vista_in(None, &[], &["merge", &p("s1of2"), &p("s2of2"), "--report-dir", &p("s1of2")]);
     assert_rejected(&into_shard, 2, &["merge into a folder of its own"]);
 }
@@ -4714,8 +4732,9 @@ fn mutate_bad_input_is_refused() {
     assert_rejected(&r, 2, &["b.png"]);
 }
 
-/// A run clears the case folders of earlier runs (only folders vista marked),
-/// and its closing summary lists every failure with one bless command.
+/// A run clears the case folders and thumbnails of earlier runs (only
+/// what vista marked), and its closing summary lists every failure with
+/// one bless command.
 fn check_clears_stale_case_folders_and_closes_with_one_bless_command() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -4723,10 +4742,12 @@ fn check_clears_stale_case_folders_and_closes_with_one_bless_command() {
     let rep = report(d.path());
     let keep = rep.join("notes");
     std::fs::create_dir_all(&keep).unwrap();
-    assert!(["a", "b", "c"].iter().all(|id| rep.join(id).is_dir()));
+    std::fs::write(rep.join("thumbs.d/mine.txt"), "a file vista did not write").unwrap();
+    let thumb = |id: &str| rep.join(format!("thumbs.d/{id}.png"));
+    assert!(["a", "b", "c"].iter().all(|id| thumb(id).is_file() && !rep.join(id).exists()));
     assert_eq!(vista_in(Some(d.path()), &[], &["check", "--case", "a"]).code, 0);
-    assert!(rep.join("a").is_dir() && !rep.join("b").exists() && !rep.join("c").exists(), "stale case folders kept");
-    assert!(keep.is_dir(), "a folder vista did not write was removed");
+    assert!(thumb("a").is_file() && !thumb("b").exists() && !thumb("c").exists(), "stale thumbnails kept");
+    assert!(rep.join("thumbs.d/mine.txt").is_file(), "a file vista did not write was removed");
     std::fs::write(
         cases_path(d.path()),
         CASES
@@ -4738,6 +4759,11 @@ fn check_clears_stale_case_folders_and_closes_with_one_bless_command() {
     assert_eq!(r.code, 1);
     assert!(r.stdout.contains("failed: a, b, c"), "{}", r.stdout);
     assert!(r.stdout.contains("vista bless --case '{a,b,c}'"), "{}", r.stdout);
+    assert!(["a", "b", "c"].iter().all(|id| rep.join(id).is_dir()), "failing cases get folders");
+    assert!(!thumb("a").exists(), "a failing case shows no thumbnail");
+    assert_eq!(vista_in(Some(d.path()), &[], &["check", "--case", "a"]).code, 1);
+    assert!(rep.join("a").is_dir() && !rep.join("b").exists() && !rep.join("c").exists(), "stale case folders kept");
+    assert!(keep.is_dir(), "a folder vista did not write was removed");
 }
 
 /// Whether a test renders (and so needs an adapter) or stops before any GPU work.

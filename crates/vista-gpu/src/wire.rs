@@ -45,17 +45,23 @@ enum Blob {
     At([u64; 2]),
 }
 
-fn put<S: Serializer>(v: &[u8], s: S) -> Result<S::Ok, S::Error> {
+/// Serializes `len` bytes that `write` appends to a buffer.
+fn put<S: Serializer>(len: usize, write: impl Fn(&mut Vec<u8>), s: S) -> Result<S::Ok, S::Error> {
     let at = OUT.with(|o| {
         o.borrow_mut().as_mut().map(|buf| {
             let at = buf.len() as u64;
-            buf.extend_from_slice(v);
-            [at, v.len() as u64]
+            buf.reserve(len);
+            write(buf);
+            [at, len as u64]
         })
     });
     match at {
         Some(at) => s.collect_seq(at),
-        None => s.serialize_str(&STANDARD.encode(v)),
+        None => {
+            let mut bytes = Vec::with_capacity(len);
+            write(&mut bytes);
+            s.serialize_str(&STANDARD.encode(bytes))
+        }
     }
 }
 
@@ -82,7 +88,7 @@ pub(crate) mod bytes {
     use super::*;
 
     pub fn serialize<S: Serializer>(v: &[u8], s: S) -> Result<S::Ok, S::Error> {
-        put(v, s)
+        put(v.len(), |buf| buf.extend_from_slice(v), s)
     }
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
@@ -95,8 +101,12 @@ pub(crate) mod words {
     use super::*;
 
     pub fn serialize<S: Serializer>(v: &[u32], s: S) -> Result<S::Ok, S::Error> {
-        let bytes: Vec<u8> = v.iter().flat_map(|w| w.to_le_bytes()).collect();
-        put(&bytes, s)
+        let write = |buf: &mut Vec<u8>| {
+            for w in v {
+                buf.extend_from_slice(&w.to_le_bytes());
+            }
+        };
+        put(4 * v.len(), write, s)
     }
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u32>, D::Error> {

@@ -47,7 +47,13 @@ pub fn permutation(seed: u32) -> Vec<u32> {
 /// perm[a] | perm[a + 1] << 8 | perm[b] << 16 | perm[b + 1] << 24 with a =
 /// perm[x] + y, b = perm[x + 1] + y. Every entry is below 256, so four fit.
 pub fn chain_words(perm: &[u32]) -> Vec<u32> {
-    let p = |k: usize| perm[k % 512];
+    // A fixed-size copy indexed modulo its length: no bounds checks in the
+    // 65536-cell loop (every small case builds this table).
+    let mut q = [0u32; 512];
+    for (k, v) in q.iter_mut().enumerate() {
+        *v = perm[k % perm.len()];
+    }
+    let p = |k: usize| q[k & 511];
     let mut out = Vec::with_capacity(512 + 256 * 256);
     out.extend((0..512).map(|k| p(k) | p(k + 1) << 8));
     for x in 0..256 {

@@ -15,8 +15,8 @@ mod results;
 pub use matrix::{MatrixColumn, cell as matrix_cell, matrix_page};
 pub use mutation::mutation_page;
 pub use report::{
-    CASE_MARKER, Detail, RunSummary, THUMB_EDGE, clear_case_folders, file_case, href, view_js, write_case_files,
-    write_report,
+    CASE_MARKER, Detail, RunSummary, THUMB_EDGE, THUMBS_DIR, clear_case_folders, file_case, href, view_js,
+    write_case_files, write_report,
 };
 pub use results::{case_line, github_annotations, json_results, junit_xml, verdict_name};
 

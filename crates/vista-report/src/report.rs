@@ -25,6 +25,14 @@ const SCRIPT: &str = include_str!("report.js");
 /// The empty file that marks a case folder as written by vista.
 pub const CASE_MARKER: &str = ".vista-case";
 
+/// The folder of passing cases' thumbnails, `<id>.png` each (no case id
+/// has a dot): a folder per passing case made and removed on every run
+/// was most of a small case's report time.
+pub const THUMBS_DIR: &str = "thumbs.d";
+
+/// The empty file that marks [`THUMBS_DIR`] as vista's.
+const THUMBS_MARKER: &str = ".vista-thumbs";
+
 /// Clears the case folders an earlier run left in `dir`, so a filtered run's
 /// report shows only its own cases. Only folders holding vista's marker are
 /// removed: a `--report-dir` pointed anywhere else loses nothing.
@@ -260,17 +268,23 @@ pub fn write_case_files(
     detail: Detail,
 ) -> Result<(), GoldenError> {
     let id = out.id.clone();
-    let case_dir = case_folder(dir, &id)?;
     // A case that passed gets one thumbnail of its render, linked to its
     // golden (which holds the full image): at 1920 x 1080 its 8-bit copies
     // and heat map were most of a passing case's cost. One that did not,
     // or a full report, gets every image at full size.
     let full = detail == Detail::All || !out.passed();
     if !full {
-        vista_image::write_png8(&case_dir.join("thumb.png"), &actual.thumbnail(THUMB_EDGE))?;
-        out.files.thumb = Some(format!("{id}/thumb.png"));
+        let thumbs = dir.join(THUMBS_DIR);
+        if !thumbs.join(THUMBS_MARKER).is_file() {
+            let io = |e: std::io::Error| GoldenError::Io { path: thumbs.display().to_string(), message: e.to_string() };
+            std::fs::create_dir_all(&thumbs).map_err(io)?;
+            std::fs::write(thumbs.join(THUMBS_MARKER), b"").map_err(io)?;
+        }
+        vista_image::write_png8(&thumbs.join(format!("{id}.png")), &actual.thumbnail(THUMB_EDGE))?;
+        out.files.thumb = Some(format!("{THUMBS_DIR}/{id}.png"));
         return Ok(());
     }
+    let case_dir = case_folder(dir, &id)?;
     let write = |name: &str, img: &Image, bits16: bool| -> Result<Option<String>, GoldenError> {
         if bits16 && !full {
             return Ok(None);
@@ -510,6 +524,37 @@ fn metric_cells(o: &Outcome) -> (String, String) {
     }
 }
 
+/// Whether a case gets the short body: it passed with its render's bits
+/// equal to its golden's (a thumbnail, not --full-report) and has nothing
+/// else to show. Its tables said the same six lines for every such case:
+/// most of a long suite's index.html.
+fn is_plainly_identical(o: &Outcome) -> bool {
+    o.files.thumb.is_some()
+        && o.metrics.as_ref().is_some_and(|m| m.psnr == f64::INFINITY && m.nan == 0)
+        && o.problems.is_empty()
+        && o.notes.is_empty()
+        && outputs_table(o).is_empty()
+        && inputs_table(o).is_empty()
+        && o.changed_files.is_empty()
+}
+
+/// The short body: the verdict's grounds in one line, and of the golden's
+/// provenance only what differs from this run.
+fn identical_body(o: &Outcome) -> String {
+    let prov = provenance(o);
+    let differs = prov.contains("class=\"differs\"");
+    format!(
+        "<p>identical to its golden <code>{golden}</code> (threshold &ge; {t:.1} dB, {driver} driver){same}</p>{prov}\
+         <p class=\"note\">viewer: <code class=\"cmd\">vista check --case '{id}' --full-report</code></p>",
+        golden = html_escape(&o.golden_file),
+        t = o.psnr_threshold,
+        driver = if o.same_driver { "same" } else { "other" },
+        same = if differs { "" } else { "; recorded with this run's backend, adapter, driver, params and shaders" },
+        prov = if differs { prov } else { String::new() },
+        id = html_escape(&o.id),
+    )
+}
+
 fn case_section(o: &Outcome, run: &RunSummary) -> String {
     let (psnr, metrics) = metric_cells(o);
     let failing = !o.passed();
@@ -542,13 +587,30 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
         ),
         None => String::new(),
     };
+    let body = match is_plainly_identical(o) {
+        true => identical_body(o),
+        false => format!(
+            "<div class=\"cols\"><div>{metrics}{outputs}{first_bad}{msgs}\
+             <p>bless this case: <code class=\"cmd\">{bless}</code></p>{accept}</div><div>{prov}</div></div>{viewer}",
+            outputs = outputs_table(o) + &inputs_table(o),
+            bless = html_escape(&o.bless_command),
+            accept = match run.pending.contains(&o.id) {
+                true => format!(
+                    "<p>or accept this very render (on any machine with this checkout): <code class=\"cmd\">vista bless \
+                     --from-report {} --case '{}'</code></p>",
+                    html_escape(&run.accept_from),
+                    html_escape(&o.id)
+                ),
+                false => String::new(),
+            },
+            prov = provenance(o),
+        ),
+    };
     format!(
         "<details class=\"case {cls}\" id=\"{anchor}\" data-failing=\"{failing}\"{open}>\
          <summary><span class=\"verdict\">{verdict}</span> <b class=\"id\">{id}</b> <span class=\"kernel\">{kernel}</span> \
          <span class=\"psnr\">PSNR {psnr}</span> <span class=\"ms\">{gpu:.1} ms</span> \
-         <span class=\"thumbs\">{thumbs}</span></summary>\
-         <div class=\"body\"><div class=\"cols\"><div>{metrics}{outputs}{first_bad}{msgs}\
-         <p>bless this case: <code class=\"cmd\">{bless}</code></p>{accept}</div><div>{prov}</div></div>{viewer}</div></details>\n",
+         <span class=\"thumbs\">{thumbs}</span></summary><div class=\"body\">{body}</div></details>\n",
         cls = if failing { "fail" } else { "pass" },
         anchor = anchor(&o.id),
         open = if failing { " open" } else { "" },
@@ -578,18 +640,6 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
                 thumb(&o.files.diff8, &o.files.diff, "heat map")
             ),
         },
-        outputs = outputs_table(o) + &inputs_table(o),
-        bless = html_escape(&o.bless_command),
-        accept = match run.pending.contains(&o.id) {
-            true => format!(
-                "<p>or accept this very render (on any machine with this checkout): <code class=\"cmd\">vista bless \
-                 --from-report {} --case '{}'</code></p>",
-                html_escape(&run.accept_from),
-                html_escape(&o.id)
-            ),
-            false => String::new(),
-        },
-        prov = provenance(o),
     )
 }
 
@@ -696,7 +746,24 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
         .map_err(|e| GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;
     let index = dir.join("index.html");
     vista_image::atomic_replace(&index, html.as_bytes())?;
+    prune_thumbs(dir, outcomes);
     Ok(index)
+}
+
+/// Removes the thumbnails no case of this report shows (an earlier run's,
+/// or a case that failed this time), where the folder is vista's.
+fn prune_thumbs(dir: &Path, outcomes: &[Outcome]) {
+    let thumbs = dir.join(THUMBS_DIR);
+    if !thumbs.join(THUMBS_MARKER).is_file() {
+        return;
+    }
+    let shown: std::collections::HashSet<&str> = outcomes.iter().filter_map(|o| o.files.thumb.as_deref()).collect();
+    for e in std::fs::read_dir(&thumbs).into_iter().flatten().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.ends_with(".png") && !shown.contains(format!("{THUMBS_DIR}/{name}").as_str()) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
 }
 
 #[cfg(test)]
