@@ -55,8 +55,13 @@ fn injected_nan_fails_the_case_naming_count_and_first_pixel(ctx: &vista_render::
     std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
     vista_image::write_png16(&golden, &Image::from_fn(16, 8, |_, _| [0.5, 0.5, 0.5, 1.0])).unwrap();
     let report_dir = dir.path().join("report");
-    let checked =
-        vista_golden::check_case(ctx, &store, &Default::default(), &nan_case(), &CheckOptions { twice: false });
+    let checked = vista_golden::check_case(
+        ctx,
+        &store,
+        &Default::default(),
+        &nan_case(),
+        &CheckOptions { twice: false, images_of_passing: false },
+    );
     let (o, unwritten) = vista_report::file_case(&report_dir, checked, vista_report::Detail::Failing);
     assert!(unwritten.is_empty(), "{unwritten:?}");
     assert!(!o.passed(), "a NaN render passed: {o:?}");

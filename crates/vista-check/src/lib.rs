@@ -97,9 +97,10 @@ pub fn default_report_dir(project: &Project, backend: &str, validate: bool) -> O
 /// The one render-twice rule: the in-process determinism check (two
 /// renders, bit-identical) runs on the default backend, lavapipe, where
 /// goldens are blessed (and only where the render is not the bless-time
-/// bits: `CheckOptions::twice`); other backends render once.
-pub fn options(ctx: &Renderer) -> CheckOptions {
-    CheckOptions { twice: ctx.backend() == "lavapipe" }
+/// bits: `CheckOptions::twice`); other backends render once. A passing
+/// case's golden images are read only for a report that shows it in full.
+pub fn options(ctx: &Renderer, detail: Detail) -> CheckOptions {
+    CheckOptions { twice: ctx.backend() == "lavapipe", images_of_passing: detail == Detail::All }
 }
 
 /// One case checked and filed in the report folder.
@@ -137,7 +138,8 @@ impl Checker<'_> {
     /// Checks `case` (render, goldens, verdict) and writes its report folder.
     pub fn check(&self, case: &Case) -> Filed {
         let started = Instant::now();
-        let mut checked = vista_golden::check_case(self.ctx, self.store, self.manifest, case, &options(self.ctx));
+        let mut checked =
+            vista_golden::check_case(self.ctx, self.store, self.manifest, case, &options(self.ctx, self.detail));
         let check_time = started.elapsed();
         let golden = self.store.dir.join(&checked.outcome.golden_file);
         checked.outcome.files.golden_href = Some(vista_report::href(self.report_dir, &golden));

@@ -67,6 +67,8 @@ pub struct GoldenFiles {
     pub found: Vec<(PathBuf, Found)>,
     /// The PNG view decoded, once: the verdict and the report both read it.
     decoded_view: std::sync::OnceLock<Result<Option<Image>, String>>,
+    /// Set where the PNG is known to hold the render's view ([`GoldenFiles::known_same`]).
+    same_as_render: std::sync::OnceLock<()>,
 }
 
 impl GoldenFiles {
@@ -86,12 +88,12 @@ impl GoldenFiles {
                 (p.clone(), found)
             })
             .collect();
-        GoldenFiles { paths, found, decoded_view: Default::default() }
+        GoldenFiles { paths, found, decoded_view: Default::default(), same_as_render: Default::default() }
     }
 
     /// Golden files already read (tests hold them in memory).
     pub fn of(paths: OutputFiles, found: Vec<(PathBuf, Found)>) -> GoldenFiles {
-        GoldenFiles { paths, found, decoded_view: Default::default() }
+        GoldenFiles { paths, found, decoded_view: Default::default(), same_as_render: Default::default() }
     }
 
     /// What was found at `path` (missing if it is not one of these files).
@@ -103,6 +105,30 @@ impl GoldenFiles {
     /// report shows it beside the render's).
     pub fn view(&self) -> Option<&Image> {
         self.view_decoded().ok().flatten()
+    }
+
+    /// Marks the PNG as holding exactly the render's view, so the verdict
+    /// judges the view against itself without decoding the PNG: the caller
+    /// knows the render's raw bits are those the golden was blessed from
+    /// (issue 55: a passing case needs no decode). Only where the PNG's bytes
+    /// are the ones the manifest entry recorded (`golden_hash`): a file
+    /// changed since is decoded and judged as ever. [`GoldenFiles::view`]
+    /// still decodes it for a report that shows it.
+    pub fn known_same(&self, golden_hash: &str) {
+        if let Some(png) = self.paths.png.as_deref()
+            && matches!(self.at(png), Found::Bytes(b) if !golden_hash.is_empty() && crate::short_hash_bytes(b) == golden_hash)
+        {
+            let _ = self.same_as_render.set(());
+        }
+    }
+
+    /// The PNG view decoded as [`GoldenFiles::view_decoded`] gives it, or
+    /// `Some(None)` where it is known to be the render's own.
+    fn view_decoded_unless_same(&self) -> Result<Option<Option<&Image>>, String> {
+        match self.same_as_render.get() {
+            Some(()) => Ok(Some(None)),
+            None => self.view_decoded().map(|v| v.map(Some)),
+        }
     }
 
     /// The PNG view decoded (once): `Ok(None)` when missing or when the
@@ -434,8 +460,8 @@ fn judge_view(
     by_tolerance: bool,
     psnr_threshold: f64,
 ) {
-    let expected = match golden.view_decoded() {
-        Ok(Some(g)) => g,
+    let expected = match golden.view_decoded_unless_same() {
+        Ok(Some(g)) => g.unwrap_or(actual),
         Ok(None) => return v.missing.push(png.to_path_buf()),
         Err(e) => return v.errors.push(e),
     };
@@ -1100,6 +1126,34 @@ mod tests {
     /// reads nothing itself: golden bytes held in memory, at a path with no
     /// file behind it, decide it (equal values pass, one changed value
     /// fails, no bytes is a missing golden).
+    /// A golden known to hold the render's view (its bless-time bits) is
+    /// judged without decoding the PNG (these bytes would not decode); a
+    /// missing PNG or an LFS pointer stays what it is.
+    #[test]
+    fn a_known_view_is_not_decoded() {
+        let png = PathBuf::from("/nowhere/golden/fbm/a.png");
+        let files = |found: Found| {
+            GoldenFiles::of(OutputFiles { png: Some(png.clone()), ..Default::default() }, vec![(png.clone(), found)])
+        };
+        let bytes = b"not a PNG at all".to_vec();
+        let recorded = crate::short_hash_bytes(&bytes);
+        let g = files(Found::Bytes(bytes.clone()));
+        g.known_same(&recorded);
+        assert_eq!(g.view_decoded_unless_same(), Ok(Some(None)), "judged as the render's own view");
+        assert!(g.view().is_none(), "the report's copy is still decoded (and these bytes fail)");
+        let undecoded = files(Found::Bytes(bytes.clone()));
+        assert!(undecoded.view_decoded_unless_same().is_err(), "without it, the bytes are decoded (and fail)");
+        let changed = files(Found::Bytes(b"not the recorded bytes".to_vec()));
+        changed.known_same(&recorded);
+        assert!(changed.view_decoded_unless_same().is_err(), "a file changed since the bless is decoded");
+        let missing = files(Found::Missing);
+        missing.known_same(&recorded);
+        assert_eq!(missing.view_decoded_unless_same(), Ok(None), "a missing golden stays missing");
+        let lfs = files(Found::Bytes(b"version https://git-lfs.github.com/spec/v1\noid sha256:0".to_vec()));
+        lfs.known_same(&recorded);
+        assert!(lfs.view_decoded_unless_same().unwrap_err().contains("Git LFS pointer"));
+    }
+
     #[test]
     fn compare_output_judges_what_the_runner_read_and_reads_nothing() {
         let text = "[[case]]\nid = \"a\"\nkernel = \"fbm\"\n";

@@ -355,7 +355,7 @@ struct Baseline<'a> {
 
 /// A mutant's case is checked once: its verdict is the first render's, and
 /// the unmutated render was already shown deterministic by bless.
-const ONCE: CheckOptions = CheckOptions { twice: false };
+const ONCE: CheckOptions = CheckOptions { twice: false, images_of_passing: false };
 
 /// The unmutated kernel through the same detectors a mutant meets. Every
 /// case must have a readable golden and pass, and every agreement setting
