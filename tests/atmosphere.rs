@@ -18,7 +18,7 @@ fn params(preset: Option<&str>, set: &[(&str, String)]) -> ParamSet {
 }
 
 fn gpu(ctx: &vista_render::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
-    vista_render::render(ctx, &K, p, w, h).unwrap_or_else(|e| panic!("render failed: {e}")).raw
+    vista_render::render(ctx, &K, p, w, h).unwrap_or_else(|e| panic!("render failed: {e}")).into_raw()
 }
 
 fn samples(view: u32, light: u32) -> [(&'static str, String); 2] {

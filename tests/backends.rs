@@ -81,7 +81,7 @@ fn backends_agree(contexts: &[Context]) -> Result<(), String> {
                 render(r, &case.kernel, &case.params, case.width, case.height)
                     .map(|o| {
                         let display = vista_render::quantize16(o.display());
-                        (o.raw, display)
+                        (o.into_raw(), display)
                     })
                     .map_err(|e| format!("{} on {}: {e}", case.id, r.backend()))
             })

@@ -14,7 +14,7 @@ fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
 }
 
 fn gpu(ctx: &vista_render::Renderer, p: &ParamSet, w: u32, h: u32) -> Image {
-    render(ctx, &CloudsKernel, p, w, h).expect("render").raw
+    render(ctx, &CloudsKernel, p, w, h).expect("render").into_raw()
 }
 
 /// Coverage 0: exactly the background (bit for bit) and alpha exactly 0.

@@ -18,7 +18,7 @@ fn params(preset: &str, sets: &[(&str, &str)]) -> ParamSet {
 }
 
 fn gpu(ctx: &vista_render::Renderer, p: &ParamSet) -> Image {
-    vista_render::render(ctx, &HeightfieldKernel, p, W, H).expect("render").raw
+    vista_render::render(ctx, &HeightfieldKernel, p, W, H).expect("render").into_raw()
 }
 
 /// Hit distance of a depth pixel (None for sky, depth 1).

@@ -19,7 +19,7 @@ fn params(preset: &str, set: &[(&str, &str)]) -> ParamSet {
 }
 
 fn gpu(ctx: &Renderer, k: &Kernel, p: &ParamSet, w: u32, h: u32) -> Image {
-    render(ctx, k, p, w, h).unwrap_or_else(|e| panic!("{}: {e}", k.name())).raw
+    render(ctx, k, p, w, h).unwrap_or_else(|e| panic!("{}: {e}", k.name())).into_raw()
 }
 
 /// The terrain settings both kernels share, as `--set` pairs.

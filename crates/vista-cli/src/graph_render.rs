@@ -43,7 +43,7 @@ pub fn render(
         match &o.value {
             OutputValue::Texture { raw, unwritten, .. } => {
                 let raw_values = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-                let img = if raw_values { raw.clone() } else { o.display().expect("a texture") };
+                let img = if raw_values { Image::clone(raw) } else { o.display().expect("a texture") };
                 vista_image::save(&path, &if i == 0 { frame(img) } else { img })?;
                 if let Some((x, y)) = raw.first_nonfinite() {
                     eprintln!(

@@ -220,7 +220,7 @@ pub fn judge_setting(gpu: &Renderer, s: &Setting) -> Result<Judged, SettingError
     let [w, h] = s.size;
     let mut g = vista_render::render(gpu, k, &p, w, h)
         .map_err(|source| SettingError::Render { setting: s.label(), source })?
-        .raw;
+        .into_raw();
     let gpu_hash = g.content_hash();
     let c = match s.kernel.as_str() {
         "landscape" => with_gpu_hits(gpu, k, s, &p)?,
@@ -246,7 +246,7 @@ fn depths(gpu: &Renderer, k: &Kernel, s: &Setting) -> Result<(Image, Image), Set
     let [w, h] = s.size;
     let gd = vista_render::render(gpu, k, &p, w, h)
         .map_err(|source| SettingError::Render { setting: format!("{} depth", s.label()), source })?
-        .raw;
+        .into_raw();
     Ok((gd, reference(k, &p, w, h)))
 }
 

@@ -1076,7 +1076,7 @@ mod tests {
             tolerance: None,
             partial: false,
             value: OutputValue::Texture {
-                raw: raw.clone(),
+                raw: raw.clone().into(),
                 format: "rgba32float",
                 view: vista_kernels::Output::Display,
                 unwritten: 0,

@@ -18,7 +18,7 @@ pub mod worker;
 
 pub use error::{Crash, RenderError};
 pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use vista_gpu::Context;
@@ -49,8 +49,8 @@ impl Default for RenderLimits {
 /// display values.
 #[derive(Debug, Clone)]
 pub struct Rendered {
-    /// What the shader wrote, unchanged.
-    pub raw: Image,
+    /// What the shader wrote, unchanged (the main output's own image).
+    pub raw: Arc<Image>,
     /// Timing of the run.
     pub stats: RunStats,
     /// The output's storage format (an integer one compares exactly).
@@ -71,6 +71,13 @@ pub struct Rendered {
 }
 
 impl Rendered {
+    /// The main image, owned (without a copy where nothing else holds it).
+    pub fn into_raw(self) -> Image {
+        let Rendered { raw, outputs, .. } = self;
+        drop(outputs);
+        Arc::unwrap_or_clone(raw)
+    }
+
     /// Display values in [0, 1] (what PNG goldens hold): `raw` itself for a
     /// display kernel, else the kernel's tone map / opaque alpha of it.
     pub fn display(&self) -> &Image {
@@ -414,8 +421,9 @@ pub struct OutputRender {
 pub enum OutputValue {
     /// A texture: raw f32 RGBA (layers stacked top to bottom).
     Texture {
-        /// What the passes wrote.
-        raw: Image,
+        /// What the passes wrote (shared with [`Rendered::raw`] for the
+        /// main image: at 2048 x 2048 a copy was 64 MiB).
+        raw: Arc<Image>,
         /// Its storage format.
         format: &'static str,
         /// Its PNG view.
@@ -440,7 +448,7 @@ impl OutputRender {
     /// A texture output's display values (a buffer has none).
     pub fn display(&self) -> Option<Image> {
         match &self.value {
-            OutputValue::Texture { raw, display, .. } => Some(display.apply(raw).unwrap_or_else(|| raw.clone())),
+            OutputValue::Texture { raw, display, .. } => Some(display.apply(raw).unwrap_or_else(|| Image::clone(raw))),
             OutputValue::Buffer { .. } => None,
         }
     }
@@ -506,7 +514,7 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
                 (
                     PlannedKind::Texture { format, view, display },
                     vista_gpu::OutputData::Texture { image, unwritten },
-                ) => OutputValue::Texture { raw: image, format, view: *view, unwritten, display: *display },
+                ) => OutputValue::Texture { raw: Arc::new(image), format, view: *view, unwritten, display: *display },
                 (PlannedKind::Buffer { element, count }, vista_gpu::OutputData::Buffer(bytes)) => {
                     OutputValue::Buffer { bytes, element: element.clone(), count: *count }
                 }
@@ -516,7 +524,7 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         .collect();
     let (raw, format, display) = match outputs.first().map(|o| &o.value) {
         Some(OutputValue::Texture { raw, format, display, .. }) => (raw.clone(), *format, *display),
-        _ => (Image::new(0, 0), "rgba32float", DisplayMap::identity()),
+        _ => (Arc::new(Image::new(0, 0)), "rgba32float", DisplayMap::identity()),
     };
     Ok(Rendered {
         raw,
