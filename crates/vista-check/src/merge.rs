@@ -178,7 +178,7 @@ pub fn merge(
                 copy_dir(&case, &out.join(&o.id))?;
             }
             // A passing case's thumbnail lives in the shard's thumbnail folder.
-            if let Some(thumb) = o.files.thumb.as_deref().filter(|t| !t.starts_with(&format!("{}/", o.id))) {
+            if let Some(thumb) = o.files.thumb.as_deref().filter(|t| t.starts_with(vista_report::THUMBS_DIR)) {
                 let to = out.join(thumb);
                 if let Some(parent) = to.parent() {
                     std::fs::create_dir_all(parent)

@@ -1122,10 +1122,6 @@ mod tests {
         }
     }
 
-    /// The verdict judges the golden files as the runner read them and
-    /// reads nothing itself: golden bytes held in memory, at a path with no
-    /// file behind it, decide it (equal values pass, one changed value
-    /// fails, no bytes is a missing golden).
     /// A golden known to hold the render's view (its bless-time bits) is
     /// judged without decoding the PNG (these bytes would not decode); a
     /// missing PNG or an LFS pointer stays what it is.
@@ -1154,6 +1150,10 @@ mod tests {
         assert!(lfs.view_decoded_unless_same().unwrap_err().contains("Git LFS pointer"));
     }
 
+    /// The verdict judges the golden files as the runner read them and
+    /// reads nothing itself: golden bytes held in memory, at a path with no
+    /// file behind it, decide it (equal values pass, one changed value
+    /// fails, no bytes is a missing golden).
     #[test]
     fn compare_output_judges_what_the_runner_read_and_reads_nothing() {
         let text = "[[case]]\nid = \"a\"\nkernel = \"fbm\"\n";

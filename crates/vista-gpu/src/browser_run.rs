@@ -111,8 +111,6 @@ impl Context {
         Ok((Readback { outputs, stats, pass_times: out.passes, pass_gpu_times }, sentinels))
     }
 
-    /// One binding as the page takes it: its bind group layout entry, and
-    /// its source (a pass's own bytes, or a resource).
     /// A composed file's WGSL for Tint, with its cache key: written once
     /// per engine (a file that needs a feature the browser lacks is
     /// unsupported, checked then).
@@ -134,6 +132,8 @@ impl Context {
         Ok((key, w))
     }
 
+    /// One binding as the page takes it: its bind group layout entry, and
+    /// its source (a pass's own bytes, or a resource).
     fn slot_json(&self, b: &BrowserEngine, g: &Graph<'_>, pass: &GraphPass, s: &GraphSlot) -> Result<Value, GpuError> {
         let b64 = vista_browser::base64;
         let filterable32 = b.features.iter().any(|f| f == "float32-filterable");

@@ -817,12 +817,15 @@ pub const OPTIONAL_CAPABILITIES: [(naga::valid::Capabilities, &str, &str); 2] = 
     (naga::valid::Capabilities::DUAL_SOURCE_BLENDING, "dual-source-blending", "dual_source_blending"),
 ];
 
+/// The default capabilities and every one of [`OPTIONAL_CAPABILITIES`].
+fn all_capabilities() -> naga::valid::Capabilities {
+    OPTIONAL_CAPABILITIES.iter().fold(naga::valid::Capabilities::default(), |c, (cap, _, _)| c | *cap)
+}
+
 /// Validates a composed module with naga alone (no device needed), the
 /// [`OPTIONAL_CAPABILITIES`] allowed.
 pub fn validate(name: &str, module: &naga::Module) -> Result<naga::valid::ModuleInfo, GpuError> {
-    let capabilities =
-        OPTIONAL_CAPABILITIES.iter().fold(naga::valid::Capabilities::default(), |c, (cap, _, _)| c | *cap);
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), all_capabilities())
         .validate(module)
         .map_err(|e| GpuError::Shader(format!("{name}: naga validation failed: {}", e.emit_to_string(""))))
 }
@@ -856,7 +859,7 @@ fn shader_defs(name: &str) -> HashMap<String, naga_oil::compose::ShaderDefValue>
 /// module's own, so the question goes to naga's validator: the module is
 /// valid only with that capability. Nothing for a module that needs none.
 pub fn features_used(module: &naga::Module) -> Vec<(&'static str, &'static str)> {
-    let all = OPTIONAL_CAPABILITIES.iter().fold(naga::valid::Capabilities::default(), |c, (cap, _, _)| c | *cap);
+    let all = all_capabilities();
     let valid = |caps| naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(module).is_ok();
     if valid(naga::valid::Capabilities::default()) || !valid(all) {
         return Vec::new();

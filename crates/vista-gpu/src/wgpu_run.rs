@@ -550,19 +550,19 @@ impl Context {
                 })
             })
         };
-        let read_as = g.resources[logical].read_as();
-        let (staging, texture) = match (&g.resources[logical], &read_as) {
-            (Resource::Texture(_) | Resource::Depth(_), Some(t)) => {
+        let (staging, texture) = match (g.resources[logical].read_as(), &g.resources[logical]) {
+            (Some(t), resource) => {
                 let format = crate::format::parse(t.format)?;
-                let padded = padded_row(t, &format);
+                let padded = padded_row(&t, &format);
                 let rows = t.height * t.layers;
                 let staging = staging_of(padded as u64 * rows as u64);
-                let depth = matches!(g.resources[logical], Resource::Depth(_));
+                // A depth texture's depth aspect reads back as r32float.
+                let aspect = match resource {
+                    Resource::Depth(_) => wgpu::TextureAspect::DepthOnly,
+                    _ => wgpu::TextureAspect::All,
+                };
                 encoder.copy_texture_to_buffer(
-                    wgpu::TexelCopyTextureInfo {
-                        aspect: if depth { wgpu::TextureAspect::DepthOnly } else { wgpu::TextureAspect::All },
-                        ..made.textures[&physical].as_image_copy()
-                    },
+                    wgpu::TexelCopyTextureInfo { aspect, ..made.textures[&physical].as_image_copy() },
                     wgpu::TexelCopyBufferInfo {
                         buffer: &staging,
                         layout: wgpu::TexelCopyBufferLayout {
@@ -575,13 +575,13 @@ impl Context {
                 );
                 (staging, Some((t, format, padded, rows)))
             }
-            (Resource::Buffer(bytes), _) => {
+            (None, Resource::Buffer(bytes)) => {
                 let size = bytes.len().max(4).next_multiple_of(4) as u64;
                 let staging = staging_of(size);
                 encoder.copy_buffer_to_buffer(&made.buffers[&physical], 0, &staging, 0, size);
                 (staging, None)
             }
-            _ => return Err(GpuError::Request("a sampler cannot be an output".into())),
+            (None, _) => return Err(GpuError::Request("a sampler cannot be an output".into())),
         };
         let index = w.queue.submit([encoder.finish()]);
         let (tx, rx) = mpsc::channel();

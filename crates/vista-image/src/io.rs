@@ -58,9 +58,9 @@ pub fn encode_png16_small(path: &Path, img: &Image) -> Result<Vec<u8>, ImageErro
     Ok(bytes)
 }
 
-/// Writes `img` as an 8-bit RGBA PNG (clamped to `[0, 1]`, NaN as 0): the
-/// light display copy reports load, beside the 16-bit file.
-/// RGB where every alpha is 1; fast compression and no sync to disk, since
+/// Writes `img` as an 8-bit PNG (clamped to `[0, 1]`, NaN as 0; RGB where
+/// every alpha is 1, else RGBA): the light display copy reports load,
+/// beside the 16-bit file. Fast compression and no sync to disk, since
 /// every run writes the report again ([`atomic_replace`]).
 pub fn write_png8(path: &Path, img: &Image) -> Result<(), ImageError> {
     let opaque = img.data.iter().all(|p| quantize8(p[3]) == u8::MAX);

@@ -857,8 +857,7 @@ fn read_texture_npy(
         })?,
     };
     let (dtype, channels) = format.numpy();
-    let same = |d: &str| d == dtype || (dtype.starts_with('|') && d.ends_with(&dtype[1..]));
-    if !same(&n.descr) || c != channels {
+    if !format.holds_numpy(&n.descr, c) {
         return Err(format!(
             "file {file} holds {} x {c} per texel but {} needs {dtype} x {channels} (shape (H, W{}))",
             n.descr,

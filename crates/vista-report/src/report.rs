@@ -439,7 +439,10 @@ fn thumb(path: &Option<String>, full: &Option<String>, alt: &str) -> String {
 }
 
 /// The golden's manifest entry beside this run, mismatches marked.
-fn provenance(o: &Outcome) -> String {
+/// The golden's provenance beside this run's, as a table, and whether any
+/// row but the date differs.
+fn provenance(o: &Outcome) -> (String, bool) {
+    let mut any_differs = false;
     let mut t = format!(
         "<table class=\"prov\"><tr><th></th><th>golden (manifest): <code>{}</code></th><th>this run</th></tr>",
         html_escape(&o.golden_file)
@@ -468,6 +471,7 @@ fn provenance(o: &Outcome) -> String {
     ];
     for (name, then, now) in rows {
         let differs = name != "date" && golden.is_some() && then != now && then != "not recorded";
+        any_differs |= differs;
         let _ = write!(
             t,
             "<tr class=\"{}\"><th>{name}</th><td>{}</td><td>{}</td></tr>",
@@ -484,7 +488,7 @@ fn provenance(o: &Outcome) -> String {
             o.changed_files.iter().map(|f| format!("<code>{}</code>", html_escape(f))).collect::<Vec<_>>().join(", ")
         );
     }
-    t
+    (t, any_differs)
 }
 
 fn metric_cells(o: &Outcome) -> (String, String) {
@@ -541,8 +545,7 @@ fn is_plainly_identical(o: &Outcome) -> bool {
 /// The short body: the verdict's grounds in one line, and of the golden's
 /// provenance only what differs from this run.
 fn identical_body(o: &Outcome) -> String {
-    let prov = provenance(o);
-    let differs = prov.contains("class=\"differs\"");
+    let (prov, differs) = provenance(o);
     format!(
         "<p>identical to its golden <code>{golden}</code> (threshold &ge; {t:.1} dB, {driver} driver){same}</p>{prov}\
          <p class=\"note\">viewer: <code class=\"cmd\">vista check --case '{id}' --full-report</code></p>",
@@ -603,7 +606,7 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
                 ),
                 false => String::new(),
             },
-            prov = provenance(o),
+            prov = provenance(o).0,
         ),
     };
     format!(

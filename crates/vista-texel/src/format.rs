@@ -309,10 +309,17 @@ impl Format {
     /// The first format whose texels a `.npy` of this dtype and channel
     /// count holds, byte for byte.
     pub fn of_numpy(descr: &str, channels: usize) -> Option<Format> {
-        format_names().into_iter().map(|n| Format::parse(n).expect("a listed name")).find(|f| {
-            let (d, c) = f.numpy();
-            (d, c) == (descr, channels) || (d.strip_prefix('|').is_some_and(|d| descr.ends_with(d)) && c == channels)
-        })
+        format_names()
+            .into_iter()
+            .map(|n| Format::parse(n).expect("a listed name"))
+            .find(|f| f.holds_numpy(descr, channels))
+    }
+
+    /// Whether a `.npy` of this dtype and channel count holds this format's
+    /// texels byte for byte (a one-byte dtype in any byte order).
+    pub fn holds_numpy(&self, descr: &str, channels: usize) -> bool {
+        let (d, c) = self.numpy();
+        c == channels && (d == descr || d.strip_prefix('|').is_some_and(|d| descr.ends_with(d)))
     }
 
     /// Bytes of one texel.
