@@ -57,14 +57,13 @@ pub struct Chromium {
     shared: Arc<Shared>,
     next_id: AtomicU64,
     session: String,
-    _profile: tempfile::TempDir,
+    profile: tempfile::TempDir,
 }
 
 impl Chromium {
     /// Starts headless Chromium with `flags` and attaches to a new blank page.
     pub fn launch(path: &Path, flags: &[&str], timeout: Duration) -> Result<Chromium, String> {
-        let profile =
-            tempfile::Builder::new().prefix("vista-chromium-").tempdir().map_err(|e| format!("profile dir: {e}"))?;
+        let profile = crate::profile::create().map_err(|e| format!("profile dir: {e}"))?;
         let (from_us, to_browser) = std::io::pipe().map_err(|e| format!("pipe: {e}"))?;
         let (from_browser, to_us) = std::io::pipe().map_err(|e| format!("pipe: {e}"))?;
         let (read_fd, write_fd) = (from_us.as_raw_fd(), to_us.as_raw_fd());
@@ -87,7 +86,9 @@ impl Chromium {
         .arg("about:blank")
         .stdin(Stdio::null())
         .stdout(Stdio::null())
-        .stderr(Stdio::null());
+        .stderr(Stdio::null())
+        // Its own group, so that its helper processes end with it.
+        .process_group(0);
         // SAFETY: between fork and exec only async-signal-safe fcntl/dup2
         // calls, putting the pipe ends where --remote-debugging-pipe expects
         // them. Both are first copied above fd 9, so that neither target is
@@ -103,6 +104,7 @@ impl Chromium {
             });
         }
         let child = cmd.spawn().map_err(|e| format!("cannot start {}: {e}", path.display()))?;
+        crate::profile::started(child.id(), profile.path());
         drop((from_us, to_us));
         let waiters: Waiters = Arc::default();
         let shared = Arc::new(Shared::default());
@@ -114,7 +116,7 @@ impl Chromium {
             shared,
             next_id: AtomicU64::new(1),
             session: String::new(),
-            _profile: profile,
+            profile,
         };
         let target = chromium
             .call_browser("Target.createTarget", json!({ "url": "about:blank" }), timeout)
@@ -128,6 +130,11 @@ impl Chromium {
             chromium.call(domain, json!({}), timeout).map_err(|e| format!("{domain}: {e}"))?;
         }
         Ok(chromium)
+    }
+
+    /// This browser's profile folder, removed with it.
+    pub fn profile_dir(&self) -> &Path {
+        self.profile.path()
     }
 
     /// A command to the attached page.
@@ -259,9 +266,10 @@ impl Chromium {
 
 impl Drop for Chromium {
     fn drop(&mut self) {
-        // Killing the browser process ends its renderer and GPU processes.
-        let _ = self.child.kill();
+        // Killing its group ends the renderer and GPU processes too.
+        crate::profile::kill_group(self.child.id());
         let _ = self.child.wait();
+        crate::profile::ended(self.child.id(), self.profile.path());
     }
 }
 

@@ -16,6 +16,7 @@
 //! dropped (killed) so the next run starts a fresh one.
 
 pub mod cdp;
+mod profile;
 
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -144,7 +145,6 @@ pub struct Output {
 
 struct Session {
     chromium: Chromium,
-    _page_dir: tempfile::TempDir,
 }
 
 /// One headless Chromium with a WebGPU device, reused across runs.
@@ -268,11 +268,7 @@ impl Session {
         let product = chromium.version(timeout).unwrap_or_default();
         // WebGPU needs a secure context; a file:// page is one, about:blank
         // and data: URLs are not.
-        let page_dir = tempfile::Builder::new()
-            .prefix("vista-browser-")
-            .tempdir()
-            .map_err(|e| launch_err(format!("temp dir: {e}")))?;
-        let page = page_dir.path().join("runner.html");
+        let page = chromium.profile_dir().join("runner.html");
         std::fs::write(
             &page,
             format!("<!doctype html><meta charset=utf-8><title>vista</title><script>\n{RUNNER}\n</script>"),
@@ -281,7 +277,7 @@ impl Session {
         chromium
             .navigate(&format!("file://{}", page.display()), timeout)
             .map_err(|e| launch_err(format!("loading the runner page: {e}")))?;
-        let session = Session { chromium, _page_dir: page_dir };
+        let session = Session { chromium };
         let reply = session.call("WebGPU init", "vistaInit()", timeout).map_err(|e| launch_err(e.to_string()))?;
         let mut info: AdapterInfo = parse_ok(&reply).map_err(BrowserError::NoWebGpu)?;
         info.product = product;

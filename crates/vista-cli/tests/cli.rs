@@ -3172,20 +3172,33 @@ fn a_kernel_described_as_data_renders() {
 }
 
 /// A project's own kernel runs in the browser too (naga writes the composed
-/// module back as one WGSL source for Tint), with lavapipe's pixels.
+/// module back as one WGSL source for Tint), with lavapipe's pixels; and
+/// Chromium's profile folder goes with the run, as does one a killed run
+/// left behind.
 fn a_project_kernel_renders_the_same_in_the_browser() {
     let d = kernel_project(K_MANIFEST, K_SHADER);
     let png = |b: &str| d.path().join(format!("{b}.png"));
+    let temp = tmp();
+    let mut child = std::process::Command::new("true").spawn().unwrap();
+    let stale = temp.path().join(format!("vista-chromium-{}-Zz9Zz9", child.id()));
+    child.wait().unwrap();
+    std::fs::create_dir(&stale).unwrap();
     for b in ["lavapipe", "browser"] {
         let out = png(b);
         let r = vista_in(
             Some(d.path()),
-            &[],
+            &[("TMPDIR", temp.path().to_str().unwrap())],
             &["--backend", b, "render", "k", "--set", "gain=0.25", "--size", "13x7", "-o", out.to_str().unwrap()],
         );
         assert_eq!(r.code, 0, "{b}: {}", r.stderr);
     }
     assert_eq!(std::fs::read(png("lavapipe")).unwrap(), std::fs::read(png("browser")).unwrap());
+    let left: Vec<_> = std::fs::read_dir(temp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.starts_with("vista-chromium-") || n.starts_with("vista-browser-"))
+        .collect();
+    assert!(left.is_empty(), "left in the temp folder: {left:?}");
 }
 
 /// Without Chromium the browser backend fails at once with the install
