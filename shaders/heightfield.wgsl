@@ -6,8 +6,8 @@
 // sun direction and fog extinction are derived here, the octave rotation and
 // terrain normaliser in lib/terrain.wgsl: in WGSL, never on the host.
 #import vista::geometry::{direction, pinhole_look_at, pinhole_ray}
-#import vista::terrain::{Light, March, Shadow, Terrain, TerrainParams, march, normal_at, surface_radiance, terrain_of}
-#import vista::enums::{VIEW_DEPTH, VIEW_NORMAL, VIEW_STEPS}
+#import vista::terrain::{Light, March, REFINE_ITERS, Shadow, Terrain, TerrainParams, march, normal_at, refine_iterations, surface_radiance, terrain_of}
+#import vista::enums::{VIEW_DEPTH, VIEW_NORMAL, VIEW_REFINE, VIEW_STEPS}
 
 struct Params {
     width: u32,
@@ -94,6 +94,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var rgb: vec3<f32>;
     if params.view == VIEW_STEPS {
         rgb = vec3(f32(m.steps) / f32(params.max_steps));
+    } else if params.view == VIEW_REFINE {
+        rgb = vec3(f32(refine_iterations) / f32(REFINE_ITERS));
     } else if params.view == VIEW_DEPTH {
         rgb = vec3(select(1.0, clamp(m.t / params.t_max, 0.0, 1.0), m.hit));
     } else if params.view == VIEW_NORMAL {

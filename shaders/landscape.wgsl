@@ -24,8 +24,8 @@
 #import vista::cloud_slab::{CloudParams, CloudSlab, cloud_march, cloud_slab, jitter_offset, layer_segment, sun_optical_depth}
 #import vista::geometry::{direction, latlong_direction, pinhole_looking, pinhole_ray}
 #import vista::sky::{Atmosphere, sky_segment, sun_transmittance_along, view_segment}
-#import vista::terrain::{Light, March, Shadow, Terrain, TerrainParams, march, surface_point, surface_radiance, terrain_of}
-#import vista::enums::{PROJECTION_LATLONG, VIEW_DEPTH}
+#import vista::terrain::{Light, March, REFINE_ITERS, Shadow, Terrain, TerrainParams, march, refine_iterations, surface_point, surface_radiance, terrain_of}
+#import vista::enums::{PROJECTION_LATLONG, VIEW_DEPTH, VIEW_REFINE}
 
 // Packed by name from kernels/landscape.toml (exposure is the host's tone map).
 struct Params {
@@ -115,6 +115,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let hit = march(s, March(params.t_max, params.relax, params.eps, params.max_steps), o, d);
     if params.view == VIEW_DEPTH {
         textureStore(output, id.xy, vec4(vec3(select(1.0, clamp(hit.t / params.t_max, 0.0, 1.0), hit.hit)), 1.0));
+        return;
+    }
+    if params.view == VIEW_REFINE {
+        textureStore(output, id.xy, vec4(vec3(f32(refine_iterations) / f32(REFINE_ITERS)), 1.0));
         return;
     }
     let sky = view_segment(air, d);

@@ -109,6 +109,11 @@ fn above(s: Terrain, o: vec3<f32>, d: vec3<f32>, t: f32) -> f32 {
     return p.y - terrain_height(s, p.xz);
 }
 
+// Evaluations of D the last refine() call made: the kernels' `refine`
+// view, which shows the refinement's cost as `steps` shows the march's
+// (0 where the march hit at its first sample or missed).
+var<private> refine_iterations: u32;
+
 // Zero of D interpolated between the last two samples a (D > 0) and b
 // (D < eps t), repeated with the newest two points until |D| <= eps t / 100:
 // secant steps while above the terrain (stop when D stops falling), Illinois
@@ -123,6 +128,7 @@ fn refine(s: Terrain, eps: f32, o: vec3<f32>, d: vec3<f32>, a0: vec2<f32>, b0: v
         if a.y <= b.y || best_d <= REFINE_TOL * eps * best_t {
             break;
         }
+        refine_iterations = i + 1u;
         let tr = b.x + b.y * (b.x - a.x) / (a.y - b.y);
         let dr = above(s, o, d, tr);
         if abs(dr) < best_d {

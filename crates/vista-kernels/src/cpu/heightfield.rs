@@ -189,6 +189,8 @@ pub struct March {
     pub t: Real,
     /// Steps taken, k.
     pub steps: u32,
+    /// Evaluations of D the hit's refinement made (0 for a miss or a hit at k = 0).
+    pub refine_iters: u32,
 }
 
 /// The relax march in Real: t_{k+1} = t_k + relax D(t_k) from t_0 = 0; hit at
@@ -197,17 +199,18 @@ pub fn relax_march(terrain: &Terrain, o: V3, d: V3, s: &MarchSettings) -> March 
     let (mut t, mut prev_t, mut prev_d) = (0.0, 0.0, 0.0);
     for k in 0..s.max_steps {
         if t > s.t_max {
-            return March { hit: false, t, steps: k };
+            return March { hit: false, t, steps: k, refine_iters: 0 };
         }
         let dh = terrain.above(o, d, t);
         if dh < s.eps * t {
-            let t = if k == 0 { t } else { refine(terrain, o, d, s.eps, (prev_t, prev_d), (t, dh)) };
-            return March { hit: true, t, steps: k };
+            let (t, refine_iters) =
+                if k == 0 { (t, 0) } else { refine(terrain, o, d, s.eps, (prev_t, prev_d), (t, dh)) };
+            return March { hit: true, t, steps: k, refine_iters };
         }
         (prev_t, prev_d) = (t, dh);
         t += s.relax * dh;
     }
-    March { hit: false, t, steps: s.max_steps }
+    March { hit: false, t, steps: s.max_steps, refine_iters: 0 }
 }
 
 /// Interpolates D linearly between the last two samples a (D > 0) and b
@@ -217,15 +220,18 @@ pub fn relax_march(terrain: &Terrain, o: V3, d: V3, s: &MarchSettings) -> March 
 /// Illinois false position once a point went under it, so the sign change
 /// is kept. The point with the smallest |D| seen is the hit; b itself
 /// already has |D| < eps t unless the last march step went under the terrain.
-pub fn refine(terrain: &Terrain, o: V3, d: V3, eps: Real, a: (Real, Real), b: (Real, Real)) -> Real {
+/// Returns the hit and the number of evaluations of D it took.
+pub fn refine(terrain: &Terrain, o: V3, d: V3, eps: Real, a: (Real, Real), b: (Real, Real)) -> (Real, u32) {
     let ((mut ta, mut da), (mut tb, mut db)) = (a, b);
     let (mut best_t, mut best_d) = (tb, db.abs());
     // +1: the last false-position step replaced a (b kept), -1: it replaced b.
     let mut last = 0;
+    let mut evaluations = 0;
     for _ in 0..REFINE_ITERS {
         if da <= db || best_d <= REFINE_TOL * eps * best_t {
             break;
         }
+        evaluations += 1;
         let tr = tb + db * (tb - ta) / (da - db);
         let dr = terrain.above(o, d, tr);
         if dr.abs() < best_d {
@@ -253,7 +259,7 @@ pub fn refine(terrain: &Terrain, o: V3, d: V3, eps: Real, a: (Real, Real), b: (R
             last = -1;
         }
     }
-    best_t
+    (best_t, evaluations)
 }
 
 /// Brute-force first hit in Real under the same hit rule as the march (the
@@ -448,7 +454,7 @@ pub struct Scene {
     pub camera: Camera,
     /// The relax march settings (also `t_max` and `eps` of the oracle).
     pub march: MarchSettings,
-    /// The `view` param: `color`, `depth`, `steps` or `normal`.
+    /// The `view` param: `color`, `depth`, `steps`, `normal` or `refine`.
     pub view: &'static str,
     /// Unit direction toward the sun.
     pub sun: V3,
@@ -476,7 +482,7 @@ impl Scene {
             camera,
             march: MarchSettings::from_params(p),
             // Every view the manifest lists; "color" is the match arms' last.
-            view: p.choice_in("view", &[("color", "color"), ("depth", "depth"), ("steps", "steps"), ("normal", "normal")]),
+            view: p.choice_in("view", &[("color", "color"), ("depth", "depth"), ("steps", "steps"), ("normal", "normal"), ("refine", "refine")]),
             sun: sun_direction(real(p, "sun_azimuth_deg"), real(p, "sun_elevation_deg")),
             shadow_steps: p.u32("shadow_steps"),
             shadow_distance: real(p, "shadow_distance"),
@@ -511,13 +517,16 @@ impl Scene {
     }
 
     /// The raw output of one pixel with hits found by `search`. The `steps`
-    /// view always shows the relax march, whose step count it is.
+    /// and `refine` views always show the relax march, whose costs they are.
     pub fn pixel_with(&self, u: Real, v: Real, search: HitSearch) -> [Real; 4] {
         let d = self.camera.ray(u, v);
         let o = self.camera.pos;
-        if self.view == "steps" {
+        if self.view == "steps" || self.view == "refine" {
             let m = relax_march(&self.terrain, o, d, &self.march);
-            let s = m.steps as Real / self.march.max_steps as Real;
+            let s = match self.view {
+                "steps" => m.steps as Real / self.march.max_steps as Real,
+                _ => m.refine_iters as Real / REFINE_ITERS as Real,
+            };
             return [s, s, s, 1.0];
         }
         let hit = match search {

@@ -13,7 +13,7 @@ use super::heightfield::{
 };
 use super::{Real, Vec3, pixel_uv, real, real3, render_cpu};
 use crate::ParamSet;
-use crate::heightfield::{BRUTE_STEPS, HitSearch};
+use crate::heightfield::{BRUTE_STEPS, HitSearch, REFINE_ITERS};
 use vista_image::Image;
 
 /// Metres per kilometre: the scene is in km, the atmosphere in m.
@@ -42,6 +42,8 @@ pub struct Landscape {
     pub latlong: bool,
     /// `view = depth`: t / t_max of the terrain hit, 1 without one.
     pub depth: bool,
+    /// `view = refine`: the relax march's refinement evaluations / 16.
+    pub refine: bool,
     /// Unit direction toward the sun (azimuth from +z toward +x, elevation above the horizon).
     pub sun_dir: V3,
     /// E_sun: the sun's irradiance above the atmosphere.
@@ -97,7 +99,8 @@ impl Landscape {
             clouds,
             view,
             latlong: p.choice_in("projection", &[("pinhole", false), ("latlong", true)]),
-            depth: p.choice_in("view", &[("color", false), ("depth", true)]),
+            depth: p.choice_in("view", &[("color", false), ("depth", true), ("refine", false)]),
+            refine: p.choice_in("view", &[("color", false), ("depth", false), ("refine", true)]),
             sun_dir,
             sun_intensity,
         }
@@ -142,6 +145,10 @@ impl Landscape {
     /// The raw output of pixel (x, y) with terrain hits found by `search`.
     pub fn pixel(&self, x: u32, y: u32, width: u32, height: u32, search: HitSearch) -> [Real; 4] {
         let (o, d) = self.ray(x, y, width, height);
+        if self.refine {
+            let r = relax_march(&self.terrain, o, d, &self.march).refine_iters as Real / REFINE_ITERS as Real;
+            return [r, r, r, 1.0];
+        }
         let hit = match search {
             HitSearch::BruteForce => brute_force_hit(&self.terrain, o, d, self.march.t_max, self.march.eps, BRUTE_STEPS),
             HitSearch::RelaxMarch => Some(relax_march(&self.terrain, o, d, &self.march)).filter(|m| m.hit).map(|m| m.t),
