@@ -179,6 +179,9 @@ impl Checker<'_> {
     /// earlier one are done.
     pub fn check_all(&self, picked: &[&Case], jobs: usize, mut each: impl FnMut(&Filed)) -> Vec<Filed> {
         let jobs = self.jobs(jobs, picked.len());
+        // Cores the jobs leave idle go to each case's FLIP and report images.
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        vista_image::set_case_threads(cores / jobs);
         let mut out = Vec::with_capacity(picked.len());
         // The device serialises the workers' GPU runs while the others plan,
         // judge and write their report folder.

@@ -34,6 +34,9 @@ pub struct Checked {
     pub actual: Option<Image>,
     /// The golden's values, when it could be read.
     pub expected: Option<Image>,
+    /// With `expected`: the golden PNG's bytes, which decode to it (the
+    /// report copies them rather than encode it again).
+    pub expected_png: Option<Vec<u8>>,
     /// The manifest entry a bless of this very render would write (its
     /// `golden_hash` is set once the PNG is written): what the report's
     /// `pending.toml` keeps for `vista bless --from-report`.
@@ -160,6 +163,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
                 outcome,
                 actual: None,
                 expected: None,
+                expected_png: None,
                 pending: None,
                 pending_files: Vec::new(),
                 output_images: Vec::new(),
@@ -169,19 +173,28 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         }
     };
     let has_image = r.raw.width > 0;
-    // Hashed once: at 1920 x 1080 each pass over the raw bits costs ~0.1 s.
-    let raw_hash = r.raw.content_hash();
     // Each texture output's display values as a 16-bit PNG holds them,
     // made once: the verdict compares them and the report shows them.
-    let mut views: Vec<Option<Image>> = r
-        .outputs
-        .iter()
-        .enumerate()
-        .map(|(i, o)| match i {
-            0 => has_image.then(|| quantize16(r.display())),
-            _ => o.display().map(|d| quantize16(&d)),
-        })
-        .collect();
+    let make_views = || -> Vec<Option<Image>> {
+        r.outputs
+            .iter()
+            .enumerate()
+            .map(|(i, o)| match i {
+                0 => has_image.then(|| quantize16(r.display())),
+                _ => o.display().map(|d| quantize16(&d)),
+            })
+            .collect()
+    };
+    // Hashed once: at 1920 x 1080 each pass over the raw bits costs ~0.03 s;
+    // beside the views where the jobs leave a core idle.
+    let (raw_hash, mut views) = match vista_image::case_threads() > 1 {
+        true => std::thread::scope(|s| {
+            let hash = s.spawn(|| r.raw.content_hash());
+            let views = make_views();
+            (hash.join().expect("hashing the render"), views)
+        }),
+        false => (r.raw.content_hash(), make_views()),
+    };
     let deterministic = case.kernel.graph().deterministic;
     let gathered = (|| -> Result<_, String> {
         let repeat_identical = match opts.twice && deterministic && !as_blessed(entry, &run, &raw_hash) {
@@ -247,6 +260,8 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     };
     let images = opts.images_of_passing || !out.passed();
     let expected = golden_files.first().filter(|_| images).and_then(|g| g.view()).cloned();
+    let expected_png =
+        golden_files.first().filter(|_| expected.is_some()).and_then(|g| g.png_bytes()).map(<[u8]>::to_vec);
     let output_images = r
         .outputs
         .iter()
@@ -269,6 +284,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         outcome: out,
         actual: views.into_iter().next().flatten(),
         expected,
+        expected_png,
         pending,
         pending_files,
         output_images,

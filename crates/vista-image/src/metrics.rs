@@ -74,10 +74,88 @@ pub fn flip_mean(reference: &Image, actual: &Image) -> f64 {
     if w == 0 || h == 0 {
         return 0.0;
     }
-    let r = nv_flip::FlipImageRgb8::with_data(w, h, &rgb8(reference));
-    let a = nv_flip::FlipImageRgb8::with_data(w, h, &rgb8(actual));
-    let errors = nv_flip::flip(r, a, FLIP_PIXELS_PER_DEGREE);
-    f64::from(nv_flip::FlipPool::from_image(&errors).mean())
+    let errors = flip_error_sums(w, h, &rgb8(reference), &rgb8(actual), crate::case_threads());
+    // Summed in f64 (FLIP's own pool sums in f32, which drifts over millions
+    // of pixels).
+    errors.iter().sum::<f64>() / (f64::from(w) * f64::from(h))
+}
+
+/// Rows of context a strip of [`flip_strips`] takes past each of its ends.
+/// FLIP's widest filter (its colour CSF) reaches ceil(3 sqrt(0.04 / (2
+/// pi^2)) ppd) = 10 pixels at 67 pixels per degree, its feature filters 9
+/// (measured: 10 rows is the least that keeps every bit).
+const FLIP_HALO: usize = 16;
+
+/// Most rows per FLIP strip: FLIP holds about 76 bytes per pixel of its
+/// own, so a 2048 x 2048 image in one piece took 320 MB; strips of at most
+/// 576 rows, two at once, take 180 MB, for 6% more rows computed.
+const FLIP_STRIP: usize = 576;
+
+/// FLIP's per-pixel errors of two `w` x `h` RGB8 images, computed in
+/// horizontal strips of at most [`FLIP_STRIP`] rows, `threads` at once
+/// (FLIP is single-threaded C++; a failing 1080p case spent most of its own
+/// time here), each handed to `take`, the results top to bottom. Each strip
+/// is computed with [`FLIP_HALO`] rows of context at each end, whose errors
+/// are dropped, so every pixel's error is bit for bit the one of the whole
+/// image.
+fn flip_strips<T: Send>(
+    w: u32,
+    h: u32,
+    reference: &[u8],
+    actual: &[u8],
+    threads: usize,
+    take: impl Fn(&[f32]) -> T + Sync,
+) -> Vec<T> {
+    // Equal strips, a multiple of the threads: no thread waits on a short one.
+    let (height, threads) = (h as usize, threads.max(1));
+    let strips = threads * height.div_ceil(threads * FLIP_STRIP);
+    flip_strips_of(w, h, reference, actual, height.div_ceil(strips.max(1)), threads, take)
+}
+
+fn flip_strips_of<T: Send>(
+    w: u32,
+    h: u32,
+    reference: &[u8],
+    actual: &[u8],
+    rows: usize,
+    threads: usize,
+    take: impl Fn(&[f32]) -> T + Sync,
+) -> Vec<T> {
+    let (width, height) = (w as usize, h as usize);
+    let row = width * 3;
+    let strip = |y0: usize| {
+        let y1 = (y0 + rows).min(height);
+        let (c0, c1) = (y0.saturating_sub(FLIP_HALO), (y1 + FLIP_HALO).min(height));
+        let image = |d: &[u8]| nv_flip::FlipImageRgb8::with_data(w, (c1 - c0) as u32, &d[c0 * row..c1 * row]);
+        let errors = nv_flip::flip(image(reference), image(actual), FLIP_PIXELS_PER_DEGREE).to_vec();
+        take(&errors[(y0 - c0) * width..(y1 - c0) * width])
+    };
+    let starts: Vec<usize> = (0..height.max(1)).step_by(rows.max(1)).collect();
+    let mut out = Vec::with_capacity(starts.len());
+    for group in starts.chunks(threads.max(1)) {
+        if group.len() == 1 {
+            out.push(strip(group[0]));
+            continue;
+        }
+        std::thread::scope(|s| {
+            let strip = &strip;
+            let parts: Vec<_> = group.iter().map(|&y0| s.spawn(move || strip(y0))).collect();
+            out.extend(parts.into_iter().map(|p| p.join().expect("a FLIP strip")));
+        });
+    }
+    if threads > 1 {
+        crate::threads::release_freed_memory();
+    }
+    out
+}
+
+/// The sum of FLIP's per-pixel errors in each row, top to bottom (see
+/// [`flip_strips`]; by row, so that the mean does not depend on the strips).
+fn flip_error_sums(w: u32, h: u32, reference: &[u8], actual: &[u8], threads: usize) -> Vec<f64> {
+    let row_sums = |e: &[f32]| -> Vec<f64> {
+        e.chunks(w.max(1) as usize).map(|row| row.iter().map(|&v| f64::from(v)).sum()).collect()
+    };
+    flip_strips(w, h, reference, actual, threads, row_sums).concat()
 }
 
 /// All metrics with a PSNR peak of 1 (LDR data in `[0, 1]`).
@@ -202,12 +280,27 @@ pub fn format_psnr(psnr: f64) -> String {
 }
 
 fn all_metrics(reference: &Image, actual: &Image, peak: f64) -> Metrics {
-    let mse = mse(reference, actual);
+    // One pass for the squared error, the largest difference and the bad
+    // pixels (the same values as mse, max_abs and bad_pixels, summed in the
+    // same order).
+    let (mut sum, mut max, mut bad) = (0.0, 0.0, 0u64);
+    for (p, q) in reference.data.iter().zip(&actual.data) {
+        let mut is_bad = false;
+        for c in 0..3 {
+            let d = abs_diff(p[c], q[c]);
+            sum += if d.is_finite() { d * d } else { 1.0 };
+            max = f64::max(max, d);
+            is_bad |= d > BAD_PIXEL_THRESHOLD;
+        }
+        bad += u64::from(is_bad);
+    }
+    let n = reference.data.len() * 3;
+    let mse = if n == 0 { 0.0 } else { sum / n as f64 };
     Metrics {
         psnr: psnr_from_mse(mse, peak),
         ssim: ssim(reference, actual),
-        max_abs: max_abs(reference, actual),
-        bad_pixels: bad_pixels(reference, actual),
+        max_abs: max,
+        bad_pixels: bad,
         nan: actual.nonfinite_count(),
         mse,
         flip_mean: None,
@@ -300,6 +393,55 @@ mod float_repr {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn one_pass_metrics_are_the_separate_ones() {
+        let (w, h) = (13u32, 7u32);
+        let pixel = |i: u32, k: f32| {
+            let v = ((i as f32 * k).sin() * 0.5 + 0.5).clamp(0.0, 1.0);
+            [v, 1.0 - v, v * v, 1.0]
+        };
+        let a = Image { width: w, height: h, data: (0..w * h).map(|i| pixel(i, 0.7)).collect() };
+        let mut b = Image { width: w, height: h, data: (0..w * h).map(|i| pixel(i, 0.71)).collect() };
+        b.data[3][1] = f32::NAN;
+        b.data[5][0] = f32::INFINITY;
+        let m = all_metrics(&a, &b, 1.0);
+        assert_eq!(m.mse.to_bits(), mse(&a, &b).to_bits());
+        assert_eq!(m.max_abs.to_bits(), max_abs(&a, &b).to_bits());
+        assert_eq!(m.bad_pixels, bad_pixels(&a, &b));
+        assert!(m.bad_pixels > 2 && m.max_abs == f64::INFINITY);
+    }
+
+    #[test]
+    fn flip_in_strips_is_the_whole_image_bit_for_bit() {
+        // Noise with edges, so that the features and the colour filters both
+        // see strip boundaries.
+        let (w, h) = (97u32, 403u32);
+        let mut state = 12345u32;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state >> 24) as u8
+        };
+        let reference: Vec<u8> = (0..w * h * 3).map(|_| next()).collect();
+        let actual: Vec<u8> = reference
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| if i % 7 == 0 { v.wrapping_add(next() % 40) } else { v })
+            .collect();
+        let errors = |rows, threads| flip_strips_of(w, h, &reference, &actual, rows, threads, <[f32]>::to_vec).concat();
+        let whole = errors(h as usize, 1);
+        assert_eq!(whole.len(), (w * h) as usize);
+        assert!(whole.iter().any(|&e| e > 0.0));
+        for (rows, threads) in [(202, 1), (202, 2), (134, 3), (40, 2)] {
+            let parts = errors(rows, threads);
+            let same = whole.iter().zip(&parts).all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(same && parts.len() == whole.len(), "strips of {rows} rows, {threads} at once, differ");
+        }
+        let sums = |threads| flip_error_sums(w, h, &reference, &actual, threads).iter().sum::<f64>();
+        assert_eq!(sums(1).to_bits(), sums(3).to_bits(), "the mean depends on the threads");
+    }
+
     use super::*;
 
     /// The shortcut for identical images says what the full passes say

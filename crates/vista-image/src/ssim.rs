@@ -37,43 +37,76 @@ fn gaussian_kernel() -> [f64; WIN] {
     k.map(|v| v / sum)
 }
 
+/// Output rows of the SSIM map per band: the map is made band by band, so
+/// its memory is a few rows of the image, not five filtered planes of it
+/// (at 2048 x 2048 those were 170 MB).
+const BAND: usize = 64;
+
 fn windowed_ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
     let k = gaussian_kernel();
-    let filter = |plane: &[f64]| filter_valid(plane, w, h, &k);
-    let product = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(p, q)| p * q).collect() };
-    let mx = filter(x);
-    let my = filter(y);
-    let mxx = filter(&product(x, x));
-    let myy = filter(&product(y, y));
-    let mxy = filter(&product(x, y));
-    let total: f64 = (0..mx.len()).map(|i| ssim_from_moments(&[mx[i], my[i], mxx[i], myy[i], mxy[i]])).sum();
-    total / mx.len() as f64
+    let oh = h - 2 * RADIUS;
+    let bands: Vec<(usize, usize)> = (0..oh).step_by(BAND).map(|r0| (r0, (r0 + BAND).min(oh))).collect();
+    let band = |&(r0, r1): &(usize, usize)| band_values(x, y, w, &k, r0, r1);
+    // Summed in row-major order whatever the threads, as one running sum.
+    let mut total = 0.0;
+    let threads = crate::case_threads().min(bands.len()).max(1);
+    for group in bands.chunks(threads) {
+        let values: Vec<Vec<f64>> = match group.len() {
+            1 => vec![band(&group[0])],
+            _ => std::thread::scope(|s| {
+                let handles: Vec<_> = group.iter().map(|b| s.spawn(move || band(b))).collect();
+                handles.into_iter().map(|h| h.join().expect("an SSIM band")).collect()
+            }),
+        };
+        for v in values.iter().flatten() {
+            total += v;
+        }
+    }
+    total / (oh * (w - 2 * RADIUS)) as f64
 }
 
-/// Separable Gaussian filter of a `w x h` plane, evaluated only where the
-/// whole window fits: returns `(w - 10) x (h - 10)` values. Both passes run
-/// over contiguous row slices so the inner loops stay simple and fast.
-fn filter_valid(src: &[f64], w: usize, h: usize, k: &[f64; WIN]) -> Vec<f64> {
+/// The SSIM map's values on output rows `r0..r1` (row-major): the separable
+/// Gaussian of the five moment planes over input rows `r0..r1 + 10`, each
+/// pass adding its taps in the same order as a whole-image filter would, so
+/// every value is bit for bit the whole image's.
+fn band_values(x: &[f64], y: &[f64], w: usize, k: &[f64; WIN], r0: usize, r1: usize) -> Vec<f64> {
     let ow = w - 2 * RADIUS;
-    let oh = h - 2 * RADIUS;
-    let mut rows = vec![0.0; h * ow];
-    for (row, out) in src.chunks_exact(w).zip(rows.chunks_exact_mut(ow)) {
-        for (t, &kt) in k.iter().enumerate() {
-            for (o, &v) in out.iter_mut().zip(&row[t..t + ow]) {
-                *o += kt * v;
+    let rows_in = r1 - r0 + 2 * RADIUS;
+    // Horizontal pass: the five planes' rows, filtered where the window fits.
+    let mut across = vec![vec![0.0; rows_in * ow]; 5];
+    let mut products = [vec![0.0; w], vec![0.0; w], vec![0.0; w]];
+    for j in 0..rows_in {
+        let (rx, ry) = (&x[(r0 + j) * w..][..w], &y[(r0 + j) * w..][..w]);
+        for i in 0..w {
+            products[0][i] = rx[i] * rx[i];
+            products[1][i] = ry[i] * ry[i];
+            products[2][i] = rx[i] * ry[i];
+        }
+        let planes: [&[f64]; 5] = [rx, ry, &products[0], &products[1], &products[2]];
+        for (plane, dst) in planes.iter().zip(across.iter_mut()) {
+            let out = &mut dst[j * ow..][..ow];
+            for (t, &kt) in k.iter().enumerate() {
+                for (o, &v) in out.iter_mut().zip(&plane[t..t + ow]) {
+                    *o += kt * v;
+                }
             }
         }
     }
-    let mut out = vec![0.0; oh * ow];
-    for (r, dst) in out.chunks_exact_mut(ow).enumerate() {
-        for (t, &kt) in k.iter().enumerate() {
-            let src_row = &rows[(r + t) * ow..(r + t + 1) * ow];
-            for (o, &v) in dst.iter_mut().zip(src_row) {
-                *o += kt * v;
+    // Vertical pass, one output row at a time, and the map's values.
+    let mut values = Vec::with_capacity((r1 - r0) * ow);
+    let mut m = vec![vec![0.0; ow]; 5];
+    for r in 0..r1 - r0 {
+        for (dst, src) in m.iter_mut().zip(&across) {
+            dst.fill(0.0);
+            for (t, &kt) in k.iter().enumerate() {
+                for (o, &v) in dst.iter_mut().zip(&src[(r + t) * ow..][..ow]) {
+                    *o += kt * v;
+                }
             }
         }
+        values.extend((0..ow).map(|i| ssim_from_moments(&[m[0][i], m[1][i], m[2][i], m[3][i], m[4][i]])));
     }
-    out
+    values
 }
 
 /// One window over the whole image with uniform weights.
@@ -107,6 +140,55 @@ fn ssim_from_moments(m: &Moments) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The whole-image form the bands replaced: five filtered planes.
+    fn whole_image_ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
+        let k = gaussian_kernel();
+        let filter = |plane: &[f64]| filter_valid(plane, w, h, &k);
+        let product = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(p, q)| p * q).collect() };
+        let (mx, my) = (filter(x), filter(y));
+        let (mxx, myy, mxy) = (filter(&product(x, x)), filter(&product(y, y)), filter(&product(x, y)));
+        let total: f64 = (0..mx.len()).map(|i| ssim_from_moments(&[mx[i], my[i], mxx[i], myy[i], mxy[i]])).sum();
+        total / mx.len() as f64
+    }
+
+    fn filter_valid(src: &[f64], w: usize, h: usize, k: &[f64; WIN]) -> Vec<f64> {
+        let (ow, oh) = (w - 2 * RADIUS, h - 2 * RADIUS);
+        let mut rows = vec![0.0; h * ow];
+        for (row, out) in src.chunks_exact(w).zip(rows.chunks_exact_mut(ow)) {
+            for (t, &kt) in k.iter().enumerate() {
+                for (o, &v) in out.iter_mut().zip(&row[t..t + ow]) {
+                    *o += kt * v;
+                }
+            }
+        }
+        let mut out = vec![0.0; oh * ow];
+        for (r, dst) in out.chunks_exact_mut(ow).enumerate() {
+            for (t, &kt) in k.iter().enumerate() {
+                for (o, &v) in dst.iter_mut().zip(&rows[(r + t) * ow..(r + t + 1) * ow]) {
+                    *o += kt * v;
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn bands_give_the_whole_image_bits_on_any_threads() {
+        // Heights around the band size, so that the last band is short, full
+        // or a single row.
+        for (w, h) in [(37, 11), (23, 74), (41, 75), (19, 150), (64, 203)] {
+            let x: Vec<f64> = (0..w * h).map(|i| ((i as f64 * 0.37).sin() * 0.5 + 0.5).powi(2)).collect();
+            let y: Vec<f64> = (0..w * h).map(|i| (i as f64 * 0.11).cos() * 0.4 + 0.5).collect();
+            let whole = whole_image_ssim(&x, &y, w, h);
+            for threads in [1, 2, 3] {
+                crate::set_case_threads(threads);
+                let banded = ssim(&x, &y, w, h);
+                assert_eq!(banded.to_bits(), whole.to_bits(), "{w}x{h}, {threads} threads: {banded} vs {whole}");
+            }
+        }
+        crate::set_case_threads(1);
+    }
 
     #[test]
     fn kernel_is_normalised_and_symmetric() {

@@ -1,0 +1,30 @@
+//! How many threads one comparison may use beside its caller's: FLIP's
+//! strips and a failing case's report images. The check driver sets it
+//! from the cores its jobs leave (`check --jobs 1` on two cores: 2); 1
+//! (everything on the calling thread) until something sets it.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+static CASE_THREADS: AtomicUsize = AtomicUsize::new(1);
+
+/// Lets each comparison use `n` threads (at least 1) from now on.
+pub fn set_case_threads(n: usize) {
+    CASE_THREADS.store(n.max(1), Ordering::Relaxed);
+}
+
+/// The threads one comparison may use.
+pub fn case_threads() -> usize {
+    CASE_THREADS.load(Ordering::Relaxed)
+}
+
+/// Hands the memory that helper threads freed back to the system: glibc
+/// keeps it in each thread's arena, where the next case's buffers, made on
+/// the job's own thread, do not reuse it (measured: 78 MB more peak memory
+/// at 1920 x 1080 without this).
+pub(crate) fn release_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free pages of the allocator's arenas.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
