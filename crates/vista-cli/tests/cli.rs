@@ -532,6 +532,36 @@ fn a_render_unlike_the_bless_time_bits_fails_check() {
     assert!(r.stdout.contains("not bit-identical with the bless-time render"), "{}", r.stdout);
 }
 
+/// A failing case big enough for the idle core (512 x 512, `--jobs 1`):
+/// the report's images, written in two groups at once, are each what they
+/// should be: the golden PNG copied as it is, the render and heat map
+/// decodable at full size, the viewer's data both images' 16-bit values.
+fn a_large_failing_case_gets_each_report_file_right() {
+    let cases = "[[case]]\nid = \"big\"\nkernel = \"fbm\"\nsize = \"512x512\"\n";
+    let d = golden_dir(cases);
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    std::fs::write(cases_path(d.path()), format!("{cases}set = {{ seed = 9 }}\n")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["check", "--jobs", "1"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    let dir = report(d.path()).join("big");
+    let golden_png = std::fs::read(golden(d.path(), "fbm", "big")).unwrap();
+    assert_eq!(std::fs::read(dir.join("expected.png")).unwrap(), golden_png, "expected.png is the golden file");
+    for f in ["actual.png", "actual8.png", "expected8.png", "diff.png", "diff8.png"] {
+        let img = vista_image::load(&dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        assert_eq!((img.width, img.height), (512, 512), "{f}");
+    }
+    let actual = vista_image::read_png16(&dir.join("actual.png")).unwrap();
+    let expected = vista_image::read_png16(&dir.join("expected.png")).unwrap();
+    let js = std::fs::read_to_string(dir.join("view.js")).unwrap();
+    assert_eq!(js, vista_report::view_js("big", Some(&expected), &actual, first_bad(&js)));
+}
+
+/// The first bad pixel a view.js names.
+fn first_bad(js: &str) -> Option<(u32, u32)> {
+    let v: serde_json::Value = serde_json::from_str(&js["vistaCase(".len()..js.len() - 3]).unwrap();
+    v["first_bad"].as_array().map(|a| (a[0].as_u64().unwrap() as u32, a[1].as_u64().unwrap() as u32))
+}
+
 fn a_changed_render_fails_check_with_metrics_and_images() {
     let d = golden_dir(CASES);
     assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
@@ -5731,6 +5761,7 @@ fn main() {
         Gpu a_foreign_import_path_composes_and_is_named_when_edited,
         Gpu unwritten_texels_fail_unless_the_output_is_partial,
         Gpu a_changed_render_fails_check_with_metrics_and_images,
+        Gpu a_large_failing_case_gets_each_report_file_right,
         Gpu a_render_unlike_the_bless_time_bits_fails_check,
         Gpu corrupt_and_wrong_size_goldens_fail_clearly,
         Cpu malformed_cases_toml_names_the_line,

@@ -187,7 +187,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
     };
     // Hashed once: at 1920 x 1080 each pass over the raw bits costs ~0.03 s;
     // beside the views where the jobs leave a core idle.
-    let (raw_hash, mut views) = match vista_image::case_threads() > 1 {
+    let (raw_hash, mut views) = match vista_image::threads_for(r.raw.data.len()) > 1 {
         true => std::thread::scope(|s| {
             let hash = s.spawn(|| r.raw.content_hash());
             let views = make_views();

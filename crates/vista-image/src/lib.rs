@@ -42,5 +42,5 @@ pub use io::{
     encode_png16_small, load, quantize8, quantize16, read_exr, read_png16, remove_stale_temps, save, write_exr,
     write_png8, write_png16,
 };
-pub use threads::{case_threads, set_case_threads};
+pub use threads::{case_threads, set_case_threads, threads_for};
 pub use tonemap::{srgb_encode, tonemap};

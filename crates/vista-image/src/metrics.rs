@@ -68,13 +68,18 @@ pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
 pub fn flip_mean(reference: &Image, actual: &Image) -> f64 {
     assert_same_size(reference, actual);
     let rgb8 = |img: &Image| -> Vec<u8> {
-        img.data.iter().flat_map(|p| p[..3].iter().map(|&v| crate::quantize8(v))).collect()
+        let mut out = Vec::with_capacity(img.data.len() * 3);
+        for p in &img.data {
+            out.extend_from_slice(&[crate::quantize8(p[0]), crate::quantize8(p[1]), crate::quantize8(p[2])]);
+        }
+        out
     };
     let (w, h) = reference.dimensions();
     if w == 0 || h == 0 {
         return 0.0;
     }
-    let errors = flip_error_sums(w, h, &rgb8(reference), &rgb8(actual), crate::case_threads());
+    let threads = crate::threads_for(reference.data.len());
+    let errors = flip_error_sums(w, h, &rgb8(reference), &rgb8(actual), threads);
     // Summed in f64 (FLIP's own pool sums in f32, which drifts over millions
     // of pixels).
     errors.iter().sum::<f64>() / (f64::from(w) * f64::from(h))

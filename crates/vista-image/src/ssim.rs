@@ -23,7 +23,12 @@ type Moments = [f64; 5];
 pub(crate) fn ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
     debug_assert_eq!(x.len(), w * h);
     debug_assert_eq!(y.len(), w * h);
-    if w >= WIN && h >= WIN { windowed_ssim(x, y, w, h) } else { global_ssim(x, y) }
+    ssim_on(x, y, w, h, crate::threads_for(x.len()))
+}
+
+/// [`ssim`] with the windowed map's bands on up to `threads` threads.
+fn ssim_on(x: &[f64], y: &[f64], w: usize, h: usize, threads: usize) -> f64 {
+    if w >= WIN && h >= WIN { windowed_ssim(x, y, w, h, threads) } else { global_ssim(x, y) }
 }
 
 /// Normalised 11-tap Gaussian, as `scipy.ndimage.gaussian_filter` builds it.
@@ -42,14 +47,14 @@ fn gaussian_kernel() -> [f64; WIN] {
 /// (at 2048 x 2048 those were 170 MB).
 const BAND: usize = 64;
 
-fn windowed_ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
+fn windowed_ssim(x: &[f64], y: &[f64], w: usize, h: usize, threads: usize) -> f64 {
     let k = gaussian_kernel();
     let oh = h - 2 * RADIUS;
     let bands: Vec<(usize, usize)> = (0..oh).step_by(BAND).map(|r0| (r0, (r0 + BAND).min(oh))).collect();
     let band = |&(r0, r1): &(usize, usize)| band_values(x, y, w, &k, r0, r1);
     // Summed in row-major order whatever the threads, as one running sum.
     let mut total = 0.0;
-    let threads = crate::case_threads().min(bands.len()).max(1);
+    let threads = threads.min(bands.len()).max(1);
     for group in bands.chunks(threads) {
         let values: Vec<Vec<f64>> = match group.len() {
             1 => vec![band(&group[0])],
@@ -182,12 +187,10 @@ mod tests {
             let y: Vec<f64> = (0..w * h).map(|i| (i as f64 * 0.11).cos() * 0.4 + 0.5).collect();
             let whole = whole_image_ssim(&x, &y, w, h);
             for threads in [1, 2, 3] {
-                crate::set_case_threads(threads);
-                let banded = ssim(&x, &y, w, h);
+                let banded = ssim_on(&x, &y, w, h, threads);
                 assert_eq!(banded.to_bits(), whole.to_bits(), "{w}x{h}, {threads} threads: {banded} vs {whole}");
             }
         }
-        crate::set_case_threads(1);
     }
 
     #[test]

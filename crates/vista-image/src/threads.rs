@@ -17,6 +17,15 @@ pub fn case_threads() -> usize {
     CASE_THREADS.load(Ordering::Relaxed)
 }
 
+/// Images under this many pixels stay on one thread: starting threads
+/// costs more than their work (a 32 x 32 case's whole check is ~1 ms).
+const PARALLEL_FROM_PIXELS: usize = 1 << 18;
+
+/// The threads one comparison of `pixels` pixels may use.
+pub fn threads_for(pixels: usize) -> usize {
+    if pixels < PARALLEL_FROM_PIXELS { 1 } else { case_threads() }
+}
+
 /// Hands the memory that helper threads freed back to the system: glibc
 /// keeps it in each thread's arena, where the next case's buffers, made on
 /// the job's own thread, do not reuse it (measured: 78 MB more peak memory

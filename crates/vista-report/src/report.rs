@@ -333,7 +333,7 @@ pub fn write_case_files(
     // leave idle take half of it (measured at 1080p: the render's images
     // and the viewer's data 0.18 s, the golden's copies and the heat map's
     // 0.18 s).
-    let (r, g, h, v) = if vista_image::case_threads() > 1 {
+    let (r, g, h, v) = if vista_image::threads_for(actual.data.len()) > 1 {
         std::thread::scope(|s| {
             let other = s.spawn(|| (goldens(), heat_map()));
             let (r, v) = (renders(), viewer());
