@@ -102,6 +102,10 @@ pub(crate) mod words {
 
     pub fn serialize<S: Serializer>(v: &[u32], s: S) -> Result<S::Ok, S::Error> {
         let write = |buf: &mut Vec<u8>| {
+            // A noise kernel's 256 KiB table per case: one copy, not 65,536.
+            #[cfg(target_endian = "little")]
+            buf.extend_from_slice(bytemuck::cast_slice(v));
+            #[cfg(not(target_endian = "little"))]
             for w in v {
                 buf.extend_from_slice(&w.to_le_bytes());
             }

@@ -93,6 +93,21 @@ enum ToWorker {
     },
 }
 
+/// [`ToWorker::Run`] as the parent sends it: borrowed, so that a request
+/// does not copy the graph's tables (serialized the same way).
+#[derive(Serialize)]
+enum RunRequest<'a> {
+    Run {
+        source: &'a ShaderSource,
+        resources: &'a [vista_gpu::Resource],
+        passes: &'a [vista_gpu::GraphPass],
+        outputs: &'a [usize],
+        hashes: Vec<String>,
+        time_passes: bool,
+        fault: Option<Fault>,
+    },
+}
+
 #[derive(Serialize, Deserialize)]
 enum FromWorker {
     Ready,
@@ -466,11 +481,11 @@ impl Worker {
         };
         let fault = self.fault.as_ref().filter(|(_, c)| Some(c.as_str()) == case).map(|(f, _)| f.clone());
         let hashes = graph.passes.iter().map(|p| graph.shaders.source_hash(&p.shader)).collect::<Result<_, _>>()?;
-        let request = ToWorker::Run {
-            source: source.clone(),
-            resources: graph.resources.clone(),
-            passes: graph.passes.clone(),
-            outputs: graph.outputs.clone(),
+        let request = RunRequest::Run {
+            source,
+            resources: &graph.resources,
+            passes: &graph.passes,
+            outputs: &graph.outputs,
             hashes,
             time_passes: ctx.timing_passes(),
             fault,
