@@ -12,6 +12,7 @@
 //! then a little-endian u64 length and that many bytes (a run's outputs,
 //! raw: texels as f32 RGBA, buffers as they are).
 
+use std::borrow::Cow;
 use std::io::{BufReader, Read, Write};
 use std::path::PathBuf;
 use std::process::{Child, ChildStdin, Command, Stdio};
@@ -77,31 +78,19 @@ struct WireConfig {
     wgpu_backends: Option<String>,
 }
 
+/// A request to the worker. The parent sends the graph borrowed (a noise
+/// kernel's 256 KiB table per case is not copied); the worker reads it
+/// owned.
 #[derive(Serialize, Deserialize)]
-enum ToWorker {
+enum ToWorker<'a> {
     Init(WireConfig),
     Run {
-        source: ShaderSource,
-        resources: Vec<vista_gpu::Resource>,
-        passes: Vec<vista_gpu::GraphPass>,
-        outputs: Vec<usize>,
+        source: Cow<'a, ShaderSource>,
+        resources: Cow<'a, [vista_gpu::Resource]>,
+        passes: Cow<'a, [vista_gpu::GraphPass]>,
+        outputs: Cow<'a, [usize]>,
         /// Each pass's source hash in the parent's set: a worker whose set
         /// differs (a file saved since it read the project) reads it again.
-        hashes: Vec<String>,
-        time_passes: bool,
-        fault: Option<Fault>,
-    },
-}
-
-/// [`ToWorker::Run`] as the parent sends it: borrowed, so that a request
-/// does not copy the graph's tables (serialized the same way).
-#[derive(Serialize)]
-enum RunRequest<'a> {
-    Run {
-        source: &'a ShaderSource,
-        resources: &'a [vista_gpu::Resource],
-        passes: &'a [vista_gpu::GraphPass],
-        outputs: &'a [usize],
         hashes: Vec<String>,
         time_passes: bool,
         fault: Option<Fault>,
@@ -209,7 +198,7 @@ pub fn serve_and_exit_code() -> i32 {
 fn serve() -> std::io::Result<()> {
     let mut input = BufReader::new(std::io::stdin().lock());
     let out = Arc::new(Mutex::new(std::io::stdout()));
-    let (first, _) = receive::<ToWorker>(&mut input)?;
+    let (first, _) = receive::<ToWorker<'static>>(&mut input)?;
     let ToWorker::Init(c) = first else {
         return Err(std::io::Error::other("the first request must be Init"));
     };
@@ -228,7 +217,7 @@ fn serve() -> std::io::Result<()> {
     let mut sets: Option<(ShaderSource, vista_gpu::ShaderSet)> = None;
     let mut sources: Option<(Option<PathBuf>, crate::Sources)> = None;
     loop {
-        let request = match receive::<ToWorker>(&mut input) {
+        let request = match receive::<ToWorker<'static>>(&mut input) {
             Ok((r, _)) => r,
             // The parent closed the pipe: the run is over.
             Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Ok(()),
@@ -240,7 +229,7 @@ fn serve() -> std::io::Result<()> {
         let same = |set: &vista_gpu::ShaderSet| {
             passes.iter().zip(&hashes).all(|(p, h)| set.source_hash(&p.shader).is_ok_and(|mine| mine == *h))
         };
-        let kept = sets.as_ref().filter(|(s, set)| *s == source && same(set)).map(|(_, set)| set.clone());
+        let kept = sets.as_ref().filter(|(s, set)| *s == *source && same(set)).map(|(_, set)| set.clone());
         let shaders = match kept {
             Some(set) => set,
             None => {
@@ -258,7 +247,7 @@ fn serve() -> std::io::Result<()> {
                 });
                 match built {
                     Ok(set) => {
-                        sets = Some((source.clone(), set.clone()));
+                        sets = Some((source.clone().into_owned(), set.clone()));
                         set
                     }
                     Err(err) => {
@@ -290,7 +279,13 @@ fn serve() -> std::io::Result<()> {
         })));
         ctx.time_passes(time_passes);
         let before = ctx.compile_time();
-        let result = ctx.run(&vista_gpu::Graph { shaders: &shaders, resources, passes, outputs });
+        let graph = vista_gpu::Graph {
+            shaders: &shaders,
+            resources: resources.into_owned(),
+            passes: passes.into_owned(),
+            outputs: outputs.into_owned(),
+        };
+        let result = ctx.run(&graph);
         let compile = ctx.compile_time().saturating_sub(before);
         let mut out = out.lock().expect("stdout");
         match result {
@@ -481,11 +476,11 @@ impl Worker {
         };
         let fault = self.fault.as_ref().filter(|(_, c)| Some(c.as_str()) == case).map(|(f, _)| f.clone());
         let hashes = graph.passes.iter().map(|p| graph.shaders.source_hash(&p.shader)).collect::<Result<_, _>>()?;
-        let request = RunRequest::Run {
-            source,
-            resources: &graph.resources,
-            passes: &graph.passes,
-            outputs: &graph.outputs,
+        let request = ToWorker::Run {
+            source: Cow::Borrowed(source),
+            resources: Cow::Borrowed(&graph.resources),
+            passes: Cow::Borrowed(&graph.passes),
+            outputs: Cow::Borrowed(&graph.outputs),
             hashes,
             time_passes: ctx.timing_passes(),
             fault,
