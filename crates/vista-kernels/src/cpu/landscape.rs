@@ -40,10 +40,9 @@ pub struct Landscape {
     pub view: Camera,
     /// `projection = latlong`: the atmosphere kernel's upper hemisphere instead of the pinhole view.
     pub latlong: bool,
-    /// `view = depth`: t / t_max of the terrain hit, 1 without one.
-    pub depth: bool,
-    /// `view = refine`: the relax march's refinement evaluations / 16.
-    pub refine: bool,
+    /// The `view` param: `color`, `depth` (t / t_max of the terrain hit, 1
+    /// without one) or `refine` (the relax march's refinement evaluations / 16).
+    pub view_output: &'static str,
     /// Unit direction toward the sun (azimuth from +z toward +x, elevation above the horizon).
     pub sun_dir: V3,
     /// E_sun: the sun's irradiance above the atmosphere.
@@ -99,8 +98,7 @@ impl Landscape {
             clouds,
             view,
             latlong: p.choice_in("projection", &[("pinhole", false), ("latlong", true)]),
-            depth: p.choice_in("view", &[("color", false), ("depth", true), ("refine", false)]),
-            refine: p.choice_in("view", &[("color", false), ("depth", false), ("refine", true)]),
+            view_output: p.choice_in("view", &[("color", "color"), ("depth", "depth"), ("refine", "refine")]),
             sun_dir,
             sun_intensity,
         }
@@ -145,7 +143,7 @@ impl Landscape {
     /// The raw output of pixel (x, y) with terrain hits found by `search`.
     pub fn pixel(&self, x: u32, y: u32, width: u32, height: u32, search: HitSearch) -> [Real; 4] {
         let (o, d) = self.ray(x, y, width, height);
-        if self.refine {
+        if self.view_output == "refine" {
             let r = relax_march(&self.terrain, o, d, &self.march).refine_iters as Real / REFINE_ITERS as Real;
             return [r, r, r, 1.0];
         }
@@ -162,7 +160,7 @@ impl Landscape {
     /// hit search.
     pub fn pixel_with_hit(&self, x: u32, y: u32, width: u32, height: u32, hit: Option<Real>) -> [Real; 4] {
         let (o, d) = self.ray(x, y, width, height);
-        if self.depth {
+        if self.view_output == "depth" {
             let z = hit.map_or(1.0, |t| (t / self.march.t_max).clamp(0.0, 1.0));
             return [z, z, z, 1.0];
         }
