@@ -241,7 +241,7 @@ pub(crate) fn write_run(
         merge::remove(report_dir)?;
     }
     vista_golden::pending::write_pending(report_dir, pending)?;
-    let json_text = serde_json::to_string_pretty(&vista_report::json_results(&run, outcomes)).expect("JSON values");
+    let json_text = vista_report::json_text(&run, outcomes);
     vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;
     if let Some(p) = &results.junit {
         vista_image::atomic_write(p, vista_report::junit_xml(&run, outcomes, report_dir)?.as_bytes())?;

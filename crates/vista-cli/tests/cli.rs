@@ -590,7 +590,6 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
     assert!(!a.exists(), "passing case a has only its thumbnail, in the thumbnails' folder, and no folder");
     assert!(report(d.path()).join("b").is_dir(), "the failing case b keeps its folder");
     let index = std::fs::read_to_string(report(d.path()).join("index.html")).unwrap();
-    assert!(index.contains("vista check --case 'a' --full-report"), "the passing case says how to get its viewer");
     // Identical to its golden: one line, not the tables (most of a long
     // suite's page); the failing case keeps them.
     let section = |id: &str| {
@@ -599,6 +598,11 @@ fn a_changed_render_fails_check_with_metrics_and_images() {
     };
     let a_section = section("a");
     assert!(a_section.contains("identical to its golden <code>fbm/a.png</code>"), "{a_section}");
+    // report.js names its viewer command when it opens (the browser test opens one).
+    assert!(
+        a_section.starts_with("id=\"case-a\"") && index.contains("<details class=\"case pass plain\" id=\"case-a\"")
+    );
+    assert!(!index.contains("<details class=\"case fail plain\""), "only passing cases are plain");
     assert!(!a_section.contains("<table"), "{a_section}");
     assert!(a_section.len() < 1000, "{} bytes: {a_section}", a_section.len());
     assert!(section("b").contains("<table class=\"metrics\">") && section("b").contains("<table class=\"prov\">"));
@@ -3389,6 +3393,8 @@ fn the_report_works_in_a_real_browser() {
     let root = t.path().join("project");
     copy_tree(&repo().join("examples/project"), &root);
     assert_eq!(vista_in(Some(&root), &[], &["bless"]).code, 0);
+    let plain = root.join("plain-report");
+    assert_eq!(vista_in(Some(&root), &[], &["check", "--report-dir", plain.to_str().unwrap()]).code, 0);
     let shader = root.join("shaders/marble.wgsl");
     let text = std::fs::read_to_string(&shader).unwrap();
     // Only the six-stripe default case changes; the calm case (3) does not.
@@ -3416,8 +3422,23 @@ fn the_report_works_in_a_real_browser() {
         .unwrap_or_else(|e| panic!("{e}"));
     let page =
         vista_browser::cdp::Chromium::launch(&path, &["--window-size=1400,1000"], wait).expect("launch Chromium");
-    page.navigate(&format!("file://{}", index.display()), wait).unwrap();
     let eval = |js: &str| page.evaluate(js, wait).unwrap_or_else(|e| panic!("{js}: {e}"));
+    // Before the edit: the passing case, identical to its golden, names its viewer's command once opened.
+    page.navigate(&format!("file://{}", plain.join("index.html").display()), wait).unwrap();
+    eval("document.querySelector('#case-marble-calm').open = true");
+    let start = std::time::Instant::now();
+    let command = "document.querySelector('#case-marble-calm .viewer-cmd')?.textContent ?? ''";
+    while eval(command) == serde_json::json!("") {
+        assert!(start.elapsed().as_secs() < 20, "the passing case never showed its viewer command");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    assert_eq!(eval(command), serde_json::json!("viewer: vista check --case 'marble-calm' --full-report"));
+    eval(
+        "document.querySelector('#case-marble-calm').open = false; document.querySelector('#case-marble-calm').open = true",
+    );
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    assert_eq!(eval("document.querySelectorAll('#case-marble-calm .viewer-cmd').length"), serde_json::json!(1), "once");
+    page.navigate(&format!("file://{}", index.display()), wait).unwrap();
     // The failing case's viewer loads its view.js by itself (it is open).
     let start = std::time::Instant::now();
     while eval("!!document.querySelector('#case-marble-default canvas.img')") != serde_json::json!(true) {

@@ -255,3 +255,37 @@ fn small_png16_is_lossless_and_smaller() {
     let back = vista_image::decode_png16(p, &vista_image::encode_png16_small(p, &t).unwrap()).unwrap();
     assert_eq!(back.get(3, 4)[3], vista_image::quantize16(0.25) as f32 / 65535.0);
 }
+
+#[test]
+fn small_png8_keeps_the_8_bit_values_in_the_fewest_channels() {
+    let dir = tempdir();
+    // PNG colour type (IHDR byte 25): 0 grey, 2 RGB, 4 grey + alpha, 6 RGBA.
+    let colour_type = |path: &Path| std::fs::read(path).unwrap()[25];
+    let noise = |x: u32, y: u32| ((x * 7919 + y * 104_729) % 251) as f32 / 250.0;
+    let grey = Image::from_fn(32, 32, |x, y| {
+        let v = noise(x, y);
+        [v, v, v, 1.0]
+    });
+    let mut coloured = grey.clone();
+    coloured.set(5, 6, [0.2, 0.4, 0.6, 1.0]);
+    let mut grey_translucent = grey.clone();
+    grey_translucent.set(1, 2, [0.5, 0.5, 0.5, 0.5]);
+    let mut translucent = coloured.clone();
+    translucent.set(1, 2, [0.1, 0.5, 0.9, 0.5]);
+    for (name, img, ty) in
+        [("grey", &grey, 0), ("rgb", &coloured, 2), ("grey_alpha", &grey_translucent, 4), ("rgba", &translucent, 6)]
+    {
+        let small = dir.path().join(format!("{name}-small.png"));
+        let plain = dir.path().join(format!("{name}-plain.png"));
+        vista_image::write_png8_small(&small, img).unwrap();
+        vista_image::write_png8(&plain, img).unwrap();
+        assert_eq!(colour_type(&small), ty, "{name}");
+        let (a, b) = (read_png16(&small).unwrap(), read_png16(&plain).unwrap());
+        assert!(a.bit_identical(&b), "{name}: the same 8-bit values as write_png8");
+        let (ls, lp) = (std::fs::metadata(&small).unwrap().len(), std::fs::metadata(&plain).unwrap().len());
+        assert!(ls < lp, "{name}: {ls} bytes, not fewer than {lp}");
+    }
+    // A grey 32 x 32 noise thumbnail fits in well under half the RGB bytes.
+    let bytes = std::fs::metadata(dir.path().join("grey-small.png")).unwrap().len();
+    assert!(bytes < 1200, "{bytes} bytes");
+}

@@ -18,7 +18,7 @@ pub use report::{
     CASE_MARKER, Detail, RunSummary, THUMB_EDGE, THUMBS_DIR, clear_case_folders, file_case, href, view_js,
     write_case_files, write_report,
 };
-pub use results::{case_line, github_annotations, json_results, junit_xml, verdict_name};
+pub use results::{case_line, github_annotations, json_results, json_text, junit_xml, verdict_name};
 
 /// The stylesheet every page carries inline (a copied report folder opens
 /// offline, and a page from `file://` may not load another origin's CSS).

@@ -11,11 +11,26 @@ let active = null;
 
 function applyFilter() {
   for (const d of document.querySelectorAll("details.case")) {
-    d.hidden = onlyFailures.checked && d.dataset.failing !== "true";
+    d.hidden = onlyFailures.checked && !d.classList.contains("fail");
   }
 }
 onlyFailures.addEventListener("change", applyFilter);
 applyFilter();
+
+// A passing case identical to its golden ("plain") shows the command for
+// its viewer once opened: made here, not written into each of a long
+// suite's rows. Toggle does not bubble, so it is caught on the way down.
+document.addEventListener("toggle", (e) => {
+  const d = e.target;
+  if (!d.open || !d.matches("details.case.plain") || d.querySelector(".viewer-cmd")) return;
+  const p = document.createElement("p");
+  p.className = "note viewer-cmd";
+  const code = document.createElement("code");
+  code.className = "cmd";
+  code.textContent = `vista check --case '${d.querySelector("summary .id").textContent}' --full-report`;
+  p.append("viewer: ", code);
+  d.querySelector(".body").append(p);
+}, true);
 
 function decode(b64) {
   const bin = atob(b64);
