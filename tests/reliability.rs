@@ -78,13 +78,13 @@ fn render_path_reports_nan_from_the_gpu_bit_exactly(ctx: &vista_render::Renderer
     assert_eq!(r.raw.nonfinite_count(), 2);
 }
 
-/// Test-only kernel backed by `shaders/test/partial.wgsl`: writes the
-/// columns x < cut only.
+/// Test-only kernel backed by `shaders/test/partial.wgsl`: writes
+/// (1, y, x, 1) to the columns x < cut only.
 fn partial_kernel() -> Arc<Kernel> {
     static PARTIAL: std::sync::OnceLock<Arc<Kernel>> = std::sync::OnceLock::new();
     PARTIAL
         .get_or_init(|| {
-            let manifest = "summary = \"writes 1 to the columns x < cut\"\nshader = \"test/partial.wgsl\"\n\
+            let manifest = "summary = \"writes (1, y, x, 1) to the columns x < cut\"\nshader = \"test/partial.wgsl\"\n\
                         [[param]]\nname = \"cut\"\ntype = \"u32\"\nrange = [0, 64]\ndefault = 16\n";
             Arc::new(Kernel::from_manifest("test-partial", "tests/reliability.rs", manifest).expect("valid manifest"))
         })
@@ -97,14 +97,38 @@ fn partial_kernel() -> Arc<Kernel> {
 fn an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it(ctx: &vista_render::Renderer) {
     let k = partial_kernel();
     let full = vista_render::render(ctx, &k, &k.resolve(None, &[]).unwrap(), 16, 8).unwrap();
-    assert_eq!(full.raw.get(12, 5), [1.0; 4]);
+    assert_eq!(full.raw.get(12, 5), [1.0, 5.0, 12.0, 1.0]);
     for _ in 0..2 {
         let part = vista_render::render(ctx, &k, &k.resolve(None, &[("cut".into(), "4".into())]).unwrap(), 16, 8);
         let part = part.unwrap().raw;
-        assert_eq!(part.get(3, 5), [1.0; 4]);
+        assert_eq!(part.get(3, 5), [1.0, 5.0, 3.0, 1.0]);
         assert_eq!(part.get(4, 0), [0.0; 4], "an earlier run's value leaked into an unwritten pixel");
         assert_eq!(part.get(15, 7), [0.0; 4], "an earlier run's value leaked into an unwritten pixel");
     }
+}
+
+/// Textures are filled with the sentinel and read back in bands of rows
+/// (at most 4 MiB each): a render three bands tall (2 KiB rows, 2048 rows a
+/// band) comes back with every row in place, its unwritten texels counted
+/// in every band, and nothing of an earlier, fully written run.
+fn a_render_taller_than_a_readback_band_comes_back_whole(ctx: &vista_render::Renderer) {
+    let k = partial_kernel();
+    let (w, h) = (128, 5000);
+    let render =
+        |cut: &str| vista_render::render(ctx, &k, &k.resolve(None, &[("cut".into(), cut.into())]).unwrap(), w, h);
+    let full = render("64").unwrap();
+    assert_eq!(full.raw.get(63, h - 1), [1.0, (h - 1) as f32, 63.0, 1.0]);
+    let part = render("5").unwrap();
+    for y in [0, 2047, 2048, 4095, 4096, h - 1] {
+        assert_eq!(part.raw.get(4, y), [1.0, y as f32, 4.0, 1.0], "row {y}");
+        assert_eq!(part.raw.get(5, y), [0.0; 4], "row {y}: unwritten");
+        assert_eq!(part.raw.get(w - 1, y), [0.0; 4], "row {y}: unwritten");
+    }
+    let unwritten = match &part.outputs[0].value {
+        vista_render::OutputValue::Texture { unwritten, .. } => *unwritten,
+        _ => panic!("a texture output"),
+    };
+    assert_eq!(unwritten, u64::from((w - 5) * h), "unwritten texels, counted in every band");
 }
 
 // ---- parameter fuzzing -----------------------------------------------------
@@ -249,6 +273,7 @@ fn main() {
         injected_nan_fails_the_case_naming_count_and_first_pixel,
         render_path_reports_nan_from_the_gpu_bit_exactly,
         an_unwritten_pixel_reads_zero_after_a_run_that_wrote_it,
+        a_render_taller_than_a_readback_band_comes_back_whole,
         random_in_range_params_give_finite_output_within_documented_bounds,
     ];
 }

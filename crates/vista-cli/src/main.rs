@@ -343,7 +343,9 @@ fn main() -> ExitCode {
     }
     // Workers inherit the environment set above.
     config.start_workers();
-    match run(&project, &config, cli.command) {
+    let result = run(&project, &config, cli.command);
+    vista_render::worker::stop_all();
+    match result {
         Ok(code) => ExitCode::from(code as u8),
         Err(e) => {
             eprintln!("error: {e}");

@@ -723,15 +723,33 @@ pub(crate) fn read_texels(
     height: u32,
     sentinel: &[u8],
 ) -> Texels {
-    let (w, tb) = (width as usize, format.texel_bytes());
-    let mut data = vec![[0.0f32; 4]; w * height as usize];
+    let mut data = vec![[0.0f32; 4]; width as usize * height as usize];
     let mut holding_sentinel = Vec::new();
+    decode_rows(bytes, stride, format, &mut data, width as usize, 0, sentinel, &mut holding_sentinel);
+    Texels { image: Image::from_raw(width, height, data).expect("one texel per pixel"), holding_sentinel }
+}
+
+/// [`read_texels`] of a band of rows into `dst` (whole rows of `width`
+/// texels), the first of which is texel `first` of the image: sentinel
+/// positions are the image's.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn decode_rows(
+    bytes: &[u8],
+    stride: usize,
+    format: &Format,
+    dst: &mut [[f32; 4]],
+    width: usize,
+    first: usize,
+    sentinel: &[u8],
+    holding_sentinel: &mut Vec<usize>,
+) {
+    let tb = format.texel_bytes();
     let rgba32 = format.storage == naga::StorageFormat::Rgba32Float;
-    for (y, dst) in data.chunks_exact_mut(w).enumerate() {
-        let row = &bytes[y * stride..][..w * tb];
+    for (y, dst) in dst.chunks_exact_mut(width).enumerate() {
+        let row = &bytes[y * stride..][..width * tb];
         for (x, (px, texel)) in dst.iter_mut().zip(row.chunks_exact(tb)).enumerate() {
             if texel == sentinel {
-                holding_sentinel.push(y * w + x);
+                holding_sentinel.push(first + y * width + x);
             }
             if rgba32 {
                 // Written in place (no per-pixel push), so even the tests'
@@ -744,7 +762,6 @@ pub(crate) fn read_texels(
             }
         }
     }
-    Texels { image: Image::from_raw(width, height, data).expect("one texel per pixel"), holding_sentinel }
 }
 
 /// Picks the adapter matching `choice` from those enumerated.

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use wgpu::util::DeviceExt;
 
 use crate::GpuError;
-use crate::context::{Compiled, Context, Pipeline, RunStats, WgpuEngine, read_texels};
+use crate::context::{Compiled, Context, Pipeline, RunStats, WgpuEngine, decode_rows};
 use crate::graph::{
     Bind, Contents, Graph, GraphPass, OutputData, Raster, Readback, Resource, TextureDesc, compare_fn, run_order,
     view_dimension,
@@ -20,6 +20,11 @@ use vista_texel::{Access, Format, SampleKind};
 
 /// Kept at most per kind: a graph's outputs, and a little more.
 const SPARES: usize = 8;
+
+/// The most bytes one readback band or sentinel fill copies: the staging
+/// and fill buffers' size for large textures (4 MiB: 128 rows of 2048
+/// rgba32float texels).
+const READBACK_BAND: u64 = 4 << 20;
 
 fn texture_key(t: &TextureDesc) -> TextureKey {
     (t.format, t.dimension, t.width, t.height, t.layers)
@@ -306,10 +311,13 @@ impl Context {
                             );
                         }
                         Contents::Sentinel => {
-                            // A copy from a kept buffer of sentinel texels,
-                            // rows padded as buffer copies need them.
+                            // Copies from a kept buffer of sentinel texels,
+                            // rows padded as buffer copies need them: one
+                            // band of rows at most READBACK_BAND bytes, copied
+                            // over each band (every texel is the same).
                             let padded = padded_row(t, &format);
-                            let key = (t.format, which, padded as u64 * (t.height * t.layers) as u64);
+                            let band = (READBACK_BAND / u64::from(padded)).clamp(1, u64::from(t.height)) as u32;
+                            let key = (t.format, which, u64::from(padded) * u64::from(band));
                             let buffer = take(&w.spares, |s| &mut s.fills, &key).unwrap_or_else(|| {
                                 d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                                     label: Some("unwritten sentinel"),
@@ -317,18 +325,28 @@ impl Context {
                                     usage: wgpu::BufferUsages::COPY_SRC,
                                 })
                             });
-                            fill.copy_buffer_to_texture(
-                                wgpu::TexelCopyBufferInfo {
-                                    buffer: &buffer,
-                                    layout: wgpu::TexelCopyBufferLayout {
-                                        offset: 0,
-                                        bytes_per_row: Some(padded),
-                                        rows_per_image: Some(t.height),
-                                    },
-                                },
-                                texture.as_image_copy(),
-                                size,
-                            );
+                            for layer in 0..t.layers {
+                                for y in (0..t.height).step_by(band as usize) {
+                                    let rows = band.min(t.height - y);
+                                    fill.copy_buffer_to_texture(
+                                        wgpu::TexelCopyBufferInfo {
+                                            buffer: &buffer,
+                                            layout: wgpu::TexelCopyBufferLayout {
+                                                offset: 0,
+                                                bytes_per_row: Some(padded),
+                                                rows_per_image: Some(rows),
+                                            },
+                                        },
+                                        wgpu::TexelCopyTextureInfo {
+                                            texture: &texture,
+                                            mip_level: 0,
+                                            origin: wgpu::Origin3d { x: 0, y, z: layer },
+                                            aspect: wgpu::TextureAspect::All,
+                                        },
+                                        wgpu::Extent3d { width: t.width, height: rows, depth_or_array_layers: 1 },
+                                    );
+                                }
+                            }
                             made.fills.push((key, buffer));
                         }
                     }
@@ -528,7 +546,10 @@ impl Context {
     }
 
     /// Reads one output back: `logical` is the name's index (its
-    /// description), `physical` the resource it binds after the swaps.
+    /// description), `physical` the resource it binds after the swaps. A
+    /// texture comes back in bands of rows through one staging buffer of at
+    /// most [`READBACK_BAND`] bytes: a whole-texture buffer was as large as
+    /// the image again (64 MiB at 2048 x 2048 rgba32float), and kept.
     fn read_resource(
         &self,
         w: &WgpuEngine,
@@ -539,7 +560,6 @@ impl Context {
         which: usize,
     ) -> Result<(OutputData, Vec<usize>), GpuError> {
         let d = &w.device;
-        let mut encoder = d.create_command_encoder(&Default::default());
         let staging_of = |size: u64| {
             take(&w.spares, |s| &mut s.staging, &size).unwrap_or_else(|| {
                 d.create_buffer(&wgpu::BufferDescriptor {
@@ -550,39 +570,80 @@ impl Context {
                 })
             })
         };
-        let (staging, texture) = match (g.resources[logical].read_as(), &g.resources[logical]) {
-            (Some(t), resource) => {
-                let format = crate::format::parse(t.format)?;
-                let padded = padded_row(&t, &format);
-                let rows = t.height * t.layers;
-                let staging = staging_of(padded as u64 * rows as u64);
-                // A depth texture's depth aspect reads back as r32float.
-                let aspect = match resource {
-                    Resource::Depth(_) => wgpu::TextureAspect::DepthOnly,
-                    _ => wgpu::TextureAspect::All,
-                };
+        let t = match (g.resources[logical].read_as(), &g.resources[logical]) {
+            (Some(t), _) => t,
+            (None, Resource::Buffer(bytes)) => {
+                let size = bytes.len().max(4).next_multiple_of(4) as u64;
+                let staging = staging_of(size);
+                let mut encoder = d.create_command_encoder(&Default::default());
+                encoder.copy_buffer_to_buffer(&made.buffers[&physical], 0, &staging, 0, size);
+                let data = self.map_read(w, &staging, encoder, |mapped| mapped[..bytes.len()].to_vec())?;
+                keep(&mut w.spares.lock().expect("spares").staging, staging.size(), staging);
+                return Ok((OutputData::Buffer(data), Vec::new()));
+            }
+            (None, _) => return Err(GpuError::Request("a sampler cannot be an output".into())),
+        };
+        let format = crate::format::parse(t.format)?;
+        let padded = padded_row(&t, &format);
+        let band = (READBACK_BAND / u64::from(padded)).clamp(1, u64::from(t.height)) as u32;
+        let staging = staging_of(u64::from(padded) * u64::from(band));
+        // A depth texture's depth aspect reads back as r32float.
+        let aspect = match &g.resources[logical] {
+            Resource::Depth(_) => wgpu::TextureAspect::DepthOnly,
+            _ => wgpu::TextureAspect::All,
+        };
+        let sentinel = format.sentinel(which);
+        let width = t.width as usize;
+        let mut data = vec![[0.0f32; 4]; width * (t.height * t.layers) as usize];
+        let mut holding = Vec::new();
+        let mut first_row = 0usize;
+        for layer in 0..t.layers {
+            for y in (0..t.height).step_by(band as usize) {
+                let rows = band.min(t.height - y);
+                let mut encoder = d.create_command_encoder(&Default::default());
                 encoder.copy_texture_to_buffer(
-                    wgpu::TexelCopyTextureInfo { aspect, ..made.textures[&physical].as_image_copy() },
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &made.textures[&physical],
+                        mip_level: 0,
+                        origin: wgpu::Origin3d { x: 0, y, z: layer },
+                        aspect,
+                    },
                     wgpu::TexelCopyBufferInfo {
                         buffer: &staging,
                         layout: wgpu::TexelCopyBufferLayout {
                             offset: 0,
                             bytes_per_row: Some(padded),
-                            rows_per_image: Some(t.height),
+                            rows_per_image: Some(rows),
                         },
                     },
-                    wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: t.layers },
+                    wgpu::Extent3d { width: t.width, height: rows, depth_or_array_layers: 1 },
                 );
-                (staging, Some((t, format, padded, rows)))
+                let dst = &mut data[first_row * width..(first_row + rows as usize) * width];
+                self.map_read(w, &staging, encoder, |mapped| {
+                    let at = first_row * width;
+                    decode_rows(mapped, padded as usize, &format, dst, width, at, &sentinel, &mut holding);
+                })?;
+                first_row += rows as usize;
             }
-            (None, Resource::Buffer(bytes)) => {
-                let size = bytes.len().max(4).next_multiple_of(4) as u64;
-                let staging = staging_of(size);
-                encoder.copy_buffer_to_buffer(&made.buffers[&physical], 0, &staging, 0, size);
-                (staging, None)
-            }
-            (None, _) => return Err(GpuError::Request("a sampler cannot be an output".into())),
+        }
+        keep(&mut w.spares.lock().expect("spares").staging, staging.size(), staging);
+        let image = vista_image::Image::from_raw(t.width, t.height * t.layers, data).expect("one texel per pixel");
+        let held = match t.contents {
+            Contents::Sentinel => holding,
+            _ => Vec::new(),
         };
+        Ok((OutputData::Texture { image, unwritten: 0 }, held))
+    }
+
+    /// Submits `encoder` (copies into `staging`), maps `staging` once they
+    /// are done, and returns `read` of its bytes, unmapped again.
+    fn map_read<T>(
+        &self,
+        w: &WgpuEngine,
+        staging: &wgpu::Buffer,
+        encoder: wgpu::CommandEncoder,
+        read: impl FnOnce(&[u8]) -> T,
+    ) -> Result<T, GpuError> {
         let index = w.queue.submit([encoder.finish()]);
         let (tx, rx) = mpsc::channel();
         staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
@@ -601,24 +662,9 @@ impl Context {
                 .slice(..)
                 .get_mapped_range()
                 .map_err(|e| GpuError::Validation { what: "readback map".into(), message: e.to_string() })?;
-            match texture {
-                Some((t, format, padded, rows)) => {
-                    let sentinel = format.sentinel(which);
-                    let texels = read_texels(&mapped, padded as usize, &format, t.width, rows, &sentinel);
-                    let held = match t.contents {
-                        Contents::Sentinel => texels.holding_sentinel,
-                        _ => Vec::new(),
-                    };
-                    (OutputData::Texture { image: texels.image, unwritten: 0 }, held)
-                }
-                None => {
-                    let Resource::Buffer(bytes) = &g.resources[logical] else { unreachable!("a buffer") };
-                    (OutputData::Buffer(mapped[..bytes.len()].to_vec()), Vec::new())
-                }
-            }
+            read(&mapped)
         };
         staging.unmap();
-        keep(&mut w.spares.lock().expect("spares").staging, staging.size(), staging);
         Ok(out)
     }
 }

@@ -155,17 +155,26 @@ impl From<WireError> for GpuError {
     }
 }
 
-/// One message: its JSON head, then `bytes` (a readback's outputs), or the
-/// byte lists the head refers to (a request's tables, uniforms, inputs:
-/// [`vista_gpu::wire`]) where `bytes` is empty.
-fn send<T: Serialize>(w: &mut impl Write, msg: &T, bytes: &[u8]) -> std::io::Result<()> {
+/// One message: its JSON head, then `parts` one after another (a
+/// readback's outputs, written from where they lie: a 2048 x 2048 image
+/// gathered into one buffer first was 64 MiB more of the worker's peak),
+/// or the byte lists the head refers to (a request's tables, uniforms,
+/// inputs: [`vista_gpu::wire`]) where there are no parts.
+fn send<T: Serialize>(w: &mut impl Write, msg: &T, parts: &[&[u8]]) -> std::io::Result<()> {
     let (head, attached) = vista_gpu::wire::attach(|| serde_json::to_vec(msg).expect("wire messages serialize"));
-    assert!(attached.is_empty() || bytes.is_empty(), "a message with byte lists carries no other bytes");
-    let bytes = if attached.is_empty() { bytes } else { &attached };
+    let parts = match attached.is_empty() {
+        true => parts,
+        false => {
+            assert!(parts.iter().all(|p| p.is_empty()), "a message with byte lists carries no other bytes");
+            &[&attached[..]]
+        }
+    };
     w.write_all(&(head.len() as u32).to_le_bytes())?;
     w.write_all(&head)?;
-    w.write_all(&(bytes.len() as u64).to_le_bytes())?;
-    w.write_all(bytes)?;
+    w.write_all(&(parts.iter().map(|p| p.len() as u64).sum::<u64>()).to_le_bytes())?;
+    for p in parts {
+        w.write_all(p)?;
+    }
     w.flush()
 }
 
@@ -291,20 +300,21 @@ fn serve() -> std::io::Result<()> {
         match result {
             Err(e) => send(&mut *out, &FromWorker::Done(Err(e.into())), &[])?,
             Ok(r) => {
-                let mut bytes = Vec::new();
+                let mut parts = Vec::new();
                 let mut heads = Vec::new();
                 for o in &r.outputs {
                     match o {
                         OutputData::Texture { image, unwritten } => {
                             heads.push(Ok((image.width, image.height, *unwritten)));
-                            bytes.extend_from_slice(&image.le_bytes());
+                            parts.push(image.le_bytes());
                         }
                         OutputData::Buffer(b) => {
                             heads.push(Err(b.len()));
-                            bytes.extend_from_slice(b);
+                            parts.push(std::borrow::Cow::Borrowed(&b[..]));
                         }
                     }
                 }
+                let parts: Vec<&[u8]> = parts.iter().map(|p| &p[..]).collect();
                 let head = ReadbackHead {
                     outputs: heads,
                     stats: r.stats,
@@ -312,7 +322,7 @@ fn serve() -> std::io::Result<()> {
                     pass_gpu_times: r.pass_gpu_times,
                     compile,
                 };
-                send(&mut *out, &FromWorker::Done(Ok(head)), &bytes)?
+                send(&mut *out, &FromWorker::Done(Ok(head)), &parts)?
             }
         }
     }
@@ -343,9 +353,43 @@ enum Heard {
 }
 
 struct Proc {
+    /// Its stdin stays in the `Child`, so that [`Proc::finish`] can close it.
     child: Child,
-    stdin: ChildStdin,
     heard: Receiver<Heard>,
+}
+
+impl Proc {
+    fn stdin(&mut self) -> &mut ChildStdin {
+        self.child.stdin.as_mut().expect("piped until finish")
+    }
+
+    /// Closes the worker's pipe, which it takes as the end of the run, and
+    /// waits up to `grace` for it to exit; dropping kills it after that.
+    fn finish(mut self, grace: Duration) {
+        drop(self.child.stdin.take());
+        let start = std::time::Instant::now();
+        while start.elapsed() < grace {
+            if let Ok(Some(_)) = self.child.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+}
+
+/// Ends every idle worker of this process and waits for it (at most two
+/// seconds each): commands call it before they return, so no worker
+/// outlives its command, and a worker's peak memory counts as the
+/// command's (`/usr/bin/time` counts only children waited for; the
+/// workers' 2048 x 2048 peak went unseen).
+pub fn stop_all() {
+    let workers = std::mem::take(&mut *WORKERS.lock().expect("workers"));
+    for w in workers {
+        let procs = std::mem::take(&mut *w.idle.lock().expect("idle workers"));
+        for p in procs {
+            p.finish(Duration::from_secs(2));
+        }
+    }
 }
 
 impl Drop for Proc {
@@ -422,7 +466,6 @@ impl Worker {
             .stderr(Stdio::inherit())
             .spawn()
             .map_err(|e| failed(format!("cannot start {}: {e}", self.exe.display())))?;
-        let mut stdin = child.stdin.take().expect("piped");
         let mut stdout = BufReader::new(child.stdout.take().expect("piped"));
         let (tx, heard) = channel();
         std::thread::spawn(move || {
@@ -447,8 +490,8 @@ impl Worker {
             timeout: c.timeout,
             wgpu_backends: c.wgpu_backends.clone(),
         });
-        send(&mut stdin, &init, &[]).map_err(|e| failed(format!("cannot talk to the worker: {e}")))?;
-        let mut proc = Proc { child, stdin, heard };
+        let mut proc = Proc { child, heard };
+        send(proc.stdin(), &init, &[]).map_err(|e| failed(format!("cannot talk to the worker: {e}")))?;
         // Device creation: the watchdog's time, and then some.
         match proc.heard.recv_timeout(c.timeout + Duration::from_secs(30)) {
             Ok(Heard::Message(FromWorker::Ready, _)) => Ok(proc),
@@ -485,10 +528,10 @@ impl Worker {
             time_passes: ctx.timing_passes(),
             fault,
         };
-        if send(&mut proc.stdin, &request, &[]).is_err() {
+        if send(proc.stdin(), &request, &[]).is_err() {
             // It died between runs: start another and try once more.
             proc = self.start()?;
-            send(&mut proc.stdin, &request, &[]).map_err(|e| {
+            send(proc.stdin(), &request, &[]).map_err(|e| {
                 RenderError::Gpu(GpuError::Device { adapter: ctx.adapter_description(), message: e.to_string() })
             })?;
         }
