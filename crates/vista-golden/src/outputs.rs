@@ -116,6 +116,22 @@ impl GoldenFiles {
         self.view_decoded().ok().flatten()
     }
 
+    /// The PNG view's values and the PNG's bytes, moved out (the view
+    /// decoded here if the verdict did not need it): the report's copies
+    /// of a failing 2048 x 2048 case were 64 MiB and its PNG again.
+    pub fn into_view_and_png(self) -> (Option<Image>, Option<Vec<u8>>) {
+        let _ = self.view_decoded();
+        let view = self.decoded_view.into_inner().and_then(Result::ok).flatten();
+        let png = self.paths.png.as_deref().and_then(|png| {
+            let at = self.found.iter().position(|(p, _)| p == png)?;
+            match self.found.into_iter().nth(at) {
+                Some((_, Found::Bytes(b))) => Some(b),
+                _ => None,
+            }
+        });
+        (view, png)
+    }
+
     /// Marks the PNG as holding exactly the render's view, so the verdict
     /// judges the view against itself without decoding the PNG: the caller
     /// knows the render's raw bits are those the golden was blessed from

@@ -259,9 +259,13 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         Err(_) => (None, Vec::new()),
     };
     let images = opts.images_of_passing || !out.passed();
-    let expected = golden_files.first().filter(|_| images).and_then(|g| g.view()).cloned();
-    let expected_png =
-        golden_files.first().filter(|_| expected.is_some()).and_then(|g| g.png_bytes()).map(<[u8]>::to_vec);
+    // The golden files are moved into what the report shows, not copied.
+    let mut golden_files: Vec<Option<GoldenFiles>> = golden_files.into_iter().map(Some).collect();
+    let mut golden_of = |i: usize| golden_files.get_mut(i).and_then(Option::take).map(GoldenFiles::into_view_and_png);
+    let (expected, expected_png) = match images.then(|| golden_of(0)).flatten() {
+        Some((Some(view), png)) => (Some(view), png),
+        _ => (None, None),
+    };
     let output_images = r
         .outputs
         .iter()
@@ -269,9 +273,9 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         .enumerate()
         .skip(1)
         .filter_map(|(i, (o, view))| {
-            let golden = match golden_files.get(i) {
+            let golden = match golden_of(i) {
                 _ if !images => None,
-                Some(g) => g.view().cloned(),
+                Some((view, _)) => view,
                 None => crate::outputs::output_files(&store.dir, case, &golden_key, i, o)
                     .png
                     .and_then(|p| vista_image::read_png16(&p).ok()),

@@ -56,6 +56,15 @@ pub fn diff_heatmap_log(reference: &Image, actual: &Image) -> Image {
     paint(reference, &pixel_diffs(reference, actual), log_position)
 }
 
+/// One row of [`diff_heatmap_log`] of two images of one size, appended to
+/// `out`: the report paints its heat maps a row at a time, as it writes
+/// them.
+pub fn diff_heatmap_log_row(reference: &[[f32; 4]], actual: &[[f32; 4]], out: &mut Vec<[f32; 4]>) {
+    out.extend(
+        reference.iter().zip(actual).map(|(&r, &a)| max_rgb_diff(r, a).map_or(INVALID, |d| colormap(log_position(d)))),
+    );
+}
+
 /// Per reference pixel: `Some(max RGB |diff|)`, or `None` when non-finite or
 /// outside `actual`.
 fn pixel_diffs(reference: &Image, actual: &Image) -> Vec<Option<f32>> {
@@ -125,6 +134,22 @@ mod tests {
         let h = diff_heatmap_log(&a, &b);
         assert_eq!(h.get(0, 0), [0.0, 0.0, 0.0, 1.0]);
         assert_eq!(h.get(1, 0), colormap(log_position(1.0 / 255.0)));
+    }
+
+    #[test]
+    fn a_heat_map_row_is_that_row_of_the_whole_map() {
+        let a = Image::from_fn(7, 3, |x, y| [x as f32 / 7.0, y as f32 / 3.0, 0.5, 1.0]);
+        let mut b = Image::from_fn(7, 3, |x, y| [x as f32 / 7.0 + (x * y) as f32 * 1e-3, y as f32 / 3.0, 0.5, 1.0]);
+        b.set(2, 1, [f32::NAN, 0.0, 0.0, 1.0]);
+        let whole = diff_heatmap_log(&a, &b);
+        for y in 0..3usize {
+            let mut row = Vec::new();
+            diff_heatmap_log_row(&a.data[y * 7..][..7], &b.data[y * 7..][..7], &mut row);
+            assert_eq!(row, whole.data[y * 7..][..7], "row {y}");
+        }
+        let mut row = Vec::new();
+        diff_heatmap_log_row(&a.data[7..14], &b.data[7..14], &mut row);
+        assert_eq!(row[2], INVALID, "a NaN difference is green");
     }
 
     #[test]

@@ -67,19 +67,23 @@ pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
 /// If the images differ in size.
 pub fn flip_mean(reference: &Image, actual: &Image) -> f64 {
     assert_same_size(reference, actual);
-    let rgb8 = |img: &Image| -> Vec<u8> {
-        let mut out = Vec::with_capacity(img.data.len() * 3);
-        for p in &img.data {
-            out.extend_from_slice(&[crate::quantize8(p[0]), crate::quantize8(p[1]), crate::quantize8(p[2])]);
-        }
-        out
-    };
     let (w, h) = reference.dimensions();
     if w == 0 || h == 0 {
         return 0.0;
     }
+    // A strip's rows as FLIP reads them, made per strip: both images whole
+    // in 8-bit RGB were 24 MiB more at 2048 x 2048.
+    fn rgb8(img: &Image, y0: usize, y1: usize) -> Vec<u8> {
+        let texels = &img.data[y0 * img.width as usize..y1 * img.width as usize];
+        let mut out = Vec::with_capacity(texels.len() * 3);
+        for p in texels {
+            out.extend_from_slice(&[crate::quantize8(p[0]), crate::quantize8(p[1]), crate::quantize8(p[2])]);
+        }
+        out
+    }
+    let (reference_rows, actual_rows) = (|y0, y1| rgb8(reference, y0, y1), |y0, y1| rgb8(actual, y0, y1));
     let threads = crate::threads_for(reference.data.len());
-    let errors = flip_error_sums(w, h, &rgb8(reference), &rgb8(actual), threads);
+    let errors = flip_error_sums(w, h, &reference_rows, &actual_rows, threads);
     // Summed in f64 (FLIP's own pool sums in f32, which drifts over millions
     // of pixels).
     errors.iter().sum::<f64>() / (f64::from(w) * f64::from(h))
@@ -96,6 +100,9 @@ const FLIP_HALO: usize = 16;
 /// 576 rows, two at once, take 180 MB, for 6% more rows computed.
 const FLIP_STRIP: usize = 576;
 
+/// Rows `y0..y1` of an image as FLIP reads them: 8-bit RGB, row after row.
+type Rows<'a> = &'a (dyn Fn(usize, usize) -> Vec<u8> + Sync);
+
 /// FLIP's per-pixel errors of two `w` x `h` RGB8 images, computed in
 /// horizontal strips of at most [`FLIP_STRIP`] rows, `threads` at once
 /// (FLIP is single-threaded C++; a failing 1080p case spent most of its own
@@ -106,8 +113,8 @@ const FLIP_STRIP: usize = 576;
 fn flip_strips<T: Send>(
     w: u32,
     h: u32,
-    reference: &[u8],
-    actual: &[u8],
+    reference: Rows<'_>,
+    actual: Rows<'_>,
     threads: usize,
     take: impl Fn(&[f32]) -> T + Sync,
 ) -> Vec<T> {
@@ -120,18 +127,17 @@ fn flip_strips<T: Send>(
 fn flip_strips_of<T: Send>(
     w: u32,
     h: u32,
-    reference: &[u8],
-    actual: &[u8],
+    reference: Rows<'_>,
+    actual: Rows<'_>,
     rows: usize,
     threads: usize,
     take: impl Fn(&[f32]) -> T + Sync,
 ) -> Vec<T> {
     let (width, height) = (w as usize, h as usize);
-    let row = width * 3;
     let strip = |y0: usize| {
         let y1 = (y0 + rows).min(height);
         let (c0, c1) = (y0.saturating_sub(FLIP_HALO), (y1 + FLIP_HALO).min(height));
-        let image = |d: &[u8]| nv_flip::FlipImageRgb8::with_data(w, (c1 - c0) as u32, &d[c0 * row..c1 * row]);
+        let image = |d: Rows<'_>| nv_flip::FlipImageRgb8::with_data(w, (c1 - c0) as u32, &d(c0, c1));
         let errors = nv_flip::flip(image(reference), image(actual), FLIP_PIXELS_PER_DEGREE).to_vec();
         take(&errors[(y0 - c0) * width..(y1 - c0) * width])
     };
@@ -156,7 +162,7 @@ fn flip_strips_of<T: Send>(
 
 /// The sum of FLIP's per-pixel errors in each row, top to bottom (see
 /// [`flip_strips`]; by row, so that the mean does not depend on the strips).
-fn flip_error_sums(w: u32, h: u32, reference: &[u8], actual: &[u8], threads: usize) -> Vec<f64> {
+fn flip_error_sums(w: u32, h: u32, reference: Rows<'_>, actual: Rows<'_>, threads: usize) -> Vec<f64> {
     let row_sums = |e: &[f32]| -> Vec<f64> {
         e.chunks(w.max(1) as usize).map(|row| row.iter().map(|&v| f64::from(v)).sum()).collect()
     };
@@ -434,6 +440,11 @@ mod tests {
             .enumerate()
             .map(|(i, &v)| if i % 7 == 0 { v.wrapping_add(next() % 40) } else { v })
             .collect();
+        let row = (w * 3) as usize;
+        let (reference, actual) = (
+            move |y0: usize, y1: usize| reference[y0 * row..y1 * row].to_vec(),
+            move |y0: usize, y1: usize| actual[y0 * row..y1 * row].to_vec(),
+        );
         let errors = |rows, threads| flip_strips_of(w, h, &reference, &actual, rows, threads, <[f32]>::to_vec).concat();
         let whole = errors(h as usize, 1);
         assert_eq!(whole.len(), (w * h) as usize);

@@ -289,3 +289,52 @@ fn small_png8_keeps_the_8_bit_values_in_the_fewest_channels() {
     let bytes = std::fs::metadata(dir.path().join("grey-small.png")).unwrap().len();
     assert!(bytes < 1200, "{bytes} bytes");
 }
+
+#[test]
+fn png_files_written_row_by_row_hold_what_the_whole_image_writers_hold() {
+    use vista_image::{PngFile, PngKind};
+    let dir = tempdir();
+    // Noise: 512 x 300 16-bit RGBA deflates to several 256 KiB IDAT chunks.
+    let noise = |x: u32, y: u32, c: u32| ((x * 7919 + y * 104_729 + c * 31) % 1009) as f32 / 1008.0;
+    let img = Image::from_fn(512, 300, |x, y| [noise(x, y, 0), noise(x, y, 1), noise(x, y, 2), noise(x, y, 3)]);
+    let mut opaque = img.clone();
+    opaque.data.iter_mut().for_each(|p| p[3] = 1.0);
+    for (name, kind, source) in
+        [("a16.png", PngKind::Rgba16, &img), ("a8.png", PngKind::Rgba8, &img), ("o8.png", PngKind::Rgb8, &opaque)]
+    {
+        let path = dir.path().join(name);
+        let mut png = PngFile::create(&path, source.width, source.height, kind).unwrap();
+        for row in source.data.chunks(source.width as usize) {
+            png.push_row(row).unwrap();
+        }
+        png.finish().unwrap();
+        let whole = dir.path().join(format!("whole-{name}"));
+        match kind {
+            PngKind::Rgba16 => write_png16(&whole, source).unwrap(),
+            _ => vista_image::write_png8(&whole, source).unwrap(),
+        }
+        let (streamed, whole) = (read_png16(&path).unwrap(), read_png16(&whole).unwrap());
+        assert!(streamed.bit_identical(&whole), "{name}: the same values as the whole-image writer");
+    }
+    let bytes = std::fs::read(dir.path().join("a16.png")).unwrap();
+    let idats = bytes.windows(4).filter(|w| w == b"IDAT").count();
+    assert!(idats > 1, "{idats} IDAT chunk(s): the chunking is not exercised");
+    assert_eq!(dir_entries(dir.path()).len(), 6, "no temp file left: {:?}", dir_entries(dir.path()));
+    assert!(PngFile::create(&dir.path().join("empty.png"), 0, 4, PngKind::Rgb8).is_err());
+}
+
+#[test]
+fn atomic_replace_with_writes_what_the_closure_writes_or_keeps_the_old_file() {
+    let dir = tempdir();
+    let path = dir.path().join("view.js");
+    std::fs::write(&path, "old").unwrap();
+    vista_image::atomic_replace_with(&path, |w| w.write_all(b"new contents")).unwrap();
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "new contents");
+    let failed = vista_image::atomic_replace_with(&path, |w| {
+        w.write_all(b"half")?;
+        Err(std::io::Error::other("the writer failed"))
+    });
+    assert!(failed.unwrap_err().to_string().contains("view.js"));
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "new contents", "the old file is kept");
+    assert_eq!(dir_entries(dir.path()), ["view.js"], "no temp file left");
+}

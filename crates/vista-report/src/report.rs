@@ -13,8 +13,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use base64::Engine;
-use vista_image::Image;
 use vista_image::metrics::format_psnr;
+use vista_image::{Image, PngFile, PngKind};
 
 use vista_golden::{BAD_PIXEL_LIMIT, GoldenError, Outcome, Verdict, bless_all_command};
 
@@ -290,44 +290,80 @@ pub fn write_case_files(
         return Ok(());
     }
     let case_dir = case_folder(dir, &id)?;
-    let write = |name: &str, img: &Image, bits16: bool| -> Result<Option<String>, GoldenError> {
-        if bits16 {
-            let path = case_dir.join(name);
-            vista_image::atomic_replace(&path, &vista_image::encode_png16(&path, img)?)?;
-        } else {
-            vista_image::write_png8(&case_dir.join(name), img)?;
-        }
-        Ok(Some(format!("{id}/{name}")))
-    };
+    let rel = |name: &str| Some(format!("{id}/{name}"));
+    type Written = Result<(Option<String>, Option<String>), GoldenError>;
+    // An image's 16-bit file (where `name16` is given) and its 8-bit display
+    // copy, written together a row at a time from `row` (y, then the row to
+    // fill): encoded whole, each held its samples and output at once (60-100
+    // MB apiece at 2048 x 2048), and the heat map was one more f32 image.
+    let pair =
+        |name16: Option<&str>, name8: &str, opaque: bool, row: &mut dyn FnMut(usize, &mut Vec<[f32; 4]>)| -> Written {
+            let (w, h) = (actual.width, actual.height);
+            let mut full = name16.map(|n| PngFile::create(&case_dir.join(n), w, h, PngKind::Rgba16)).transpose()?;
+            let kind = if opaque { PngKind::Rgb8 } else { PngKind::Rgba8 };
+            let mut display = PngFile::create(&case_dir.join(name8), w, h, kind)?;
+            let mut buf = Vec::with_capacity(w as usize);
+            for y in 0..h as usize {
+                buf.clear();
+                row(y, &mut buf);
+                if let Some(f) = &mut full {
+                    f.push_row(&buf)?;
+                }
+                display.push_row(&buf)?;
+            }
+            if let Some(f) = full {
+                f.finish()?;
+            }
+            display.finish()?;
+            Ok((name16.and_then(rel), rel(name8)))
+        };
+    let opaque = |img: &Image| img.data.iter().all(|p| vista_image::quantize8(p[3]) == u8::MAX);
     // The viewer compares where both have one size; otherwise (a missing
     // golden, a size change) it shows the render alone, at full size.
     let comparable = expected.filter(|e| (e.width, e.height) == (actual.width, actual.height));
-    type Written = Result<(Option<String>, Option<String>), GoldenError>;
-    let renders = || -> Written { Ok((write("actual.png", actual, true)?, write("actual8.png", actual, false)?)) };
+    let width = actual.width as usize;
+    let renders = || {
+        pair(Some("actual.png"), "actual8.png", opaque(actual), &mut |y, buf| {
+            buf.extend_from_slice(&actual.data[y * width..][..width]);
+        })
+    };
     let goldens = || -> Written {
         let Some(e) = expected else { return Ok((None, None)) };
+        let write = |name: &str, kind: PngKind| -> Result<Option<String>, GoldenError> {
+            let mut png = PngFile::create(&case_dir.join(name), e.width, e.height, kind)?;
+            for row in e.data.chunks(e.width as usize) {
+                png.push_row(row)?;
+            }
+            png.finish()?;
+            Ok(rel(name))
+        };
+        // The golden's own PNG where given, not encoded again.
         let full = match expected_png {
             Some(bytes) => {
                 vista_image::atomic_replace(&case_dir.join("expected.png"), bytes)?;
-                Some(format!("{id}/expected.png"))
+                rel("expected.png")
             }
-            None => write("expected.png", e, true)?,
+            None => write("expected.png", PngKind::Rgba16)?,
         };
-        Ok((full, write("expected8.png", e, false)?))
+        Ok((full, write("expected8.png", if opaque(e) { PngKind::Rgb8 } else { PngKind::Rgba8 })?))
     };
     let heat_map = || -> Written {
         let Some(expected) = comparable else { return Ok((None, None)) };
-        let heat = heat_map_of(expected, actual, &out.ignore);
-        Ok((write("diff.png", &heat, true)?, write("diff8.png", &heat, false)?))
+        let w = width;
+        pair(Some("diff.png"), "diff8.png", true, &mut |y, buf| {
+            vista_image::diff_heatmap_log_row(&expected.data[y * w..][..w], &actual.data[y * w..][..w], buf);
+            outline_ignored(y as u32, buf, &out.ignore);
+        })
     };
     // The viewer's data is both images' 16-bit values in base64: about
     // 1 MB per 256 x 256 case, more than half of a report. A reviewer
     // inspects pixels where a case did not pass.
     let first_bad = out.first_bad.as_ref().map(|b| (b.0, b.1));
     let viewer = || -> Result<Option<String>, GoldenError> {
-        let view = view_js(&id, comparable, actual, first_bad);
-        vista_image::atomic_replace(&case_dir.join("view.js"), view.as_bytes())?;
-        Ok(Some(format!("{id}/view.js")))
+        vista_image::atomic_replace_with(&case_dir.join("view.js"), |w| {
+            write_view_js(w, &id, comparable, actual, first_bad)
+        })?;
+        Ok(rel("view.js"))
     };
     // A failing 1920 x 1080 case spent about 0.45 s here; cores the jobs
     // leave idle take half of it (measured at 1080p: the render's images
@@ -354,27 +390,27 @@ pub fn write_case_files(
     Ok(())
 }
 
-/// The log-scale heat map of `actual` against `expected`, with the ignored
-/// rectangles outlined in cyan.
-fn heat_map_of(expected: &Image, actual: &Image, ignore: &[[u32; 4]]) -> Image {
-    let mut heat = vista_image::diff_heatmap_log(expected, actual);
-    for &[x, y, w, h] in ignore {
-        for i in 0..w {
-            for yy in [y, y + h - 1] {
-                if x + i < heat.width && yy < heat.height {
-                    heat.set(x + i, yy, [0.0, 1.0, 1.0, 1.0]);
-                }
-            }
+/// Outlines the ignored rectangles `[x, y, w, h]` in cyan on row `y` of a
+/// heat map.
+fn outline_ignored(y: u32, row: &mut [[f32; 4]], ignore: &[[u32; 4]]) {
+    const CYAN: [f32; 4] = [0.0, 1.0, 1.0, 1.0];
+    let width = row.len() as u32;
+    for &[rx, ry, rw, rh] in ignore {
+        if rw == 0 || rh == 0 || y < ry || y > ry + (rh - 1) {
+            continue;
         }
-        for j in 0..h {
-            for xx in [x, x + w - 1] {
-                if xx < heat.width && y + j < heat.height {
-                    heat.set(xx, y + j, [0.0, 1.0, 1.0, 1.0]);
+        if y == ry || y == ry + (rh - 1) {
+            for x in rx..(rx + rw).min(width) {
+                row[x as usize] = CYAN;
+            }
+        } else {
+            for x in [rx, rx + (rw - 1)] {
+                if x < width {
+                    row[x as usize] = CYAN;
                 }
             }
         }
     }
-    heat
 }
 
 /// Which cases get their 16-bit images and the pixel viewer's data
@@ -412,32 +448,47 @@ pub struct RunSummary {
 /// (RGB, little-endian u16, base64; `expected` null when there is no
 /// golden of the render's size) and the first bad pixel.
 pub fn view_js(id: &str, expected: Option<&Image>, actual: &Image, first_bad: Option<(u32, u32)>) -> String {
-    // Written straight into one string (33 MB at 1920 x 1080): base64 needs
-    // no JSON escaping, and a JSON value would copy and scan it twice more.
-    let u16s = |out: &mut String, img: &Image| {
-        let bytes: Vec<u8> = img
-            .data
-            .iter()
-            .flat_map(|p| p[..3].iter().map(|&v| vista_image::quantize16(v)))
-            .flat_map(u16::to_le_bytes)
-            .collect();
-        out.push('"');
-        base64::engine::general_purpose::STANDARD.encode_string(bytes, out);
-        out.push('"');
+    let mut out = Vec::new();
+    write_view_js(&mut out, id, expected, actual, first_bad).expect("writing to memory");
+    String::from_utf8(out).expect("view.js is ASCII and JSON")
+}
+
+/// [`view_js`] written to `out` a row at a time: whole, a 2048 x 2048
+/// case's was one 64 MiB string and its 16-bit values once more. A row's
+/// 6 bytes a texel are a multiple of 3, so its base64 needs no padding and
+/// the rows' texts join into the whole image's.
+pub fn write_view_js(
+    out: &mut dyn std::io::Write,
+    id: &str,
+    expected: Option<&Image>,
+    actual: &Image,
+    first_bad: Option<(u32, u32)>,
+) -> std::io::Result<()> {
+    let w = actual.width as usize;
+    let mut bytes = Vec::with_capacity(w * 6);
+    let mut text = vec![0u8; w * 8];
+    let mut u16s = |out: &mut dyn std::io::Write, img: &Image| -> std::io::Result<()> {
+        out.write_all(b"\"")?;
+        for row in img.data.chunks(img.width.max(1) as usize) {
+            bytes.clear();
+            bytes
+                .extend(row.iter().flat_map(|p| p[..3].iter().flat_map(|&v| vista_image::quantize16(v).to_le_bytes())));
+            text.resize(bytes.len().div_ceil(3) * 4, 0);
+            let n = base64::engine::general_purpose::STANDARD.encode_slice(&bytes, &mut text).expect("sized for it");
+            out.write_all(&text[..n])?;
+        }
+        out.write_all(b"\"")
     };
-    let pixels = actual.data.len() * if expected.is_some() { 2 } else { 1 };
-    let mut out = String::with_capacity(pixels * 8 + 256);
     let id = serde_json::to_string(id).expect("a string");
-    out.push_str(&format!("vistaCase({{\"id\":{id},\"w\":{},\"h\":{},\"expected\":", actual.width, actual.height));
+    write!(out, "vistaCase({{\"id\":{id},\"w\":{},\"h\":{},\"expected\":", actual.width, actual.height)?;
     match expected {
-        Some(e) => u16s(&mut out, e),
-        None => out.push_str("null"),
+        Some(e) => u16s(out, e)?,
+        None => out.write_all(b"null")?,
     }
-    out.push_str(",\"actual\":");
-    u16s(&mut out, actual);
+    out.write_all(b",\"actual\":")?;
+    u16s(out, actual)?;
     let first_bad = first_bad.map_or("null".to_string(), |(x, y)| format!("[{x},{y}]"));
-    out.push_str(&format!(",\"first_bad\":{first_bad}}});\n"));
-    out
+    writeln!(out, ",\"first_bad\":{first_bad}}});")
 }
 
 fn verdict_word(o: &Outcome) -> &'static str {
@@ -836,6 +887,26 @@ mod href_tests {
 #[cfg(test)]
 mod view_tests {
     use super::*;
+
+    #[test]
+    fn ignored_rectangles_are_outlined_row_by_row() {
+        let (w, h) = (6u32, 5u32);
+        let ignore = [[1, 1, 3, 3], [4, 0, 5, 2]];
+        let cyan: Vec<(u32, u32)> = (0..h)
+            .flat_map(|y| {
+                let mut row = vec![[0.0f32; 4]; w as usize];
+                outline_ignored(y, &mut row, &ignore);
+                row.into_iter().enumerate().filter(|(_, p)| *p == [0.0, 1.0, 1.0, 1.0]).map(move |(x, _)| (x as u32, y))
+            })
+            .collect();
+        // The first rectangle's border (its middle texel (2, 2) stays), the
+        // second's two rows clipped at the right edge.
+        let expected = [(4, 0), (5, 0), (1, 1), (2, 1), (3, 1), (4, 1), (5, 1), (1, 2), (3, 2), (1, 3), (2, 3), (3, 3)];
+        assert_eq!(cyan, expected);
+        let mut row = vec![[0.0f32; 4]; 6];
+        outline_ignored(0, &mut row, &[[0, 0, 0, 3], [0, 0, 2, 0]]);
+        assert!(row.iter().all(|p| *p == [0.0; 4]), "an empty rectangle outlines nothing");
+    }
 
     #[test]
     fn view_js_holds_both_images_16_bit_values_as_json() {
