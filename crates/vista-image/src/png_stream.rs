@@ -67,6 +67,41 @@ impl<W: Write> Write for Idat<W> {
     }
 }
 
+/// Where a streamed write goes: a temp file renamed into place at the end
+/// (or the file itself, under the fault plan's in-place writer), numbered
+/// for fault injection ([`crate::fault`]).
+struct Streamed {
+    n: usize,
+    temp: Option<tempfile::NamedTempFile>,
+}
+
+impl Streamed {
+    /// Opens the write to `path`, through a 64 KiB buffer.
+    fn open(path: &Path) -> Result<(Streamed, BufWriter<std::fs::File>), ImageError> {
+        let io_err = |source| ImageError::Io { path: path.to_path_buf(), source };
+        let n = crate::fault::next_write();
+        let (temp, file) = match crate::fault::plan().plain_writer {
+            true => (None, std::fs::File::create(path).map_err(io_err)?),
+            false => {
+                let temp = create_temp(&parent_dir(path), path).map_err(io_err)?;
+                let file = temp.as_file().try_clone().map_err(io_err)?;
+                (Some(temp), file)
+            }
+        };
+        Ok((Streamed { n, temp }, BufWriter::with_capacity(1 << 16, file)))
+    }
+
+    /// Puts the file in place once its last byte is flushed.
+    fn place(self, path: &Path) -> Result<(), ImageError> {
+        maybe_stop(self.n, Stop::BeforeRename, path);
+        if let Some(temp) = self.temp {
+            temp.persist(path).map_err(|e| ImageError::Io { path: path.to_path_buf(), source: e.error })?;
+        }
+        maybe_stop(self.n, Stop::After, path);
+        Ok(())
+    }
+}
+
 /// A PNG file written one row at a time, replaced as
 /// [`crate::atomic_replace`] replaces (a temp file renamed into place, no
 /// sync): rows filtered by least absolute sum and deflated by fdeflate (the
@@ -74,10 +109,7 @@ impl<W: Write> Write for Idat<W> {
 /// rows of samples and at most one chunk of output.
 pub struct PngFile {
     path: PathBuf,
-    /// The write's number for fault injection ([`crate::fault`]).
-    n: usize,
-    /// None when the fault plan asks for writes in place.
-    temp: Option<tempfile::NamedTempFile>,
+    streamed: Streamed,
     deflate: fdeflate::Compressor<Idat<BufWriter<std::fs::File>>>,
     kind: PngKind,
     width: u32,
@@ -96,17 +128,8 @@ impl PngFile {
             let message = format!("cannot store an empty {width}x{height} image");
             return Err(ImageError::Encode { path: path.to_path_buf(), format: "PNG", msg: message });
         }
-        let n = crate::fault::next_write();
-        let (temp, file) = match crate::fault::plan().plain_writer {
-            true => (None, std::fs::File::create(path).map_err(io_err)?),
-            false => {
-                let temp = create_temp(&parent_dir(path), path).map_err(io_err)?;
-                let file = temp.as_file().try_clone().map_err(io_err)?;
-                (Some(temp), file)
-            }
-        };
+        let (streamed, mut out) = Streamed::open(path)?;
         let (bpp, depth, colour) = kind.layout();
-        let mut out = BufWriter::with_capacity(1 << 16, file);
         let mut header = b"\x89PNG\r\n\x1a\n".to_vec();
         let mut ihdr = Vec::with_capacity(13);
         ihdr.extend_from_slice(&width.to_be_bytes());
@@ -118,8 +141,7 @@ impl PngFile {
         let stride = width as usize * bpp;
         Ok(PngFile {
             path: path.to_path_buf(),
-            n,
-            temp,
+            streamed,
             deflate,
             kind,
             width,
@@ -165,7 +187,7 @@ impl PngFile {
         std::mem::swap(&mut self.previous, &mut self.samples);
         self.rows += 1;
         if self.rows == self.height.div_ceil(2) {
-            maybe_stop(self.n, Stop::Partial, &self.path);
+            maybe_stop(self.streamed.n, Stop::Partial, &self.path);
         }
         Ok(())
     }
@@ -182,12 +204,7 @@ impl PngFile {
         idat.out.write_all(&end).map_err(io_err)?;
         idat.out.flush().map_err(io_err)?;
         drop(idat);
-        maybe_stop(self.n, Stop::BeforeRename, &path);
-        if let Some(temp) = self.temp {
-            temp.persist(&path).map_err(|e| io_err(e.error))?;
-        }
-        maybe_stop(self.n, Stop::After, &path);
-        Ok(())
+        self.streamed.place(&path)
     }
 }
 
@@ -200,24 +217,10 @@ pub fn atomic_replace_with(
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), ImageError> {
     let io_err = |source| ImageError::Io { path: path.to_path_buf(), source };
-    let n = crate::fault::next_write();
-    let (temp, file) = match crate::fault::plan().plain_writer {
-        true => (None, std::fs::File::create(path).map_err(io_err)?),
-        false => {
-            let temp = create_temp(&parent_dir(path), path).map_err(io_err)?;
-            let file = temp.as_file().try_clone().map_err(io_err)?;
-            (Some(temp), file)
-        }
-    };
-    let mut out = BufWriter::with_capacity(1 << 16, file);
+    let (streamed, mut out) = Streamed::open(path)?;
     write(&mut out).map_err(io_err)?;
     out.flush().map_err(io_err)?;
     drop(out);
-    maybe_stop(n, Stop::Partial, path);
-    maybe_stop(n, Stop::BeforeRename, path);
-    if let Some(temp) = temp {
-        temp.persist(path).map_err(|e| io_err(e.error))?;
-    }
-    maybe_stop(n, Stop::After, path);
-    Ok(())
+    maybe_stop(streamed.n, Stop::Partial, path);
+    streamed.place(path)
 }
