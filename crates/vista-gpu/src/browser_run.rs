@@ -24,7 +24,7 @@ impl Context {
     ) -> Result<(Readback, Vec<Vec<usize>>), GpuError> {
         let b64 = vista_browser::base64;
         let mut resources = Vec::new();
-        for r in &g.resources {
+        for r in g.resources.iter() {
             resources.push(match r {
                 Resource::Texture(t) => {
                     let format = crate::format::parse(t.format)?;
@@ -52,7 +52,7 @@ impl Context {
             });
         }
         let mut passes = Vec::new();
-        for pass in &g.passes {
+        for pass in g.passes.iter() {
             let (key, wgsl) = self.browser_wgsl(b, g, &pass.shader, &pass.entry, &pass.constants)?;
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
             if let Some(r) = &pass.raster {

@@ -405,12 +405,14 @@ pub struct Graph<'a> {
     /// The project's WGSL sources.
     pub shaders: &'a ShaderSet,
     /// Every resource; bindings, swaps and outputs name them by index.
-    pub resources: Vec<Resource>,
+    /// Borrowed from a plan where one runs it (a noise kernel's passes hold
+    /// a 256 KiB table: a copy per case was a tenth of a small case's time).
+    pub resources: std::borrow::Cow<'a, [Resource]>,
     /// The passes, in order.
-    pub passes: Vec<GraphPass>,
+    pub passes: std::borrow::Cow<'a, [GraphPass]>,
     /// Resources read back after the last pass (after its swaps: a swapped
     /// name reads the resource it binds then).
-    pub outputs: Vec<usize>,
+    pub outputs: std::borrow::Cow<'a, [usize]>,
 }
 
 /// The view a binding of `t` sees: six layers as a cube for a sampled
@@ -474,7 +476,7 @@ impl Context {
     /// each run's sentinel was never written.
     pub fn run(&self, g: &Graph<'_>) -> Result<Readback, GpuError> {
         let max = self.max_dimension();
-        for r in &g.resources {
+        for r in g.resources.iter() {
             if let Resource::Texture(t) = r
                 && (t.width > max || t.height > max)
             {
@@ -484,7 +486,7 @@ impl Context {
                 )));
             }
         }
-        for pass in &g.passes {
+        for pass in g.passes.iter() {
             self.require_needs(&pass.label, &pass.needs())?;
         }
         let start = Instant::now();

@@ -202,7 +202,7 @@ impl Context {
         let copy_start = Instant::now();
         let mut outputs = Vec::new();
         let mut sentinels = Vec::new();
-        for &o in &g.outputs {
+        for &o in g.outputs.iter() {
             let (data, held) = self.read_resource(w, g, &made, o, current[o], which)?;
             outputs.push(data);
             sentinels.push(held);

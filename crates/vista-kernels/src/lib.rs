@@ -481,14 +481,16 @@ impl Kernel {
             Some(Value::Int(s)) => *s as u32,
             _ => 0,
         };
-        let mut table = noise::permutation(seed);
-        let chain = noise::chain_words(&table);
-        let plane = match self.hash_plane(p) {
-            Some(z) => noise::plane_hashes(&table, &chain[512..], z),
-            None => vec![0, 0],
-        };
-        table.extend(chain);
-        table.extend(plane);
+        let perm = noise::permutation(seed);
+        // The chain words are built where they end up: appended, they were
+        // copied once more (256 KiB per case).
+        let mut table = Vec::with_capacity(perm.len() + 512 + 256 * 256 + 2 + 256 * 256);
+        table.extend_from_slice(&perm);
+        noise::chain_words_into(&perm, &mut table);
+        match self.hash_plane(p) {
+            Some(z) => noise::plane_hashes_into(&perm, &mut table, perm.len() + 512, z),
+            None => table.extend([0, 0]),
+        }
         table
     }
 

@@ -47,6 +47,13 @@ pub fn permutation(seed: u32) -> Vec<u32> {
 /// perm[a] | perm[a + 1] << 8 | perm[b] << 16 | perm[b + 1] << 24 with a =
 /// perm[x] + y, b = perm[x + 1] + y. Every entry is below 256, so four fit.
 pub fn chain_words(perm: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(512 + 256 * 256);
+    chain_words_into(perm, &mut out);
+    out
+}
+
+/// [`chain_words`] appended to `out`.
+pub fn chain_words_into(perm: &[u32], out: &mut Vec<u32>) {
     // A fixed-size copy indexed modulo its length: no bounds checks in the
     // 65536-cell loop (every small case builds this table).
     let mut q = [0u32; 512];
@@ -54,7 +61,7 @@ pub fn chain_words(perm: &[u32]) -> Vec<u32> {
         *v = perm[k % perm.len()];
     }
     let p = |k: usize| q[k & 511];
-    let mut out = Vec::with_capacity(512 + 256 * 256);
+    out.reserve(512 + 256 * 256);
     out.extend((0..512).map(|k| p(k) | p(k + 1) << 8));
     for x in 0..256 {
         for y in 0..256 {
@@ -62,7 +69,6 @@ pub fn chain_words(perm: &[u32]) -> Vec<u32> {
             out.push(p(a) | p(a + 1) << 8 | p(b) << 16 | p(b + 1) << 24);
         }
     }
-    out
 }
 
 /// The flag, plane and corner hashes the WGSL Perlin reads after the
@@ -74,12 +80,24 @@ pub fn chain_words(perm: &[u32]) -> Vec<u32> {
 /// [`chain_words`] (`cells`, after its 512 pair words): a cell's four hashes
 /// are perm[c + z] of its bytes perm[a], perm[b], perm[a + 1], perm[b + 1].
 pub fn plane_hashes(perm: &[u32], cells: &[u32], z: i64) -> Vec<u32> {
+    let mut out = cells.to_vec();
+    plane_hashes_into(perm, &mut out, 0, z);
+    out.drain(..cells.len());
+    out
+}
+
+/// [`plane_hashes`] of the cell words `table[cells_at..cells_at + 65536]`,
+/// appended to `table` (a case's table grows in place: no 256 KiB copy).
+pub fn plane_hashes_into(perm: &[u32], table: &mut Vec<u32>, cells_at: usize, z: i64) {
     let z = (z & 255) as usize;
     let h = |word: u32, byte: u32| perm[(word >> (8 * byte) & 255) as usize + z];
-    let mut out = Vec::with_capacity(2 + cells.len());
-    out.extend([1, z as u32]);
-    out.extend(cells.iter().map(|&w| h(w, 0) | h(w, 2) << 8 | h(w, 1) << 16 | h(w, 3) << 24));
-    out
+    let cells = table.len() - cells_at;
+    table.reserve(2 + cells);
+    table.extend([1, z as u32]);
+    for i in cells_at..cells_at + cells {
+        let w = table[i];
+        table.push(h(w, 0) | h(w, 2) << 8 | h(w, 1) << 16 | h(w, 3) << 24);
+    }
 }
 
 /// pcg3d (Jarzynski & Olano 2020): a 3D -> 3D integer hash, wrapping u32 math.

@@ -406,12 +406,15 @@ impl Planning<'_> {
         })?;
         let constants = kernel.overrides_in(module, &pp, false).map_err(|e| RenderError::BadInput(e.to_string()))?;
         let blocks = kernel.uniforms(layout, &pp, width, height);
-        let table = kernel.table(layout, &pp);
+        let mut table = Some(kernel.table(layout, &pp));
+        let tables = slots.iter().filter(|s| matches!(s.feed, SlotFeed::Table)).count();
         let mut gslots = Vec::new();
         for s in slots {
             let bind = match &s.feed {
                 SlotFeed::Uniform(n) => Bind::Uniform(blocks[*n].clone()),
-                SlotFeed::Table => Bind::Table(table.clone()),
+                // Moved into the one slot that binds it (256 KiB for noise).
+                SlotFeed::Table if tables == 1 => Bind::Table(table.take().unwrap_or_default()),
+                SlotFeed::Table => Bind::Table(table.clone().unwrap_or_default()),
                 SlotFeed::Resource(r, usage) => match usage {
                     Usage::UniformBuffer => Bind::UniformBuffer(*r),
                     Usage::StorageBuffer { read_only } => Bind::Storage { resource: *r, read_only: *read_only },

@@ -490,9 +490,9 @@ pub fn for_case<R>(id: &str, f: impl FnOnce() -> R) -> R {
 pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
     let graph = vista_gpu::Graph {
         shaders: &gpu.shaders,
-        resources: plan.resources.clone(),
-        passes: plan.passes.clone(),
-        outputs: plan.output_ids.clone(),
+        resources: std::borrow::Cow::Borrowed(&plan.resources),
+        passes: std::borrow::Cow::Borrowed(&plan.passes),
+        outputs: std::borrow::Cow::Borrowed(&plan.output_ids),
     };
     let out = match &gpu.worker {
         Some(w) => {

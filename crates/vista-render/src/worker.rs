@@ -288,12 +288,7 @@ fn serve() -> std::io::Result<()> {
         })));
         ctx.time_passes(time_passes);
         let before = ctx.compile_time();
-        let graph = vista_gpu::Graph {
-            shaders: &shaders,
-            resources: resources.into_owned(),
-            passes: passes.into_owned(),
-            outputs: outputs.into_owned(),
-        };
+        let graph = vista_gpu::Graph { shaders: &shaders, resources, passes, outputs };
         let result = ctx.run(&graph);
         let compile = ctx.compile_time().saturating_sub(before);
         let mut out = out.lock().expect("stdout");
