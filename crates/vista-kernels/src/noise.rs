@@ -61,13 +61,16 @@ pub fn chain_words_into(perm: &[u32], out: &mut Vec<u32>) {
         *v = perm[k % perm.len()];
     }
     let p = |k: usize| q[k & 511];
+    // The pair words first; a cell word is two of them: pair[a] | pair[b] << 16.
+    let mut pair = [0u32; 512];
+    for (k, v) in pair.iter_mut().enumerate() {
+        *v = p(k) | p(k + 1) << 8;
+    }
     out.reserve(512 + 256 * 256);
-    out.extend((0..512).map(|k| p(k) | p(k + 1) << 8));
+    out.extend_from_slice(&pair);
     for x in 0..256 {
-        for y in 0..256 {
-            let (a, b) = (p(x) as usize + y, p(x + 1) as usize + y);
-            out.push(p(a) | p(a + 1) << 8 | p(b) << 16 | p(b + 1) << 24);
-        }
+        let (a0, b0) = (p(x) as usize, p(x + 1) as usize);
+        out.extend((0..256).map(|y| pair[(a0 + y) & 511] | pair[(b0 + y) & 511] << 16));
     }
 }
 
