@@ -262,7 +262,14 @@ pub fn psnr_with_peak(a: &Image, b: &Image, peak: f64) -> f64 {
 pub fn ssim(a: &Image, b: &Image) -> f64 {
     assert_same_size(a, b);
     let (w, h) = (a.width as usize, a.height as usize);
-    ssim_impl::ssim(&luma(a), &luma(b), w, h)
+    // Luma made a row at a time where a band reads it, not as whole planes.
+    fn rows(img: &Image, r: usize, row: &mut [f64]) {
+        let w = img.width as usize;
+        for (v, p) in row.iter_mut().zip(&img.data[r * w..][..w]) {
+            *v = luma_of(p);
+        }
+    }
+    ssim_impl::ssim_rows(&|r, row| rows(a, r, row), &|r, row| rows(b, r, row), w, h)
 }
 
 /// Largest absolute RGB difference; `+inf` if any differing pair is non-finite.
@@ -347,9 +354,10 @@ fn rgb_values(img: &Image) -> impl Iterator<Item = f64> + '_ {
 }
 
 /// Rec. 709 luma with non-finite channels replaced by 0 (see module docs).
-fn luma(img: &Image) -> Vec<f64> {
+/// Rec. 709 luma of a texel, non-finite channels as 0: what SSIM compares.
+fn luma_of(p: &[f32; 4]) -> f64 {
     let finite = |v: f32| if v.is_finite() { f64::from(v) } else { 0.0 };
-    img.data.iter().map(|p| 0.2126 * finite(p[0]) + 0.7152 * finite(p[1]) + 0.0722 * finite(p[2])).collect()
+    0.2126 * finite(p[0]) + 0.7152 * finite(p[1]) + 0.0722 * finite(p[2])
 }
 
 fn check_same_size(reference: &Image, actual: &Image) -> Result<(), ImageError> {

@@ -13,22 +13,31 @@ const C2: f64 = 0.03 * 0.03;
 /// Local moments under the window: E[x], E[y], E[x²], E[y²], E[xy].
 type Moments = [f64; 5];
 
-/// Mean SSIM of two `w x h` single-channel images.
+/// Fills one row (its index, then the row) of a single-channel image.
+pub(crate) type Rows<'a> = &'a (dyn Fn(usize, &mut [f64]) + Sync);
+
+/// Mean SSIM of two `w x h` single-channel images given a row at a time,
+/// each band making the rows it reads (whole f64 planes of a 2048 x 2048
+/// image pair were 64 MiB).
 ///
 /// The map is averaged over pixels whose whole 11x11 window lies inside the
 /// image (a 5-pixel border is cropped, exactly like scikit-image), so the
 /// border mode of the filter never matters. Images narrower or shorter than
 /// 11 pixels have no such pixel; they fall back to one global window with
-/// uniform weights over the whole image. An empty image scores 1.
-pub(crate) fn ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
-    debug_assert_eq!(x.len(), w * h);
-    debug_assert_eq!(y.len(), w * h);
-    ssim_on(x, y, w, h, crate::threads_for(x.len()))
-}
-
-/// [`ssim`] with the windowed map's bands on up to `threads` threads.
-fn ssim_on(x: &[f64], y: &[f64], w: usize, h: usize, threads: usize) -> f64 {
-    if w >= WIN && h >= WIN { windowed_ssim(x, y, w, h, threads) } else { global_ssim(x, y) }
+/// uniform weights over the whole image (gathered whole). An empty image
+/// scores 1.
+pub(crate) fn ssim_rows(x: Rows<'_>, y: Rows<'_>, w: usize, h: usize) -> f64 {
+    if w >= WIN && h >= WIN {
+        return windowed_ssim(x, y, w, h, crate::threads_for(w * h));
+    }
+    let whole = |rows: Rows<'_>| {
+        let mut plane = vec![0.0; w * h];
+        for (r, row) in plane.chunks_exact_mut(w.max(1)).enumerate() {
+            rows(r, row);
+        }
+        plane
+    };
+    global_ssim(&whole(x), &whole(y))
 }
 
 /// Normalised 11-tap Gaussian, as `scipy.ndimage.gaussian_filter` builds it.
@@ -47,7 +56,7 @@ fn gaussian_kernel() -> [f64; WIN] {
 /// (at 2048 x 2048 those were 170 MB).
 const BAND: usize = 64;
 
-fn windowed_ssim(x: &[f64], y: &[f64], w: usize, h: usize, threads: usize) -> f64 {
+fn windowed_ssim(x: Rows<'_>, y: Rows<'_>, w: usize, h: usize, threads: usize) -> f64 {
     let k = gaussian_kernel();
     let oh = h - 2 * RADIUS;
     let bands: Vec<(usize, usize)> = (0..oh).step_by(BAND).map(|r0| (r0, (r0 + BAND).min(oh))).collect();
@@ -74,14 +83,17 @@ fn windowed_ssim(x: &[f64], y: &[f64], w: usize, h: usize, threads: usize) -> f6
 /// Gaussian of the five moment planes over input rows `r0..r1 + 10`, each
 /// pass adding its taps in the same order as a whole-image filter would, so
 /// every value is bit for bit the whole image's.
-fn band_values(x: &[f64], y: &[f64], w: usize, k: &[f64; WIN], r0: usize, r1: usize) -> Vec<f64> {
+fn band_values(x: Rows<'_>, y: Rows<'_>, w: usize, k: &[f64; WIN], r0: usize, r1: usize) -> Vec<f64> {
     let ow = w - 2 * RADIUS;
     let rows_in = r1 - r0 + 2 * RADIUS;
     // Horizontal pass: the five planes' rows, filtered where the window fits.
     let mut across = vec![vec![0.0; rows_in * ow]; 5];
     let mut products = [vec![0.0; w], vec![0.0; w], vec![0.0; w]];
+    let (mut rx, mut ry) = (vec![0.0; w], vec![0.0; w]);
     for j in 0..rows_in {
-        let (rx, ry) = (&x[(r0 + j) * w..][..w], &y[(r0 + j) * w..][..w]);
+        x(r0 + j, &mut rx);
+        y(r0 + j, &mut ry);
+        let (rx, ry) = (&rx[..], &ry[..]);
         for i in 0..w {
             products[0][i] = rx[i] * rx[i];
             products[1][i] = ry[i] * ry[i];
@@ -145,6 +157,22 @@ fn ssim_from_moments(m: &Moments) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`ssim_rows`] of two whole planes.
+    fn ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
+        debug_assert_eq!(x.len(), w * h);
+        debug_assert_eq!(y.len(), w * h);
+        ssim_on(x, y, w, h, crate::threads_for(x.len()))
+    }
+
+    /// [`ssim`] with the windowed map's bands on up to `threads` threads.
+    fn ssim_on(x: &[f64], y: &[f64], w: usize, h: usize, threads: usize) -> f64 {
+        let (rx, ry) = (
+            |r: usize, row: &mut [f64]| row.copy_from_slice(&x[r * w..][..w]),
+            |r: usize, row: &mut [f64]| row.copy_from_slice(&y[r * w..][..w]),
+        );
+        if w >= WIN && h >= WIN { windowed_ssim(&rx, &ry, w, h, threads) } else { global_ssim(x, y) }
+    }
 
     /// The whole-image form the bands replaced: five filtered planes.
     fn whole_image_ssim(x: &[f64], y: &[f64], w: usize, h: usize) -> f64 {
