@@ -178,14 +178,20 @@ fn send<T: Serialize>(w: &mut impl Write, msg: &T, parts: &[&[u8]]) -> std::io::
     w.flush()
 }
 
-fn receive<T: for<'de> Deserialize<'de>>(r: &mut impl Read) -> std::io::Result<(T, Vec<u8>)> {
+/// A message's JSON head and the length of the bytes after it.
+fn receive_head(r: &mut impl Read) -> std::io::Result<(Vec<u8>, usize)> {
     let mut n = [0u8; 4];
     r.read_exact(&mut n)?;
     let mut head = vec![0u8; u32::from_le_bytes(n) as usize];
     r.read_exact(&mut head)?;
     let mut m = [0u8; 8];
     r.read_exact(&mut m)?;
-    let mut bytes = vec![0u8; u64::from_le_bytes(m) as usize];
+    Ok((head, u64::from_le_bytes(m) as usize))
+}
+
+fn receive<T: for<'de> Deserialize<'de>>(r: &mut impl Read) -> std::io::Result<(T, Vec<u8>)> {
+    let (head, len) = receive_head(r)?;
+    let mut bytes = vec![0u8; len];
     r.read_exact(&mut bytes)?;
     let (msg, bytes) = vista_gpu::wire::read_attached(bytes, || serde_json::from_slice(&head));
     let msg = msg.map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
@@ -210,13 +216,7 @@ impl Answer {
 /// [`receive`] of a worker's answer (answers carry no byte lists in their
 /// head, only the outputs after it).
 fn receive_answer(r: &mut impl Read) -> std::io::Result<(FromWorker, Answer)> {
-    let mut n = [0u8; 4];
-    r.read_exact(&mut n)?;
-    let mut head = vec![0u8; u32::from_le_bytes(n) as usize];
-    r.read_exact(&mut head)?;
-    let mut m = [0u8; 8];
-    r.read_exact(&mut m)?;
-    let len = u64::from_le_bytes(m) as usize;
+    let (head, len) = receive_head(r)?;
     let mut texels = vec![[0.0f32; 4]; len.div_ceil(16)];
     r.read_exact(&mut bytemuck::cast_slice_mut(&mut texels)[..len])?;
     let msg = serde_json::from_slice(&head).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
