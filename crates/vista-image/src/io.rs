@@ -63,11 +63,17 @@ pub fn encode_png16_small(path: &Path, img: &Image) -> Result<Vec<u8>, ImageErro
 /// beside the 16-bit file. Fast compression and no sync to disk, since
 /// every run writes the report again ([`atomic_replace`]).
 pub fn write_png8(path: &Path, img: &Image) -> Result<(), ImageError> {
-    let opaque = img.data.iter().all(|p| quantize8(p[3]) == u8::MAX);
+    let opaque = opaque8(img);
     let channels = if opaque { 3 } else { 4 };
     let samples: Vec<u8> = img.data.iter().flat_map(|p| p[..channels].iter().map(|&v| quantize8(v))).collect();
     let color = if opaque { image::ExtendedColorType::Rgb8 } else { image::ExtendedColorType::Rgba8 };
     atomic_replace(path, &encode_fast(path, img, &samples, color)?)
+}
+
+/// Whether every alpha of `img` is 1 at 8 bits: its 8-bit PNG needs no
+/// alpha channel.
+pub fn opaque8(img: &Image) -> bool {
+    img.data.iter().all(|p| quantize8(p[3]) == u8::MAX)
 }
 
 /// Writes `img` as the smallest 8-bit PNG this writes (clamped to
@@ -96,12 +102,7 @@ pub fn encode_png8_small(img: &Image) -> Vec<u8> {
         _ => texels.iter().flat_map(|p| keep.iter().map(move |&c| p[c])).collect(),
     };
     let filtered = filter_rows(&samples, img.width as usize * keep.len(), keep.len());
-    let mut ihdr = Vec::with_capacity(13);
-    ihdr.extend_from_slice(&img.width.to_be_bytes());
-    ihdr.extend_from_slice(&img.height.to_be_bytes());
-    ihdr.extend_from_slice(&[8, colour_type, 0, 0, 0]);
-    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
-    png_chunk(&mut png, b"IHDR", &ihdr);
+    let mut png = png_header(img.width, img.height, 8, colour_type);
     png_chunk(&mut png, b"IDAT", &zlib_best(&filtered));
     png_chunk(&mut png, b"IEND", &[]);
     png
@@ -232,6 +233,17 @@ fn zlib_best(data: &[u8]) -> Vec<u8> {
             }
         }
     })
+}
+
+/// A PNG's signature and IHDR chunk (no interlace).
+pub(crate) fn png_header(width: u32, height: u32, depth: u8, colour_type: u8) -> Vec<u8> {
+    let mut ihdr = Vec::with_capacity(13);
+    ihdr.extend_from_slice(&width.to_be_bytes());
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[depth, colour_type, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png_chunk(&mut png, b"IHDR", &ihdr);
+    png
 }
 
 /// Appends one PNG chunk: length, type, data, CRC of type and data.

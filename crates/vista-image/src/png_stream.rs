@@ -8,7 +8,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::fault::{Stop, maybe_stop};
-use crate::io::{RowFilter, create_temp, parent_dir, png_chunk};
+use crate::io::{RowFilter, create_temp, parent_dir, png_chunk, png_header};
 use crate::{ImageError, quantize8, quantize16};
 
 /// The samples a [`PngFile`] stores per texel.
@@ -130,13 +130,7 @@ impl PngFile {
         }
         let (streamed, mut out) = Streamed::open(path)?;
         let (bpp, depth, colour) = kind.layout();
-        let mut header = b"\x89PNG\r\n\x1a\n".to_vec();
-        let mut ihdr = Vec::with_capacity(13);
-        ihdr.extend_from_slice(&width.to_be_bytes());
-        ihdr.extend_from_slice(&height.to_be_bytes());
-        ihdr.extend_from_slice(&[depth, colour, 0, 0, 0]);
-        png_chunk(&mut header, b"IHDR", &ihdr);
-        out.write_all(&header).map_err(io_err)?;
+        out.write_all(&png_header(width, height, depth, colour)).map_err(io_err)?;
         let deflate = fdeflate::Compressor::new(Idat { out, pending: Vec::new() }).map_err(io_err)?;
         let stride = width as usize * bpp;
         Ok(PngFile {

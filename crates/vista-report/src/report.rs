@@ -296,61 +296,53 @@ pub fn write_case_files(
     // copy, written together a row at a time from `row` (y, then the row to
     // fill): encoded whole, each held its samples and output at once (60-100
     // MB apiece at 2048 x 2048), and the heat map was one more f32 image.
-    let pair =
-        |name16: Option<&str>, name8: &str, opaque: bool, row: &mut dyn FnMut(usize, &mut Vec<[f32; 4]>)| -> Written {
-            let (w, h) = (actual.width, actual.height);
-            let mut full = name16.map(|n| PngFile::create(&case_dir.join(n), w, h, PngKind::Rgba16)).transpose()?;
-            let kind = if opaque { PngKind::Rgb8 } else { PngKind::Rgba8 };
-            let mut display = PngFile::create(&case_dir.join(name8), w, h, kind)?;
-            let mut buf = Vec::with_capacity(w as usize);
-            for y in 0..h as usize {
-                buf.clear();
-                row(y, &mut buf);
-                if let Some(f) = &mut full {
-                    f.push_row(&buf)?;
-                }
-                display.push_row(&buf)?;
+    let pair = |name16: Option<&str>,
+                name8: &str,
+                (w, h): (u32, u32),
+                opaque: bool,
+                row: &mut dyn FnMut(usize, &mut Vec<[f32; 4]>)|
+     -> Written {
+        let mut full = name16.map(|n| PngFile::create(&case_dir.join(n), w, h, PngKind::Rgba16)).transpose()?;
+        let kind = if opaque { PngKind::Rgb8 } else { PngKind::Rgba8 };
+        let mut display = PngFile::create(&case_dir.join(name8), w, h, kind)?;
+        let mut buf = Vec::with_capacity(w as usize);
+        for y in 0..h as usize {
+            buf.clear();
+            row(y, &mut buf);
+            if let Some(f) = &mut full {
+                f.push_row(&buf)?;
             }
-            if let Some(f) = full {
-                f.finish()?;
-            }
-            display.finish()?;
-            Ok((name16.and_then(rel), rel(name8)))
-        };
-    let opaque = |img: &Image| img.data.iter().all(|p| vista_image::quantize8(p[3]) == u8::MAX);
+            display.push_row(&buf)?;
+        }
+        if let Some(f) = full {
+            f.finish()?;
+        }
+        display.finish()?;
+        Ok((name16.and_then(rel), rel(name8)))
+    };
     // The viewer compares where both have one size; otherwise (a missing
     // golden, a size change) it shows the render alone, at full size.
     let comparable = expected.filter(|e| (e.width, e.height) == (actual.width, actual.height));
-    let width = actual.width as usize;
-    let renders = || {
-        pair(Some("actual.png"), "actual8.png", opaque(actual), &mut |y, buf| {
-            buf.extend_from_slice(&actual.data[y * width..][..width]);
-        })
-    };
+    let size = |img: &Image| (img.width, img.height);
+    let renders =
+        || pair(Some("actual.png"), "actual8.png", size(actual), vista_image::opaque8(actual), &mut rows_of(actual));
     let goldens = || -> Written {
         let Some(e) = expected else { return Ok((None, None)) };
-        let write = |name: &str, kind: PngKind| -> Result<Option<String>, GoldenError> {
-            let mut png = PngFile::create(&case_dir.join(name), e.width, e.height, kind)?;
-            for row in e.data.chunks(e.width as usize) {
-                png.push_row(row)?;
-            }
-            png.finish()?;
-            Ok(rel(name))
-        };
         // The golden's own PNG where given, not encoded again.
-        let full = match expected_png {
+        let name16 = match expected_png {
             Some(bytes) => {
                 vista_image::atomic_replace(&case_dir.join("expected.png"), bytes)?;
-                rel("expected.png")
+                None
             }
-            None => write("expected.png", PngKind::Rgba16)?,
+            None => Some("expected.png"),
         };
-        Ok((full, write("expected8.png", if opaque(e) { PngKind::Rgb8 } else { PngKind::Rgba8 })?))
+        let (_, copy8) = pair(name16, "expected8.png", size(e), vista_image::opaque8(e), &mut rows_of(e))?;
+        Ok((rel("expected.png"), copy8))
     };
     let heat_map = || -> Written {
         let Some(expected) = comparable else { return Ok((None, None)) };
-        let w = width;
-        pair(Some("diff.png"), "diff8.png", true, &mut |y, buf| {
+        let w = actual.width as usize;
+        pair(Some("diff.png"), "diff8.png", size(actual), true, &mut |y, buf| {
             vista_image::diff_heatmap_log_row(&expected.data[y * w..][..w], &actual.data[y * w..][..w], buf);
             outline_ignored(y as u32, buf, &out.ignore);
         })
@@ -388,6 +380,12 @@ pub fn write_case_files(
     }
     out.files.view = v?;
     Ok(())
+}
+
+/// Row `y` of `img` appended to a buffer, as `write_case_files` writes rows.
+fn rows_of(img: &Image) -> impl FnMut(usize, &mut Vec<[f32; 4]>) + '_ {
+    let w = img.width as usize;
+    move |y, buf| buf.extend_from_slice(&img.data[y * w..][..w])
 }
 
 /// Outlines the ignored rectangles `[x, y, w, h]` in cyan on row `y` of a
