@@ -26,6 +26,12 @@ const SPARES: usize = 8;
 /// rgba32float texels).
 const READBACK_BAND: u64 = 4 << 20;
 
+/// Rows of `padded` bytes per readback band or sentinel fill copy: as many
+/// as [`READBACK_BAND`] holds, at least one, at most the texture's height.
+fn band_rows(padded: u32, height: u32) -> u32 {
+    (READBACK_BAND / u64::from(padded)).clamp(1, u64::from(height)) as u32
+}
+
 fn texture_key(t: &TextureDesc) -> TextureKey {
     (t.format, t.dimension, t.width, t.height, t.layers)
 }
@@ -316,7 +322,7 @@ impl Context {
                             // band of rows at most READBACK_BAND bytes, copied
                             // over each band (every texel is the same).
                             let padded = padded_row(t, &format);
-                            let band = (READBACK_BAND / u64::from(padded)).clamp(1, u64::from(t.height)) as u32;
+                            let band = band_rows(padded, t.height);
                             let key = (t.format, which, u64::from(padded) * u64::from(band));
                             let buffer = take(&w.spares, |s| &mut s.fills, &key).unwrap_or_else(|| {
                                 d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -585,7 +591,7 @@ impl Context {
         };
         let format = crate::format::parse(t.format)?;
         let padded = padded_row(&t, &format);
-        let band = (READBACK_BAND / u64::from(padded)).clamp(1, u64::from(t.height)) as u32;
+        let band = band_rows(padded, t.height);
         let staging = staging_of(u64::from(padded) * u64::from(band));
         // A depth texture's depth aspect reads back as r32float.
         let aspect = match &g.resources[logical] {
