@@ -601,37 +601,33 @@ impl Worker {
 /// The outputs a [`ReadbackHead`] describes, from the bytes after it: a
 /// lone texture output takes the answer's texels as they are.
 fn readback(head: ReadbackHead, answer: Answer) -> Readback {
-    if let [Ok((width, height, unwritten))] = head.outputs[..]
-        && cfg!(target_endian = "little")
-        && answer.len == width as usize * height as usize * 16
-    {
-        let image = Image::from_raw(width, height, answer.texels).expect("one texel per pixel");
-        let outputs = vec![OutputData::Texture { image, unwritten }];
-        return Readback {
-            outputs,
-            stats: head.stats,
-            pass_times: head.pass_times,
-            pass_gpu_times: head.pass_gpu_times,
-        };
-    }
-    let bytes = answer.bytes();
-    let mut at = 0;
-    let outputs = head
-        .outputs
-        .iter()
-        .map(|o| match *o {
-            Ok((width, height, unwritten)) => {
-                let n = width as usize * height as usize * 16;
-                let image = Image::from_le_bytes(width, height, &bytes[at..at + n]).expect("sized");
-                at += n;
-                OutputData::Texture { image, unwritten }
-            }
-            Err(len) => {
-                at += len;
-                OutputData::Buffer(bytes[at - len..at].to_vec())
-            }
-        })
-        .collect();
+    let outputs = match head.outputs[..] {
+        [Ok((width, height, unwritten))]
+            if cfg!(target_endian = "little") && answer.len == width as usize * height as usize * 16 =>
+        {
+            let image = Image::from_raw(width, height, answer.texels).expect("one texel per pixel");
+            vec![OutputData::Texture { image, unwritten }]
+        }
+        _ => {
+            let bytes = answer.bytes();
+            let mut at = 0;
+            head.outputs
+                .iter()
+                .map(|o| match *o {
+                    Ok((width, height, unwritten)) => {
+                        let n = width as usize * height as usize * 16;
+                        let image = Image::from_le_bytes(width, height, &bytes[at..at + n]).expect("sized");
+                        at += n;
+                        OutputData::Texture { image, unwritten }
+                    }
+                    Err(len) => {
+                        at += len;
+                        OutputData::Buffer(bytes[at - len..at].to_vec())
+                    }
+                })
+                .collect()
+        }
+    };
     Readback { outputs, stats: head.stats, pass_times: head.pass_times, pass_gpu_times: head.pass_gpu_times }
 }
 
