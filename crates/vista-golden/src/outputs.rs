@@ -101,15 +101,6 @@ impl GoldenFiles {
         self.found.iter().find(|(p, _)| p == path).map_or(&Found::Missing, |(_, f)| f)
     }
 
-    /// The PNG's bytes as read, where there is one: the report copies them
-    /// instead of encoding the decoded values again.
-    pub fn png_bytes(&self) -> Option<&[u8]> {
-        match self.at(self.paths.png.as_deref()?) {
-            Found::Bytes(b) => Some(b),
-            _ => None,
-        }
-    }
-
     /// The PNG view's values, where there is one that decodes (the
     /// report shows it beside the render's).
     pub fn view(&self) -> Option<&Image> {
