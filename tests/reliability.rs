@@ -267,8 +267,40 @@ fn a_validation_message_fails_the_dispatch(_shared: &vista_render::Renderer) {
     vista_render::render(&gpu, k, &p, 32, 32).expect("messages are per dispatch");
 }
 
+/// A parent whose GPU work runs in workers describes the device by the
+/// facts a worker sends (issue 55: the parent loads no Vulkan driver).
+/// Through the wire's JSON, that context answers what vista asks of the
+/// device as the device's own context does, and refuses to run a graph.
+fn a_described_device_answers_as_the_device_does(shared: &vista_render::Renderer) {
+    let ctx = shared.ctx;
+    let facts = ctx.facts().expect("the tests' device is a wgpu one");
+    let sent: vista_gpu::DeviceFacts = serde_json::from_str(&serde_json::to_string(&facts).unwrap()).unwrap();
+    assert_eq!(sent, facts, "the facts cross the pipe whole");
+    let described = vista_gpu::Context::described(ctx.config(), sent, std::time::Duration::ZERO);
+    assert_eq!(described.facts().as_ref(), Some(&facts));
+    assert_eq!(described.adapter_description(), ctx.adapter_description());
+    assert_eq!(
+        (described.backend(), described.is_software(), described.max_dimension()),
+        (ctx.backend(), ctx.is_software(), ctx.max_dimension())
+    );
+    for name in ["maxComputeWorkgroupSizeX", "maxBindGroups", "maxTextureDimension2D", "maxStorageBufferBindingSize"] {
+        assert!(ctx.limit(name).is_some(), "{name}");
+        assert_eq!(described.limit(name), ctx.limit(name), "{name}");
+    }
+    let too_many = vista_gpu::Needs { workgroup_size: [4096, 1, 1], workgroups: [1, 1, 1], ..Default::default() };
+    assert_eq!(
+        described.require_needs("k", &too_many).unwrap_err().to_string(),
+        ctx.require_needs("k", &too_many).unwrap_err().to_string()
+    );
+    let gpu = vista_render::Renderer::new(&described, &common::project(), Default::default()).unwrap();
+    let k = vista_kernels::find("fbm").unwrap();
+    let e = vista_render::render(&gpu, k, &k.resolve(None, &[]).unwrap(), 8, 8).unwrap_err().to_string();
+    assert!(e.contains("only describes a worker's device"), "{e}");
+}
+
 fn main() {
     common::gpu_tests![
+        a_described_device_answers_as_the_device_does,
         a_validation_message_fails_the_dispatch,
         injected_nan_fails_the_case_naming_count_and_first_pixel,
         render_path_reports_nan_from_the_gpu_bit_exactly,

@@ -145,7 +145,8 @@ impl AdapterChoice {
         }
     }
 
-    fn hint(&self) -> &'static str {
+    /// How to install what this choice needs.
+    pub fn hint(&self) -> &'static str {
         match self {
             AdapterChoice::SwiftShader => SWIFTSHADER_HINT,
             AdapterChoice::Browser => vista_browser::INSTALL_HINT,
@@ -218,6 +219,25 @@ pub type PassHook = Arc<dyn Fn(&str) + Send + Sync>;
 pub(crate) enum Engine {
     Wgpu(Box<WgpuEngine>),
     Browser(Box<BrowserEngine>),
+    /// A device in another process (a GPU worker), known by its facts:
+    /// this process plans and judges, and runs no graph.
+    Described(Box<DeviceFacts>),
+}
+
+/// What vista asks of a wgpu device, without the device: a worker sends
+/// its device's to its parent, which then loads no Vulkan driver of its
+/// own (the loader and lavapipe's LLVM were 60 MB of the parent's RSS,
+/// issue 55) and still refuses what the device cannot do before any run.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DeviceFacts {
+    /// The adapter's info.
+    pub info: wgpu::AdapterInfo,
+    /// The device's limits.
+    pub limits: wgpu::Limits,
+    /// The features the device was created with.
+    pub features: wgpu::Features,
+    /// Storage formats the device binds `read_write`.
+    pub read_write: Vec<String>,
 }
 
 pub(crate) struct WgpuEngine {
@@ -275,7 +295,16 @@ impl Context {
     /// The process-wide context, created on first use from `config`. Every
     /// later call must pass the same configuration: one process, one device.
     pub fn shared(config: &GpuConfig) -> Result<&'static Context, GpuError> {
-        let (made_with, ctx) = SHARED.get_or_init(|| (config.clone(), Context::new(config)));
+        Context::shared_with(config, || Context::new(config))
+    }
+
+    /// [`Context::shared`], made by `make` on first use (a context that
+    /// describes a worker's device, [`Context::described`]).
+    pub fn shared_with(
+        config: &GpuConfig,
+        make: impl FnOnce() -> Result<Context, GpuError>,
+    ) -> Result<&'static Context, GpuError> {
+        let (made_with, ctx) = SHARED.get_or_init(|| (config.clone(), make()));
         if made_with != config {
             return Err(GpuError::Request(format!(
                 "this process's shared context was made for {:?}, not {:?}; one process has one context",
@@ -438,6 +467,41 @@ impl Context {
         })
     }
 
+    /// The facts of this context's wgpu device, which a worker sends its
+    /// parent ([`Context::described`]); `None` for the browser.
+    pub fn facts(&self) -> Option<DeviceFacts> {
+        match &self.engine {
+            Engine::Wgpu(w) => Some(DeviceFacts {
+                info: self.info.clone(),
+                limits: w.device.limits(),
+                features: w.device.features(),
+                read_write: w.read_write.iter().map(ToString::to_string).collect(),
+            }),
+            Engine::Browser(_) => None,
+            Engine::Described(f) => Some(DeviceFacts::clone(f)),
+        }
+    }
+
+    /// A context for a device another process holds, made from `config`
+    /// and the facts that process sent: it answers every question about
+    /// the device as the device's own context would, and refuses to run a
+    /// graph. `creation_time` is how long getting the facts took.
+    pub fn described(config: &GpuConfig, facts: DeviceFacts, creation_time: Duration) -> Context {
+        Context {
+            info: facts.info.clone(),
+            engine: Engine::Described(Box::new(facts)),
+            backend: config.adapter.backend_name(),
+            timeout: config.timeout,
+            submit_lock: Mutex::new(()),
+            creation_time,
+            validate: config.validate,
+            config: config.clone(),
+            time_passes: Default::default(),
+            on_pass: Mutex::new(None),
+            compile_nanos: Default::default(),
+        }
+    }
+
     /// Turns GPU timestamps around every graph pass run on or off (where
     /// the device has them): `Rendered::pass_gpu_times` for benches. Off by
     /// default, since each run then waits for a timestamp readback.
@@ -512,6 +576,7 @@ impl Context {
         match &self.engine {
             Engine::Wgpu(w) => w.device.limits().max_texture_dimension_2d,
             Engine::Browser(b) => b.browser.info().max_dimension,
+            Engine::Described(f) => f.limits.max_texture_dimension_2d,
         }
     }
 
@@ -650,6 +715,7 @@ impl Context {
             || match &self.engine {
                 Engine::Wgpu(w) => w.read_write.contains(&format.name),
                 Engine::Browser(b) => b.features.iter().any(|f| f == "texture-formats-tier2"),
+                Engine::Described(f) => f.read_write.iter().any(|n| n == format.name),
             }
     }
 
@@ -671,22 +737,26 @@ impl Context {
     /// Whether this device has one of the optional features vista asks
     /// for, by its WebGPU name (`float32-blendable`, `shader-f16`, ...).
     pub(crate) fn has_feature(&self, feature: &str) -> bool {
+        let wgpu_feature = || match feature {
+            "shader-f16" => wgpu::Features::SHADER_F16,
+            "dual-source-blending" => wgpu::Features::DUAL_SOURCE_BLENDING,
+            "float32-blendable" => wgpu::Features::FLOAT32_BLENDABLE,
+            "rg11b10ufloat-renderable" => wgpu::Features::RG11B10UFLOAT_RENDERABLE,
+            other => unreachable!("vista asks for no feature {other}"),
+        };
         match &self.engine {
-            Engine::Wgpu(w) => w.device.features().contains(match feature {
-                "shader-f16" => wgpu::Features::SHADER_F16,
-                "dual-source-blending" => wgpu::Features::DUAL_SOURCE_BLENDING,
-                "float32-blendable" => wgpu::Features::FLOAT32_BLENDABLE,
-                "rg11b10ufloat-renderable" => wgpu::Features::RG11B10UFLOAT_RENDERABLE,
-                other => unreachable!("vista asks for no feature {other}"),
-            }),
+            Engine::Wgpu(w) => w.device.features().contains(wgpu_feature()),
             Engine::Browser(b) => b.features.iter().any(|f| f == feature),
+            Engine::Described(f) => f.features.contains(wgpu_feature()),
         }
     }
 
     /// The feature that [`Context::binds_read_write`] depends on here.
     pub(crate) fn read_write_feature(&self) -> &'static str {
         match &self.engine {
-            Engine::Wgpu(_) => "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES with STORAGE_READ_WRITE for this format",
+            Engine::Wgpu(_) | Engine::Described(_) => {
+                "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES with STORAGE_READ_WRITE for this format"
+            }
             Engine::Browser(_) => "texture-formats-tier2",
         }
     }
@@ -792,6 +862,7 @@ impl Context {
         match &self.engine {
             Engine::Wgpu(w) => crate::limits::wgpu_limit(&w.device.limits(), name),
             Engine::Browser(b) => b.browser.info().limits.get(name).map(|v| *v as u64),
+            Engine::Described(f) => crate::limits::wgpu_limit(&f.limits, name),
         }
     }
 

@@ -493,6 +493,9 @@ impl Context {
         let once = |which: usize| match &self.engine {
             Engine::Wgpu(w) => self.run_wgpu(w, g, which),
             Engine::Browser(b) => self.run_in_browser(b, g, which),
+            Engine::Described(_) => Err(GpuError::Request(
+                "this process only describes a worker's device; its graphs run in the worker".into(),
+            )),
         };
         let mut first = once(0)?;
         let suspects: Vec<Vec<usize>> = first.1.clone();

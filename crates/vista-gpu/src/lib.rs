@@ -22,7 +22,7 @@ mod wgpu_run;
 pub mod wire;
 
 pub use context::{
-    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, GpuConfig, PassHook, RunStats,
+    AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, DeviceFacts, GpuConfig, PassHook, RunStats,
     SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
 };
 pub use fullscreen::{FULLSCREEN_ENTRY, FULLSCREEN_WGSL};

@@ -99,8 +99,9 @@ enum ToWorker<'a> {
 
 #[derive(Serialize, Deserialize)]
 enum FromWorker {
-    Ready,
-    Failed(String),
+    /// Its device is made: what the parent's context describes it by.
+    Ready(Box<vista_gpu::DeviceFacts>),
+    Failed(WireError),
     Pass(String),
     Done(Result<ReadbackHead, WireError>),
 }
@@ -117,9 +118,10 @@ struct ReadbackHead {
 }
 
 /// A [`GpuError`] as it crosses the pipe (`NoAdapter`'s hint is static:
-/// it arrives as a device error with its text).
+/// it is the choice's again on the other side).
 #[derive(Serialize, Deserialize)]
 enum WireError {
+    NoAdapter { wanted: String, seen: String, choice: vista_gpu::AdapterChoice },
     Shader(String),
     Validation { what: String, message: String },
     Timeout { what: String, seconds: f64 },
@@ -137,6 +139,7 @@ impl From<GpuError> for WireError {
             GpuError::Request(m) => WireError::Request(m),
             GpuError::Unsupported { adapter, what, feature } => WireError::Unsupported { adapter, what, feature },
             GpuError::Device { adapter, message } => WireError::Device { adapter, message },
+            // Only a worker's start meets it, where its choice is at hand.
             e @ GpuError::NoAdapter { .. } => WireError::Device { adapter: "worker".into(), message: e.to_string() },
         }
     }
@@ -151,6 +154,7 @@ impl From<WireError> for GpuError {
             WireError::Request(m) => GpuError::Request(m),
             WireError::Unsupported { adapter, what, feature } => GpuError::Unsupported { adapter, what, feature },
             WireError::Device { adapter, message } => GpuError::Device { adapter, message },
+            WireError::NoAdapter { wanted, seen, choice } => GpuError::NoAdapter { wanted, seen, hint: choice.hint() },
         }
     }
 }
@@ -249,11 +253,16 @@ fn serve() -> std::io::Result<()> {
         wgpu_backends: c.wgpu_backends,
         ..Default::default()
     };
+    let failed = |e: WireError| send(&mut *out.lock().expect("stdout"), &FromWorker::Failed(e), &[]);
     let ctx = match Context::new(&config) {
         Ok(ctx) => ctx,
-        Err(e) => return send(&mut *out.lock().expect("stdout"), &FromWorker::Failed(e.to_string()), &[]),
+        Err(GpuError::NoAdapter { wanted, seen, .. }) => {
+            return failed(WireError::NoAdapter { wanted, seen, choice: config.adapter });
+        }
+        Err(e) => return failed(e.into()),
     };
-    send(&mut *out.lock().expect("stdout"), &FromWorker::Ready, &[])?;
+    let facts = ctx.facts().expect("a worker's device is a wgpu one");
+    send(&mut *out.lock().expect("stdout"), &FromWorker::Ready(Box::new(facts)), &[])?;
     let mut sets: Option<(ShaderSource, vista_gpu::ShaderSet)> = None;
     let mut sources: Option<(Option<PathBuf>, crate::Sources)> = None;
     loop {
@@ -436,6 +445,8 @@ pub struct Worker {
     fault: Option<(Fault, String)>,
     idle: Mutex<Vec<Proc>>,
     compile: Mutex<Duration>,
+    /// What the first worker to start said of its device.
+    facts: OnceLock<vista_gpu::DeviceFacts>,
 }
 
 /// What started the worker mode: this binary, and a fault to inject.
@@ -473,6 +484,7 @@ impl Worker {
             fault: mode.fault.clone(),
             idle: Mutex::new(Vec::new()),
             compile: Mutex::new(Duration::ZERO),
+            facts: OnceLock::new(),
         });
         all.push(w.clone());
         Some(w)
@@ -483,8 +495,19 @@ impl Worker {
         *self.compile.lock().expect("compile time")
     }
 
-    fn start(&self) -> Result<Proc, RenderError> {
-        let failed = |m: String| RenderError::Gpu(GpuError::Device { adapter: "vista worker".into(), message: m });
+    /// The facts of the device the workers hold, from a worker started
+    /// for them (kept for the first run) unless one has already said.
+    pub fn describe(&self) -> Result<vista_gpu::DeviceFacts, GpuError> {
+        if let Some(f) = self.facts.get() {
+            return Ok(f.clone());
+        }
+        let proc = self.start()?;
+        self.idle.lock().expect("workers").push(proc);
+        Ok(self.facts.get().expect("set by a worker's start").clone())
+    }
+
+    fn start(&self) -> Result<Proc, GpuError> {
+        let failed = |m: String| GpuError::Device { adapter: "vista worker".into(), message: m };
         let mut child = Command::new(&self.exe)
             .env(WORKER_VAR, "1")
             .stdin(Stdio::piped())
@@ -520,8 +543,11 @@ impl Worker {
         send(proc.stdin(), &init, &[]).map_err(|e| failed(format!("cannot talk to the worker: {e}")))?;
         // Device creation: the watchdog's time, and then some.
         match proc.heard.recv_timeout(c.timeout + Duration::from_secs(30)) {
-            Ok(Heard::Message(FromWorker::Ready, _)) => Ok(proc),
-            Ok(Heard::Message(FromWorker::Failed(m), _)) => Err(failed(m)),
+            Ok(Heard::Message(FromWorker::Ready(facts), _)) => {
+                let _ = self.facts.set(*facts);
+                Ok(proc)
+            }
+            Ok(Heard::Message(FromWorker::Failed(e), _)) => Err(e.into()),
             _ => {
                 let status = proc.child.try_wait().ok().flatten();
                 Err(failed(format!("the worker did not start ({})", describe_exit(status))))
