@@ -147,6 +147,7 @@ impl Checker<'_> {
         let started = Instant::now();
         let (outcome, report_errors) = vista_report::file_case(self.report_dir, checked, self.detail);
         let report_time = started.elapsed();
+        vista_image::release_after_case(u64::from(outcome.width) * u64::from(outcome.height));
         // A failing or missing case's render, as bless --from-report may take it.
         let pending = match entry {
             Some(mut entry) if matches!(outcome.verdict, Verdict::Fail | Verdict::Missing) => {

@@ -252,6 +252,7 @@ fn die_quietly_on_closed_pipe() {
 fn main() -> ExitCode {
     // Started as a GPU worker by another vista process: serve it, then exit.
     vista::config::serve_worker_if_asked();
+    vista_image::one_arena();
     #[cfg(unix)]
     die_quietly_on_closed_pipe();
     let cli = Cli::parse();

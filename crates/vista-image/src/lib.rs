@@ -46,5 +46,5 @@ pub use io::{
     remove_stale_temps, save, write_exr, write_png8, write_png8_small, write_png16,
 };
 pub use png_stream::{PngFile, PngKind, atomic_replace_with};
-pub use threads::{case_threads, set_case_threads, threads_for};
+pub use threads::{case_threads, one_arena, release_after_case, set_case_threads, threads_for};
 pub use tonemap::{srgb_encode, tonemap};
