@@ -102,6 +102,24 @@ const FLIP_HALO: usize = 16;
 /// 1080 these cost 0.01-0.03 s more per case and peak 120 MB lower).
 const FLIP_STRIP: usize = 256;
 
+/// What FLIP holds per pixel of a strip (measured: 76 bytes).
+const FLIP_BYTES_PER_PIXEL: usize = 76;
+
+/// What FLIP's strips at once may hold together: a fixed amount, not a
+/// share of the image, so a wide image gets shorter strips. 256-row strips
+/// of a 2048-wide image were 90 MB, the peak of a failing 2048 x 2048
+/// case; 48 MiB lets them be 129 rows (50 MB) there and 140 at 1920 wide.
+const FLIP_BUDGET: usize = 48 << 20;
+
+/// The most rows a strip of a `width`-wide image may have when `threads`
+/// strips are computed at once: [`FLIP_BUDGET`] less their halos, at most
+/// [`FLIP_STRIP`], at least 4 halos' worth (narrower strips compute more
+/// halo than image).
+fn flip_strip_rows(width: usize, threads: usize) -> usize {
+    let rows = FLIP_BUDGET / (threads.max(1) * width.max(1) * FLIP_BYTES_PER_PIXEL);
+    rows.saturating_sub(2 * FLIP_HALO).clamp(4 * FLIP_HALO, FLIP_STRIP)
+}
+
 /// Rows `y0..y1` of an image as FLIP reads them: 8-bit RGB, row after row.
 type Rows<'a> = &'a (dyn Fn(usize, usize) -> Vec<u8> + Sync);
 
@@ -122,7 +140,7 @@ fn flip_strips<T: Send>(
 ) -> Vec<T> {
     // Equal strips, a multiple of the threads: no thread waits on a short one.
     let (height, threads) = (h as usize, threads.max(1));
-    let strips = threads * height.div_ceil(threads * FLIP_STRIP);
+    let strips = threads * height.div_ceil(threads * flip_strip_rows(w as usize, threads));
     flip_strips_of(w, h, reference, actual, height.div_ceil(strips.max(1)), threads, take)
 }
 
