@@ -14,8 +14,8 @@
 
 use std::path::{Path, PathBuf};
 
-use vista_image::Image;
 use vista_image::metrics::format_psnr;
+use vista_image::{Image, Image16, Texels};
 use vista_kernels::Kernel;
 use vista_kernels::graph::Tolerance;
 use vista_render::{OutputRender, OutputValue, quantize16};
@@ -65,8 +65,9 @@ pub struct GoldenFiles {
     pub paths: OutputFiles,
     /// What was found at each of `paths.all()`.
     pub found: Vec<(PathBuf, Found)>,
-    /// The PNG view decoded, once: the verdict and the report both read it.
-    decoded_view: std::sync::OnceLock<Result<Option<Image>, String>>,
+    /// The PNG view decoded, once, in 16 bits (half an `Image`'s memory):
+    /// the verdict and the report both read it.
+    decoded_view: std::sync::OnceLock<Result<Option<Image16>, String>>,
     /// Set where the PNG is known to hold the render's view ([`GoldenFiles::known_same`]).
     same_as_render: std::sync::OnceLock<()>,
 }
@@ -103,14 +104,14 @@ impl GoldenFiles {
 
     /// The PNG view's values, where there is one that decodes (the
     /// report shows it beside the render's).
-    pub fn view(&self) -> Option<&Image> {
+    pub fn view(&self) -> Option<&Image16> {
         self.view_decoded().ok().flatten()
     }
 
     /// The PNG view's values and the PNG's bytes, moved out (the view
     /// decoded here if the verdict did not need it): the report's copies
     /// of a failing 2048 x 2048 case were 64 MiB and its PNG again.
-    pub fn into_view_and_png(self) -> (Option<Image>, Option<Vec<u8>>) {
+    pub fn into_view_and_png(self) -> (Option<Image16>, Option<Vec<u8>>) {
         let _ = self.view_decoded();
         let view = self.decoded_view.into_inner().and_then(Result::ok).flatten();
         let png = self.paths.png.as_deref().and_then(|png| {
@@ -140,7 +141,7 @@ impl GoldenFiles {
 
     /// The PNG view decoded as [`GoldenFiles::view_decoded`] gives it, or
     /// `Some(None)` where it is known to be the render's own.
-    fn view_decoded_unless_same(&self) -> Result<Option<Option<&Image>>, String> {
+    fn view_decoded_unless_same(&self) -> Result<Option<Option<&Image16>>, String> {
         match self.same_as_render.get() {
             Some(()) => Ok(Some(None)),
             None => self.view_decoded().map(|v| v.map(Some)),
@@ -149,9 +150,9 @@ impl GoldenFiles {
 
     /// The PNG view decoded (once): `Ok(None)` when missing or when the
     /// output has none.
-    fn view_decoded(&self) -> Result<Option<&Image>, String> {
+    fn view_decoded(&self) -> Result<Option<&Image16>, String> {
         let decoded = self.decoded_view.get_or_init(|| match self.paths.png.as_deref() {
-            Some(png) => self.decode(png, vista_image::decode_png16),
+            Some(png) => self.decode(png, vista_image::decode_png16_compact),
             None => Ok(None),
         });
         decoded.as_ref().map(Option::as_ref).map_err(Clone::clone)
@@ -476,19 +477,20 @@ fn judge_view(
     by_tolerance: bool,
     psnr_threshold: f64,
 ) {
-    let expected = match golden.view_decoded_unless_same() {
-        Ok(Some(g)) => g.unwrap_or(actual),
+    let expected: &dyn Texels = match golden.view_decoded_unless_same() {
+        Ok(Some(Some(g))) => g,
+        Ok(Some(None)) => actual,
         Ok(None) => return v.missing.push(png.to_path_buf()),
         Err(e) => return v.errors.push(e),
     };
     let named = if index == 0 { String::new() } else { format!("output {}: ", v.name) };
-    if (expected.width, expected.height) != (actual.width, actual.height) {
+    if expected.size() != (actual.width, actual.height) {
         let what = if index == 0 { "the case renders" } else { "the render is" };
         return v.problems.push(format!(
             "{named}golden {} is {}x{} but {what} {}x{}; re-bless if the size change is intended",
             png.display(),
-            expected.width,
-            expected.height,
+            expected.size().0,
+            expected.size().1,
             actual.width,
             actual.height
         ));
@@ -497,12 +499,13 @@ fn judge_view(
     let actual = match index == 0 && !case.ignore.is_empty() {
         false => actual,
         true => {
-            let mut a = actual.clone();
+            let (mut a, mut row) = (actual.clone(), Vec::new());
             let mut n = 0u64;
             for &[x, y, w, h] in &case.ignore {
                 for yy in y..(y + h).min(a.height) {
+                    let theirs = expected.row(yy, &mut row);
                     for xx in x..(x + w).min(a.width) {
-                        a.set(xx, yy, expected.get(xx, yy));
+                        a.set(xx, yy, theirs[xx as usize]);
                         n += 1;
                     }
                 }
@@ -540,7 +543,7 @@ fn thresholds(
     case: &Case,
     named: &str,
     m: &mut vista_image::metrics::Metrics,
-    expected: &Image,
+    expected: &dyn Texels,
     actual: &Image,
     raw: &Image,
     psnr_threshold: f64,
@@ -600,10 +603,15 @@ fn thresholds(
 }
 
 /// PSNR (peak 1) of two views' alpha channels.
-fn alpha_psnr(a: &Image, b: &Image) -> f64 {
-    let n = a.data.len().max(1) as f64;
-    let mse: f64 = a.data.iter().zip(&b.data).map(|(x, y)| (x[3] as f64 - y[3] as f64).powi(2)).sum::<f64>() / n;
-    vista_image::metrics::psnr_from_mse(mse, 1.0)
+fn alpha_psnr(a: &dyn Texels, b: &Image) -> f64 {
+    let n = b.data.len().max(1) as f64;
+    let (w, mut row, mut sum) = (b.width as usize, Vec::new(), 0.0);
+    for y in 0..b.height {
+        for (x, y) in a.row(y, &mut row).iter().zip(&b.data[y as usize * w..][..w]) {
+            sum += (x[3] as f64 - y[3] as f64).powi(2);
+        }
+    }
+    vista_image::metrics::psnr_from_mse(sum / n, 1.0)
 }
 
 /// "N of M texels never written": a workgroup size, dispatch or bounds check

@@ -32,8 +32,9 @@ pub struct Checked {
     pub outcome: Outcome,
     /// The render's display values as a 16-bit PNG holds them (none when it failed).
     pub actual: Option<Image>,
-    /// The golden's values, when it could be read.
-    pub expected: Option<Image>,
+    /// The golden's values, when it could be read (in 16 bits, as its PNG
+    /// holds them: the report makes its `Image` once the render is gone).
+    pub expected: Option<vista_image::Image16>,
     /// With `expected`: the golden PNG's bytes, which decode to it (the
     /// report copies them rather than encode it again).
     pub expected_png: Option<Vec<u8>>,
@@ -275,7 +276,7 @@ pub fn check_case(ctx: &Renderer, store: &Store, manifest: &Manifest, case: &Cas
         .filter_map(|(i, (o, view))| {
             let golden = match golden_of(i) {
                 _ if !images => None,
-                Some((view, _)) => view,
+                Some((view, _)) => view.map(|v| v.to_image()),
                 None => crate::outputs::output_files(&store.dir, case, &golden_key, i, o)
                     .png
                     .and_then(|p| vista_image::read_png16(&p).ok()),

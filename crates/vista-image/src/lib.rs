@@ -32,6 +32,7 @@ pub mod metrics;
 pub mod npy;
 mod png_stream;
 mod ssim;
+mod texels;
 mod threads;
 mod tonemap;
 
@@ -41,10 +42,11 @@ pub use heatmap::{
     LOG_FLOOR, STOPS as HEATMAP_STOPS, diff_heatmap, diff_heatmap_log, diff_heatmap_log_row, log_position,
 };
 pub use io::{
-    atomic_replace, atomic_write, decode_exr, decode_png16, encode_exr, encode_png8_small, encode_png16,
-    encode_png16_channel, encode_png16_small, load, opaque8, quantize8, quantize16, read_exr, read_png16,
+    atomic_replace, atomic_write, decode_exr, decode_png16, decode_png16_compact, encode_exr, encode_png8_small,
+    encode_png16, encode_png16_channel, encode_png16_small, load, opaque8, quantize8, quantize16, read_exr, read_png16,
     remove_stale_temps, save, write_exr, write_png8, write_png8_small, write_png16,
 };
 pub use png_stream::{PngFile, PngKind, atomic_replace_with};
+pub use texels::{Image16, Texels};
 pub use threads::{case_threads, one_arena, release_after_case, set_case_threads, threads_for};
 pub use tonemap::{srgb_encode, tonemap};

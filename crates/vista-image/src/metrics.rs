@@ -20,7 +20,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Image, ImageError, ssim as ssim_impl};
+use crate::{Image, ImageError, Texels, ssim as ssim_impl};
 
 /// A pixel is "bad" when any RGB channel differs by more than one 8-bit step.
 pub const BAD_PIXEL_THRESHOLD: f64 = 1.0 / 255.0;
@@ -65,24 +65,25 @@ pub const FLIP_PIXELS_PER_DEGREE: f32 = 67.0;
 ///
 /// # Panics
 /// If the images differ in size.
-pub fn flip_mean(reference: &Image, actual: &Image) -> f64 {
+pub fn flip_mean(reference: &(impl Texels + ?Sized), actual: &(impl Texels + ?Sized)) -> f64 {
     assert_same_size(reference, actual);
-    let (w, h) = reference.dimensions();
+    let (w, h) = reference.size();
     if w == 0 || h == 0 {
         return 0.0;
     }
     // A strip's rows as FLIP reads them, made per strip: both images whole
     // in 8-bit RGB were 24 MiB more at 2048 x 2048.
-    fn rgb8(img: &Image, y0: usize, y1: usize) -> Vec<u8> {
-        let texels = &img.data[y0 * img.width as usize..y1 * img.width as usize];
-        let mut out = Vec::with_capacity(texels.len() * 3);
-        for p in texels {
-            out.extend_from_slice(&[crate::quantize8(p[0]), crate::quantize8(p[1]), crate::quantize8(p[2])]);
+    fn rgb8(img: &(impl Texels + ?Sized), y0: usize, y1: usize) -> Vec<u8> {
+        let (mut out, mut buf) = (Vec::with_capacity((y1 - y0) * img.size().0 as usize * 3), Vec::new());
+        for y in y0..y1 {
+            for p in img.row(y as u32, &mut buf) {
+                out.extend_from_slice(&[crate::quantize8(p[0]), crate::quantize8(p[1]), crate::quantize8(p[2])]);
+            }
         }
         out
     }
     let (reference_rows, actual_rows) = (|y0, y1| rgb8(reference, y0, y1), |y0, y1| rgb8(actual, y0, y1));
-    let threads = crate::threads_for(reference.data.len());
+    let threads = crate::threads_for(w as usize * h as usize);
     let errors = flip_error_sums(w, h, &reference_rows, &actual_rows, threads);
     // Summed in f64 (FLIP's own pool sums in f32, which drifts over millions
     // of pixels).
@@ -190,7 +191,7 @@ fn flip_error_sums(w: u32, h: u32, reference: Rows<'_>, actual: Rows<'_>, thread
 }
 
 /// All metrics with a PSNR peak of 1 (LDR data in `[0, 1]`).
-pub fn compare(reference: &Image, actual: &Image) -> Result<Metrics, ImageError> {
+pub fn compare(reference: &(impl Texels + ?Sized), actual: &Image) -> Result<Metrics, ImageError> {
     check_same_size(reference, actual)?;
     if let Some(m) = identical(reference, actual, true) {
         return Ok(m);
@@ -203,10 +204,17 @@ pub fn compare(reference: &Image, actual: &Image) -> Result<Metrics, ImageError>
 /// golden bit for bit, and SSIM and FLIP cost most of a check): PSNR +inf,
 /// SSIM 1, no difference, FLIP 0 where asked. `None` where any bit differs
 /// or a value is not finite.
-fn identical(reference: &Image, actual: &Image, flip: bool) -> Option<Metrics> {
+fn identical(reference: &(impl Texels + ?Sized), actual: &Image, flip: bool) -> Option<Metrics> {
     let bits = |p: &[f32; 4]| p.map(f32::to_bits);
-    let same = reference.data.len() == actual.data.len()
-        && reference.data.iter().zip(&actual.data).all(|(r, a)| bits(r) == bits(a) && a.iter().all(|v| v.is_finite()));
+    let mut buf = Vec::new();
+    let same = reference.size() == actual.size()
+        && (0..actual.height).all(|y| {
+            reference
+                .row(y, &mut buf)
+                .iter()
+                .zip(actual.row(y, &mut Vec::new()))
+                .all(|(r, a)| bits(r) == bits(a) && a.iter().all(|v| v.is_finite()))
+        });
     same.then_some(Metrics {
         psnr: f64::INFINITY,
         ssim: 1.0,
@@ -279,13 +287,13 @@ pub fn psnr_with_peak(a: &Image, b: &Image, peak: f64) -> f64 {
 ///
 /// # Panics
 /// If the images differ in size.
-pub fn ssim(a: &Image, b: &Image) -> f64 {
+pub fn ssim(a: &(impl Texels + ?Sized), b: &(impl Texels + ?Sized)) -> f64 {
     assert_same_size(a, b);
-    let (w, h) = (a.width as usize, a.height as usize);
+    let (w, h) = (a.size().0 as usize, a.size().1 as usize);
     // Luma made a row at a time where a band reads it, not as whole planes.
-    fn rows(img: &Image, r: usize, row: &mut [f64]) {
-        let w = img.width as usize;
-        for (v, p) in row.iter_mut().zip(&img.data[r * w..][..w]) {
+    fn rows(img: &(impl Texels + ?Sized), r: usize, row: &mut [f64]) {
+        let mut buf = Vec::new();
+        for (v, p) in row.iter_mut().zip(img.row(r as u32, &mut buf)) {
             *v = luma_of(p);
         }
     }
@@ -317,22 +325,26 @@ pub fn format_psnr(psnr: f64) -> String {
     if psnr == f64::INFINITY { "identical".to_string() } else { format!("{psnr:.2} dB") }
 }
 
-fn all_metrics(reference: &Image, actual: &Image, peak: f64) -> Metrics {
+fn all_metrics(reference: &(impl Texels + ?Sized), actual: &Image, peak: f64) -> Metrics {
     // One pass for the squared error, the largest difference and the bad
     // pixels (the same values as mse, max_abs and bad_pixels, summed in the
     // same order).
     let (mut sum, mut max, mut bad) = (0.0, 0.0, 0u64);
-    for (p, q) in reference.data.iter().zip(&actual.data) {
-        let mut is_bad = false;
-        for c in 0..3 {
-            let d = abs_diff(p[c], q[c]);
-            sum += if d.is_finite() { d * d } else { 1.0 };
-            max = f64::max(max, d);
-            is_bad |= d > BAD_PIXEL_THRESHOLD;
+    let (w, mut buf) = (actual.width as usize, Vec::new());
+    for y in 0..actual.height {
+        let theirs = reference.row(y, &mut buf);
+        for (p, q) in theirs.iter().zip(&actual.data[y as usize * w..][..w]) {
+            let mut is_bad = false;
+            for c in 0..3 {
+                let d = abs_diff(p[c], q[c]);
+                sum += if d.is_finite() { d * d } else { 1.0 };
+                max = f64::max(max, d);
+                is_bad |= d > BAD_PIXEL_THRESHOLD;
+            }
+            bad += u64::from(is_bad);
         }
-        bad += u64::from(is_bad);
     }
-    let n = reference.data.len() * 3;
+    let n = actual.data.len() * 3;
     let mse = if n == 0 { 0.0 } else { sum / n as f64 };
     Metrics {
         psnr: psnr_from_mse(mse, peak),
@@ -380,15 +392,15 @@ fn luma_of(p: &[f32; 4]) -> f64 {
     0.2126 * finite(p[0]) + 0.7152 * finite(p[1]) + 0.0722 * finite(p[2])
 }
 
-fn check_same_size(reference: &Image, actual: &Image) -> Result<(), ImageError> {
-    if reference.dimensions() == actual.dimensions() {
+fn check_same_size(reference: &(impl Texels + ?Sized), actual: &(impl Texels + ?Sized)) -> Result<(), ImageError> {
+    if reference.size() == actual.size() {
         Ok(())
     } else {
-        Err(ImageError::SizeMismatch { expected: reference.dimensions(), actual: actual.dimensions() })
+        Err(ImageError::SizeMismatch { expected: reference.size(), actual: actual.size() })
     }
 }
 
-fn assert_same_size(a: &Image, b: &Image) {
+fn assert_same_size(a: &(impl Texels + ?Sized), b: &(impl Texels + ?Sized)) {
     if let Err(e) = check_same_size(a, b) {
         panic!("{e}");
     }
