@@ -164,17 +164,7 @@ fn flip_strips_of<T: Send>(
     };
     let starts: Vec<usize> = (0..height.max(1)).step_by(rows.max(1)).collect();
     let mut out = Vec::with_capacity(starts.len());
-    for group in starts.chunks(threads.max(1)) {
-        if group.len() == 1 {
-            out.push(strip(group[0]));
-            continue;
-        }
-        std::thread::scope(|s| {
-            let strip = &strip;
-            let parts: Vec<_> = group.iter().map(|&y0| s.spawn(move || strip(y0))).collect();
-            out.extend(parts.into_iter().map(|p| p.join().expect("a FLIP strip")));
-        });
-    }
+    crate::threads::in_groups(&starts, threads, |&y0| strip(y0), |r| out.push(r));
     if threads > 1 {
         crate::threads::release_freed_memory();
     }

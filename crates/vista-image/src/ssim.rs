@@ -64,18 +64,11 @@ fn windowed_ssim(x: Rows<'_>, y: Rows<'_>, w: usize, h: usize, threads: usize) -
     // Summed in row-major order whatever the threads, as one running sum.
     let mut total = 0.0;
     let threads = threads.min(bands.len()).max(1);
-    for group in bands.chunks(threads) {
-        let values: Vec<Vec<f64>> = match group.len() {
-            1 => vec![band(&group[0])],
-            _ => std::thread::scope(|s| {
-                let handles: Vec<_> = group.iter().map(|b| s.spawn(move || band(b))).collect();
-                handles.into_iter().map(|h| h.join().expect("an SSIM band")).collect()
-            }),
-        };
-        for v in values.iter().flatten() {
+    crate::threads::in_groups(&bands, threads, band, |values| {
+        for v in values {
             total += v;
         }
-    }
+    });
     total / (oh * (w - 2 * RADIUS)) as f64
 }
 

@@ -26,6 +26,30 @@ pub fn threads_for(pixels: usize) -> usize {
     if pixels < PARALLEL_FROM_PIXELS { 1 } else { case_threads() }
 }
 
+/// Runs `work` on every item, `threads` items at once on scoped threads
+/// (a group of one on the calling thread), and hands each result to `take`
+/// in item order: FLIP's strips and SSIM's bands, whose sums must not
+/// depend on the threads.
+pub(crate) fn in_groups<T: Sync, R: Send>(
+    items: &[T],
+    threads: usize,
+    work: impl Fn(&T) -> R + Sync,
+    mut take: impl FnMut(R),
+) {
+    for group in items.chunks(threads.max(1)) {
+        if let [one] = group {
+            take(work(one));
+            continue;
+        }
+        let results: Vec<R> = std::thread::scope(|s| {
+            let work = &work;
+            let running: Vec<_> = group.iter().map(|item| s.spawn(move || work(item))).collect();
+            running.into_iter().map(|r| r.join().expect("a helper thread")).collect()
+        });
+        results.into_iter().for_each(&mut take);
+    }
+}
+
 /// Makes every thread of this process allocate from glibc's one main
 /// arena; call it first in `main`. A helper thread otherwise gets an arena
 /// of its own, and the freed top of one (a FLIP strip's 45 MB) is what
