@@ -43,8 +43,18 @@ pub(crate) fn ended(pid: u32, dir: &Path) {
     remove(dir);
 }
 
-/// Removes `dir`, again while a dying helper process still adds files.
+/// Removes `dir`, again while a dying helper process still adds files,
+/// and the folder of its `SingletonSocket`: Chromium keeps the socket in
+/// `<temp>/org.chromium.Chromium.XXXXXX`, linked from the profile, and
+/// removes it only when it exits itself (a `make test` left 74 of them).
 fn remove(dir: &Path) {
+    let socket_dir = std::fs::read_link(dir.join("SingletonSocket"))
+        .ok()
+        .and_then(|to| to.parent().map(Path::to_path_buf))
+        .filter(|d| d.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("org.chromium.Chromium.")));
+    if let Some(d) = socket_dir {
+        let _ = std::fs::remove_dir_all(d);
+    }
     for _ in 0..20 {
         if std::fs::remove_dir_all(dir).is_ok() || !dir.exists() {
             return;
@@ -72,7 +82,7 @@ pub(crate) fn sweep(temp: &Path) {
         let name = entry.file_name();
         let Some(pid) = name.to_str().and_then(owner) else { continue };
         if pid != std::process::id() && !alive(pid) {
-            let _ = std::fs::remove_dir_all(entry.path());
+            remove(&entry.path());
         }
     }
 }
@@ -110,6 +120,29 @@ mod tests {
             std::fs::read_dir(temp.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
         left.sort();
         assert_eq!(left, ["other-1-c".to_string(), format!("{PREFIX}{ours}-b"), format!("{PREFIX}x")]);
+    }
+
+    #[test]
+    fn a_profile_goes_with_its_singleton_socket_folder_and_nothing_else() {
+        let temp = tempfile::tempdir().unwrap();
+        let (profile, socket, other) = (
+            temp.path().join(format!("{PREFIX}1-a")),
+            temp.path().join("org.chromium.Chromium.Xy12Ab"),
+            temp.path().join("elsewhere"),
+        );
+        for d in [&profile, &socket, &other] {
+            std::fs::create_dir(d).unwrap();
+        }
+        std::fs::write(socket.join("SingletonSocket"), "").unwrap();
+        std::os::unix::fs::symlink(socket.join("SingletonSocket"), profile.join("SingletonSocket")).unwrap();
+        remove(&profile);
+        assert!(!profile.exists() && !socket.exists(), "the profile and its socket's folder are gone");
+        // A link to anything but Chromium's socket folder removes only the profile.
+        std::fs::create_dir(&profile).unwrap();
+        std::fs::write(other.join("SingletonSocket"), "").unwrap();
+        std::os::unix::fs::symlink(other.join("SingletonSocket"), profile.join("SingletonSocket")).unwrap();
+        remove(&profile);
+        assert!(!profile.exists() && other.join("SingletonSocket").exists());
     }
 
     #[test]
