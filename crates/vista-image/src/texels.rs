@@ -47,15 +47,20 @@ impl Image16 {
         f32::from(v) / 65535.0
     }
 
+    /// The texel whose four channels are `p`, as f32.
+    fn texel(p: &[u16]) -> [f32; 4] {
+        [0, 1, 2, 3].map(|c| Image16::value(p[c]))
+    }
+
     /// The texel at `(x, y)`.
     pub fn get(&self, x: u32, y: u32) -> [f32; 4] {
         let at = 4 * (y as usize * self.width as usize + x as usize);
-        [0, 1, 2, 3].map(|c| Image16::value(self.data[at + c]))
+        Image16::texel(&self.data[at..at + 4])
     }
 
     /// The same values as an [`Image`] (the report's images take one).
     pub fn to_image(&self) -> Image {
-        let data = self.data.chunks_exact(4).map(|p| [0, 1, 2, 3].map(|c| Image16::value(p[c]))).collect();
+        let data = self.data.chunks_exact(4).map(Image16::texel).collect();
         Image::from_raw(self.width, self.height, data).expect("one texel per pixel")
     }
 }
@@ -68,11 +73,7 @@ impl Texels for Image16 {
     fn row<'a>(&'a self, y: u32, buf: &'a mut Vec<[f32; 4]>) -> &'a [[f32; 4]] {
         let w = self.width as usize;
         buf.clear();
-        buf.extend(
-            self.data[4 * y as usize * w..][..4 * w]
-                .chunks_exact(4)
-                .map(|p| [0, 1, 2, 3].map(|c| Image16::value(p[c]))),
-        );
+        buf.extend(self.data[4 * y as usize * w..][..4 * w].chunks_exact(4).map(Image16::texel));
         buf
     }
 }
