@@ -70,7 +70,8 @@ function vistaChunk(offset, length) {
 // sampler], passes: [{ key, wgsl, entry, workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding,
 // layout, owned (base64) | resource, level (a texture's one mip level, or null: all) }] }], outputs: [resource
 // index] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
-// the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64) }; a sampler: { kind,
+// the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64), usage (WebGPU usage names the passes
+// bind it with; copies are added) }, made and bound with exactly its declared bytes; a sampler: { kind,
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility; `vertex`: the render pass's vertex entry reads it too); a texture slot's view
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
@@ -169,7 +170,8 @@ async function vistaRun(job) {
         made.push(d.createTexture({ size: [r.width, r.height], format: "depth32float", usage: T.RENDER_ATTACHMENT | T.TEXTURE_BINDING | T.COPY_SRC }));
       } else if (r.kind === "buffer") {
         const bytes = fromBase64(r.contents);
-        const buffer = d.createBuffer({ size: Math.max(4, Math.ceil(bytes.length / 4) * 4), usage: B.STORAGE | B.UNIFORM | B.VERTEX | B.INDEX | B.COPY_SRC | B.COPY_DST, mappedAtCreation: true });
+        const usage = r.usage.reduce((u, name) => u | B[name], B.COPY_SRC | B.COPY_DST);
+        const buffer = d.createBuffer({ size: Math.max(4, Math.ceil(bytes.length / 4) * 4), usage, mappedAtCreation: true });
         new Uint8Array(buffer.getMappedRange()).set(bytes);
         buffer.unmap();
         made.push(buffer);
@@ -185,7 +187,7 @@ async function vistaRun(job) {
         if (s.owned === undefined || s.owned === null) return null;
         const bytes = fromBase64(s.owned);
         const usage = s.layout.buffer.type === "uniform" ? B.UNIFORM : B.STORAGE;
-        const buffer = d.createBuffer({ size: Math.max(16, Math.ceil(bytes.length / 16) * 16), usage, mappedAtCreation: true });
+        const buffer = d.createBuffer({ size: Math.max(4, Math.ceil(bytes.length / 4) * 4), usage, mappedAtCreation: true });
         new Uint8Array(buffer.getMappedRange()).set(bytes);
         buffer.unmap();
         scratch.push(buffer);
@@ -215,9 +217,10 @@ async function vistaRun(job) {
       {
         d.pushErrorScope("validation");
         const resource = (s, i) => {
-          if (owned[p][i]) return { buffer: owned[p][i] };
+          // A buffer binding covers the whole buffer: its declared bytes.
+          if (owned[p][i]) return { buffer: owned[p][i], size: owned[p][i].size };
           const r = made[current[s.resource]];
-          if (s.layout.buffer) return { buffer: r };
+          if (s.layout.buffer) return { buffer: r, size: r.size };
           if (s.layout.sampler) return r;
           const dim = (s.layout.texture || s.layout.storageTexture).viewDimension;
           // One level (a storage binding's, or `name@level`), else all of them.

@@ -24,7 +24,8 @@ impl Context {
     ) -> Result<(Readback, Vec<Vec<usize>>), GpuError> {
         let b64 = vista_browser::base64;
         let mut resources = Vec::new();
-        for r in g.resources.iter() {
+        let usages = crate::graph::buffer_usages(&g.resources, &g.passes);
+        for (i, r) in g.resources.iter().enumerate() {
             resources.push(match r {
                 Resource::Texture(t) => {
                     let format = crate::format::parse(t.format)?;
@@ -41,7 +42,10 @@ impl Context {
                         "contents": contents, "fill": fill,
                     })
                 }
-                Resource::Buffer(bytes) => json!({ "kind": "buffer", "size": bytes.len(), "contents": b64(bytes) }),
+                Resource::Buffer(bytes) => json!({
+                    "kind": "buffer", "size": bytes.len(), "contents": b64(bytes),
+                    "usage": usages[i].unwrap_or_default().web_names(),
+                }),
                 Resource::Depth([w, h]) => json!({ "kind": "depth", "width": w, "height": h }),
                 Resource::Sampler(s) => json!({
                     "kind": "sampler",

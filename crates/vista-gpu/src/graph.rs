@@ -415,6 +415,112 @@ pub struct Graph<'a> {
     pub outputs: std::borrow::Cow<'a, [usize]>,
 }
 
+/// The usages each buffer resource needs, by index (`None` for other
+/// resources): only what the passes bind it as, plus copies for reading it
+/// back. WebGPU lets a shader observe a buffer's size (`arrayLength`), and
+/// wgpu grows a buffer with VERTEX usage by a few bytes, so a buffer no draw
+/// reads must not carry it. Ping-pong partners exchange bindings, so each
+/// takes the other's usages too.
+pub fn buffer_usages(resources: &[Resource], passes: &[GraphPass]) -> Vec<Option<BufferUse>> {
+    let mut uses: Vec<Option<BufferUse>> =
+        resources.iter().map(|r| matches!(r, Resource::Buffer(_)).then(BufferUse::default)).collect();
+    let mut mark = |i: usize, f: &dyn Fn(&mut BufferUse)| {
+        if let Some(Some(u)) = uses.get_mut(i) {
+            f(u)
+        }
+    };
+    for pass in passes {
+        for s in &pass.slots {
+            match s.bind {
+                Bind::UniformBuffer(r) => mark(r, &|u| u.uniform = true),
+                Bind::Storage { resource, .. } => mark(resource, &|u| u.storage = true),
+                _ => {}
+            }
+        }
+        if let Some(raster) = &pass.raster {
+            for v in &raster.buffers {
+                mark(v.resource, &|u| u.vertex = true);
+            }
+            if let Some(i) = raster.indices {
+                mark(i, &|u| u.index = true);
+            }
+        }
+    }
+    // Swapped pairs share usages (to a fixed point: chains of pairs).
+    loop {
+        let mut changed = false;
+        for pass in passes {
+            for &(a, b) in &pass.swap {
+                if let (Some(Some(x)), Some(Some(y))) = (uses.get(a).cloned(), uses.get(b).cloned()) {
+                    let both = x.union(y);
+                    if both != x || both != y {
+                        uses[a] = Some(both);
+                        uses[b] = Some(both);
+                        changed = true;
+                    }
+                }
+            }
+        }
+        if !changed {
+            return uses;
+        }
+    }
+}
+
+/// How a buffer resource is bound by the passes of a graph.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct BufferUse {
+    /// Bound as `var<storage>`.
+    pub storage: bool,
+    /// Bound as `var<uniform>`.
+    pub uniform: bool,
+    /// Read by a draw as a vertex buffer.
+    pub vertex: bool,
+    /// Read by a draw as its index buffer.
+    pub index: bool,
+}
+
+impl BufferUse {
+    fn union(self, o: BufferUse) -> BufferUse {
+        BufferUse {
+            storage: self.storage || o.storage,
+            uniform: self.uniform || o.uniform,
+            vertex: self.vertex || o.vertex,
+            index: self.index || o.index,
+        }
+    }
+
+    /// WebGPU's usage names, as the browser engine passes them.
+    pub fn web_names(self) -> Vec<&'static str> {
+        [(self.storage, "STORAGE"), (self.uniform, "UNIFORM"), (self.vertex, "VERTEX"), (self.index, "INDEX")]
+            .into_iter()
+            .filter_map(|(on, name)| on.then_some(name))
+            .collect()
+    }
+
+    pub(crate) fn wgpu(self) -> wgpu::BufferUsages {
+        let mut u = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        for (on, usage) in [
+            (self.storage, wgpu::BufferUsages::STORAGE),
+            (self.uniform, wgpu::BufferUsages::UNIFORM),
+            (self.vertex, wgpu::BufferUsages::VERTEX),
+            (self.index, wgpu::BufferUsages::INDEX),
+        ] {
+            if on {
+                u |= usage;
+            }
+        }
+        u
+    }
+}
+
+/// The bytes a buffer resource is made and bound with: its declared size,
+/// with a 4-byte floor (WebGPU binds no empty buffer; every WGSL type's
+/// size is a multiple of 4).
+pub fn buffer_size(bytes: &[u8]) -> u64 {
+    bytes.len().max(4).next_multiple_of(4) as u64
+}
+
 /// The view a binding of `t` sees: six layers as a cube for a sampled
 /// `texture_cube`, else the texture's own dimension.
 pub(crate) fn view_dimension(t: &TextureDesc, cube: bool) -> wgpu::TextureViewDimension {

@@ -127,7 +127,10 @@ impl Stamps {
 
 struct Made {
     textures: HashMap<usize, wgpu::Texture>,
-    buffers: HashMap<usize, wgpu::Buffer>,
+    /// Each buffer with the bytes it was declared with: every binding and
+    /// vertex or index slice covers exactly those (wgpu pads a buffer with
+    /// VERTEX usage, and a shader sees a binding's size in `arrayLength`).
+    buffers: HashMap<usize, (wgpu::Buffer, u64)>,
     samplers: HashMap<usize, wgpu::Sampler>,
     /// The fill buffers the sentinel copies read (spares again after the run).
     fills: Vec<((&'static str, usize, u64), wgpu::Buffer)>,
@@ -254,6 +257,7 @@ impl Context {
         let mut made =
             Made { textures: HashMap::new(), buffers: HashMap::new(), samplers: HashMap::new(), fills: Vec::new() };
         let mut fill = d.create_command_encoder(&Default::default());
+        let usages = crate::graph::buffer_usages(&g.resources, &g.passes);
         for (i, r) in g.resources.iter().enumerate() {
             match r {
                 Resource::Texture(t) => {
@@ -359,22 +363,14 @@ impl Context {
                     made.textures.insert(i, texture);
                 }
                 Resource::Buffer(bytes) => {
-                    // Zero-length buffers cannot be bound; a 4-byte floor.
                     let mut contents = bytes.clone();
-                    contents.resize(contents.len().max(4).next_multiple_of(4), 0);
-                    made.buffers.insert(
-                        i,
-                        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                            label: Some("resource"),
-                            contents: &contents,
-                            usage: wgpu::BufferUsages::STORAGE
-                                | wgpu::BufferUsages::UNIFORM
-                                | wgpu::BufferUsages::VERTEX
-                                | wgpu::BufferUsages::INDEX
-                                | wgpu::BufferUsages::COPY_SRC
-                                | wgpu::BufferUsages::COPY_DST,
-                        }),
-                    );
+                    contents.resize(crate::graph::buffer_size(bytes) as usize, 0);
+                    let buffer = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("resource"),
+                        contents: &contents,
+                        usage: usages[i].unwrap_or_default().wgpu(),
+                    });
+                    made.buffers.insert(i, (buffer, contents.len() as u64));
                 }
                 Resource::Sampler(s) => {
                     let filter = if s.linear { wgpu::FilterMode::Linear } else { wgpu::FilterMode::Nearest };
@@ -579,10 +575,10 @@ impl Context {
         let t = match (g.resources[logical].read_as(), &g.resources[logical]) {
             (Some(t), _) => t,
             (None, Resource::Buffer(bytes)) => {
-                let size = bytes.len().max(4).next_multiple_of(4) as u64;
+                let size = crate::graph::buffer_size(bytes);
                 let staging = staging_of(size);
                 let mut encoder = d.create_command_encoder(&Default::default());
-                encoder.copy_buffer_to_buffer(&made.buffers[&physical], 0, &staging, 0, size);
+                encoder.copy_buffer_to_buffer(&made.buffers[&physical].0, 0, &staging, 0, size);
                 let data = self.map_read(w, &staging, encoder, |mapped| mapped[..bytes.len()].to_vec())?;
                 keep(&mut w.spares.lock().expect("spares").staging, staging.size(), staging);
                 return Ok((OutputData::Buffer(data), Vec::new()));
@@ -748,7 +744,12 @@ fn bind_groups(
                             owned[i].as_ref().expect("owned buffer").as_entire_binding()
                         }
                         Bind::UniformBuffer(r) | Bind::Storage { resource: r, .. } => {
-                            made.buffers[&current[r]].as_entire_binding()
+                            let (buffer, size) = &made.buffers[&current[r]];
+                            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                                buffer,
+                                offset: 0,
+                                size: std::num::NonZeroU64::new(*size),
+                            })
                         }
                         Bind::StorageTexture { .. } | Bind::Sampled { .. } => {
                             wgpu::BindingResource::TextureView(views[i].as_ref().expect("a view"))
@@ -868,11 +869,13 @@ fn encode_draw(
         pass.set_blend_constant(wgpu::Color { r, g, b, a });
     }
     for (slot, v) in raster.buffers.iter().enumerate() {
-        pass.set_vertex_buffer(slot as u32, made.buffers[&current[v.resource]].slice(..));
+        let (buffer, size) = &made.buffers[&current[v.resource]];
+        pass.set_vertex_buffer(slot as u32, buffer.slice(..*size));
     }
     match raster.indices {
         Some(i) => {
-            pass.set_index_buffer(made.buffers[&current[i]].slice(..), crate::raster::index_format(raster));
+            let (buffer, size) = &made.buffers[&current[i]];
+            pass.set_index_buffer(buffer.slice(..*size), crate::raster::index_format(raster));
             pass.draw_indexed(0..raster.count, 0, 0..raster.instances);
         }
         None => pass.draw(0..raster.count, 0..raster.instances),

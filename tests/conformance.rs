@@ -1,0 +1,160 @@
+//! vista's host layer against the WGSL and WebGPU specs (SPEC 18): every
+//! probe of `tests/conformance/` (a vista project of its own) runs on
+//! lavapipe, SwiftShader and headless Chromium, and its output's 32-bit
+//! words must equal `tests/conformance/expected.toml`, which
+//! `expected.py` derives from the specs (never from vista, never blessed).
+//! A backend that differs from the spec in a known way is named there as a
+//! `[[difference]]`, never hidden by a looser comparison. One test per
+//! backend and probe (`conformance::<backend>::<kernel>[::<set>]`), plus one
+//! that the table is what the script writes.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use common::allow_no_gpu;
+use libtest_mimic::{Arguments, Trial};
+use vista_gpu::{AdapterChoice, Context};
+use vista_project::Project;
+use vista_render::{OutputValue, Renderer, render};
+
+mod common;
+
+const BACKENDS: [&str; 3] = ["lavapipe", "swiftshader", "browser"];
+
+fn suite() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/conformance")
+}
+
+#[derive(serde::Deserialize)]
+struct Table {
+    probe: Vec<Probe>,
+    #[serde(default)]
+    difference: Vec<Difference>,
+}
+
+#[derive(serde::Deserialize, Clone)]
+struct Probe {
+    kernel: String,
+    set: toml::Table,
+    output: String,
+    why: String,
+    words: Vec<u32>,
+}
+
+/// A documented way a backend differs from the spec on one probe: its
+/// words are expected as listed instead.
+#[derive(serde::Deserialize, Clone)]
+struct Difference {
+    backend: String,
+    kernel: String,
+    #[serde(default)]
+    set: toml::Table,
+    words: Vec<u32>,
+    reason: String,
+}
+
+fn table() -> Table {
+    let path = suite().join("expected.toml");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The backend's context, made once per process.
+fn context(backend: usize) -> Result<&'static Context, String> {
+    static CONTEXTS: [OnceLock<Result<Context, String>>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    CONTEXTS[backend]
+        .get_or_init(|| {
+            let config = vista_gpu::GpuConfig {
+                adapter: AdapterChoice::of_backend(BACKENDS[backend]).expect("known backend"),
+                ..common::config().gpu.clone()
+            };
+            // The browser has Dawn's validation always on; the Khronos layer is wgpu's.
+            let config = vista_gpu::GpuConfig { validate: config.validate && BACKENDS[backend] != "browser", ..config };
+            Context::new(&config).map_err(|e| format!("{}: {e}", BACKENDS[backend]))
+        })
+        .as_ref()
+        .map_err(Clone::clone)
+}
+
+fn set_pairs(set: &toml::Table) -> Vec<(String, String)> {
+    set.iter().map(|(k, v)| (k.clone(), v.to_string())).collect()
+}
+
+fn set_label(set: &toml::Table) -> String {
+    set.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(",")
+}
+
+/// Renders one probe on one backend; its output's words.
+fn words_of(backend: usize, probe: &Probe) -> Result<Vec<u32>, String> {
+    let ctx = context(backend)?;
+    let project = Project::at(&suite()).map_err(|e| e.to_string())?;
+    let gpu = Renderer::new(ctx, &project, common::config().limits).map_err(|e| e.to_string())?;
+    let kernels = vista_kernels::Registry::of_project(&project).map_err(|e| e.to_string())?;
+    let kernel = kernels.find(&probe.kernel).map_err(|e| e.to_string())?;
+    let params = kernel.resolve(None, &set_pairs(&probe.set)).map_err(|e| e.to_string())?;
+    let out = render(&gpu, kernel, &params, 8, 8).map_err(|e| format!("{} on {}: {e}", probe.kernel, BACKENDS[backend]))?;
+    let output = out
+        .outputs
+        .iter()
+        .find(|o| o.name == probe.output)
+        .ok_or_else(|| format!("{}: no output {}", probe.kernel, probe.output))?;
+    let OutputValue::Buffer { bytes, .. } = &output.value else {
+        return Err(format!("{}: output {} is not a buffer", probe.kernel, probe.output));
+    };
+    Ok(bytes.chunks_exact(4).map(|w| u32::from_le_bytes(w.try_into().expect("4 bytes"))).collect())
+}
+
+fn check(backend: usize, probe: &Probe, differences: &[Difference]) -> Result<(), String> {
+    let known = differences
+        .iter()
+        .find(|d| d.backend == BACKENDS[backend] && d.kernel == probe.kernel && d.set == probe.set);
+    let want = known.map_or(&probe.words, |d| &d.words);
+    let got = words_of(backend, probe)?;
+    if &got == want {
+        return Ok(());
+    }
+    let first = got.iter().zip(want).position(|(a, b)| a != b).unwrap_or(got.len().min(want.len()));
+    Err(format!(
+        "{} {} on {}: word {first} is {:?}, the spec says {:?}\n  got  {got:?}\n  want {want:?}\n  ({})",
+        probe.kernel,
+        set_label(&probe.set),
+        BACKENDS[backend],
+        got.get(first),
+        want.get(first),
+        known.map_or(probe.why.as_str(), |d| d.reason.as_str()),
+    ))
+}
+
+fn main() {
+    let args = Arguments::from_args();
+    let table = table();
+    let missing: Vec<String> = if args.list { Vec::new() } else { (0..3).filter_map(|b| context(b).err()).collect() };
+    let skip = !missing.is_empty() && allow_no_gpu();
+    if skip {
+        eprintln!("\n!!! VISTA_ALLOW_NO_GPU=1 and a backend is missing: {}", missing.join("; "));
+        eprintln!("!!! SKIPPED {} conformance probes (reported ignored)\n", table.probe.len() * 3);
+    }
+    let mut trials = vec![Trial::test("conformance::expected_toml_is_what_expected_py_writes", || {
+        let out = std::process::Command::new("python3")
+            .arg(suite().join("expected.py"))
+            .arg("--check")
+            .output()
+            .map_err(|e| format!("python3 (the spec-derived table's script) cannot run: {e}"))?;
+        match out.status.success() {
+            true => Ok(()),
+            false => Err(String::from_utf8_lossy(&out.stdout).into_owned().into()),
+        }
+    })];
+    for (b, backend) in BACKENDS.iter().enumerate() {
+        for probe in &table.probe {
+            let (probe, differences) = (probe.clone(), table.difference.clone());
+            let label = set_label(&probe.set);
+            let name = match label.is_empty() {
+                true => format!("conformance::{backend}::{}", probe.kernel),
+                false => format!("conformance::{backend}::{}::{label}", probe.kernel),
+            };
+            trials.push(Trial::test(name, move || check(b, &probe, &differences).map_err(Into::into)).with_ignored_flag(skip));
+        }
+    }
+    libtest_mimic::run(&args, trials).exit()
+}
