@@ -14,6 +14,9 @@
 //! `list`, `render`, `compare`, `bench` and `sweep`; `check` and `bless`
 //! need a root ([`Project::require_root`]).
 //!
+//! Every file a command reads from a project goes through [`guard`]: a
+//! regular file inside the project after symlinks, under a size cap.
+//!
 //! Not for: parsing kernel manifests or cases (that is `vista-kernels` and
 //! `vista-golden`), or writing anything.
 
@@ -25,6 +28,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 pub mod builtin;
+pub mod guard;
 
 /// The file that marks a project root.
 pub const PROJECT_FILE: &str = "vista.toml";
@@ -154,7 +158,7 @@ impl Project {
 
     fn with_root(root: PathBuf, found: Found, cwd: PathBuf) -> Result<Project, ProjectError> {
         let path = root.join(PROJECT_FILE);
-        let text = read(&path)?;
+        let text = read(&root, &path)?;
         let config: Config = toml::from_str(&text).map_err(|e| ProjectError::Config {
             path: path.display().to_string(),
             message: one_line_toml_error(&text, &e),
@@ -206,8 +210,9 @@ impl Project {
         if rel.split('/').any(|c| c == "..") {
             return None;
         }
-        let path = self.root()?.join(rel);
-        let text = fs::read_to_string(&path).ok()?;
+        let root = self.root()?;
+        let path = root.join(rel);
+        let text = guard::read_text(root, &path).ok()?;
         Some((text, path.display().to_string()))
     }
 
@@ -222,14 +227,14 @@ impl Project {
         let path = root.join(rel);
         let paths = match path.is_file() {
             true => vec![path],
-            false if path.is_dir() => files_with_ext(&path, ext)?,
+            false if path.is_dir() => files_with_ext(root, &path, ext)?,
             false => Vec::new(),
         };
         paths
             .into_iter()
             .map(|p| {
                 let rel = p.strip_prefix(root).unwrap_or(&p).to_string_lossy().replace('\\', "/");
-                Ok(SourceFile { rel, text: read(&p)?, origin: p.display().to_string() })
+                Ok(SourceFile { rel, text: read(root, &p)?, origin: p.display().to_string() })
             })
             .collect()
     }
@@ -255,9 +260,9 @@ impl Project {
         if let Some(root) = self.root() {
             let dir = root.join(sub);
             if dir.is_dir() {
-                for path in files_with_ext(&dir, ext)? {
+                for path in files_with_ext(root, &dir, ext)? {
                     let rel = path.strip_prefix(&dir).unwrap_or(&path).to_string_lossy().replace('\\', "/");
-                    let text = read(&path)?;
+                    let text = read(root, &path)?;
                     files.insert(rel.clone(), SourceFile { rel, text, origin: path.display().to_string() });
                 }
             }
@@ -270,25 +275,46 @@ fn absolute(p: &Path) -> PathBuf {
     std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
 }
 
-fn read(path: &Path) -> Result<String, ProjectError> {
-    fs::read_to_string(path)
-        .map_err(|e| ProjectError::Io { path: path.display().to_string(), message: format!("cannot read: {e}") })
+fn read(root: &Path, path: &Path) -> Result<String, ProjectError> {
+    guard::read_text(root, path).map_err(|e| ProjectError::Io { path: e.path, message: e.message })
 }
 
-fn files_with_ext(dir: &Path, ext: &[&str]) -> Result<Vec<PathBuf>, ProjectError> {
+/// Files with one of the extensions under `dir`, sorted. A symlinked
+/// folder is followed only when it resolves inside `root` and is not one
+/// of the folders it sits in (a loop); others are skipped.
+fn files_with_ext(root: &Path, dir: &Path, ext: &[&str]) -> Result<Vec<PathBuf>, ProjectError> {
+    let real_root = root.canonicalize().unwrap_or_else(|_| root.to_path_buf());
     let mut out = Vec::new();
+    let mut stack = Vec::new();
+    walk(&real_root, dir, ext, &mut stack, &mut out)?;
+    out.sort();
+    Ok(out)
+}
+
+fn walk(
+    real_root: &Path,
+    dir: &Path,
+    ext: &[&str],
+    stack: &mut Vec<PathBuf>,
+    out: &mut Vec<PathBuf>,
+) -> Result<(), ProjectError> {
+    let real = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    if !real.starts_with(real_root) || stack.contains(&real) {
+        return Ok(());
+    }
+    stack.push(real);
     let entries = fs::read_dir(dir)
         .map_err(|e| ProjectError::Io { path: dir.display().to_string(), message: format!("cannot list: {e}") })?;
     for entry in entries.flatten() {
         let path = entry.path();
         if path.is_dir() {
-            out.extend(files_with_ext(&path, ext)?);
+            walk(real_root, &path, ext, stack, out)?;
         } else if path.extension().is_some_and(|e| ext.iter().any(|x| e == *x)) {
             out.push(path);
         }
     }
-    out.sort();
-    Ok(out)
+    stack.pop();
+    Ok(())
 }
 
 /// A yes/no setting's value (`VISTA_ALLOW_NO_GPU`, `VISTA_VALIDATION`, ...):
