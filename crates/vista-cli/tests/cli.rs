@@ -514,6 +514,67 @@ fn bless_then_check_passes_and_bless_is_refused_in_ci() {
     );
 }
 
+/// A symlink planted where the report keeps its thumbnails
+/// (`target/vista-report/thumbs.d -> ../../golden/fbm`) is replaced by a
+/// folder of vista's: the goldens it pointed at stay byte-identical and the
+/// next check still passes.
+#[cfg(unix)]
+fn a_symlinked_thumbs_folder_never_touches_the_goldens() {
+    let d = blessed_project();
+    let goldens = || {
+        let mut files = walk(&d.path().join("golden"));
+        files.sort();
+        files.into_iter().map(|p| (p.clone(), std::fs::read(p).unwrap())).collect::<Vec<_>>()
+    };
+    let before = goldens();
+    std::fs::create_dir_all(report(d.path())).unwrap();
+    std::os::unix::fs::symlink("../../golden/fbm", report(d.path()).join("thumbs.d")).unwrap();
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 0, "{}{}", c.stdout, c.stderr);
+    assert_eq!(goldens(), before, "check wrote through the thumbs.d symlink");
+    let thumbs = std::fs::symlink_metadata(report(d.path()).join("thumbs.d")).unwrap();
+    assert!(thumbs.is_dir(), "thumbs.d is a real folder again");
+    let again = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(again.code, 0, "{}{}", again.stdout, again.stderr);
+}
+
+/// A golden folder that is a symlink out of the project: bless refuses
+/// with exit 2 naming it and where it leads, and writes nothing there.
+#[cfg(unix)]
+fn bless_never_writes_through_a_symlinked_golden_folder() {
+    let d = golden_dir(CASES);
+    let outside = tmp();
+    std::os::unix::fs::symlink(outside.path(), d.path().join("golden/fbm")).unwrap();
+    let b = vista_in(Some(d.path()), &[], &["bless"]);
+    assert_rejected(&b, 2, &["golden/fbm", "is a symlink to", "real folders"]);
+    assert!(walk(outside.path()).is_empty(), "bless wrote outside the project: {:?}", walk(outside.path()));
+}
+
+/// A shader include that is a symlink out of the project, or to a device,
+/// or a FIFO: refused with one line naming what it resolves to, at once,
+/// and nothing of the outside file is echoed.
+#[cfg(unix)]
+fn symlinks_out_of_the_project_devices_and_fifos_are_refused() {
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    std::fs::create_dir_all(d.path().join("shaders")).unwrap();
+    let outside = tmp();
+    std::fs::write(outside.path().join("pw"), "root:x:0:0:root:/root:/bin/bash\n").unwrap();
+    let shader = d.path().join("shaders/fbm.wgsl");
+    std::os::unix::fs::symlink(outside.path().join("pw"), &shader).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["list"]);
+    assert_rejected(&r, 2, &["shaders/fbm.wgsl", "outside the project"]);
+    assert!(!r.stdout.contains("root:x") && !r.stderr.contains("root:x"), "{}{}", r.stdout, r.stderr);
+    std::fs::remove_file(&shader).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &shader).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["list"]);
+    assert_rejected(&r, 2, &["shaders/fbm.wgsl", "/dev/zero"]);
+    std::fs::remove_file(&shader).unwrap();
+    assert!(Command::new("mkfifo").arg(&shader).status().unwrap().success());
+    let r = vista_in(Some(d.path()), &[], &["list"]);
+    assert_rejected(&r, 2, &["shaders/fbm.wgsl", "a FIFO", "expected a regular file"]);
+}
+
 /// Check requires the bless-time raw bits on the same adapter, shader and
 /// params (what lets the golden harness skip its second render): a
 /// manifest whose raw hash the render does not reproduce fails the case.
@@ -5718,6 +5779,9 @@ fn main() {
         Gpu sweep_writes_csv_plots_and_names_the_cheapest_setting,
         Gpu sweep_grid_has_one_row_per_point,
         Gpu missing_golden_fails_with_the_bless_command_and_is_not_created,
+        #[cfg(unix)] Gpu a_symlinked_thumbs_folder_never_touches_the_goldens,
+        #[cfg(unix)] Gpu bless_never_writes_through_a_symlinked_golden_folder,
+        #[cfg(unix)] Cpu symlinks_out_of_the_project_devices_and_fifos_are_refused,
         Gpu bless_then_check_passes_and_bless_is_refused_in_ci,
         Gpu bless_refuses_what_check_would_fail,
         Gpu workgroup_size_comes_from_reflection_not_8x8,

@@ -92,7 +92,7 @@ pub fn bless(ctx: &Renderer, store: &Store, opts: &BlessOptions) -> Result<Bless
         };
         // A pass graph's other files first: each atomic, named in the entry.
         let extra = crate::outputs::golden_bytes(&store.dir, case, &key, &r.outputs)?;
-        let (extra_hashes, extra_changed) = write_extra_files(&extra)?;
+        let (extra_hashes, extra_changed) = write_extra_files(store, &extra)?;
         let run = crate::RunInfo {
             backend: ctx.backend().to_string(),
             adapter: adapter.clone(),
@@ -185,17 +185,24 @@ fn render_checked<'c>(
     Ok(rendered)
 }
 
+/// Makes `dir` (under the store's folder) a real folder reached from the
+/// project without a symlink: goldens are never written through one.
+fn golden_dir(store: &Store, dir: &std::path::Path) -> Result<(), GoldenError> {
+    let from = store.dir.parent().unwrap_or(&store.dir);
+    vista_image::real_dir_under(from, dir).map_err(|e| GoldenError::BadInput(e.to_string()))
+}
+
 /// Writes the golden files a case keeps besides its main image (each only
 /// if its bytes changed); their hashes by file name, and whether any changed.
 fn write_extra_files(
+    store: &Store,
     extra: &[(std::path::PathBuf, Vec<u8>)],
 ) -> Result<(std::collections::BTreeMap<String, String>, bool), GoldenError> {
     let mut extra_hashes = std::collections::BTreeMap::new();
     let mut extra_changed = false;
     for (file, bytes) in extra {
         if let Some(parent) = file.parent() {
-            std::fs::create_dir_all(parent)
-                .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+            golden_dir(store, parent)?;
         }
         let hash = crate::short_hash_bytes(bytes);
         if std::fs::read(file).ok().map(|b| crate::short_hash_bytes(&b)).as_deref() != Some(hash.as_str()) {
@@ -239,8 +246,7 @@ fn write_main_image(
         None => ("new", "new".to_string()),
     };
     if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent)
-            .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+        golden_dir(store, parent)?;
     }
     // Goldens live in a repository: the smallest lossless encoding, and
     // a golden whose pixels did not change keeps its bytes (another

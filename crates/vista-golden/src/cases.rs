@@ -310,8 +310,10 @@ pub use vista_project::one_line_toml_error;
 
 /// Reads the case file at `path` and validates it (see [`parse_cases`]).
 pub fn load_cases(path: &Path, kernels: &vista_kernels::Registry) -> Result<Vec<Case>, GoldenError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| GoldenError::Cases { path: path.display().to_string(), message: format!("cannot read: {e}") })?;
+    // golden/cases.toml: the project root is two folders up.
+    let root = path.parent().and_then(Path::parent).unwrap_or(Path::new("."));
+    let text = vista_project::guard::read_text(root, path)
+        .map_err(|e| GoldenError::Cases { path: path.display().to_string(), message: e.message })?;
     parse_cases(path, &text, kernels)
 }
 

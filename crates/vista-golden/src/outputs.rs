@@ -79,12 +79,12 @@ impl GoldenFiles {
             .all()
             .into_iter()
             .map(|p| {
-                let found = match std::fs::read(p) {
-                    Ok(bytes) => Found::Bytes(bytes),
-                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => Found::Missing,
-                    Err(source) => {
-                        Found::Unreadable(vista_image::ImageError::Io { path: p.clone(), source }.to_string())
-                    }
+                // A regular file under the data cap: a golden that is a
+                // device or a FIFO is unreadable, never read forever.
+                let found = match vista_project::guard::read_regular(p, vista_project::guard::MAX_DATA_BYTES) {
+                    Ok(Some(bytes)) => Found::Bytes(bytes),
+                    Ok(None) => Found::Missing,
+                    Err(e) => Found::Unreadable(e.to_string()),
                 };
                 (p.clone(), found)
             })

@@ -170,13 +170,17 @@ impl Store {
     /// The manifest; empty if the file does not exist yet.
     pub fn manifest(&self) -> Result<Manifest, GoldenError> {
         let path = self.manifest_path();
-        match std::fs::read_to_string(&path) {
-            Ok(text) => toml::from_str(&text).map_err(|e| GoldenError::Cases {
-                path: path.display().to_string(),
-                message: format!("malformed manifest: {}", crate::cases::one_line_toml_error(&text, &e)),
-            }),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Manifest::default()),
-            Err(e) => Err(GoldenError::Io { path: path.display().to_string(), message: e.to_string() }),
+        let io = |message: String| GoldenError::Io { path: path.display().to_string(), message };
+        match vista_project::guard::read_regular(&path, vista_project::guard::MAX_TEXT_BYTES) {
+            Ok(Some(bytes)) => {
+                let text = String::from_utf8(bytes).map_err(|_| io("is not UTF-8 text".into()))?;
+                toml::from_str(&text).map_err(|e| GoldenError::Cases {
+                    path: path.display().to_string(),
+                    message: format!("malformed manifest: {}", crate::cases::one_line_toml_error(&text, &e)),
+                })
+            }
+            Ok(None) => Ok(Manifest::default()),
+            Err(e) => Err(io(e.message)),
         }
     }
 

@@ -516,6 +516,42 @@ fn sync_dir(dir: &Path) {
     let _ = dir;
 }
 
+/// Makes `dir` a real directory for files vista owns (the report's
+/// folders): a symlink in its place is removed (the link, never what it
+/// points at) and a directory made instead, so no write goes through it.
+/// A `thumbs.d -> ../../golden/rings` planted in the report folder leaves
+/// the goldens untouched.
+pub fn own_dir(dir: &Path) -> Result<(), ImageError> {
+    let io_err = |source| ImageError::Io { path: dir.to_path_buf(), source };
+    if std::fs::symlink_metadata(dir).is_ok_and(|m| m.file_type().is_symlink()) {
+        std::fs::remove_file(dir).map_err(io_err)?;
+    }
+    std::fs::create_dir_all(dir).map_err(io_err)
+}
+
+/// Makes `dir` (a folder under `root`) a real directory reached from
+/// `root` without a symlink, for files the user keeps (goldens): a symlink
+/// on the way is refused, naming where it leads, never followed.
+pub fn real_dir_under(root: &Path, dir: &Path) -> Result<(), ImageError> {
+    let rel = dir.strip_prefix(root).unwrap_or(dir);
+    let mut at = root.to_path_buf();
+    for part in rel.components() {
+        at.push(part);
+        if let Ok(m) = std::fs::symlink_metadata(&at)
+            && m.file_type().is_symlink()
+        {
+            let to = std::fs::read_link(&at).map(|t| t.display().to_string()).unwrap_or_default();
+            return Err(ImageError::Io {
+                path: at.clone(),
+                source: std::io::Error::other(format!(
+                    "is a symlink to {to}; vista writes goldens only into real folders of the project"
+                )),
+            });
+        }
+    }
+    std::fs::create_dir_all(dir).map_err(|source| ImageError::Io { path: dir.to_path_buf(), source })
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

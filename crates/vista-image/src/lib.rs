@@ -43,8 +43,8 @@ pub use heatmap::{
 };
 pub use io::{
     atomic_replace, atomic_write, decode_exr, decode_png16, decode_png16_compact, encode_exr, encode_png8_small,
-    encode_png16, encode_png16_channel, encode_png16_small, load, opaque8, quantize8, quantize16, read_exr, read_png16,
-    remove_stale_temps, save, write_exr, write_png8, write_png8_small, write_png16,
+    encode_png16, encode_png16_channel, encode_png16_small, load, opaque8, own_dir, quantize8, quantize16, read_exr,
+    read_png16, real_dir_under, remove_stale_temps, save, write_exr, write_png8, write_png8_small, write_png16,
 };
 pub use png_stream::{PngFile, PngKind, atomic_replace_with};
 pub use texels::{Image16, Texels};

@@ -824,7 +824,7 @@ impl Planning<'_> {
 /// rgba8unorm; 16-bit PNG and EXR: rgba32float) and its values.
 fn read_texture(root: Option<&Path>, file: &str) -> Result<(&'static str, Image), String> {
     let path = under(root, file)?;
-    let bytes = std::fs::read(&path).map_err(|e| format!("file {file} cannot be read ({}): {e}", path.display()))?;
+    let bytes = read_input(root, file, &path)?;
     if file.ends_with(".exr") {
         let image = vista_image::read_exr(&path).map_err(|e| format!("file {file}: {e}"))?;
         return Ok(("rgba32float", image));
@@ -906,12 +906,19 @@ fn under(root: Option<&Path>, file: &str) -> Result<PathBuf, String> {
     Ok(root.join(file))
 }
 
+/// An input file's bytes: a regular file inside the project after
+/// symlinks, at most [`vista_project::guard::MAX_DATA_BYTES`].
+fn read_input(root: Option<&Path>, file: &str, path: &Path) -> Result<Vec<u8>, String> {
+    let root = root.ok_or_else(|| format!("file {file} needs a project root (vista.toml) to be found under"))?;
+    vista_project::guard::read_bytes(root, path, vista_project::guard::MAX_DATA_BYTES)
+        .map_err(|e| format!("file {file} cannot be read: {e}"))
+}
+
 /// A buffer file: `.npy` (dtype checked against the element) or `.bin`
 /// (raw little-endian bytes, a whole number of elements).
 fn read_buffer(root: Option<&Path>, file: &str, e: &Element) -> Result<Vec<u8>, String> {
     let path = under(root, file)?;
-    let bytes =
-        std::fs::read(&path).map_err(|err| format!("file {file} cannot be read ({}): {err}", path.display()))?;
+    let bytes = read_input(root, file, &path)?;
     let data = match file.ends_with(".npy") {
         true => {
             let n = vista_image::npy::decode_npy(&path, &bytes).map_err(|err| format!("file {file}: {err}"))?;

@@ -39,7 +39,9 @@ const THUMBS_MARKER: &str = ".vista-thumbs";
 pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
     let Ok(entries) = std::fs::read_dir(dir) else { return Ok(()) };
     for e in entries.flatten() {
-        if e.path().is_dir() && e.path().join(CASE_MARKER).is_file() {
+        // Never through a symlink: a link to a marked folder elsewhere stays.
+        let real = e.file_type().is_ok_and(|t| t.is_dir());
+        if real && e.path().join(CASE_MARKER).is_file() {
             std::fs::remove_dir_all(e.path())
                 .map_err(|err| GoldenError::Io { path: e.path().display().to_string(), message: err.to_string() })?;
         }
@@ -67,8 +69,7 @@ pub fn file_case(dir: &Path, checked: vista_golden::Checked, detail: Detail) -> 
             let path = vista_golden::pending::pending_file(dir, &outcome.id, name);
             case_folder(dir, &outcome.id)?;
             if let Some(parent) = path.parent() {
-                std::fs::create_dir_all(parent)
-                    .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+                vista_image::own_dir(parent)?;
             }
             vista_image::atomic_replace(&path, bytes)?;
         }
@@ -92,14 +93,10 @@ pub fn file_case(dir: &Path, checked: vista_golden::Checked, detail: Detail) -> 
 /// it and nothing else).
 fn case_folder(dir: &Path, id: &str) -> Result<std::path::PathBuf, GoldenError> {
     let case_dir = dir.join(id);
-    std::fs::create_dir_all(&case_dir).map_err(|e| GoldenError::Io {
-        path: case_dir.display().to_string(),
-        message: format!("cannot create report dir: {e}"),
-    })?;
+    vista_image::own_dir(&case_dir)?;
     let marker = case_dir.join(CASE_MARKER);
-    if !marker.exists() {
-        std::fs::write(&marker, b"")
-            .map_err(|e| GoldenError::Io { path: marker.display().to_string(), message: e.to_string() })?;
+    if !marker.is_file() {
+        vista_image::atomic_replace(&marker, b"")?;
     }
     Ok(case_dir)
 }
@@ -283,10 +280,10 @@ pub fn write_case_files(
     let full = detail == Detail::All || !out.passed();
     if !full {
         let thumbs = dir.join(THUMBS_DIR);
+        // A real folder of vista's: a symlink planted here is replaced, never written through.
+        vista_image::own_dir(&thumbs)?;
         if !thumbs.join(THUMBS_MARKER).is_file() {
-            let io = |e: std::io::Error| GoldenError::Io { path: thumbs.display().to_string(), message: e.to_string() };
-            std::fs::create_dir_all(&thumbs).map_err(io)?;
-            std::fs::write(thumbs.join(THUMBS_MARKER), b"").map_err(io)?;
+            vista_image::atomic_replace(&thumbs.join(THUMBS_MARKER), b"")?;
         }
         vista_image::write_png8_small(&thumbs.join(format!("{id}.png")), &actual.thumbnail(THUMB_EDGE))?;
         out.files.thumb = Some(format!("{THUMBS_DIR}/{id}.png"));
@@ -860,7 +857,8 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
 /// or a case that failed this time), where the folder is vista's.
 fn prune_thumbs(dir: &Path, outcomes: &[Outcome]) {
     let thumbs = dir.join(THUMBS_DIR);
-    if !thumbs.join(THUMBS_MARKER).is_file() {
+    let linked = std::fs::symlink_metadata(&thumbs).is_ok_and(|m| m.file_type().is_symlink());
+    if linked || !thumbs.join(THUMBS_MARKER).is_file() {
         return;
     }
     let shown: std::collections::HashSet<&str> = outcomes.iter().filter_map(|o| o.files.thumb.as_deref()).collect();
