@@ -92,7 +92,8 @@ fn words_of(backend: usize, probe: &Probe) -> Result<Vec<u32>, String> {
     let kernels = vista_kernels::Registry::of_project(&project).map_err(|e| e.to_string())?;
     let kernel = kernels.find(&probe.kernel).map_err(|e| e.to_string())?;
     let params = kernel.resolve(None, &set_pairs(&probe.set)).map_err(|e| e.to_string())?;
-    let out = render(&gpu, kernel, &params, 8, 8).map_err(|e| format!("{} on {}: {e}", probe.kernel, BACKENDS[backend]))?;
+    let out =
+        render(&gpu, kernel, &params, 8, 8).map_err(|e| format!("{} on {}: {e}", probe.kernel, BACKENDS[backend]))?;
     let output = out
         .outputs
         .iter()
@@ -105,9 +106,8 @@ fn words_of(backend: usize, probe: &Probe) -> Result<Vec<u32>, String> {
 }
 
 fn check(backend: usize, probe: &Probe, differences: &[Difference]) -> Result<(), String> {
-    let known = differences
-        .iter()
-        .find(|d| d.backend == BACKENDS[backend] && d.kernel == probe.kernel && d.set == probe.set);
+    let known =
+        differences.iter().find(|d| d.backend == BACKENDS[backend] && d.kernel == probe.kernel && d.set == probe.set);
     let want = known.map_or(&probe.words, |d| &d.words);
     let got = words_of(backend, probe)?;
     if &got == want {
@@ -153,7 +153,9 @@ fn main() {
                 true => format!("conformance::{backend}::{}", probe.kernel),
                 false => format!("conformance::{backend}::{}::{label}", probe.kernel),
             };
-            trials.push(Trial::test(name, move || check(b, &probe, &differences).map_err(Into::into)).with_ignored_flag(skip));
+            trials.push(
+                Trial::test(name, move || check(b, &probe, &differences).map_err(Into::into)).with_ignored_flag(skip),
+            );
         }
     }
     libtest_mimic::run(&args, trials).exit()

@@ -122,11 +122,17 @@ def layout_probes():
     ]
 
 
+def entry_name_probes():
+    # fill_u32 writes 32 and arrayLength of the 4-u32 buffer; fill_f16 writes 16; the last word stays 0.
+    return [{"kernel": "entry_names", "set": {}, "output": "words", "words": [32, 4, 16, 0],
+             "why": "each pass ran its own entry point, found by the name the module gives it"}]
+
+
 def render():
     out = ["# Written by expected.py from the WGSL and WebGPU specs; do not edit.",
            "# tests/conformance.rs runs each probe on every backend and compares the",
            "# output's 32-bit words exactly.", ""]
-    for p in array_length_probes() + layout_probes():
+    for p in array_length_probes() + layout_probes() + entry_name_probes():
         sets = ", ".join(f"{k} = {v}" for k, v in p["set"].items())
         out += ["[[probe]]", f'kernel = "{p["kernel"]}"', f"set = {{ {sets} }}" if sets else "set = {}",
                 f'output = "{p["output"]}"', f'why = "{p["why"]}"']

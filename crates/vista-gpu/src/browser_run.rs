@@ -57,22 +57,29 @@ impl Context {
         }
         let mut passes = Vec::new();
         for pass in g.passes.iter() {
-            let (key, wgsl) = self.browser_wgsl(b, g, &pass.shader, &pass.entry, &pass.constants)?;
+            let (key, written) = self.browser_wgsl(b, g, &pass.shader, &pass.entry, &pass.constants)?;
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
             if let Some(r) = &pass.raster {
                 let adapter = || self.adapter_description();
                 crate::raster::check_targets(r, &g.resources, &pass.label, &|f| self.has_feature(f), &adapter)?;
             }
             // A vertex entry of another file travels as its own WGSL.
-            let vertex_wgsl = match pass.raster.as_ref() {
+            let vertex_written = match pass.raster.as_ref() {
                 Some(r @ crate::graph::Raster { vertex_shader: Some(file), vertex: Some(vs), .. }) => {
                     Some(self.browser_wgsl(b, g, file, vs, &r.vertex_constants)?.1)
                 }
                 _ => None,
             };
-            let raster = pass.raster.as_ref().map(|r| raster_json(r, vertex_wgsl.as_deref().map(String::as_str)));
+            let raster = pass.raster.as_ref().map(|r| {
+                // A vertex entry by the name the written WGSL gives it.
+                let vertex = r.vertex.as_deref().map(|vs| match &vertex_written {
+                    Some(v) => (Some(v.wgsl.as_str()), v.entry(vs)),
+                    None => (None, written.entry(vs)),
+                });
+                raster_json(r, vertex)
+            });
             passes.push(json!({
-                "key": key, "label": pass.label, "wgsl": *wgsl, "entry": pass.entry,
+                "key": key, "label": pass.label, "wgsl": written.wgsl, "entry": written.entry(&pass.entry),
                 "workgroups": pass.workgroups, "repeat": pass.repeat, "span": pass.span,
                 "swap": pass.swap.iter().map(|(a, b)| [a, b]).collect::<Vec<_>>(),
                 "slots": slots, "raster": raster,
@@ -125,13 +132,13 @@ impl Context {
         shader: &str,
         entry: &str,
         constants: &[(String, f64)],
-    ) -> Result<(String, Arc<String>), GpuError> {
+    ) -> Result<(String, Arc<Written>), GpuError> {
         let key = format!("{shader}#{}@{entry}{constants:?}", g.shaders.source_hash(shader)?);
         if let Some(w) = b.sources.lock().expect("wgsl cache").get(&key).cloned() {
             return Ok((key, w));
         }
         self.check_features(shader, [Some(&*g.shaders.compose(shader)?), None])?;
-        let w = Arc::new(Context::wgsl_source(g.shaders, shader, entry, constants)?);
+        let w = Arc::new(Context::written_wgsl(g.shaders, shader, entry, constants)?);
         b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
         Ok((key, w))
     }
@@ -217,7 +224,46 @@ impl Context {
 /// full-screen triangle or another file's WGSL, or `vertex_entry` of the
 /// pass's own module when `vertex` is null), WebGPU's blend states, buffers
 /// and fixed-function state.
-fn raster_json(r: &crate::graph::Raster, vertex_wgsl: Option<&str>) -> Value {
+/// naga's WGSL of one composed kernel, and each entry point's name in it.
+pub(crate) struct Written {
+    /// The text the page hands Dawn.
+    pub(crate) wgsl: String,
+    /// (the module's entry name, the name the writer gave it): naga's
+    /// namer renames some (`fill_f32` becomes `fill_f32_`), and Dawn must
+    /// be asked for the name the text has.
+    entries: Vec<(String, String)>,
+}
+
+impl Written {
+    /// `wgsl`, the writer's text of `module`, with its entry names.
+    pub(crate) fn of(module: &naga::Module, wgsl: String) -> Written {
+        let entries = written_entries(module, &wgsl);
+        Written { wgsl, entries }
+    }
+
+    /// The written name of entry `name` (itself if the writer kept it).
+    pub(crate) fn entry<'a>(&'a self, name: &'a str) -> &'a str {
+        self.entries.iter().find(|(from, _)| from == name).map_or(name, |(_, to)| to.as_str())
+    }
+}
+
+/// Each entry point of `module` with its name in `wgsl`, the writer's text
+/// of it: the writer keeps their order, so the n-th entry of the text, parsed
+/// back, is the n-th of the module.
+fn written_entries(module: &naga::Module, wgsl: &str) -> Vec<(String, String)> {
+    let Ok(back) = naga::front::wgsl::parse_str(wgsl) else { return Vec::new() };
+    module
+        .entry_points
+        .iter()
+        .zip(back.entry_points.iter())
+        .filter(|(a, b)| a.name != b.name)
+        .map(|(a, b)| (a.name.clone(), b.name.clone()))
+        .collect()
+}
+
+/// A render pass as the page takes it; `vertex`: the vertex entry's WGSL
+/// (when it is another file's) and its name in the written text.
+fn raster_json(r: &crate::graph::Raster, vertex: Option<(Option<&str>, &str)>) -> Value {
     let blend = |b: vista_texel::Blend| {
         b.components().map(|(c, a)| {
             let part = |p: vista_texel::BlendComponent| {
@@ -226,10 +272,7 @@ fn raster_json(r: &crate::graph::Raster, vertex_wgsl: Option<&str>) -> Value {
             json!({ "color": part(c), "alpha": part(a) })
         })
     };
-    let (vertex, vertex_entry) = match &r.vertex {
-        None => (Some(crate::FULLSCREEN_WGSL), crate::FULLSCREEN_ENTRY),
-        Some(vs) => (vertex_wgsl, vs.as_str()),
-    };
+    let (vertex, vertex_entry) = vertex.unwrap_or((Some(crate::FULLSCREEN_WGSL), crate::FULLSCREEN_ENTRY));
     json!({
         "vertex": vertex, "vertex_entry": vertex_entry,
         "targets": r.targets.iter().map(|t| json!({

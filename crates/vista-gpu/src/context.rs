@@ -283,7 +283,7 @@ pub(crate) struct BrowserEngine {
     /// The WebGPU device's features (requested: every one the adapter has).
     pub(crate) features: Vec<String>,
     /// naga's WGSL of each composed kernel, by source hash.
-    pub(crate) sources: Mutex<HashMap<String, Arc<String>>>,
+    pub(crate) sources: Mutex<HashMap<String, Arc<crate::browser_run::Written>>>,
 }
 
 /// Where Debian's vulkan-validationlayers puts the layer's manifest.
@@ -592,11 +592,22 @@ impl Context {
         entry: &str,
         constants: &[(String, f64)],
     ) -> Result<String, GpuError> {
+        Ok(Context::written_wgsl(shaders, shader, entry, constants)?.wgsl)
+    }
+
+    /// [`Context::wgsl_source`] with the name each entry point has in it.
+    pub(crate) fn written_wgsl(
+        shaders: &ShaderSet,
+        shader: &str,
+        entry: &str,
+        constants: &[(String, f64)],
+    ) -> Result<crate::browser_run::Written, GpuError> {
         let module = shaders.compose(shader)?;
         let (resolved, info) = crate::shaders::resolve_overrides(shader, &module, entry, constants)?;
         let text = naga::back::wgsl::write_string(&resolved, &info, naga::back::wgsl::WriterFlags::empty())
             .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))?;
-        crate::shaders::keep_struct_layouts(shader, &resolved, text)
+        let wgsl = crate::shaders::keep_struct_layouts(shader, &resolved, text)?;
+        Ok(crate::browser_run::Written::of(&resolved, wgsl))
     }
 
     /// Compiles a kernel file's entry point with one bind group layout per

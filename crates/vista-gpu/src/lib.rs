@@ -27,8 +27,8 @@ pub use context::{
 };
 pub use fullscreen::{FULLSCREEN_ENTRY, FULLSCREEN_WGSL};
 pub use graph::{
-    Address, Bind, COMPARE_NAMES, Contents, Depth, Graph, GraphPass, GraphSlot, OutputData, Raster, RasterTarget,
-    Readback, Resource, SamplerDesc, TextureDesc, VertexBuffer, BufferUse, buffer_size, buffer_usages, run_order,
+    Address, Bind, BufferUse, COMPARE_NAMES, Contents, Depth, Graph, GraphPass, GraphSlot, OutputData, Raster,
+    RasterTarget, Readback, Resource, SamplerDesc, TextureDesc, VertexBuffer, buffer_size, buffer_usages, run_order,
 };
 pub use limits::Needs;
 pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};
