@@ -5327,7 +5327,7 @@ fn greedy(@location(0) p: vec2<f32>) -> @builtin(position) vec4<f32> {
         ),
         (
             instanced.replace("format = \"float32x2\"", "format = \"uint32x2\""),
-            &["placed's input @location(1) shift is vec2<f32> but shifts's attribute is uint32x2; allowed: float32x2"][..],
+            &["placed's input @location(1) shift is vec2<f32> but shifts's attribute is uint32x2; allowed: unorm8x2|snorm8x2|unorm16x2|snorm16x2|float16x2|float32x2"][..],
         ),
         (instanced.replace("vertex = \"placed\"", "vertex = \"placed\"\ncount = 99"), &["count = 99 but vertices tri holds 6"][..]),
         (indexed.replace("vertex = \"flat\"", "vertex = \"fullscreen\""), &["vertices needs a vertex entry"][..]),

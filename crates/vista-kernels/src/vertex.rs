@@ -116,8 +116,10 @@ fn parse_attributes(v: &toml::Value) -> Result<Vec<Attribute>, String> {
             .ok_or_else(|| at("needs format = \"float32x3\" (a WebGPU vertex format)".into()))?;
         let format = VertexFormat::parse(format).map_err(at)?;
         let offset = number(t.get("offset").unwrap_or(&toml::Value::Integer(0)), "offset").map_err(at)?;
-        if !offset.is_multiple_of(4) {
-            return Err(at(format!("offset = {offset} is not a multiple of 4")));
+        // WebGPU: a multiple of min(4, the format's byte size).
+        let align = format.bytes.min(4);
+        if !offset.is_multiple_of(align) {
+            return Err(at(format!("offset = {offset} is not a multiple of {align} (a {} attribute)", format.name)));
         }
         out.push(Attribute { location, format, offset });
     }
@@ -296,8 +298,10 @@ fn element_of(layout: &VertexLayout, inputs: &[VertexInput], resource: &str) -> 
                 let path = if a.format.components == 1 { name.clone() } else { format!("{name}[{c}]") };
                 leaves.push((a.offset + 4 * c, a.format.kind, path));
             }
-        } else {
-            leaves.push((a.offset, 'u', name.clone()));
+        } else if !leaves.iter().any(|l: &(u32, char, String)| l.0 == a.offset & !3) {
+            // Packed formats as the 32-bit word holding them (two 16-bit
+            // attributes may share one).
+            leaves.push((a.offset & !3, 'u', name.clone()));
         }
         fields.push(format!("{name}: {} @ {}", a.format.name, a.offset));
     }
@@ -373,7 +377,7 @@ mod tests {
             ..spec("q")
         };
         let e = layouts("vs", &inputs, &[explicit.clone(), wrong], &[None, None]).unwrap_err();
-        assert!(e.contains("@location(1) uv is vec2<f32> but q's attribute is uint32x2; allowed: float32x2"), "{e}");
+        assert!(e.contains("@location(1) uv is vec2<f32> but q's attribute is uint32x2; allowed: unorm8x2|snorm8x2|unorm16x2|snorm16x2|float16x2|float32x2"), "{e}");
         let both = layouts("vs", &inputs, &[spec("a"), spec("b")], &[None, None]).unwrap_err();
         assert!(both.contains("both take vs's inputs by reflection"), "{both}");
         let mixed = layouts("vs", &inputs, &[explicit, spec("uvs")], &[None, None]).unwrap();

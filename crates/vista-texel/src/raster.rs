@@ -199,12 +199,39 @@ pub struct VertexFormat {
 }
 
 impl VertexFormat {
-    /// Every vertex format vista reads.
-    pub const ALL: [VertexFormat; 16] = {
+    /// Every vertex format of WebGPU (`GPUVertexFormat`), in its order.
+    pub const ALL: [VertexFormat; 41] = {
         const fn f(name: &'static str, kind: char, components: u32, bytes: u32) -> VertexFormat {
             VertexFormat { name, kind, components, bytes }
         }
         [
+            f("uint8", 'u', 1, 1),
+            f("uint8x2", 'u', 2, 2),
+            f("uint8x4", 'u', 4, 4),
+            f("sint8", 'i', 1, 1),
+            f("sint8x2", 'i', 2, 2),
+            f("sint8x4", 'i', 4, 4),
+            f("unorm8", 'f', 1, 1),
+            f("unorm8x2", 'f', 2, 2),
+            f("unorm8x4", 'f', 4, 4),
+            f("snorm8", 'f', 1, 1),
+            f("snorm8x2", 'f', 2, 2),
+            f("snorm8x4", 'f', 4, 4),
+            f("uint16", 'u', 1, 2),
+            f("uint16x2", 'u', 2, 4),
+            f("uint16x4", 'u', 4, 8),
+            f("sint16", 'i', 1, 2),
+            f("sint16x2", 'i', 2, 4),
+            f("sint16x4", 'i', 4, 8),
+            f("unorm16", 'f', 1, 2),
+            f("unorm16x2", 'f', 2, 4),
+            f("unorm16x4", 'f', 4, 8),
+            f("snorm16", 'f', 1, 2),
+            f("snorm16x2", 'f', 2, 4),
+            f("snorm16x4", 'f', 4, 8),
+            f("float16", 'f', 1, 2),
+            f("float16x2", 'f', 2, 4),
+            f("float16x4", 'f', 4, 8),
             f("float32", 'f', 1, 4),
             f("float32x2", 'f', 2, 8),
             f("float32x3", 'f', 3, 12),
@@ -217,10 +244,8 @@ impl VertexFormat {
             f("sint32x2", 'i', 2, 8),
             f("sint32x3", 'i', 3, 12),
             f("sint32x4", 'i', 4, 16),
-            f("unorm8x4", 'f', 4, 4),
-            f("snorm8x4", 'f', 4, 4),
-            f("uint8x4", 'u', 4, 4),
-            f("sint8x4", 'i', 4, 4),
+            f("unorm10-10-10-2", 'f', 4, 4),
+            f("unorm8x4-bgra", 'f', 4, 4),
         ]
     };
 
@@ -323,7 +348,8 @@ mod tests {
         assert_eq!(VertexFormat::of_input('f', 3).unwrap().name, "float32x3");
         assert_eq!(VertexFormat::of_input('u', 1).unwrap().name, "uint32");
         assert!(!VertexFormat::parse("unorm8x4").unwrap().is_32bit());
-        assert!(VertexFormat::parse("float16x2").unwrap_err().contains("float32x4"));
+        assert!(VertexFormat::parse("float16x3").unwrap_err().contains("float32x4"));
+        assert_eq!(VertexFormat::parse("unorm10-10-10-2").unwrap().components, 4);
         assert_eq!(Topology::parse("line-strip").unwrap().web(), "line-strip");
         assert!(Cull::parse("both").unwrap_err().contains("none|back|front"));
     }
