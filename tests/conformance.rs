@@ -36,7 +36,9 @@ struct Table {
 struct Probe {
     kernel: String,
     set: toml::Table,
-    output: String,
+    /// Read back in order: a buffer's 32-bit words, a texture's f32 bits
+    /// (r, g, b, a per texel, rows top to bottom).
+    outputs: Vec<String>,
     why: String,
     words: Vec<u32>,
 }
@@ -94,15 +96,21 @@ fn words_of(backend: usize, probe: &Probe) -> Result<Vec<u32>, String> {
     let params = kernel.resolve(None, &set_pairs(&probe.set)).map_err(|e| e.to_string())?;
     let out =
         render(&gpu, kernel, &params, 8, 8).map_err(|e| format!("{} on {}: {e}", probe.kernel, BACKENDS[backend]))?;
-    let output = out
-        .outputs
-        .iter()
-        .find(|o| o.name == probe.output)
-        .ok_or_else(|| format!("{}: no output {}", probe.kernel, probe.output))?;
-    let OutputValue::Buffer { bytes, .. } = &output.value else {
-        return Err(format!("{}: output {} is not a buffer", probe.kernel, probe.output));
-    };
-    Ok(bytes.chunks_exact(4).map(|w| u32::from_le_bytes(w.try_into().expect("4 bytes"))).collect())
+    let mut words = Vec::new();
+    for name in &probe.outputs {
+        let output = out
+            .outputs
+            .iter()
+            .find(|o| &o.name == name)
+            .ok_or_else(|| format!("{}: no output {name}", probe.kernel))?;
+        match &output.value {
+            OutputValue::Buffer { bytes, .. } => {
+                words.extend(bytes.chunks_exact(4).map(|w| u32::from_le_bytes(w.try_into().expect("4 bytes"))))
+            }
+            OutputValue::Texture { raw, .. } => words.extend(raw.data.iter().flatten().map(|v| v.to_bits())),
+        }
+    }
+    Ok(words)
 }
 
 fn check(backend: usize, probe: &Probe, differences: &[Difference]) -> Result<(), String> {

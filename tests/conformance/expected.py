@@ -2,8 +2,8 @@
 """Expected values of vista's host-layer conformance probes, derived from
 the WGSL and WebGPU specifications (never from vista, never blessed).
 
-    python3 expected.py          # writes expected.toml beside this file
-    python3 expected.py --check  # exits 1 if expected.toml is not what it would write
+    python3 expected.py          # writes expected.toml and the probes' inputs/ beside this file
+    python3 expected.py --check  # exits 1 if any of them is not what it would write
 
 WGSL 13.4 (memory layout): AlignOf/SizeOf of scalars, vectors, matrices,
 arrays and structures; a runtime-sized array's element stride is
@@ -75,7 +75,7 @@ def array_length_probes():
         # Each buffer is declared with n elements: n * stride bytes bound.
         words = [(n * s) // s for s in strides] + [(seen_len * 4) // 4, 0xA11]
         probes.append({
-            "kernel": "array_length", "set": {"n": n}, "output": "lengths", "words": words,
+            "kernel": "array_length", "set": {"n": n}, "outputs": ["lengths"], "words": words,
             "why": f"strides {strides}, {n} elements declared: arrayLength = floor({n} * stride / stride) = {n}; "
                    f"the output itself {seen_len}; then the marker 0xA11",
         })
@@ -117,25 +117,181 @@ def layout_probes():
     storage_words = [bits(k, v) for k, v in zip(kinds, data)]
     why = "each leaf's components in declaration order, matrices column after column, as the shader reads them"
     return [
-        {"kernel": "layout_uniform", "set": {}, "output": "leaves", "words": words, "why": why},
-        {"kernel": "layout_storage", "set": {}, "output": "leaves", "words": storage_words, "why": why},
+        {"kernel": "layout_uniform", "set": {}, "outputs": ["leaves"], "words": words, "why": why},
+        {"kernel": "layout_storage", "set": {}, "outputs": ["leaves"], "words": storage_words, "why": why},
     ]
 
 
 def entry_name_probes():
     # fill_u32 writes 32 and arrayLength of the 4-u32 buffer; fill_f16 writes 16; the last word stays 0.
-    return [{"kernel": "entry_names", "set": {}, "output": "words", "words": [32, 4, 16, 0],
+    return [{"kernel": "entry_names", "set": {}, "outputs": ["words"], "words": [32, 4, 16, 0],
              "why": "each pass ran its own entry point, found by the name the module gives it"}]
+
+
+# WebGPU 23.2.6 (blend state): factor values for a colour component (rgb)
+# and for the alpha component, given source S, destination D and constant C.
+def factor(name, comp, S, D, C):
+    alpha = comp == 3
+    sat = 1.0 if alpha else min(S[3], 1.0 - D[3])
+    return {
+        "zero": 0.0, "one": 1.0,
+        "src": S[comp], "one-minus-src": 1.0 - S[comp],
+        "src-alpha": S[3], "one-minus-src-alpha": 1.0 - S[3],
+        "dst": D[comp], "one-minus-dst": 1.0 - D[comp],
+        "dst-alpha": D[3], "one-minus-dst-alpha": 1.0 - D[3],
+        "src-alpha-saturated": sat,
+        "constant": C[comp], "one-minus-constant": 1.0 - C[comp],
+    }[name]
+
+
+def blend(state, comp, S, D, C):
+    sf, df, op = state
+    s, d = S[comp] * factor(sf, comp, S, D, C), D[comp] * factor(df, comp, S, D, C)
+    return {"add": s + d, "subtract": s - d, "reverse-subtract": d - s,
+            "min": min(S[comp], D[comp]), "max": max(S[comp], D[comp])}[op]
+
+
+def f16_bits_as_f32(v):
+    """v stored in an rgba16float texel (round to nearest), read back as f32 bits."""
+    h = struct.unpack("<e", struct.pack("<e", v))[0]
+    return bits("f32", h)
+
+
+def blend_probes():
+    manifest = tomllib.loads((HERE / "kernels/blend.toml").read_text())
+    shader = (HERE / "shaders/blend.wgsl").read_text()
+    src = [float(x) for x in shader.split("const SRC = vec4<f32>(")[1].split(")")[0].split(",")]
+    outputs, words = [], []
+    for p in manifest["pass"]:
+        for t in p["targets"]:
+            D, C = t["clear"], t["blend"].get("constant", [0.0, 0.0, 0.0, 0.0])
+            out = [blend(t["blend"]["color"] if c < 3 else t["blend"]["alpha"], c, src, D, C) for c in range(4)]
+            outputs.append(t["resource"])
+            words += [f16_bits_as_f32(v) for v in out]
+    return [{"kernel": "blend", "set": {}, "outputs": outputs, "words": words,
+             "why": "WebGPU's blend equation per target: result = op(src * srcFactor, dst * dstFactor), "
+                    "stored in rgba16float; four words (r, g, b, a) per target"}]
+
+
+# The vertices of kernels/vertex_fetch.toml's buffer: one tuple per attribute, raw values as stored.
+VERTICES = [
+    {"u8": (0, 255), "i8": (-128, 127), "un8": (0, 255, 255, 0), "sn8": (-127, 127, 0, -128),
+     "u16": (0, 65535), "i16": (-32768, 32767), "un16": (0, 65535), "h4": (0.5, -2.0, 1024.0, 2.0 ** -10),
+     "f3": (1.5, -0.25, 300000.0), "packed": (1023, 0, 1023, 3)},
+    {"u8": (7, 200), "i8": (-1, 64), "un8": (255, 0, 0, 255), "sn8": (127, -127, -128, 0),
+     "u16": (1234, 4321), "i16": (-1, 1000), "un16": (65535, 0), "h4": (-0.5, 65504.0, 0.0, 1.0),
+     "f3": (-7.0, 0.125, 2.0 ** -20), "packed": (0, 1023, 0, 0)},
+    {"u8": (128, 1), "i8": (5, -5), "un8": (0, 0, 255, 255), "sn8": (0, 0, 127, -127),
+     "u16": (40000, 2), "i16": (-300, 300), "un16": (0, 0), "h4": (3.0, -6.25, 0.75, -1.0),
+     "f3": (0.0, -1.0, 1.0), "packed": (1023, 1023, 0, 3)},
+]
+INSTANCES = [(100, 200), (101, 201)]
+POINT_WORDS = 40
+
+
+def pack_vertex(v):
+    r, g, b, a = v["packed"]
+    return (struct.pack("<2B", *v["u8"]) + struct.pack("<2b", *v["i8"]) + struct.pack("<4B", *v["un8"])
+            + struct.pack("<4b", *v["sn8"]) + struct.pack("<2H", *v["u16"]) + struct.pack("<2h", *v["i16"])
+            + struct.pack("<2H", *v["un16"]) + struct.pack("<4e", *v["h4"]) + struct.pack("<3f", *v["f3"])
+            + struct.pack("<I", r | g << 10 | b << 20 | a << 30))
+
+
+def vertex_inputs():
+    """The two .bin files the vertex_fetch probe reads, as bytes."""
+    vertices = b"".join(pack_vertex(v) for v in VERTICES)
+    assert len(vertices) == 48 * len(VERTICES)
+    return {"inputs/vertices.bin": vertices,
+            "inputs/instances.bin": b"".join(struct.pack("<2I", *i) for i in INSTANCES)}
+
+
+def vertex_probes():
+    # WebGPU 23.2.5 (vertex formats): unorm c / (2^n - 1); snorm max(c / (2^(n-1) - 1), -1); integers as
+    # stored; float16 widened exactly; unorm10-10-10-2 r in bits 0-9, g 10-19, b 20-29, a 30-31.
+    words = []
+    for i, inst in enumerate(INSTANCES):
+        for vi, v in enumerate(VERTICES):
+            f = lambda x: bits("f32", x)
+            w = [vi, i]
+            w += list(v["u8"]) + [bits("i32", x) for x in v["i8"]]
+            w += [f(c / 255) for c in v["un8"]] + [f(max(c / 127, -1.0)) for c in v["sn8"]]
+            w += list(v["u16"]) + [bits("i32", x) for x in v["i16"]] + [f(c / 65535) for c in v["un16"]]
+            w += [f(x) for x in v["h4"]] + [f(x) for x in v["f3"]]
+            r, g, b, a = v["packed"]
+            w += [f(r / 1023), f(g / 1023), f(b / 1023), f(a / 3)]
+            w += list(inst)
+            w += [len(INSTANCES) * 2]  # arrayLength of the 16-byte instance buffer as array<u32>
+            words += w + [0] * (POINT_WORDS - len(w))
+    return [{"kernel": "vertex_fetch", "set": {}, "outputs": ["fetched"], "words": words,
+             "why": "per point: vertex and instance index, then each attribute converted as WebGPU's vertex "
+                    "formats say (normalized values chosen at 0 and the extremes, so exact), then the "
+                    "per-instance attribute"}]
+
+
+def texture_query_probes():
+    # WGSL 17.7 (texture built-ins): textureDimensions(t, level) = max(1, size >> level) per axis (the
+    # array layers and cube faces not counted); textureNumLevels = the view's mip levels;
+    # textureNumLayers = the array layers. A storage view of level L has the extent of level L.
+    manifest = tomllib.loads((HERE / "kernels/texture_queries.toml").read_text())
+    res = {r["name"]: r for r in manifest["resource"]}
+    dim = lambda name, level: [max(1, n >> level) for n in res[name]["size"]]
+    levels = lambda name: res[name].get("mip_levels", 1)
+    w = dim("line", 0) + [levels("line")]
+    w += dim("plane", 0) + dim("plane", 2) + dim("plane", 3) + [levels("plane")]
+    w += dim("layers", 0)[:2] + [res["layers"]["size"][2], levels("layers")]
+    w += dim("volume", 0) + dim("volume", 1) + [levels("volume")]
+    w += dim("sky", 0) * 2 + [levels("sky")]
+    w += dim("mips", 2) + [0xD1A]
+    return [{"kernel": "texture_queries", "set": {}, "outputs": ["shape"], "words": w,
+             "why": "size >> level per axis (at least 1), mip levels and array layers as declared"}]
+
+
+# WebGPU 23.3 / Vulkan 16.x (texel filtering and addressing), for a W x H texture.
+def wrap(i, n, mode):
+    if mode == "clamp-to-edge":
+        return min(max(i, 0), n - 1)
+    if mode == "repeat":
+        return i % n
+    mirror = lambda k: k if k >= 0 else -(1 + k)
+    return (n - 1) - mirror((i % (2 * n)) - n)
+
+
+def sample(texel, size, uv, linear, mode):
+    import math
+    if not linear:
+        x, y = (wrap(math.floor(c * n), n, mode) for c, n in zip(uv, size))
+        return texel(x, y)
+    (x0, a), (y0, b) = ((math.floor(c * n - 0.5), c * n - 0.5 - math.floor(c * n - 0.5)) for c, n in zip(uv, size))
+    t = lambda i, j: texel(wrap(i, size[0], mode), wrap(j, size[1], mode))
+    return [(1 - a) * (1 - b) * p + a * (1 - b) * q + (1 - a) * b * r + a * b * s
+            for p, q, r, s in zip(t(x0, y0), t(x0 + 1, y0), t(x0, y0 + 1), t(x0 + 1, y0 + 1))]
+
+
+def sampling_probes():
+    shader = (HERE / "shaders/sampling.wgsl").read_text()
+    body = shader.split("const COORDS = array<vec2<f32>, 8>(")[1].split(");")[0]
+    coords = [[float(v) / 64 for v in pair.split(",")] for pair in body.replace("vec2<f32>(", "").split("),") if pair.strip()]
+    coords = [[c for c in pair if True] for pair in coords]
+    assert len(coords) == 8, coords
+    texel = lambda x, y: [x / 8 + y / 2, float(x), float(y), 1.0]
+    words = []
+    for uv in coords:
+        for linear in (False, True):
+            for mode in ("clamp-to-edge", "repeat", "mirror-repeat"):
+                words += [bits("f32", v) for v in sample(texel, (4, 4), uv, linear, mode)]
+    return [{"kernel": "sampling", "set": {}, "outputs": ["samples"], "words": words,
+             "why": "per coordinate: nearest then linear, each clamp-to-edge, repeat, mirror-repeat; "
+                    "four words (r, g, b, a) per sample, bilinear in f64 from the texel centres"}]
 
 
 def render():
     out = ["# Written by expected.py from the WGSL and WebGPU specs; do not edit.",
            "# tests/conformance.rs runs each probe on every backend and compares the",
            "# output's 32-bit words exactly.", ""]
-    for p in array_length_probes() + layout_probes() + entry_name_probes():
+    for p in array_length_probes() + layout_probes() + entry_name_probes() + blend_probes() + vertex_probes() + texture_query_probes() + sampling_probes():
         sets = ", ".join(f"{k} = {v}" for k, v in p["set"].items())
         out += ["[[probe]]", f'kernel = "{p["kernel"]}"', f"set = {{ {sets} }}" if sets else "set = {}",
-                f'output = "{p["output"]}"', f'why = "{p["why"]}"']
+                "outputs = [" + ", ".join(f'"{o}"' for o in p["outputs"]) + "]", f'why = "{p["why"]}"']
         out += ["words = [" + ", ".join(str(w) for w in p["words"]) + "]", ""]
     # Backend differences from the specs, named here so the suite shows them.
     out += ["# [[difference]] backend = \"...\", kernel = \"...\", reason = \"...\": none found."]
@@ -143,12 +299,14 @@ def render():
 
 
 if __name__ == "__main__":
-    text = render()
-    target = HERE / "expected.toml"
+    files = {"expected.toml": render().encode(), **vertex_inputs()}
     if "--check" in sys.argv[1:]:
-        if not target.exists() or target.read_text() != text:
-            print("expected.toml is not what expected.py writes: run python3 tests/conformance/expected.py")
+        stale = [name for name, data in files.items()
+                 if not (HERE / name).exists() or (HERE / name).read_bytes() != data]
+        if stale:
+            print(f"{', '.join(stale)}: not what expected.py writes: run python3 tests/conformance/expected.py")
             sys.exit(1)
-        print("expected.toml matches expected.py")
+        print("expected.toml and the probes' inputs match expected.py")
     else:
-        target.write_text(text)
+        for name, data in files.items():
+            (HERE / name).write_bytes(data)
