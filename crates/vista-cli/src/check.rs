@@ -23,7 +23,7 @@ pub struct Pick {
 }
 
 /// A results file's directory must exist and be writable, before any GPU work.
-fn check_results_path(flag: &str, path: &Path) -> Result<(), GoldenError> {
+pub(crate) fn check_results_path(flag: &str, path: &Path) -> Result<(), GoldenError> {
     if path.is_dir() {
         return Err(bad(format!("{flag} {} is a directory; expected a file path", path.display())));
     }
@@ -43,8 +43,15 @@ pub(crate) fn print_case(o: &vista_golden::Outcome, report_dir: &Path) {
         None => String::new(),
     };
     if o.crashed {
-        // One block: what crashed, where, and that the run went on.
-        println!("CRASH {}: {}", o.id, o.problems.first().map(String::as_str).unwrap_or("the worker died"));
+        // One block: what crashed, where, and that the run went on. An
+        // expected crash keeps its cause (moved to the notes by the
+        // expectation) and says it was expected.
+        let cause = o.problems.first().or_else(|| o.notes.first()).map(String::as_str).unwrap_or("the worker died");
+        let cause = cause.rsplit_once("it failed with: ").map_or(cause, |(_, c)| c);
+        println!("CRASH {}: {}", o.id, cause);
+        if o.verdict == vista_golden::Verdict::ExpectedFail {
+            o.notes.iter().for_each(|n| println!("  xfail: {n}"));
+        }
         return;
     }
     println!("{label:<6} {:<40} {:<17} {:>8.1} ms{per_backend}", o.id, o.headline(), o.gpu_ms);
@@ -127,7 +134,12 @@ pub fn check(
     }
     let failing: Vec<&str> = outcomes.iter().filter(|o| !o.passed()).map(|o| o.id.as_str()).collect();
     let failed = failing.len();
-    println!("{} passed, {} failed", outcomes.len() - failed, failed);
+    // An expected failure is neither a pass nor a failure: counted apart.
+    let xfail = outcomes.iter().filter(|o| o.verdict == vista_golden::Verdict::ExpectedFail).count();
+    match xfail {
+        0 => println!("{} passed, {} failed", outcomes.len() - failed, failed),
+        n => println!("{} passed, {} failed, {n} expected to fail", outcomes.len() - failed - n, failed),
+    }
     // Goldens no case refers to: a renamed or deleted case left them behind.
     let orphans = vista_check::orphans(&store, &cases);
     for o in &orphans {

@@ -388,16 +388,15 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             render::render(project, config, render::Args { kernel, preset, set, size, crop, zoom, out })
         }
         Command::Compare { a, b, json, hdr, blur, crop } => compare::compare(&a, &b, json, hdr, blur, crop),
-        Command::Check { matrix: true, junit: Some(_), .. } | Command::Check { matrix: true, json: Some(_), .. } => {
-            Err(bad(
-                "--junit and --json are written by a check on one backend; drop --matrix (or run check per backend)",
-            ))
+        Command::Check { matrix: true, junit: Some(_), .. } => {
+            Err(bad("--junit is written by a check on one backend; drop --matrix (or run check per backend); \
+             --matrix --json writes every cell"))
         }
         Command::Check { matrix: true, changed, failed, partition, .. } if changed || failed || partition.is_some() => {
             Err(bad("--changed, --failed and --partition select cases of a check on one backend; drop --matrix"))
         }
-        Command::Check { case, report_dir, matrix: true, .. } => {
-            matrix::matrix(project, config, case.as_deref(), report_dir)
+        Command::Check { case, report_dir, matrix: true, json, .. } => {
+            matrix::matrix(project, config, case.as_deref(), report_dir, json)
         }
         Command::Check {
             case,

@@ -1,6 +1,7 @@
 //! `vista check --matrix`: every case on every implementation, one
 //! case x backend table (PSNR per cell) in the terminal and in
-//! `<report>/matrix.html`.
+//! `<report>/matrix.html`, each failing cell's first reason under it, and
+//! with `--json F` every cell as JSON.
 
 use std::path::PathBuf;
 
@@ -17,7 +18,11 @@ pub fn matrix(
     config: &vista::Config,
     glob: Option<&str>,
     report_dir: Option<PathBuf>,
+    json: Option<PathBuf>,
 ) -> Result<i32, GoldenError> {
+    if let Some(p) = &json {
+        crate::check::check_results_path("--json", p)?;
+    }
     let store = Store::of_project(project, "vista check --matrix")?;
     let cases = store.load_cases()?;
     let picked = vista_golden::select(&cases, glob)?;
@@ -73,6 +78,16 @@ pub fn matrix(
         }
         println!();
     }
+    // Each failing cell's first reason, so the table needs no report to read.
+    for (i, case) in picked.iter().enumerate() {
+        for (b, col) in &columns {
+            if let Ok((_, outcomes)) = col
+                && !outcomes[i].passed()
+            {
+                println!("- FAIL {} on {b}: {}", case.id, vista_report::matrix_reason(&outcomes[i]));
+            }
+        }
+    }
     let mut missing = 0;
     for (b, col) in &columns {
         match col {
@@ -85,6 +100,10 @@ pub fn matrix(
     }
     let ids: Vec<&str> = picked.iter().map(|c| c.id.as_str()).collect();
     let path = vista_report::write_page(&report_dir, "matrix.html", &vista_report::matrix_page(&ids, &columns))?;
+    if let Some(p) = &json {
+        let text = serde_json::to_string_pretty(&vista_report::matrix_json(&ids, &columns)).expect("JSON of values");
+        vista_image::atomic_replace(p, text.as_bytes())?;
+    }
     let ran = columns.len() - missing;
     println!("matrix: {} cases x {ran} backends, {failed} failed, {missing} backend(s) skipped", picked.len());
     println!("report: {}", path.display());

@@ -4799,9 +4799,34 @@ fn a_driver_crash_fails_one_case_not_the_run() {
     let m = with(&fault("segv:a"), &["mutate", "--kernel", "fbm", "--sample", "1"]);
     assert_rejected(&m, 2, &["case a fails before any mutation", "crashed (signal 11, SIGSEGV)"]);
     // The matrix goes on past the crashed cell.
-    let x = with(&fault("segv:a"), &["check", "--matrix", "--case", "a"]);
+    let json = d.path().join("matrix.json");
+    let x = with(&fault("segv:a"), &["check", "--matrix", "--case", "a", "--json", json.to_str().unwrap()]);
     assert_eq!(x.code, 1, "{}", x.stdout);
     assert!(x.stdout.contains("matrix: 1 cases x 3 backends"), "{}", x.stdout);
+    // Each failing cell's first reason, in the terminal, matrix.html and the JSON.
+    let reason =
+        x.stdout.lines().find(|l| l.starts_with("- FAIL a on lavapipe: ")).unwrap_or_else(|| panic!("{}", x.stdout));
+    assert!(reason.contains("crashed (signal 11, SIGSEGV)"), "{reason}");
+    let page = std::fs::read_to_string(d.path().join("target/vista-report/matrix.html")).unwrap();
+    assert!(page.contains("Why each failing cell failed") && page.contains("crashed (signal 11, SIGSEGV)"), "{page}");
+    let cells: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let lavapipe = cells["cells"].as_array().unwrap().iter().find(|c| c["backend"] == "lavapipe").unwrap();
+    assert_eq!((lavapipe["case"].as_str(), lavapipe["passed"].as_bool()), (Some("a"), Some(false)), "{cells}");
+    assert!(lavapipe["reason"].as_str().unwrap().contains("SIGSEGV"), "{cells}");
+    // An expected crash: the whole CRASH block, counted as expected to fail, never as passed.
+    let xfail = "expect_fail = [{ backend = \"lavapipe\", reason = \"the driver crashes here\" }]\n";
+    std::fs::write(
+        cases_path(d.path()),
+        CASES.replacen("size = \"32x32\"\n", &format!("size = \"32x32\"\n{xfail}"), 1),
+    )
+    .unwrap();
+    let c = with(&fault("segv:a"), &["check"]);
+    assert_eq!(c.code, 0, "{}{}", c.stdout, c.stderr);
+    let block = c.stdout.lines().find(|l| l.starts_with("CRASH a: ")).unwrap_or_else(|| panic!("{}", c.stdout));
+    assert!(block.contains("the lavapipe driver (llvmpipe") && block.contains("(signal 11, SIGSEGV)"), "{block}");
+    assert!(c.stdout.contains("xfail: expected failure on lavapipe"), "{}", c.stdout);
+    assert!(c.stdout.contains("2 passed, 0 failed, 1 expected to fail"), "{}", c.stdout);
+    std::fs::write(cases_path(d.path()), CASES).unwrap();
     // A sweep names the crashed point, measures and writes the others, exits 1.
     let out = d.path().join("sw");
     let sweep = ["sweep", "fbm", "--param", "octaves", "--values", "1,2,4", "--size", "16x16", "--runs", "1"];

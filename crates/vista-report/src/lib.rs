@@ -12,7 +12,7 @@ mod mutation;
 mod report;
 mod results;
 
-pub use matrix::{MatrixColumn, cell as matrix_cell, matrix_page};
+pub use matrix::{MatrixColumn, cell as matrix_cell, matrix_json, matrix_page, matrix_reason};
 pub use mutation::mutation_page;
 pub use report::{
     CASE_MARKER, Detail, RunSummary, THUMB_EDGE, THUMBS_DIR, clear_case_folders, file_case, href, view_js,

@@ -24,6 +24,42 @@ pub fn cell(o: &Outcome) -> String {
     }
 }
 
+/// Why a cell did not pass, in one line: its first problem (an expected
+/// failure: its note).
+pub fn matrix_reason(o: &Outcome) -> String {
+    let first = o.problems.first().or_else(|| o.notes.first()).map(String::as_str).unwrap_or("failed");
+    first.lines().next().unwrap_or(first).to_string()
+}
+
+/// Every cell of the matrix as JSON: the backends (adapter, or why one was
+/// skipped) and per case and backend the verdict, PSNR and reason.
+pub fn matrix_json(ids: &[&str], columns: &[MatrixColumn]) -> serde_json::Value {
+    let backends: Vec<serde_json::Value> = columns
+        .iter()
+        .map(|(b, col)| match col {
+            Ok((adapter, _)) => serde_json::json!({ "backend": b, "adapter": adapter }),
+            Err(why) => serde_json::json!({ "backend": b, "skipped": why }),
+        })
+        .collect();
+    let mut cells = Vec::new();
+    for (i, id) in ids.iter().enumerate() {
+        for (b, col) in columns {
+            let Ok((_, outcomes)) = col else { continue };
+            let o = &outcomes[i];
+            cells.push(serde_json::json!({
+                "case": id,
+                "backend": b,
+                "verdict": format!("{:?}", o.verdict).to_lowercase(),
+                "passed": o.passed(),
+                "psnr": o.metrics.map(|m| m.psnr).filter(|p| p.is_finite()),
+                "golden": o.golden_file,
+                "reason": (!o.passed() || o.verdict == Verdict::ExpectedFail).then(|| matrix_reason(o)),
+            }));
+        }
+    }
+    serde_json::json!({ "cases": ids, "backends": backends, "cells": cells })
+}
+
 /// The matrix page: a row per case id, a column per backend.
 pub fn matrix_page(ids: &[&str], columns: &[MatrixColumn]) -> String {
     let rows: Vec<Vec<(&str, String)>> = ids
@@ -49,9 +85,28 @@ pub fn matrix_page(ids: &[&str], columns: &[MatrixColumn]) -> String {
         })
         .collect();
     let head: Vec<&str> = std::iter::once("case").chain(columns.iter().map(|(b, _)| b.as_str())).collect();
+    let reasons: String = ids
+        .iter()
+        .enumerate()
+        .flat_map(|(i, id)| {
+            columns.iter().filter_map(move |(b, col)| match col {
+                Ok((_, outcomes)) if !outcomes[i].passed() => Some(format!(
+                    "<li><b>{}</b> on {}: {}</li>",
+                    html_escape(id),
+                    html_escape(b),
+                    html_escape(&matrix_reason(&outcomes[i]))
+                )),
+                _ => None,
+            })
+        })
+        .collect();
+    let reasons = match reasons.is_empty() {
+        true => String::new(),
+        false => format!("<h2>Why each failing cell failed</h2><ul class=\"reasons\">{reasons}</ul>"),
+    };
     let body = format!(
         "<h1>vista check --matrix</h1><p>PSNR against each golden; the bless-time backend and driver use the \
-         same-driver threshold, every other the other-driver one.</p><ul>{legend}</ul>{}",
+         same-driver threshold, every other the other-driver one.</p><ul>{legend}</ul>{}{reasons}",
         table("matrix", &head, &rows)
     );
     page("vista matrix", &body, None)
