@@ -49,7 +49,9 @@ mutants=(
 )
 
 backup=$(mktemp -d)
-trap 'cp -a "$backup/." . 2>/dev/null; rm -rf "$backup"' EXIT
+# Restored with a new mtime (never the backup's old one: cargo would
+# take the mutant's build for current).
+trap 'cp -r "$backup/." . 2>/dev/null; (cd "$backup" && find . -type f -exec touch "$root/{}" \;); rm -rf "$backup"' EXIT
 
 missed=0
 for ((m = 0; m < ${#mutants[@]}; m += 4)); do
