@@ -285,3 +285,35 @@ fn a_missing_module_names_the_importing_file_and_line() {
     let err = set_of_dir(dir.path()).source_hash("k.wgsl").unwrap_err().to_string();
     assert!(err.contains("bindings.wgsl:3:") && err.contains("mylib::sky::gone"), "{err}");
 }
+
+/// Dual-source blending through naga_oil (an `#ifdef` makes the file go
+/// through composition): `@blend_src` composes, and the `enable` directive
+/// naga_oil drops is still declared, under the def that selects it.
+#[test]
+fn dual_source_blending_composes_and_its_enable_is_declared() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("sky.wgsl"),
+        "#ifdef DUAL_SOURCE_BLENDING\nenable dual_source_blending;\n#endif\n\nstruct Out {\n#ifdef DUAL_SOURCE_BLENDING\n    \
+         @location(0) @blend_src(0) colour: vec4<f32>,\n    @location(0) @blend_src(1) weight: vec4<f32>,\n#else\n    \
+         @location(0) colour: vec4<f32>,\n#endif\n}\n\n@fragment\nfn shade() -> Out {\n    var o: Out;\n    \
+         o.colour = vec4<f32>(0.5);\n#ifdef DUAL_SOURCE_BLENDING\n    o.weight = vec4<f32>(0.25);\n#endif\n    return o;\n}\n",
+    )
+    .unwrap();
+    let set = set_of_dir(dir.path());
+    set.compose("sky.wgsl?DUAL_SOURCE_BLENDING").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        set.declared_features("sky.wgsl?DUAL_SOURCE_BLENDING").unwrap(),
+        [("dual-source-blending", "dual_source_blending")]
+    );
+    set.compose("sky.wgsl").unwrap_or_else(|e| panic!("{e}"));
+    assert!(set.declared_features("sky.wgsl").unwrap().is_empty());
+    // Unconditional, the directive counts though nothing uses the feature.
+    std::fs::write(
+        dir.path().join("plain.wgsl"),
+        "enable f16;\n#ifdef NEVER\n#endif\n@compute @workgroup_size(1)\nfn main() {}\n",
+    )
+    .unwrap();
+    let set = set_of_dir(dir.path());
+    assert_eq!(set.declared_features("plain.wgsl").unwrap(), [("shader-f16", "f16")]);
+}

@@ -138,6 +138,7 @@ impl Context {
             return Ok((key, w));
         }
         self.check_features(shader, [Some(&*g.shaders.compose(shader)?), None])?;
+        self.check_declared(shader, &g.shaders.declared_features(shader)?)?;
         let w = Arc::new(Context::written_wgsl(g.shaders, shader, entry, constants)?);
         b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
         Ok((key, w))

@@ -627,6 +627,7 @@ impl Context {
     ) -> Result<Arc<Compiled>, GpuError> {
         let module = shaders.compose(shader)?;
         self.check_features(shader, [Some(&*module), render.as_ref().and_then(|r| r.vertex_module.map(|(m, _)| m))])?;
+        self.check_declared(shader, &shaders.declared_features(shader)?)?;
         let started = std::time::Instant::now();
         let _count = CountInto(&self.compile_nanos, started);
         let scope = w.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -743,6 +744,19 @@ impl Context {
             }
         }
         Ok(())
+    }
+
+    /// The features a shader's `enable` directives declare: each one the
+    /// device lacks makes the pass unsupported, used or not.
+    pub(crate) fn check_declared(&self, shader: &str, declared: &[(&str, &str)]) -> Result<(), GpuError> {
+        match declared.iter().find(|(feature, _)| !self.has_feature(feature)) {
+            Some((feature, enable)) => Err(GpuError::Unsupported {
+                adapter: self.adapter_description(),
+                what: format!("{shader}: enable {enable};"),
+                feature: feature.to_string(),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Whether this device has one of the optional features vista asks

@@ -117,10 +117,20 @@ impl Source {
 
 /// A composer of [`ShaderSet`]'s pool and the generated `vista::enums`
 /// text it holds, if any.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 struct Pooled {
     composer: Composer,
     enums: Option<String>,
+}
+
+impl Default for Pooled {
+    /// A composer that validates with the [`OPTIONAL_CAPABILITIES`] allowed
+    /// (naga_oil's default refuses `@blend_src`, f16, ...): whether the
+    /// device has them is [`ShaderSet::declared_features`]' and
+    /// [`features_used`]' question, asked per backend.
+    fn default() -> Pooled {
+        Pooled { composer: Composer::default().with_capabilities(all_capabilities()), enums: None }
+    }
 }
 
 /// The import path of the module generated from a kernel's manifest.
@@ -404,6 +414,50 @@ impl ShaderSet {
         Ok(())
     }
 
+    /// The optional features kernel `name` declares with `enable`
+    /// directives (as WebGPU feature, `enable` name), whether or not the
+    /// module uses them: WGSL requires the feature of every `enable`, and
+    /// naga_oil drops the directive from the module. A directive inside
+    /// `#ifdef X` / `#ifndef X` counts as the name's defs select it; one
+    /// under another kind of `#if` does not count.
+    pub fn declared_features(&self, name: &str) -> Result<Vec<(&'static str, &'static str)>, GpuError> {
+        let unit = self.unit(name)?;
+        let defs = shader_defs(name);
+        let on = |d: &str| defs.get(d).is_some_and(|v| !matches!(v, naga_oil::compose::ShaderDefValue::Bool(false)));
+        // One entry per open #if: whether its branch is taken (None: unknown).
+        let mut stack: Vec<Option<bool>> = Vec::new();
+        let mut out = Vec::new();
+        for line in unit.source.text.lines() {
+            let t = line.split("//").next().unwrap_or("").trim();
+            let word = |p: &str| t.strip_prefix(p).map(|r| r.trim().to_string());
+            if let Some(d) = word("#ifdef") {
+                stack.push(Some(on(&d)));
+            } else if let Some(d) = word("#ifndef") {
+                stack.push(Some(!on(&d)));
+            } else if t.starts_with("#if") {
+                stack.push(None);
+            } else if t.starts_with("#else") {
+                if let Some(top) = stack.last_mut() {
+                    *top = match (t == "#else", *top) {
+                        (true, Some(b)) => Some(!b),
+                        _ => None,
+                    };
+                }
+            } else if t.starts_with("#endif") {
+                stack.pop();
+            } else if let Some(list) = t.strip_prefix("enable ").and_then(|r| r.strip_suffix(';'))
+                && stack.iter().all(|b| *b == Some(true))
+            {
+                for e in list.split(',').map(str::trim) {
+                    if let Some((_, f, en)) = OPTIONAL_CAPABILITIES.iter().find(|(_, _, en)| *en == e) {
+                        out.push((*f, *en));
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
+
     /// Composes and validates the kernel file `name` (relative to
     /// `shaders/`), once per set.
     pub fn compose(&self, name: &str) -> Result<Arc<naga::Module>, GpuError> {
@@ -479,12 +533,26 @@ impl ShaderSet {
         let kernel = &unit.source;
         let mut h = blake3::Hasher::new();
         h.update(name.as_bytes());
-        h.update(kernel.text.as_bytes());
-        // Every file an assembly read, as written: an edit a compiler drops
-        // (a WESL comment) is still an edit `check` names.
-        for p in unit.assembled.iter().flat_map(|a| &a.parts) {
-            h.update(p.path.as_bytes());
-            h.update(p.text.as_bytes());
+        match unit.assembled.as_ref().filter(|a| !a.traced()) {
+            // A compiler's output (WESL): the files it read, by path, not
+            // its text, whose order of declarations is the compiler's own
+            // and need not repeat from one process to the next.
+            Some(a) => {
+                let mut parts: Vec<&vista_source::Part> = a.parts.iter().collect();
+                parts.sort_by(|x, y| x.path.cmp(&y.path));
+                for p in parts {
+                    h.update(p.path.as_bytes());
+                    h.update(p.text.as_bytes());
+                }
+            }
+            None => {
+                h.update(kernel.text.as_bytes());
+                // Every file an assembly read, as written.
+                for p in unit.assembled.iter().flat_map(|a| &a.parts) {
+                    h.update(p.path.as_bytes());
+                    h.update(p.text.as_bytes());
+                }
+            }
         }
         let lib = self.imported_lib(kernel)?;
         for e in &lib {
