@@ -18,7 +18,8 @@ use vista_render::RenderLimits;
 pub struct Config {
     /// Adapter, validation layer, watchdog, wgpu backends, Chromium.
     pub gpu: GpuConfig,
-    /// `VISTA_MAX_WORK`: the cap on a render's work estimate.
+    /// `VISTA_MAX_WORK` and `VISTA_MAX_BYTES`: the caps on a render's
+    /// work estimate and memory.
     pub limits: RenderLimits,
     /// `CI` set (to anything but 0 or false): bless is refused without `--force`.
     pub in_ci: bool,
@@ -120,6 +121,16 @@ impl Config {
                 ))
             })?,
         };
+        let max_bytes = match text("VISTA_MAX_BYTES").filter(|v| !v.is_empty()) {
+            None => vista_render::DEFAULT_MAX_BYTES,
+            Some(v) => {
+                v.parse::<f64>().ok().filter(|b| b.is_finite() && *b >= 1.0).map(|b| b as u64).ok_or_else(|| {
+                    GoldenError::BadInput(format!(
+                        "VISTA_MAX_BYTES={v} is not valid; expected a number of bytes such as 8e9"
+                    ))
+                })?
+            }
+        };
         Ok(Config {
             gpu: GpuConfig {
                 adapter: AdapterChoice::from_settings(&adapter)?,
@@ -140,7 +151,7 @@ impl Config {
                 wgpu_backends: text("WGPU_BACKEND").filter(|v| !v.is_empty()),
                 browser: vista_browser::BrowserConfig::from_lookup(get),
             },
-            limits: RenderLimits { max_work },
+            limits: RenderLimits { max_work, max_bytes },
             // CI systems spell it true, 1 or their own name (CI=woodpecker).
             in_ci: text("CI").is_some_and(|v| !matches!(v.to_ascii_lowercase().as_str(), "" | "0" | "false")),
             allow_no_gpu: truthy("VISTA_ALLOW_NO_GPU", text("VISTA_ALLOW_NO_GPU"))?,

@@ -3787,6 +3787,41 @@ fn the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu() {
 /// or dtype that does not fit, NaN in a float input, a case's replacement
 /// naming no resource; each exit 2 with one line naming the resource, the
 /// file and what was expected. A case's replacement file is used.
+/// Memory is counted before anything is allocated: a texture inside the
+/// size limits but past the budget, a buffer past a lowered budget, and a
+/// small PNG whose header says it decodes to 8192 x 8192 are refused with
+/// exit 2 naming the size and the budget, never a wgpu panic or an abort.
+fn memory_past_the_budget_is_refused_before_allocation() {
+    let (_t, root) = graphs_copy();
+    let run = |env: &[(&str, &str)], args: &[&str]| vista_in(Some(&root), env, args);
+    let edit = |file: &str, from: &str, to: &str| edit_file(&root, file, from, to);
+    edit(
+        "kernels/blur.toml",
+        "name = \"horizontal\"\nkind = \"texture\"\nsize = [64, 64]",
+        "name = \"horizontal\"\nkind = \"texture\"\nsize = [16384, 16384]",
+    );
+    let r = run(&[], &["render", "blur", "-o", "b.png"]);
+    assert_rejected(
+        &r,
+        2,
+        &["resource horizontal", "16384x16384x1", "above the memory budget of 4294967296 bytes", "VISTA_MAX_BYTES"],
+    );
+    edit("kernels/blur.toml", "size = [16384, 16384]", "size = [64, 64]");
+    let r = run(&[("VISTA_MAX_BYTES", "1e5")], &["render", "scan", "-o", "s.npy"]);
+    assert_rejected(&r, 2, &["above the memory budget of 100000 bytes"]);
+    let r = run(&[("VISTA_MAX_BYTES", "lots")], &["render", "scan", "-o", "s.npy"]);
+    assert_rejected(&r, 2, &["VISTA_MAX_BYTES=lots is not valid"]);
+    // A PNG header that says 8192 x 8192, in 33 bytes.
+    let mut png = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR".to_vec();
+    png.extend(8192u32.to_be_bytes());
+    png.extend(8192u32.to_be_bytes());
+    png.extend([16, 6, 0, 0, 0, 0, 0, 0, 0]);
+    std::fs::write(root.join("inputs/huge.png"), &png).unwrap();
+    edit("kernels/blur.toml", "file = \"inputs/photo.png\"", "file = \"inputs/huge.png\"");
+    let r = run(&[("VISTA_MAX_BYTES", "1e9")], &["render", "blur", "-o", "b.png"]);
+    assert_rejected(&r, 2, &["inputs/huge.png is a 8192x8192 PNG", "above the memory budget of 1000000000 bytes"]);
+}
+
 fn graph_inputs_are_checked_before_gpu_work() {
     let (_t, root) = graphs_copy();
     let run = |args: &[&str]| vista_in(Some(&root), &[], args);
@@ -5861,6 +5896,7 @@ fn main() {
         Gpu assembled_sources_name_their_own_files,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,
         Gpu graph_inputs_are_checked_before_gpu_work,
+        Gpu memory_past_the_budget_is_refused_before_allocation,
         Gpu every_output_of_a_graph_is_judged,
         Gpu per_backend_goldens_are_used_on_their_backend,
         Gpu watch_rechecks_what_a_saved_file_reaches,

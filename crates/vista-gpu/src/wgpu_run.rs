@@ -148,6 +148,9 @@ impl Context {
     ) -> Result<(Readback, Vec<Vec<usize>>), GpuError> {
         let d = &w.device;
         let start = Instant::now();
+        // A resource the device cannot allocate is this case's error, never
+        // a panic of wgpu's uncaptured-error handler.
+        let memory = d.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
         // Textures some render pass draws into: RENDER_ATTACHMENT, never pooled.
         let targets: Vec<usize> =
@@ -155,7 +158,13 @@ impl Context {
         let (made, fill) = self.make_resources(w, g, which, &targets)?;
         let pipelines: Vec<Arc<Compiled>> =
             g.passes.iter().map(|p| self.pipeline(w, g, p)).collect::<Result<_, _>>()?;
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        let invalid = pollster::block_on(scope.pop());
+        if let Some(e) = pollster::block_on(memory.pop()) {
+            return Err(GpuError::Request(format!(
+                "the device could not allocate the pass graph's resources: {e}; make them smaller"
+            )));
+        }
+        if let Some(e) = invalid {
             return Err(GpuError::Validation { what: "the pass graph's resources".into(), message: e.to_string() });
         }
         // Contents and sentinels land before the first pass is timed.

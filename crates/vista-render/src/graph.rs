@@ -93,7 +93,8 @@ pub type Inputs = [(String, String)];
 
 /// Plans `kernel`'s graph for `p` at `width` x `height` (the case size
 /// that resources without a `size` take), reading input files under
-/// `root` (or the case's `inputs` instead).
+/// `root` (or the case's `inputs` instead), within `max_bytes` of memory.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn plan_graph(
     shaders: &vista_gpu::ShaderSet,
     root: Option<&Path>,
@@ -102,6 +103,7 @@ pub(crate) fn plan_graph(
     inputs: &Inputs,
     width: u32,
     height: u32,
+    max_bytes: u64,
 ) -> Result<Plan, RenderError> {
     let g = kernel.graph();
     let bad = |m: String| RenderError::BadInput(format!("kernel {}: {m}", kernel.name()));
@@ -147,7 +149,7 @@ pub(crate) fn plan_graph(
             return Err(bad(format!("case inputs: {name} names no resource; resources: {}", names.join(", "))));
         }
     }
-    let at = Planning { root, kernel, p, inputs, width, height };
+    let at = Planning { root, kernel, p, inputs, width, height, max_bytes, spent: std::cell::Cell::new(0) };
     let mut resources = resolved
         .resources
         .iter()
@@ -157,7 +159,7 @@ pub(crate) fn plan_graph(
                 at.texture(r, size.as_deref(), file.as_ref(), *mip_levels, resolved.outputs.contains(&ri))
             }
             ResourceKind::Buffer { file, data, fill, length } => {
-                at.buffer(r, file.as_ref(), data.as_deref(), *fill, length.as_ref())
+                at.buffer(r, file.as_ref(), data.as_deref(), *fill, length.as_ref(), resolved.outputs.contains(&ri))
             }
             ResourceKind::Depth { size } => at.depth(r, size.as_deref()),
             ResourceKind::Sampler { linear, address, compare } => {
@@ -206,11 +208,30 @@ struct Planning<'a> {
     inputs: &'a Inputs,
     width: u32,
     height: u32,
+    /// The memory budget ([`crate::RenderLimits::max_bytes`]).
+    max_bytes: u64,
+    /// What the resources planned so far need of it.
+    spent: std::cell::Cell<u64>,
 }
 
 impl Planning<'_> {
     fn bad(&self, m: String) -> RenderError {
         RenderError::BadInput(format!("kernel {}: {m}", self.kernel.name()))
+    }
+
+    /// Counts `bytes` of resource `name` against the memory budget, before
+    /// they are allocated: past it, the case is refused naming both.
+    fn spend(&self, name: &str, what: &str, bytes: u64) -> Result<(), RenderError> {
+        let total = self.spent.get().saturating_add(bytes);
+        self.spent.set(total);
+        if total <= self.max_bytes {
+            return Ok(());
+        }
+        Err(self.bad(format!(
+            "resource {name}: {what} needs {bytes} bytes ({total} with the resources before it), above the memory \
+             budget of {} bytes; make it smaller, or raise VISTA_MAX_BYTES",
+            self.max_bytes
+        )))
     }
 
     /// The file a case's `inputs` give resource `name`, else its own.
@@ -255,7 +276,7 @@ impl Planning<'_> {
                 (format, Contents::Bytes(bytes))
             }
             Some(f) => {
-                let (natural, image) = read_texture(root, f).map_err(at)?;
+                let (natural, image) = read_texture(root, f, self.max_bytes).map_err(at)?;
                 extent = Some(file_extent(f, [image.width, image.height], extent, cube).map_err(at)?);
                 if let Some((x, y)) = image.first_nonfinite() {
                     return Err(at(format!("file {f} holds NaN/Inf at ({x}, {y}); inputs must be finite")));
@@ -294,6 +315,14 @@ impl Planning<'_> {
                 if dimension == Dimension::D3 { format!("x{l}") } else { String::new() }
             )));
         }
+        // Its texels (a full mip chain adds at most a third), and an
+        // output's read-back image of f32 RGBA.
+        let texels = u64::from(w) * u64::from(h) * u64::from(l);
+        let texel_bytes = vista_texel::Format::parse(format).map_err(at)?.texel_bytes() as u64;
+        let chain = if mip_levels > 1 { texels * texel_bytes / 3 } else { 0 };
+        let readback = if is_output { texels * 16 } else { 0 };
+        let what = format!("a {w}x{h}x{l} {format} texture");
+        self.spend(&r.spec.name, &what, texels * texel_bytes + chain + readback)?;
         Ok(vista_gpu::Resource::Texture(vista_gpu::TextureDesc {
             format,
             dimension,
@@ -337,6 +366,7 @@ impl Planning<'_> {
         data: Option<&[f64]>,
         fill: Option<f64>,
         length: Option<&vista_kernels::expr::Expr>,
+        is_output: bool,
     ) -> Result<vista_gpu::Resource, RenderError> {
         let (root, p, width, height) = (self.root, self.p, self.width, self.height);
         let bad = |m: String| self.bad(m);
@@ -365,8 +395,12 @@ impl Planning<'_> {
                         )));
                     }
                 };
+                // Counted before it is made; one element encoded, then repeated.
+                let bytes = u64::from(e.header) + n * u64::from(e.stride);
+                let what = format!("{n} elements of {} bytes", e.stride);
+                self.spend(&r.spec.name, &what, if is_output { 2 * bytes } else { bytes })?;
                 let v = fill.unwrap_or(0.0);
-                encode_values(&vec![v; (n * e.leaves.len() as u64) as usize], e).map_err(at)?
+                encode_values(&vec![v; e.leaves.len()], e).map_err(at)?.repeat(n as usize)
             }
         };
         let mut bytes = vec![0u8; e.header as usize];
@@ -822,9 +856,21 @@ impl Planning<'_> {
 
 /// A texture file under the project root: its natural format (8-bit PNG:
 /// rgba8unorm; 16-bit PNG and EXR: rgba32float) and its values.
-fn read_texture(root: Option<&Path>, file: &str) -> Result<(&'static str, Image), String> {
+fn read_texture(root: Option<&Path>, file: &str, max_bytes: u64) -> Result<(&'static str, Image), String> {
     let path = under(root, file)?;
     let bytes = read_input(root, file, &path)?;
+    // A small PNG may decode to a huge image: its header says how large,
+    // before any decoding (4 f32 per texel).
+    if bytes.starts_with(b"\x89PNG") && bytes.len() >= 24 {
+        let [w, h] = [16, 20].map(|o| u64::from(u32::from_be_bytes(bytes[o..o + 4].try_into().expect("4 bytes"))));
+        if w * h * 16 > max_bytes {
+            return Err(format!(
+                "file {file} is a {w}x{h} PNG: {} bytes decoded, above the memory budget of {max_bytes} bytes; \
+                 make it smaller, or raise VISTA_MAX_BYTES",
+                w * h * 16
+            ));
+        }
+    }
     if file.ends_with(".exr") {
         let image = vista_image::read_exr(&path).map_err(|e| format!("file {file}: {e}"))?;
         return Ok(("rgba32float", image));

@@ -31,17 +31,27 @@ use vista_kernels::{DisplayMap, Kernel, ParamSet};
 /// dispatch under about a minute there instead of stalling the device.
 pub const DEFAULT_MAX_WORK: f64 = 4.0e10;
 
+/// The memory a case may ask for, in bytes, unless `VISTA_MAX_BYTES` says
+/// otherwise: 4 GiB, counted before anything is allocated (every
+/// resource's texels or bytes, and what its outputs read back as f32
+/// RGBA). A fixed number rather than a share of the machine's memory, so
+/// that a case is accepted or refused alike on every machine; a 2048^2
+/// rgba32float case with three outputs needs 0.3 GiB.
+pub const DEFAULT_MAX_BYTES: u64 = 4 << 30;
+
 /// Bounds every render is held to before GPU work, set at the edge
-/// (`VISTA_MAX_WORK`).
+/// (`VISTA_MAX_WORK`, `VISTA_MAX_BYTES`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderLimits {
     /// Cap on `work_per_pixel * pixels`.
     pub max_work: f64,
+    /// Cap on the bytes a case's resources and read-back outputs need.
+    pub max_bytes: u64,
 }
 
 impl Default for RenderLimits {
     fn default() -> RenderLimits {
-        RenderLimits { max_work: DEFAULT_MAX_WORK }
+        RenderLimits { max_work: DEFAULT_MAX_WORK, max_bytes: DEFAULT_MAX_BYTES }
     }
 }
 
@@ -418,7 +428,7 @@ pub fn plan(
     limits: &RenderLimits,
 ) -> Result<Plan, RenderError> {
     check_request(kernel, p, width, height, limits)?;
-    graph::plan_graph(shaders, root, kernel, p, inputs, width, height)
+    graph::plan_graph(shaders, root, kernel, p, inputs, width, height, limits.max_bytes)
 }
 
 /// One output of a pass graph as read back.
