@@ -317,3 +317,25 @@ fn dual_source_blending_composes_and_its_enable_is_declared() {
     let set = set_of_dir(dir.path());
     assert_eq!(set.declared_features("plain.wgsl").unwrap(), [("shader-f16", "f16")]);
 }
+
+/// A 5000-term constant overflowed naga's stack (exit 134): it is refused
+/// before parsing, naming the file and line, in a kernel and in a module
+/// it imports.
+#[test]
+fn expressions_past_the_parsers_depth_are_refused_not_a_stack_overflow() {
+    let dir = tempfile::tempdir().unwrap();
+    let long = format!("const TAU: f32 = 6.28{};\n", " + 0.0".repeat(5000));
+    std::fs::write(dir.path().join("k.wgsl"), format!("{long}@compute @workgroup_size(1)\nfn main() {{}}\n")).unwrap();
+    std::fs::create_dir_all(dir.path().join("lib")).unwrap();
+    std::fs::write(dir.path().join("lib/deep.wgsl"), format!("#define_import_path my::deep\n{long}")).unwrap();
+    std::fs::write(
+        dir.path().join("uses.wgsl"),
+        "#import my::deep::TAU\n@compute @workgroup_size(1)\nfn main() { let t = TAU; }\n",
+    )
+    .unwrap();
+    let set = set_of_dir(dir.path());
+    let e = set.compose("k.wgsl").unwrap_err().to_string();
+    assert!(e.contains("k.wgsl:1: one statement chains more than 1024 operators"), "{e}");
+    let e = set.compose("uses.wgsl").unwrap_err().to_string();
+    assert!(e.contains("deep.wgsl") && e.contains("more than 1024 operators"), "{e}");
+}

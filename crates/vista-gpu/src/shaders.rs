@@ -484,6 +484,9 @@ impl ShaderSet {
 
     fn compose_unit(&self, name: &str, kernel: &Source) -> Result<naga::Module, GpuError> {
         let (source, origin) = (&kernel.text, &kernel.origin);
+        // Expressions deeper or longer than the parsers' stacks take are
+        // refused before any parser sees them.
+        vista_source::check_depth(source, origin).map_err(GpuError::Shader)?;
         // A file without preprocessor directives needs no composition; naga
         // parses it directly. naga_oil 0.23 loses the expressions of an
         // `override` named in `@workgroup_size` ("Handle N of Expression is
@@ -502,6 +505,9 @@ impl ShaderSet {
         // The manifest's constants must agree with the library's even where
         // the kernel passes the index through without naming it.
         let lib = self.imported_lib(kernel)?;
+        for module in &lib {
+            vista_source::check_depth(&module.text, &module.origin).map_err(GpuError::Shader)?;
+        }
         if let Some(Ok(text)) = self.enums.get(file_of(name)) {
             self.check_enums(name, text, &lib)?;
         }

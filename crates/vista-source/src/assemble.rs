@@ -113,6 +113,11 @@ pub fn assemble(
     })
 }
 
+/// How deep `#include`s may nest: expanding them recurses, and a chain
+/// thousands of files deep overflowed the stack (exit 134). Real projects
+/// nest a handful.
+pub const MAX_INCLUDE_DEPTH: usize = 64;
+
 impl State<'_> {
     /// Adds a joined file (or the shader) as a new part.
     fn add(&mut self, path: &str, what: &str) -> Result<(), String> {
@@ -138,6 +143,14 @@ impl State<'_> {
                 continue;
             };
             self.stack.push((index, i + 1));
+            if self.stack.len() > MAX_INCLUDE_DEPTH {
+                return Err(format!(
+                    "#include nested {} deep at {}; allowed: {MAX_INCLUDE_DEPTH} (a chain of files each including \
+                     the next)",
+                    self.stack.len(),
+                    self.stack.last().map(|(p, l)| format!("{}:{l}", self.parts[*p].origin)).unwrap_or_default()
+                ));
+            }
             let name = include_name(rest).map_err(|e| format!("{}: #include{rest}: {e}", self.chain()))?;
             let found = self.resolve(&self.parts[index].path.clone(), &name)?;
             if let Some(on) = self.stack.iter().position(|(p, _)| self.parts[*p].path == found) {
@@ -220,6 +233,18 @@ mod tests {
     fn run(fs: &BTreeMap<String, String>, spec: &SourceSpec, values: &[String]) -> Result<Assembled, String> {
         let read = |p: &str| fs.get(p).map(|t| (t.clone(), format!("/proj/{p}")));
         assemble("shaders/k.wgsl", spec, values, &read)
+    }
+
+    /// A chain 3000 files deep is refused at the documented depth, naming
+    /// it, instead of overflowing the stack.
+    #[test]
+    fn a_deep_include_chain_is_refused_at_the_depth_limit() {
+        let files: Vec<(String, String)> =
+            (0..3000).map(|i| (format!("shaders/f{i}.wgsl"), format!("#include \"f{}.wgsl\"\n", i + 1))).collect();
+        let read = |p: &str| files.iter().find(|(f, _)| f == p).map(|(_, t)| (t.clone(), format!("/p/{p}")));
+        let read = |p: &str| read(p).or_else(|| (p == "shaders/f3000.wgsl").then(|| (String::new(), p.into())));
+        let e = assemble("shaders/f0.wgsl", &includes(&[]), &[], &read).unwrap_err();
+        assert!(e.contains("#include nested 65 deep") && e.contains("allowed: 64"), "{e}");
     }
 
     fn includes(folders: &[&str]) -> SourceSpec {

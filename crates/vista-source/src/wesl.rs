@@ -87,12 +87,27 @@ pub fn compile_wesl(
         return Err(format!("{main}: a .wesl shader lies under shaders/"));
     };
     let root = ModulePath { origin: PathOrigin::Absolute, components: module.split('/').map(str::to_string).collect() };
-    let files = Files { packages: &spec.packages, read, parts: RefCell::new(Vec::new()) };
+    // Every module file is checked for depth before the wesl crate parses
+    // it (its parser recurses on expressions too); the first refusal wins.
+    let refused = RefCell::new(None);
+    let checked = |path: &str| {
+        let found = read(path)?;
+        if let Err(e) = crate::check_depth(&found.0, &found.1) {
+            refused.borrow_mut().get_or_insert(e);
+            return None;
+        }
+        Some(found)
+    };
+    let files = Files { packages: &spec.packages, read: &checked, parts: RefCell::new(Vec::new()) };
     let mut compiler = wesl::Wesl::new("shaders").set_custom_resolver(files);
     for (name, on) in features {
         compiler.set_feature(name, *on);
     }
-    let result = compiler.compile(&root).map_err(|e| format!("WESL error: {}", plain(&e.to_string())))?;
+    let result = compiler.compile(&root);
+    if let Some(e) = refused.take() {
+        return Err(e);
+    }
+    let result = result.map_err(|e| format!("WESL error: {}", plain(&e.to_string())))?;
     let text = result.to_string();
     let parts = compiler.resolver().parts.take();
     Ok(Assembled::untraced(text, parts))
