@@ -575,6 +575,26 @@ fn symlinks_out_of_the_project_devices_and_fifos_are_refused() {
     assert_rejected(&r, 2, &["shaders/fbm.wgsl", "a FIFO", "expected a regular file"]);
 }
 
+/// Names with terminal escapes are refused at parse time and printed
+/// escaped: a case id or a preset name never reaches the terminal raw.
+fn control_characters_in_names_are_refused_and_escaped() {
+    let d = golden_dir("[[case]]\nid = \"a\\u001b[31mred\"\nkernel = \"fbm\"\nsize = \"8x8\"\n");
+    let r = vista_in(Some(d.path()), &[], &["check"]);
+    assert_rejected(&r, 2, &["case 'a\\u{1b}[31mred'", "only letters, digits"]);
+    assert!(!r.stderr.contains('\u{1b}') && !r.stdout.contains('\u{1b}'), "{:?}", r.stderr);
+    std::fs::create_dir_all(d.path().join("kernels")).unwrap();
+    std::fs::write(cases_path(d.path()), "").unwrap();
+    let manifest = std::fs::read_to_string(repo().join("examples/project/kernels/marble.toml")).unwrap();
+    std::fs::write(
+        d.path().join("kernels/m.toml"),
+        format!("{manifest}\n[preset.\"x\\u001b]0;pwned\\u0007\"]\nstripes = 2.0\n"),
+    )
+    .unwrap();
+    let r = vista_in(Some(d.path()), &[], &["list"]);
+    assert_rejected(&r, 2, &["preset 'x\\u{1b}]0;pwned\\u{7}' must use only letters"]);
+    assert!(!r.stderr.contains('\u{1b}') && !r.stdout.contains('\u{1b}'), "{:?}", r.stderr);
+}
+
 /// Check requires the bless-time raw bits on the same adapter, shader and
 /// params (what lets the golden harness skip its second render): a
 /// manifest whose raw hash the render does not reproduce fails the case.
@@ -5839,6 +5859,7 @@ fn main() {
         Gpu sweep_writes_csv_plots_and_names_the_cheapest_setting,
         Gpu sweep_grid_has_one_row_per_point,
         Gpu missing_golden_fails_with_the_bless_command_and_is_not_created,
+        Cpu control_characters_in_names_are_refused_and_escaped,
         #[cfg(unix)] Gpu a_symlinked_thumbs_folder_never_touches_the_goldens,
         #[cfg(unix)] Gpu bless_never_writes_through_a_symlinked_golden_folder,
         #[cfg(unix)] Cpu symlinks_out_of_the_project_devices_and_fifos_are_refused,

@@ -168,7 +168,8 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
     for raw in file.case {
         let bad = |message: String| GoldenError::Cases {
             path: path.display().to_string(),
-            message: format!("case '{}': {message}", raw.id),
+            // Escaped: an id is not yet known to be printable.
+            message: format!("case '{}': {message}", raw.id.escape_debug()),
         };
         if raw.id.is_empty() || !raw.id.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
             return Err(bad("id must be non-empty and use only letters, digits, '-' and '_'".into()));

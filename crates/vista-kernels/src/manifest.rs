@@ -587,6 +587,10 @@ fn parse_presets(
 
     let mut presets = Vec::new();
     for (pname, table) in preset {
+        // A name is printed in lists and errors: letters, digits, '-' and '_' only.
+        if pname.is_empty() || !pname.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+            return Err(kfail(format!("preset '{}' must use only letters, digits, '-' and '_'", pname.escape_debug())));
+        }
         let Some(mut table) = table.as_table().cloned() else {
             return Err(kfail(format!("preset {pname} must be a table ([preset.{pname}] with name = value lines)")));
         };
