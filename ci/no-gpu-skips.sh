@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
-suites=(golden agreement atmosphere clouds cloudmap heightfield landscape mutate noise reliability backends)
+suites=(golden agreement atmosphere clouds cloudmap heightfield landscape mutate noise reliability backends conformance references)
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
 # The test executables `cargo test --workspace` built (make test's), run

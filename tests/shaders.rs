@@ -339,3 +339,17 @@ fn expressions_past_the_parsers_depth_are_refused_not_a_stack_overflow() {
     let e = set.compose("uses.wgsl").unwrap_err().to_string();
     assert!(e.contains("deep.wgsl") && e.contains("more than 1024 operators"), "{e}");
 }
+
+/// The conformance suite's expected values and input files are what
+/// `tests/conformance/expected.py` derives from the specs (no device
+/// needed, so it runs here, beside the other shader checks).
+#[test]
+fn conformance_expectations_are_what_expected_py_writes() {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/conformance/expected.py");
+    let out = std::process::Command::new("python3")
+        .arg(&script)
+        .arg("--check")
+        .output()
+        .unwrap_or_else(|e| panic!("python3 runs the spec-derived table's script: {e}"));
+    assert!(out.status.success(), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+}
