@@ -5659,6 +5659,23 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_rejected(&bad("<u4", &[32]), 2, &["has shape [32]; a texture is (H, W) or (H, W, channels)"]);
 }
 
+/// An index past the vertices a draw's buffers hold is refused before GPU
+/// work, naming it (one index of 60000 with 1204 vertices passed silently).
+fn indices_past_the_vertex_count_are_refused() {
+    let t = tmp();
+    let root = t.path().join("render");
+    copy_tree(&repo().join("examples/render"), &root);
+    let path = root.join("inputs/grass_indices.npy");
+    let mut bytes = std::fs::read(&path).unwrap();
+    let header = 10 + u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    bytes[header + 2 * 7..header + 2 * 8].copy_from_slice(&60000u16.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let out = root.join("g.png");
+    let r = vista_in(Some(&root), &[], &["render", "grass", "-o", out.to_str().unwrap()]);
+    assert_rejected(&r, 2, &["index 60000 (number 7 of indices card_indices) is past the", "vertices cards holds"]);
+    assert!(!out.exists());
+}
+
 /// examples/render (SPEC 17's examples a and b), copied with a copied
 /// binary: its goldens pass on lavapipe, SwiftShader and Chromium; the
 /// full-screen sky draws what the built-in compute sky dispatches (within
@@ -5918,6 +5935,7 @@ fn main() {
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,
         Gpu graph_inputs_are_checked_before_gpu_work,
         Gpu memory_past_the_budget_is_refused_before_allocation,
+        Gpu indices_past_the_vertex_count_are_refused,
         Gpu every_output_of_a_graph_is_judged,
         Gpu per_backend_goldens_are_used_on_their_backend,
         Gpu watch_rechecks_what_a_saved_file_reaches,

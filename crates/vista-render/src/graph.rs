@@ -798,6 +798,33 @@ impl Planning<'_> {
         {
             return Err(self.bad(format!("{label}: count = {count} but {what} holds {n}")));
         }
+        // Indices the host gives (a file or data) must name vertices the
+        // per-vertex buffers hold: WebGPU leaves an index past them to the
+        // driver (robust access reads zeros, or not). A strip's restart
+        // value is not an index.
+        if let (Some((ix, u16)), Some((vertices, vr))) = (indices, held(false))
+            && let Some(ResourceKind::Buffer { file, data, .. }) =
+                self.kernel.graph().resources.get(ix).map(|x| &x.kind)
+            && (file.is_some() || data.is_some())
+            && let vista_gpu::Resource::Buffer(bytes) = &resources[ix]
+        {
+            let strip = matches!(r.topology, vista_texel::Topology::TriangleStrip | vista_texel::Topology::LineStrip);
+            let restart = if u16 { 0xFFFF } else { 0xFFFF_FFFF };
+            let size = if u16 { 2 } else { 4 };
+            let values = bytes.chunks_exact(size).take(count as usize).map(|c| match u16 {
+                true => u64::from(u16::from_le_bytes([c[0], c[1]])),
+                false => u64::from(u32::from_le_bytes([c[0], c[1], c[2], c[3]])),
+            });
+            if let Some((at, v)) = values.enumerate().find(|&(_, v)| v >= vertices && !(strip && v == restart)) {
+                return Err(self.bad(format!(
+                    "{label}: index {v} (number {at} of indices {}) is past the {vertices} vertices {} holds; \
+                     allowed: [0, {}]",
+                    name(ix),
+                    name(vr),
+                    vertices - 1
+                )));
+            }
+        }
         let per_instance = held(true);
         let instances = match (&r.instances, per_instance) {
             (Some(e), _) => eval("instances", e)?,
