@@ -595,6 +595,27 @@ fn control_characters_in_names_are_refused_and_escaped() {
     assert!(!r.stderr.contains('\u{1b}') && !r.stdout.contains('\u{1b}'), "{:?}", r.stderr);
 }
 
+/// `range = [1, 64, 3]` took the first two numbers, and a list for a
+/// scalar param was joined into one value: both are refused, named.
+fn malformed_ranges_and_lists_for_scalars_are_refused() {
+    let d = golden_dir("[[case]]\nid = \"a\"\nkernel = \"fbm\"\nsize = \"8x8\"\nset = { octaves = [3] }\n");
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["check"]),
+        2,
+        &["case 'a': set: octaves = [3] is a list, but octaves takes one value"],
+    );
+    std::fs::write(cases_path(d.path()), "").unwrap();
+    std::fs::create_dir_all(d.path().join("kernels")).unwrap();
+    let manifest = std::fs::read_to_string(repo().join("examples/project/kernels/marble.toml")).unwrap();
+    std::fs::write(d.path().join("kernels/m.toml"), manifest.replacen("range = [0.0, 64.0]", "range = [1, 64, 3]", 1))
+        .unwrap();
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["list"]),
+        2,
+        &["kernels/m.toml: line 7", "3 numbers where [min, max] takes two"],
+    );
+}
+
 /// Check requires the bless-time raw bits on the same adapter, shader and
 /// params (what lets the golden harness skip its second render): a
 /// manifest whose raw hash the render does not reproduce fails the case.
@@ -5877,6 +5898,7 @@ fn main() {
         Gpu sweep_grid_has_one_row_per_point,
         Gpu missing_golden_fails_with_the_bless_command_and_is_not_created,
         Cpu control_characters_in_names_are_refused_and_escaped,
+        Gpu malformed_ranges_and_lists_for_scalars_are_refused,
         #[cfg(unix)] Gpu a_symlinked_thumbs_folder_never_touches_the_goldens,
         #[cfg(unix)] Gpu bless_never_writes_through_a_symlinked_golden_folder,
         #[cfg(unix)] Cpu symlinks_out_of_the_project_devices_and_fifos_are_refused,

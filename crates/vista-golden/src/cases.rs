@@ -178,6 +178,16 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             return Err(bad("duplicate id".into()));
         }
         let kernel = kernels.find(&raw.kernel).map_err(|e| bad(e.to_string()))?;
+        // A list for a scalar would be joined into one number: refused.
+        for (k, v) in &raw.set {
+            let scalar = kernel.params().iter().find(|p| &p.name == k).is_some_and(|p| {
+                use vista_kernels::ParamType as T;
+                matches!(p.ty, T::U32 | T::I32 | T::F32 | T::Bool | T::Enum)
+            });
+            if scalar && v.is_array() {
+                return Err(bad(format!("set: {k} = {v} is a list, but {k} takes one value")));
+            }
+        }
         let overrides: Vec<(String, String)> =
             raw.set.iter().map(|(k, v)| (k.clone(), vista_kernels::values::value_text(v))).collect();
         let params = kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?;

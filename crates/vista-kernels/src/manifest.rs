@@ -88,6 +88,7 @@ struct RawManifest {
     display_alpha: Option<String>,
     #[serde(default)]
     work: Vec<String>,
+    #[serde(default, deserialize_with = "min_max")]
     output_range: Option<[f64; 2]>,
     hash_plane: Option<toml::Value>,
     #[serde(default)]
@@ -150,12 +151,23 @@ struct RawOutput {
     exposure: Option<f64>,
 }
 
+/// `[min, max]`: exactly two numbers (serde's fixed-size arrays took the
+/// first two of `[1, 64, 3]` and dropped the rest).
+fn min_max<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+    let v: Vec<f64> = Vec::deserialize(d)?;
+    match v.as_slice() {
+        &[lo, hi] => Ok(Some([lo, hi])),
+        other => Err(serde::de::Error::custom(format!("{} numbers where [min, max] takes two", other.len()))),
+    }
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawParam {
     name: String,
     #[serde(rename = "type")]
     ty: String,
+    #[serde(default, deserialize_with = "min_max")]
     range: Option<[f64; 2]>,
     #[serde(default)]
     open_min: bool,
