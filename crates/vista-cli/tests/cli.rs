@@ -2100,6 +2100,25 @@ fn bless_from_report_accepts_what_another_clone_rendered() {
     }
     let c = vista_in(Some(dev.path()), &[], &["check"]);
     assert!(c.code == 0 && c.stdout.contains("3 passed, 0 failed"), "{}", c.stdout);
+    // A crafted pending entry never reaches golden/manifest.toml.
+    let pending = report.join("pending.toml");
+    let honest = std::fs::read_to_string(&pending).unwrap();
+    let manifest_before = std::fs::read(dev.path().join("golden/manifest.toml")).unwrap();
+    for (from, to, want) in [
+        (
+            "kernel = \"k\"",
+            "kernel = \"../../../outside\"",
+            "it names kernel '../../../outside', but the case's kernel is k",
+        ),
+        ("size = \"16x16\"", "size = \"16x16\\u001b[2J\"", "it says size '16x16\\u{1b}[2J', but the case is 16x16"),
+    ] {
+        assert!(honest.contains(from), "{honest}");
+        std::fs::write(&pending, honest.replacen(from, to, 1)).unwrap();
+        let r = vista_in(Some(dev.path()), &[], &["bless", "--from-report", report.to_str().unwrap()]);
+        assert_rejected(&r, 2, &["is stale", want]);
+        assert_eq!(std::fs::read(dev.path().join("golden/manifest.toml")).unwrap(), manifest_before);
+    }
+    std::fs::write(&pending, &honest).unwrap();
     // Another edit in the developer's clone: the report is stale now.
     let before = std::fs::read(dev.path().join("golden/k/a.png")).unwrap();
     std::fs::write(dev.path().join("shaders/k.wgsl"), edited.replace("params.gain * u", "params.gain * v")).unwrap();

@@ -120,6 +120,24 @@ pub fn bless_from_report(
             .iter()
             .find(|c| &c.id == id)
             .ok_or_else(|| stale(id, "it is no longer in golden/cases.toml".into()))?;
+        // Every field that lands in golden/manifest.toml is checked as the
+        // manifest's own: a crafted kernel or golden path is refused.
+        if entry.kernel != case.kernel.name() {
+            return Err(stale(
+                id,
+                format!(
+                    "it names kernel '{}', but the case's kernel is {}",
+                    entry.kernel.escape_debug(),
+                    case.kernel.name()
+                ),
+            ));
+        }
+        if entry.size != format!("{}x{}", case.width, case.height) {
+            return Err(stale(
+                id,
+                format!("it says size '{}', but the case is {}x{}", entry.size.escape_debug(), case.width, case.height),
+            ));
+        }
         if params_hash(case) != entry.params_hash {
             return Err(stale(id, "its params (preset, set or size) changed since the check".into()));
         }
@@ -163,8 +181,9 @@ pub fn bless_from_report(
     for (case, entry, png, others) in accepted {
         let golden = store.golden_path(case);
         if let Some(parent) = golden.parent() {
-            std::fs::create_dir_all(parent)
-                .map_err(|e| GoldenError::Io { path: parent.display().to_string(), message: e.to_string() })?;
+            // A real folder reached without a symlink, as bless writes.
+            let from = store.dir.parent().unwrap_or(&store.dir);
+            vista_image::real_dir_under(from, parent).map_err(|e| GoldenError::BadInput(e.to_string()))?;
         }
         // The other files first, each atomic and named in the entry (as
         // bless writes them).
