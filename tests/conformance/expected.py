@@ -284,11 +284,42 @@ def sampling_probes():
                     "four words (r, g, b, a) per sample, bilinear in f64 from the texel centres"}]
 
 
+# WebGPU 26.1 / WGSL 17.7.6 (texel formats): what textureStore writes into each storable format.
+def stored(fmt, v):
+    import math
+    rne = lambda x: math.floor(x + 0.5) if x - math.floor(x) != 0.5 else 2 * round(x / 2)
+    channels = {"r32": 1, "rg32": 2}.get(fmt.rstrip("floatuinsi"), 4)
+    if fmt.endswith("unorm"):
+        out = [rne(min(max(x, 0.0), 1.0) * 255) / 255 for x in v]
+    elif fmt.endswith("snorm"):
+        out = [max(rne(min(max(x, -1.0), 1.0) * 127) / 127, -1.0) for x in v]
+    elif fmt == "rgba16float":
+        out = [struct.unpack("<e", struct.pack("<e", x))[0] for x in v]
+    else:
+        out = [float(x) for x in v]  # 32-bit floats and integers as stored, read back as f32
+    return out[:channels] + [0.0, 0.0, 1.0][channels - 1:] if channels < 4 else out
+
+
+def format_probes():
+    shader = (HERE / "shaders/formats.wgsl").read_text()
+    manifest = tomllib.loads((HERE / "kernels/formats.toml").read_text())
+    words = []
+    for out in manifest["output"]:
+        fmt = out["resource"]
+        line = next(l for l in shader.splitlines() if l.strip().startswith(f"textureStore(t_{fmt},"))
+        args = line.split("vec4<")[1].split(">(")[1].rstrip(");").split(",")
+        v = [float(a.strip().rstrip("u")) for a in args]
+        words += [bits("f32", x) for x in stored(fmt, v)]
+    return [{"kernel": "formats", "set": {}, "outputs": [o["resource"] for o in manifest["output"]], "words": words,
+             "why": "each format's texel as textureStore converts the written value, read back as f32 RGBA "
+                    "(normalized values rounded to the nearest step, missing channels 0, 0, 1)"}]
+
+
 def render():
     out = ["# Written by expected.py from the WGSL and WebGPU specs; do not edit.",
            "# tests/conformance.rs runs each probe on every backend and compares the",
            "# output's 32-bit words exactly.", ""]
-    for p in array_length_probes() + layout_probes() + entry_name_probes() + blend_probes() + vertex_probes() + texture_query_probes() + sampling_probes():
+    for p in array_length_probes() + layout_probes() + entry_name_probes() + blend_probes() + vertex_probes() + texture_query_probes() + sampling_probes() + format_probes():
         sets = ", ".join(f"{k} = {v}" for k, v in p["set"].items())
         out += ["[[probe]]", f'kernel = "{p["kernel"]}"', f"set = {{ {sets} }}" if sets else "set = {}",
                 "outputs = [" + ", ".join(f'"{o}"' for o in p["outputs"]) + "]", f'why = "{p["why"]}"']
