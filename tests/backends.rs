@@ -12,7 +12,7 @@
 use common::allow_no_gpu;
 use libtest_mimic::{Arguments, Trial};
 use vista_golden::Case;
-use vista_gpu::{AdapterChoice, Context};
+use vista_gpu::Context;
 use vista_image::{Image, metrics};
 use vista_render::{Renderer, render};
 
@@ -30,16 +30,7 @@ const SAME_DEVICE_PSNR: f64 = 100.0;
 const SAME_DEVICE_MAX_ABS: f64 = 2e-5;
 
 fn contexts() -> Result<Vec<Context>, String> {
-    BACKENDS
-        .iter()
-        .map(|b| {
-            let config = vista_gpu::GpuConfig {
-                adapter: AdapterChoice::of_backend(b).expect("known backend"),
-                ..common::config().gpu.clone()
-            };
-            Context::new(&config).map_err(|e| format!("{b}: {e}"))
-        })
-        .collect()
+    BACKENDS.iter().map(|b| common::backend_context(b)).collect()
 }
 
 fn picked(cases: &[Case]) -> Vec<Case> {

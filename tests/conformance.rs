@@ -13,9 +13,8 @@ use std::sync::OnceLock;
 
 use common::allow_no_gpu;
 use libtest_mimic::{Arguments, Trial};
-use vista_gpu::{AdapterChoice, Context};
-use vista_project::Project;
-use vista_render::{OutputValue, Renderer, render};
+use vista_gpu::Context;
+use vista_render::OutputValue;
 
 mod common;
 
@@ -64,18 +63,7 @@ fn table() -> Table {
 /// The backend's context, made once per process.
 fn context(backend: usize) -> Result<&'static Context, String> {
     static CONTEXTS: [OnceLock<Result<Context, String>>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
-    CONTEXTS[backend]
-        .get_or_init(|| {
-            let config = vista_gpu::GpuConfig {
-                adapter: AdapterChoice::of_backend(BACKENDS[backend]).expect("known backend"),
-                ..common::config().gpu.clone()
-            };
-            // The browser has Dawn's validation always on; the Khronos layer is wgpu's.
-            let config = vista_gpu::GpuConfig { validate: config.validate && BACKENDS[backend] != "browser", ..config };
-            Context::new(&config).map_err(|e| format!("{}: {e}", BACKENDS[backend]))
-        })
-        .as_ref()
-        .map_err(Clone::clone)
+    CONTEXTS[backend].get_or_init(|| common::backend_context(BACKENDS[backend])).as_ref().map_err(Clone::clone)
 }
 
 fn set_pairs(set: &toml::Table) -> Vec<(String, String)> {
@@ -88,14 +76,7 @@ fn set_label(set: &toml::Table) -> String {
 
 /// Renders one probe on one backend; its output's words.
 fn words_of(backend: usize, probe: &Probe) -> Result<Vec<u32>, String> {
-    let ctx = context(backend)?;
-    let project = Project::at(&suite()).map_err(|e| e.to_string())?;
-    let gpu = Renderer::new(ctx, &project, common::config().limits).map_err(|e| e.to_string())?;
-    let kernels = vista_kernels::Registry::of_project(&project).map_err(|e| e.to_string())?;
-    let kernel = kernels.find(&probe.kernel).map_err(|e| e.to_string())?;
-    let params = kernel.resolve(None, &set_pairs(&probe.set)).map_err(|e| e.to_string())?;
-    let out =
-        render(&gpu, kernel, &params, 8, 8).map_err(|e| format!("{} on {}: {e}", probe.kernel, BACKENDS[backend]))?;
+    let out = common::render_in_project(context(backend)?, &suite(), &probe.kernel, &set_pairs(&probe.set), (8, 8))?;
     let mut words = Vec::new();
     for name in &probe.outputs {
         let output = out

@@ -9,8 +9,7 @@ use std::path::{Path, PathBuf};
 
 use common::allow_no_gpu;
 use libtest_mimic::{Arguments, Trial};
-use vista_project::Project;
-use vista_render::{OutputValue, Renderer, render};
+use vista_render::OutputValue;
 
 mod common;
 
@@ -22,18 +21,14 @@ fn example(name: &str) -> PathBuf {
 /// `width` x `height` on this process's device.
 fn render_example(name: &str, kernel: &str, width: u32, height: u32) -> Result<vista_render::Rendered, String> {
     let ctx = vista_gpu::Context::shared(&common::config().gpu).map_err(|e| e.to_string())?;
-    let project = Project::at(&example(name)).map_err(|e| e.to_string())?;
-    let gpu = Renderer::new(ctx, &project, common::config().limits).map_err(|e| e.to_string())?;
-    let kernels = vista_kernels::Registry::of_project(&project).map_err(|e| e.to_string())?;
-    let kernel = kernels.find(kernel).map_err(|e| e.to_string())?;
-    let params = kernel.resolve(None, &[]).map_err(|e| e.to_string())?;
-    render(&gpu, kernel, &params, width, height).map_err(|e| e.to_string())
+    common::render_in_project(ctx, &example(name), kernel, &[], (width, height))
 }
 
 fn npy_u32(path: &Path) -> Vec<u32> {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let header = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    bytes[10 + header..].chunks_exact(4).map(|w| u32::from_le_bytes(w.try_into().expect("4 bytes"))).collect()
+    let npy = vista_image::npy::decode_npy(path, &bytes).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(npy.descr, "<u4", "{}", path.display());
+    npy.data.chunks_exact(4).map(|w| u32::from_le_bytes(w.try_into().expect("4 bytes"))).collect()
 }
 
 /// examples/graphs, row_offsets: compressed-row offsets of the counts in

@@ -45,6 +45,37 @@ pub fn renderer() -> Result<&'static Renderer<'static>, String> {
     .map_err(Clone::clone)
 }
 
+/// A context of its own on backend `name` (lavapipe, swiftshader,
+/// browser) with this process's settings; the Khronos layer, being wgpu's,
+/// is left off for the browser, whose Dawn validates always.
+pub fn backend_context(name: &str) -> Result<vista_gpu::Context, String> {
+    let base = &config().gpu;
+    let config = vista_gpu::GpuConfig {
+        adapter: vista_gpu::AdapterChoice::of_backend(name).map_err(|e| e.to_string())?,
+        validate: base.validate && name != "browser",
+        ..base.clone()
+    };
+    vista_gpu::Context::new(&config).map_err(|e| format!("{name}: {e}"))
+}
+
+/// Renders `kernel` of the vista project at `dir` on `ctx`, its params the
+/// defaults with `set` over them, at `width` x `height`.
+pub fn render_in_project(
+    ctx: &vista_gpu::Context,
+    dir: &Path,
+    kernel: &str,
+    set: &[(String, String)],
+    size: (u32, u32),
+) -> Result<vista_render::Rendered, String> {
+    let project = Project::at(dir).map_err(|e| e.to_string())?;
+    let gpu = Renderer::new(ctx, &project, config().limits).map_err(|e| e.to_string())?;
+    let kernels = vista_kernels::Registry::of_project(&project).map_err(|e| e.to_string())?;
+    let kernel = kernels.find(kernel).map_err(|e| e.to_string())?;
+    let params = kernel.resolve(None, set).map_err(|e| e.to_string())?;
+    vista_render::render(&gpu, kernel, &params, size.0, size.1)
+        .map_err(|e| format!("{} on {}: {e}", kernel.name(), gpu.backend()))
+}
+
 /// For benches: the renderer, or a panic with the install hint.
 pub fn gpu_for_bench() -> &'static Renderer<'static> {
     renderer().unwrap_or_else(|e| panic!("benchmarks need a GPU adapter: {e}"))
