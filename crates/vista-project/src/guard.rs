@@ -48,15 +48,32 @@ pub fn check_file(root: &Path, path: &Path, max: u64) -> Result<PathBuf, GuardEr
         ));
     }
     let meta = std::fs::metadata(&real).map_err(|e| refuse(path, format!("cannot read: {e}")))?;
+    let via = if real != path { format!(" (resolves to {})", real.display()) } else { String::new() };
+    regular(path, &meta, &via, max)?;
+    Ok(real)
+}
+
+/// A regular file of at most `max` bytes (`via`: where a symlink led).
+fn regular(path: &Path, meta: &std::fs::Metadata, via: &str, max: u64) -> Result<(), GuardError> {
     if !meta.is_file() {
-        let what = kind_of(&meta);
-        let via = if real != path { format!(" (resolves to {})", real.display()) } else { String::new() };
-        return Err(refuse(path, format!("is {what}{via}; expected a regular file")));
+        return Err(refuse(path, format!("is {}{via}; expected a regular file", kind_of(meta))));
     }
     if meta.len() > max {
         return Err(refuse(path, format!("{} bytes is larger than vista reads ({max} bytes at most)", meta.len())));
     }
-    Ok(real)
+    Ok(())
+}
+
+/// The bytes of `real` (checked), named `path` in errors: reading stops at
+/// `max` bytes whatever the file grew to after the check.
+fn read_capped(path: &Path, real: &Path, max: u64) -> Result<Vec<u8>, GuardError> {
+    let file = std::fs::File::open(real).map_err(|e| refuse(path, format!("cannot read: {e}")))?;
+    let mut bytes = Vec::new();
+    file.take(max + 1).read_to_end(&mut bytes).map_err(|e| refuse(path, format!("cannot read: {e}")))?;
+    if bytes.len() as u64 > max {
+        return Err(refuse(path, format!("grew past {max} bytes while read; vista reads at most that")));
+    }
+    Ok(bytes)
 }
 
 fn kind_of(meta: &std::fs::Metadata) -> &'static str {
@@ -77,17 +94,10 @@ fn kind_of(meta: &std::fs::Metadata) -> &'static str {
     if meta.is_dir() { "a directory" } else { "not a regular file" }
 }
 
-/// The bytes of `path`, checked by [`check_file`]; reading stops at `max`
-/// bytes whatever the file grew to after the check.
+/// The bytes of `path`, checked by [`check_file`].
 pub fn read_bytes(root: &Path, path: &Path, max: u64) -> Result<Vec<u8>, GuardError> {
     let real = check_file(root, path, max)?;
-    let file = std::fs::File::open(&real).map_err(|e| refuse(path, format!("cannot read: {e}")))?;
-    let mut bytes = Vec::new();
-    file.take(max + 1).read_to_end(&mut bytes).map_err(|e| refuse(path, format!("cannot read: {e}")))?;
-    if bytes.len() as u64 > max {
-        return Err(refuse(path, format!("grew past {max} bytes while read; vista reads at most that")));
-    }
-    Ok(bytes)
+    read_capped(path, &real, max)
 }
 
 /// The bytes of `path` where no project root applies (a golden found by
@@ -99,16 +109,8 @@ pub fn read_regular(path: &Path, max: u64) -> Result<Option<Vec<u8>>, GuardError
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(refuse(path, format!("cannot read: {e}"))),
     };
-    if !meta.is_file() {
-        return Err(refuse(path, format!("is {}; expected a regular file", kind_of(&meta))));
-    }
-    if meta.len() > max {
-        return Err(refuse(path, format!("{} bytes is larger than vista reads ({max} bytes at most)", meta.len())));
-    }
-    let file = std::fs::File::open(path).map_err(|e| refuse(path, format!("cannot read: {e}")))?;
-    let mut bytes = Vec::new();
-    file.take(max).read_to_end(&mut bytes).map_err(|e| refuse(path, format!("cannot read: {e}")))?;
-    Ok(Some(bytes))
+    regular(path, &meta, "", max)?;
+    read_capped(path, path, max).map(Some)
 }
 
 /// The text of `path` (UTF-8), checked by [`check_file`] with
