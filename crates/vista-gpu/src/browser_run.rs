@@ -236,10 +236,10 @@ pub(crate) struct Written {
 }
 
 impl Written {
-    /// `wgsl`, the writer's text of `module`, with its entry names.
-    pub(crate) fn of(module: &naga::Module, wgsl: String) -> Written {
-        let entries = written_entries(module, &wgsl);
-        Written { wgsl, entries }
+    /// `wgsl`, the writer's text of `module`, with the entry names
+    /// `written` (that text parsed back) gives them.
+    pub(crate) fn of(module: &naga::Module, written: &naga::Module, wgsl: String) -> Written {
+        Written { wgsl, entries: written_entries(module, written) }
     }
 
     /// The written name of entry `name` (itself if the writer kept it).
@@ -248,11 +248,10 @@ impl Written {
     }
 }
 
-/// Each entry point of `module` with its name in `wgsl`, the writer's text
-/// of it: the writer keeps their order, so the n-th entry of the text, parsed
-/// back, is the n-th of the module.
-fn written_entries(module: &naga::Module, wgsl: &str) -> Vec<(String, String)> {
-    let Ok(back) = naga::front::wgsl::parse_str(wgsl) else { return Vec::new() };
+/// Each entry point of `module` renamed in `back`, the writer's text of it
+/// parsed back: the writer keeps their order, so the n-th entry of the text
+/// is the n-th of the module.
+fn written_entries(module: &naga::Module, back: &naga::Module) -> Vec<(String, String)> {
     module
         .entry_points
         .iter()

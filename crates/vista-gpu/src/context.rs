@@ -606,8 +606,8 @@ impl Context {
         let (resolved, info) = crate::shaders::resolve_overrides(shader, &module, entry, constants)?;
         let text = naga::back::wgsl::write_string(&resolved, &info, naga::back::wgsl::WriterFlags::empty())
             .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))?;
-        let wgsl = crate::shaders::keep_struct_layouts(shader, &resolved, text)?;
-        Ok(crate::browser_run::Written::of(&resolved, wgsl))
+        let (wgsl, written) = crate::shaders::keep_struct_layouts(shader, &resolved, text)?;
+        Ok(crate::browser_run::Written::of(&resolved, &written, wgsl))
     }
 
     /// Compiles a kernel file's entry point with one bind group layout per

@@ -687,8 +687,14 @@ pub fn resolve_overrides(
 /// other offsets than the ones vista packs its uniforms by (Chrome's
 /// relaxed uniform layout then accepts it and reads shifted values). Each
 /// member whose offset or struct size differs gets `@size(next offset -
-/// offset)`; structs that already agree are left as written.
-pub fn keep_struct_layouts(name: &str, module: &naga::Module, text: String) -> Result<String, GpuError> {
+/// offset)`; structs that already agree are left as written. Also returns
+/// the writer's text parsed back (its names, entry points included, are
+/// the ones the returned text has).
+pub fn keep_struct_layouts(
+    name: &str,
+    module: &naga::Module,
+    text: String,
+) -> Result<(String, naga::Module), GpuError> {
     use naga::TypeInner;
     // naga's writer leaves out the enable directives its own output needs.
     let enables: String = features_used(module)
@@ -726,7 +732,7 @@ pub fn keep_struct_layouts(name: &str, module: &naga::Module, text: String) -> R
     }
     let mut out = lines.join("\n");
     out.push('\n');
-    Ok(out)
+    Ok((out, written))
 }
 
 /// The kernel file of a kernel name (`fbm.wgsl?A&B` -> `fbm.wgsl`,
