@@ -66,7 +66,7 @@ seed-study: lavapipe build
 	bash ci/seed-study.sh $(VISTA) docs/seed-study/shell $(or $(SIZE),480x270) seed-scene
 	bash ci/seed-study-index.sh docs/seed-study
 
-# Issue 31's hardware-GPU figures into docs/device: `vista bench` for every
+# The hardware-GPU figures into docs/device: `vista bench` for every
 # kernel and the seed study on both scenes at 1920x1080 with --backend gpu
 # (BACKEND=lavapipe SIZE=64x36 tries it without a GPU). Never part of make test.
 device-figures: build

@@ -57,7 +57,7 @@ sweep clouds-riemann-none-linear clouds --preset cumulus --set integrator=rieman
     --param steps --values 8,16,32,64,128,256 --param2 light_steps --values2 2,4,6,12,24 --size 96x96
 sweep clouds-analytic-ign-linear clouds --preset cumulus --set integrator=analytic --set jitter=ign --metric linear \
     --param steps --values 8,16,32,64,128,256 --param2 light_steps --values2 2,4,6,12,24 --size 96x96
-# Issue 19's cheaper sampling, at the light-step count where the primary
+# The cheaper sampling options, at the light-step count where the primary
 # march is the bottleneck (4): primary steps growing geometrically from the
 # slab entry (step_spread, 1 = the uniform steps above), at both sizes the
 # target names; and golden-ratio offsets per step (the grid of

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 31's figures on a hardware GPU, in one run: `vista bench` for every
+# The figures on a hardware GPU, in one run: `vista bench` for every
 # kernel (its default params) and the seed's clouds study on both scenes,
 # written under OUT with the adapter named. Never part of make test or CI.
 # Usage: ci/device-figures.sh VISTA OUT [WxH]

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Time and memory of `vista check` per case against image size and case
-# count, passing and failing (issue 55): prints a markdown table. Builds
+# count, passing and failing: prints a markdown table. Builds
 # throwaway projects of fbm cases under a temporary folder; not part of
 # `make test`. Usage: bash ci/scaling.sh [vista binary] [counts...]
 set -euo pipefail

@@ -70,7 +70,7 @@ const FAULTS: &[Fault] = &[
     ("clouds", "lib/phase.wgsl", "(4.0 * PI * denom * sqrt(denom))", "(4.2 * PI * denom * sqrt(denom))"),
     // The powder term's exponent: only the powder setting (no preset turns it on) sees it.
     ("clouds", "lib/cloud_slab.wgsl", "s.c.powder * exp(-2.0 * tau_sun)", "s.c.powder * exp(-2.1 * tau_sun)"),
-    // Issue 19's sampling options: geometric primary steps, golden-ratio
+    // The cheaper sampling options: geometric primary steps, golden-ratio
     // offsets, steps per ray from step_km.
     (
         "clouds",
@@ -86,7 +86,7 @@ const FAULTS: &[Fault] = &[
         "let g = 0.5 + 0.5 * sum * s.inv_amplitude;",
         "let g = 0.5 + 0.525 * sum * s.inv_amplitude;",
     ),
-    // Issue 32's cloud shell: its altitude and its sphere crossings.
+    // The cloud shell: its altitude and its sphere crossings.
     ("clouds", "lib/cloud_slab.wgsl", "p.y * (p.y + 2.0 * PLANET_RADIUS_KM);", "p.y * (p.y + 2.1 * PLANET_RADIUS_KM);"),
     (
         "clouds",

@@ -1,4 +1,4 @@
-//! landscape (issue 16) on the GPU: the invariants that tie it to the
+//! landscape (the seed's whole frame) on the GPU: the invariants that tie it to the
 //! kernels it is composed of (its GPU-vs-CPU agreement is in agreement.rs).
 //! Without air or clouds it is the heightfield kernel's shading under a
 //! white sun; over flat ground it is the atmosphere kernel's sky; radiance is

@@ -268,7 +268,7 @@ fn a_validation_message_fails_the_dispatch(_shared: &vista_render::Renderer) {
 }
 
 /// A parent whose GPU work runs in workers describes the device by the
-/// facts a worker sends (issue 55: the parent loads no Vulkan driver).
+/// facts a worker sends (the parent loads no Vulkan driver).
 /// Through the wire's JSON, that context answers what vista asks of the
 /// device as the device's own context does, and refuses to run a graph.
 fn a_described_device_answers_as_the_device_does(shared: &vista_render::Renderer) {

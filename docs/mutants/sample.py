@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent mutation sample, judged by the goldens alone (issue 27).
+"""An independent mutation sample, judged by the goldens alone.
 
 Draws N single-token mutants uniformly over every mutable token of the
 project's WGSL (shaders/*.wgsl and shaders/lib/*.wgsl; not shaders/test),

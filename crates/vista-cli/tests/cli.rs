@@ -3644,7 +3644,7 @@ fn the_report_works_in_a_real_browser() {
     let errors = page.errors();
     assert!(errors.is_empty(), "console errors: {errors:?}");
     // `vista bench --open-report` times the same page over the DevTools
-    // protocol (issue 55's 2 s target for a large suite's index.html).
+    // protocol (the 2 s target for a large suite's index.html).
     let report = root.join("target/vista-report");
     let r = vista_in(Some(&root), &[], &["bench", "--open-report", report.to_str().unwrap(), "--runs", "2", "--json"]);
     assert_eq!(r.code, 0, "{}", r.stderr);

@@ -1,4 +1,4 @@
-//! Structure-aware fuzzing of what vista reads (issue 54, point 8): the
+//! Structure-aware fuzzing of what vista reads: the
 //! checkout's own manifests, cases, `vista.toml`, pending renders, `.npy`,
 //! `.png`, `.exr` and `.wgsl` files, mutated, must each be accepted or
 //! refused with an error, never a panic, a signal or a hang.

@@ -127,7 +127,7 @@ impl GoldenFiles {
     /// Marks the PNG as holding exactly the render's view, so the verdict
     /// judges the view against itself without decoding the PNG: the caller
     /// knows the render's raw bits are those the golden was blessed from
-    /// (issue 55: a passing case needs no decode). Only where the PNG's bytes
+    /// (a passing case needs no decode). Only where the PNG's bytes
     /// are the ones the manifest entry recorded (`golden_hash`): a file
     /// changed since is decoded and judged as ever. [`GoldenFiles::view`]
     /// still decodes it for a report that shows it.

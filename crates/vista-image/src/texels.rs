@@ -30,7 +30,7 @@ impl Texels for Image {
 /// `v / 65535` in f32, the very values [`crate::decode_png16`] gives (for
 /// an 8-bit PNG too: `257 v / 65535` and `v / 255` are the same real, so
 /// the same correctly rounded f32). A 2048 x 2048 golden is 32 MiB here,
-/// 64 MiB as an [`Image`] (issue 55: a failing case's peak memory).
+/// 64 MiB as an [`Image`] (a failing case's peak memory).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Image16 {
     /// Width in pixels.

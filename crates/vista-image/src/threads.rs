@@ -55,7 +55,7 @@ pub(crate) fn in_groups<T: Sync, R: Send>(
 /// of its own, and the freed top of one (a FLIP strip's 45 MB) is what
 /// `malloc_trim` does not hand back: four failing 2048 x 2048 cases
 /// peaked at 364 MB, not 308, since each case after the first started
-/// with about 110 MB of such tops resident (issue 55). The arena's lock
+/// with about 110 MB of such tops resident. The arena's lock
 /// costs nothing measurable: a thread allocates a few large buffers per
 /// band or strip.
 pub fn one_arena() {

@@ -11,7 +11,7 @@
 //! that meets the slab is marched in `steps` equal steps of length dt over
 //! its part inside the slab (cut at `max_distance_km`), sample k at
 //! t0 + (k + xi) dt with xi = 0.5 (midpoint rule) or a per-pixel jitter
-//! hash. Two options move the samples (issue 19): `step_spread` > 1 makes
+//! hash. Two options move the samples: `step_spread` > 1 makes
 //! the steps grow geometrically from t0 (step k spans the fractions
 //! (r^k - 1) / (r^n - 1) to (r^(k+1) - 1) / (r^n - 1) of the segment,
 //! r = step_spread^(1 / (n - 1)), each sample xi of its step in), and

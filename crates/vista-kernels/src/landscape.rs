@@ -1,4 +1,4 @@
-//! `landscape`: the seed's whole frame as one kernel (issue 16).
+//! `landscape`: the seed's whole frame as one kernel.
 //!
 //! The scene is the heightfield kernel's terrain (ridged by default; same
 //! march, refinement, normals, soft shadow and surface shading), under the

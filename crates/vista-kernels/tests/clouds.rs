@@ -294,7 +294,7 @@ fn light_step_spacings_converge_to_the_same_image() {
     }
 }
 
-/// Issue 19's primary-step options change where the samples sit, not what
+/// The primary-step options change where the samples sit, not what
 /// they integrate: geometric steps (step_spread) and golden-ratio offsets
 /// per step (jitter_steps) converge to the uniform march's image.
 #[test]

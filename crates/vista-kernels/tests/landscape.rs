@@ -1,4 +1,4 @@
-//! landscape (issue 16): CPU-only checks of the composed f64 reference.
+//! landscape (the seed's whole frame): CPU-only checks of the composed f64 reference.
 
 use vista_kernels::landscape::{Landscape, LandscapeKernel};
 use vista_kernels::{ParamError, ParamSet};

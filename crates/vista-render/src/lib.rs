@@ -144,7 +144,7 @@ fn shared_context(gpu: &vista_gpu::GpuConfig) -> Result<&'static Context, vista_
 
 /// A context for `config`: where GPU work runs in workers, one that
 /// describes the device a worker holds (this process then loads no
-/// Vulkan driver: 60 MB less of its peak, issue 55), else the device.
+/// Vulkan driver: 60 MB less of its peak), else the device.
 fn context_for(config: &vista_gpu::GpuConfig) -> Result<Context, vista_gpu::GpuError> {
     match worker::Worker::for_config(config) {
         Some(w) => {
