@@ -38,8 +38,9 @@ test: lavapipe swiftshader validation browser
 	# lavapipe under the Khronos validation layer (any message fails the
 	# case), and two more runs of the golden harness: every golden case again
 	# on SwiftShader (other-driver thresholds, expectations from
-	# golden/cases.toml) and in headless Chromium's WebGPU (naga's WGSL
-	# through Tint and Dawn). Each writes its own report.
+	# golden/cases.toml) and in headless Chromium's WebGPU (the
+	# project's WGSL, or naga's rewrite of a naga_oil module, through Tint
+	# and Dawn). Each writes its own report.
 	set -o pipefail; CARGO=$(CARGO) GOLDEN_ENV=VISTA_VALIDATION=1 PASSES=$$'VISTA_BACKEND=swiftshader\nVISTA_BACKEND=browser' \
 		bash ci/test-parallel.sh 2>&1 | tee target/test.log
 	@echo "---- examples/harness-crate: another crate's cargo test running its golden cases through vista::harness::main()"

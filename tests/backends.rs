@@ -1,7 +1,8 @@
 //! The same cases on the three implementations, compared with each other
 //! rather than with the goldens: lavapipe (naga -> SPIR-V -> Mesa),
-//! swiftshader (naga -> SPIR-V -> SwiftShader) and browser (naga's WGSL ->
-//! Tint -> Dawn -> SwiftShader in headless Chromium). Prints, per kernel, the
+//! swiftshader (naga -> SPIR-V -> SwiftShader) and browser (the WGSL text,
+//! or naga's rewrite of a naga_oil module, -> Tint -> Dawn -> SwiftShader
+//! in headless Chromium). Prints, per kernel, the
 //! max abs difference of the raw output and the display PSNR of each pair;
 //! every pair must hold the goldens' other-driver PSNR, and the two
 //! SwiftShader paths a display PSNR and a raw max-abs of their own.
@@ -88,7 +89,7 @@ fn backends_agree(contexts: &[Context]) -> Result<(), String> {
             }
             // swiftshader and browser run the same SwiftShader build (both
             // from Debian's chromium-common), so the compile path (naga's
-            // SPIR-V vs naga's WGSL through Tint) is their only difference;
+            // SPIR-V vs the WGSL through Tint) is their only difference;
             // measured at 130 dB or better over all cases.
             if (a, b) == (1, 2) && psnr < SAME_DEVICE_PSNR {
                 failures.push(format!(

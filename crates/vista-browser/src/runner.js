@@ -67,7 +67,8 @@ function vistaChunk(offset, length) {
 }
 
 // A pass graph (SPEC 14; a one-pass kernel is a graph of one pass): job = { resources: [texture | buffer |
-// sampler], passes: [{ key, wgsl, entry, workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding,
+// sampler], passes: [{ key, wgsl (the project's text, or naga's rewrite of a composed module), entry, constants (WebGPU
+// pipeline constants), workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding,
 // layout, owned (base64) | resource, level (a texture's one mip level, or null: all) }] }], outputs: [resource
 // index] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
 // the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64), usage (WebGPU usage names the passes
@@ -75,14 +76,14 @@ function vistaChunk(offset, length) {
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility; `vertex`: the render pass's vertex entry reads it too); a texture slot's view
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
-// another file's; null: vertex_entry is in the pass's own module), vertex_entry, targets: [{ resource, level, layer, clear, clear_once (the first run only),
+// another file's; null: vertex_entry is in the pass's own module), vertex_entry, vertex_constants, targets: [{ resource, level, layer, clear, clear_once (the first run only),
 // blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a
 // buffer or null), index_format (uint32 or uint16), count, instances, topology, cull, depth ({ resource, compare, write, clear } or null), blend_constant }. Outputs are read back one after another into vista.out: textures
 // unpadded, layers stacked; buffers whole.
 async function pipeline(pass, resources) {
   const targets = pass.raster ? pass.raster.targets.map((t) => ({ format: resources[t.resource].format, blend: t.blend || undefined })) : null;
   const r = pass.raster;
-  const fixed = r ? [r.vertex_entry, r.vertex, r.buffers.map((b) => [b.arrayStride, b.stepMode, b.attributes]), r.topology, r.cull, r.depth, r.indices !== null && r.index_format] : null;
+  const fixed = r ? [r.vertex_entry, r.vertex, r.vertex_constants, r.buffers.map((b) => [b.arrayStride, b.stepMode, b.attributes]), r.topology, r.cull, r.depth, r.indices !== null && r.index_format] : null;
   const key = `${pass.key}@${pass.entry}${JSON.stringify(pass.slots.map((s) => [s.group, s.binding, s.layout, s.vertex]))}${JSON.stringify(targets)}${JSON.stringify(fixed)}`;
   const cached = vista.pipelines.get(key);
   if (cached) return cached;
@@ -117,13 +118,13 @@ async function pipeline(pass, resources) {
       const strip = r.indices !== null && (r.topology === "triangle-strip" || r.topology === "line-strip");
       p = await d.createRenderPipelineAsync({
         layout,
-        vertex: { module: vertex, entryPoint: r.vertex_entry, buffers: r.buffers.map((b) => ({ arrayStride: b.arrayStride, stepMode: b.stepMode, attributes: b.attributes })) },
-        fragment: { module, entryPoint: pass.entry, targets },
+        vertex: { module: vertex, entryPoint: r.vertex_entry, constants: r.vertex_constants, buffers: r.buffers.map((b) => ({ arrayStride: b.arrayStride, stepMode: b.stepMode, attributes: b.attributes })) },
+        fragment: { module, entryPoint: pass.entry, constants: pass.constants, targets },
         primitive: { topology: r.topology, cullMode: r.cull, frontFace: "ccw", ...(strip ? { stripIndexFormat: r.index_format } : {}) },
         ...(r.depth ? { depthStencil: { format: "depth32float", depthWriteEnabled: r.depth.write, depthCompare: r.depth.compare } } : {}),
       });
     } else {
-      p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: pass.entry } });
+      p = await d.createComputePipelineAsync({ layout, compute: { module, entryPoint: pass.entry, constants: pass.constants } });
     }
   } finally {
     const e = await d.popErrorScope();

@@ -3326,8 +3326,8 @@ fn a_kernel_described_as_data_renders() {
     assert_eq!(r.code, 0, "{}", r.stderr);
 }
 
-/// A project's own kernel runs in the browser too (naga writes the composed
-/// module back as one WGSL source for Tint), with lavapipe's pixels; and
+/// A project's own kernel runs in the browser too (Tint compiles its text),
+/// with lavapipe's pixels; and
 /// Chromium's profile folder goes with the run, as does one a killed run
 /// left behind.
 fn a_project_kernel_renders_the_same_in_the_browser() {
@@ -3354,6 +3354,45 @@ fn a_project_kernel_renders_the_same_in_the_browser() {
         .filter(|n| n.starts_with("vista-chromium-") || n.starts_with("vista-browser-"))
         .collect();
     assert!(left.is_empty(), "left in the temp folder: {left:?}");
+}
+
+/// The browser hands Tint the project's own text, not naga's rewrite: a
+/// literal naga's writer would print above f32's range (3.402823466e+38)
+/// renders as on lavapipe, the entry keeps its digit-final name, overrides
+/// (the workgroup size among them) go as pipeline constants; and where
+/// Tint refuses what naga accepts, the error names the user's file and line.
+fn the_browser_runs_the_projects_own_text() {
+    let manifest = "summary = \"far\"\noverrides = { WG = 8 }\n[[param]]\nname = \"GAIN\"\ntype = \"f32\"\n\
+                    range = [0.0, 1.0]\ndefault = 0.5\ndoc = \"g\"\n[[pass]]\nentry = \"fill_f32\"\n";
+    let shader = "override GAIN: f32 = 1.0;\noverride WG: u32 = 1;\n\
+                  @group(0) @binding(0) var output: texture_storage_2d<rgba32float, write>;\n\
+                  @compute @workgroup_size(WG, WG)\nfn fill_f32(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                  \x20   var minDistance = 3.402823466e+38;\n\
+                  \x20   textureStore(output, id.xy, vec4(min(minDistance, GAIN), f32(id.x) * 0.125, 0.0, 1.0));\n}\n";
+    let d = kernel_project(manifest, shader);
+    let exr = |b: &str| d.path().join(format!("{b}.exr"));
+    for b in ["lavapipe", "browser"] {
+        let out = exr(b);
+        let r = vista_in(
+            Some(d.path()),
+            &[],
+            &["--backend", b, "render", "k", "--set", "GAIN=0.25", "--size", "16x8", "-o", out.to_str().unwrap()],
+        );
+        assert_eq!(r.code, 0, "{b}: {}", r.stderr);
+    }
+    let (a, b) = (vista_image::load(&exr("lavapipe")).unwrap(), vista_image::load(&exr("browser")).unwrap());
+    assert_eq!(a.get(15, 7), [0.25, 1.875, 0.0, 1.0], "GAIN from the param, every texel of 16x8 written");
+    assert_eq!(a.data, b.data, "lavapipe and Chromium");
+    // 3.4028235e38 is above f32::MAX: naga rounds it, Tint refuses it.
+    std::fs::write(d.path().join("shaders/k.wgsl"), shader.replace("3.402823466e+38", "3.4028235e38")).unwrap();
+    let out = exr("refused");
+    let r = vista_in(
+        Some(d.path()),
+        &[],
+        &["--backend", "browser", "render", "k", "--size", "16x8", "-o", out.to_str().unwrap()],
+    );
+    let at = format!("{}:6:23", d.path().join("shaders/k.wgsl").display());
+    assert_rejected(&r, 1, &["Tint rejected the WGSL", &at, "cannot be represented as 'f32'"]);
 }
 
 /// Without Chromium the browser backend fails at once with the install
@@ -5907,6 +5946,7 @@ fn main() {
         Cpu unwritable_output_directory_is_refused,
         Cpu browser_backend_without_chromium_names_the_install_command,
         Gpu a_project_kernel_renders_the_same_in_the_browser,
+        Gpu the_browser_runs_the_projects_own_text,
         Gpu the_report_works_in_a_real_browser,
         Gpu max_flip_fails_a_case_above_it,
         Gpu compare_reports_json_fields_and_rejects_bad_files,

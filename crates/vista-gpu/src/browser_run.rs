@@ -1,5 +1,5 @@
 //! The browser engine's one executor: the same graph as JSON for
-//! `runner.js`'s `vistaRun` (naga's WGSL of each pass, the same resources,
+//! `runner.js`'s `vistaRun` (each pass's WGSL as [`TintWgsl`] says, the same resources,
 //! contents, bindings, repeats and swaps), the outputs decoded as on wgpu.
 
 use std::sync::Arc;
@@ -13,7 +13,7 @@ use crate::graph::{Bind, Contents, Graph, GraphPass, GraphSlot, OutputData, Read
 use vista_texel::{Access, SampleKind};
 
 impl Context {
-    /// The same graph in headless Chromium: naga's WGSL of each pass, the
+    /// The same graph in headless Chromium: each pass's WGSL as Tint gets it, the
     /// same resources, contents, bindings, repeats and swaps (`runner.js`,
     /// `vistaRun`), the outputs decoded as on wgpu.
     pub(crate) fn run_in_browser(
@@ -56,6 +56,8 @@ impl Context {
             });
         }
         let mut passes = Vec::new();
+        // Each pass's text by its key, to place Tint's line numbers.
+        let mut texts: Vec<(String, Arc<TintWgsl>)> = Vec::new();
         for pass in g.passes.iter() {
             let (key, written) = self.browser_wgsl(b, g, &pass.shader, &pass.entry, &pass.constants)?;
             let slots = pass.slots.iter().map(|s| self.slot_json(b, g, pass, s)).collect::<Result<Vec<_>, _>>()?;
@@ -73,13 +75,15 @@ impl Context {
             let raster = pass.raster.as_ref().map(|r| {
                 // A vertex entry by the name the written WGSL gives it.
                 let vertex = r.vertex.as_deref().map(|vs| match &vertex_written {
-                    Some(v) => (Some(v.wgsl.as_str()), v.entry(vs)),
-                    None => (None, written.entry(vs)),
+                    Some(v) => (Some(v.wgsl.as_str()), v.entry(vs), constants_json(&v.constants)),
+                    None => (None, written.entry(vs), constants_json(&written.constants)),
                 });
                 raster_json(r, vertex)
             });
+            texts.push((key.clone(), written.clone()));
             passes.push(json!({
                 "key": key, "label": pass.label, "wgsl": written.wgsl, "entry": written.entry(&pass.entry),
+                "constants": constants_json(&written.constants),
                 "workgroups": pass.workgroups, "repeat": pass.repeat, "span": pass.span,
                 "swap": pass.swap.iter().map(|(a, b)| [a, b]).collect::<Vec<_>>(),
                 "slots": slots, "raster": raster,
@@ -91,6 +95,10 @@ impl Context {
         let out = b.browser.run(&label, &job).map_err(|e| match e {
             vista_browser::BrowserError::Timeout { case, seconds } => GpuError::Timeout { what: case, seconds },
             vista_browser::BrowserError::Page { case, message } => {
+                let message = match texts.iter().find(|(key, _)| message.contains(&format!("WGSL of {key}:"))) {
+                    Some((key, text)) => text.locate(&message.replace(&format!("WGSL of {key}:"), "WGSL:")),
+                    None => message,
+                };
                 GpuError::Validation { what: format!("{case} (in the browser)"), message }
             }
             other => GpuError::Device { adapter: self.adapter_description(), message: other.to_string() },
@@ -132,14 +140,14 @@ impl Context {
         shader: &str,
         entry: &str,
         constants: &[(String, f64)],
-    ) -> Result<(String, Arc<Written>), GpuError> {
+    ) -> Result<(String, Arc<TintWgsl>), GpuError> {
         let key = format!("{shader}#{}@{entry}{constants:?}", g.shaders.source_hash(shader)?);
         if let Some(w) = b.sources.lock().expect("wgsl cache").get(&key).cloned() {
             return Ok((key, w));
         }
         self.check_features(shader, [Some(&*g.shaders.compose(shader)?), None])?;
         self.check_declared(shader, &g.shaders.declared_features(shader)?)?;
-        let w = Arc::new(Context::written_wgsl(g.shaders, shader, entry, constants)?);
+        let w = Arc::new(Context::wgsl_for_tint(g.shaders, shader, entry, constants)?);
         b.sources.lock().expect("wgsl cache").insert(key.clone(), w.clone());
         Ok((key, w))
     }
@@ -221,31 +229,83 @@ impl Context {
     }
 }
 
-/// A render pass as runner.js builds it: the vertex stage (vista's
-/// full-screen triangle or another file's WGSL, or `vertex_entry` of the
-/// pass's own module when `vertex` is null), WebGPU's blend states, buffers
-/// and fixed-function state.
-/// naga's WGSL of one composed kernel, and each entry point's name in it.
-pub(crate) struct Written {
+/// The WGSL the page hands Tint for one kernel file, each entry point's
+/// name in it, the pipeline constants that go with it, and where its lines
+/// came from.
+#[derive(Debug)]
+pub struct TintWgsl {
     /// The text the page hands Dawn.
-    pub(crate) wgsl: String,
+    pub wgsl: String,
     /// (the module's entry name, the name the writer gave it): naga's
     /// namer renames some (`fill_f32` becomes `fill_f32_`), and Dawn must
-    /// be asked for the name the text has.
+    /// be asked for the name the text has. Empty for the project's text.
     entries: Vec<(String, String)>,
+    /// WebGPU pipeline constants (the project's text keeps its `override`s;
+    /// a rewrite has them resolved).
+    pub constants: Vec<(String, f64)>,
+    /// The project's text and its lines' files; `None` for naga's rewrite.
+    pub source: Option<crate::SourceText>,
 }
 
-impl Written {
-    /// `wgsl`, the writer's text of `module`, with the entry names
-    /// `written` (that text parsed back) gives them.
-    pub(crate) fn of(module: &naga::Module, written: &naga::Module, wgsl: String) -> Written {
-        Written { wgsl, entries: written_entries(module, written) }
+impl TintWgsl {
+    /// The project's own text, its overrides set by `constants`.
+    pub(crate) fn source(source: crate::SourceText, constants: &[(String, f64)]) -> TintWgsl {
+        TintWgsl { wgsl: source.text.clone(), entries: Vec::new(), constants: constants.to_vec(), source: Some(source) }
     }
 
-    /// The written name of entry `name` (itself if the writer kept it).
-    pub(crate) fn entry<'a>(&'a self, name: &'a str) -> &'a str {
+    /// `wgsl`, naga's rewrite of `module`, with the entry names `written`
+    /// (that text parsed back) gives them.
+    pub(crate) fn rewrite(module: &naga::Module, written: &naga::Module, wgsl: String) -> TintWgsl {
+        TintWgsl { wgsl, entries: written_entries(module, written), constants: Vec::new(), source: None }
+    }
+
+    /// The name entry `name` has in the text (itself unless the writer renamed it).
+    pub fn entry<'a>(&'a self, name: &'a str) -> &'a str {
         self.entries.iter().find(|(from, _)| from == name).map_or(name, |(_, to)| to.as_str())
     }
+
+    /// Where line `line`, column `col` (1-based) of the text is, for an
+    /// error: the project's file and line, or, in a rewrite or a
+    /// compiler's untraced output, that line of the text printed.
+    pub fn place(&self, line: usize, col: usize) -> String {
+        let text = self.wgsl.lines().nth(line.wrapping_sub(1)).unwrap_or("").trim();
+        match &self.source {
+            Some(s) => match s.locate(line) {
+                Some((file, at)) => format!("{file}:{at}:{col}"),
+                None => format!("line {line}:{col} of {} `{text}`", s.origin()),
+            },
+            None => format!("line {line}:{col} of naga's rewrite of the composed module, `{text}`"),
+        }
+    }
+
+    /// `message` (runner.js's `line L:C: ...` list for this text) with each
+    /// place named by [`TintWgsl::place`].
+    pub(crate) fn locate(&self, message: &str) -> String {
+        let mut out = String::new();
+        let mut rest = message;
+        while let Some(at) = rest.find("line ") {
+            out.push_str(&rest[..at]);
+            let after = &rest[at + "line ".len()..];
+            match leading_number(after).and_then(|(l, t)| Some((l, leading_number(t.strip_prefix(':')?)?))) {
+                Some((line, (col, tail))) if tail.starts_with(':') => {
+                    out.push_str(&self.place(line, col));
+                    rest = tail;
+                }
+                _ => {
+                    out.push_str("line ");
+                    rest = after;
+                }
+            }
+        }
+        out.push_str(rest);
+        out
+    }
+}
+
+/// The number `t` starts with, and what follows it.
+fn leading_number(t: &str) -> Option<(usize, &str)> {
+    let d = t.chars().take_while(char::is_ascii_digit).count();
+    t[..d].parse::<usize>().ok().map(|n| (n, &t[d..]))
 }
 
 /// Each entry point of `module` renamed in `back`, the writer's text of it
@@ -261,9 +321,15 @@ fn written_entries(module: &naga::Module, back: &naga::Module) -> Vec<(String, S
         .collect()
 }
 
+/// Pipeline constants as WebGPU's `constants` record.
+fn constants_json(constants: &[(String, f64)]) -> Value {
+    Value::Object(constants.iter().map(|(k, v)| (k.clone(), json!(v))).collect())
+}
+
 /// A render pass as the page takes it; `vertex`: the vertex entry's WGSL
-/// (when it is another file's) and its name in the written text.
-fn raster_json(r: &crate::graph::Raster, vertex: Option<(Option<&str>, &str)>) -> Value {
+/// (when it is another file's), its name in that text and its pipeline
+/// constants.
+fn raster_json(r: &crate::graph::Raster, vertex: Option<(Option<&str>, &str, Value)>) -> Value {
     let blend = |b: vista_texel::Blend| {
         b.components().map(|(c, a)| {
             let part = |p: vista_texel::BlendComponent| {
@@ -272,9 +338,10 @@ fn raster_json(r: &crate::graph::Raster, vertex: Option<(Option<&str>, &str)>) -
             json!({ "color": part(c), "alpha": part(a) })
         })
     };
-    let (vertex, vertex_entry) = vertex.unwrap_or((Some(crate::FULLSCREEN_WGSL), crate::FULLSCREEN_ENTRY));
+    let (vertex, vertex_entry, vertex_constants) =
+        vertex.unwrap_or((Some(crate::FULLSCREEN_WGSL), crate::FULLSCREEN_ENTRY, json!({})));
     json!({
-        "vertex": vertex, "vertex_entry": vertex_entry,
+        "vertex": vertex, "vertex_entry": vertex_entry, "vertex_constants": vertex_constants,
         "targets": r.targets.iter().map(|t| json!({
             "resource": t.resource, "level": t.level, "layer": t.layer, "clear": t.clear, "clear_once": t.clear_once,
             "blend": blend(t.blend),

@@ -22,8 +22,8 @@ pub enum AdapterChoice {
     Hardware,
     /// The first adapter whose name contains this text (case-insensitive).
     Named(String),
-    /// Headless Chromium's WebGPU: naga writes the composed module back as
-    /// WGSL, Tint compiles it, Dawn runs it on SwiftShader.
+    /// Headless Chromium's WebGPU: Tint compiles the project's WGSL (naga's
+    /// rewrite of a naga_oil module), Dawn runs it on SwiftShader.
     Browser,
 }
 
@@ -226,8 +226,8 @@ pub(crate) enum Engine {
 
 /// What vista asks of a wgpu device, without the device: a worker sends
 /// its device's to its parent, which then loads no Vulkan driver of its
-/// own (the loader and lavapipe's LLVM were 60 MB of the parent's RSS,
-/// issue 55) and still refuses what the device cannot do before any run.
+/// own (the loader and lavapipe's LLVM were 60 MB of the parent's RSS)
+/// and still refuses what the device cannot do before any run.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DeviceFacts {
     /// The adapter's info.
@@ -282,8 +282,8 @@ pub(crate) struct BrowserEngine {
     pub(crate) browser: vista_browser::Browser,
     /// The WebGPU device's features (requested: every one the adapter has).
     pub(crate) features: Vec<String>,
-    /// naga's WGSL of each composed kernel, by source hash.
-    pub(crate) sources: Mutex<HashMap<String, Arc<crate::browser_run::Written>>>,
+    /// The WGSL Tint gets for each kernel file, by source hash.
+    pub(crate) sources: Mutex<HashMap<String, Arc<crate::TintWgsl>>>,
 }
 
 /// Where Debian's vulkan-validationlayers puts the layer's manifest.
@@ -580,34 +580,29 @@ impl Context {
         }
     }
 
-    /// The composed kernel as one WGSL source, as naga writes it back: what
-    /// the browser backend hands to Tint. `override` constants are first
-    /// resolved to `constants` for `entry`: naga's WGSL writer keeps an
-    /// `override` but writes an overridden `@workgroup_size` as its
-    /// placeholder, so the page gets the values baked in instead of
-    /// pipeline constants.
-    pub fn wgsl_source(
+    /// The WGSL the browser backend hands to Tint for `shader`'s `entry`
+    /// with override `constants`: the project's own text wherever naga
+    /// parses it directly (overrides then go as WebGPU pipeline constants),
+    /// else naga's rewrite of the naga_oil-composed module, with `override`
+    /// constants resolved to `constants` first (naga's WGSL writer writes an
+    /// overridden `@workgroup_size` as its placeholder, so the values are
+    /// baked in instead).
+    pub fn wgsl_for_tint(
         shaders: &ShaderSet,
         shader: &str,
         entry: &str,
         constants: &[(String, f64)],
-    ) -> Result<String, GpuError> {
-        Ok(Context::written_wgsl(shaders, shader, entry, constants)?.wgsl)
-    }
-
-    /// [`Context::wgsl_source`] with the name each entry point has in it.
-    pub(crate) fn written_wgsl(
-        shaders: &ShaderSet,
-        shader: &str,
-        entry: &str,
-        constants: &[(String, f64)],
-    ) -> Result<crate::browser_run::Written, GpuError> {
+    ) -> Result<crate::TintWgsl, GpuError> {
+        if let Some(source) = shaders.source_text(shader)? {
+            return Ok(crate::TintWgsl::source(source, constants));
+        }
         let module = shaders.compose(shader)?;
         let (resolved, info) = crate::shaders::resolve_overrides(shader, &module, entry, constants)?;
         let text = naga::back::wgsl::write_string(&resolved, &info, naga::back::wgsl::WriterFlags::empty())
             .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))?;
-        let (wgsl, written) = crate::shaders::keep_struct_layouts(shader, &resolved, text)?;
-        Ok(crate::browser_run::Written::of(&resolved, &written, wgsl))
+        let (wgsl, written) =
+            crate::shaders::keep_struct_layouts(shader, &resolved, crate::shaders::exact_f32_max(&text))?;
+        Ok(crate::TintWgsl::rewrite(&resolved, &written, wgsl))
     }
 
     /// Compiles a kernel file's entry point with one bind group layout per

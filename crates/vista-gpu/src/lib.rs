@@ -21,6 +21,7 @@ pub mod validation;
 mod wgpu_run;
 pub mod wire;
 
+pub use browser_run::TintWgsl;
 pub use context::{
     AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, DeviceFacts, GpuConfig, PassHook, RunStats,
     SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
@@ -31,7 +32,7 @@ pub use graph::{
     RasterTarget, Readback, Resource, SamplerDesc, TextureDesc, VertexBuffer, buffer_size, buffer_usages, run_order,
 };
 pub use limits::Needs;
-pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, resolve_overrides, validate};
+pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, SourceText, resolve_overrides, validate};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
 pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \

@@ -491,7 +491,7 @@ impl ShaderSet {
         // parses it directly. naga_oil 0.23 loses the expressions of an
         // `override` named in `@workgroup_size` ("Handle N of Expression is
         // either not present"), so such kernels work when they import nothing.
-        if !source.lines().any(|l| l.trim_start().starts_with('#')) {
+        if !has_directives(source) {
             let module = naga::front::wgsl::parse_str(source).map_err(|e| {
                 GpuError::Shader(format!(
                     "WGSL error ({}):\n{}",
@@ -528,6 +528,23 @@ impl ShaderSet {
         self.composers.lock().expect("composer pool").push(pooled);
         validate(name, &module)?;
         Ok(module)
+    }
+
+    /// The text naga parses for `name` when it parses it directly (a file
+    /// with no preprocessor directive, an `#include`/prepend/append/replace
+    /// assembly, the wesl crate's output): what the browser hands Tint, so
+    /// that Tint reads what the project wrote. `None` for a file naga_oil
+    /// composes (`#import`, `#ifdef`, ...): naga's IR is all there is.
+    pub fn source_text(&self, name: &str) -> Result<Option<SourceText>, GpuError> {
+        let unit = self.unit(name)?;
+        if has_directives(&unit.source.text) {
+            return Ok(None);
+        }
+        Ok(Some(SourceText {
+            text: unit.source.text.clone(),
+            origin: unit.source.origin.clone(),
+            assembled: unit.assembled.clone(),
+        }))
     }
 
     /// Hash of the kernel file (with its shader defs, if any) and of the library modules it imports,
@@ -733,6 +750,48 @@ pub fn keep_struct_layouts(
     let mut out = lines.join("\n");
     out.push('\n');
     Ok((out, written))
+}
+
+/// A kernel's WGSL as its files give it, and where each line came from.
+#[derive(Debug, Clone)]
+pub struct SourceText {
+    /// The text naga parses.
+    pub text: String,
+    /// What errors name: the kernel file's real path.
+    origin: String,
+    /// Set for an assembly or a compiler's output.
+    assembled: Option<vista_source::Assembled>,
+}
+
+impl SourceText {
+    /// The file and 1-based line that line `line` (1-based) of `text`
+    /// came from; `None` where the text is a compiler's untraced output.
+    pub fn locate(&self, line: usize) -> Option<(String, usize)> {
+        match &self.assembled {
+            None => (line >= 1 && line <= self.text.lines().count()).then(|| (self.origin.clone(), line)),
+            Some(a) => a.locate(line).map(|(file, at)| (file.to_string(), at)),
+        }
+    }
+
+    /// What errors name for the whole text.
+    pub fn origin(&self) -> &str {
+        &self.origin
+    }
+}
+
+/// Whether `source` has a line naga_oil's preprocessor acts on (`#import`,
+/// `#ifdef`, `#define_import_path`, ...); WGSL itself has no `#`.
+fn has_directives(source: &str) -> bool {
+    source.lines().any(|l| l.trim_start().starts_with('#'))
+}
+
+/// naga's writer prints an f32 as its shortest decimal, and that of
+/// `f32::MAX` (3.4028235e38) is above `f32::MAX`, which Tint refuses as
+/// "cannot be represented as 'f32'". Every other finite f32's shortest
+/// decimal lies within half an ulp of it, inside the range. The hex form
+/// is exact.
+pub(crate) fn exact_f32_max(text: &str) -> String {
+    text.replace("340282350000000000000000000000000000000f", "0x1.fffffep+127f")
 }
 
 /// The kernel file of a kernel name (`fbm.wgsl?A&B` -> `fbm.wgsl`,
