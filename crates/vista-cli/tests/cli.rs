@@ -2826,6 +2826,39 @@ fn a_foreign_import_path_composes_and_is_named_when_edited() {
     assert!(c.stdout.contains("changed shader files: mylib/sky/tone.wgsl"), "{}", c.stdout);
 }
 
+/// Two modules that import each other: naga_oil says "required import ...
+/// not found"; vista names the cycle with each file and line.
+fn an_import_cycle_is_named_as_a_cycle() {
+    let shader = K_SHADER
+        .replace("struct Params", "#import atmos::bindings\n\nstruct Params")
+        .replace("vec4(vec3(params.gain), 1.0)", "vec4(vec3(params.gain * atmos::bindings::b()), 1.0)");
+    let d = kernel_project(K_MANIFEST, &shader);
+    let lib = d.path().join("shaders/lib");
+    std::fs::create_dir(&lib).unwrap();
+    let bindings =
+        "#define_import_path atmos::bindings\n#import atmos::common\nfn b() -> f32 { return atmos::common::c(); }\n";
+    let common = "#define_import_path atmos::common\n\n#import atmos::bindings\nfn c() -> f32 { return 1.0; }\n\
+                  fn d() -> f32 { return atmos::bindings::b(); }\n";
+    std::fs::write(lib.join("bindings.wgsl"), bindings).unwrap();
+    std::fs::write(lib.join("common.wgsl"), common).unwrap();
+    let out = d.path().join("k.png");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    let (b, c) = (lib.join("bindings.wgsl"), lib.join("common.wgsl"));
+    assert_rejected(
+        &r,
+        2,
+        &[
+            "its imports form a cycle",
+            &format!("{}:2 imports atmos::common, which {}:3 imports atmos::bindings", b.display(), c.display()),
+        ],
+    );
+    // Without the cycle it composes.
+    std::fs::write(lib.join("common.wgsl"), "#define_import_path atmos::common\nfn c() -> f32 { return 1.0; }\n")
+        .unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
 /// Manifest defs with values reach the kernel and the modules it imports.
 fn valued_defs_reach_imported_modules() {
     let module = "#define_import_path mylib::steps\n\n#if STEPS == 3\nconst K: f32 = 0.25;\n#else\nconst K: f32 = 1.0;\n#endif\n\
@@ -3354,6 +3387,48 @@ fn a_project_kernel_renders_the_same_in_the_browser() {
         .filter(|n| n.starts_with("vista-chromium-") || n.starts_with("vista-browser-"))
         .collect();
     assert!(left.is_empty(), "left in the temp folder: {left:?}");
+}
+
+/// Render-setup mistakes wgpu would report only as "Validation Error" at
+/// pipeline creation are named before any GPU work, exit 2: a u32 output
+/// into an rgba8unorm target, a src1 blend factor without a dual-source
+/// output, a vertex stride that is no multiple of 4.
+fn render_setup_mistakes_are_named_before_gpu_work() {
+    let shader = "struct VOut { @builtin(position) pos: vec4<f32>, @location(0) c: vec4<f32> }\n\
+                  @vertex\nfn vs(@location(0) p: vec2<f32>) -> VOut {\n\
+                  \x20   return VOut(vec4<f32>(p, 0.0, 1.0), vec4<f32>(1.0, 0.5, 0.25, 1.0));\n}\n\
+                  @fragment\nfn fs_u(v: VOut) -> @location(0) vec4<u32> { return vec4<u32>(1u, 2u, 3u, 4u); }\n\
+                  @fragment\nfn fs(v: VOut) -> @location(0) vec4<f32> { return v.c; }\n";
+    let base = "summary = \"s\"\n[[resource]]\nname = \"img\"\nkind = \"texture\"\nformat = \"rgba8unorm\"\n\
+                [[resource]]\nname = \"tri\"\nkind = \"buffer\"\ndata = [-1.0, -1.0, 3.0, -1.0, -1.0, 3.0]\n\
+                [[pass]]\nkind = \"render\"\nvertex = \"vs\"\n";
+    let src1 = "targets = [{ resource = \"img\", blend = { color = [\"src1\", \"zero\", \"add\"], alpha = [\"one\", \"zero\", \"add\"] } }]";
+    for (pass, needles) in [
+        (
+            "fragment = \"fs_u\"\nvertices = [\"tri\"]\ntargets = [{ resource = \"img\" }]\n".to_string(),
+            vec!["pass 1 (fs_u, k.wgsl)", "writes @location(0) as u32", "target 0 is rgba8unorm, which stores f32"],
+        ),
+        (
+            format!("fragment = \"fs\"\nvertices = [\"tri\"]\n{src1}\n"),
+            vec!["target 0 (rgba8unorm) blends with a src1 factor", "no @location(0) @blend_src(1) output"],
+        ),
+        (
+            "fragment = \"fs\"\nvertices = [{ resource = \"tri\", stride = 22, attributes = [{ location = 0, format = \
+             \"float32x2\", offset = 0 }] }]\ntargets = [{ resource = \"img\" }]\n"
+                .to_string(),
+            vec!["vertices[0]: stride = 22 is not valid", "a multiple of 4 from 0 to 2048"],
+        ),
+    ] {
+        let r = render_k(&format!("{base}{pass}"), shader);
+        assert_rejected(&r, 2, &needles);
+        assert!(!r.stderr.contains("Validation Error"), "{}", r.stderr);
+    }
+    // The same pass with a float output and plain targets renders.
+    let ok = render_k(
+        &format!("{base}fragment = \"fs\"\nvertices = [\"tri\"]\ntargets = [{{ resource = \"img\" }}]\n"),
+        shader,
+    );
+    assert_eq!(ok.code, 0, "{}", ok.stderr);
 }
 
 /// The browser hands Tint the project's own text, not naga's rewrite: a
@@ -5947,6 +6022,7 @@ fn main() {
         Cpu browser_backend_without_chromium_names_the_install_command,
         Gpu a_project_kernel_renders_the_same_in_the_browser,
         Gpu the_browser_runs_the_projects_own_text,
+        Gpu render_setup_mistakes_are_named_before_gpu_work,
         Gpu the_report_works_in_a_real_browser,
         Gpu max_flip_fails_a_case_above_it,
         Gpu compare_reports_json_fields_and_rejects_bad_files,
@@ -6025,6 +6101,7 @@ fn main() {
         Gpu the_seed_study_generator_runs_on_the_shell_scene,
         Gpu matrices_integer_vectors_arrays_and_padding_are_packed,
         Gpu a_foreign_import_path_composes_and_is_named_when_edited,
+        Gpu an_import_cycle_is_named_as_a_cycle,
         Gpu unwritten_texels_fail_unless_the_output_is_partial,
         Gpu a_changed_render_fails_check_with_metrics_and_images,
         Gpu a_large_failing_case_gets_each_report_file_right,

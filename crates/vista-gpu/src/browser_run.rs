@@ -64,6 +64,8 @@ impl Context {
             if let Some(r) = &pass.raster {
                 let adapter = || self.adapter_description();
                 crate::raster::check_targets(r, &g.resources, &pass.label, &|f| self.has_feature(f), &adapter)?;
+                let module = g.shaders.compose(&pass.shader)?;
+                crate::raster::check_fragment(&module, &pass.entry, r, &g.resources, &pass.label)?;
             }
             // A vertex entry of another file travels as its own WGSL.
             let vertex_written = match pass.raster.as_ref() {

@@ -709,7 +709,7 @@ impl Context {
             }
         };
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Validation { what: shader.to_string(), message: e.to_string() });
+            return Err(GpuError::wgpu(shader, &e));
         }
         Ok(Arc::new(Compiled { pipeline, groups }))
     }

@@ -106,3 +106,38 @@ pub enum GpuError {
         feature: String,
     },
 }
+
+impl GpuError {
+    /// A wgpu validation error of `what`, its innermost cause first: wgpu's
+    /// own text starts "Validation Error" and puts the reason last.
+    pub(crate) fn wgpu(what: &str, e: &wgpu::Error) -> GpuError {
+        GpuError::Validation { what: what.to_string(), message: detail_first(&e.to_string()) }
+    }
+}
+
+/// wgpu's "Validation Error\n\nCaused by:\n  In ...\n    reason" as
+/// "reason (In ...; ...)"; any other text as it is.
+fn detail_first(text: &str) -> String {
+    let Some((_, causes)) = text.split_once("Caused by:") else { return text.to_string() };
+    let mut lines: Vec<&str> = causes.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    match lines.pop() {
+        None => text.to_string(),
+        Some(last) if lines.is_empty() => last.to_string(),
+        Some(last) => format!("{last} ({})", lines.join("; ")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn wgpu_errors_put_their_reason_first() {
+        let wgpu = "Validation Error\n\nCaused by:\n  In Device::create_render_pipeline, label = 'k.wgsl'\n    Color state [0] is \
+                    invalid\n      Output format Float32x4 is incompatible with the shader Uint32x4\n";
+        assert_eq!(
+            super::detail_first(wgpu),
+            "Output format Float32x4 is incompatible with the shader Uint32x4 (In Device::create_render_pipeline, \
+             label = 'k.wgsl'; Color state [0] is invalid)"
+        );
+        assert_eq!(super::detail_first("map failed"), "map failed");
+    }
+}

@@ -65,6 +65,83 @@ pub(crate) fn check_targets(
     Ok(())
 }
 
+/// The fragment entry's outputs against the pass's targets, before any
+/// pipeline is made (wgpu would only say "Color state [0] is invalid"):
+/// each target's `@location` must be written with the scalar kind its
+/// format stores (f32 for float and normalized formats, u32, i32), and a
+/// `src1` blend factor needs the entry's second (`@blend_src(1)`) output.
+pub(crate) fn check_fragment(
+    module: &naga::Module,
+    entry: &str,
+    r: &Raster,
+    resources: &[Resource],
+    label: &str,
+) -> Result<(), GpuError> {
+    let Some(ep) = module.entry_points.iter().find(|e| e.name == entry && e.stage == naga::ShaderStage::Fragment)
+    else {
+        return Ok(()); // naga and wgpu name a missing entry themselves.
+    };
+    // (location, blend_src, scalar kind) of every output.
+    let mut outputs: Vec<(u32, Option<u32>, Option<naga::ScalarKind>)> = Vec::new();
+    let kind = |ty: naga::Handle<naga::Type>| module.types[ty].inner.scalar_kind();
+    if let Some(result) = &ep.function.result {
+        match (&result.binding, &module.types[result.ty].inner) {
+            (Some(naga::Binding::Location { location, blend_src, .. }), _) => {
+                outputs.push((*location, *blend_src, kind(result.ty)))
+            }
+            (None, naga::TypeInner::Struct { members, .. }) => {
+                for m in members {
+                    if let Some(naga::Binding::Location { location, blend_src, .. }) = &m.binding {
+                        outputs.push((*location, *blend_src, kind(m.ty)));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let name = |k: naga::ScalarKind| match k {
+        naga::ScalarKind::Uint => "u32",
+        naga::ScalarKind::Sint => "i32",
+        naga::ScalarKind::Bool => "bool",
+        _ => "f32",
+    };
+    for (n, t) in r.targets.iter().enumerate() {
+        let Resource::Texture(desc) = &resources[t.resource] else { continue };
+        let format = crate::format::parse(desc.format)?;
+        let want = match format.sample_kind() {
+            vista_texel::SampleKind::Float => naga::ScalarKind::Float,
+            vista_texel::SampleKind::Uint => naga::ScalarKind::Uint,
+            vista_texel::SampleKind::Sint => naga::ScalarKind::Sint,
+        };
+        let written = outputs.iter().find(|(l, b, _)| *l == n as u32 && b.unwrap_or(0) == 0).and_then(|o| o.2);
+        if let Some(got) = written.filter(|g| *g != want) {
+            return Err(GpuError::Request(format!(
+                "{label}: fragment entry {entry} writes @location({n}) as {}, but target {n} is {}, which stores {}; \
+                 write {} there, or draw into a format that stores {}",
+                name(got),
+                desc.format,
+                name(want),
+                name(want),
+                name(got)
+            )));
+        }
+        let src1 = t.blend.components().is_some_and(|(c, a)| {
+            use vista_texel::BlendFactor::*;
+            [c.src, c.dst, a.src, a.dst]
+                .iter()
+                .any(|f| matches!(f, Src1 | OneMinusSrc1 | Src1Alpha | OneMinusSrc1Alpha))
+        });
+        if src1 && !outputs.iter().any(|(l, b, _)| *l == n as u32 && *b == Some(1)) {
+            return Err(GpuError::Request(format!(
+                "{label}: target {n} ({}) blends with a src1 factor, but fragment entry {entry} has no \
+                 @location({n}) @blend_src(1) output; add one (enable dual_source_blending;) or use src factors",
+                desc.format
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Each target's format and blend state.
 pub(crate) fn color_targets(
     r: &Raster,

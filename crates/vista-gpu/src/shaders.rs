@@ -667,7 +667,61 @@ impl ShaderSet {
                 wanted.extend(self.lib[k].imports.iter().map(|i| (&self.lib[k], i)));
             }
         }
+        // naga_oil reports a cycle as "required import ... not found".
+        if let Some(cycle) = self.import_cycle(&used) {
+            let steps: Vec<String> = cycle
+                .iter()
+                .map(|(k, i)| {
+                    let at = i.line.map_or(String::new(), |l| format!(":{l}"));
+                    format!("{}{at} imports {}", self.lib[*k].origin, i.module)
+                })
+                .collect();
+            return Err(GpuError::Shader(format!(
+                "{}: its imports form a cycle, which naga_oil cannot compose: {}; move what both need into a third \
+                 module",
+                kernel.origin,
+                steps.join(", which ")
+            )));
+        }
         Ok(self.lib.iter().zip(used).filter(|(_, u)| *u).map(|(e, _)| e).collect())
+    }
+
+    /// A cycle among the `used` library modules, as (module index, the
+    /// import that leads to the next) from the first module of the cycle
+    /// back to it; `None` when their imports form no cycle.
+    fn import_cycle(&self, used: &[bool]) -> Option<Vec<(usize, &Import)>> {
+        let index = |m: &str| self.lib.iter().position(|e| e.module.as_deref() == Some(m));
+        // 0: unvisited, 1: on the path, 2: done.
+        let mut state = vec![0u8; self.lib.len()];
+        for start in (0..self.lib.len()).filter(|&k| used[k]) {
+            if state[start] != 0 {
+                continue;
+            }
+            // Depth-first with an explicit stack: (module, next import to try).
+            let mut path: Vec<(usize, usize)> = vec![(start, 0)];
+            state[start] = 1;
+            while let Some(&mut (k, ref mut next)) = path.last_mut() {
+                let Some(import) = self.lib[k].imports.get(*next) else {
+                    state[k] = 2;
+                    path.pop();
+                    continue;
+                };
+                *next += 1;
+                let Some(to) = index(&import.module) else { continue };
+                match state[to] {
+                    0 => {
+                        state[to] = 1;
+                        path.push((to, 0));
+                    }
+                    1 => {
+                        let from = path.iter().position(|(m, _)| *m == to).expect("on the path");
+                        return Some(path[from..].iter().map(|(m, n)| (*m, &self.lib[*m].imports[n - 1])).collect());
+                    }
+                    _ => {}
+                }
+            }
+        }
+        None
     }
 }
 

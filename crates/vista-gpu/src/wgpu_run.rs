@@ -165,7 +165,7 @@ impl Context {
             )));
         }
         if let Some(e) = invalid {
-            return Err(GpuError::Validation { what: "the pass graph's resources".into(), message: e.to_string() });
+            return Err(GpuError::wgpu("the pass graph's resources", &e));
         }
         // Contents and sentinels land before the first pass is timed.
         let index = w.queue.submit([fill.finish()]);
@@ -199,7 +199,7 @@ impl Context {
                     s.resolve(&mut encoder);
                 }
                 if let Some(e) = pollster::block_on(scope.pop()) {
-                    return Err(GpuError::Validation { what: pass.label.clone(), message: e.to_string() });
+                    return Err(GpuError::wgpu(&pass.label, &e));
                 }
                 if let Some(hook) = &hook {
                     hook(&pass.label);
@@ -502,6 +502,8 @@ impl Context {
             Some(r) => {
                 let adapter = || self.adapter_description();
                 crate::raster::check_targets(r, &g.resources, &pass.label, &|f| self.has_feature(f), &adapter)?;
+                let module = g.shaders.compose(&pass.shader)?;
+                crate::raster::check_fragment(&module, &pass.entry, r, &g.resources, &pass.label)?;
                 Some(crate::raster::color_targets(r, &g.resources, &pass.label)?)
             }
             None => None,

@@ -84,6 +84,10 @@ pub fn parse(v: &toml::Value, known: &dyn Fn(&str) -> Result<(), String>) -> Res
                     Some(_) => return Err(at(format!("step = {} is not valid; expected vertex|instance", t["step"]))),
                 };
                 let stride = t.get("stride").map(|s| number(s, "stride")).transpose().map_err(at)?;
+                // WebGPU: arrayStride is a multiple of 4, at most maxVertexBufferArrayStride.
+                if let Some(s) = stride.filter(|s| !s.is_multiple_of(4) || *s > 2048) {
+                    return Err(at(format!("stride = {s} is not valid; expected a multiple of 4 from 0 to 2048")));
+                }
                 let attributes = match t.get("attributes") {
                     None => None,
                     Some(a) => Some(parse_attributes(a).map_err(at)?),
