@@ -107,10 +107,30 @@ pub fn compile_wesl(
     if let Some(e) = refused.take() {
         return Err(e);
     }
-    let result = result.map_err(|e| format!("WESL error: {}", plain(&e.to_string())))?;
+    let result = result.map_err(|e| located(&plain(&e.to_string())))?;
     let text = result.to_string();
     let parts = compiler.resolver().parts.take();
     Ok(Assembled::untraced(text, parts))
+}
+
+/// The wesl crate's diagnostic with its place first: its headline says
+/// "error: chars 229..230: unexpected token" and the file, line and column
+/// only on the `-->` line below, so the headline becomes
+/// "WESL error: FILE:LINE:COL: unexpected token", the snippet kept below.
+fn located(diagnostic: &str) -> String {
+    let (head, rest) = diagnostic.split_once('\n').unwrap_or((diagnostic, ""));
+    let mut reason = head.trim().trim_start_matches("error:").trim();
+    // "chars 229..230: " is a byte range in the file; the place replaces it.
+    if let Some(after) = reason.strip_prefix("chars ") {
+        let range = after.chars().take_while(|c| c.is_ascii_digit() || *c == '.').count();
+        if let Some(r) = after[range..].strip_prefix(": ") {
+            reason = r;
+        }
+    }
+    match rest.lines().find_map(|l| l.trim_start().strip_prefix("--> ")) {
+        Some(place) => format!("WESL error: {}: {reason}\n{rest}", place.trim()),
+        None => format!("WESL error: {reason}\n{rest}"),
+    }
 }
 
 /// `text` without terminal colour codes (the wesl crate's diagnostics carry
@@ -254,5 +274,20 @@ mod tests {
         assert_eq!(paths, ["shaders/k.wesl", "shaders/m.wesl", "vendor/consts/package.wesl"]);
         let e = compile_wesl("shaders/k.wesl", &SourceSpec::default(), &[], &read).unwrap_err();
         assert!(e.contains("package consts is not in [source] packages (none)"), "{e}");
+    }
+
+    /// A syntax error in an imported module: the headline names its file,
+    /// line and column (the wesl crate's says "chars 41..42").
+    #[test]
+    fn syntax_errors_name_the_file_line_and_column_first() {
+        let files: Vec<(&str, &str)> = vec![
+            ("shaders/k.wesl", "import package::m::half;\n@compute @workgroup_size(1) fn main() { let x = half(); }\n"),
+            ("shaders/m.wesl", "// half\npublic fn half() -> f32 {\n    return 0.5; )\n}\n"),
+        ];
+        let read = |p: &str| files.iter().find(|(f, _)| *f == p).map(|(_, t)| (t.to_string(), format!("/p/{p}")));
+        let e = compile_wesl("shaders/k.wesl", &SourceSpec::default(), &[], &read).unwrap_err();
+        let head = e.lines().next().unwrap();
+        assert!(head.starts_with("WESL error: /p/shaders/m.wesl:3:17: unexpected token `)`"), "{e}");
+        assert!(!head.contains("chars "), "{head}");
     }
 }
