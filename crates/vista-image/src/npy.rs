@@ -118,22 +118,36 @@ pub fn decode_npy(path: &Path, bytes: &[u8]) -> Result<Npy, ImageError> {
         .collect::<Result<_, _>>()?;
     let item_bytes = dtype_bytes(&descr).map_err(bad)?;
     let data = bytes[start + len..].to_vec();
-    let want = shape.iter().product::<u64>() * item_bytes;
+    // Checked: a crafted shape must not wrap around to the file's length.
+    let want = shape
+        .iter()
+        .try_fold(1u64, |n, &d| n.checked_mul(d))
+        .and_then(|n| n.checked_mul(item_bytes))
+        .ok_or_else(|| bad(format!("shape {shape:?} of {descr} overflows 64-bit byte counts")))?;
     if data.len() as u64 != want {
         return Err(bad(format!("{} data bytes for shape {shape:?} of {descr} ({want} expected)", data.len())));
     }
     Ok(Npy { descr, shape, item_bytes, data })
 }
 
+/// The largest dtype item [`dtype_bytes`] accepts: 64 KiB, far above any
+/// struct a shader reads (a 4x4 matrix is 64 bytes).
+pub const MAX_ITEM_BYTES: u64 = 1 << 16;
+
 /// Bytes of one item of a dtype: a simple one (`<f4`, `|u1`, `|V4`) or a
 /// structured list (`[('a', '<f4'), ('b', '<u4', (3,))]`).
 pub fn dtype_bytes(descr: &str) -> Result<u64, String> {
+    let mut total = 0u64;
     if !descr.starts_with('[') {
-        return simple_bytes(descr);
+        total = simple_bytes(descr)?;
     }
-    let mut total = 0;
-    for (ty, count) in structured_fields(descr)? {
-        total += simple_bytes(&ty)? * count;
+    for (ty, count) in if descr.starts_with('[') { structured_fields(descr)? } else { Vec::new() } {
+        total = simple_bytes(&ty)?.checked_mul(count).and_then(|b| total.checked_add(b)).unwrap_or(u64::MAX);
+    }
+    // An item is a few numbers; one larger than this is a crafted header
+    // (and listing its numbers would take the machine's memory).
+    if total > MAX_ITEM_BYTES {
+        return Err(format!("dtype {descr} has items of {total} bytes; at most {MAX_ITEM_BYTES} are allowed"));
     }
     Ok(total)
 }
@@ -161,10 +175,11 @@ fn structured_fields(descr: &str) -> Result<Vec<(String, u64)>, String> {
         }
         let parts: Vec<&str> = field.splitn(3, ',').map(str::trim).collect();
         let ty = parts.get(1).ok_or_else(|| format!("structured field {field} has no type"))?;
-        let mut count = 1;
+        let mut count = 1u64;
         if let Some(dims) = parts.get(2) {
             for d in dims.trim_matches(|c| c == '(' || c == ')').split(',').map(str::trim).filter(|d| !d.is_empty()) {
-                count *= d.parse::<u64>().map_err(|_| format!("structured field {field} has a bad shape"))?;
+                let d = d.parse::<u64>().map_err(|_| format!("structured field {field} has a bad shape"))?;
+                count = count.checked_mul(d).ok_or_else(|| format!("structured field {field}'s shape overflows"))?;
             }
         }
         out.push((ty.trim_matches(|c| c == '\'' || c == '"').to_string(), count));
@@ -183,6 +198,7 @@ pub fn dtype_numbers(descr: &str) -> Result<Vec<(u64, char, u64)>, String> {
         let (kind, n) = simple(descr)?;
         return Ok(vec![(0, kind, n)]);
     }
+    dtype_bytes(descr)?;
     let mut out = Vec::new();
     let mut at = 0;
     for (ty, count) in structured_fields(descr)? {
@@ -248,5 +264,25 @@ mod tests {
         item.extend([0xFF; 4]);
         let n = decode_npy(p, &encode_npy(s, &[1], &item)).unwrap();
         assert_eq!(values(&n).unwrap(), [1.5, 2.5, 7.0], "padding skipped");
+    }
+
+    /// Shapes and dtypes whose byte count overflows 64 bits (or whose one
+    /// item is absurdly large) are refused, never wrapped to the file's
+    /// length or listed number by number.
+    #[test]
+    fn crafted_shapes_and_dtypes_are_refused_with_checked_arithmetic() {
+        let p = Path::new("x.npy");
+        let data = [0u8; 16];
+        // 2^62 * 4 * 4 bytes wraps to 0 in u64; with a 0 the data is empty too.
+        let e = decode_npy(p, &encode_npy("<f4", &[1 << 62, 4, 0], &[])).unwrap_err().to_string();
+        assert!(e.contains("overflows 64-bit byte counts"), "{e}");
+        let e = decode_npy(p, &encode_npy("<f4", &[1 << 62, 4], &data)).unwrap_err().to_string();
+        assert!(e.contains("overflows"), "{e}");
+        let e = decode_npy(p, &encode_npy("<f18446744073709551615", &[1], &data)).unwrap_err().to_string();
+        assert!(e.contains("at most 65536 are allowed"), "{e}");
+        let huge = "[('a', '<f4', (4294967296, 4294967296))]";
+        let e = decode_npy(p, &encode_npy(huge, &[0], &[])).unwrap_err().to_string();
+        assert!(e.contains("overflows") || e.contains("at most 65536"), "{e}");
+        assert!(dtype_numbers("[('a', '<f4', (1000000000,))]").unwrap_err().contains("at most 65536"));
     }
 }
