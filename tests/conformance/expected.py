@@ -315,11 +315,321 @@ def format_probes():
                     "(normalized values rounded to the nearest step, missing channels 0, 0, 1)"}]
 
 
+def workgroup_zero_probes():
+    # WGSL (variable declarations, workgroup address space): a workgroup variable is zero-initialized when its
+    # workgroup starts, so every word a workgroup reads before writing is 0 (f32 +0.0 has bits 0); the
+    # atomic, zero at the start, counts the 64 lanes that then add one each.
+    lanes, groups = 64, 8
+    words = []
+    for g in range(groups):
+        words += [0] * lanes + [0] * 12 + [0] + [0] + [lanes, g]
+    return [{"kernel": "workgroup_zero", "set": {}, "outputs": ["seen"], "words": words,
+             "why": "per workgroup (80 words): the 64-word array, the struct Cell (vec3, i32, mat2x2, array<u32, 4>), "
+                    "the f32 and the atomic as read before any write, all zero; then the atomic after 64 adds "
+                    "and the workgroup id"}]
+
+
+# WebGPU (primitive assembly; rasterization, polygon coverage) for the 8 x 8 targets of
+# kernels/indices.toml: every corner lies on whole pixels, so a pixel centre (x + 0.5, y + 0.5) is either
+# strictly inside or outside each triangle, or on an edge that two triangles of the draw share from opposite
+# sides (a quad's diagonal), where the tie-break rule gives it to exactly one of them: covered either way.
+def edge(a, b, p):
+    return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+
+
+def covered(triangles, p):
+    on_edges = []
+    for tri in triangles:
+        e = [edge(tri[i], tri[(i + 1) % 3], p) for i in range(3)]
+        if all(v > 0 for v in e) or all(v < 0 for v in e):
+            return True
+        if all(v >= 0 for v in e) or all(v <= 0 for v in e):
+            if sum(1 for v in e if v == 0) == 1 and abs(sum(e)) > 0:  # on one edge of a non-degenerate triangle
+                i = next(i for i in range(3) if e[i] == 0)
+                on_edges.append(frozenset([tri[i], tri[(i + 1) % 3]]))
+    for seg in set(on_edges):
+        assert on_edges.count(seg) == 2, f"pixel centre {p} lies on an unshared edge {sorted(seg)}: ambiguous"
+    return bool(on_edges)
+
+
+def index_probes():
+    manifest = tomllib.loads((HERE / "kernels/indices.toml").read_text())
+    data = {r["name"]: r["data"] for r in manifest["resource"] if "data" in r}
+    outputs, words = [], []
+    for p in manifest["pass"]:
+        fmt, tag = p["indices"]["format"], p["set"]["tag"]
+        restart = {"uint16": 0xFFFF, "uint32": 0xFFFFFFFF}[fmt]
+        indices = data[p["indices"]["resource"]][:p["count"]]
+        assert all(0 <= i <= restart for i in indices)
+        # A vertex's corner as shaders/indices.wgsl places it: from the index's low byte if its high bits
+        # are the pass's tag, else (0, 8).
+        corner = lambda i: ((i & 0xF, (i >> 4) & 0xF) if i >> 8 == tag else (0, 8))
+        if p["topology"] == "triangle-strip":
+            strips, run = [], []
+            for i in indices + [restart]:  # the strip restarts at the format's largest value
+                if i == restart:
+                    strips.append(run)
+                    run = []
+                else:
+                    run.append(corner(i))
+            triangles = [s[k:k + 3] for s in strips for k in range(len(s) - 2)]
+        else:
+            triangles = [[corner(i) for i in indices[k:k + 3]] for k in range(0, len(indices) - 2, 3)]
+        target = p["targets"][0]["resource"]
+        outputs.append(target)
+        for y in range(8):
+            for x in range(8):
+                v = 1.0 if covered(triangles, (x + 0.5, y + 0.5)) else 0.0
+                words += [bits("f32", c) for c in (v, 0.0, 0.0, 1.0)]
+    return [{"kernel": "indices", "set": {}, "outputs": outputs, "words": words,
+             "why": "per target, rows top to bottom, r32uint read back as f32 (r, 0, 0, 1): 1 where a triangle "
+                    "covers the pixel centre; strips restart at 0xFFFF (uint16) and 0xFFFFFFFF (uint32), "
+                    "0xFFFF in a uint32 strip is an ordinary index"}]
+
+
+# WebGPU (depth test): a fragment passes if compare(its depth, the stored depth) holds, then (with
+# depth writes) stores its depth. kernels/depth_compare.toml clears to 0.5; shaders/depth_compare.wgsl writes
+# frag_depth 0.25, 0.5, 0.75 at pixels 0, 1, 2 (exact in f32 and depth32float).
+COMPARE = {
+    "never": lambda f, s: False, "less": lambda f, s: f < s, "equal": lambda f, s: f == s,
+    "less-equal": lambda f, s: f <= s, "greater": lambda f, s: f > s, "not-equal": lambda f, s: f != s,
+    "greater-equal": lambda f, s: f >= s, "always": lambda f, s: True,
+}
+
+
+def depth_probes():
+    manifest = tomllib.loads((HERE / "kernels/depth_compare.toml").read_text())
+    colors, depths = {}, {}
+    for p in manifest["pass"]:
+        d, target = p["depth"], p["targets"][0]["resource"]
+        passed = [COMPARE[d["compare"]](f, d["clear"]) for f in (0.25, 0.5, 0.75)]
+        colors[target] = [1.0 if ok else 0.0 for ok in passed]
+        depths[d["resource"]] = [f if ok and d["write"] else d["clear"] for f, ok in zip((0.25, 0.5, 0.75), passed)]
+    outputs = [o["resource"] for o in manifest["output"]]
+    words = []
+    for name in outputs:
+        for v in {**colors, **depths}[name]:
+            words += [bits("f32", c) for c in (v, 0.0, 0.0, 1.0)]
+    return [{"kernel": "depth_compare", "set": {}, "outputs": outputs, "words": words,
+             "why": "per compare function, the r32uint colour (1 where the fragment passed) then the depth32float "
+                    "buffer, each read back as f32 (r, 0, 0, 1) for pixels at fragment depth 0.25, 0.5, 0.75 "
+                    "against a clear of 0.5"}]
+
+
+# Exact rounding of a rational to a binary float of `mantissa` stored bits and exponents down to `emin`
+# (subnormals below), to nearest even or toward zero.
+def round_float(q, mantissa, emin, toward_zero=False):
+    from fractions import Fraction
+    q = Fraction(q)
+    if q == 0:
+        return q
+    sign, a = (-1 if q < 0 else 1), abs(q)
+    e = a.numerator.bit_length() - a.denominator.bit_length()
+    e += 1 if a >= Fraction(2) ** (e + 1) else 0
+    e -= 1 if a < Fraction(2) ** e else 0
+    step = Fraction(2) ** (max(e, emin) - mantissa)
+    n, rest = divmod(a / step, 1)
+    if not toward_zero and (rest > Fraction(1, 2) or (rest == Fraction(1, 2) and n % 2 == 1)):
+        n += 1
+    return sign * n * step
+
+
+def f32_of(q):
+    return round_float(q, 23, -126)
+
+
+def f32_bits_of(q):
+    return bits("f32", float(f32_of(q)))
+
+
+def render_format_probes():
+    # WebGPU (texture formats) with Vulkan's conversions (fixed-point data conversions: unorm
+    # clamps to [0, 1] and rounds x * (2^n - 1) to the nearest integer; 16-bit and packed unsigned floats
+    # round to the nearest representable value). Read back as vista reads a texture: f32 RGBA, a unorm
+    # channel k / (2^n - 1) divided in f32, missing channels 0, 0, 1, bgra8unorm's channels back in
+    # r, g, b, a order.
+    import re
+    from fractions import Fraction
+    shader = (HERE / "shaders/render_formats.wgsl").read_text()
+    consts = {name.lower(): (kind, [Fraction(v.strip().rstrip("u")) for v in args.split(",")])
+              for name, kind, args in re.findall(r"const (\w+) = vec4<(f32|u32|i32)>\(([^)]*)\);", shader)}
+
+    def unorm(v, n):
+        top = 2 ** n - 1
+        x = min(max(v, Fraction(0)), Fraction(1)) * top
+        k = round(x)
+        assert abs(x - k) <= Fraction(1, 4), f"{float(v)} scales to {float(x)}: too near a rounding tie"
+        return f32_of(Fraction(k, top))
+
+    def narrow(v, mantissa):
+        near, zero = round_float(v, mantissa, -14), round_float(v, mantissa, -14, toward_zero=True)
+        assert near == zero, f"{float(v)}: rounding to nearest and toward zero differ"
+        return near
+
+    probes = []
+    for kernel in ("render_formats", "render_packed"):
+        manifest = tomllib.loads((HERE / f"kernels/{kernel}.toml").read_text())
+        outputs, words = [o["resource"] for o in manifest["output"]], []
+        for fmt in outputs:
+            kind, v = consts[fmt]
+            v = [f32_of(x) for x in v] if kind == "f32" else v
+            if fmt == "rgb10a2unorm":
+                out = [unorm(x, 10) for x in v[:3]] + [unorm(v[3], 2)]
+            elif fmt == "rg11b10ufloat":
+                assert all(x >= 0 for x in v)
+                out = [narrow(v[0], 6), narrow(v[1], 6), narrow(v[2], 5)]
+            elif "8unorm" in fmt:
+                out = [unorm(x, 8) for x in v]
+            elif "16float" in fmt:
+                out = [narrow(x, 10) for x in v]
+            else:
+                out = v  # 32-bit floats and every integer format: stored as written
+                assert all(f32_of(x) == x for x in out), f"{fmt}: pick values exact in f32 (vista reads back f32)"
+            n = 3 if fmt == "rg11b10ufloat" else {"r": 1, "rg": 2}.get(re.match(r"[a-z]+", fmt).group(), 4)
+            out = out[:n] + [Fraction(0), Fraction(0), Fraction(1)][n - 1:] if n < 4 else out[:4]
+            words += [f32_bits_of(x) for x in out]
+        probes.append({"kernel": kernel, "set": {}, "outputs": outputs, "words": words,
+                       "why": "each target's texel as the attachment format converts the fragment's value, read back "
+                              "as f32 RGBA (unorm rounded to the nearest step, values chosen at least 0.25 of a step "
+                              "from a tie; float16 and 11/10-bit floats where nearest and toward-zero rounding "
+                              "agree; missing channels 0, 0, 1)"})
+    return probes
+
+
+# shaders/struct_arrays.wgsl's Item: (member, leaf kind, (align, size) by WGSL 13.4, components).
+ITEM = [("p", "f32", vec(3), 3), ("id", "u32", scalar(), 1), ("uv", "f32", vec(2), 2), ("k", "i32", scalar(), 1),
+        ("m", "f32", mat(2, 2), 4), ("tags", "u32", array(scalar(), 3), 3), ("q", "i32", vec(4), 4)]
+FILE_ITEMS = [
+    [0.375, -0.625, 12.5, 301, -1.25, 1.75, -66, 0.5, 0.25, -0.5, -0.25, 57, 58, 59, 1000, -2000, 3000, -4000],
+    [-13.5, 14.25, -15.0, 302, 16.5, -17.75, 77, -18.0, 19.0, -20.0, 21.0, 67, 68, 69, -5000, 6000, -7000, 8000],
+]
+
+
+def item_offsets():
+    """Each member's byte offset, the Item's stride and size by WGSL 13.4."""
+    offsets, offset = [], 0
+    for _, _, (a, s), _ in ITEM:
+        offset = round_up(a, offset)
+        offsets.append(offset)
+        offset += s
+    align, size = struct_of([m[2] for m in ITEM])
+    return offsets, stride((align, size)), align
+
+
+def item_inputs():
+    """inputs/items.bin: FILE_ITEMS laid out at their offsets, padding bytes 0xEE."""
+    offsets, step, _ = item_offsets()
+    out = b""
+    for values in FILE_ITEMS:
+        el, at = bytearray(b"\xEE" * step), 0
+        for (_, kind, _, n), off in zip(ITEM, offsets):
+            for c in range(n):
+                el[off + 4 * c:off + 4 * c + 4] = struct.pack("<I", bits(kind, values[at]))
+                at += 1
+        out += bytes(el)
+    return {"inputs/items.bin": out}
+
+
+def struct_array_probes():
+    offsets, step, align = item_offsets()
+    assert (offsets, step, align) == ([0, 12, 16, 24, 32, 48, 64], 80, 16), (offsets, step, align)
+    manifest = tomllib.loads((HERE / "kernels/struct_arrays.toml").read_text())
+    data = {r["name"]: r.get("data") for r in manifest["resource"]}
+    kinds = [kind for _, kind, _, n in ITEM for _ in range(n)]
+    per = len(kinds)
+    flat_file = [v for it in FILE_ITEMS for v in it]
+    words, lengths = [], []
+    for values in (data["from_data"], flat_file, data["tail"]):
+        assert len(values) % per == 0
+        words += [bits(k, v) for k, v in zip(kinds * (len(values) // per), values)]
+        lengths.append(len(values) // per)
+    # tail.count: the header before the array (offset 0, the array at roundUp(16, 4) = 16) is never fed: 0.
+    words += lengths + [0, 0x57AC]
+    return [{"kernel": "struct_arrays", "set": {}, "outputs": ["leaves"], "words": words,
+             "why": "every leaf of every Item (stride 80: vec3 at 0, u32 at 12, vec2 at 16, i32 at 24, mat2x2 at 32, "
+                    "array<u32, 3> at 48, vec4<i32> at 64) from data, from the file and behind the header; then the "
+                    "three arrayLengths, the header's zero count and the marker"}]
+
+
+def view_probes():
+    # WebGPU (texture views): a view of base level k and one level sees the texture's level k as its level
+    # 0, with that level's size (max(1, size >> k)) and one level; a render target or storage view of one
+    # level (and layer) writes only that subresource. kernels/views.toml writes texel (x, y) of level l of
+    # pyr as (10 + l, x, y, 1), of level l of layer a of arr as (100 + 10a + l, x, y, 1); nearest sampling
+    # at level l takes texel floor(uv * size of level l).
+    import math
+    manifest = tomllib.loads((HERE / "kernels/views.toml").read_text())
+    res = {r["name"]: r for r in manifest["resource"]}
+    tags = {}
+    for p in manifest["pass"]:
+        target = p["bind"]["level_out"] if "bind" in p and "level_out" in p["bind"] else None
+        target = target or (p["targets"][0]["resource"] if "targets" in p else None)
+        if target:
+            name, _, rest = target.partition("@")
+            level, _, layer = rest.partition("@layer")
+            tags[(name, int(level or 0), int(layer or 0))] = p["set"]["tag"]
+    size = lambda name, level: [max(1, n >> level) for n in res[name]["size"][:2]]
+
+    def load(name, level, x, y, layer=0):
+        w, h = size(name, level)
+        assert 0 <= x < w and 0 <= y < h
+        return [tags[(name, level, layer)], x, y, 1]
+
+    def nearest(name, level, uv, layer=0):
+        return load(name, level, *(math.floor(c * n) for c, n in zip(uv, size(name, level))), layer)
+
+    levels = lambda name: res[name].get("mip_levels", 1)
+    rows = []
+    for level in range(levels("pyr")):
+        last = size("pyr", level)[0] - 1
+        rows += [load("pyr", level, last, 0), load("pyr", level, 0, last)]
+    rows += [load("pyr", 1, 2, 3), load("pyr", 2, 1, 1)]  # through views of levels 1 and 2, at their level 0
+    rows += [nearest("pyr", 2, (0.75, 0.25))] * 2 + [nearest("pyr", 1, (0.3, 0.8))] * 2
+    rows += [size("pyr", 0) + [levels("pyr"), 1], size("pyr", 1) + [1, 1], size("pyr", 2) + [1, 1]]
+    layers = res["arr"]["size"][2]
+    for layer in range(layers):
+        rows += [load("arr", 0, 3, 3, layer), load("arr", 1, 1, 1, layer), load("arr", 1, 1, 0, layer)]
+    rows += [nearest("arr", 1, (0.6, 0.1), 2)] * 2
+    rows += [size("arr", 0) + [levels("arr"), layers], size("arr", 1) + [1, layers]]
+    words = [bits("f32", v) for row in rows for v in row]
+    return [{"kernel": "views", "set": {}, "outputs": ["seen"], "words": words,
+             "why": "four words per read: texels (tag, x, y, 1) loaded and nearest-sampled through the whole "
+                    "texture and through one-level views, and (width, height, levels, layers) of each view"}]
+
+
+def out_of_bounds_probes():
+    # WGSL (out-of-bounds access; textureLoad, textureStore): the shader flags each
+    # out-of-bounds result 1 when it is one the spec allows (see shaders/out_of_bounds.wgsl), so every flag
+    # is 1 whatever a conforming backend chose; the words of the buffer beside the stored-to one are
+    # unchanged, and each arrayLength is the declared length.
+    manifest = tomllib.loads((HERE / "kernels/out_of_bounds.toml").read_text())
+    data = {r["name"]: r.get("data") for r in manifest["resource"]}
+    n = len(data["idx"])
+    # Past the end of every array they index (5, 4 and 2 elements), as u32 and as i32 (2^31 and up: negative).
+    assert all(i >= max(len(data["data"]), len(data["victim"])) for i in data["idx"])
+    words = [1] * (5 * n)                  # loads: data (u32 and i32 index), private, workgroup, uniform
+    words += [1] * (2 * len(data["victim"]))  # the stored-to storage and private arrays afterwards
+    words += data["guard"] + [len(data["data"]), len(data["victim"])]
+    texels = 2 * 2
+    words += [1] * texels + [1] * (len(data["coords"]) // 2 + len(data["levels"])) + [0x00B5]
+    return [{"kernel": "out_of_bounds", "set": {}, "outputs": ["flags"], "words": words,
+             "why": "1 per out-of-bounds result that WGSL allows (zero, bytes of the bound buffer or variable, "
+                    "(0, 0, 0, x) for vectors; a store dropped or kept inside its buffer; a texel, (0, 0, 0, 0) or "
+                    "(0, 0, 0, 1) for textureLoad), the guard buffer's own words, arrayLength of data and victim, "
+                    "texture flags, marker"}]
+
+
+PROBES = [array_length_probes, layout_probes, entry_name_probes, blend_probes, vertex_probes, texture_query_probes,
+          sampling_probes, format_probes, workgroup_zero_probes,
+          index_probes, depth_probes, render_format_probes,
+          struct_array_probes, view_probes, out_of_bounds_probes]
+
+
 def render():
     out = ["# Written by expected.py from the WGSL and WebGPU specs; do not edit.",
            "# tests/conformance.rs runs each probe on every backend and compares the",
            "# output's 32-bit words exactly.", ""]
-    for p in array_length_probes() + layout_probes() + entry_name_probes() + blend_probes() + vertex_probes() + texture_query_probes() + sampling_probes() + format_probes():
+    for p in [p for probes in PROBES for p in probes()]:
         sets = ", ".join(f"{k} = {v}" for k, v in p["set"].items())
         out += ["[[probe]]", f'kernel = "{p["kernel"]}"', f"set = {{ {sets} }}" if sets else "set = {}",
                 "outputs = [" + ", ".join(f'"{o}"' for o in p["outputs"]) + "]", f'why = "{p["why"]}"']
@@ -330,7 +640,7 @@ def render():
 
 
 if __name__ == "__main__":
-    files = {"expected.toml": render().encode(), **vertex_inputs()}
+    files = {"expected.toml": render().encode(), **vertex_inputs(), **item_inputs()}
     if "--check" in sys.argv[1:]:
         stale = [name for name, data in files.items()
                  if not (HERE / name).exists() or (HERE / name).read_bytes() != data]

@@ -46,6 +46,16 @@ mutants=(
     crates/vista-gpu/src/wgpu_run.rs
     "base_mip_level: level.unwrap_or(0),"
     "base_mip_level: 0,"
+
+    "depth compare less and less-equal swapped"
+    crates/vista-gpu/src/graph.rs
+    "let all = [C::Never, C::Less, C::Equal, C::LessEqual,"
+    "let all = [C::Never, C::LessEqual, C::Equal, C::Less,"
+
+    "uint16 indices drawn as uint32"
+    crates/vista-gpu/src/raster.rs
+    "if r.index_u16 { wgpu::IndexFormat::Uint16 } else { wgpu::IndexFormat::Uint32 }"
+    "if r.index_u16 { wgpu::IndexFormat::Uint32 } else { wgpu::IndexFormat::Uint32 }"
 )
 
 backup=$(mktemp -d)
