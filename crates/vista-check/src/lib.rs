@@ -178,6 +178,9 @@ impl Checker<'_> {
     /// Checks and files every case of `picked` with [`Checker::jobs`]
     /// workers, handing each to `each` in case order as soon as it and every
     /// earlier one are done.
+    /// Stops starting cases once [`interrupted`]: what finished before the
+    /// interrupt is returned and passed to `each`; a case in flight then
+    /// (its worker killed by the same Ctrl-C) is left out, not failed.
     pub fn check_all(&self, picked: &[&Case], jobs: usize, mut each: impl FnMut(&Filed)) -> Vec<Filed> {
         let jobs = self.jobs(jobs, picked.len());
         // Cores the jobs leave idle go to each case's FLIP and report images.
@@ -189,14 +192,31 @@ impl Checker<'_> {
         vista_golden::in_order(
             picked,
             jobs,
-            |case| self.check(case),
+            |case| (!interrupted()).then(|| self.check(case)),
             |_, filed| {
-                each(&filed);
-                out.push(filed);
+                if let Some(filed) = filed.filter(|_| !interrupted()) {
+                    each(&filed);
+                    out.push(filed);
+                }
             },
         );
         out
     }
+}
+
+/// Set by [`interrupt`] (the binary's SIGINT handler): runs stop starting
+/// cases and write the report of those that finished.
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Marks the process interrupted; only an atomic store, so a signal
+/// handler may call it.
+pub fn interrupt() {
+    INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+/// Whether [`interrupt`] was called.
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst)
 }
 
 /// Files a run writes beside its report, if asked.

@@ -104,6 +104,8 @@ pub fn check(
     }
     let ctx = &Renderer::shared(&config.gpu, project, config.limits)?;
     vista_report::clear_case_folders(&report_dir)?;
+    // Ctrl-C: the cases that finished still get their report.
+    crate::stop_on_interrupt();
     let mut time = Phases::start(ctx);
     let checker = Checker { ctx, store: &store, manifest: &manifest, report_dir: &report_dir, detail: viewers };
     time.jobs = checker.jobs(pick.jobs, picked.len());
@@ -122,6 +124,13 @@ pub fn check(
         backend: ctx.backend().to_string(),
         adapter: ctx.adapter_description(),
         partition: pick.selection.partition,
+        stopped: vista_check::interrupted().then(|| {
+            format!(
+                "Interrupted (Ctrl-C) after {} of {} cases: this report holds the cases that finished.",
+                filed.len(),
+                picked.len()
+            )
+        }),
         ..Default::default()
     };
     let started = std::time::Instant::now();
@@ -173,7 +182,14 @@ pub fn check(
         }
     }
     println!("{}", time.summary(ctx, outcomes.len()));
+    if let Some(line) = &run.stopped {
+        println!("interrupted: {line}");
+    }
     println!("report: {}", index.display());
+    if vista_check::interrupted() {
+        // 128 + SIGINT, as a shell reports a command Ctrl-C ended.
+        return Ok(130);
+    }
     Ok(if failed == 0 && !orphans_fail && !report_failed { 0 } else { 1 })
 }
 

@@ -249,6 +249,27 @@ fn die_quietly_on_closed_pipe() {
     }
 }
 
+/// From here on, SIGINT (Ctrl-C) marks the run interrupted instead of
+/// ending the process: `vista check` stops starting cases, writes the
+/// report of those that finished and exits 130. A second Ctrl-C ends it
+/// at once (the handler is reset to the default after the first).
+pub(crate) fn stop_on_interrupt() {
+    #[cfg(unix)]
+    {
+        extern "C" fn on_sigint(_: libc::c_int) {
+            vista_check::interrupt();
+            // SAFETY: signal() is async-signal-safe; SIG_DFL is valid.
+            unsafe {
+                libc::signal(libc::SIGINT, libc::SIG_DFL);
+            }
+        }
+        // SAFETY: the handler only stores an atomic and resets itself.
+        unsafe {
+            libc::signal(libc::SIGINT, on_sigint as *const () as libc::sighandler_t);
+        }
+    }
+}
+
 fn main() -> ExitCode {
     // Started as a GPU worker by another vista process: serve it, then exit.
     vista::config::serve_worker_if_asked();

@@ -3389,6 +3389,54 @@ fn a_project_kernel_renders_the_same_in_the_browser() {
     assert!(left.is_empty(), "left in the temp folder: {left:?}");
 }
 
+/// Ctrl-C during `check` (SIGINT to its process group, workers included):
+/// no new case starts, the report of the cases that finished is written
+/// (index.html saying it was interrupted, results.json), exit 130.
+fn an_interrupted_check_writes_the_report_of_what_finished() {
+    use std::io::BufRead;
+    use std::os::unix::process::CommandExt;
+    let report = tmp();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_vista"))
+        .current_dir(repo())
+        .args(["check", "--report-dir", report.path().to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .process_group(0)
+        .spawn()
+        .unwrap();
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut seen = Vec::new();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        let first_case = line.starts_with("ok ");
+        seen.push(line);
+        if first_case {
+            // SAFETY: kill(2) on the child's own process group.
+            assert_eq!(unsafe { libc::kill(-(child.id() as i32), libc::SIGINT) }, 0);
+            break;
+        }
+    }
+    seen.extend(lines.map(Result::unwrap));
+    let status = child.wait().unwrap();
+    let out = seen.join("\n");
+    assert_eq!(status.code(), Some(130), "{out}");
+    let line = seen.iter().find(|l| l.starts_with("interrupted: ")).unwrap_or_else(|| panic!("{out}"));
+    let finished = seen.iter().filter(|l| l.starts_with("ok ")).count();
+    assert!(line.contains(&format!("after {finished} of ")), "{line}");
+    assert!(!out.contains("FAIL") && !out.contains("CRASH"), "a case cut short is left out, not failed: {out}");
+    let index = std::fs::read_to_string(report.path().join("index.html")).unwrap();
+    assert!(index.contains("Interrupted (Ctrl-C)"), "the report says so");
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.path().join("results.json")).unwrap()).unwrap();
+    let total = vista_golden::Store::of_project(&vista_project::Project::at(&repo()).unwrap(), "t")
+        .unwrap()
+        .load_cases()
+        .unwrap()
+        .len();
+    assert!(finished < total, "interrupted before the end: {finished} of {total}");
+    assert_eq!(results["cases"].as_array().unwrap().len(), finished, "results.json holds the finished cases");
+}
+
 /// Render-setup mistakes wgpu would report only as "Validation Error" at
 /// pipeline creation are named before any GPU work, exit 2: a u32 output
 /// into an rgba8unorm target, a src1 blend factor without a dual-source
@@ -6023,6 +6071,7 @@ fn main() {
         Gpu a_project_kernel_renders_the_same_in_the_browser,
         Gpu the_browser_runs_the_projects_own_text,
         Gpu render_setup_mistakes_are_named_before_gpu_work,
+        Gpu an_interrupted_check_writes_the_report_of_what_finished,
         Gpu the_report_works_in_a_real_browser,
         Gpu max_flip_fails_a_case_above_it,
         Gpu compare_reports_json_fields_and_rejects_bad_files,

@@ -230,6 +230,13 @@ fn receive_answer(r: &mut impl Read) -> std::io::Result<(FromWorker, Answer)> {
 /// Serves as a worker (the edge calls it when [`WORKER_VAR`] is set, first
 /// in `main`): reads requests on stdin until it closes; the exit code.
 pub fn serve_and_exit_code() -> i32 {
+    // Ctrl-C reaches the whole process group; what an interrupt means
+    // (finish the report of what finished) is the parent's to decide, and a
+    // worker killed mid-case would look like a driver crash.
+    // SAFETY: set before any thread starts; SIG_IGN is a valid disposition.
+    unsafe {
+        libc::signal(libc::SIGINT, libc::SIG_IGN);
+    }
     match serve() {
         Ok(()) => 0,
         Err(e) => {

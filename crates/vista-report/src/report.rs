@@ -440,6 +440,10 @@ pub struct RunSummary {
     /// `vista merge` joins).
     #[serde(default)]
     pub partition: Option<(u64, u64)>,
+    /// Why the run stopped before its last case (an interrupt), if it did:
+    /// the report then holds the cases that finished.
+    #[serde(default)]
+    pub stopped: Option<String>,
 }
 
 /// The viewer's data for one case: both images' 16-bit display values
@@ -825,7 +829,7 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
     let body = format!(
         "<header><h1>vista report</h1>\
          <p class=\"counts\"><b>{n}</b> cases: <b class=\"{fcls}\">{nfail} failing</b>, {passed} passed, {xfail} expected failures.</p>\
-         <p>Backend <b>{backend}</b>, adapter <code>{adapter}</code>. Command: <code class=\"cmd\">{command}</code>. Written {date}.{others}</p>\
+         <p>Backend <b>{backend}</b>, adapter <code>{adapter}</code>. Command: <code class=\"cmd\">{command}</code>. Written {date}.{others}</p>{stopped}\
          </header>\n<section id=\"summary\"><h2>Failures, worst first</h2>{summary}{expectations}</section>\n\
          <section id=\"controls\"><label><input type=\"checkbox\" id=\"failures-only\"{checked}> failures only</label> \
          <label>heat map scale <select id=\"heat-scale\"><option value=\"log\">log, fixed: 1/65535 .. 1 (same in every case)</option>\
@@ -835,6 +839,8 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
          <span class=\"help\">In a viewer: <kbd>f</kbd> flips expected/actual, the wheel or +/- zooms (all views together), drag pans.</span></section>\n\
          <section id=\"cases\"><h2>Cases</h2>\n{sections}</section>",
         n = sorted.len(),
+        stopped =
+            run.stopped.as_ref().map_or(String::new(), |s| format!("<p class=\"bad\"><b>{}</b></p>", html_escape(s))),
         nfail = failing.len(),
         fcls = if failing.is_empty() { "ok" } else { "bad" },
         backend = html_escape(&run.backend),
