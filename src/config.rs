@@ -21,6 +21,9 @@ pub struct Config {
     /// `VISTA_MAX_WORK` and `VISTA_MAX_BYTES`: the caps on a render's
     /// work estimate and memory.
     pub limits: RenderLimits,
+    /// `VISTA_COMPILE_TIMEOUT_S`: how long composing and validating one
+    /// shader may take (default a minute).
+    pub compile_timeout: Duration,
     /// `CI` set (to anything but 0 or false): bless is refused without `--force`.
     pub in_ci: bool,
     /// `VISTA_ALLOW_NO_GPU=1`: without an adapter, GPU tests are reported
@@ -92,10 +95,12 @@ pub fn serve_worker_if_asked() {
 }
 
 impl Config {
-    /// Runs this process's GPU work in workers re-executed from this very
-    /// binary (which calls `vista_render::worker::serve_if_asked` first),
-    /// unless `VISTA_WORKERS=0`.
-    pub fn start_workers(&self) {
+    /// Applies the settings that are the process's: the composition time
+    /// limit, and GPU work in workers re-executed from this very binary
+    /// (which calls `vista_render::worker::serve_if_asked` first), unless
+    /// `VISTA_WORKERS=0`.
+    pub fn apply_to_process(&self) {
+        vista_gpu::set_compose_limit(self.compile_timeout);
         if let (true, Ok(exe)) = (self.workers, std::env::current_exe()) {
             vista_render::worker::enable(exe, self.worker_fault.clone());
         }
@@ -120,6 +125,18 @@ impl Config {
                     "VISTA_MAX_WORK={v} is not valid; expected a positive number such as 4e10"
                 ))
             })?,
+        };
+        let compile_timeout = match text("VISTA_COMPILE_TIMEOUT_S").filter(|v| !v.is_empty()) {
+            None => vista_gpu::DEFAULT_COMPOSE_LIMIT,
+            Some(v) => {
+                v.parse::<f64>().ok().filter(|s| s.is_finite() && *s > 0.0).map(Duration::from_secs_f64).ok_or_else(
+                    || {
+                        GoldenError::BadInput(format!(
+                            "VISTA_COMPILE_TIMEOUT_S={v} is not valid; expected a number of seconds > 0"
+                        ))
+                    },
+                )?
+            }
         };
         let max_bytes = match text("VISTA_MAX_BYTES").filter(|v| !v.is_empty()) {
             None => vista_render::DEFAULT_MAX_BYTES,
@@ -152,6 +169,7 @@ impl Config {
                 browser: vista_browser::BrowserConfig::from_lookup(get),
             },
             limits: RenderLimits { max_work, max_bytes },
+            compile_timeout,
             // CI systems spell it true, 1 or their own name (CI=woodpecker).
             in_ci: text("CI").is_some_and(|v| !matches!(v.to_ascii_lowercase().as_str(), "" | "0" | "false")),
             allow_no_gpu: truthy("VISTA_ALLOW_NO_GPU", text("VISTA_ALLOW_NO_GPU"))?,
@@ -265,6 +283,7 @@ mod tests {
                 ("VISTA_FONT", "/f.ttf"),
                 ("VISTA_VALIDATION", "1"),
                 ("VISTA_GPU_TIMEOUT_S", "7.5"),
+                ("VISTA_COMPILE_TIMEOUT_S", "2.5"),
                 ("VISTA_CHROMIUM", "/c"),
                 ("VISTA_ROOT", "/r"),
                 ("VISTA_FAULT", "x"),
@@ -275,6 +294,7 @@ mod tests {
         assert!(c.in_ci && c.allow_no_gpu && c.gpu.validate);
         assert_eq!(c.font.as_deref(), Some(std::path::Path::new("/f.ttf")));
         assert_eq!(c.gpu.timeout, std::time::Duration::from_secs_f64(7.5));
+        assert_eq!(c.compile_timeout, std::time::Duration::from_secs_f64(2.5));
         assert_eq!(c.gpu.browser.chromium.as_deref(), Some(std::path::Path::new("/c")));
         assert_eq!(c.root.as_deref(), Some(std::ffi::OsStr::new("/r")));
         assert_eq!(c.fault.as_deref(), Some("x"));
@@ -293,6 +313,7 @@ mod tests {
             ("VISTA_BACKEND", "metal", "lavapipe|swiftshader|browser|gpu"),
             ("VISTA_ADAPTER", "fast", "cpu|gpu"),
             ("VISTA_GPU_TIMEOUT_S", "-1", "seconds"),
+            ("VISTA_COMPILE_TIMEOUT_S", "0", "seconds > 0"),
             ("VISTA_VALIDATION", "yes", "1|0|true|false"),
             ("VISTA_ALLOW_NO_GPU", "maybe", "1|0|true|false"),
         ] {

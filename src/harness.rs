@@ -85,7 +85,7 @@ fn fail(message: &str) -> ! {
 /// names the run in the report.
 pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
     let config = crate::Config::from_env(&crate::Flags::default()).unwrap_or_else(|e| fail(&e.to_string()));
-    config.start_workers();
+    config.apply_to_process();
     let store = Store::of_project(project, "the golden tests").unwrap_or_else(|e| fail(&e.to_string()));
     let cases = store.load_cases().unwrap_or_else(|e| fail(&format!("cannot load golden cases: {e}")));
     let manifest = Arc::new(store.manifest().unwrap_or_else(|e| fail(&format!("cannot load the manifest: {e}"))));

@@ -239,13 +239,28 @@ enum Command {
 
 /// A closed stdout (`vista list | head -1`) ends vista quietly like other
 /// Unix tools: Rust ignores SIGPIPE, which turns every println! after the
-/// reader left into a panic.
+/// reader left into a panic. Only a closed stdout: a worker that died
+/// between cases also raises SIGPIPE (on the parent's next request), and
+/// that write must fail with EPIPE so the parent starts another worker.
 #[cfg(unix)]
 fn die_quietly_on_closed_pipe() {
-    // SAFETY: called first thing in main, before any thread starts; SIG_DFL
-    // is a valid disposition for SIGPIPE.
+    extern "C" fn on_sigpipe(_: libc::c_int) {
+        // poll(2) is async-signal-safe; a pipe whose reader left reports POLLERR.
+        let mut out = libc::pollfd { fd: libc::STDOUT_FILENO, events: libc::POLLOUT, revents: 0 };
+        // SAFETY: one valid pollfd, no wait.
+        let closed = unsafe { libc::poll(&mut out, 1, 0) } == 1 && out.revents & libc::POLLERR != 0;
+        if closed {
+            // SAFETY: the default action ends the process as SIGPIPE would have.
+            unsafe {
+                libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+                libc::raise(libc::SIGPIPE);
+            }
+        }
+    }
+    // SAFETY: called first thing in main, before any thread starts; the
+    // handler only polls and re-raises.
     unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        libc::signal(libc::SIGPIPE, on_sigpipe as *const () as libc::sighandler_t);
     }
 }
 
@@ -364,7 +379,7 @@ fn main() -> ExitCode {
         unsafe { std::env::set_var(name, value) };
     }
     // Workers inherit the environment set above.
-    config.start_workers();
+    config.apply_to_process();
     let result = run(&project, &config, cli.command);
     vista_render::worker::stop_all();
     match result {

@@ -3437,6 +3437,35 @@ fn an_interrupted_check_writes_the_report_of_what_finished() {
     assert_eq!(results["cases"].as_array().unwrap().len(), finished, "results.json holds the finished cases");
 }
 
+/// Composition has a time limit (`VISTA_COMPILE_TIMEOUT_S`): naga's WGSL
+/// front end is quadratic in module-scope constants, so 20,000 `const`
+/// lines would take minutes. `render` refuses it (exit 2) and `check` fails
+/// that case alone, naming the setting, within about the limit.
+fn composition_past_its_time_limit_fails_the_case_not_the_run() {
+    let mut big: String = (0..20000).map(|i| format!("const C{i}: f32 = {i}.0;\n")).collect();
+    big.push_str(&K_SHADER.replace("vec3(params.gain)", "vec3(params.gain * C1)"));
+    let d = kernel_project(K_MANIFEST, K_SHADER);
+    std::fs::write(d.path().join("shaders/big.wgsl"), big).unwrap();
+    std::fs::write(d.path().join("kernels/big.toml"), format!("shader = \"big.wgsl\"\n{K_MANIFEST}")).unwrap();
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    let cases = "[[case]]\nid = \"small\"\nkernel = \"k\"\nsize = \"8x8\"\n[[case]]\nid = \"big\"\nkernel = \"big\"\nsize = \"8x8\"\n";
+    std::fs::write(cases_path(d.path()), cases).unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless", "--case", "small"]).code, 0);
+    let limit = [("VISTA_COMPILE_TIMEOUT_S", "1")];
+    let out = d.path().join("big.png");
+    let started = std::time::Instant::now();
+    let r = vista_in(Some(d.path()), &limit, &["render", "big", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    assert_rejected(&r, 2, &["big.wgsl: composing and validating it took longer than 1 s", "VISTA_COMPILE_TIMEOUT_S"]);
+    let c = vista_in(Some(d.path()), &limit, &["check"]);
+    assert_eq!(c.code, 1, "{}{}", c.stdout, c.stderr);
+    assert!(c.stdout.contains("took longer than 1 s"), "{}", c.stdout);
+    assert!(c.stdout.lines().any(|l| l.starts_with("FAIL") && l.contains("big")), "{}", c.stdout);
+    assert!(c.stdout.contains("1 passed, 1 failed"), "the other case still ran: {}", c.stdout);
+    assert!(started.elapsed() < std::time::Duration::from_secs(30), "{:?}", started.elapsed());
+    let bad = vista_in(Some(d.path()), &[("VISTA_COMPILE_TIMEOUT_S", "0")], &["list"]);
+    assert_rejected(&bad, 2, &["VISTA_COMPILE_TIMEOUT_S=0 is not valid; expected a number of seconds > 0"]);
+}
+
 /// Render-setup mistakes wgpu would report only as "Validation Error" at
 /// pipeline creation are named before any GPU work, exit 2: a u32 output
 /// into an rgba8unorm target, a src1 blend factor without a dual-source
@@ -6072,6 +6101,7 @@ fn main() {
         Gpu the_browser_runs_the_projects_own_text,
         Gpu render_setup_mistakes_are_named_before_gpu_work,
         Gpu an_interrupted_check_writes_the_report_of_what_finished,
+        Gpu composition_past_its_time_limit_fails_the_case_not_the_run,
         Gpu the_report_works_in_a_real_browser,
         Gpu max_flip_fails_a_case_above_it,
         Gpu compare_reports_json_fields_and_rejects_bad_files,

@@ -32,7 +32,10 @@ pub use graph::{
     RasterTarget, Readback, Resource, SamplerDesc, TextureDesc, VertexBuffer, buffer_size, buffer_usages, run_order,
 };
 pub use limits::Needs;
-pub use shaders::{ENUMS_MODULE, Reader, ShaderSet, SourceText, resolve_overrides, validate};
+pub use shaders::{
+    DEFAULT_COMPOSE_LIMIT, ENUMS_MODULE, Reader, ShaderSet, SourceText, compose_limit, resolve_overrides,
+    runaway_compositions, set_compose_limit, validate,
+};
 
 /// Hint printed whenever no usable Vulkan adapter is found.
 pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \

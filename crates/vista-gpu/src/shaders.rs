@@ -465,11 +465,47 @@ impl ShaderSet {
             return Ok(m.clone());
         }
         let started = std::time::Instant::now();
-        let module = self.compose_uncached(name);
+        let module = self.compose_within_limit(name);
         self.compose_nanos.fetch_add(started.elapsed().as_nanos() as u64, std::sync::atomic::Ordering::Relaxed);
         let module = Arc::new(module?);
         self.composed.lock().expect("compose cache").insert(name.to_string(), module.clone());
         Ok(module)
+    }
+
+    /// [`ShaderSet::compose_uncached`] on a thread of its own, given at most
+    /// [`compose_limit`]: naga's WGSL front end slows quadratically with a
+    /// module's constants (10,000 `const` lines take seconds, 400,000 hours),
+    /// and a parse cannot be stopped, so past the limit the thread is left
+    /// to finish in the background ([`runaway_compositions`] counts them; a
+    /// worker process then exits) and the case fails naming the setting.
+    /// A panic in naga or naga_oil becomes this file's error too.
+    fn compose_within_limit(&self, name: &str) -> Result<naga::Module, GpuError> {
+        let limit = compose_limit();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let (set, owned) = (self.clone(), name.to_string());
+        std::thread::Builder::new()
+            .name("vista-compose".into())
+            .spawn(move || {
+                let _ = tx.send(set.compose_uncached(&owned));
+            })
+            .map_err(|e| GpuError::Shader(format!("{}: no thread to compose it on: {e}", file_of(name))))?;
+        match rx.recv_timeout(limit) {
+            Ok(result) => result,
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                RUNAWAY.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                Err(GpuError::Shader(format!(
+                    "{}: composing and validating it took longer than {} s, the limit \
+                     (VISTA_COMPILE_TIMEOUT_S); naga's WGSL front end slows quadratically with module-scope \
+                     constants ({} lines here): split the module or raise the limit",
+                    file_of(name),
+                    limit.as_secs_f64(),
+                    self.unit(name).map_or(0, |u| u.source.text.lines().count())
+                )))
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                Err(GpuError::Shader(format!("{}: composing it panicked in naga or naga_oil", file_of(name))))
+            }
+        }
     }
 
     fn compose_uncached(&self, name: &str) -> Result<naga::Module, GpuError> {
@@ -804,6 +840,30 @@ pub fn keep_struct_layouts(
     let mut out = lines.join("\n");
     out.push('\n');
     Ok((out, written))
+}
+
+/// The default of [`compose_limit`]: a minute, about 30,000 `const` lines
+/// on a CI core; no shader a project ships comes near it.
+pub const DEFAULT_COMPOSE_LIMIT: std::time::Duration = std::time::Duration::from_secs(60);
+
+static COMPOSE_LIMIT: std::sync::OnceLock<std::time::Duration> = std::sync::OnceLock::new();
+static RUNAWAY: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// Sets this process's [`compose_limit`] (the binary's configuration does,
+/// from `VISTA_COMPILE_TIMEOUT_S`); the first setting wins.
+pub fn set_compose_limit(limit: std::time::Duration) {
+    let _ = COMPOSE_LIMIT.set(limit);
+}
+
+/// How long composing and validating one shader may take: as set (a
+/// worker gets its parent's), else [`DEFAULT_COMPOSE_LIMIT`].
+pub fn compose_limit() -> std::time::Duration {
+    COMPOSE_LIMIT.get().copied().unwrap_or(DEFAULT_COMPOSE_LIMIT)
+}
+
+/// Compositions that passed the limit and still run in the background.
+pub fn runaway_compositions() -> usize {
+    RUNAWAY.load(std::sync::atomic::Ordering::SeqCst)
 }
 
 /// A kernel's WGSL as its files give it, and where each line came from.

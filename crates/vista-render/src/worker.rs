@@ -76,6 +76,8 @@ struct WireConfig {
     validate: bool,
     timeout: Duration,
     wgpu_backends: Option<String>,
+    /// The parent's `vista_gpu::compose_limit`.
+    compose_limit: Duration,
 }
 
 /// A request to the worker. The parent sends the graph borrowed (a noise
@@ -253,6 +255,7 @@ fn serve() -> std::io::Result<()> {
     let ToWorker::Init(c) = first else {
         return Err(std::io::Error::other("the first request must be Init"));
     };
+    vista_gpu::set_compose_limit(c.compose_limit);
     let config = GpuConfig {
         adapter: c.adapter,
         validate: c.validate,
@@ -338,6 +341,10 @@ fn serve() -> std::io::Result<()> {
         let graph = vista_gpu::Graph { shaders: &shaders, resources, passes, outputs };
         let result = ctx.run(&graph);
         let compile = ctx.compile_time().saturating_sub(before);
+        // A composition past its limit still runs on a thread of its own;
+        // only ending the process stops it (the parent starts a fresh
+        // worker for the next case).
+        let runaway = vista_gpu::runaway_compositions() > 0;
         let mut out = out.lock().expect("stdout");
         match result {
             Err(e) => send(&mut *out, &FromWorker::Done(Err(e.into())), &[])?,
@@ -366,6 +373,9 @@ fn serve() -> std::io::Result<()> {
                 };
                 send(&mut *out, &FromWorker::Done(Ok(head)), &parts)?
             }
+        }
+        if runaway {
+            return Ok(());
         }
     }
 }
@@ -545,6 +555,7 @@ impl Worker {
             validate: c.validate,
             timeout: c.timeout,
             wgpu_backends: c.wgpu_backends.clone(),
+            compose_limit: vista_gpu::compose_limit(),
         });
         let mut proc = Proc { child, heard };
         send(proc.stdin(), &init, &[]).map_err(|e| failed(format!("cannot talk to the worker: {e}")))?;
