@@ -1,4 +1,4 @@
-// landscape kernel: the seed's whole frame in one kernel (issue 16). Ridged
+// landscape kernel: the seed's whole frame in one kernel. Ridged
 // terrain by the heightfield kernel's march, lit by the sun through the
 // atmosphere; the atmosphere kernel's sky; aerial perspective over the
 // terrain; the clouds kernel's slab, composited in depth order. Every piece

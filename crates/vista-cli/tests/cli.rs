@@ -1790,6 +1790,35 @@ fn table_keys(doc: &str, heading: &str) -> std::collections::BTreeSet<String> {
         .collect()
 }
 
+/// The project speaks of itself, not of how it was built: no tracked file
+/// names an issue or a session by its number; history is git's.
+fn no_tracked_file_cites_an_issue_or_session_number() {
+    let listed = std::process::Command::new("git").current_dir(repo()).args(["ls-files", "-z"]).output().unwrap();
+    assert!(listed.status.success(), "git ls-files");
+    let mut found = Vec::new();
+    for rel in listed.stdout.split(|b| *b == 0).filter(|p| !p.is_empty()) {
+        let rel = String::from_utf8_lossy(rel).into_owned();
+        let Ok(text) = std::fs::read_to_string(repo().join(&rel)) else { continue }; // binary files
+        for (n, line) in text.lines().enumerate() {
+            let lower = line.to_ascii_lowercase();
+            for word in ["issue", "session"] {
+                let mut rest = lower.as_str();
+                while let Some(at) = rest.find(word) {
+                    let before = rest[..at].chars().next_back();
+                    let after = rest[at + word.len()..].trim_start_matches(['s', ' ', '#']);
+                    if !before.is_some_and(|c| c.is_ascii_alphanumeric())
+                        && after.starts_with(|c: char| c.is_ascii_digit())
+                    {
+                        found.push(format!("{rel}:{}: {}", n + 1, line.trim()));
+                    }
+                    rest = &rest[at + word.len()..];
+                }
+            }
+        }
+    }
+    assert!(found.is_empty(), "issue or session numbers in the project:\n{}", found.join("\n"));
+}
+
 /// The README's schemas are the parsers' own key lists: each is compared
 /// with the list serde (or the resource parser) gives for an unknown key,
 /// so neither can drift.
@@ -6085,6 +6114,7 @@ fn main() {
     }
     let tests: &[(Needs, &str, fn())] = tests![
         Cpu unknown_kernel_lists_valid_kernels,
+        Cpu no_tracked_file_cites_an_issue_or_session_number,
         Cpu unknown_preset_lists_valid_presets,
         Cpu unknown_param_lists_valid_params,
         Cpu out_of_range_value_names_value_and_range,
