@@ -5764,6 +5764,30 @@ fn two() -> Two {
             ),
         }
     }
+    // The same through naga_oil, as engines write it: the `enable` and the
+    // second output under a def. naga_oil drops the directive; the backend
+    // is still asked for the feature the def selects.
+    let composed = TWO
+        .replace("enable dual_source_blending;", "#ifdef DUAL_SOURCE_BLENDING\nenable dual_source_blending;\n#endif")
+        .replace(
+            "    @location(0) @blend_src(1) weight: vec4<f32>,",
+            "#ifdef DUAL_SOURCE_BLENDING\n    @location(0) @blend_src(1) weight: vec4<f32>,\n#endif",
+        );
+    let d = kernel_project(&format!("defs = {{ DUAL_SOURCE_BLENDING = true }}\n{manifest}"), &composed);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let out = d.path().join(format!("composed-{backend}.exr"));
+        let args = ["render", "k", "--size", "8x4", "--backend", backend, "-o", out.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        match DUAL_SOURCE.contains(&backend) {
+            true => {
+                assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+                assert_eq!(vista_image::load(&out).unwrap().get(5, 2), [0.75; 4], "{backend}");
+            }
+            false => {
+                assert_rejected(&r, 1, &["unsupported on", "enable dual_source_blending;", "dual-source-blending"])
+            }
+        }
+    }
 }
 
 /// Render targets of the formats engines draw into but core WebGPU does
