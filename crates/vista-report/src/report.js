@@ -83,6 +83,9 @@ class Viewer {
   load(d) {
     this.w = d.w;
     this.h = d.h;
+    // A tall image (stacked layers) comes as rows y0 .. y0 + h of full_h.
+    this.y0 = d.y0 || 0;
+    this.fullH = d.full_h || d.h;
     // No golden of this size: the render alone, at full size, to review.
     this.alone = d.expected === null;
     this.exp = this.alone ? null : decode(d.expected);
@@ -224,7 +227,7 @@ class Viewer {
         img.data[4 * i + 3] = 255;
       }
       this.canvas.getContext("2d").putImageData(img, 0, 0);
-      this.el.querySelector(".img-label").textContent = "actual: no golden of this size yet; review it, then bless it";
+      this.el.querySelector(".img-label").textContent = "actual: no golden of this size yet; review it, then bless it" + this.rows();
       return;
     }
     const img = new ImageData(this.w, this.h);
@@ -240,9 +243,14 @@ class Viewer {
     }
     this.canvas.getContext("2d").putImageData(img, 0, 0);
     const label = this.slider ? `slider: expected left, actual right of x = ${cut}` : `showing: ${this.showing}`;
-    this.el.querySelector(".img-label").textContent = label;
+    this.el.querySelector(".img-label").textContent = label + this.rows();
     for (const b of this.el.querySelectorAll("button[data-show]")) b.classList.toggle("on", !this.slider && b.dataset.show === this.showing);
     this.el.dataset.showing = this.showing;
+  }
+
+  // Which rows a tall image's viewer holds (the PNG files hold them all).
+  rows() {
+    return this.fullH > this.h ? ` (rows ${this.y0}-${this.y0 + this.h - 1} of ${this.fullH}; the PNG files hold all)` : "";
   }
 
   diffAt(i) {
@@ -283,8 +291,9 @@ class Viewer {
     if (x < 0 || y < 0 || x >= this.w || y >= this.h) return;
     const i = y * this.w + x;
     const px = (a) => [0, 1, 2].map((k) => fmt(a[3 * i + k])).join(" ");
+    const at = `(${x}, ${y + this.y0})`;
     if (this.alone) {
-      this.el.querySelector(".readout").textContent = `(${x}, ${y})  actual ${px(this.act)}`;
+      this.el.querySelector(".readout").textContent = `${at}  actual ${px(this.act)}`;
       return;
     }
     const diff = [0, 1, 2].map((k) => {
@@ -292,7 +301,7 @@ class Viewer {
       return (d >= 0 ? "+" : "") + d;
     });
     this.el.querySelector(".readout").textContent =
-      `(${x}, ${y})  expected ${px(this.exp)}  actual ${px(this.act)}  diff ${diff.join(" ")} /65535`;
+      `${at}  expected ${px(this.exp)}  actual ${px(this.act)}  diff ${diff.join(" ")} /65535`;
   }
 }
 

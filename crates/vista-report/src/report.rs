@@ -446,6 +446,10 @@ pub struct RunSummary {
     pub stopped: Option<String>,
 }
 
+/// The most texels a case's viewer data holds (2048 x 2048: about 67 MB
+/// of view.js with both images).
+pub const MAX_VIEW_TEXELS: usize = 2048 * 2048;
+
 /// The viewer's data for one case: both images' 16-bit display values
 /// (RGB, little-endian u16, base64; `expected` null when there is no
 /// golden of the render's size) and the first bad pixel.
@@ -459,6 +463,11 @@ pub fn view_js(id: &str, expected: Option<&Image>, actual: &Image, first_bad: Op
 /// case's was one 64 MiB string and its 16-bit values once more. A row's
 /// 6 bytes a texel are a multiple of 3, so its base64 needs no padding and
 /// the rows' texts join into the whole image's.
+///
+/// At most [`MAX_VIEW_TEXELS`] go in: a taller image (a 3d texture's or an
+/// array's stacked layers: 512^3 made a 1 GB view.js) gives the rows around
+/// its first bad pixel (else its first rows), and says which (`y0`,
+/// `full_h`); the 16-bit PNGs beside it keep every row.
 pub fn write_view_js(
     out: &mut dyn std::io::Write,
     id: &str,
@@ -467,6 +476,19 @@ pub fn write_view_js(
     first_bad: Option<(u32, u32)>,
 ) -> std::io::Result<()> {
     let w = actual.width as usize;
+    let full_h = actual.height as usize;
+    let rows = (MAX_VIEW_TEXELS / w.max(1)).clamp(1, full_h.max(1));
+    let y0 = first_bad.map_or(0, |(_, y)| (y as usize).saturating_sub(rows / 2)).min(full_h.saturating_sub(rows));
+    let window = |img: &Image| -> Image {
+        let data = img.data.get(y0 * w..(y0 + rows) * w).unwrap_or(&img.data).to_vec();
+        Image { width: img.width, height: (data.len() / w.max(1)) as u32, data }
+    };
+    let cropped = (rows < full_h).then(|| (expected.map(window), window(actual)));
+    let (expected, actual) = match &cropped {
+        Some((e, a)) => (e.as_ref(), a),
+        None => (expected, actual),
+    };
+    let first_bad = first_bad.map(|(x, y)| (x, y - y0 as u32));
     let mut bytes = Vec::with_capacity(w * 6);
     let mut text = vec![0u8; w * 8];
     let mut u16s = |out: &mut dyn std::io::Write, img: &Image| -> std::io::Result<()> {
@@ -482,7 +504,11 @@ pub fn write_view_js(
         out.write_all(b"\"")
     };
     let id = serde_json::to_string(id).expect("a string");
-    write!(out, "vistaCase({{\"id\":{id},\"w\":{},\"h\":{},\"expected\":", actual.width, actual.height)?;
+    write!(
+        out,
+        "vistaCase({{\"id\":{id},\"w\":{},\"h\":{},\"y0\":{y0},\"full_h\":{full_h},\"expected\":",
+        actual.width, actual.height
+    )?;
     match expected {
         Some(e) => u16s(out, e)?,
         None => out.write_all(b"null")?,
@@ -933,5 +959,38 @@ mod view_tests {
         let alone = view_js("x", None, &actual, None);
         let v: serde_json::Value = serde_json::from_str(&alone["vistaCase(".len()..alone.len() - 3]).expect("JSON");
         assert!(v["expected"].is_null() && v["first_bad"].is_null());
+    }
+
+    /// A stacked 3d output taller than the cap: the viewer gets the rows
+    /// around its first bad pixel, never more than MAX_VIEW_TEXELS, and
+    /// says which rows of how many.
+    #[test]
+    fn a_tall_image_s_viewer_holds_the_rows_around_its_first_bad_pixel() {
+        let (w, h) = (512u32, 512 * 64);
+        let row_value = |y: u32| (y % 1000) as f32 / 1000.0;
+        let img = Image {
+            width: w,
+            height: h,
+            data: (0..h).flat_map(|y| vec![[row_value(y), 0.0, 0.0, 1.0]; w as usize]).collect(),
+        };
+        let js = view_js("tall", Some(&img), &img, Some((7, 20000)));
+        assert!(js.len() < MAX_VIEW_TEXELS * 6 * 2 * 4 / 3 + 1000, "{} bytes", js.len());
+        let json = js.strip_prefix("vistaCase(").and_then(|s| s.strip_suffix(");\n")).expect("vistaCase(...);");
+        let v: serde_json::Value = serde_json::from_str(json).expect("JSON");
+        let rows = (MAX_VIEW_TEXELS / w as usize) as u64;
+        let y0 = 20000 - rows / 2;
+        assert_eq!((v["h"].as_u64(), v["y0"].as_u64(), v["full_h"].as_u64()), (Some(rows), Some(y0), Some(h as u64)));
+        assert_eq!(v["first_bad"], serde_json::json!([7, rows / 2]), "relative to the window");
+        let first = base64::engine::general_purpose::STANDARD.decode(&v["actual"].as_str().unwrap()[..8]).unwrap();
+        assert_eq!(
+            u16::from_le_bytes([first[0], first[1]]),
+            vista_image::quantize16(row_value(y0 as u32)),
+            "row y0 first"
+        );
+        // Without a bad pixel: the first rows; a short image: all of it.
+        let head = |js: String| js[..120].to_string();
+        assert!(head(view_js("t", None, &img, None)).contains(&format!("\"h\":{rows},\"y0\":0,")));
+        let short = Image { width: 4, height: 3, data: vec![[0.0; 4]; 12] };
+        assert!(head(view_js("s", None, &short, Some((1, 2)))).contains("\"h\":3,\"y0\":0,\"full_h\":3,"));
     }
 }
