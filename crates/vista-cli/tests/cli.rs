@@ -3466,6 +3466,31 @@ fn an_interrupted_check_writes_the_report_of_what_finished() {
     assert_eq!(results["cases"].as_array().unwrap().len(), finished, "results.json holds the finished cases");
 }
 
+/// A buffer larger than the device binds (lavapipe: 128 MiB of storage) is
+/// refused in the parent, naming the limit, before a worker or the device
+/// holds a copy of it (a 1 GiB buffer peaked at 3.2 GB before wgpu refused
+/// the bind group).
+fn a_buffer_past_the_device_s_binding_size_is_refused_before_the_worker() {
+    let shader = "@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
+                  @group(0) @binding(1) var out: texture_storage_2d<rgba32float, write>;\n\
+                  @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                  \x20   textureStore(out, id.xy, vec4<f32>(f32(data[id.x])));\n}\n";
+    let manifest = |n: u64| {
+        format!(
+            "summary = \"b\"\n[[resource]]\nname = \"data\"\nkind = \"buffer\"\nlength = {n}\n[[resource]]\nname = \"out\"\n\
+             kind = \"texture\"\nformat = \"rgba32float\"\n[[pass]]\nentry = \"main\"\n"
+        )
+    };
+    let r = render_k(&manifest(67_108_864), shader);
+    assert_rejected(
+        &r,
+        1,
+        &["unsupported on", "(268435456 bytes), bound as storage", "needs maxStorageBufferBindingSize >= 268435456"],
+    );
+    assert!(!r.stderr.contains("Validation Error"), "{}", r.stderr);
+    assert_eq!(render_k(&manifest(1024), shader).code, 0, "a small one binds");
+}
+
 /// Composition has a time limit (`VISTA_COMPILE_TIMEOUT_S`): naga's WGSL
 /// front end is quadratic in module-scope constants, so 20,000 `const`
 /// lines would take minutes. `render` refuses it (exit 2) and `check` fails
@@ -6156,6 +6181,7 @@ fn main() {
         Gpu render_setup_mistakes_are_named_before_gpu_work,
         Gpu an_interrupted_check_writes_the_report_of_what_finished,
         Gpu composition_past_its_time_limit_fails_the_case_not_the_run,
+        Gpu a_buffer_past_the_device_s_binding_size_is_refused_before_the_worker,
         Gpu the_report_works_in_a_real_browser,
         Gpu max_flip_fails_a_case_above_it,
         Gpu compare_reports_json_fields_and_rejects_bad_files,

@@ -581,20 +581,7 @@ impl Context {
     /// sentinel 0 somewhere are run again over sentinel 1: a texel holding
     /// each run's sentinel was never written.
     pub fn run(&self, g: &Graph<'_>) -> Result<Readback, GpuError> {
-        let max = self.max_dimension();
-        for r in g.resources.iter() {
-            if let Resource::Texture(t) = r
-                && (t.width > max || t.height > max)
-            {
-                return Err(GpuError::Request(format!(
-                    "size {}x{} is outside this device's range: each side in [1, {max}]",
-                    t.width, t.height
-                )));
-            }
-        }
-        for pass in g.passes.iter() {
-            self.require_needs(&pass.label, &pass.needs())?;
-        }
+        self.require_graph(g)?;
         let start = Instant::now();
         let once = |which: usize| match &self.engine {
             Engine::Wgpu(w) => self.run_wgpu(w, g, which),
@@ -620,5 +607,41 @@ impl Context {
         }
         first.0.stats.total = start.elapsed();
         Ok(first.0)
+    }
+
+    /// What the graph needs of the device, refused before any run (the
+    /// parent asks this of a worker's device before sending the graph):
+    /// texture sizes, each pass's workgroups and bindings, and each
+    /// buffer's size.
+    pub fn require_graph(&self, g: &Graph<'_>) -> Result<(), GpuError> {
+        let max = self.max_dimension();
+        for r in g.resources.iter() {
+            if let Resource::Texture(t) = r
+                && (t.width > max || t.height > max)
+            {
+                return Err(GpuError::Request(format!(
+                    "size {}x{} is outside this device's range: each side in [1, {max}]",
+                    t.width, t.height
+                )));
+            }
+        }
+        for pass in g.passes.iter() {
+            self.require_needs(&pass.label, &pass.needs())?;
+        }
+        // A buffer is bound whole: one past the device's binding size is
+        // refused here, before a worker or the device holds a copy of it.
+        for (i, used) in buffer_usages(&g.resources, &g.passes).iter().enumerate() {
+            let (Some(used), Resource::Buffer(bytes)) = (used, &g.resources[i]) else { continue };
+            let what = format!("buffer resource {i} ({} bytes)", bytes.len());
+            let size = bytes.len() as u64;
+            self.require(&what, "maxBufferSize", size)?;
+            if used.storage {
+                self.require(&format!("{what}, bound as storage"), "maxStorageBufferBindingSize", size)?;
+            }
+            if used.uniform {
+                self.require(&format!("{what}, bound as uniform"), "maxUniformBufferBindingSize", size)?;
+            }
+        }
+        Ok(())
     }
 }

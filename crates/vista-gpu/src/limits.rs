@@ -30,7 +30,7 @@ pub struct Needs {
 type Read = fn(&wgpu::Limits) -> u64;
 
 /// The limits vista checks, by WebGPU's name, read from wgpu's.
-const WGPU_LIMITS: [(&str, Read); 17] = [
+const WGPU_LIMITS: [(&str, Read); 19] = [
     ("maxComputeWorkgroupSizeX", |l| l.max_compute_workgroup_size_x as u64),
     ("maxComputeWorkgroupSizeY", |l| l.max_compute_workgroup_size_y as u64),
     ("maxComputeWorkgroupSizeZ", |l| l.max_compute_workgroup_size_z as u64),
@@ -48,6 +48,8 @@ const WGPU_LIMITS: [(&str, Read); 17] = [
     ("maxTextureDimension3D", |l| l.max_texture_dimension_3d as u64),
     ("maxTextureArrayLayers", |l| l.max_texture_array_layers as u64),
     ("maxStorageBufferBindingSize", |l| l.max_storage_buffer_binding_size),
+    ("maxUniformBufferBindingSize", |l| l.max_uniform_buffer_binding_size),
+    ("maxBufferSize", |l| l.max_buffer_size),
 ];
 
 /// Limit `name` (WebGPU's spelling) of a wgpu device, where vista checks it.

@@ -403,8 +403,9 @@ impl Planning<'_> {
                 encode_values(&vec![v; e.leaves.len()], e).map_err(at)?.repeat(n as usize)
             }
         };
-        let mut bytes = vec![0u8; e.header as usize];
-        bytes.extend(body);
+        // The header in front, without a second copy of a large body.
+        let mut bytes = body;
+        bytes.splice(0..0, std::iter::repeat_n(0u8, e.header as usize));
         if let Some(n) = e.fixed {
             let want = e.header as u64 + n as u64 * e.stride as u64;
             if bytes.len() as u64 != want {

@@ -524,6 +524,8 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
     };
     let out = match &gpu.worker {
         Some(w) => {
+            // Refused here, before the worker holds a copy of the graph.
+            gpu.ctx.require_graph(&graph)?;
             let source = worker::ShaderSource { root: gpu.root.clone(), edit: gpu.edit.clone() };
             let case = CASE.with(|c| c.borrow().clone());
             w.run(gpu.ctx, &graph, &source, &plan.kernel, case.as_deref())?
