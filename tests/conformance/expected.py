@@ -619,10 +619,30 @@ def out_of_bounds_probes():
                     "texture flags, marker"}]
 
 
+def draw_offset_probes():
+    # WebGPU draw(vertexCount, instanceCount, firstVertex, firstInstance) and drawIndexed(indexCount,
+    # instanceCount, firstIndex, baseVertex, firstInstance); WGSL: vertex_index is the vertex's index
+    # (for an indexed draw, the index buffer's entry plus baseVertex), instance_index counts from
+    # firstInstance, and attributes are fetched at those indices.
+    seen = [[0, 0, 0, 0] for _ in range(64)]
+    def point(v, i):
+        seen[i * 8 + v] = [v, i, 100 + v, 1000 + i]
+    for i in (5, 6):                       # first_instance 5, instances 2
+        for v in (3, 4):                   # first_vertex 3, count 2
+            point(v, i)
+    for index in (0, 2):                   # indices [0, 2], base_vertex 5, first_instance 1
+        point(index + 5, 1)
+    for index in (4, 6):                   # indices [4, 6], base_vertex -3, first_instance 7
+        point(index - 3, 7)
+    return [{"kernel": "draw_offsets", "set": {}, "outputs": ["seen"], "words": [w for p in seen for w in p],
+             "why": "per pixel (vertex_index, instance_index) of an 8 x 8 target: the vertex and instance index "
+                    "and the per-vertex and per-instance attributes fetched there, zeros where no point fell"}]
+
+
 PROBES = [array_length_probes, layout_probes, entry_name_probes, blend_probes, vertex_probes, texture_query_probes,
           sampling_probes, format_probes, workgroup_zero_probes,
           index_probes, depth_probes, render_format_probes,
-          struct_array_probes, view_probes, out_of_bounds_probes]
+          struct_array_probes, view_probes, out_of_bounds_probes, draw_offset_probes]
 
 
 def render():

@@ -56,6 +56,14 @@ mutants=(
     crates/vista-gpu/src/raster.rs
     "if r.index_u16 { wgpu::IndexFormat::Uint16 } else { wgpu::IndexFormat::Uint32 }"
     "if r.index_u16 { wgpu::IndexFormat::Uint32 } else { wgpu::IndexFormat::Uint32 }"
+    "a draw's first instance dropped"
+    crates/vista-gpu/src/wgpu_run.rs
+    "let instances = raster.first_instance..raster.first_instance + raster.instances;"
+    "let instances = 0..raster.instances;"
+    "an indexed draw's base vertex dropped"
+    crates/vista-gpu/src/wgpu_run.rs
+    "pass.draw_indexed(0..raster.count, raster.base_vertex, instances);"
+    "pass.draw_indexed(0..raster.count, 0, instances);"
 )
 
 backup=$(mktemp -d)

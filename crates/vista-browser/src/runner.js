@@ -78,7 +78,7 @@ function vistaChunk(offset, length) {
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
 // another file's; null: vertex_entry is in the pass's own module), vertex_entry, vertex_constants, targets: [{ resource, level, layer, clear, clear_once (the first run only),
 // blend (WebGPU's blend state or null) }], buffers: [{ resource, arrayStride, stepMode, attributes }], indices (a
-// buffer or null), index_format (uint32 or uint16), count, instances, topology, cull, depth ({ resource, compare, write, clear } or null), blend_constant }. Outputs are read back one after another into vista.out: textures
+// buffer or null), index_format (uint32 or uint16), count, instances, first_vertex, first_instance, base_vertex, topology, cull, depth ({ resource, compare, write, clear } or null), blend_constant }. Outputs are read back one after another into vista.out: textures
 // unpadded, layers stacked; buffers whole.
 async function pipeline(pass, resources) {
   const targets = pass.raster ? pass.raster.targets.map((t) => ({ format: resources[t.resource].format, blend: t.blend || undefined })) : null;
@@ -255,9 +255,9 @@ async function vistaRun(job) {
           r.buffers.forEach((b, slot) => rp.setVertexBuffer(slot, made[current[b.resource]]));
           if (r.indices !== null) {
             rp.setIndexBuffer(made[current[r.indices]], r.index_format);
-            rp.drawIndexed(r.count, r.instances);
+            rp.drawIndexed(r.count, r.instances, 0, r.base_vertex, r.first_instance);
           } else {
-            rp.draw(r.count, r.instances);
+            rp.draw(r.count, r.instances, r.first_vertex, r.first_instance);
           }
           rp.end();
         } else {

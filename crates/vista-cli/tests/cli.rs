@@ -3466,6 +3466,48 @@ fn an_interrupted_check_writes_the_report_of_what_finished() {
     assert_eq!(results["cases"].as_array().unwrap().len(), finished, "results.json holds the finished cases");
 }
 
+/// Draw offsets are checked like counts, before GPU work: first_vertex is
+/// for a draw without indices and base_vertex for an indexed one, and the
+/// vertices and instances they reach must be in the buffers.
+fn draw_offsets_are_checked_against_the_buffers() {
+    let shader = "@vertex\nfn vs(@location(0) p: vec2<f32>, @location(1) o: f32) -> @builtin(position) vec4<f32> {\n\
+                  \x20   return vec4<f32>(p.x + o, p.y, 0.0, 1.0);\n}\n\
+                  @fragment\nfn fs() -> @location(0) vec4<f32> { return vec4<f32>(1.0); }\n";
+    let base = "summary = \"d\"\n[[resource]]\nname = \"img\"\nkind = \"texture\"\nformat = \"rgba8unorm\"\n\
+                [[resource]]\nname = \"tri\"\nkind = \"buffer\"\ndata = [-1.0, -1.0, 3.0, -1.0, -1.0, 3.0, 0.0, 0.0]\n\
+                [[resource]]\nname = \"shift\"\nkind = \"buffer\"\ndata = [0.0, 0.5]\n\
+                [[pass]]\nkind = \"render\"\nvertex = \"vs\"\nfragment = \"fs\"\n\
+                vertices = [\"tri\", { resource = \"shift\", step = \"instance\", stride = 4, attributes = [{ location = 1, format = \"float32\", offset = 0 }] }]\n\
+                targets = [{ resource = \"img\" }]\n";
+    // The index buffer joins where a draw names it (an unbound buffer is refused).
+    let with_indices = |keys: &str| match keys.contains("\"ix\"") {
+        true => format!("{base}{keys}[[resource]]\nname = \"ix\"\nkind = \"buffer\"\ndata = [0, 1, 2]\n"),
+        false => format!("{base}{keys}"),
+    };
+    for (keys, needles) in [
+        ("indices = \"ix\"\nfirst_vertex = 1\n", vec!["first_vertex is for a draw without indices"]),
+        ("base_vertex = 1\n", vec!["base_vertex is for an indexed draw"]),
+        (
+            "first_vertex = 2\ncount = 3\n",
+            vec!["first_vertex = 2 and count = 3 reach vertex 4 but vertices tri holds 4"],
+        ),
+        ("indices = \"ix\"\nbase_vertex = 2\n", vec!["index 2 + base_vertex 2", "is past the 4 vertices tri holds"]),
+        (
+            "first_instance = 1\ninstances = 2\n",
+            vec!["first_instance = 1 and instances = 2 reach instance 2", "shift holds 2"],
+        ),
+        ("first_instance = -1\n", vec!["first_instance is -1; allowed: [0, 67108864]"]),
+    ] {
+        let r = render_k(&with_indices(keys), shader);
+        assert_rejected(&r, 2, &needles);
+    }
+    // In range, each renders: vertices 1..3 of instance 1, and an indexed draw from base vertex 1.
+    for keys in ["first_vertex = 1\ncount = 3\nfirst_instance = 1\n", "indices = \"ix\"\nbase_vertex = 1\n"] {
+        let r = render_k(&with_indices(keys), shader);
+        assert_eq!(r.code, 0, "{keys}: {}", r.stderr);
+    }
+}
+
 /// A buffer larger than the device binds (lavapipe: 128 MiB of storage) is
 /// refused in the parent, naming the limit, before a worker or the device
 /// holds a copy of it (a 1 GiB buffer peaked at 3.2 GB before wgpu refused
@@ -6182,6 +6224,7 @@ fn main() {
         Gpu an_interrupted_check_writes_the_report_of_what_finished,
         Gpu composition_past_its_time_limit_fails_the_case_not_the_run,
         Gpu a_buffer_past_the_device_s_binding_size_is_refused_before_the_worker,
+        Gpu draw_offsets_are_checked_against_the_buffers,
         Gpu the_report_works_in_a_real_browser,
         Gpu max_flip_fails_a_case_above_it,
         Gpu compare_reports_json_fields_and_rejects_bad_files,

@@ -355,6 +355,7 @@ fn raster_json(r: &crate::graph::Raster, vertex: Option<(Option<&str>, &str, Val
         })).collect::<Vec<_>>(),
         "indices": r.indices, "index_format": if r.index_u16 { "uint16" } else { "uint32" },
         "count": r.count, "instances": r.instances,
+        "first_vertex": r.first_vertex, "first_instance": r.first_instance, "base_vertex": r.base_vertex,
         "topology": r.topology.web(), "cull": r.cull.web(),
         "depth": r.depth.as_ref().map(|d| json!({
             "resource": d.resource, "compare": d.compare, "write": d.write, "clear": d.clear,

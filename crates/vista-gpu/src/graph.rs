@@ -331,6 +331,15 @@ pub struct Raster {
     pub count: u32,
     /// Instances drawn.
     pub instances: u32,
+    /// The first vertex of a draw without indices.
+    #[serde(default)]
+    pub first_vertex: u32,
+    /// The first instance.
+    #[serde(default)]
+    pub first_instance: u32,
+    /// Added to each index of an indexed draw.
+    #[serde(default)]
+    pub base_vertex: i32,
     /// How vertices make primitives.
     pub topology: vista_texel::Topology,
     /// Which faces are discarded.

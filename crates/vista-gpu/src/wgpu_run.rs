@@ -883,13 +883,14 @@ fn encode_draw(
         let (buffer, size) = &made.buffers[&current[v.resource]];
         pass.set_vertex_buffer(slot as u32, buffer.slice(..*size));
     }
+    let instances = raster.first_instance..raster.first_instance + raster.instances;
     match raster.indices {
         Some(i) => {
             let (buffer, size) = &made.buffers[&current[i]];
             pass.set_index_buffer(buffer.slice(..*size), crate::raster::index_format(raster));
-            pass.draw_indexed(0..raster.count, 0, 0..raster.instances);
+            pass.draw_indexed(0..raster.count, raster.base_vertex, instances);
         }
-        None => pass.draw(0..raster.count, 0..raster.instances),
+        None => pass.draw(raster.first_vertex..raster.first_vertex + raster.count, instances),
     }
 }
 

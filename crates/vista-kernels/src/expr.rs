@@ -199,6 +199,17 @@ impl Expr {
         Expr::parse(&text, params).map_err(|e| format!("entry \"{text}\": {e}"))
     }
 
+    /// [`Expr::parse_entry`] for an offset: any whole number (zero and
+    /// negatives too; where it must lie is the caller's to check).
+    pub fn parse_offset(v: &toml::Value, params: &[ParamSpec]) -> Result<Expr, String> {
+        match v {
+            toml::Value::Integer(n) if *n < 0 => Expr::parse(&format!("0 - {}", n.unsigned_abs()), params),
+            toml::Value::Integer(n) => Expr::parse(&n.to_string(), params),
+            toml::Value::String(s) => Expr::parse(s, params).map_err(|e| format!("entry \"{s}\": {e}")),
+            other => Err(format!("{other} is not valid; expected a whole number, a param name or an expression")),
+        }
+    }
+
     /// Parses `text` over `params`: each name must be an integer param,
     /// `width` or `height`.
     pub fn parse(text: &str, params: &[ParamSpec]) -> Result<Expr, String> {

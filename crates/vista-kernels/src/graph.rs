@@ -226,6 +226,12 @@ pub struct RasterSpec {
     pub count: Option<Expr>,
     /// Instances; `None`: the per-instance buffer's elements, else 1.
     pub instances: Option<Expr>,
+    /// The draw's first vertex (`first_vertex`, a draw without indices).
+    pub first_vertex: Option<Expr>,
+    /// The draw's first instance (`first_instance`).
+    pub first_instance: Option<Expr>,
+    /// Added to every index (`base_vertex`, an indexed draw; may be negative).
+    pub base_vertex: Option<Expr>,
     /// How vertices make primitives.
     pub topology: Topology,
     /// Which faces are discarded.
@@ -241,7 +247,8 @@ pub const BLEND_KEYS: [&str; 3] = ["color", "alpha", "constant"];
 /// The keys of a render pass's depth table.
 pub const DEPTH_KEYS: [&str; 4] = ["resource", "compare", "write", "clear"];
 /// A render pass's keys beyond `kind`, `vertex`, `fragment` and `targets`.
-const DRAW_KEYS: [&str; 6] = ["vertices", "indices", "count", "instances", "topology", "cull"];
+const DRAW_KEYS: [&str; 9] =
+    ["vertices", "indices", "count", "instances", "first_vertex", "first_instance", "base_vertex", "topology", "cull"];
 
 /// One `[[pass]]` table.
 #[derive(Debug, Clone, PartialEq)]
@@ -415,7 +422,7 @@ pub const RESOURCE_KEYS: [&str; 13] = [
     "compare",
 ];
 /// The keys of a `[[pass]]` table.
-pub const PASS_KEYS: [&str; 22] = [
+pub const PASS_KEYS: [&str; 25] = [
     "kind",
     "entry",
     "vertex",
@@ -425,6 +432,9 @@ pub const PASS_KEYS: [&str; 22] = [
     "indices",
     "count",
     "instances",
+    "first_vertex",
+    "first_instance",
+    "base_vertex",
     "topology",
     "cull",
     "depth",
@@ -979,6 +989,22 @@ fn parse_raster(
     }
     let expr = |k: &str| t.get(k).map(|v| Expr::parse_entry(v, params).map_err(|e| at(format!("{k} {e}")))).transpose();
     let (count, instances) = (expr("count")?, expr("instances")?);
+    let offset =
+        |k: &str| t.get(k).map(|v| Expr::parse_offset(v, params).map_err(|e| at(format!("{k} {e}")))).transpose();
+    let (first_vertex, first_instance, base_vertex) =
+        (offset("first_vertex")?, offset("first_instance")?, offset("base_vertex")?);
+    // WebGPU: firstVertex belongs to draw(), baseVertex to drawIndexed().
+    match (&indices, &first_vertex, &base_vertex) {
+        (Some(_), Some(_), _) => {
+            return Err(at("first_vertex is for a draw without indices; an indexed draw takes base_vertex".into()));
+        }
+        (None, _, Some(_)) => {
+            return Err(at(
+                "base_vertex is for an indexed draw (indices = ...); without indices use first_vertex".into()
+            ));
+        }
+        _ => {}
+    }
     let topology = match string_key(t, "topology", at)? {
         None => Topology::TriangleList,
         Some(name) => Topology::parse(&name).map_err(at)?,
@@ -1012,7 +1038,20 @@ fn parse_raster(
         }
         Some(other) => return Err(at(format!("depth = {other} is not valid; expected {{ compare, write, clear }}"))),
     };
-    Ok(Some(RasterSpec { vertex, targets, vertices, indices, count, instances, topology, cull, depth }))
+    Ok(Some(RasterSpec {
+        vertex,
+        targets,
+        vertices,
+        indices,
+        count,
+        instances,
+        first_vertex,
+        first_instance,
+        base_vertex,
+        topology,
+        cull,
+        depth,
+    }))
 }
 
 /// The resources' names for a message ("none" for none).

@@ -201,6 +201,16 @@ pub(crate) fn plan_graph(
 }
 
 /// What planning each resource, pass and output of one graph reads.
+/// A draw's counts and offsets, as WebGPU's draw() and drawIndexed() take them.
+#[derive(Debug, Default)]
+struct Draw {
+    count: u32,
+    instances: u32,
+    first_vertex: u32,
+    first_instance: u32,
+    base_vertex: i32,
+}
+
 struct Planning<'a> {
     root: Option<&'a Path>,
     kernel: &'a Kernel,
@@ -693,8 +703,7 @@ impl Planning<'_> {
             .unwrap_or_default();
         let indices = draw.and_then(|d| d.indices);
         let index_u16 = draw.is_some_and(|d| d.index_u16);
-        let (count, instances) =
-            self.draw_counts(r, label, resources, &buffers, indices.map(|i| (i, index_u16)), pp)?;
+        let d = self.draw_counts(r, label, resources, &buffers, indices.map(|i| (i, index_u16)), pp)?;
         // The pass's own depth buffer is one more depth resource of its
         // targets' size: the engines draw every depth test one way, and
         // make it once per run, not once per draw.
@@ -720,8 +729,11 @@ impl Planning<'_> {
             buffers,
             indices,
             index_u16,
-            count,
-            instances,
+            count: d.count,
+            instances: d.instances,
+            first_vertex: d.first_vertex,
+            first_instance: d.first_instance,
+            base_vertex: d.base_vertex,
             topology: r.topology,
             cull: r.cull,
             depth,
@@ -757,9 +769,9 @@ impl Planning<'_> {
         buffers: &[vista_gpu::VertexBuffer],
         indices: Option<(usize, bool)>,
         pp: &ParamSet,
-    ) -> Result<(u32, u32), RenderError> {
+    ) -> Result<Draw, RenderError> {
         if r.vertex == vista_kernels::graph::VertexStage::Fullscreen {
-            return Ok((3, 1));
+            return Ok(Draw { count: 3, instances: 1, ..Draw::default() });
         }
         let len = |ri: usize| match &resources[ri] {
             vista_gpu::Resource::Buffer(b) => b.len() as u64,
@@ -772,22 +784,33 @@ impl Planning<'_> {
                 .map(|b| (len(b.resource) / b.stride.max(1) as u64, b.resource))
                 .min()
         };
-        let eval = |k: &str, e: &vista_kernels::expr::Expr| -> Result<u32, RenderError> {
+        // Counts in [1, 2^26], offsets in [0, 2^26] (base_vertex: +-2^26).
+        let ranged = |k: &str, e: &vista_kernels::expr::Expr, lo: i64| -> Result<i64, RenderError> {
             let n = e.eval(pp, self.width, self.height).map_err(|m| self.bad(format!("{label}: {k} {m}")))?;
-            u32::try_from(n)
-                .ok()
-                .filter(|n| (1..=1 << 26).contains(n))
-                .ok_or_else(|| self.bad(format!("{label}: {k} is {n}; allowed: [1, 67108864]")))
+            (lo..=1 << 26)
+                .contains(&n)
+                .then_some(n)
+                .ok_or_else(|| self.bad(format!("{label}: {k} is {n}; allowed: [{lo}, 67108864]")))
         };
+        let eval = |k: &str, e: &vista_kernels::expr::Expr| ranged(k, e, 1).map(|n| n as u32);
+        let offset = |k: &str, e: &Option<vista_kernels::expr::Expr>, lo: i64| -> Result<i64, RenderError> {
+            e.as_ref().map_or(Ok(0), |e| ranged(k, e, lo))
+        };
+        let first_vertex = offset("first_vertex", &r.first_vertex, 0)? as u32;
+        let first_instance = offset("first_instance", &r.first_instance, 0)? as u32;
+        let base_vertex = offset("base_vertex", &r.base_vertex, -(1 << 26))? as i32;
         let name = |ri: usize| self.kernel.graph().resources.get(ri).map_or("?".to_string(), |x| x.name.clone());
         let (available, what) = match (indices, held(false)) {
             (Some((ix, u16)), _) => (Some(len(ix) / if u16 { 2 } else { 4 }), format!("indices {}", name(ix))),
             (None, Some((n, ri))) => (Some(n), format!("vertices {}", name(ri))),
             (None, None) => (None, String::new()),
         };
+        // Without indices the draw starts at first_vertex: by default it
+        // takes the vertices from there on.
+        let skipped = if indices.is_some() { 0 } else { u64::from(first_vertex) };
         let count = match (&r.count, available) {
             (Some(e), _) => eval("count", e)?,
-            (None, Some(n)) => n.min(u32::MAX as u64) as u32,
+            (None, Some(n)) => n.saturating_sub(skipped).min(u32::MAX as u64) as u32,
             (None, None) => {
                 return Err(self.bad(format!(
                     "{label}: no vertex buffer or index buffer says how many vertices to draw; give count = N"
@@ -795,9 +818,15 @@ impl Planning<'_> {
             }
         };
         if let Some(n) = available
-            && count as u64 > n
+            && skipped + count as u64 > n
         {
-            return Err(self.bad(format!("{label}: count = {count} but {what} holds {n}")));
+            return Err(self.bad(match skipped {
+                0 => format!("{label}: count = {count} but {what} holds {n}"),
+                s => format!(
+                    "{label}: first_vertex = {s} and count = {count} reach vertex {} but {what} holds {n}",
+                    s + count as u64 - 1
+                ),
+            }));
         }
         // Indices the host gives (a file or data) must name vertices the
         // per-vertex buffers hold: WebGPU leaves an index past them to the
@@ -816,9 +845,15 @@ impl Planning<'_> {
                 true => u64::from(u16::from_le_bytes([c[0], c[1]])),
                 false => u64::from(u32::from_le_bytes([c[0], c[1], c[2], c[3]])),
             });
-            if let Some((at, v)) = values.enumerate().find(|&(_, v)| v >= vertices && !(strip && v == restart)) {
+            // Each index plus base_vertex names the vertex fetched.
+            let fetched = |v: u64| v as i64 + i64::from(base_vertex);
+            if let Some((at, v)) = values
+                .enumerate()
+                .find(|&(_, v)| !((0..vertices as i64).contains(&fetched(v)) || strip && v == restart))
+            {
+                let with = if base_vertex == 0 { String::new() } else { format!(" + base_vertex {base_vertex}") };
                 return Err(self.bad(format!(
-                    "{label}: index {v} (number {at} of indices {}) is past the {vertices} vertices {} holds; \
+                    "{label}: index {v}{with} (number {at} of indices {}) is past the {vertices} vertices {} holds; \
                      allowed: [0, {}]",
                     name(ix),
                     name(vr),
@@ -827,20 +862,28 @@ impl Planning<'_> {
             }
         }
         let per_instance = held(true);
+        let first = u64::from(first_instance);
         let instances = match (&r.instances, per_instance) {
             (Some(e), _) => eval("instances", e)?,
-            (None, Some((n, _))) => n.min(u32::MAX as u64) as u32,
+            (None, Some((n, _))) => n.saturating_sub(first).min(u32::MAX as u64) as u32,
             (None, None) => 1,
         };
         if let Some((n, ri)) = per_instance
-            && instances as u64 > n
+            && first + instances as u64 > n
         {
-            return Err(self.bad(format!("{label}: instances = {instances} but vertices {} holds {n}", name(ri))));
+            return Err(self.bad(match first {
+                0 => format!("{label}: instances = {instances} but vertices {} holds {n}", name(ri)),
+                f => format!(
+                    "{label}: first_instance = {f} and instances = {instances} reach instance {} but vertices {} holds {n}",
+                    f + instances as u64 - 1,
+                    name(ri)
+                ),
+            }));
         }
         if count == 0 || instances == 0 {
             return Err(self.bad(format!("{label}: the draw has no vertices (count {count}, instances {instances})")));
         }
-        Ok((count, instances))
+        Ok(Draw { count, instances, first_vertex, first_instance, base_vertex })
     }
 
     /// The outputs as planned, and the resource each reads.
