@@ -3466,6 +3466,59 @@ fn an_interrupted_check_writes_the_report_of_what_finished() {
     assert_eq!(results["cases"].as_array().unwrap().len(), finished, "results.json holds the finished cases");
 }
 
+/// A case sets shader defs (`defs = { BRIGHT = true }`), and an enum
+/// param's value can name one (`defs = { bright = "BRIGHT" }`): one kernel
+/// covers its variants. The defs are part of the params hash, so a golden
+/// blessed without them is not the one a case with them checks against.
+fn cases_set_defs_and_enum_values_name_them() {
+    let shader = K_SHADER.replace(
+        "    textureStore(output, id.xy, vec4(vec3(params.gain), 1.0));",
+        "#ifdef BRIGHT\n    textureStore(output, id.xy, vec4(vec3(params.gain * 2.0), 1.0));\n#else\n    \
+         textureStore(output, id.xy, vec4(vec3(params.gain), 1.0));\n#endif",
+    );
+    let manifest = format!(
+        "{K_MANIFEST}[[param]]\nname = \"look\"\ntype = \"enum\"\nvalues = [\"dim\", \"bright\"]\n\
+         defs = {{ bright = \"BRIGHT\" }}\ndefault = \"dim\"\ndoc = \"which variant\"\n"
+    )
+    .replace("struct Params", "struct Params");
+    let shader = shader.replace("    gain: f32,\n}", "    gain: f32,\n    look: u32,\n}");
+    let d = kernel_project(&manifest, &shader);
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    let cases = "[[case]]\nid = \"plain\"\nkernel = \"k\"\nsize = \"8x8\"\nset = { gain = 0.25 }\n\
+                 [[case]]\nid = \"by-def\"\nkernel = \"k\"\nsize = \"8x8\"\nset = { gain = 0.25 }\ndefs = { BRIGHT = true }\n\
+                 [[case]]\nid = \"by-enum\"\nkernel = \"k\"\nsize = \"8x8\"\nset = { gain = 0.25, look = \"bright\" }\n";
+    std::fs::write(cases_path(d.path()), cases).unwrap();
+    let b = vista_in(Some(d.path()), &[], &["bless"]);
+    assert_eq!(b.code, 0, "{}{}", b.stdout, b.stderr);
+    let value = |id: &str| {
+        vista_image::load(&d.path().join(format!("golden/k/{id}.exr")))
+            .map(|i| i.get(3, 3))
+            .unwrap_or_else(|_| vista_image::load(&d.path().join(format!("golden/k/{id}.png"))).unwrap().get(3, 3))
+    };
+    // 16-bit display goldens: within one step of 1/65535.
+    let near = |id: &str, want: f32| (value(id)[0] - want).abs() < 1.0 / 65535.0;
+    assert!(near("plain", 0.25), "{:?}", value("plain"));
+    assert!(near("by-def", 0.5), "the case's def: {:?}", value("by-def"));
+    assert!(near("by-enum", 0.5), "the enum value's def: {:?}", value("by-enum"));
+    let c = vista_in(Some(d.path()), &[], &["check"]);
+    assert_eq!(c.code, 0, "{}", c.stdout);
+    let manifest_toml = std::fs::read_to_string(d.path().join("golden/manifest.toml")).unwrap();
+    let hashes: Vec<&str> = manifest_toml.lines().filter(|l| l.starts_with("params_hash")).collect();
+    assert_eq!(hashes.len(), 3);
+    assert!(hashes[0] != hashes[1] && hashes[1] != hashes[2] && hashes[0] != hashes[2], "{hashes:?}");
+    // Bad defs are refused naming them.
+    std::fs::write(cases_path(d.path()), cases.replace("defs = { BRIGHT = true }", "defs = { \"BR IGHT\" = 1 }"))
+        .unwrap();
+    assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["by-def", "'BR IGHT' is not a shader def name"]);
+    let bad_enum = manifest.replace("defs = { bright = \"BRIGHT\" }", "defs = { shiny = \"BRIGHT\" }");
+    std::fs::write(d.path().join("kernels/k.toml"), bad_enum).unwrap();
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["list"]),
+        2,
+        &["param look: defs: 'shiny' is not one of its values (dim, bright)"],
+    );
+}
+
 /// Draw offsets are checked like counts, before GPU work: first_vertex is
 /// for a draw without indices and base_vertex for an indexed one, and the
 /// vertices and instances they reach must be in the buffers.
@@ -6225,6 +6278,7 @@ fn main() {
         Gpu composition_past_its_time_limit_fails_the_case_not_the_run,
         Gpu a_buffer_past_the_device_s_binding_size_is_refused_before_the_worker,
         Gpu draw_offsets_are_checked_against_the_buffers,
+        Gpu cases_set_defs_and_enum_values_name_them,
         Gpu the_report_works_in_a_real_browser,
         Gpu max_flip_fails_a_case_above_it,
         Gpu compare_reports_json_fields_and_rejects_bad_files,

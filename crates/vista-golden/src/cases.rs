@@ -15,6 +15,7 @@
 //! max_bad_ratio = 0.001          # optional: the same as a share of the pixels, in [0, 1]
 //! ignore = [[0, 0, 16, 8]]       # optional: rectangles [x, y, w, h] the comparison leaves out
 //! inputs = { photo = "inputs/other.png" }  # optional: a pass graph's resource files replaced
+//! defs = { TONEMAP_METHOD_AGX = true }  # optional: shader defs over the kernel's, every pass
 //! ```
 
 use std::collections::BTreeMap;
@@ -62,6 +63,8 @@ struct RawCase {
     inputs: BTreeMap<String, String>,
     #[serde(default)]
     tolerances: BTreeMap<String, toml::Value>,
+    #[serde(default)]
+    defs: toml::Table,
     #[serde(default)]
     doc: String,
 }
@@ -190,7 +193,9 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         }
         let overrides: Vec<(String, String)> =
             raw.set.iter().map(|(k, v)| (k.clone(), vista_kernels::values::value_text(v))).collect();
-        let params = kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?;
+        let defs = vista_kernels::values::parse_defs(&raw.defs).map_err(bad)?;
+        let params =
+            kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?.with_defs(defs);
         let (width, height) = match &raw.size {
             Some(s) => vista_kernels::parse_size(s).map_err(|e| bad(e.to_string()))?,
             None => DEFAULT_SIZE,

@@ -587,11 +587,23 @@ impl Kernel {
     /// replacement's text follows the defs as `%i=text` (an enum's value
     /// name, a number's decimal text), so each distinct text composes once.
     fn with_defs(&self, file: &str, pass_defs: &[String], source: &vista_source::SourceSpec, p: &ParamSet) -> String {
-        // A pass's def replaces the kernel's of the same name.
+        // A case's def replaces the kernel's of the same name, and a pass's
+        // replaces both: the pass's is its structure, the case's a variant.
         let name = |d: &String| d.split('=').next().unwrap_or_default().to_string();
-        let mut defs: Vec<String> =
-            self.manifest.defs.iter().filter(|d| !pass_defs.iter().any(|q| name(q) == name(d))).cloned().collect();
-        defs.extend(pass_defs.iter().cloned());
+        let mut defs: Vec<String> = Vec::new();
+        for layer in [&self.manifest.defs[..], p.defs(), pass_defs] {
+            defs.retain(|d| !layer.iter().any(|q| name(q) == name(d)));
+            defs.extend(layer.iter().cloned());
+        }
+        // An enum param's value that names a def sets it.
+        for spec in &self.manifest.params {
+            if let Some(Value::Enum(v)) = p.value(&spec.name)
+                && let Some((_, def)) = spec.defs.iter().find(|(value, _)| value == v)
+                && !defs.iter().any(|d| name(d) == *def)
+            {
+                defs.push(def.clone());
+            }
+        }
         if self.hash_plane(p).is_some() {
             defs.push("VISTA_HASH_PLANE".into());
         }

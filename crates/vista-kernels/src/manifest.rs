@@ -177,6 +177,8 @@ struct RawParam {
     values: Option<Vec<String>>,
     /// An enum's WGSL constant prefix (default: the name in upper case).
     constants: Option<String>,
+    /// An enum's values that set a shader def: value -> def name.
+    defs: Option<toml::Table>,
     default: toml::Value,
     #[serde(default)]
     doc: String,
@@ -573,7 +575,34 @@ fn parse_params(
         if p.open_min && !matches!(ty, ParamType::F32) {
             return Err(pfail("open_min is only for type f32".into()));
         }
-        let spec = ParamSpec { name: p.name.clone(), ty, kind, default: value_text(&p.default), doc: p.doc.clone() };
+        let defs = match (&p.defs, &kind) {
+            (None, _) => Vec::new(),
+            (Some(table), Kind::Enum(values)) => {
+                let mut defs = Vec::new();
+                for (value, def) in table {
+                    if !values.contains(value) {
+                        return Err(pfail(format!(
+                            "defs: '{value}' is not one of its values ({})",
+                            values.join(", ")
+                        )));
+                    }
+                    match def.as_str() {
+                        Some(d) if ident(d) && !d.starts_with(|c: char| c.is_ascii_digit()) => {
+                            defs.push((value.clone(), d.to_string()))
+                        }
+                        _ => {
+                            return Err(pfail(format!(
+                                "defs: {value} = {def} is not a shader def name (letters, digits and '_')"
+                            )));
+                        }
+                    }
+                }
+                defs
+            }
+            (Some(_), _) => return Err(pfail(format!("defs is only for type enum, not {}", p.ty))),
+        };
+        let spec =
+            ParamSpec { name: p.name.clone(), ty, kind, default: value_text(&p.default), doc: p.doc.clone(), defs };
         parse_value(&spec, &spec.default).map_err(|e| pfail(format!("default: {e}")))?;
         params.push(spec);
     }

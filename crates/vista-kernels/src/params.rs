@@ -251,6 +251,9 @@ pub struct ParamSpec {
     pub default: String,
     /// One line for `vista list`.
     pub doc: String,
+    /// An enum's values that also set a shader def: (value, def name),
+    /// the manifest's `defs = { aces = "TONEMAP_METHOD_ACES" }`.
+    pub defs: Vec<(String, String)>,
 }
 
 /// A named set of overrides on top of the defaults.
@@ -355,6 +358,8 @@ pub fn parse_value(spec: &ParamSpec, text: &str) -> Result<Value, ParamError> {
 pub struct ParamSet {
     kernel: String,
     values: BTreeMap<String, Value>,
+    /// Shader defs a case sets (`NAME=value`), over the kernel's.
+    defs: Vec<String>,
 }
 
 impl ParamSet {
@@ -366,7 +371,7 @@ impl ParamSet {
         preset: Option<&str>,
         overrides: &[(String, String)],
     ) -> Result<ParamSet, ParamError> {
-        let mut set = ParamSet { kernel: kernel.to_string(), values: BTreeMap::new() };
+        let mut set = ParamSet { kernel: kernel.to_string(), values: BTreeMap::new(), defs: Vec::new() };
         for spec in specs {
             // Manifests are validated when parsed, defaults included.
             let v = parse_value(spec, &spec.default)
@@ -514,7 +519,25 @@ impl ParamSet {
     /// `name=value` pairs sorted by name: the canonical text that is hashed
     /// into the golden manifest.
     pub fn canonical(&self) -> String {
-        self.values.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";")
+        let values = self.values.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";");
+        // Defs join only where a case sets some: every older hash stands.
+        match self.defs.is_empty() {
+            true => values,
+            false => format!("{values};defs:{}", self.defs.join("&")),
+        }
+    }
+
+    /// These values with shader defs set by a case (`NAME=value`, sorted by
+    /// name): they join every pass's composition, over the kernel's own.
+    pub fn with_defs(mut self, mut defs: Vec<String>) -> ParamSet {
+        defs.sort();
+        self.defs = defs;
+        self
+    }
+
+    /// The shader defs a case set ([`ParamSet::with_defs`]).
+    pub fn defs(&self) -> &[String] {
+        &self.defs
     }
 
     /// Every `(name, value)` pair, sorted by name.

@@ -10,9 +10,9 @@ pub fn value_text(v: &toml::Value) -> String {
     }
 }
 
-/// A `defs` table (the kernel's, or a pass's) as `NAME=value` strings:
-/// naga_oil shader defs, bool or integer.
-pub(crate) fn parse_defs(table: &toml::Table) -> Result<Vec<String>, String> {
+/// A `defs` table (the kernel's, a pass's or a case's) as `NAME=value`
+/// strings: naga_oil shader defs, bool or integer.
+pub fn parse_defs(table: &toml::Table) -> Result<Vec<String>, String> {
     let mut defs = Vec::new();
     for (k, v) in table {
         if k.is_empty() || !k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
