@@ -3580,7 +3580,11 @@ fn a_buffer_past_the_device_s_binding_size_is_refused_before_the_worker() {
     assert_rejected(
         &r,
         1,
-        &["unsupported on", "(268435456 bytes), bound as storage", "needs maxStorageBufferBindingSize >= 268435456"],
+        &[
+            "unsupported on",
+            "buffer data (268435456 bytes), bound as storage",
+            "needs maxStorageBufferBindingSize >= 268435456",
+        ],
     );
     assert!(!r.stderr.contains("Validation Error"), "{}", r.stderr);
     assert_eq!(render_k(&manifest(1024), shader).code, 0, "a small one binds");

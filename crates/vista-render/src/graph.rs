@@ -58,6 +58,9 @@ pub struct Plan {
     pub kernel: String,
     /// Every resource with its initial contents.
     pub resources: Vec<vista_gpu::Resource>,
+    /// The names of the kernel's resources, the first of `resources` (the
+    /// rest are passes' own uniform blocks and depth buffers).
+    pub names: Vec<String>,
     /// The passes in order.
     pub passes: Vec<vista_gpu::GraphPass>,
     /// Resource index of each output, in `outputs` order.
@@ -189,8 +192,11 @@ pub(crate) fn plan_graph(
         }
     }
     let (outputs, output_ids) = at.outputs(&resources, &resolved);
+    // The kernel's resources come first, by name; what passes own after them.
+    let names = resolved.resources.iter().map(|r| r.spec.name.clone()).collect();
     Ok(Plan {
         kernel: kernel.name().to_string(),
+        names,
         resources,
         passes,
         output_ids,
@@ -200,7 +206,6 @@ pub(crate) fn plan_graph(
     })
 }
 
-/// What planning each resource, pass and output of one graph reads.
 /// A draw's counts and offsets, as WebGPU's draw() and drawIndexed() take them.
 #[derive(Debug, Default)]
 struct Draw {
@@ -211,6 +216,7 @@ struct Draw {
     base_vertex: i32,
 }
 
+/// What planning each resource, pass and output of one graph reads.
 struct Planning<'a> {
     root: Option<&'a Path>,
     kernel: &'a Kernel,
