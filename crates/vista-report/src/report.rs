@@ -776,8 +776,17 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
     )
 }
 
-/// Writes the report (atomically) and returns the index path.
+/// Writes the report (atomically), removes the thumbnails none of
+/// `outcomes` shows ([`prune_thumbs`]) and returns the index path.
 pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result<PathBuf, GoldenError> {
+    let index = write_index(dir, run, outcomes)?;
+    prune_thumbs(dir, outcomes);
+    Ok(index)
+}
+
+/// [`write_report`] without pruning: for a run whose other processes may be
+/// filing cases (and their thumbnails) the index does not list yet.
+pub fn write_index(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result<PathBuf, GoldenError> {
     let mut sorted: Vec<&Outcome> = outcomes.iter().collect();
     sorted.sort_by_key(|o| (severity(o), o.id.clone()));
     let failing: Vec<&Outcome> = sorted.iter().copied().filter(|o| !o.passed()).collect();
@@ -881,13 +890,12 @@ pub fn write_report(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Resul
         .map_err(|e| GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })?;
     let index = dir.join("index.html");
     vista_image::atomic_replace(&index, html.as_bytes())?;
-    prune_thumbs(dir, outcomes);
     Ok(index)
 }
 
-/// Removes the thumbnails no case of this report shows (an earlier run's,
+/// Removes the thumbnails no case of `outcomes` shows (an earlier run's,
 /// or a case that failed this time), where the folder is vista's.
-fn prune_thumbs(dir: &Path, outcomes: &[Outcome]) {
+pub fn prune_thumbs(dir: &Path, outcomes: &[Outcome]) {
     let thumbs = dir.join(THUMBS_DIR);
     let linked = std::fs::symlink_metadata(&thumbs).is_ok_and(|m| m.file_type().is_symlink());
     if linked || !thumbs.join(THUMBS_MARKER).is_file() {
