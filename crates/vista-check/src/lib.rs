@@ -6,8 +6,10 @@
 //! the one render-twice rule, [`options`]; `vista_report::file_case`
 //! writes its folder), then what a run
 //! leaves ([`finish`]: the report, `pending.toml`, `results.json`, JUnit)
-//! and the goldens no case refers to ([`orphans`]); and the shards of a
-//! split suite joined into one report ([`merge`]). `vista mutate` judges
+//! and the goldens no case refers to ([`orphans`]); a run whose cases are
+//! checked in processes of their own (cargo-nextest's), each recording its
+//! cases and rebuilding the whole report ([`SharedRun`]); and the shards of
+//! a split suite joined into one report ([`merge`]). `vista mutate` judges
 //! every mutant with the same `vista_golden::check_case`.
 //!
 //! Not for: rendering or judging themselves (`vista-render`,
@@ -15,8 +17,10 @@
 //! (the binary and the harness).
 
 mod merge;
+mod shared;
 
 pub use merge::{OUTCOMES_FILE, merge};
+pub use shared::{RUN_DIR, SharedRun, parent_run_id};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -235,31 +239,44 @@ pub fn finish(report_dir: &Path, run: &RunSummary, filed: &[Filed], results: &Re
     let pending: BTreeMap<String, ManifestEntry> =
         filed.iter().filter_map(|f| Some((f.outcome.id.clone(), f.pending.clone()?))).collect();
     let outcomes: Vec<Outcome> = filed.iter().map(|f| f.outcome.clone()).collect();
-    write_run(report_dir, run, &outcomes, pending, results)
+    write_run(report_dir, run, &outcomes, pending, results, None)
 }
 
-/// The files a run's outcomes make, for `finish` and `merge` alike: the
-/// report, `outcomes.cbor` for a shard, `pending.toml`, `results.json` and
-/// `results`' files. `run` gets the pending ids and, unless it names one,
-/// `report_dir` as the folder `bless --from-report` takes.
+/// The files a run's outcomes make, for `finish`, `merge` and a
+/// [`SharedRun`] alike: the report, `outcomes.cbor` for a shard,
+/// `pending.toml`, `results.json` and `results`' files. `run` gets the
+/// pending ids and, unless it names one, `report_dir` as the folder `bless
+/// --from-report` takes. `suite` is a shared run's (every case id of the
+/// project): its processes may still be filing cases, so no thumbnail is
+/// pruned, and `outcomes.cbor` is always kept, naming the suite.
 pub(crate) fn write_run(
     report_dir: &Path,
     run: &RunSummary,
     outcomes: &[Outcome],
     pending: BTreeMap<String, ManifestEntry>,
     results: &Results,
+    suite: Option<&[String]>,
 ) -> Result<PathBuf, GoldenError> {
     let mut run = run.clone();
     run.pending = pending.keys().cloned().collect();
     if run.accept_from.is_empty() {
         run.accept_from = report_dir.display().to_string();
     }
-    let index = vista_report::write_report(report_dir, &run, outcomes)?;
-    // Only a shard is merged: a whole run's report keeps no second copy of its outcomes.
-    if run.partition.is_some() {
-        merge::save(report_dir, &run, outcomes)?;
+    let index = match suite {
+        Some(_) => vista_report::write_index(report_dir, &run, outcomes)?,
+        None => vista_report::write_report(report_dir, &run, outcomes)?,
+    };
+    // Only a shard is merged: a whole run's report keeps no second copy of
+    // its outcomes. A shared run cannot tell (nextest does not say which
+    // partition a process runs), so it always keeps one.
+    if run.partition.is_some() || suite.is_some() {
+        merge::save(report_dir, &run, outcomes, suite)?;
     } else {
         merge::remove(report_dir)?;
+    }
+    // A whole run in a folder a shared run left: its records are stale.
+    if suite.is_none() {
+        shared::remove_records(report_dir)?;
     }
     vista_golden::pending::write_pending(report_dir, pending)?;
     let json_text = vista_report::json_text(&run, outcomes);

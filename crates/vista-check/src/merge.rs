@@ -1,8 +1,12 @@
 //! `vista merge`: the report folders of `vista check --partition K/N` runs
-//! (CI shards) joined into one report, `results.json`, JUnit file and
-//! `pending.toml`, with every verdict and metric as its shard gave it. A
-//! shard missing or given twice is named and nothing is written: a merge
-//! never passes as a smaller suite.
+//! (CI shards), or of the harness's runs under `cargo nextest run
+//! --partition` ([`SharedRun`](crate::SharedRun)), joined into one report,
+//! `results.json`, JUnit file and `pending.toml`, with every verdict and
+//! metric as its shard gave it. A shard missing or given twice is named and
+//! nothing is written: a merge never passes as a smaller suite. `check`'s
+//! shards say which K of N they are; nextest's do not (it tells a test
+//! process nothing of its partition), so theirs must hold every case of
+//! the suite they name once.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -12,22 +16,32 @@ use vista_report::RunSummary;
 
 use crate::Results;
 
-/// The file a `--partition` check leaves beside `results.json`: its run
-/// and every outcome, losslessly (CBOR keeps PSNR +inf and NaN), for
-/// `vista merge`.
+/// The file a `--partition` check (or a run shared by processes) leaves
+/// beside `results.json`: its run and every outcome, losslessly (CBOR keeps
+/// PSNR +inf and NaN), for `vista merge`.
 pub const OUTCOMES_FILE: &str = "outcomes.cbor";
 
 #[derive(serde::Serialize, serde::Deserialize)]
 struct Saved {
     run: RunSummary,
     outcomes: Vec<Outcome>,
+    /// A shared run's: every case id of the project's suite.
+    #[serde(default)]
+    suite: Option<Vec<String>>,
 }
 
 /// Writes `outcomes.cbor` into `report_dir`.
-pub(crate) fn save(report_dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result<(), GoldenError> {
+pub(crate) fn save(
+    report_dir: &Path,
+    run: &RunSummary,
+    outcomes: &[Outcome],
+    suite: Option<&[String]>,
+) -> Result<(), GoldenError> {
     let mut bytes = Vec::new();
-    ciborium::into_writer(&Saved { run: run.clone(), outcomes: outcomes.to_vec() }, &mut bytes).map_err(|e| {
-        GoldenError::Io { path: report_dir.join(OUTCOMES_FILE).display().to_string(), message: e.to_string() }
+    let saved = Saved { run: run.clone(), outcomes: outcomes.to_vec(), suite: suite.map(<[String]>::to_vec) };
+    ciborium::into_writer(&saved, &mut bytes).map_err(|e| GoldenError::Io {
+        path: report_dir.join(OUTCOMES_FILE).display().to_string(),
+        message: e.to_string(),
     })?;
     vista_image::atomic_write(&report_dir.join(OUTCOMES_FILE), &bytes)?;
     Ok(())
@@ -50,13 +64,14 @@ struct Shard {
     dir: PathBuf,
     run: RunSummary,
     outcomes: Vec<Outcome>,
+    suite: Option<Vec<String>>,
 }
 
 /// Why a whole run's report is not a shard.
 fn unpartitioned(dir: &Path) -> String {
     format!(
-        "{} is the report of a check without --partition; merge joins the shards of `vista check --partition K/N` \
-         runs",
+        "{} is the report of a check without --partition (or of `cargo test`); merge joins the shards of `vista \
+         check --partition K/N` runs, or of the golden harness's `cargo nextest run --partition` runs",
         dir.display()
     )
 }
@@ -68,20 +83,31 @@ fn read(dir: &Path) -> Result<Shard, GoldenError> {
             true => unpartitioned(dir),
             false => format!(
                 "{} is not a check's report folder ({OUTCOMES_FILE}: {e}); merge takes the --report-dir of each \
-                 `vista check --partition K/N` run",
+                 `vista check --partition K/N` run (or the VISTA_REPORT_DIR of each `cargo nextest run --partition` \
+                 run)",
                 dir.display()
             ),
         })
     })?;
     let saved: Saved = ciborium::from_reader(bytes.as_slice())
         .map_err(|e| GoldenError::BadInput(format!("{}: not a report this vista wrote: {e}", path.display())))?;
-    Ok(Shard { dir: dir.to_path_buf(), run: saved.run, outcomes: saved.outcomes })
+    Ok(Shard { dir: dir.to_path_buf(), run: saved.run, outcomes: saved.outcomes, suite: saved.suite })
 }
 
 /// Every shard's K of one N, each once, on one backend; else the error
 /// naming the shard missing, given twice, or out of place.
 fn check_shards(shards: &[Shard]) -> Result<u64, GoldenError> {
     let bad = |m: String| Err(GoldenError::BadInput(m));
+    if let Some(shared) = shards.iter().find(|s| s.suite.is_some()) {
+        if let Some(s) = shards.iter().find(|s| s.suite.is_none()) {
+            return bad(format!(
+                "{} is the report of the golden harness under cargo-nextest, {} is not: merge the shards of one kind",
+                shared.dir.display(),
+                s.dir.display()
+            ));
+        }
+        return check_suite(shards);
+    }
     let mut n = None;
     let mut seen: BTreeMap<u64, &Path> = BTreeMap::new();
     for s in shards {
@@ -123,6 +149,59 @@ fn check_shards(shards: &[Shard]) -> Result<u64, GoldenError> {
         ));
     }
     Ok(n)
+}
+
+/// The shards of runs shared by processes (nextest's partitions): one
+/// backend, one suite, and together every case of it once; else the error
+/// naming the case given twice or the cases missing.
+fn check_suite(shards: &[Shard]) -> Result<u64, GoldenError> {
+    let bad = |m: String| Err(GoldenError::BadInput(m));
+    let first = &shards[0];
+    let suite = first.suite.as_deref().unwrap_or_default();
+    let mut seen: BTreeMap<&str, &Path> = BTreeMap::new();
+    for s in shards {
+        if s.suite.as_deref().unwrap_or_default() != suite {
+            return bad(format!(
+                "{} and {} are reports of different suites (golden/cases.toml changed between the runs): merge the \
+                 shards of one suite",
+                first.dir.display(),
+                s.dir.display()
+            ));
+        }
+        if s.run.backend != first.run.backend {
+            return bad(format!(
+                "{} ran on {} but {} on {}: merge the shards of one backend",
+                s.dir.display(),
+                s.run.backend,
+                first.dir.display(),
+                first.run.backend
+            ));
+        }
+        for o in &s.outcomes {
+            if let Some(other) = seen.insert(&o.id, &s.dir) {
+                return bad(format!(
+                    "case {} is in both {} and {}: a shard is given twice, or the runs overlapped",
+                    o.id,
+                    other.display(),
+                    s.dir.display()
+                ));
+            }
+        }
+    }
+    let missing: Vec<&str> = suite.iter().map(String::as_str).filter(|id| !seen.contains_key(id)).collect();
+    if !missing.is_empty() {
+        let named = missing.iter().take(5).copied().collect::<Vec<_>>().join(", ");
+        return bad(format!(
+            "{} of the suite's {} cases {} in none of the {} shards given ({named}{}): a shard is missing, or a run \
+             was filtered or stopped early; a merge of fewer cases would pass as a smaller suite",
+            missing.len(),
+            suite.len(),
+            if missing.len() == 1 { "is" } else { "are" },
+            shards.len(),
+            if missing.len() > 5 { ", ..." } else { "" }
+        ));
+    }
+    Ok(shards.len() as u64)
 }
 
 fn copy_dir(from: &Path, to: &Path) -> Result<(), GoldenError> {
@@ -198,6 +277,6 @@ pub fn merge(
         adapter: first.adapter.clone(),
         ..Default::default()
     };
-    let index = crate::write_run(out, &run, &outcomes, pending, results)?;
+    let index = crate::write_run(out, &run, &outcomes, pending, results, None)?;
     Ok((index, outcomes))
 }
