@@ -46,6 +46,19 @@ pub struct Config {
     pub workers: bool,
     /// `GITHUB_ACTIONS=true`: check also prints `::error` annotations.
     pub github_actions: bool,
+    /// `NEXTEST` set: the test runner is cargo-nextest, which starts a
+    /// process per test, so the harness's processes share one report.
+    pub nextest: bool,
+    /// `NEXTEST_RUN_ID`: the id nextest gives every test process of one
+    /// `cargo nextest run`.
+    pub nextest_run_id: Option<String>,
+    /// `VISTA_REPORT_DIR`: the harness's report folder (relative to the
+    /// project root), instead of the project's `target/vista-report*`
+    /// (`vista check` takes `--report-dir`).
+    pub report_dir: Option<PathBuf>,
+    /// `VISTA_JUNIT`: the harness also writes the run's cases as JUnit XML
+    /// there, relative to the project root (`vista check` takes `--junit`).
+    pub junit: Option<PathBuf>,
     /// `MESA_SHADER_CACHE_DIR` is set: the user placed Mesa's shader cache,
     /// so the binary leaves it where it is (else it goes under the
     /// project's `target/vista-cache/mesa`, see [`MESA_CACHE`]).
@@ -177,6 +190,10 @@ impl Config {
             root: get("VISTA_ROOT").filter(|v| !v.is_empty()),
             crate_dir: get("CARGO_MANIFEST_DIR").filter(|v| !v.is_empty()).map(PathBuf::from),
             github_actions: text("GITHUB_ACTIONS").is_some_and(|v| v.eq_ignore_ascii_case("true")),
+            nextest: get("NEXTEST").is_some_and(|v| !v.is_empty()) || get("NEXTEST_RUN_ID").is_some(),
+            nextest_run_id: text("NEXTEST_RUN_ID").filter(|v| !v.is_empty()),
+            report_dir: get("VISTA_REPORT_DIR").filter(|v| !v.is_empty()).map(PathBuf::from),
+            junit: get("VISTA_JUNIT").filter(|v| !v.is_empty()).map(PathBuf::from),
             fault: text("VISTA_FAULT"),
             worker_fault: match text("VISTA_WORKER_FAULT").filter(|v| !v.is_empty()) {
                 None => None,
@@ -287,6 +304,10 @@ mod tests {
                 ("VISTA_CHROMIUM", "/c"),
                 ("VISTA_ROOT", "/r"),
                 ("VISTA_FAULT", "x"),
+                ("NEXTEST", "1"),
+                ("NEXTEST_RUN_ID", "1f79aa0d-4ec8-4a5c-aa83-5e8dc2f36573"),
+                ("VISTA_REPORT_DIR", "shard-1"),
+                ("VISTA_JUNIT", "j.xml"),
             ],
         )
         .unwrap();
@@ -298,7 +319,12 @@ mod tests {
         assert_eq!(c.gpu.browser.chromium.as_deref(), Some(std::path::Path::new("/c")));
         assert_eq!(c.root.as_deref(), Some(std::ffi::OsStr::new("/r")));
         assert_eq!(c.fault.as_deref(), Some("x"));
+        assert!(c.nextest);
+        assert_eq!(c.nextest_run_id.as_deref(), Some("1f79aa0d-4ec8-4a5c-aa83-5e8dc2f36573"));
+        assert_eq!(c.report_dir.as_deref(), Some(std::path::Path::new("shard-1")));
+        assert_eq!(c.junit.as_deref(), Some(std::path::Path::new("j.xml")));
         let d = config(&Flags::default(), &[]).unwrap();
+        assert!(!d.nextest && d.nextest_run_id.is_none() && d.report_dir.is_none() && d.junit.is_none());
         assert_eq!(d.limits.max_work, vista_render::DEFAULT_MAX_WORK);
         assert!(!d.in_ci && !d.allow_no_gpu && !d.gpu.validate);
         for (ci, is) in [("woodpecker", true), ("1", true), ("0", false), ("false", false)] {

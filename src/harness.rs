@@ -26,11 +26,22 @@
 //! `--list`, `--ignored`, `--skip`) and nextest lists and partitions them.
 //! After the run the report is written (`target/vista-report/` of the
 //! project, `target/vista-report-<backend>/` for another `VISTA_BACKEND`,
-//! `target/vista-report-<backend>-validation/` under `VISTA_VALIDATION=1`),
-//! so runs side by side do not clear each other's case folders, with
-//! `pending.toml` and `results.json` as `vista check` leaves them (the one
-//! driver, `vista-check`). Goldens no case refers to fail one more test,
+//! `target/vista-report-<backend>-validation/` under `VISTA_VALIDATION=1`,
+//! or `VISTA_REPORT_DIR`, relative to the project root), so runs side by
+//! side do not clear each other's case folders, with `pending.toml` and
+//! `results.json` as `vista check` leaves them (the one driver,
+//! `vista-check`), and a JUnit file where `VISTA_JUNIT` names one (relative
+//! to the project root too). Goldens no case refers to fail one more test,
 //! `golden::orphans`, present only when there are some.
+//!
+//! Under cargo-nextest every test is a process of its own: each records its
+//! case in the report folder and rebuilds the report from every case of
+//! the run (`vista_check::SharedRun`), the run being nextest's
+//! `NEXTEST_RUN_ID` (else the nextest process that started this one); a
+//! folder an earlier run left is cleared by the run's first process. The
+//! folders of `cargo nextest run --partition count:K/N` runs, each with a
+//! `VISTA_REPORT_DIR` of its own, join with `vista merge`.
+//!
 //! Without an adapter every case fails naming the install command, unless
 //! `VISTA_ALLOW_NO_GPU=1`: then each is reported ignored and a loud line
 //! names them.
@@ -61,19 +72,19 @@ pub fn main() -> ! {
             start.display()
         ));
     }
-    run(&args, &project, &command_name())
+    run(&args, &project, &command_name(config.nextest && args.exact))
 }
 
-/// `cargo test --test <name>`: this binary's test target, from its file name
-/// (`golden-<hash>`).
-fn command_name() -> String {
+/// `cargo test --test <name>` (`cargo nextest run --test <name>` under
+/// nextest): this binary's test target, from its file name (`golden-<hash>`).
+fn command_name(nextest: bool) -> String {
     let exe = std::env::args().next().unwrap_or_default();
     let stem = Path::new(&exe).file_stem().and_then(|s| s.to_str()).unwrap_or("golden").to_string();
     let name = match stem.rsplit_once('-') {
         Some((name, hash)) if hash.len() == 16 && hash.chars().all(|c| c.is_ascii_hexdigit()) => name.to_string(),
         _ => stem,
     };
-    format!("cargo test --test {name}")
+    format!("{} --test {name}", if nextest { "cargo nextest run" } else { "cargo test" })
 }
 
 fn fail(message: &str) -> ! {
@@ -92,8 +103,15 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
     // One report per implementation (VISTA_BACKEND) and for the validation
     // layer, so runs (side by side in `make test`) do not overwrite each other.
     let backend = config.gpu.adapter.backend_name();
-    let report_dir =
-        vista_check::default_report_dir(project, backend, config.gpu.validate).expect("a store has a root");
+    let report_dir = match &config.report_dir {
+        Some(dir) => project.root().expect("a store has a root").join(dir),
+        None => vista_check::default_report_dir(project, backend, config.gpu.validate).expect("a store has a root"),
+    };
+    // Under nextest each case is a process of its own (started with
+    // `--exact <test>`), and the run's processes share the report. A harness
+    // a test under nextest starts whole (no --exact) is a run of its own.
+    let shared_id = (config.nextest && args.exact)
+        .then(|| config.nextest_run_id.clone().unwrap_or_else(vista_check::parent_run_id));
     let filed: Arc<Mutex<Vec<Filed>>> = Arc::new(Mutex::new(Vec::new()));
     // Listing needs no device (nextest lists before it runs). One renderer
     // per process, shared by every case.
@@ -105,11 +123,21 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
             .map_err(Clone::clone)
     });
     let missing = renderer.as_ref().and_then(|r| r.as_ref().err().cloned());
-    // A run that will render clears the last report's case folders; one that
-    // skips (no adapter) leaves the last report whole.
+    // A run that will render clears the last report's case folders (under
+    // nextest, the run's first process does); one that skips (no adapter)
+    // leaves the last report whole.
+    let mut shared = None;
     if renderer.as_ref().is_some_and(|r| r.is_ok()) {
-        vista_report::clear_case_folders(&report_dir)
-            .unwrap_or_else(|e| fail(&format!("cannot clear the report: {e}")));
+        match &shared_id {
+            Some(id) => {
+                shared = Some(
+                    vista_check::SharedRun::join(&report_dir, id)
+                        .unwrap_or_else(|e| fail(&format!("cannot join the report of run {id}: {e}"))),
+                )
+            }
+            None => vista_report::clear_case_folders(&report_dir)
+                .unwrap_or_else(|e| fail(&format!("cannot clear the report: {e}"))),
+        }
     }
     let skip = missing.is_some() && config.allow_no_gpu;
     if let Some(e) = &missing
@@ -187,10 +215,22 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
             backend: ctx.backend().to_string(),
             ..Default::default()
         };
-        match vista_check::finish(&report_dir, &run, &filed, &Default::default()) {
+        let root = project.root().expect("a store has a root");
+        let results = vista_check::Results { junit: config.junit.as_ref().map(|j| root.join(j)), json: None };
+        let written = match &shared {
+            Some(shared) => {
+                let suite: Vec<String> = cases.iter().map(|c| c.id.clone()).collect();
+                shared.finish(&run, &filed, &results, &suite)
+            }
+            None => vista_check::finish(&report_dir, &run, &filed, &results),
+        };
+        match written {
             Ok(index) => eprintln!("vista report: {}", index.display()),
             Err(e) => eprintln!("could not write the vista report: {e}"),
         }
     }
+    // No worker outlives the test process: nextest calls a test whose
+    // output a child still holds open leaky.
+    vista_render::worker::stop_all();
     conclusion.exit()
 }
