@@ -5,7 +5,8 @@
 # each a test named golden::<kernel>::<case> that libtest's arguments select.
 # It shares vista's target directory, so the third-party crates build once.
 set -euo pipefail
-cd "$(dirname "$0")/../examples/harness-crate"
+ci=$(cd "$(dirname "$0")" && pwd)
+cd "$ci/../examples/harness-crate"
 CARGO_TARGET_DIR="$(cd ../.. && pwd)/target"
 export CARGO_TARGET_DIR
 cargo=${CARGO:-cargo}
@@ -39,3 +40,5 @@ echo "$out" | grep -q "crashed (signal 11, SIGSEGV) in pass 1" ||
     { echo "$out"; echo "harness-example: the crash was not named"; exit 1; }
 echo "$out" | grep -q "1 passed; 1 failed" || { echo "$out"; echo "harness-example: the other case did not pass"; exit 1; }
 echo "harness-example: the crate's own cargo test ran its 2 golden cases through vista::harness::main()"
+# The same test binary under cargo-nextest, a process per case (where nextest is installed; else a loud line).
+bash "$ci/harness-nextest.sh"
