@@ -194,8 +194,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
         let overrides: Vec<(String, String)> =
             raw.set.iter().map(|(k, v)| (k.clone(), vista_kernels::values::value_text(v))).collect();
         let defs = vista_kernels::values::parse_defs(&raw.defs).map_err(bad)?;
-        let params =
-            kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?.with_defs(defs);
+        let params = kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?.with_defs(defs);
         let (width, height) = match &raw.size {
             Some(s) => vista_kernels::parse_size(s).map_err(|e| bad(e.to_string()))?,
             None => DEFAULT_SIZE,

@@ -581,10 +581,7 @@ fn parse_params(
                 let mut defs = Vec::new();
                 for (value, def) in table {
                     if !values.contains(value) {
-                        return Err(pfail(format!(
-                            "defs: '{value}' is not one of its values ({})",
-                            values.join(", ")
-                        )));
+                        return Err(pfail(format!("defs: '{value}' is not one of its values ({})", values.join(", "))));
                     }
                     match def.as_str() {
                         Some(d) if ident(d) && !d.starts_with(|c: char| c.is_ascii_digit()) => {
