@@ -79,7 +79,12 @@ mutants: lavapipe build
 
 # The fuzz test of make test (200 rounds from a fixed seed), 20,000 rounds
 # from a new seed; an input that fails is kept in tests/fuzz/ and replayed
-# by every later run.
+# by every later run. Its hostile-project classes (symlinks out of the
+# project, FIFOs and devices in place of read files, shapes past the memory
+# budget, includes and expressions past the parsers' depth, each through the
+# binary) run every sub-case once in make test and 500 rounds each here;
+# VISTA_FUZZ_KNOWN_GAPS=1 also runs the known gaps they leave out (see
+# KNOWN_GAPS in crates/vista-cli/tests/fuzz.rs), failing while one is open.
 fuzz:
 	VISTA_FUZZ_ITERATIONS=20000 VISTA_FUZZ_SEED=$$(date +%s) $(CARGO) test -p vista-cli --test fuzz -- --nocapture
 
