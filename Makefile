@@ -83,8 +83,8 @@ mutants: lavapipe build
 # project, FIFOs and devices in place of read files, shapes past the memory
 # budget, includes and expressions past the parsers' depth, each through the
 # binary) run every sub-case once in make test and 500 rounds each here;
-# VISTA_FUZZ_KNOWN_GAPS=1 also runs the known gaps they leave out (see
-# KNOWN_GAPS in crates/vista-cli/tests/fuzz.rs), failing while one is open.
+# the gaps they once found run as fixed rounds too (ONCE_OPEN in
+# crates/vista-cli/tests/fuzz.rs).
 fuzz:
 	VISTA_FUZZ_ITERATIONS=20000 VISTA_FUZZ_SEED=$$(date +%s) $(CARGO) test -p vista-cli --test fuzz -- --nocapture
 

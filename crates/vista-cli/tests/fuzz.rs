@@ -388,10 +388,8 @@ fn mutated_project_and_pending_files_exit_0_1_or_2() {
 /// round that failed is kept in `tests/fuzz/hostile-<class>-...` (its
 /// sub-case and seed) and replayed first by every later run.
 ///
-/// Known gaps (vista does not handle these yet; they are left out of the
-/// classes and run only with `VISTA_FUZZ_KNOWN_GAPS=1` by
-/// `known_gaps_of_hostile_projects`, which then fails while any is open):
-/// see [`hostile::KNOWN_GAPS`].
+/// The gaps these classes found once (each now in its class) also run as
+/// fixed rounds, so each stays closed: see [`hostile::ONCE_OPEN`].
 #[cfg(unix)]
 mod hostile {
     use super::{Rng, iterations, repo, seed};
@@ -550,8 +548,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         /// Through `vista_project::guard`: a symlink out of the project, a
         /// FIFO or a device is refused naming the path.
         Guarded,
-        /// `vista.toml`: a FIFO or a device there is taken for no project
-        /// file at all (exit 0 or 2, the file not named; a known gap).
+        /// `vista.toml`: it marks the project whatever it is, and is then
+        /// read through the guard (a FIFO or device refused naming it).
         ProjectFile,
         /// Goldens and `golden/manifest.toml`: found through the manifest,
         /// a regular file after symlinks, wherever they lead (by design:
@@ -601,26 +599,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         ("inputs", INPUT_READERS, &["inputs/", "outside the project"]),
         ("golden", CASE_READERS, &["golden/cases.toml", "outside the project"]),
     ];
-
-    /// The known gap ([`KNOWN_GAPS`]) that `cmd` on `rel` made `hostile`
-    /// runs into, if any: such rounds are left out of the classes.
-    fn gap(rel: &str, cmd: Cmd, hostile: Hostile) -> Option<&'static str> {
-        let unreadable = matches!(hostile, Hostile::Fifo | Hostile::Device);
-        match (rel, cmd) {
-            // read_texture_npy reads with read_npy, not through the guard.
-            ("inputs/m.npy", Cmd::Check | Cmd::Bless | Cmd::RenderK) if unreadable => Some("texture-npy-fifo"),
-            ("inputs/m.npy", Cmd::Check | Cmd::Bless | Cmd::RenderK) if hostile == Hostile::Outside => {
-                Some("texture-npy-outside")
-            }
-            // check's input listing for the report reads .npy and .png inputs unguarded.
-            ("inputs/w.npy" | "inputs/t.png", Cmd::Check) if unreadable => Some("check-input-listing-fifo"),
-            // bless reads the old golden unguarded.
-            ("golden/k/a.png" | "golden/k/a.exr" | "golden/w/b.png", Cmd::Bless) if unreadable => {
-                Some("bless-old-golden-fifo")
-            }
-            _ => None,
-        }
-    }
 
     #[derive(Debug, Clone, Copy, PartialEq, Eq)]
     enum Hostile {
@@ -902,11 +880,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         assert_eq!(rc, 0, "mkfifo {}: {}", path.display(), std::io::Error::last_os_error());
     }
 
-    /// Whether the known gaps run too (`VISTA_FUZZ_KNOWN_GAPS=1`).
-    fn known_gaps_enabled() -> bool {
-        std::env::var("VISTA_FUZZ_KNOWN_GAPS").is_ok_and(|v| v == "1")
-    }
-
     /// Rounds of a class: every sub-case once under `make test` (200
     /// iterations), 500 rounds under `make fuzz` (20,000).
     fn rounds(subcases: usize) -> usize {
@@ -1140,9 +1113,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         lines[lines.len().saturating_sub(12)..].join("\n    ")
     }
 
-    /// Commands among `readers` (or all) for `rel` that are no known gap.
-    fn commands(rel: &str, hostile: Hostile, readers: &[Cmd], rng: &mut Rng) -> Cmd {
-        let ok: Vec<Cmd> = ALL.iter().copied().filter(|c| gap(rel, *c, hostile).is_none()).collect();
+    /// A command for `rel`: mostly one of `readers`, else any.
+    fn commands(_rel: &str, _hostile: Hostile, readers: &[Cmd], rng: &mut Rng) -> Cmd {
+        let ok: Vec<Cmd> = ALL.to_vec();
         // Mostly a command that reads the file (the interesting case).
         let reading: Vec<Cmd> = ok.iter().copied().filter(|c| readers.contains(c)).collect();
         match (rng.below(4), reading.is_empty()) {
@@ -1359,8 +1332,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             };
             let expect = match (readers.contains(&cmd), how) {
                 (false, _) => Expect::Accepted,
-                // Known gap: taken for no project file (see KNOWN_GAPS).
-                (true, How::ProjectFile) => Expect::Survives,
+                // bless replaces an old golden it cannot read by rename:
+                // the FIFO or link goes, nothing is read or written through it.
+                // (The manifest it must read: that is refused.)
+                (true, How::Golden) if cmd == Cmd::Bless && rel != "golden/manifest.toml" => Expect::Accepted,
                 (true, _) => Expect::Refused(vec![rel.to_string(), needle]),
             };
             let mut round = Round::new(what, cmd, expect);
@@ -1674,12 +1649,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         });
     }
 
-    /// Hostile inputs vista does not handle yet, found by these classes
-    /// and left out of them: name, what it is, and what vista does today.
-    /// `VISTA_FUZZ_KNOWN_GAPS=1 cargo test -p vista-cli --test fuzz
-    /// known_gaps` runs each (20 s watchdog) and fails naming those still
-    /// open; once one is fixed, fold it into its class (see [`gap`]).
-    pub(super) const KNOWN_GAPS: &[(&str, &str, &str)] = &[
+    /// Hostile inputs these classes found vista not handling, each fixed
+    /// since: name, what it is, and what vista did then. Each runs as a
+    /// fixed round (20 s watchdog) in `once_open_gaps_stay_closed`.
+    pub(super) const ONCE_OPEN: &[(&str, &str, &str)] = &[
         (
             "bless-old-golden-fifo",
             "golden/k/a.png a FIFO, vista bless",
@@ -1732,10 +1705,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         ),
     ];
 
-    /// The round that reproduces known gap `name` (as it should end once fixed).
+    /// The round that once reproduced gap `name`, as it ends now.
     fn gap_round(name: &str, project: &Path, outside: &Path) -> Round {
         let refused = |needles: &[&str]| Expect::Refused(needles.iter().map(|n| n.to_string()).collect());
-        let what = KNOWN_GAPS.iter().find(|g| g.0 == name).map_or(name.to_string(), |g| g.1.to_string());
+        let what = ONCE_OPEN.iter().find(|g| g.0 == name).map_or(name.to_string(), |g| g.1.to_string());
         let (cmd, expect) = match name {
             "bless-old-golden-fifo" => {
                 mkfifo(&project.join("golden/k/a.png"));
@@ -1781,7 +1754,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 symlink(&outside.join("report"), &project.join("target/vista-report"));
                 (Cmd::Check, Expect::Survives)
             }
-            other => panic!("no reproduction for known gap {other}"),
+            other => panic!("no round for gap {other}"),
         };
         let mut round = Round::new(what, cmd, expect);
         if name == "check-input-listing-outside" {
@@ -1790,24 +1763,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         round
     }
 
-    /// The known gaps ([`KNOWN_GAPS`]), each run as it should end once
-    /// fixed: only with `VISTA_FUZZ_KNOWN_GAPS=1` (they hang, blow memory
-    /// up to the cap or panic today); fails listing those still open.
+    /// The gaps once open ([`ONCE_OPEN`]), each run as it ends now it is
+    /// fixed (they hung, blew memory up or panicked); fails naming any
+    /// that opens again.
     #[test]
-    fn known_gaps_of_hostile_projects() {
-        if !known_gaps_enabled() {
-            let names: Vec<&str> = KNOWN_GAPS.iter().map(|g| g.0).collect();
-            eprintln!(
-                "hostile: {} known gaps left out (VISTA_FUZZ_KNOWN_GAPS=1 runs them): {}",
-                names.len(),
-                names.join(", ")
-            );
-            return;
-        }
+    fn once_open_gaps_stay_closed() {
         let template = template();
         let limit = Duration::from_secs(20);
         let mut open = Vec::new();
-        for (name, what, today) in KNOWN_GAPS {
+        for (name, what, then) in ONCE_OPEN {
             let project_dir = tempfile::tempdir().expect("a temp dir");
             let project = project_dir.path().join("p");
             copy_tree(template.path(), &project);
@@ -1821,17 +1785,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 true => Ok(()),
                 false => Err("changed what lies outside the project".into()),
             });
-            match verdict {
-                Ok(()) => eprintln!("known gap {name} is fixed: {what} (fold it into its class)"),
-                Err(why) => {
-                    eprintln!(
-                        "known gap {name} still open: {what}: {why} (exit {:?}, {:.1?})\n  today: {today}",
-                        o.code, o.elapsed
-                    );
-                    open.push(*name);
-                }
+            if let Err(why) = verdict {
+                eprintln!(
+                    "gap {name} open again: {what}: {why} (exit {:?}, {:.1?})\n  as it once was: {then}",
+                    o.code, o.elapsed
+                );
+                open.push(*name);
             }
         }
-        assert!(open.is_empty(), "{} known gaps still open: {}", open.len(), open.join(", "));
+        assert!(open.is_empty(), "{} gaps open again: {}", open.len(), open.join(", "));
     }
 }

@@ -205,7 +205,9 @@ fn write_extra_files(
             golden_dir(store, parent)?;
         }
         let hash = crate::short_hash_bytes(bytes);
-        if std::fs::read(file).ok().map(|b| crate::short_hash_bytes(&b)).as_deref() != Some(hash.as_str()) {
+        // The old file, if a regular one (a FIFO or device is rewritten, never read).
+        let old = vista_project::guard::read_regular(file, vista_project::guard::MAX_DATA_BYTES).ok().flatten();
+        if old.map(|b| crate::short_hash_bytes(&b)).as_deref() != Some(hash.as_str()) {
             extra_changed = true;
             vista_image::atomic_write(file, bytes)?;
         }
@@ -233,7 +235,8 @@ fn write_main_image(
 ) -> Result<(&'static str, String), GoldenError> {
     let new = quantize16(display);
     // Read once: decoded for the PSNR against the new golden, hashed below.
-    let old_bytes = std::fs::read(path).ok();
+    // A regular file only: a FIFO or a device in its place is replaced, never read.
+    let old_bytes = vista_project::guard::read_regular(path, vista_project::guard::MAX_DATA_BYTES).ok().flatten();
     let old = old_bytes.as_deref().map(|b| vista_image::decode_png16(path, b));
     let (status, psnr) = match old {
         Some(Ok(old)) if (old.width, old.height) == (new.width, new.height) => {

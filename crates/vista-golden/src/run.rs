@@ -70,11 +70,17 @@ pub fn inputs_of(case: &Case, root: Option<&std::path::Path>) -> Vec<(String, St
     let mut out = Vec::new();
     for r in &g.resources {
         let replaced = case.inputs.iter().find(|(n, _)| *n == r.name).map(|(_, f)| f.clone());
-        let at = |f: &str| root.map(|r| r.join(f)).unwrap_or_else(|| f.into());
+        // Through the guard as the render reads them: a FIFO, a device or a
+        // file out of the project is named, never opened.
+        let at = |f: &str| -> Result<std::path::PathBuf, String> {
+            let Some(root) = root else { return Ok(f.into()) };
+            vista_project::guard::check_file(root, &root.join(f), vista_project::guard::MAX_DATA_BYTES)
+                .map_err(|e| e.to_string())
+        };
         match &r.kind {
             ResourceKind::Texture { file, .. } => {
                 let Some(f) = replaced.or(file.clone()) else { continue };
-                match vista_image::load(&at(&f)) {
+                match at(&f).and_then(|p| vista_image::load(&p).map_err(|e| e.to_string())) {
                     Ok(img) => out.push((
                         r.name.clone(),
                         format!("texture from {f} ({}x{})", img.width, img.height),
@@ -85,11 +91,13 @@ pub fn inputs_of(case: &Case, root: Option<&std::path::Path>) -> Vec<(String, St
             }
             ResourceKind::Buffer { file, data, .. } => {
                 let what = match (replaced.or(file.clone()), data) {
-                    (Some(f), _) if f.ends_with(".npy") => match vista_image::npy::read_npy(&at(&f)) {
-                        Ok(n) => format!("buffer from {f} (dtype {}, shape {:?})", n.descr, n.shape),
-                        Err(e) => format!("buffer from {f}: {e}"),
-                    },
-                    (Some(f), _) => match std::fs::metadata(at(&f)) {
+                    (Some(f), _) if f.ends_with(".npy") => {
+                        match at(&f).and_then(|p| vista_image::npy::read_npy(&p).map_err(|e| e.to_string())) {
+                            Ok(n) => format!("buffer from {f} (dtype {}, shape {:?})", n.descr, n.shape),
+                            Err(e) => format!("buffer from {f}: {e}"),
+                        }
+                    }
+                    (Some(f), _) => match at(&f).and_then(|p| std::fs::metadata(p).map_err(|e| e.to_string())) {
                         Ok(m) => format!("buffer from {f} ({} bytes)", m.len()),
                         Err(e) => format!("buffer from {f}: {e}"),
                     },

@@ -117,6 +117,14 @@ pub struct SourceFile {
     pub origin: String,
 }
 
+/// Whether `dir` holds a `vista.toml` entry of any kind but a folder: a
+/// FIFO, device or link out of the project there still marks the project,
+/// and reading it then refuses it by name (the guard), instead of the walk
+/// going on up as if there were none.
+fn marks_project(dir: &Path) -> bool {
+    std::fs::symlink_metadata(dir.join(PROJECT_FILE)).is_ok_and(|m| !m.is_dir())
+}
+
 impl Project {
     /// Finds the root: `flag` (`--root`), else `env` (`VISTA_ROOT`), else
     /// the nearest `vista.toml` at or above `cwd`. A flag or variable that
@@ -126,7 +134,7 @@ impl Project {
         let cwd = absolute(cwd);
         let named = |from: &'static str, dir: &Path, found: Found| -> Result<Project, ProjectError> {
             let dir = absolute(&cwd.join(dir));
-            if !dir.join(PROJECT_FILE).is_file() {
+            if !marks_project(&dir) {
                 return Err(ProjectError::NotAProject { from, dir: dir.display().to_string() });
             }
             Project::with_root(dir, found, cwd.clone())
@@ -138,7 +146,7 @@ impl Project {
             return named("VISTA_ROOT", Path::new(&dir), Found::Env);
         }
         for dir in cwd.ancestors() {
-            if dir.join(PROJECT_FILE).is_file() {
+            if marks_project(dir) {
                 return Project::with_root(dir.to_path_buf(), Found::WalkUp, cwd.clone());
             }
         }

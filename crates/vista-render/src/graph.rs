@@ -939,12 +939,13 @@ fn read_texture(root: Option<&Path>, file: &str, max_bytes: u64) -> Result<(&'st
     // A small PNG may decode to a huge image: its header says how large,
     // before any decoding (4 f32 per texel).
     if bytes.starts_with(b"\x89PNG") && bytes.len() >= 24 {
-        let [w, h] = [16, 20].map(|o| u64::from(u32::from_be_bytes(bytes[o..o + 4].try_into().expect("4 bytes"))));
-        if w * h * 16 > max_bytes {
+        let [w, h] = [16, 20].map(|o| u128::from(u32::from_be_bytes(bytes[o..o + 4].try_into().expect("4 bytes"))));
+        // In u128: 2^32 x 2^32 x 16 does not fit in u64.
+        let decoded = w * h * 16;
+        if decoded > u128::from(max_bytes) {
             return Err(format!(
-                "file {file} is a {w}x{h} PNG: {} bytes decoded, above the memory budget of {max_bytes} bytes; \
-                 make it smaller, or raise VISTA_MAX_BYTES",
-                w * h * 16
+                "file {file} is a {w}x{h} PNG: {decoded} bytes decoded, above the memory budget of {max_bytes} \
+                 bytes; make it smaller, or raise VISTA_MAX_BYTES"
             ));
         }
     }
@@ -970,7 +971,8 @@ fn read_texture_npy(
     declared: Option<&'static str>,
 ) -> Result<(&'static str, [u32; 2], Vec<u8>), String> {
     let path = under(root, file)?;
-    let n = vista_image::npy::read_npy(&path).map_err(|e| format!("file {file}: {e}"))?;
+    let bytes = read_input(root, file, &path)?;
+    let n = vista_image::npy::decode_npy(&path, &bytes).map_err(|e| format!("file {file}: {e}"))?;
     let (h, w, c) = match n.shape[..] {
         [h, w] => (h, w, 1),
         [h, w, c] => (h, w, c as usize),

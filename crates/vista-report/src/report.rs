@@ -35,8 +35,12 @@ const THUMBS_MARKER: &str = ".vista-thumbs";
 
 /// Clears the case folders an earlier run left in `dir`, so a filtered run's
 /// report shows only its own cases. Only folders holding vista's marker are
-/// removed: a `--report-dir` pointed anywhere else loses nothing.
+/// removed: a `--report-dir` pointed anywhere else loses nothing. The
+/// report folder itself is the run's: a symlink in its place (planted to
+/// lead the report out of the project) is replaced by a real folder, never
+/// written through.
 pub fn clear_case_folders(dir: &Path) -> Result<(), GoldenError> {
+    vista_image::own_dir(dir)?;
     let Ok(entries) = std::fs::read_dir(dir) else { return Ok(()) };
     for e in entries.flatten() {
         // Never through a symlink: a link to a marked folder elsewhere stays.
