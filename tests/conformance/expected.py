@@ -639,10 +639,22 @@ def draw_offset_probes():
                     "and the per-vertex and per-instance attributes fetched there, zeros where no point fell"}]
 
 
+def depth_as_float_probes():
+    # WebGPU: a depth32float texture binds as sampleType "unfilterable-float"; only .r of the loaded
+    # value is the depth, so the shader stores (d, 0, 0, 1). The triangle's z = 0.25 at w = 1 is the
+    # fragment depth (viewport depth range [0, 1]), exact in f32.
+    words = []
+    for _ in range(8 * 8):
+        words += [bits("f32", 0.25), bits("f32", 0.0), bits("f32", 0.0), bits("f32", 1.0)]
+    return [{"kernel": "depth_as_float", "set": {}, "outputs": ["out"], "words": words,
+             "why": "per texel of 8 x 8: the depth 0.25 a full-screen draw wrote, loaded through texture_2d<f32>"}]
+
+
 PROBES = [array_length_probes, layout_probes, entry_name_probes, blend_probes, vertex_probes, texture_query_probes,
           sampling_probes, format_probes, workgroup_zero_probes,
           index_probes, depth_probes, render_format_probes,
-          struct_array_probes, view_probes, out_of_bounds_probes, draw_offset_probes]
+          struct_array_probes, view_probes, out_of_bounds_probes, draw_offset_probes,
+          depth_as_float_probes]
 
 
 def render():

@@ -191,8 +191,13 @@ impl Context {
                     json!({ "resource": resource, "level": level }),
                 )
             }
-            Bind::Sampled { resource, .. } if matches!(g.resources[*resource], Resource::Depth(_)) => (
-                json!({ "texture": { "sampleType": "depth", "viewDimension": "2d", "multisampled": false } }),
+            // A depth resource: texture_depth_2d, or texture_2d<f32> as WebGPU
+            // allows (unfilterable-float).
+            Bind::Sampled { resource, depth, .. } if matches!(g.resources[*resource], Resource::Depth(_)) => (
+                json!({ "texture": {
+                    "sampleType": if *depth { "depth" } else { "unfilterable-float" },
+                    "viewDimension": "2d", "multisampled": false,
+                } }),
                 json!({ "resource": resource, "level": null }),
             ),
             Bind::Sampled { resource, depth, cube, level } => {

@@ -456,10 +456,14 @@ impl Context {
                         view_dimension: crate::format::view_dimension(t.dimension),
                     }
                 }
-                // A depth resource: texture_depth_2d.
-                Bind::Sampled { resource, .. } if matches!(g.resources[resource], Resource::Depth(_)) => {
+                // A depth resource: texture_depth_2d, or texture_2d<f32> as
+                // WebGPU allows (unfilterable-float).
+                Bind::Sampled { resource, depth, .. } if matches!(g.resources[resource], Resource::Depth(_)) => {
                     wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
+                        sample_type: match depth {
+                            true => wgpu::TextureSampleType::Depth,
+                            false => wgpu::TextureSampleType::Float { filterable: false },
+                        },
                         view_dimension: wgpu::TextureViewDimension::D2,
                         multisampled: false,
                     }

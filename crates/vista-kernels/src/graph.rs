@@ -1979,11 +1979,13 @@ fn sampled_slot(
         )));
     };
     let ri = find(resources, rn);
-    // A depth resource is sampled as texture_depth_2d, and only so.
+    // A depth resource is sampled as texture_depth_2d, or read as
+    // texture_2d<f32> (WebGPU's unfilterable-float view of depth32float).
     if kind_of(resources, ri) == "depth" {
-        if (kind, dim) != (SampledKind::Depth, Dimension::D2) {
+        if !matches!((kind, dim), (SampledKind::Depth | SampledKind::Float, Dimension::D2)) {
             return Err(bad(format!(
-                "{label}: {described} is bound to {rn}, a depth texture; it is sampled as texture_depth_2d"
+                "{label}: {described} is bound to {rn}, a depth texture; it is sampled as texture_depth_2d or \
+                 read as texture_2d<f32>"
             )));
         }
         resources[ri].read = true;
