@@ -41,27 +41,10 @@ pub fn render(
         let is_buffer = matches!(o.value, OutputValue::Buffer { .. });
         let path = output_path(out, i == 0, &o.name, is_buffer);
         match &o.value {
-            OutputValue::Texture { raw, unwritten, .. } => {
+            OutputValue::Texture { raw, .. } => {
                 let raw_values = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
                 let img = if raw_values { Image::clone(raw) } else { o.display().expect("a texture") };
                 vista_image::save(&path, &if i == 0 { frame(img) } else { img })?;
-                if let Some((x, y)) = raw.first_nonfinite() {
-                    eprintln!(
-                        "error: output {} has {} NaN/Inf texels, first at ({x}, {y})",
-                        o.name,
-                        raw.nonfinite_count()
-                    );
-                    code = 1;
-                }
-                if *unwritten > 0 && !o.partial {
-                    eprintln!(
-                        "error: kernel {}: output {}: {}",
-                        k.name(),
-                        o.name,
-                        vista_golden::unwritten_problem(*unwritten, raw)
-                    );
-                    code = 1;
-                }
             }
             OutputValue::Buffer { .. } => {
                 let (descr, shape) = o.npy().expect("a buffer");
@@ -71,6 +54,12 @@ pub fn render(
         if r.outputs.len() > 1 {
             eprintln!("  output {} -> {}", o.name, path.display());
         }
+    }
+    // The checks check and bless make of every output (unwritten texels,
+    // NaN/Inf in textures and float buffers), from the one guard.
+    for problem in vista_golden::output_guards(&r.outputs) {
+        eprintln!("error: kernel {}: {problem}", k.name());
+        code = 1;
     }
     let passes: Vec<String> = r.pass_times.iter().map(|t| format!("{:.1}", t.as_secs_f64() * 1e3)).collect();
     let passes = match passes.len() {

@@ -3466,6 +3466,33 @@ fn an_interrupted_check_writes_the_report_of_what_finished() {
     assert_eq!(results["cases"].as_array().unwrap().len(), finished, "results.json holds the finished cases");
 }
 
+/// `vista render` judges every output with check's own guard: a float
+/// buffer holding NaN fails the render (exit 1) naming the output and the
+/// first value, as it fails a check; the file is still written.
+fn render_guards_buffer_outputs_as_check_does() {
+    let shader = "struct Params { width: u32, height: u32, bits: u32 }\n\
+                  @group(0) @binding(0) var<uniform> params: Params;\n\
+                  @group(0) @binding(1) var<storage, read_write> values: array<f32>;\n\
+                  @compute @workgroup_size(1)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                  \x20   values[id.x] = select(1.0, bitcast<f32>(params.bits), id.x == 2u);\n}\n";
+    let manifest = |bits: u32| {
+        format!(
+            "summary = \"b\"\n[[param]]\nname = \"bits\"\ntype = \"u32\"\nrange = [0, 4294967295]\ndefault = {bits}\n\
+             doc = \"the third value's bits\"\n[[resource]]\nname = \"values\"\nkind = \"buffer\"\nlength = 4\n\
+             [[pass]]\nentry = \"main\"\nworkgroups = [4, 1, 1]\n[[output]]\nresource = \"values\"\n"
+        )
+    };
+    // 0x7fc00000: a quiet NaN.
+    let d = kernel_project(&manifest(0x7fc0_0000), shader);
+    let out = d.path().join("v.npy");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "4x1", "-o", out.to_str().unwrap()]);
+    assert_rejected(&r, 1, &["kernel k: output values: 1 values are NaN/Inf; first at value 2"]);
+    assert!(out.exists(), "the output is written for inspection");
+    let d = kernel_project(&manifest(0x3f80_0000), shader);
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "4x1", "-o", out.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "1.0 everywhere: {}", r.stderr);
+}
+
 /// A case sets shader defs (`defs = { BRIGHT = true }`), and an enum
 /// param's value can name one (`defs = { bright = "BRIGHT" }`): one kernel
 /// covers its variants. The defs are part of the params hash, so a golden
@@ -6274,6 +6301,7 @@ fn main() {
         Gpu a_buffer_past_the_device_s_binding_size_is_refused_before_the_worker,
         Gpu draw_offsets_are_checked_against_the_buffers,
         Gpu cases_set_defs_and_enum_values_name_them,
+        Gpu render_guards_buffer_outputs_as_check_does,
         Gpu the_report_works_in_a_real_browser,
         Gpu max_flip_fails_a_case_above_it,
         Gpu compare_reports_json_fields_and_rejects_bad_files,
