@@ -590,7 +590,7 @@ impl Context {
     /// sentinel 0 somewhere are run again over sentinel 1: a texel holding
     /// each run's sentinel was never written.
     pub fn run(&self, g: &Graph<'_>) -> Result<Readback, GpuError> {
-        self.require_graph(g)?;
+        self.require_graph(g, &[])?;
         let start = Instant::now();
         let once = |which: usize| match &self.engine {
             Engine::Wgpu(w) => self.run_wgpu(w, g, which),
@@ -621,8 +621,9 @@ impl Context {
     /// What the graph needs of the device, refused before any run (the
     /// parent asks this of a worker's device before sending the graph):
     /// texture sizes, each pass's workgroups and bindings, and each
-    /// buffer's size.
-    pub fn require_graph(&self, g: &Graph<'_>) -> Result<(), GpuError> {
+    /// buffer's size. `names`: the first resources' names, for messages
+    /// (a resource without one is named by its index).
+    pub fn require_graph(&self, g: &Graph<'_>, names: &[String]) -> Result<(), GpuError> {
         let max = self.max_dimension();
         for r in g.resources.iter() {
             if let Resource::Texture(t) = r
@@ -641,7 +642,10 @@ impl Context {
         // refused here, before a worker or the device holds a copy of it.
         for (i, used) in buffer_usages(&g.resources, &g.passes).iter().enumerate() {
             let (Some(used), Resource::Buffer(bytes)) = (used, &g.resources[i]) else { continue };
-            let what = format!("buffer resource {i} ({} bytes)", bytes.len());
+            let what = match names.get(i) {
+                Some(name) => format!("buffer {name} ({} bytes)", bytes.len()),
+                None => format!("buffer resource {i} ({} bytes)", bytes.len()),
+            };
             let size = bytes.len() as u64;
             self.require(&what, "maxBufferSize", size)?;
             if used.storage {

@@ -514,24 +514,6 @@ pub fn for_case<R>(id: &str, f: impl FnOnce() -> R) -> R {
     out
 }
 
-/// `e` with the graph's "buffer resource N" called by the kernel's name
-/// for resource N, where it has one.
-fn named(e: vista_gpu::GpuError, names: &[String]) -> vista_gpu::GpuError {
-    match e {
-        vista_gpu::GpuError::Unsupported { adapter, what, feature } => {
-            let what = match what.strip_prefix("buffer resource ").and_then(|r| r.split_once(' ')) {
-                Some((n, rest)) => match n.parse::<usize>().ok().and_then(|i| names.get(i)) {
-                    Some(name) => format!("buffer {name} {rest}"),
-                    None => what,
-                },
-                None => what,
-            };
-            vista_gpu::GpuError::Unsupported { adapter, what, feature }
-        }
-        other => other,
-    }
-}
-
 /// Runs a plan on the renderer's engine (in its worker process, if it has one).
 pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
     let graph = vista_gpu::Graph {
@@ -540,10 +522,11 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         passes: std::borrow::Cow::Borrowed(&plan.passes),
         outputs: std::borrow::Cow::Borrowed(&plan.output_ids),
     };
+    // Refused here, with the kernel's names, before a worker holds a copy
+    // of the graph.
+    gpu.ctx.require_graph(&graph, &plan.names)?;
     let out = match &gpu.worker {
         Some(w) => {
-            // Refused here, before the worker holds a copy of the graph.
-            gpu.ctx.require_graph(&graph).map_err(|e| named(e, &plan.names))?;
             let source = worker::ShaderSource { root: gpu.root.clone(), edit: gpu.edit.clone() };
             let case = CASE.with(|c| c.borrow().clone());
             w.run(gpu.ctx, &graph, &source, &plan.kernel, case.as_deref())?
