@@ -105,7 +105,7 @@ pub fn check(
     let ctx = &Renderer::shared(&config.gpu, project, config.limits)?;
     vista_report::clear_case_folders(&report_dir)?;
     // Ctrl-C: the cases that finished still get their report.
-    crate::stop_on_interrupt();
+    crate::signals::stop_on_interrupt();
     let mut time = Phases::start(ctx);
     let checker = Checker { ctx, store: &store, manifest: &manifest, report_dir: &report_dir, detail: viewers };
     time.jobs = checker.jobs(pick.jobs, picked.len());

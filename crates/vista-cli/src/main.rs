@@ -19,6 +19,7 @@ mod list;
 mod matrix;
 mod mutate;
 mod render;
+mod signals;
 mod sweep;
 mod watch;
 
@@ -237,60 +238,11 @@ enum Command {
     Bench(bench::Args),
 }
 
-/// A closed stdout (`vista list | head -1`) ends vista quietly like other
-/// Unix tools: Rust ignores SIGPIPE, which turns every println! after the
-/// reader left into a panic. Only a closed stdout: a worker that died
-/// between cases also raises SIGPIPE (on the parent's next request), and
-/// that write must fail with EPIPE so the parent starts another worker.
-#[cfg(unix)]
-fn die_quietly_on_closed_pipe() {
-    extern "C" fn on_sigpipe(_: libc::c_int) {
-        // poll(2) is async-signal-safe; a pipe whose reader left reports POLLERR.
-        let mut out = libc::pollfd { fd: libc::STDOUT_FILENO, events: libc::POLLOUT, revents: 0 };
-        // SAFETY: one valid pollfd, no wait.
-        let closed = unsafe { libc::poll(&mut out, 1, 0) } == 1 && out.revents & libc::POLLERR != 0;
-        if closed {
-            // SAFETY: the default action ends the process as SIGPIPE would have.
-            unsafe {
-                libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-                libc::raise(libc::SIGPIPE);
-            }
-        }
-    }
-    // SAFETY: called first thing in main, before any thread starts; the
-    // handler only polls and re-raises.
-    unsafe {
-        libc::signal(libc::SIGPIPE, on_sigpipe as *const () as libc::sighandler_t);
-    }
-}
-
-/// From here on, SIGINT (Ctrl-C) marks the run interrupted instead of
-/// ending the process: `vista check` stops starting cases, writes the
-/// report of those that finished and exits 130. A second Ctrl-C ends it
-/// at once (the handler is reset to the default after the first).
-pub(crate) fn stop_on_interrupt() {
-    #[cfg(unix)]
-    {
-        extern "C" fn on_sigint(_: libc::c_int) {
-            vista_check::interrupt();
-            // SAFETY: signal() is async-signal-safe; SIG_DFL is valid.
-            unsafe {
-                libc::signal(libc::SIGINT, libc::SIG_DFL);
-            }
-        }
-        // SAFETY: the handler only stores an atomic and resets itself.
-        unsafe {
-            libc::signal(libc::SIGINT, on_sigint as *const () as libc::sighandler_t);
-        }
-    }
-}
-
 fn main() -> ExitCode {
     // Started as a GPU worker by another vista process: serve it, then exit.
     vista::config::serve_worker_if_asked();
     vista_image::one_arena();
-    #[cfg(unix)]
-    die_quietly_on_closed_pipe();
+    signals::die_quietly_on_closed_pipe();
     let cli = Cli::parse();
     if let Some(a) = &cli.adapter {
         let instead = if a == "cpu" { "lavapipe" } else { a.as_str() };
