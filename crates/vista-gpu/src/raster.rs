@@ -125,13 +125,7 @@ pub(crate) fn check_fragment(
                 name(got)
             )));
         }
-        let src1 = t.blend.components().is_some_and(|(c, a)| {
-            use vista_texel::BlendFactor::*;
-            [c.src, c.dst, a.src, a.dst]
-                .iter()
-                .any(|f| matches!(f, Src1 | OneMinusSrc1 | Src1Alpha | OneMinusSrc1Alpha))
-        });
-        if src1 && !outputs.iter().any(|(l, b, _)| *l == n as u32 && *b == Some(1)) {
+        if t.blend.uses_src1() && !outputs.iter().any(|(l, b, _)| *l == n as u32 && *b == Some(1)) {
             return Err(GpuError::Request(format!(
                 "{label}: target {n} ({}) blends with a src1 factor, but fragment entry {entry} has no \
                  @location({n}) @blend_src(1) output; add one (enable dual_source_blending;) or use src factors",

@@ -134,6 +134,11 @@ impl BlendComponent {
     pub fn uses_constant(self) -> bool {
         [self.src, self.dst].iter().any(|f| matches!(f, BlendFactor::Constant | BlendFactor::OneMinusConstant))
     }
+
+    /// Whether either factor reads the fragment's second source.
+    pub fn uses_src1(self) -> bool {
+        self.src.is_src1() || self.dst.is_src1()
+    }
 }
 
 /// How a render pass's fragment output meets what its target holds
@@ -181,6 +186,11 @@ impl Blend {
     /// Whether the blend reads the pass's blend constant.
     pub fn uses_constant(self) -> bool {
         self.components().is_some_and(|(c, a)| c.uses_constant() || a.uses_constant())
+    }
+
+    /// Whether the blend reads the fragment's second source (`@blend_src(1)`).
+    pub fn uses_src1(self) -> bool {
+        self.components().is_some_and(|(c, a)| c.uses_src1() || a.uses_src1())
     }
 }
 
