@@ -143,7 +143,7 @@ pub struct Case {
     pub inputs: Vec<(String, String)>,
     /// Tolerances this case gives some outputs instead of their manifest's
     /// (`tolerances = { heights = { rmse = 0.002 } }`), by output name.
-    pub tolerances: Vec<(String, vista_kernels::graph::Tolerance)>,
+    pub tolerances: Vec<(String, vista_manifest::graph::Tolerance)>,
     /// What the case covers, in a few words (`doc` in cases.toml).
     pub doc: String,
 }
@@ -192,8 +192,8 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             }
         }
         let overrides: Vec<(String, String)> =
-            raw.set.iter().map(|(k, v)| (k.clone(), vista_kernels::values::value_text(v))).collect();
-        let defs = vista_kernels::values::parse_defs(&raw.defs).map_err(bad)?;
+            raw.set.iter().map(|(k, v)| (k.clone(), vista_manifest::values::value_text(v))).collect();
+        let defs = vista_manifest::values::parse_defs(&raw.defs).map_err(bad)?;
         let params = kernel.resolve(raw.preset.as_deref(), &overrides).map_err(|e| bad(e.to_string()))?.with_defs(defs);
         let (width, height) = match &raw.size {
             Some(s) => vista_kernels::parse_size(s).map_err(|e| bad(e.to_string()))?,
@@ -273,7 +273,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             if !outputs.contains(&name.as_str()) {
                 return Err(bad(format!("tolerances: {name} names no output; outputs: {}", outputs.join(", "))));
             }
-            let t = vista_kernels::graph::parse_tolerance(v).map_err(|e| bad(format!("tolerances: {name}: {e}")))?;
+            let t = vista_manifest::graph::parse_tolerance(v).map_err(|e| bad(format!("tolerances: {name}: {e}")))?;
             tolerances.push((name.clone(), t));
         }
         for x in &raw.expect_fail {

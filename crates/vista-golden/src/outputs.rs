@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use vista_image::metrics::format_psnr;
 use vista_image::{Image, Image16, Texels};
 use vista_kernels::Kernel;
-use vista_kernels::graph::Tolerance;
+use vista_manifest::graph::Tolerance;
 use vista_render::{OutputRender, OutputValue, quantize16};
 
 use crate::Case;
@@ -845,7 +845,7 @@ fn colour_channels(format: &str) -> usize {
     }
 }
 
-fn is_f32(e: &vista_kernels::graph::Element) -> bool {
+fn is_f32(e: &vista_manifest::graph::Element) -> bool {
     e.leaves.iter().all(|l| l.1 == 'f')
 }
 
@@ -1184,7 +1184,7 @@ mod tests {
         let case = crate::cases::parse_cases(Path::new("cases.toml"), text, vista_kernels::Registry::builtin())
             .unwrap()
             .remove(0);
-        let element = vista_kernels::graph::Element {
+        let element = vista_manifest::graph::Element {
             stride: 4,
             header: 0,
             fixed: None,
@@ -1227,7 +1227,7 @@ mod tests {
             partial: false,
             value: OutputValue::Buffer {
                 bytes: vec![0; 16],
-                element: vista_kernels::graph::Element {
+                element: vista_manifest::graph::Element {
                     stride: 16,
                     header: 0,
                     fixed: None,

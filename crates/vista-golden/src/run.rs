@@ -65,7 +65,7 @@ pub struct Checked {
 /// they leave it)). Files are read relative to `root`; one that cannot be
 /// read says so (the render refuses it before this is asked).
 pub fn inputs_of(case: &Case, root: Option<&std::path::Path>) -> Vec<(String, String, Option<Image>)> {
-    use vista_kernels::graph::ResourceKind;
+    use vista_manifest::graph::ResourceKind;
     let g = case.kernel.graph();
     let mut out = Vec::new();
     for r in &g.resources {

@@ -1,4 +1,4 @@
-//! The same CPU references (`src/cpu/`) compiled with f32 arithmetic: the
+//! The same CPU references (each kernel's `cpu.rs`, `src/cpu/`) compiled with f32 arithmetic: the
 //! CPU doing the GPU's work at the GPU's precision, the baseline of the
 //! throughput benches, and a measure of what the f64 oracles buy (see
 //! `tests/precision.rs`, which checks it against the f64 build; the unit

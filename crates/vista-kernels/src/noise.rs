@@ -1,11 +1,37 @@
 //! The integer side of the noise bases (SPEC 3.1): Perlin's permutation,
 //! seeded shuffles, the pcg3d hash and the basis names. The float side
-//! (perlin, value, fBm, ridged) is in `src/cpu/noise.rs`, built once per
+//! (perlin, value, fBm, ridged) is in `src/cpu/noise.rs` (shared math), built once per
 //! precision; its f64 build is re-exported here.
 
 use rand::seq::SliceRandom;
 
 pub use crate::cpu64::noise::*;
+use crate::{Kernel, ParamSet, UniformLayout, Value};
+
+/// The read-only table lib/noise.wgsl reads: Perlin's permutation for the
+/// kernel's `seed` param (seed 0 without one), its chain values packed
+/// ([`chain_words`]), then the plane flag and z and, on a hash plane, its
+/// corner hashes ([`plane_hashes`]).
+pub fn table(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet) -> Vec<u32> {
+    if !layout.uses_table {
+        return vec![0; 4];
+    }
+    let seed = match p.value("seed") {
+        Some(Value::Int(s)) => *s as u32,
+        _ => 0,
+    };
+    let perm = permutation(seed);
+    // The chain words are built where they end up: appended, they were
+    // copied once more (256 KiB per case).
+    let mut table = Vec::with_capacity(perm.len() + 512 + 256 * 256 + 2 + 256 * 256);
+    table.extend_from_slice(&perm);
+    chain_words_into(&perm, &mut table);
+    match kernel.hash_plane(p) {
+        Some(z) => plane_hashes_into(&perm, &mut table, perm.len() + 512, z),
+        None => table.extend([0, 0]),
+    }
+    table
+}
 
 /// Ken Perlin's reference permutation (Improved Noise, 2002).
 pub const PERLIN_PERMUTATION: [u8; 256] = [

@@ -4,38 +4,33 @@
 //! test keeps the two lists equal); inside the repository, or any project
 //! that has a file of the same path, the file on disk wins.
 
-macro_rules! embed {
-    ($dir:literal: $($rel:literal),* $(,)?) => {
-        &[$(($rel, include_str!(concat!("../../../", $dir, "/", $rel)))),*]
+macro_rules! builtins {
+    (libs: $($lib:literal),* $(,)?; kernels: $($kernel:literal),* $(,)?) => {
+        /// `shaders/` files: `(path relative to shaders/, text)`.
+        pub const SHADERS: &[(&str, &str)] = &[
+            $(($lib, include_str!(concat!("../../../shaders/", $lib))),)*
+            $((concat!($kernel, ".wgsl"), include_str!(concat!("../../../shaders/", $kernel, ".wgsl"))),)*
+        ];
+
+        /// `kernels/` manifests: `(path relative to kernels/, text)`.
+        pub const KERNELS: &[(&str, &str)] = &[
+            $((concat!($kernel, ".toml"), include_str!(concat!("../../../kernels/", $kernel, ".toml"))),)*
+        ];
     };
 }
 
-/// `shaders/` files: `(path relative to shaders/, text)`.
-pub const SHADERS: &[(&str, &str)] = embed!("shaders":
-    "lib/hash.wgsl",
-    "lib/noise.wgsl",
-    "lib/fractal.wgsl",
-    "lib/phase.wgsl",
-    "lib/geometry.wgsl",
-    "lib/terrain.wgsl",
-    "lib/sky.wgsl",
-    "lib/cloud_slab.wgsl",
-    "fbm.wgsl",
-    "ridged.wgsl",
-    "atmosphere.wgsl",
-    "heightfield.wgsl",
-    "clouds.wgsl",
-    "cloudmap.wgsl",
-    "landscape.wgsl",
-);
-
-/// `kernels/` manifests: `(path relative to kernels/, text)`.
-pub const KERNELS: &[(&str, &str)] = embed!("kernels":
-    "fbm.toml",
-    "ridged.toml",
-    "atmosphere.toml",
-    "clouds.toml",
-    "heightfield.toml",
-    "cloudmap.toml",
-    "landscape.toml",
-);
+// A built-in kernel is one name here (its `kernels/<name>.toml` and
+// `shaders/<name>.wgsl`) and one line of vista-kernels' `builtin_kernels!`
+// (its Rust folder); a test there keeps the two lists equal.
+builtins! {
+    libs:
+        "lib/hash.wgsl",
+        "lib/noise.wgsl",
+        "lib/fractal.wgsl",
+        "lib/phase.wgsl",
+        "lib/geometry.wgsl",
+        "lib/terrain.wgsl",
+        "lib/sky.wgsl",
+        "lib/cloud_slab.wgsl";
+    kernels: "fbm", "ridged", "atmosphere", "clouds", "heightfield", "cloudmap", "landscape",
+}

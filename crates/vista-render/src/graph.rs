@@ -9,9 +9,9 @@ use std::path::{Path, PathBuf};
 
 use vista_gpu::{Bind, Contents, GraphSlot};
 use vista_image::Image;
-use vista_kernels::element::leaf_numpy;
-use vista_kernels::graph::{Element, ResourceKind, SlotFeed, Tolerance, Usage};
-use vista_kernels::{DisplayMap, Kernel, ParamSet};
+use vista_manifest::element::leaf_numpy;
+use vista_manifest::graph::{Element, ResourceKind, SlotFeed, Tolerance, Usage};
+use vista_manifest::{DisplayMap, Kernel, ParamSet};
 use vista_texel::Dimension;
 
 use crate::error::RenderError;
@@ -37,7 +37,7 @@ pub enum PlannedKind {
         /// Its storage format.
         format: &'static str,
         /// Its PNG view.
-        view: vista_kernels::Output,
+        view: vista_manifest::Output,
         /// Raw to display values.
         display: DisplayMap,
     },
@@ -84,8 +84,8 @@ impl Plan {
 /// its composed shader file and module, and its vertex entry's where that
 /// lives in another file.
 struct PassParts<'a> {
-    slots: &'a [vista_kernels::graph::PassSlot],
-    layout: &'a vista_kernels::UniformLayout,
+    slots: &'a [vista_manifest::graph::PassSlot],
+    layout: &'a vista_manifest::UniformLayout,
     module: &'a naga::Module,
     file: &'a str,
     vertex: Option<(&'a naga::Module, &'a str)>,
@@ -260,8 +260,8 @@ impl Planning<'_> {
     /// an output no pass reads, else zeros).
     fn texture(
         &self,
-        r: &vista_kernels::graph::ResolvedResource,
-        size: Option<&[vista_kernels::expr::Expr]>,
+        r: &vista_manifest::graph::ResolvedResource,
+        size: Option<&[vista_manifest::expr::Expr]>,
         file: Option<&String>,
         mip_levels: u32,
         is_output: bool,
@@ -351,7 +351,7 @@ impl Planning<'_> {
     }
 
     /// Entry `i` of a resource's `size` for these params, in [1, 16384].
-    fn size_entry(&self, i: usize, e: &vista_kernels::expr::Expr) -> Result<u32, String> {
+    fn size_entry(&self, i: usize, e: &vista_manifest::expr::Expr) -> Result<u32, String> {
         let n = e.eval(self.p, self.width, self.height).map_err(|m| format!("size[{i}] {m}"))?;
         u32::try_from(n)
             .ok()
@@ -362,8 +362,8 @@ impl Planning<'_> {
     /// A depth resource: its size (default the case's).
     fn depth(
         &self,
-        r: &vista_kernels::graph::ResolvedResource,
-        size: Option<&[vista_kernels::expr::Expr]>,
+        r: &vista_manifest::graph::ResolvedResource,
+        size: Option<&[vista_manifest::expr::Expr]>,
     ) -> Result<vista_gpu::Resource, RenderError> {
         let at = |m: String| self.bad(format!("resource {}: {m}", r.spec.name));
         let mut wh = [self.width, self.height];
@@ -377,11 +377,11 @@ impl Planning<'_> {
     /// `data`, or `length` copies of `fill`.
     fn buffer(
         &self,
-        r: &vista_kernels::graph::ResolvedResource,
+        r: &vista_manifest::graph::ResolvedResource,
         file: Option<&String>,
         data: Option<&[f64]>,
         fill: Option<f64>,
-        length: Option<&vista_kernels::expr::Expr>,
+        length: Option<&vista_manifest::expr::Expr>,
         is_output: bool,
     ) -> Result<vista_gpu::Resource, RenderError> {
         let (root, p, width, height) = (self.root, self.p, self.width, self.height);
@@ -440,10 +440,10 @@ impl Planning<'_> {
     fn pass(
         &self,
         i: usize,
-        pass: &vista_kernels::graph::PassSpec,
+        pass: &vista_manifest::graph::PassSpec,
         parts: PassParts<'_>,
         resources: &mut Vec<vista_gpu::Resource>,
-        resolved: &vista_kernels::graph::Resolved,
+        resolved: &vista_manifest::graph::Resolved,
     ) -> Result<vista_gpu::GraphPass, RenderError> {
         let PassParts { slots, layout, module, file, vertex } = parts;
         let (kernel, width, height) = (self.kernel, self.width, self.height);
@@ -457,7 +457,7 @@ impl Planning<'_> {
         })?;
         let constants = kernel.overrides_in(module, &pp, false).map_err(|e| RenderError::BadInput(e.to_string()))?;
         let blocks = kernel.uniforms(layout, &pp, width, height);
-        let mut table = Some(kernel.table(layout, &pp));
+        let mut table = Some(vista_kernels::noise::table(kernel, layout, &pp));
         let tables = slots.iter().filter(|s| matches!(s.feed, SlotFeed::Table)).count();
         let mut gslots = Vec::new();
         for s in slots {
@@ -474,7 +474,7 @@ impl Planning<'_> {
                     }
                     Usage::Sampled { kind, dim } => Bind::Sampled {
                         resource: *r,
-                        depth: *kind == vista_kernels::graph::SampledKind::Depth,
+                        depth: *kind == vista_manifest::graph::SampledKind::Depth,
                         cube: *dim == Dimension::Cube,
                         level: s.level,
                     },
@@ -502,8 +502,8 @@ impl Planning<'_> {
             }
         };
         let repeat = match &pass.repeat {
-            vista_kernels::graph::Repeat::Count(n) => *n,
-            vista_kernels::graph::Repeat::Param(name) => {
+            vista_manifest::graph::Repeat::Count(n) => *n,
+            vista_manifest::graph::Repeat::Param(name) => {
                 let n = pp.int(name);
                 u32::try_from(n)
                     .ok()
@@ -533,10 +533,10 @@ impl Planning<'_> {
     #[allow(clippy::too_many_arguments)]
     fn dispatch(
         &self,
-        pass: &vista_kernels::graph::PassSpec,
-        slots: &[vista_kernels::graph::PassSlot],
+        pass: &vista_manifest::graph::PassSpec,
+        slots: &[vista_manifest::graph::PassSlot],
         resources: &[vista_gpu::Resource],
-        resolved: &vista_kernels::graph::Resolved,
+        resolved: &vista_manifest::graph::Resolved,
         pp: &ParamSet,
         size: [u32; 3],
         label: &str,
@@ -600,7 +600,7 @@ impl Planning<'_> {
     }
 
     /// The case's params with the pass's `set` over them.
-    fn pass_params(&self, pass: &vista_kernels::graph::PassSpec) -> Result<ParamSet, RenderError> {
+    fn pass_params(&self, pass: &vista_manifest::graph::PassSpec) -> Result<ParamSet, RenderError> {
         let mut pp = self.p.clone();
         for (k, v) in &pass.set {
             pp = pp.with(self.kernel.params(), k, v).map_err(|e| RenderError::BadInput(format!("set: {e}")))?;
@@ -614,13 +614,13 @@ impl Planning<'_> {
     fn raster(
         &self,
         i: usize,
-        r: &vista_kernels::graph::RasterSpec,
+        r: &vista_manifest::graph::RasterSpec,
         label: &str,
         resources: &mut Vec<vista_gpu::Resource>,
-        resolved: &vista_kernels::graph::Resolved,
+        resolved: &vista_manifest::graph::Resolved,
         pp: &ParamSet,
     ) -> Result<vista_gpu::Raster, RenderError> {
-        use vista_kernels::graph::VertexStage;
+        use vista_manifest::graph::VertexStage;
         let index = |name: &str| resolved.resources.iter().position(|x| x.spec.name == name).expect("resolved");
         let mut targets = Vec::new();
         let mut size: Option<(u32, u32, String)> = None;
@@ -749,7 +749,7 @@ impl Planning<'_> {
 
     /// Whether a pass before pass `i` writes resource `ri` (a storage
     /// texture written, or a render target).
-    fn written_before(&self, i: usize, ri: usize, resolved: &vista_kernels::graph::Resolved) -> bool {
+    fn written_before(&self, i: usize, ri: usize, resolved: &vista_manifest::graph::Resolved) -> bool {
         let g = self.kernel.graph();
         (0..i).any(|j| {
             let stored = resolved.slots[j].iter().any(|s| {
@@ -769,14 +769,14 @@ impl Planning<'_> {
     /// of the per-instance ones; never more than the buffers hold.
     fn draw_counts(
         &self,
-        r: &vista_kernels::graph::RasterSpec,
+        r: &vista_manifest::graph::RasterSpec,
         label: &str,
         resources: &[vista_gpu::Resource],
         buffers: &[vista_gpu::VertexBuffer],
         indices: Option<(usize, bool)>,
         pp: &ParamSet,
     ) -> Result<Draw, RenderError> {
-        if r.vertex == vista_kernels::graph::VertexStage::Fullscreen {
+        if r.vertex == vista_manifest::graph::VertexStage::Fullscreen {
             return Ok(Draw { count: 3, instances: 1, ..Draw::default() });
         }
         let len = |ri: usize| match &resources[ri] {
@@ -791,15 +791,15 @@ impl Planning<'_> {
                 .min()
         };
         // Counts in [1, 2^26], offsets in [0, 2^26] (base_vertex: +-2^26).
-        let ranged = |k: &str, e: &vista_kernels::expr::Expr, lo: i64| -> Result<i64, RenderError> {
+        let ranged = |k: &str, e: &vista_manifest::expr::Expr, lo: i64| -> Result<i64, RenderError> {
             let n = e.eval(pp, self.width, self.height).map_err(|m| self.bad(format!("{label}: {k} {m}")))?;
             (lo..=1 << 26)
                 .contains(&n)
                 .then_some(n)
                 .ok_or_else(|| self.bad(format!("{label}: {k} is {n}; allowed: [{lo}, 67108864]")))
         };
-        let eval = |k: &str, e: &vista_kernels::expr::Expr| ranged(k, e, 1).map(|n| n as u32);
-        let offset = |k: &str, e: &Option<vista_kernels::expr::Expr>, lo: i64| -> Result<i64, RenderError> {
+        let eval = |k: &str, e: &vista_manifest::expr::Expr| ranged(k, e, 1).map(|n| n as u32);
+        let offset = |k: &str, e: &Option<vista_manifest::expr::Expr>, lo: i64| -> Result<i64, RenderError> {
             e.as_ref().map_or(Ok(0), |e| ranged(k, e, lo))
         };
         let first_vertex = offset("first_vertex", &r.first_vertex, 0)? as u32;
@@ -896,7 +896,7 @@ impl Planning<'_> {
     fn outputs(
         &self,
         resources: &[vista_gpu::Resource],
-        resolved: &vista_kernels::graph::Resolved,
+        resolved: &vista_manifest::graph::Resolved,
     ) -> (Vec<PlannedOutput>, Vec<usize>) {
         let (kernel, p) = (self.kernel, self.p);
         let g = kernel.graph();

@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 use vista_gpu::Context;
 pub use vista_gpu::{RunStats, ShaderSet};
 use vista_image::Image;
-use vista_kernels::{DisplayMap, Kernel, ParamSet};
+use vista_manifest::{DisplayMap, Kernel, ParamSet};
 
 /// Default cap on `work_per_pixel * pixels`. Lavapipe on 2 cores evaluates
 /// roughly 1e8-1e9 noise samples per second, so this keeps any accepted
@@ -103,7 +103,7 @@ pub fn check_request(
     height: u32,
     limits: &RenderLimits,
 ) -> Result<(), RenderError> {
-    vista_kernels::check_size(width, height).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    vista_manifest::check_size(width, height).map_err(|e| RenderError::BadInput(e.to_string()))?;
     let work = kernel.work_per_pixel(p) * width as f64 * height as f64;
     let cap = limits.max_work;
     if work > cap {
@@ -437,7 +437,7 @@ pub struct OutputRender {
     /// The resource's name (golden files add it after the case id).
     pub name: String,
     /// The manifest's tolerance, if any.
-    pub tolerance: Option<vista_kernels::graph::Tolerance>,
+    pub tolerance: Option<vista_manifest::graph::Tolerance>,
     /// Texels left unwritten are allowed.
     pub partial: bool,
     /// What the passes left in it.
@@ -455,7 +455,7 @@ pub enum OutputValue {
         /// Its storage format.
         format: &'static str,
         /// Its PNG view.
-        view: vista_kernels::Output,
+        view: vista_manifest::Output,
         /// Texels of a sentinel-filled output no pass wrote.
         unwritten: u64,
         /// Raw values to display values.
@@ -466,7 +466,7 @@ pub enum OutputValue {
         /// Every byte, a struct's fixed header included.
         bytes: Vec<u8>,
         /// The element its binding declares.
-        element: vista_kernels::graph::Element,
+        element: vista_manifest::graph::Element,
         /// Elements after the header.
         count: u64,
     },

@@ -255,7 +255,9 @@ mod tests {
 
     #[test]
     fn expressions_parse_evaluate_and_name_what_is_wrong() {
-        let k = crate::find("fbm").unwrap();
+        // The built-in fbm's manifest: its integer param `octaves` (8).
+        let (_, text) = vista_project::builtin::KERNELS.iter().find(|(f, _)| *f == "fbm.toml").unwrap();
+        let k = crate::Kernel::from_manifest("fbm", "<built-in>", text).unwrap();
         let p = k.resolve(None, &[]).unwrap();
         let e = |t: &str| Expr::parse(t, k.params());
         assert_eq!(e("ceil_div(width, 8) * 2 + octaves - (3)").unwrap().eval(&p, 33, 7).unwrap(), 5 * 2 + 8 - 3);

@@ -26,7 +26,7 @@
 //! above the horizon, and without air or clouds it is the heightfield
 //! kernel's shading under a white sun (`sun_intensity` = pi).
 //!
-//! The CPU reference (`src/cpu/landscape.rs`, its f64 build re-exported
+//! The CPU reference (`landscape/cpu.rs`, its f64 build re-exported
 //! here) composes the three references; the WGSL (`shaders/landscape.wgsl`)
 //! composes the three `shaders/lib` modules the kernels share.
 

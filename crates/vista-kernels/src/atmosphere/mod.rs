@@ -9,7 +9,7 @@
 //! ray, `light_samples` steps toward the sun at every view sample. The view
 //! transmittance to the midpoint t_i uses the sums of the previous steps plus
 //! half of step i, so the whole scheme is second order in the step length.
-//! The CPU reference (`src/cpu/atmosphere.rs`, re-exported here in its f64
+//! The CPU reference (`atmosphere/cpu.rs`, re-exported here in its f64
 //! build) evaluates the same discrete scheme with explicit 3D positions
 //! (|p| - R_ground for altitudes); the WGSL works in f32 from camera-relative
 //! scalars it derives from the params itself (see shaders/atmosphere.wgsl),

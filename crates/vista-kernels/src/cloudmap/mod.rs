@@ -1,6 +1,6 @@
 //! `cloudmap`: Hugo Elias's 2D cloud map, a built-in added as data
 //! (`kernels/cloudmap.toml`, `shaders/cloudmap.wgsl`); its only Rust is the
-//! CPU reference (`src/cpu/cloudmap.rs`), registered by name.
+//! CPU reference (`cloudmap/cpu.rs`), registered by name.
 
 pub use crate::cpu64::cloudmap::*;
 use crate::{CpuReference, ParamSet};

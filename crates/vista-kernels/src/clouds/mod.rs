@@ -41,7 +41,7 @@
 //! (1 - exp(-sigma_t dt)) / sigma_t (Hillaire 2016; -> dt as sigma_t -> 0);
 //! then T *= exp(-sigma_t dt). A ray stops (T = 0) once T < [`T_CUTOFF`].
 //!
-//! The CPU reference, written from these formulas, is `src/cpu/clouds.rs`
+//! The CPU reference, written from these formulas, is `clouds/cpu.rs`
 //! (its f64 build is re-exported here); the WGSL in `shaders/clouds.wgsl`
 //! does the same in f32.
 
