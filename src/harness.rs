@@ -217,13 +217,16 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
         };
         let root = project.root().expect("a store has a root");
         let results = vista_check::Results { junit: config.junit.as_ref().map(|j| root.join(j)), json: None };
-        let written = match &shared {
-            Some(shared) => {
-                let suite: Vec<String> = cases.iter().map(|c| c.id.clone()).collect();
-                shared.finish(&run, &filed, &results, &suite)
-            }
-            None => vista_check::finish(&report_dir, &run, &filed, &results),
+        let suite: Vec<String> = cases.iter().map(|c| c.id.clone()).collect();
+        let checker = Checker {
+            ctx,
+            store: &store,
+            manifest: &manifest,
+            report_dir: &report_dir,
+            detail: vista_report::Detail::Failing,
         };
+        let run = vista_check::Run { checker, summary: run, results, shared: shared.map(|s| (s, suite)) };
+        let written = run.finish(&filed);
         match written {
             Ok(index) => eprintln!("vista report: {}", index.display()),
             Err(e) => eprintln!("could not write the vista report: {e}"),

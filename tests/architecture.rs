@@ -186,3 +186,228 @@ fn files_are_written_by_rename_but_for_the_two_named_exceptions() {
     let doc = architecture();
     assert!(doc.contains("Chromium's page in its own") && doc.contains("`render`'s writability probe"), "named there");
 }
+
+/// The first identifier of `text`.
+fn ident(text: &str) -> &str {
+    let end = text.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(text.len());
+    &text[..end]
+}
+
+/// The first segment of each path a `use` group `{a, b::C, d::{e, f}}` names
+/// (`text` starts after the `{`).
+fn group_heads(text: &str) -> Vec<&str> {
+    let (mut depth, mut heads, mut start) = (0, Vec::new(), 0);
+    for (i, c) in text.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' if depth == 0 => {
+                heads.push(ident(text[start..i].trim_start()));
+                break;
+            }
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                heads.push(ident(text[start..i].trim_start()));
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    heads.into_iter().filter(|h| !h.is_empty()).collect()
+}
+
+/// One crate's module graph: a node per top-level module (a file or folder
+/// under `src/`) and `crate` for the root file; an edge where a module's
+/// code names another's items (`crate::m::..`, `use crate::{m, ..}`,
+/// `super::` from a top-level file, a root item re-exported from `m`). The
+/// root's own `mod` and `pub use` lines declare and re-export; they are not
+/// uses.
+fn module_graph(files: &[(PathBuf, String)], src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let node = |p: &Path| {
+        let rel = p.strip_prefix(src).unwrap();
+        let first = rel.components().next().unwrap().as_os_str().to_string_lossy().into_owned();
+        match first.as_str() {
+            "lib.rs" | "main.rs" => "crate".to_string(),
+            _ => first.trim_end_matches(".rs").to_string(),
+        }
+    };
+    let nodes: BTreeSet<String> = files.iter().map(|(p, _)| node(p)).collect();
+    let root = files.iter().find(|(p, _)| node(p) == "crate").map(|(_, c)| c.as_str()).unwrap_or("");
+    // Root items re-exported from a module: `pub use m::{A, B};`, `pub use m::A;`.
+    let mut reexported: BTreeMap<String, String> = BTreeMap::new();
+    for line in root.lines().map(str::trim) {
+        let Some(rest) = line.strip_prefix("pub use ").or_else(|| line.strip_prefix("pub(crate) use ")) else {
+            continue;
+        };
+        let m = ident(rest);
+        if !nodes.contains(m) {
+            continue;
+        }
+        let tail = rest[m.len()..].trim_start_matches("::");
+        let names: Vec<&str> = match tail.strip_prefix('{') {
+            Some(group) => group.split([',', '}']).map(|s| s.trim().rsplit("::").next().unwrap()).collect(),
+            None => vec![tail.trim_end_matches(';').rsplit("::").next().unwrap()],
+        };
+        for n in names.into_iter().filter(|n| !n.is_empty()) {
+            reexported.insert(n.to_string(), m.to_string());
+        }
+    }
+    let mut graph: BTreeMap<String, BTreeSet<String>> = nodes.iter().map(|n| (n.clone(), BTreeSet::new())).collect();
+    for (path, code) in files {
+        let from = node(path);
+        let top_level = path.parent() == Some(src);
+        let target = |name: &str| -> String {
+            if nodes.contains(name) {
+                name.to_string()
+            } else {
+                reexported.get(name).cloned().unwrap_or_else(|| "crate".to_string())
+            }
+        };
+        let mut to = Vec::new();
+        for line in code.lines() {
+            let t = line.trim_start();
+            if from == "crate" && (t.starts_with("pub use ") || t.starts_with("pub(crate) use ") || t.contains("mod "))
+            {
+                continue;
+            }
+            let mut prefixes = vec!["crate::"];
+            if top_level && from != "crate" {
+                prefixes.push("super::");
+            }
+            for prefix in prefixes {
+                for (at, _) in line.match_indices(prefix) {
+                    let before = line[..at].chars().next_back();
+                    if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == ':' || c == '$') {
+                        continue;
+                    }
+                    let rest = &line[at + prefix.len()..];
+                    match rest.strip_prefix('{') {
+                        Some(group) => to.extend(group_heads(group).into_iter().map(target)),
+                        None => to.push(target(ident(rest))),
+                    }
+                }
+            }
+            if from == "crate" {
+                for m in nodes.iter().filter(|m| *m != "crate") {
+                    let used = line.match_indices(&format!("{m}::")).any(|(at, _)| {
+                        !line[..at]
+                            .chars()
+                            .next_back()
+                            .is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == ':')
+                    });
+                    if used {
+                        to.push(m.clone());
+                    }
+                }
+            }
+        }
+        let edges = graph.get_mut(&from).unwrap();
+        edges.extend(to.into_iter().filter(|t| *t != from));
+    }
+    graph
+}
+
+/// The cycles of `graph`: each strongly connected set of two or more nodes.
+fn cycles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<BTreeSet<String>> {
+    let reach = |from: &str| {
+        let (mut seen, mut todo) = (BTreeSet::new(), vec![from.to_string()]);
+        while let Some(n) = todo.pop() {
+            for m in graph.get(&n).into_iter().flatten() {
+                if seen.insert(m.clone()) {
+                    todo.push(m.clone());
+                }
+            }
+        }
+        seen
+    };
+    let reaches: BTreeMap<&String, BTreeSet<String>> = graph.keys().map(|n| (n, reach(n))).collect();
+    let mut out: Vec<BTreeSet<String>> = Vec::new();
+    for n in graph.keys() {
+        let set: BTreeSet<String> =
+            graph.keys().filter(|m| *m == n || (reaches[n].contains(*m) && reaches[m].contains(n))).cloned().collect();
+        if set.len() > 1 && !out.contains(&set) {
+            out.push(set);
+        }
+    }
+    out
+}
+
+#[test]
+fn no_crate_has_a_module_cycle() {
+    let mut by_crate: BTreeMap<String, Vec<(PathBuf, String)>> = BTreeMap::new();
+    for (krate, path, code) in non_test_sources() {
+        by_crate.entry(krate).or_default().push((path, code));
+    }
+    let mut found = Vec::new();
+    for (krate, files) in &by_crate {
+        let src = files[0].0.ancestors().find(|a| a.ends_with("src")).unwrap().to_path_buf();
+        let graph = module_graph(files, &src);
+        for cycle in cycles(&graph) {
+            let edges: Vec<String> = cycle
+                .iter()
+                .flat_map(|a| graph[a].iter().filter(|b| cycle.contains(*b)).map(move |b| format!("{a} -> {b}")))
+                .collect();
+            found.push(format!("{krate}: {}", edges.join(", ")));
+        }
+    }
+    assert!(found.is_empty(), "module cycles:\n{}", found.join("\n"));
+}
+
+/// The detector itself: a root that uses a module which names a root item
+/// is a cycle; a root item re-exported from a module is that module's.
+#[test]
+fn the_module_cycle_check_sees_a_cycle_and_a_reexport() {
+    let src = Path::new("/x/src");
+    let file = |rel: &str, code: &str| (src.join(rel), code.to_string());
+    let cyclic = [file("lib.rs", "mod a;\npub struct E;\nfn f() { a::g() }\n"), file("a.rs", "use crate::E;\n")];
+    assert_eq!(cycles(&module_graph(&cyclic, src)).len(), 1);
+    let layered = [
+        file("lib.rs", "mod a;\nmod b;\npub use b::E;\n"),
+        file("a.rs", "use crate::{E, b::F};\n"),
+        file("b.rs", "pub struct E;\n"),
+    ];
+    let graph = module_graph(&layered, src);
+    assert!(cycles(&graph).is_empty(), "{graph:?}");
+    assert_eq!(graph["a"], BTreeSet::from(["b".to_string()]));
+}
+
+/// Every non-test function of `code` longer than `limit` lines, as
+/// `name (lines)`: a `fn` line at some indent runs to the first `}` line
+/// at the same indent (the code is rustfmt's).
+fn long_functions(code: &str, limit: usize) -> Vec<String> {
+    let lines: Vec<&str> = code.lines().collect();
+    let mut out = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let t = line.trim_start();
+        let indent = line.len() - t.len();
+        let signature =
+            ["pub fn ", "pub(crate) fn ", "fn ", "pub const fn ", "const fn ", "unsafe fn ", "pub unsafe fn "]
+                .iter()
+                .find_map(|p| t.strip_prefix(p));
+        let Some(rest) = signature else { continue };
+        let close = format!("{}}}", " ".repeat(indent));
+        let Some(end) = lines[i..].iter().position(|l| *l == close || l.trim_end().ends_with(';') && l == line) else {
+            continue;
+        };
+        if end + 1 > limit {
+            out.push(format!("{} ({} lines)", ident(rest), end + 1));
+        }
+    }
+    out
+}
+
+#[test]
+fn no_non_test_function_is_over_150_lines() {
+    // Counted with their comments: the file as written, cut at its tests.
+    let long: Vec<String> = non_test_sources()
+        .into_iter()
+        .flat_map(|(_, path, _)| {
+            let text = std::fs::read_to_string(&path).expect("source");
+            let code = text.split("#[cfg(test)]").next().unwrap().to_string();
+            let file = path.strip_prefix(root()).unwrap().display().to_string();
+            long_functions(&code, 150).into_iter().map(move |f| format!("{file}: {f}"))
+        })
+        .collect();
+    assert!(long.is_empty(), "functions over 150 lines:\n{}", long.join("\n"));
+    let sample = format!("fn short() {{\n{}}}\nfn long() {{\n{}}}\n", "    x;\n".repeat(3), "    x;\n".repeat(151));
+    assert_eq!(long_functions(&sample, 150), ["long (153 lines)"], "the measure itself");
+}

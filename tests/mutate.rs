@@ -24,7 +24,8 @@ fn run_one(gpu: &Renderer, file: &str, line_text: &str, before: &str, after: &st
         .unwrap_or_else(|| panic!("no mutant {before} -> {after} on {file}:{line}"));
     let kernel = vista_kernels::find("fbm").unwrap();
     let planned = [Planned { kernel: kernel.clone(), mutant }];
-    let mut r = vista_mutate::run(gpu, &project, &store, &cases, &planned, 1, &|_, _| {}).unwrap();
+    let judge = vista_mutate::Judge::new(gpu, &project, &store, &cases, &planned).unwrap();
+    let mut r = vista_check::mutants(&judge, &planned, 1, &mut |_: &vista_check::Filed| {});
     r.pop().unwrap()
 }
 

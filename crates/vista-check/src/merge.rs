@@ -14,50 +14,8 @@ use std::path::{Path, PathBuf};
 use vista_golden::{GoldenError, ManifestEntry, Outcome};
 use vista_report::RunSummary;
 
-use crate::Results;
-
-/// The file a `--partition` check (or a run shared by processes) leaves
-/// beside `results.json`: its run and every outcome, losslessly (CBOR keeps
-/// PSNR +inf and NaN), for `vista merge`.
-pub const OUTCOMES_FILE: &str = "outcomes.cbor";
-
-#[derive(serde::Serialize, serde::Deserialize)]
-struct Saved {
-    run: RunSummary,
-    outcomes: Vec<Outcome>,
-    /// A shared run's: every case id of the project's suite.
-    #[serde(default)]
-    suite: Option<Vec<String>>,
-}
-
-/// Writes `outcomes.cbor` into `report_dir`.
-pub(crate) fn save(
-    report_dir: &Path,
-    run: &RunSummary,
-    outcomes: &[Outcome],
-    suite: Option<&[String]>,
-) -> Result<(), GoldenError> {
-    let mut bytes = Vec::new();
-    let saved = Saved { run: run.clone(), outcomes: outcomes.to_vec(), suite: suite.map(<[String]>::to_vec) };
-    ciborium::into_writer(&saved, &mut bytes).map_err(|e| GoldenError::Io {
-        path: report_dir.join(OUTCOMES_FILE).display().to_string(),
-        message: e.to_string(),
-    })?;
-    vista_image::atomic_write(&report_dir.join(OUTCOMES_FILE), &bytes)?;
-    Ok(())
-}
-
-/// Removes an earlier shard's `outcomes.cbor` from a folder a whole run now
-/// reports into, so it is never merged as that run's.
-pub(crate) fn remove(report_dir: &Path) -> Result<(), GoldenError> {
-    let path = report_dir.join(OUTCOMES_FILE);
-    match std::fs::remove_file(&path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(GoldenError::Io { path: path.display().to_string(), message: e.to_string() })
-        }
-        _ => Ok(()),
-    }
-}
+use crate::files::{Results, write_run};
+use crate::kept::{OUTCOMES_FILE, Saved};
 
 /// One shard as read back.
 struct Shard {
@@ -277,6 +235,6 @@ pub fn merge(
         adapter: first.adapter.clone(),
         ..Default::default()
     };
-    let index = crate::write_run(out, &run, &outcomes, pending, results, None)?;
+    let index = write_run(out, &run, &outcomes, pending, results, None)?;
     Ok((index, outcomes))
 }

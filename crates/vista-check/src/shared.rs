@@ -21,11 +21,10 @@ use std::path::{Path, PathBuf};
 use vista_golden::{GoldenError, ManifestEntry, Outcome};
 use vista_report::RunSummary;
 
-use crate::{Filed, Results};
+use crate::checker::Filed;
+use crate::files::{Results, write_run};
+use crate::kept::{RUN_DIR, remove_records};
 
-/// The hidden folder of a shared run's records in the report folder: `run`
-/// (the run's id) and `cases/<id>.cbor`, one record per case.
-pub const RUN_DIR: &str = ".vista-run";
 const MARK: &str = "run";
 const CASES: &str = "cases";
 
@@ -73,15 +72,6 @@ impl Lock {
 /// The id of the run whose records `run_dir` holds, if any.
 fn current(run_dir: &Path) -> Option<String> {
     std::fs::read_to_string(run_dir.join(MARK)).ok().map(|s| s.trim().to_string())
-}
-
-/// Removes `dir` and all in it; nothing if it is not there.
-pub(crate) fn remove_records(report_dir: &Path) -> Result<(), GoldenError> {
-    let dir = report_dir.join(RUN_DIR);
-    match std::fs::remove_dir_all(&dir) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(io(&dir, e)),
-        _ => Ok(()),
-    }
 }
 
 /// The id of a run of processes that gives none: the parent process (the
@@ -192,7 +182,7 @@ impl SharedRun {
         let pending: BTreeMap<String, ManifestEntry> =
             recorded.iter().filter_map(|r| Some((r.outcome.id.clone(), r.pending.clone()?))).collect();
         let outcomes: Vec<Outcome> = recorded.into_iter().map(|r| r.outcome).collect();
-        crate::write_run(&self.report_dir, run, &outcomes, pending, results, Some(suite))
+        write_run(&self.report_dir, run, &outcomes, pending, results, Some(suite))
     }
 }
 

@@ -9,7 +9,7 @@ use vista_golden::GoldenError;
 use vista_project::Project;
 use vista_render::Renderer;
 
-use crate::{bad, parse_sets};
+use crate::input::{bad, parse_sets};
 
 /// `vista bench`'s arguments.
 #[derive(clap::Args)]
@@ -54,7 +54,7 @@ pub fn bench(project: &Project, config: &vista::Config, a: Args) -> Result<i32, 
         (None, None) => return Err(bad("give a kernel to bench, or --open-report DIR")),
     };
     let (kernel, preset, set, size) = (kernel.as_str(), preset.as_deref(), set.as_slice(), size.as_str());
-    let k = crate::registry(project)?.find(kernel).cloned().map_err(bad)?;
+    let k = crate::input::registry(project)?.find(kernel).cloned().map_err(bad)?;
     let p = k.resolve(preset, &parse_sets(set)?).map_err(bad)?;
     let (w, h) = vista_kernels::parse_size(size).map_err(bad)?;
     let shaders = vista_render::shader_set(project)?;

@@ -4,12 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use vista::Config;
-use vista_check::{Checker, Results};
+use vista_check::{Checker, Filed, Results, Run};
 use vista_golden::{GoldenError, Store};
 use vista_project::Project;
 use vista_render::Renderer;
 
-use crate::bad;
+use crate::input::bad;
 use crate::render::check_parent_writable;
 
 /// Which cases a check runs, and how.
@@ -62,6 +62,28 @@ pub(crate) fn print_case(o: &vista_golden::Outcome, report_dir: &Path) {
     }
 }
 
+/// What `vista check` and `vista watch` print as each case is filed: its
+/// status line ([`print_case`]) and any report folder it could not write;
+/// its times are added to `time` where one is kept.
+pub(crate) struct Terminal<'a> {
+    pub report_dir: &'a Path,
+    pub time: Option<&'a mut Phases>,
+}
+
+impl vista_check::Reporter for Terminal<'_> {
+    fn case(&mut self, f: &Filed) {
+        if let Some(time) = self.time.as_deref_mut() {
+            time.cases += f.check_time;
+            time.report += f.report_time;
+            time.gpu += std::time::Duration::from_secs_f64(f.outcome.gpu_ms / 1000.0);
+        }
+        print_case(&f.outcome, self.report_dir);
+        for e in &f.report_errors {
+            println!("error: {}: its report folder could not be written: {e}", f.outcome.id);
+        }
+    }
+}
+
 /// GitHub Actions `::error` annotations of the failing cases, with paths
 /// relative to the working directory, where the workflow runs.
 fn annotate(store: &Store, outcomes: &[vista_golden::Outcome]) {
@@ -109,33 +131,21 @@ pub fn check(
     let mut time = Phases::start(ctx);
     let checker = Checker { ctx, store: &store, manifest: &manifest, report_dir: &report_dir, detail: viewers };
     time.jobs = checker.jobs(pick.jobs, picked.len());
-    let filed = checker.check_all(&picked, pick.jobs, |f| {
-        time.cases += f.check_time;
-        time.report += f.report_time;
-        time.gpu += std::time::Duration::from_secs_f64(f.outcome.gpu_ms / 1000.0);
-        print_case(&f.outcome, &report_dir);
-        for e in &f.report_errors {
-            println!("error: {}: its report folder could not be written: {e}", f.outcome.id);
-        }
-    });
-    let report_failed = filed.iter().any(|f| !f.report_errors.is_empty());
-    let run = vista_report::RunSummary {
+    let summary = vista_report::RunSummary {
         command: command_line(),
         backend: ctx.backend().to_string(),
         adapter: ctx.adapter_description(),
         partition: pick.selection.partition,
-        stopped: vista_check::interrupted().then(|| {
-            format!(
-                "Interrupted (Ctrl-C) after {} of {} cases: this report holds the cases that finished.",
-                filed.len(),
-                picked.len()
-            )
-        }),
         ..Default::default()
     };
+    let mut run = Run { checker, summary, results, shared: None };
+    let filed = run.check(&picked, pick.jobs, &mut Terminal { report_dir: &report_dir, time: Some(&mut time) });
+    let report_failed = filed.iter().any(|f| !f.report_errors.is_empty());
     let started = std::time::Instant::now();
-    let index = vista_check::finish(&report_dir, &run, &filed, &results)?;
+    run.note_interrupt(filed.len(), picked.len());
+    let index = run.finish(&filed)?;
     time.report += started.elapsed();
+    let run = run.summary;
     let accept = vista_check::accept_command(&report_dir, &filed);
     let outcomes: Vec<vista_golden::Outcome> = filed.into_iter().map(|f| f.outcome).collect();
     if config.github_actions {
@@ -196,7 +206,7 @@ pub fn check(
 /// Where a check's wall time went: compiling (composing WGSL, creating
 /// pipelines), the GPU runs, the rest of each case (planning, the CPU's
 /// part of running it, judging), and writing the report.
-struct Phases {
+pub(crate) struct Phases {
     started: std::time::Instant,
     compile0: std::time::Duration,
     cases: std::time::Duration,

@@ -5,7 +5,7 @@ use std::path::Path;
 use vista_golden::GoldenError;
 use vista_image::metrics;
 
-use crate::bad;
+use crate::input::bad;
 use crate::render::parse_crop;
 
 /// Compares `a` with `b` and prints the metrics (or JSON).

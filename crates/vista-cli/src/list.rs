@@ -4,7 +4,7 @@
 use vista_golden::GoldenError;
 use vista_project::Project;
 
-use crate::registry;
+use crate::input::registry;
 
 /// Lists the project's kernels (`names`: `kernel preset` pairs only); 2
 /// where one is not usable.

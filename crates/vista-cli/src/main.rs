@@ -1,6 +1,7 @@
 //! `vista`: thin command-line glue over vista's libraries.
 //! Exit codes: 0 success, 1 failed check (or run failure), 2 bad input.
 
+use input::bad;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -15,6 +16,7 @@ mod check;
 mod compare;
 mod graph_render;
 mod init;
+mod input;
 mod list;
 mod matrix;
 mod mutate;
@@ -343,21 +345,6 @@ fn main() -> ExitCode {
     }
 }
 
-/// Splits `NAME=VALUE` pairs.
-pub fn parse_sets(sets: &[String]) -> Result<Vec<(String, String)>, GoldenError> {
-    sets.iter()
-        .map(|s| {
-            s.split_once('=')
-                .map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))
-                .ok_or_else(|| GoldenError::BadInput(format!("--set '{s}' is not NAME=VALUE")))
-        })
-        .collect()
-}
-
-fn bad(e: impl std::fmt::Display) -> GoldenError {
-    GoldenError::BadInput(e.to_string())
-}
-
 fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenError> {
     match cmd {
         Command::Init { .. } => unreachable!("init runs before a project is found"),
@@ -419,9 +406,4 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
         ),
         Command::Bench(args) => bench::bench(project, config, args),
     }
-}
-
-/// The project's kernels (its manifests over the built-ins).
-pub fn registry(project: &Project) -> Result<vista_kernels::Registry, GoldenError> {
-    vista_kernels::Registry::of_project(project).map_err(bad)
 }

@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use vista_check::Checker;
+use vista_check::{Checker, Filed, Run};
 use vista_golden::{GoldenError, Outcome, Store};
 use vista_project::Project;
 use vista_render::Renderer;
@@ -45,15 +45,21 @@ pub fn matrix(
         let dir = report_dir.join(b);
         let checker =
             Checker { ctx: &gpu, store: &store, manifest: &manifest, report_dir: &dir, detail: Default::default() };
-        let outcomes: Vec<Outcome> = checker
-            .check_all(&picked, 1, |f| {
-                for e in &f.report_errors {
-                    println!("error: {} on {b}: its report folder could not be written: {e}", f.outcome.id);
-                }
-            })
-            .into_iter()
-            .map(|f| f.outcome)
-            .collect();
+        let summary = vista_report::RunSummary {
+            command: crate::check::command_line(),
+            backend: b.to_string(),
+            adapter: ctx.adapter_description(),
+            ..Default::default()
+        };
+        // Each backend's column is a whole run: its own report in <report>/<backend>/.
+        let mut run = Run { checker, summary, results: Default::default(), shared: None };
+        let mut errors = |f: &Filed| {
+            for e in &f.report_errors {
+                println!("error: {} on {b}: its report folder could not be written: {e}", f.outcome.id);
+            }
+        };
+        let ran = run.run(&picked, 1, &mut errors)?;
+        let outcomes: Vec<Outcome> = ran.filed.into_iter().map(|f| f.outcome).collect();
         columns.push((b.to_string(), Ok((ctx.adapter_description(), outcomes))));
     }
 

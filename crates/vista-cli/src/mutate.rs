@@ -8,7 +8,7 @@ use vista_golden::{GoldenError, Store};
 use vista_mutate::{Options, Report};
 use vista_project::Project;
 
-use crate::bad;
+use crate::input::bad;
 
 /// A mutant may loop for ever; the watchdog ends it as a timeout.
 const MUTANT_TIMEOUT: Duration = Duration::from_secs(20);
@@ -108,10 +108,9 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
     );
     let base =
         vista_render::Renderer::with_shaders(&ctx, shaders.clone(), config.limits, project.root().map(Into::into));
-    let results =
-        vista_mutate::run(&base, project, &store, &cases, &planned, a.jobs, &|done, _| bar.set_position(done as u64))?;
+    let judge = vista_mutate::Judge::new(&base, project, &store, &cases, &planned)?;
+    let mut results = vista_check::mutants(&judge, &planned, a.jobs, &mut Progress(&bar));
     bar.finish_and_clear();
-    let mut results = results;
     let unused = vista_mutate::apply_argued(&mut results, &argued);
     // A partition holds only part of the survivors: its unmatched arguments say nothing.
     if a.partition.is_none() {
@@ -119,6 +118,15 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
     }
     let report = Report::new(a.seed, a.sample, vec![format!("{}/{}", partition.0, partition.1)], results);
     finish(project, &report, a.json.as_ref())
+}
+
+/// The progress bar, moved on as each mutant is judged.
+struct Progress<'a>(&'a ProgressBar);
+
+impl vista_check::Reporter for Progress<'_> {
+    fn mutant(&mut self, done: usize, _total: usize, _report: &vista_mutate::MutantReport) {
+        self.0.set_position(done as u64);
+    }
 }
 
 /// Arguments that matched no survivor: the code moved, or a case kills it now.

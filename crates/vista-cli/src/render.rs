@@ -8,7 +8,8 @@ use vista_golden::GoldenError;
 use vista_project::Project;
 use vista_render::Renderer;
 
-use crate::{bad, graph_render, parse_sets, registry};
+use crate::graph_render;
+use crate::input::{bad, parse_sets, registry};
 
 /// The `render` command's arguments.
 pub struct Args {

@@ -9,7 +9,7 @@ use vista_project::Project;
 use vista_render::Renderer;
 use vista_sweep::{Axis, Metric, SweepSpec};
 
-use crate::{bad, parse_sets};
+use crate::input::{bad, parse_sets};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -48,7 +48,7 @@ pub struct Args {
 }
 
 pub fn sweep(project: &Project, config: &vista::Config, a: Args) -> Result<i32, GoldenError> {
-    let kernel = crate::registry(project)?.find(&a.kernel).cloned().map_err(bad)?;
+    let kernel = crate::input::registry(project)?.find(&a.kernel).cloned().map_err(bad)?;
     let (width, height) = vista_kernels::parse_size(&a.size).map_err(bad)?;
     let y = match (a.param2, a.values2) {
         (Some(name), Some(v)) => Some(Axis { name, values: vista_sweep::parse_values("--values2", &v)? }),

@@ -12,12 +12,13 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use vista_check::{Checker, Filed};
+use vista_check::{Checker, Filed, Run};
 use vista_golden::{GoldenError, Store};
 use vista_project::Project;
 use vista_render::Renderer;
 
-use crate::bad;
+use crate::check::Terminal;
+use crate::input::bad;
 
 /// Every watched file under the root, by path relative to it, with the
 /// hash of its bytes: `shaders/`, `kernels/`, `golden/cases.toml` and the
@@ -111,29 +112,21 @@ pub fn watch(
             report_dir: &report_dir,
             detail: Default::default(),
         };
-        for case in reached {
-            let f = checker.check(case);
-            let o = &f.outcome;
-            let label = if o.passed() { "ok" } else { "FAIL" };
-            println!("{label:<6} {:<40} {:>8.1} ms", o.id, o.gpu_ms);
-            if !o.passed() {
-                print!("{}", o.explain(&report_dir));
-            }
-            for e in &f.report_errors {
-                println!("error: {}: its report folder could not be written: {e}", o.id);
-            }
-            filed.insert(o.id.clone(), f);
-        }
-        // Cases no longer selected (renamed, deleted) leave the report, in case order.
-        let all: Vec<Filed> = picked.iter().filter_map(|c| filed.get(&c.id).cloned()).collect();
-        filed.retain(|id, _| picked.iter().any(|c| &c.id == id));
-        let run = vista_report::RunSummary {
+        let summary = vista_report::RunSummary {
             command: "vista watch".into(),
             backend: gpu.backend().to_string(),
             adapter: gpu.adapter_description(),
             ..Default::default()
         };
-        let index = vista_check::finish(&report_dir, &run, &all, &Default::default())?;
+        let run = Run { checker, summary, results: Default::default(), shared: None };
+        // Printed as `vista check` prints them (xfail, CRASH and all).
+        for f in run.check(&reached, 1, &mut Terminal { report_dir: &report_dir, time: None }) {
+            filed.insert(f.outcome.id.clone(), f);
+        }
+        // Cases no longer selected (renamed, deleted) leave the report, in case order.
+        let all: Vec<Filed> = picked.iter().filter_map(|c| filed.get(&c.id).cloned()).collect();
+        filed.retain(|id, _| picked.iter().any(|c| &c.id == id));
+        let index = run.finish(&all)?;
         let failed = all.iter().filter(|f| !f.outcome.passed()).count();
         println!("{} passed, {failed} failed; report: {} (watching; Ctrl-C ends)", all.len() - failed, index.display());
         // Wait for the next change.

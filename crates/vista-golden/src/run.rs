@@ -345,47 +345,6 @@ fn pending(
     }
 }
 
-/// Runs `work` on every item with `jobs` threads (at least one, at most
-/// one per item), which take the items in order, and hands each result to
-/// `take` on the calling thread in item order, as soon as it and every
-/// earlier one are done. `vista check` checks cases with it and `vista
-/// mutate` judges mutants: the device serialises their GPU runs while the
-/// other threads compose, judge and write.
-pub fn in_order<T: Sync, R: Send>(
-    items: &[T],
-    jobs: usize,
-    work: impl Fn(&T) -> R + Sync,
-    mut take: impl FnMut(usize, R),
-) {
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let (tx, rx) = std::sync::mpsc::channel();
-    std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, items.len().max(1)) {
-            let (tx, next, work) = (tx.clone(), &next, &work);
-            scope.spawn(move || {
-                loop {
-                    let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    let Some(item) = items.get(i) else { break };
-                    // The receiver is gone only if `take` panicked.
-                    if tx.send((i, work(item))).is_err() {
-                        break;
-                    }
-                }
-            });
-        }
-        drop(tx);
-        let mut waiting = std::collections::BTreeMap::new();
-        let mut taken = 0;
-        for (i, r) in rx {
-            waiting.insert(i, r);
-            while let Some(r) = waiting.remove(&taken) {
-                take(taken, r);
-                taken += 1;
-            }
-        }
-    });
-}
-
 /// Renders a case: its kernel, params, size and replacement inputs.
 pub fn render_case(ctx: &Renderer, case: &Case) -> Result<Rendered, vista_render::RenderError> {
     vista_render::for_case(&case.id, || {

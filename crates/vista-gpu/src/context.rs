@@ -283,7 +283,7 @@ pub(crate) struct BrowserEngine {
     /// The WebGPU device's features (requested: every one the adapter has).
     pub(crate) features: Vec<String>,
     /// The WGSL Tint gets for each kernel file, by source hash.
-    pub(crate) sources: Mutex<HashMap<String, Arc<crate::TintWgsl>>>,
+    pub(crate) sources: Mutex<HashMap<String, Arc<crate::tint::TintWgsl>>>,
 }
 
 /// Where Debian's vulkan-validationlayers puts the layer's manifest.
@@ -592,9 +592,9 @@ impl Context {
         shader: &str,
         entry: &str,
         constants: &[(String, f64)],
-    ) -> Result<crate::TintWgsl, GpuError> {
+    ) -> Result<crate::tint::TintWgsl, GpuError> {
         if let Some(source) = shaders.source_text(shader)? {
-            return Ok(crate::TintWgsl::source(source, constants));
+            return Ok(crate::tint::TintWgsl::source(source, constants));
         }
         let module = shaders.compose(shader)?;
         let (resolved, info) = crate::shaders::resolve_overrides(shader, &module, entry, constants)?;
@@ -602,7 +602,7 @@ impl Context {
             .map_err(|e| GpuError::Shader(format!("{shader}: naga's WGSL writer failed: {e}")))?;
         let (wgsl, written) =
             crate::shaders::keep_struct_layouts(shader, &resolved, crate::shaders::exact_f32_max(&text))?;
-        Ok(crate::TintWgsl::rewrite(&resolved, &written, wgsl))
+        Ok(crate::tint::TintWgsl::rewrite(&resolved, &written, wgsl))
     }
 
     /// Compiles a kernel file's entry point with one bind group layout per

@@ -17,11 +17,11 @@ mod limits;
 mod raster;
 mod shaders;
 mod spares;
+mod tint;
 pub mod validation;
 mod wgpu_run;
 pub mod wire;
 
-pub use browser_run::TintWgsl;
 pub use context::{
     AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, DeviceFacts, GpuConfig, PassHook, RunStats,
     SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
@@ -36,6 +36,7 @@ pub use shaders::{
     DEFAULT_COMPOSE_LIMIT, ENUMS_MODULE, Reader, ShaderSet, SourceText, compose_limit, resolve_overrides,
     runaway_compositions, set_compose_limit, validate,
 };
+pub use tint::TintWgsl;
 
 /// Hint printed whenever no usable Vulkan adapter is found.
 pub const INSTALL_HINT: &str = "install Mesa's lavapipe software Vulkan driver with `bash ci/install-lavapipe.sh` \

@@ -252,6 +252,111 @@ impl Context {
         Ok((Readback { outputs, stats, pass_times, pass_gpu_times }, sentinels))
     }
 
+    /// Texture resource `i` (`t`) created (or taken from the spares) with
+    /// its contents: written, or the sentinel copies recorded on `fill`.
+    #[allow(clippy::too_many_arguments)]
+    fn make_texture(
+        &self,
+        w: &WgpuEngine,
+        t: &crate::graph::TextureDesc,
+        i: usize,
+        which: usize,
+        target: bool,
+        fill: &mut wgpu::CommandEncoder,
+        made: &mut Made,
+    ) -> Result<wgpu::Texture, GpuError> {
+        let d = &w.device;
+        let format = crate::format::parse(t.format)?;
+        let size = wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: t.layers };
+        // Only single-level textures that no pass draws into are
+        // kept (the key has no levels or usages).
+        let spare = match t.contents {
+            Contents::Sentinel if t.mip_levels == 1 && !target => take(&w.spares, |s| &mut s.textures, &texture_key(t)),
+            _ => None,
+        };
+        let texture = spare.unwrap_or_else(|| {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some("resource"),
+                size,
+                mip_level_count: t.mip_levels,
+                sample_count: 1,
+                dimension: crate::format::texture_dimension(t.dimension),
+                format: crate::format::wgpu_format(&format),
+                usage: if format.is_storable() {
+                    wgpu::TextureUsages::STORAGE_BINDING
+                } else {
+                    wgpu::TextureUsages::empty()
+                } | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC
+                    | wgpu::TextureUsages::COPY_DST
+                    | if target { wgpu::TextureUsages::RENDER_ATTACHMENT } else { wgpu::TextureUsages::empty() },
+                view_formats: &[],
+            })
+        });
+        let row = t.width * format.texel_bytes() as u32;
+        match &t.contents {
+            Contents::Zeros => {}
+            Contents::Bytes(bytes) => {
+                if bytes.len() != row as usize * (t.height * t.layers) as usize {
+                    return Err(GpuError::Request(format!(
+                        "texture resource {i}: {} bytes of contents for {}x{}x{} {} texels",
+                        bytes.len(),
+                        t.width,
+                        t.height,
+                        t.layers,
+                        t.format
+                    )));
+                }
+                w.queue.write_texture(
+                    texture.as_image_copy(),
+                    bytes,
+                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(t.height) },
+                    size,
+                );
+            }
+            Contents::Sentinel => {
+                // Copies from a kept buffer of sentinel texels,
+                // rows padded as buffer copies need them: one
+                // band of rows at most READBACK_BAND bytes, copied
+                // over each band (every texel is the same).
+                let padded = padded_row(t, &format);
+                let band = band_rows(padded, t.height);
+                let key = (t.format, which, u64::from(padded) * u64::from(band));
+                let buffer = take(&w.spares, |s| &mut s.fills, &key).unwrap_or_else(|| {
+                    d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("unwritten sentinel"),
+                        contents: &format.sentinel(which).repeat(key.2 as usize / format.texel_bytes()),
+                        usage: wgpu::BufferUsages::COPY_SRC,
+                    })
+                });
+                for layer in 0..t.layers {
+                    for y in (0..t.height).step_by(band as usize) {
+                        let rows = band.min(t.height - y);
+                        fill.copy_buffer_to_texture(
+                            wgpu::TexelCopyBufferInfo {
+                                buffer: &buffer,
+                                layout: wgpu::TexelCopyBufferLayout {
+                                    offset: 0,
+                                    bytes_per_row: Some(padded),
+                                    rows_per_image: Some(rows),
+                                },
+                            },
+                            wgpu::TexelCopyTextureInfo {
+                                texture: &texture,
+                                mip_level: 0,
+                                origin: wgpu::Origin3d { x: 0, y, z: layer },
+                                aspect: wgpu::TextureAspect::All,
+                            },
+                            wgpu::Extent3d { width: t.width, height: rows, depth_or_array_layers: 1 },
+                        );
+                    }
+                }
+                made.fills.push((key, buffer));
+            }
+        }
+        Ok(texture)
+    }
+
     /// Creates every resource with its initial contents (`which` picks the
     /// sentinel of sentinel-filled textures; `targets` are drawn into), and
     /// the copies of the sentinel over them, to submit before the first pass.
@@ -270,105 +375,7 @@ impl Context {
         for (i, r) in g.resources.iter().enumerate() {
             match r {
                 Resource::Texture(t) => {
-                    let format = crate::format::parse(t.format)?;
-                    let size = wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: t.layers };
-                    let target = targets.contains(&i);
-                    // Only single-level textures that no pass draws into are
-                    // kept (the key has no levels or usages).
-                    let spare = match t.contents {
-                        Contents::Sentinel if t.mip_levels == 1 && !target => {
-                            take(&w.spares, |s| &mut s.textures, &texture_key(t))
-                        }
-                        _ => None,
-                    };
-                    let texture = spare.unwrap_or_else(|| {
-                        d.create_texture(&wgpu::TextureDescriptor {
-                            label: Some("resource"),
-                            size,
-                            mip_level_count: t.mip_levels,
-                            sample_count: 1,
-                            dimension: crate::format::texture_dimension(t.dimension),
-                            format: crate::format::wgpu_format(&format),
-                            usage: if format.is_storable() {
-                                wgpu::TextureUsages::STORAGE_BINDING
-                            } else {
-                                wgpu::TextureUsages::empty()
-                            } | wgpu::TextureUsages::TEXTURE_BINDING
-                                | wgpu::TextureUsages::COPY_SRC
-                                | wgpu::TextureUsages::COPY_DST
-                                | if target {
-                                    wgpu::TextureUsages::RENDER_ATTACHMENT
-                                } else {
-                                    wgpu::TextureUsages::empty()
-                                },
-                            view_formats: &[],
-                        })
-                    });
-                    let row = t.width * format.texel_bytes() as u32;
-                    match &t.contents {
-                        Contents::Zeros => {}
-                        Contents::Bytes(bytes) => {
-                            if bytes.len() != row as usize * (t.height * t.layers) as usize {
-                                return Err(GpuError::Request(format!(
-                                    "texture resource {i}: {} bytes of contents for {}x{}x{} {} texels",
-                                    bytes.len(),
-                                    t.width,
-                                    t.height,
-                                    t.layers,
-                                    t.format
-                                )));
-                            }
-                            w.queue.write_texture(
-                                texture.as_image_copy(),
-                                bytes,
-                                wgpu::TexelCopyBufferLayout {
-                                    offset: 0,
-                                    bytes_per_row: Some(row),
-                                    rows_per_image: Some(t.height),
-                                },
-                                size,
-                            );
-                        }
-                        Contents::Sentinel => {
-                            // Copies from a kept buffer of sentinel texels,
-                            // rows padded as buffer copies need them: one
-                            // band of rows at most READBACK_BAND bytes, copied
-                            // over each band (every texel is the same).
-                            let padded = padded_row(t, &format);
-                            let band = band_rows(padded, t.height);
-                            let key = (t.format, which, u64::from(padded) * u64::from(band));
-                            let buffer = take(&w.spares, |s| &mut s.fills, &key).unwrap_or_else(|| {
-                                d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                                    label: Some("unwritten sentinel"),
-                                    contents: &format.sentinel(which).repeat(key.2 as usize / format.texel_bytes()),
-                                    usage: wgpu::BufferUsages::COPY_SRC,
-                                })
-                            });
-                            for layer in 0..t.layers {
-                                for y in (0..t.height).step_by(band as usize) {
-                                    let rows = band.min(t.height - y);
-                                    fill.copy_buffer_to_texture(
-                                        wgpu::TexelCopyBufferInfo {
-                                            buffer: &buffer,
-                                            layout: wgpu::TexelCopyBufferLayout {
-                                                offset: 0,
-                                                bytes_per_row: Some(padded),
-                                                rows_per_image: Some(rows),
-                                            },
-                                        },
-                                        wgpu::TexelCopyTextureInfo {
-                                            texture: &texture,
-                                            mip_level: 0,
-                                            origin: wgpu::Origin3d { x: 0, y, z: layer },
-                                            aspect: wgpu::TextureAspect::All,
-                                        },
-                                        wgpu::Extent3d { width: t.width, height: rows, depth_or_array_layers: 1 },
-                                    );
-                                }
-                            }
-                            made.fills.push((key, buffer));
-                        }
-                    }
+                    let texture = self.make_texture(w, t, i, which, targets.contains(&i), &mut fill, &mut made)?;
                     made.textures.insert(i, texture);
                 }
                 Resource::Buffer(bytes) => {
@@ -407,96 +414,105 @@ impl Context {
         Ok((made, fill))
     }
 
+    /// The binding type of slot `s` of `pass`, checked against what the
+    /// device binds.
+    fn binding_type(
+        &self,
+        w: &WgpuEngine,
+        g: &Graph<'_>,
+        pass: &GraphPass,
+        s: &crate::graph::GraphSlot,
+    ) -> Result<wgpu::BindingType, GpuError> {
+        let filterable32 = w.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE);
+        Ok(match s.bind {
+            Bind::Uniform(_) | Bind::UniformBuffer(_) => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Bind::Table(_) => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Bind::Storage { read_only, .. } => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Bind::StorageTexture { resource, access, .. } => {
+                let Resource::Texture(t) = &g.resources[resource] else {
+                    return Err(GpuError::Request(format!("{}: a storage texture bound to a non-texture", pass.label)));
+                };
+                let format = crate::format::parse(t.format)?;
+                // Read-only storage is core for every storage format;
+                // read_write beyond the r32 formats needs a feature.
+                if access == Access::ReadWrite && !self.binds_read_write(&format) {
+                    return Err(GpuError::Unsupported {
+                        adapter: self.adapter_description(),
+                        what: format!("{}: a {} {} storage texture", pass.label, access.wgsl(), t.format),
+                        feature: self.read_write_feature().to_string(),
+                    });
+                }
+                wgpu::BindingType::StorageTexture {
+                    access: match access {
+                        Access::Write => wgpu::StorageTextureAccess::WriteOnly,
+                        Access::Read => wgpu::StorageTextureAccess::ReadOnly,
+                        Access::ReadWrite => wgpu::StorageTextureAccess::ReadWrite,
+                    },
+                    format: crate::format::wgpu_format(&format),
+                    view_dimension: crate::format::view_dimension(t.dimension),
+                }
+            }
+            // A depth resource: texture_depth_2d, or texture_2d<f32> as
+            // WebGPU allows (unfilterable-float).
+            Bind::Sampled { resource, depth, .. } if matches!(g.resources[resource], Resource::Depth(_)) => {
+                wgpu::BindingType::Texture {
+                    sample_type: match depth {
+                        true => wgpu::TextureSampleType::Depth,
+                        false => wgpu::TextureSampleType::Float { filterable: false },
+                    },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                }
+            }
+            Bind::Sampled { resource, depth, cube, .. } => {
+                let Resource::Texture(t) = &g.resources[resource] else {
+                    return Err(GpuError::Request(format!("{}: a texture bound to a non-texture", pass.label)));
+                };
+                let format = crate::format::parse(t.format)?;
+                wgpu::BindingType::Texture {
+                    sample_type: match (depth, format.sample_kind()) {
+                        (true, _) => wgpu::TextureSampleType::Depth,
+                        (_, SampleKind::Uint) => wgpu::TextureSampleType::Uint,
+                        (_, SampleKind::Sint) => wgpu::TextureSampleType::Sint,
+                        (_, SampleKind::Float) => {
+                            wgpu::TextureSampleType::Float { filterable: !format.is_float32() || filterable32 }
+                        }
+                    },
+                    view_dimension: view_dimension(t, cube),
+                    multisampled: false,
+                }
+            }
+            Bind::Sampler(r) => {
+                let Resource::Sampler(sd) = &g.resources[r] else {
+                    return Err(GpuError::Request(format!("{}: a sampler bound to a non-sampler", pass.label)));
+                };
+                wgpu::BindingType::Sampler(match (sd.compare.is_some(), sd.linear) {
+                    (true, _) => wgpu::SamplerBindingType::Comparison,
+                    (false, true) => wgpu::SamplerBindingType::Filtering,
+                    (false, false) => wgpu::SamplerBindingType::NonFiltering,
+                })
+            }
+        })
+    }
+
     /// The pipeline of one pass, with bind group layouts from its slots
     /// and the resources they name; cached like single dispatches.
     fn pipeline(&self, w: &WgpuEngine, g: &Graph<'_>, pass: &GraphPass) -> Result<Arc<Compiled>, GpuError> {
-        let filterable32 = w.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE);
         let mut entries: Vec<(u32, wgpu::BindGroupLayoutEntry)> = Vec::new();
         for s in &pass.slots {
-            let ty = match s.bind {
-                Bind::Uniform(_) | Bind::UniformBuffer(_) => wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                Bind::Table(_) => wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                Bind::Storage { read_only, .. } => wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                Bind::StorageTexture { resource, access, .. } => {
-                    let Resource::Texture(t) = &g.resources[resource] else {
-                        return Err(GpuError::Request(format!(
-                            "{}: a storage texture bound to a non-texture",
-                            pass.label
-                        )));
-                    };
-                    let format = crate::format::parse(t.format)?;
-                    // Read-only storage is core for every storage format;
-                    // read_write beyond the r32 formats needs a feature.
-                    if access == Access::ReadWrite && !self.binds_read_write(&format) {
-                        return Err(GpuError::Unsupported {
-                            adapter: self.adapter_description(),
-                            what: format!("{}: a {} {} storage texture", pass.label, access.wgsl(), t.format),
-                            feature: self.read_write_feature().to_string(),
-                        });
-                    }
-                    wgpu::BindingType::StorageTexture {
-                        access: match access {
-                            Access::Write => wgpu::StorageTextureAccess::WriteOnly,
-                            Access::Read => wgpu::StorageTextureAccess::ReadOnly,
-                            Access::ReadWrite => wgpu::StorageTextureAccess::ReadWrite,
-                        },
-                        format: crate::format::wgpu_format(&format),
-                        view_dimension: crate::format::view_dimension(t.dimension),
-                    }
-                }
-                // A depth resource: texture_depth_2d, or texture_2d<f32> as
-                // WebGPU allows (unfilterable-float).
-                Bind::Sampled { resource, depth, .. } if matches!(g.resources[resource], Resource::Depth(_)) => {
-                    wgpu::BindingType::Texture {
-                        sample_type: match depth {
-                            true => wgpu::TextureSampleType::Depth,
-                            false => wgpu::TextureSampleType::Float { filterable: false },
-                        },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    }
-                }
-                Bind::Sampled { resource, depth, cube, .. } => {
-                    let Resource::Texture(t) = &g.resources[resource] else {
-                        return Err(GpuError::Request(format!("{}: a texture bound to a non-texture", pass.label)));
-                    };
-                    let format = crate::format::parse(t.format)?;
-                    wgpu::BindingType::Texture {
-                        sample_type: match (depth, format.sample_kind()) {
-                            (true, _) => wgpu::TextureSampleType::Depth,
-                            (_, SampleKind::Uint) => wgpu::TextureSampleType::Uint,
-                            (_, SampleKind::Sint) => wgpu::TextureSampleType::Sint,
-                            (_, SampleKind::Float) => {
-                                wgpu::TextureSampleType::Float { filterable: !format.is_float32() || filterable32 }
-                            }
-                        },
-                        view_dimension: view_dimension(t, cube),
-                        multisampled: false,
-                    }
-                }
-                Bind::Sampler(r) => {
-                    let Resource::Sampler(sd) = &g.resources[r] else {
-                        return Err(GpuError::Request(format!("{}: a sampler bound to a non-sampler", pass.label)));
-                    };
-                    wgpu::BindingType::Sampler(match (sd.compare.is_some(), sd.linear) {
-                        (true, _) => wgpu::SamplerBindingType::Comparison,
-                        (false, true) => wgpu::SamplerBindingType::Filtering,
-                        (false, false) => wgpu::SamplerBindingType::NonFiltering,
-                    })
-                }
-            };
+            let ty = self.binding_type(w, g, pass, s)?;
             entries.push((
                 s.group,
                 wgpu::BindGroupLayoutEntry { binding: s.binding, visibility: stages(pass, s), ty, count: None },

@@ -921,28 +921,7 @@ fn parse_raster(
     if t.contains_key("entry") {
         return Err(at("a render pass names its fragment entry as fragment = \"...\", not entry".into()));
     }
-    let vertex = match t.get("vertex") {
-        None => VertexStage::Fullscreen,
-        Some(toml::Value::String(v)) if v == "fullscreen" => VertexStage::Fullscreen,
-        Some(toml::Value::String(v)) if valid_name(v) => VertexStage::Entry(v.clone()),
-        Some(toml::Value::Table(v)) => {
-            if let Some(k) = v.keys().find(|k| !["shader", "entry"].contains(&k.as_str())) {
-                return Err(at(format!("vertex: unknown key {k}; allowed: shader, entry")));
-            }
-            let shader = string_key(v, "shader", at)?.ok_or_else(|| at("vertex needs shader = \"<file>\"".into()))?;
-            let entry =
-                string_key(v, "entry", at)?.ok_or_else(|| at("vertex needs entry = \"<@vertex entry>\"".into()))?;
-            if !valid_name(&entry) {
-                return Err(at(format!("vertex entry = \"{entry}\" is not a WGSL function name")));
-            }
-            VertexStage::File { shader, entry }
-        }
-        Some(other) => {
-            return Err(at(format!(
-                "vertex = {other} is not valid; expected \"fullscreen\" or a @vertex entry of the pass's shader"
-            )));
-        }
-    };
+    let vertex = parse_vertex_stage(t, at)?;
     if vertex == VertexStage::Fullscreen
         && let Some(k) = DRAW_KEYS.into_iter().find(|k| t.contains_key(*k))
     {
@@ -960,30 +939,7 @@ fn parse_raster(
         None => Vec::new(),
         Some(v) => crate::vertex::parse(v, &buffer).map_err(at)?,
     };
-    let indices = match t.get("indices") {
-        None => None,
-        Some(toml::Value::String(name)) => Some((name.clone(), false)),
-        Some(toml::Value::Table(i)) => {
-            if let Some(k) = i.keys().find(|k| !["resource", "format"].contains(&k.as_str())) {
-                return Err(at(format!("indices: unknown key {k}; allowed: resource, format")));
-            }
-            let name =
-                string_key(i, "resource", at)?.ok_or_else(|| at("indices needs resource = \"<buffer>\"".into()))?;
-            let u16 = match string_key(i, "format", at)?.as_deref() {
-                None | Some("uint32") => false,
-                Some("uint16") => true,
-                Some(other) => {
-                    return Err(at(format!("indices format = \"{other}\" is not valid; expected uint32|uint16")));
-                }
-            };
-            Some((name, u16))
-        }
-        Some(other) => {
-            return Err(at(format!(
-                "indices = {other} is not valid; expected a buffer name or {{ resource, format }}"
-            )));
-        }
-    };
+    let indices = parse_indices(t, at)?;
     if let Some((i, _)) = &indices {
         buffer(i).map_err(|m| at(format!("indices = {m}")))?;
     }
@@ -1052,6 +1008,62 @@ fn parse_raster(
         cull,
         depth,
     }))
+}
+
+/// A render pass's `vertex`: vista's fullscreen triangle, an entry of the
+/// pass's shader, or `{ shader, entry }` in another file.
+fn parse_vertex_stage(t: &toml::Table, at: &dyn Fn(String) -> ParamError) -> Result<VertexStage, ParamError> {
+    Ok(match t.get("vertex") {
+        None => VertexStage::Fullscreen,
+        Some(toml::Value::String(v)) if v == "fullscreen" => VertexStage::Fullscreen,
+        Some(toml::Value::String(v)) if valid_name(v) => VertexStage::Entry(v.clone()),
+        Some(toml::Value::Table(v)) => {
+            if let Some(k) = v.keys().find(|k| !["shader", "entry"].contains(&k.as_str())) {
+                return Err(at(format!("vertex: unknown key {k}; allowed: shader, entry")));
+            }
+            let shader = string_key(v, "shader", at)?.ok_or_else(|| at("vertex needs shader = \"<file>\"".into()))?;
+            let entry =
+                string_key(v, "entry", at)?.ok_or_else(|| at("vertex needs entry = \"<@vertex entry>\"".into()))?;
+            if !valid_name(&entry) {
+                return Err(at(format!("vertex entry = \"{entry}\" is not a WGSL function name")));
+            }
+            VertexStage::File { shader, entry }
+        }
+        Some(other) => {
+            return Err(at(format!(
+                "vertex = {other} is not valid; expected \"fullscreen\" or a @vertex entry of the pass's shader"
+            )));
+        }
+    })
+}
+
+/// A draw's `indices`: a buffer's name, or `{ resource, format }`; the
+/// name and whether its indices are uint16.
+fn parse_indices(t: &toml::Table, at: &dyn Fn(String) -> ParamError) -> Result<Option<(String, bool)>, ParamError> {
+    Ok(match t.get("indices") {
+        None => None,
+        Some(toml::Value::String(name)) => Some((name.clone(), false)),
+        Some(toml::Value::Table(i)) => {
+            if let Some(k) = i.keys().find(|k| !["resource", "format"].contains(&k.as_str())) {
+                return Err(at(format!("indices: unknown key {k}; allowed: resource, format")));
+            }
+            let name =
+                string_key(i, "resource", at)?.ok_or_else(|| at("indices needs resource = \"<buffer>\"".into()))?;
+            let u16 = match string_key(i, "format", at)?.as_deref() {
+                None | Some("uint32") => false,
+                Some("uint16") => true,
+                Some(other) => {
+                    return Err(at(format!("indices format = \"{other}\" is not valid; expected uint32|uint16")));
+                }
+            };
+            Some((name, u16))
+        }
+        Some(other) => {
+            return Err(at(format!(
+                "indices = {other} is not valid; expected a buffer name or {{ resource, format }}"
+            )));
+        }
+    })
 }
 
 /// The resources' names for a message ("none" for none).

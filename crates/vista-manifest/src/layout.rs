@@ -510,6 +510,95 @@ pub fn pack(kernel: &Kernel, layout: &UniformLayout, p: &ParamSet, width: u32, h
     blocks
 }
 
+/// The layouts of a kernel's passes, from naga's reflection of each.
+impl Kernel {
+    /// Reflects every pass of the graph (`modules[i]`: pass i's composed
+    /// file name and module), resolves what feeds each binding, and checks
+    /// each pass's uniform blocks against the params: a leaf with no param,
+    /// or a param that feeds nothing in any pass, is refused.
+    pub fn graph_layouts(
+        &self,
+        modules: &[(&str, &naga::Module)],
+    ) -> Result<(crate::graph::Resolved, Vec<UniformLayout>), ParamError> {
+        self.graph_layouts_with(modules, &[])
+    }
+
+    /// [`Kernel::graph_layouts`], with the composed file and module of each
+    /// pass's vertex entry that lives in another file (`vertex[i]`).
+    pub fn graph_layouts_with(
+        &self,
+        modules: &[(&str, &naga::Module)],
+        vertex: &[Option<(&str, &naga::Module)>],
+    ) -> Result<(crate::graph::Resolved, Vec<UniformLayout>), ParamError> {
+        let g = self.graph();
+        let mut reflected = Vec::new();
+        for (i, ((shader, module), pass)) in modules.iter().zip(&g.passes).enumerate() {
+            let stage = match pass.raster {
+                Some(_) => naga::ShaderStage::Fragment,
+                None => naga::ShaderStage::Compute,
+            };
+            let mut b = crate::bindings::reflect_all(self.name(), shader, &pass.entry, stage, module)?;
+            let vs = pass.raster.as_ref().and_then(|r| r.vertex.entry());
+            match (vs, vertex.get(i).copied().flatten()) {
+                (Some(vs), None) => {
+                    let v = crate::bindings::reflect_all(self.name(), shader, vs, naga::ShaderStage::Vertex, module)?;
+                    b = crate::bindings::merge_stages(self.name(), b, v)?;
+                }
+                (Some(vs), Some((file, vmodule))) => {
+                    let v = crate::bindings::reflect_all(self.name(), file, vs, naga::ShaderStage::Vertex, vmodule)?;
+                    b = crate::bindings::match_vertex_file(self.name(), b, module, v, vmodule, file)?;
+                }
+                (None, _) => {}
+            }
+            reflected.push(b);
+        }
+        let passes: Vec<(&str, &[crate::bindings::Binding], &naga::Module)> =
+            modules.iter().zip(&reflected).map(|((s, m), b)| (*s, b.as_slice(), *m)).collect();
+        let vertex_modules: Vec<Option<&naga::Module>> = vertex.iter().map(|v| v.map(|(_, m)| m)).collect();
+        let resolved = crate::graph::resolve(self.name(), g, &passes, &vertex_modules)?;
+        let mut layouts = Vec::new();
+        for (((shader, module), bindings), slots) in modules.iter().zip(reflected).zip(&resolved.slots) {
+            // Params feed the uniforms and the table that no resource feeds.
+            let by_params = |b: &crate::bindings::Binding| {
+                slots.iter().any(|s| {
+                    (s.group, s.binding) == (b.group, b.binding)
+                        && matches!(s.feed, crate::graph::SlotFeed::Uniform(_) | crate::graph::SlotFeed::Table)
+                })
+            };
+            // The pass's uniform layout is its shader's: a vertex file's own
+            // uniform must come from a buffer resource.
+            if let Some(b) = bindings.iter().find(|b| b.in_vertex_file && by_params(b)) {
+                return Err(ParamError::Layout {
+                    kernel: self.name().to_string(),
+                    message: format!(
+                        "{shader}: the vertex entry's file binds {} (@group({}) @binding({})), which params would \
+                         fill, but the fragment entry does not; declare it in the pass's shader too, or bind it to \
+                         a buffer resource in the pass's bind",
+                        b.name, b.group, b.binding
+                    ),
+                });
+            }
+            let fed: Vec<crate::bindings::Binding> = bindings.iter().filter(|b| by_params(b)).cloned().collect();
+            layouts.push((*shader, blocks_of(self.name(), shader, module, fed)?));
+        }
+        // As for one pass: a group that names no struct field first.
+        check_groups(self, &layouts.iter().map(|(_, l)| l).collect::<Vec<_>>())?;
+        for (_, l) in &mut layouts {
+            name_leaves(self, l);
+            check_fields(self, l)?;
+        }
+        let layouts: Vec<UniformLayout> = layouts.into_iter().map(|(_, l)| l).collect();
+        check_params(self, &layouts.iter().collect::<Vec<_>>())?;
+        Ok((resolved, layouts))
+    }
+
+    /// Each uniform block's bytes for `p` at `width` x `height`, in
+    /// [`UniformLayout::blocks`] order.
+    pub fn uniforms(&self, layout: &UniformLayout, p: &ParamSet, width: u32, height: u32) -> Vec<Vec<u8>> {
+        pack(self, layout, p, width, height)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

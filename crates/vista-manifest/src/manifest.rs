@@ -464,79 +464,7 @@ fn parse_params(
                 p.ty
             ))
         })?;
-        let range = |limits: (f64, f64)| -> Result<(f64, f64), ParamError> {
-            let [lo, hi] = p.range.ok_or_else(|| pfail(format!("type {} needs range = [min, max]", p.ty)))?;
-            if !(lo.is_finite() && hi.is_finite()) || lo > hi {
-                return Err(pfail(format!("range = [{lo}, {hi}] is not valid; expected finite min <= max")));
-            }
-            if lo < limits.0 || hi > limits.1 {
-                return Err(pfail(format!(
-                    "range = [{lo}, {hi}] exceeds what {} holds: [{}, {}]",
-                    p.ty, limits.0, limits.1
-                )));
-            }
-            Ok((lo, hi))
-        };
-        let no_range = |what: &str| -> Result<(), ParamError> {
-            match p.range {
-                Some(_) => Err(pfail(format!("type {what} takes no range"))),
-                None => Ok(()),
-            }
-        };
-        let int = |r: (f64, f64)| -> Result<(i64, i64), ParamError> {
-            if r.0.fract() != 0.0 || r.1.fract() != 0.0 {
-                return Err(pfail(format!("range = [{}, {}] of an integer type must be whole numbers", r.0, r.1)));
-            }
-            Ok((r.0 as i64, r.1 as i64))
-        };
-        let kind = match &ty {
-            ParamType::U32 => {
-                let (min, max) = int(range((0.0, u32::MAX as f64))?)?;
-                Kind::Int { min, max }
-            }
-            ParamType::I32 => {
-                let (min, max) = int(range((i32::MIN as f64, i32::MAX as f64))?)?;
-                Kind::Int { min, max }
-            }
-            ParamType::F32 => {
-                let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
-                Kind::Float { min, max, open_min: p.open_min }
-            }
-            ParamType::Vec(n) => {
-                let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
-                Kind::Vector { n: *n as usize, min, max }
-            }
-            ParamType::Wgsl(leaf) => match leaf.scalar {
-                crate::params::Scalar::F32 => {
-                    let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
-                    Kind::Vector { n: leaf.count, min, max }
-                }
-                crate::params::Scalar::U32 => {
-                    let (min, max) = int(range((0.0, u32::MAX as f64))?)?;
-                    Kind::IntVector { n: leaf.count, min, max }
-                }
-                crate::params::Scalar::I32 => {
-                    let (min, max) = int(range((i32::MIN as f64, i32::MAX as f64))?)?;
-                    Kind::IntVector { n: leaf.count, min, max }
-                }
-            },
-            ParamType::Bool => {
-                no_range("bool")?;
-                Kind::Bool
-            }
-            ParamType::Enum => {
-                no_range("enum")?;
-                let values = p.values.as_ref().filter(|v| !v.is_empty()).ok_or_else(|| {
-                    pfail("type enum needs values = [\"a\", \"b\", ...] (WGSL receives the index as u32)".into())
-                })?;
-                for (i, v) in values.iter().enumerate() {
-                    if v.is_empty() || values[..i].contains(v) {
-                        return Err(pfail(format!("values: '{v}' is empty or repeated")));
-                    }
-                }
-                Kind::Enum(values.clone())
-            }
-        };
+        let kind = param_kind(p, &ty, &pfail)?;
         if p.values.is_some() && ty != ParamType::Enum {
             return Err(pfail(format!("values is only for type enum, not {}", p.ty)));
         }
@@ -575,35 +503,123 @@ fn parse_params(
         if p.open_min && !matches!(ty, ParamType::F32) {
             return Err(pfail("open_min is only for type f32".into()));
         }
-        let defs = match (&p.defs, &kind) {
-            (None, _) => Vec::new(),
-            (Some(table), Kind::Enum(values)) => {
-                let mut defs = Vec::new();
-                for (value, def) in table {
-                    if !values.contains(value) {
-                        return Err(pfail(format!("defs: '{value}' is not one of its values ({})", values.join(", "))));
-                    }
-                    match def.as_str() {
-                        Some(d) if ident(d) && !d.starts_with(|c: char| c.is_ascii_digit()) => {
-                            defs.push((value.clone(), d.to_string()))
-                        }
-                        _ => {
-                            return Err(pfail(format!(
-                                "defs: {value} = {def} is not a shader def name (letters, digits and '_')"
-                            )));
-                        }
-                    }
-                }
-                defs
-            }
-            (Some(_), _) => return Err(pfail(format!("defs is only for type enum, not {}", p.ty))),
-        };
+        let defs = param_defs(p, &kind, &pfail)?;
         let spec =
             ParamSpec { name: p.name.clone(), ty, kind, default: value_text(&p.default), doc: p.doc.clone(), defs };
         parse_value(&spec, &spec.default).map_err(|e| pfail(format!("default: {e}")))?;
         params.push(spec);
     }
     Ok((params, enum_constants))
+}
+
+/// What param `p` of type `ty` holds: its range checked against what the
+/// type holds, or its enum values.
+fn param_kind(p: &RawParam, ty: &ParamType, pfail: &dyn Fn(String) -> ParamError) -> Result<Kind, ParamError> {
+    let range = |limits: (f64, f64)| -> Result<(f64, f64), ParamError> {
+        let [lo, hi] = p.range.ok_or_else(|| pfail(format!("type {} needs range = [min, max]", p.ty)))?;
+        if !(lo.is_finite() && hi.is_finite()) || lo > hi {
+            return Err(pfail(format!("range = [{lo}, {hi}] is not valid; expected finite min <= max")));
+        }
+        if lo < limits.0 || hi > limits.1 {
+            return Err(pfail(format!(
+                "range = [{lo}, {hi}] exceeds what {} holds: [{}, {}]",
+                p.ty, limits.0, limits.1
+            )));
+        }
+        Ok((lo, hi))
+    };
+    let no_range = |what: &str| -> Result<(), ParamError> {
+        match p.range {
+            Some(_) => Err(pfail(format!("type {what} takes no range"))),
+            None => Ok(()),
+        }
+    };
+    let int = |r: (f64, f64)| -> Result<(i64, i64), ParamError> {
+        if r.0.fract() != 0.0 || r.1.fract() != 0.0 {
+            return Err(pfail(format!("range = [{}, {}] of an integer type must be whole numbers", r.0, r.1)));
+        }
+        Ok((r.0 as i64, r.1 as i64))
+    };
+    Ok(match ty {
+        ParamType::U32 => {
+            let (min, max) = int(range((0.0, u32::MAX as f64))?)?;
+            Kind::Int { min, max }
+        }
+        ParamType::I32 => {
+            let (min, max) = int(range((i32::MIN as f64, i32::MAX as f64))?)?;
+            Kind::Int { min, max }
+        }
+        ParamType::F32 => {
+            let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
+            Kind::Float { min, max, open_min: p.open_min }
+        }
+        ParamType::Vec(n) => {
+            let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
+            Kind::Vector { n: *n as usize, min, max }
+        }
+        ParamType::Wgsl(leaf) => match leaf.scalar {
+            crate::params::Scalar::F32 => {
+                let (min, max) = range((-f32::MAX as f64, f32::MAX as f64))?;
+                Kind::Vector { n: leaf.count, min, max }
+            }
+            crate::params::Scalar::U32 => {
+                let (min, max) = int(range((0.0, u32::MAX as f64))?)?;
+                Kind::IntVector { n: leaf.count, min, max }
+            }
+            crate::params::Scalar::I32 => {
+                let (min, max) = int(range((i32::MIN as f64, i32::MAX as f64))?)?;
+                Kind::IntVector { n: leaf.count, min, max }
+            }
+        },
+        ParamType::Bool => {
+            no_range("bool")?;
+            Kind::Bool
+        }
+        ParamType::Enum => {
+            no_range("enum")?;
+            let values = p.values.as_ref().filter(|v| !v.is_empty()).ok_or_else(|| {
+                pfail("type enum needs values = [\"a\", \"b\", ...] (WGSL receives the index as u32)".into())
+            })?;
+            for (i, v) in values.iter().enumerate() {
+                if v.is_empty() || values[..i].contains(v) {
+                    return Err(pfail(format!("values: '{v}' is empty or repeated")));
+                }
+            }
+            Kind::Enum(values.clone())
+        }
+    })
+}
+
+/// An enum param's `defs`: each value's shader def, checked.
+fn param_defs(
+    p: &RawParam,
+    kind: &Kind,
+    pfail: &dyn Fn(String) -> ParamError,
+) -> Result<Vec<(String, String)>, ParamError> {
+    let ident = |w: &str| !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    Ok(match (&p.defs, kind) {
+        (None, _) => Vec::new(),
+        (Some(table), Kind::Enum(values)) => {
+            let mut defs = Vec::new();
+            for (value, def) in table {
+                if !values.contains(value) {
+                    return Err(pfail(format!("defs: '{value}' is not one of its values ({})", values.join(", "))));
+                }
+                match def.as_str() {
+                    Some(d) if ident(d) && !d.starts_with(|c: char| c.is_ascii_digit()) => {
+                        defs.push((value.clone(), d.to_string()))
+                    }
+                    _ => {
+                        return Err(pfail(format!(
+                            "defs: {value} = {def} is not a shader def name (letters, digits and '_')"
+                        )));
+                    }
+                }
+            }
+            defs
+        }
+        (Some(_), _) => return Err(pfail(format!("defs is only for type enum, not {}", p.ty))),
+    })
 }
 
 /// The `[preset.<name>]` tables and `[sweep_reference]`: every value

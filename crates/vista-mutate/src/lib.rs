@@ -464,54 +464,63 @@ fn judge(
     report("survived", None, identical, run)
 }
 
-/// Runs the plan on `base` (the device, the unmutated shaders and the
-/// limits; its context's watchdog should be short: a mutant can loop for
-/// ever) with `jobs` workers; `progress(done, total)` is called after each
-/// mutant. The project's files are only read.
-pub fn run(
-    base: &Renderer,
-    project: &Project,
-    store: &Store,
-    cases: &[&Case],
-    planned: &[Planned],
-    jobs: usize,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<Vec<MutantReport>, GoldenError> {
-    let sources = vista_render::Sources::of(project)?;
-    // Each mutant's file as the project has it (under shaders/, or outside
-    // it where a [source] reaches).
-    let mut texts: BTreeMap<String, String> = project.shader_files()?.into_iter().map(|f| (f.rel, f.text)).collect();
-    texts.extend(outside_files(project)?.into_iter().map(|f| (f.rel, f.text)));
-    let manifest = store.manifest()?;
-    let mut baselines = BTreeMap::new();
-    for p in planned {
-        if !baselines.contains_key(p.kernel.name()) {
-            baselines.insert(p.kernel.name(), baseline(base, store, &manifest, &p.kernel, cases)?);
+/// What judging a plan's mutants needs, read once: the device, the
+/// unmutated shaders and limits (`base`; its context's watchdog should be
+/// short: a mutant can loop for ever), each mutant's file as the project
+/// has it, and each planned kernel's [`Baseline`]. The project's files are
+/// only read. vista-check's run loop judges each mutant with
+/// [`Judge::judge`].
+pub struct Judge<'a> {
+    base: &'a Renderer<'a>,
+    store: &'a Store,
+    manifest: Manifest,
+    sources: vista_render::Sources,
+    texts: BTreeMap<String, String>,
+    baselines: BTreeMap<String, Baseline<'a>>,
+}
+
+impl<'a> Judge<'a> {
+    /// Reads the project's shaders and checks every planned kernel's
+    /// unmutated baseline (an error if the suite itself fails).
+    pub fn new(
+        base: &'a Renderer<'a>,
+        project: &Project,
+        store: &'a Store,
+        cases: &[&'a Case],
+        planned: &[Planned],
+    ) -> Result<Judge<'a>, GoldenError> {
+        let sources = vista_render::Sources::of(project)?;
+        // Each mutant's file as the project has it (under shaders/, or
+        // outside it where a [source] reaches).
+        let mut texts: BTreeMap<String, String> =
+            project.shader_files()?.into_iter().map(|f| (f.rel, f.text)).collect();
+        texts.extend(outside_files(project)?.into_iter().map(|f| (f.rel, f.text)));
+        let manifest = store.manifest()?;
+        let mut baselines = BTreeMap::new();
+        for p in planned {
+            if !baselines.contains_key(p.kernel.name()) {
+                let b = baseline(base, store, &manifest, &p.kernel, cases)?;
+                baselines.insert(p.kernel.name().to_string(), b);
+            }
         }
+        Ok(Judge { base, store, manifest, sources, texts, baselines })
     }
-    let mut results = Vec::with_capacity(planned.len());
-    vista_golden::in_order(
-        planned,
-        jobs,
-        |p| {
-            let m = &p.mutant;
-            let text = texts.get(&m.file).map(|t| m.apply(t)).unwrap_or_default();
-            let gpu = Renderer {
-                ctx: base.ctx,
-                worker: base.worker.clone(),
-                edit: Some((m.file.clone(), text.clone())),
-                shaders: sources.with_file("mutant", &m.file, text),
-                limits: base.limits,
-                root: base.root.clone(),
-            };
-            judge(&gpu, store, &manifest, &p.kernel, &baselines[p.kernel.name()], m)
-        },
-        |i, r| {
-            results.push(r);
-            progress(i + 1, planned.len());
-        },
-    );
-    Ok(results)
+
+    /// One planned mutant judged: its file mutated in memory, then every
+    /// detector of its kernel until one kills it.
+    pub fn judge(&self, p: &Planned) -> MutantReport {
+        let m = &p.mutant;
+        let text = self.texts.get(&m.file).map(|t| m.apply(t)).unwrap_or_default();
+        let gpu = Renderer {
+            ctx: self.base.ctx,
+            worker: self.base.worker.clone(),
+            edit: Some((m.file.clone(), text.clone())),
+            shaders: self.sources.with_file("mutant", &m.file, text),
+            limits: self.base.limits,
+            root: self.base.root.clone(),
+        };
+        judge(&gpu, self.store, &self.manifest, &p.kernel, &self.baselines[p.kernel.name()], m)
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,112 @@
+//! A project's WGSL read once ([`Sources`]): its shader files, each
+//! kernel's generated enum module and `[source]` assemblies, from which
+//! the project's [`ShaderSet`] (or one with a file replaced) is made.
+
+use vista_gpu::ShaderSet;
+
+use crate::RenderError;
+
+/// A project's WGSL read once: its `shaders/` files over the built-ins,
+/// each kernel's generated `vista::enums` module, its `[source]`
+/// assemblies and a reader of the files they reach outside `shaders/`.
+/// Makes the project's [`ShaderSet`], or one with a file's text replaced
+/// (each mutant of `vista mutate`), without reading the project again.
+#[derive(Debug, Clone)]
+pub struct Sources {
+    label: String,
+    /// (path relative to `shaders/`, text, origin).
+    files: Vec<(String, String, String)>,
+    enums: Vec<(String, String, String)>,
+    specs: Vec<(String, vista_source::SourceSpec)>,
+    reader: vista_gpu::Reader,
+}
+
+impl Sources {
+    /// The project's sources, read now.
+    pub fn of(project: &vista_project::Project) -> Result<Sources, RenderError> {
+        let label = match project.root() {
+            Some(r) => format!("project {}", r.display()),
+            None => "built-in shaders".to_string(),
+        };
+        let files = project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin)).collect();
+        let (specs, reader) = source_specs(project)?;
+        Ok(Sources { label, files, enums: enum_modules(project)?, specs, reader })
+    }
+
+    /// The project's shader set.
+    pub fn shader_set(&self) -> ShaderSet {
+        ShaderSet::from_files(&self.label, self.files.iter().cloned())
+            .with_enums(self.enums.iter().cloned())
+            .with_sources(self.specs.iter().cloned(), self.reader.clone())
+    }
+
+    /// The set with file `rel` holding `text` instead (a path relative to
+    /// `shaders/`, or relative to the root for a file a `[source]` reaches
+    /// outside it).
+    pub fn with_file(&self, label: &str, rel: &str, text: String) -> ShaderSet {
+        let files: Vec<(String, String, String)> = self
+            .files
+            .iter()
+            .map(|f| match f.0 == rel {
+                true => (f.0.clone(), text.clone(), f.2.clone()),
+                false => f.clone(),
+            })
+            .collect();
+        let (read, edited) = (self.reader.clone(), rel.to_string());
+        let reader = vista_gpu::Reader::new(move |path| match path == edited {
+            true => read.read(path).map(|(_, origin)| (text.clone(), origin)),
+            false => read.read(path),
+        });
+        ShaderSet::from_files(label, files)
+            .with_enums(self.enums.iter().cloned())
+            .with_sources(self.specs.iter().cloned(), reader)
+    }
+}
+
+/// Every kernel's `[source]` assemblies, by id (SPEC 16), and a reader of
+/// the project's files for what they reach outside `shaders/`.
+pub fn source_specs(
+    project: &vista_project::Project,
+) -> Result<(Vec<(String, vista_source::SourceSpec)>, vista_gpu::Reader), RenderError> {
+    let registry = vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let project = project.clone();
+    let specs = registry.kernels().iter().flat_map(|k| k.source_specs()).collect();
+    Ok((specs, vista_gpu::Reader::new(move |rel| project.read_text(rel))))
+}
+
+/// Each kernel's generated `vista::enums` module (from its manifest's enum
+/// params), as `(shader file, kernel, text)` for every file its passes use.
+/// A manifest that does not parse contributes none (its error comes when
+/// the kernel is named).
+pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, String, String)>, RenderError> {
+    let registry = vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let mut out = Vec::new();
+    for k in registry.kernels() {
+        let text = k.enum_module();
+        for f in k.shader_files() {
+            out.push((f.to_string(), k.name().to_string(), text.clone()));
+        }
+    }
+    Ok(out)
+}
+
+/// The project's WGSL as one [`ShaderSet`].
+pub fn shader_set(project: &vista_project::Project) -> Result<ShaderSet, RenderError> {
+    Ok(Sources::of(project)?.shader_set())
+}
+
+/// The project's WGSL with every file's text passed through `edit(relative
+/// path, text)` (a mutant, a deliberate fault), composed in memory: nothing
+/// is written. Kernel files keep their generated `vista::enums` modules.
+pub fn edited_shader_set(
+    project: &vista_project::Project,
+    label: &str,
+    edit: impl Fn(&str, String) -> String,
+) -> Result<ShaderSet, RenderError> {
+    let mut sources = Sources::of(project)?;
+    sources.label = label.to_string();
+    for f in &mut sources.files {
+        f.1 = edit(&f.0, std::mem::take(&mut f.1));
+    }
+    Ok(sources.shader_set())
+}
