@@ -263,16 +263,12 @@ impl Phases {
 }
 
 /// This process's command line as a user would type it again (`vista` and
-/// its arguments, quoted where the shell would need it), for reports.
+/// its arguments, quoted where the shell would need it: shlex's quoting),
+/// for reports.
 pub(crate) fn command_line() -> String {
-    let quote = |a: String| {
-        if !a.is_empty() && a.chars().all(|c| c.is_ascii_alphanumeric() || "-_=./:,@+".contains(c)) {
-            a
-        } else {
-            format!("'{}'", a.replace('\'', "'\\''"))
-        }
-    };
-    std::iter::once("vista".to_string()).chain(std::env::args().skip(1).map(quote)).collect::<Vec<_>>().join(" ")
+    let args: Vec<String> = std::iter::once("vista".to_string()).chain(std::env::args().skip(1)).collect();
+    // An argument cannot hold a NUL (the OS passes C strings).
+    shlex::try_join(args.iter().map(String::as_str)).expect("arguments hold no NUL")
 }
 
 /// `vista merge`: the shards' report folders joined into `out`; prints each

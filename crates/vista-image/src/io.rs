@@ -85,7 +85,11 @@ pub fn write_png8_small(path: &Path, img: &Image) -> Result<(), ImageError> {
     atomic_replace(path, &encode_png8_small(img))
 }
 
-/// The bytes [`write_png8_small`] writes.
+/// The bytes [`write_png8_small`] writes. Filtered and framed here, not by
+/// the png crate: with one deflate state per thread, reset instead of set
+/// up anew, a 32 x 32 grey thumbnail took 43-65 us against the png crate's
+/// 166-211 us at its best deflate, for the same 1124 bytes (2026-12-07), of
+/// a small case's ~1 ms.
 pub fn encode_png8_small(img: &Image) -> Vec<u8> {
     let texels: Vec<[u8; 4]> = img.data.iter().map(|p| p.map(quantize8)).collect();
     let opaque = texels.iter().all(|p| p[3] == u8::MAX);

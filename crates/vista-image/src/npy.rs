@@ -3,7 +3,9 @@
 //! padding as void fields), a C-order shape, and the raw little-endian
 //! bytes. Written by hand rather than with npyz: vista's buffers are bytes
 //! whose dtype comes from naga's reflection at run time, which a typed
-//! reader/writer would have to re-derive.
+//! reader/writer would have to re-derive; and npyz 0.9 brings 27 more crates
+//! (a Python-literal parser on pest, big integers) and 11.8 s of build
+//! (18 CPU-s, debug, 2 cores; 2026-12-07) for these 290 lines.
 
 use std::path::Path;
 

@@ -1,14 +1,16 @@
-//! PNG files written row by row: a report's large images without holding
-//! them whole. Encoded at once, a failing 2048 x 2048 case's 16-bit PNG
+//! PNG files written row by row (the png crate's stream writer): a report's
+//! large images without holding them whole. Encoded at once, a failing 2048 x 2048 case's 16-bit PNG
 //! took its samples (32 MiB), the encoder's big-endian copy of them and
 //! the compressed output (60-100 MB in all) while the other images were
 //! being encoded beside it.
 
+use std::cell::RefCell;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use crate::fault::{Stop, maybe_stop};
-use crate::io::{RowFilter, create_temp, parent_dir, png_chunk, png_header};
+use crate::io::{create_temp, parent_dir};
 use crate::{ImageError, quantize8, quantize16};
 
 /// The samples a [`PngFile`] stores per texel.
@@ -33,37 +35,39 @@ impl PngKind {
     }
 }
 
-/// Bytes of compressed data per IDAT chunk.
-const IDAT_CHUNK: usize = 256 << 10;
-
-/// Collects the zlib stream and writes it out as IDAT chunks.
-struct Idat<W: Write> {
-    out: W,
-    pending: Vec<u8>,
+/// The file under the png crate's stream writer, keeping the first write
+/// or flush error: the writer's end (IEND, the last flush) happens in its
+/// `Drop`, which drops errors, and a short PNG must not be put in place.
+struct Sink {
+    out: BufWriter<std::fs::File>,
+    error: Rc<RefCell<Option<std::io::Error>>>,
 }
 
-impl<W: Write> Idat<W> {
-    fn flush_chunks(&mut self, all: bool) -> std::io::Result<()> {
-        while self.pending.len() >= IDAT_CHUNK || (all && !self.pending.is_empty()) {
-            let n = self.pending.len().min(IDAT_CHUNK);
-            let mut chunk = Vec::with_capacity(n + 12);
-            png_chunk(&mut chunk, b"IDAT", &self.pending[..n]);
-            self.out.write_all(&chunk)?;
-            self.pending.drain(..n);
+impl Sink {
+    fn keep<T>(&self, r: std::io::Result<T>) -> std::io::Result<T> {
+        if let Err(e) = &r {
+            self.error.borrow_mut().get_or_insert_with(|| std::io::Error::new(e.kind(), e.to_string()));
         }
-        Ok(())
+        r
     }
 }
 
-impl<W: Write> Write for Idat<W> {
+impl Write for Sink {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.pending.extend_from_slice(buf);
-        self.flush_chunks(false)?;
-        Ok(buf.len())
+        let r = self.out.write(buf);
+        self.keep(r)
     }
 
     fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
+        let r = self.out.flush();
+        self.keep(r)
+    }
+}
+
+impl Drop for Sink {
+    fn drop(&mut self) {
+        let r = self.out.flush();
+        let _ = self.keep(r);
     }
 }
 
@@ -104,46 +108,49 @@ impl Streamed {
 
 /// A PNG file written one row at a time, replaced as
 /// [`crate::atomic_replace`] replaces (a temp file renamed into place, no
-/// sync): rows filtered by least absolute sum and deflated by fdeflate (the
-/// png crate's fast level) into IDAT chunks as they come. It holds two
-/// rows of samples and at most one chunk of output.
+/// sync): the png crate's stream writer, adaptive row filters and its fast
+/// deflate, as rows come. It holds a row of samples and the encoder's
+/// buffers, never the image.
 pub struct PngFile {
     path: PathBuf,
     streamed: Streamed,
-    deflate: fdeflate::Compressor<Idat<BufWriter<std::fs::File>>>,
+    stream: png::StreamWriter<'static, Sink>,
+    error: Rc<RefCell<Option<std::io::Error>>>,
     kind: PngKind,
     width: u32,
     height: u32,
     rows: u32,
     samples: Vec<u8>,
-    previous: Vec<u8>,
-    filter: RowFilter,
 }
 
 impl PngFile {
     /// Starts `path` (`width` x `height` texels of `kind`), writing its header.
     pub fn create(path: &Path, width: u32, height: u32, kind: PngKind) -> Result<PngFile, ImageError> {
-        let io_err = |source| ImageError::Io { path: path.to_path_buf(), source };
+        let encode_err =
+            |e: png::EncodingError| ImageError::Encode { path: path.to_path_buf(), format: "PNG", msg: e.to_string() };
         if width == 0 || height == 0 {
             let message = format!("cannot store an empty {width}x{height} image");
             return Err(ImageError::Encode { path: path.to_path_buf(), format: "PNG", msg: message });
         }
-        let (streamed, mut out) = Streamed::open(path)?;
+        let (streamed, out) = Streamed::open(path)?;
+        let error = Rc::new(RefCell::new(None));
+        let mut encoder = png::Encoder::new(Sink { out, error: error.clone() }, width, height);
         let (bpp, depth, colour) = kind.layout();
-        out.write_all(&png_header(width, height, depth, colour)).map_err(io_err)?;
-        let deflate = fdeflate::Compressor::new(Idat { out, pending: Vec::new() }).map_err(io_err)?;
-        let stride = width as usize * bpp;
+        encoder.set_depth(if depth == 16 { png::BitDepth::Sixteen } else { png::BitDepth::Eight });
+        encoder.set_color(if colour == 2 { png::ColorType::Rgb } else { png::ColorType::Rgba });
+        encoder.set_compression(png::Compression::Fast);
+        encoder.set_adaptive_filter(png::AdaptiveFilterType::Adaptive);
+        let stream = encoder.write_header().and_then(|w| w.into_stream_writer()).map_err(encode_err)?;
         Ok(PngFile {
             path: path.to_path_buf(),
             streamed,
-            deflate,
+            stream,
+            error,
             kind,
             width,
             height,
             rows: 0,
-            samples: Vec::with_capacity(stride),
-            previous: vec![0; stride],
-            filter: RowFilter::new(stride),
+            samples: Vec::with_capacity(width as usize * bpp),
         })
     }
 
@@ -174,11 +181,7 @@ impl PngFile {
                 }
             }
         }
-        let filter = self.filter.filter(&self.samples, &self.previous, bpp);
-        let io_err = |source| ImageError::Io { path: self.path.clone(), source };
-        self.deflate.write_data(&[filter]).map_err(io_err)?;
-        self.deflate.write_data(self.filter.best()).map_err(io_err)?;
-        std::mem::swap(&mut self.previous, &mut self.samples);
+        self.stream.write_all(&self.samples).map_err(|source| ImageError::Io { path: self.path.clone(), source })?;
         self.rows += 1;
         if self.rows == self.height.div_ceil(2) {
             maybe_stop(self.streamed.n, Stop::Partial, &self.path);
@@ -189,15 +192,13 @@ impl PngFile {
     /// Ends the file (every row pushed) and puts it in place.
     pub fn finish(self) -> Result<(), ImageError> {
         let path = self.path;
-        let io_err = |source| ImageError::Io { path: path.clone(), source };
         assert_eq!(self.rows, self.height, "every row of the PNG pushed");
-        let mut idat = self.deflate.finish().map_err(io_err)?;
-        idat.flush_chunks(true).map_err(io_err)?;
-        let mut end = Vec::with_capacity(12);
-        png_chunk(&mut end, b"IEND", &[]);
-        idat.out.write_all(&end).map_err(io_err)?;
-        idat.out.flush().map_err(io_err)?;
-        drop(idat);
+        let finished = self.stream.finish();
+        // The stream's writer, and with it the file's last bytes, are gone now.
+        if let Some(source) = self.error.borrow_mut().take() {
+            return Err(ImageError::Io { path, source });
+        }
+        finished.map_err(|e| ImageError::Encode { path: path.clone(), format: "PNG", msg: e.to_string() })?;
         self.streamed.place(&path)
     }
 }

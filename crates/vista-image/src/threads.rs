@@ -26,27 +26,27 @@ pub fn threads_for(pixels: usize) -> usize {
     if pixels < PARALLEL_FROM_PIXELS { 1 } else { case_threads() }
 }
 
-/// Runs `work` on every item, `threads` items at once on scoped threads
-/// (a group of one on the calling thread), and hands each result to `take`
-/// in item order: FLIP's strips and SSIM's bands, whose sums must not
-/// depend on the threads.
+/// Runs `work` on every item, at most `threads` at once (on the calling
+/// thread alone for one), and hands each result to `take` in item order:
+/// FLIP's strips and SSIM's bands, whose sums must not depend on the
+/// threads. A rayon pool of `threads`, not the global one: the check's
+/// jobs share the cores ([`set_case_threads`]).
 pub(crate) fn in_groups<T: Sync, R: Send>(
     items: &[T],
     threads: usize,
     work: impl Fn(&T) -> R + Sync,
-    mut take: impl FnMut(R),
+    take: impl FnMut(R),
 ) {
-    for group in items.chunks(threads.max(1)) {
-        if let [one] = group {
-            take(work(one));
-            continue;
-        }
-        let results: Vec<R> = std::thread::scope(|s| {
-            let work = &work;
-            let running: Vec<_> = group.iter().map(|item| s.spawn(move || work(item))).collect();
-            running.into_iter().map(|r| r.join().expect("a helper thread")).collect()
-        });
-        results.into_iter().for_each(&mut take);
+    use rayon::prelude::*;
+    if threads <= 1 || items.len() <= 1 {
+        items.iter().map(work).for_each(take);
+        return;
+    }
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.min(items.len())).build();
+    match pool {
+        Ok(pool) => pool.install(|| items.par_iter().map(&work).collect::<Vec<R>>()).into_iter().for_each(take),
+        // No thread to be had: the same work on this one.
+        Err(_) => items.iter().map(work).for_each(take),
     }
 }
 

@@ -165,7 +165,10 @@ impl From<WireError> for GpuError {
 /// readback's outputs, written from where they lie: a 2048 x 2048 image
 /// gathered into one buffer first was 64 MiB more of the worker's peak),
 /// or the byte lists the head refers to (a request's tables, uniforms,
-/// inputs: [`vista_gpu::wire`]) where there are no parts.
+/// inputs: [`vista_gpu::wire`]) where there are no parts. Two lengths frame
+/// it, by hand rather than with postcard or ciborium: they serialize a byte
+/// list inside the message, so the parts would be copied in on one side and
+/// out on the other (see [`receive_answer`]: 128 MiB held twice).
 fn send<T: Serialize>(w: &mut impl Write, msg: &T, parts: &[&[u8]]) -> std::io::Result<()> {
     let (head, attached) = vista_gpu::wire::attach(|| serde_json::to_vec(msg).expect("wire messages serialize"));
     let parts = match attached.is_empty() {
