@@ -87,6 +87,16 @@ fn command_name(nextest: bool) -> String {
     format!("{} --test {name}", if nextest { "cargo nextest run" } else { "cargo test" })
 }
 
+/// The harness's checker of every case: failing cases' images in full.
+fn checker<'a>(
+    ctx: &'a Renderer<'a>,
+    store: &'a Store,
+    manifest: &'a vista_golden::Manifest,
+    report_dir: &'a Path,
+) -> Checker<'a> {
+    Checker { ctx, store, manifest, report_dir, detail: vista_report::Detail::Failing }
+}
+
 fn fail(message: &str) -> ! {
     eprintln!("error: {message}");
     std::process::exit(2)
@@ -162,14 +172,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
                     Some(Err(e)) => return Err(Failed::from(format!("no GPU adapter: {e}"))),
                     None => return Err(Failed::from("listed, not run")),
                 };
-                let checker = Checker {
-                    ctx,
-                    store: &store,
-                    manifest: &manifest,
-                    report_dir: &report_dir,
-                    detail: vista_report::Detail::Failing,
-                };
-                let f = checker.check(&case);
+                let f = checker(ctx, &store, &manifest, &report_dir).check(&case);
                 let o = &f.outcome;
                 let result = match (o.passed(), f.report_errors.is_empty()) {
                     (true, true) => Ok(()),
@@ -218,13 +221,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
         let root = project.root().expect("a store has a root");
         let results = vista_check::Results { junit: config.junit.as_ref().map(|j| root.join(j)), json: None };
         let suite: Vec<String> = cases.iter().map(|c| c.id.clone()).collect();
-        let checker = Checker {
-            ctx,
-            store: &store,
-            manifest: &manifest,
-            report_dir: &report_dir,
-            detail: vista_report::Detail::Failing,
-        };
+        let checker = checker(ctx, &store, &manifest, &report_dir);
         let run = vista_check::Run { checker, summary: run, results, shared: shared.map(|s| (s, suite)) };
         let written = run.finish(&filed);
         match written {

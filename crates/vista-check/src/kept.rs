@@ -41,24 +41,23 @@ pub(crate) fn save(
 /// Removes an earlier shard's `outcomes.cbor` from a folder a whole run now
 /// reports into, so it is never merged as that run's.
 pub(crate) fn remove(report_dir: &Path) -> Result<(), GoldenError> {
-    let path = report_dir.join(OUTCOMES_FILE);
-    match std::fs::remove_file(&path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(GoldenError::Io { path: path.display().to_string(), message: e.to_string() })
-        }
-        _ => Ok(()),
-    }
+    gone(&report_dir.join(OUTCOMES_FILE), |p| std::fs::remove_file(p))
 }
 
 /// The hidden folder of a shared run's records in the report folder: `run`
 /// (the run's id) and `cases/<id>.cbor`, one record per case.
 pub const RUN_DIR: &str = ".vista-run";
-/// Removes `dir` and all in it; nothing if it is not there.
+
+/// Removes a report folder's [`RUN_DIR`] and all in it, if it is there.
 pub(crate) fn remove_records(report_dir: &Path) -> Result<(), GoldenError> {
-    let dir = report_dir.join(RUN_DIR);
-    match std::fs::remove_dir_all(&dir) {
+    gone(&report_dir.join(RUN_DIR), |p| std::fs::remove_dir_all(p))
+}
+
+/// `path` removed by `remove`; nothing if it is not there.
+fn gone(path: &Path, remove: impl Fn(&Path) -> std::io::Result<()>) -> Result<(), GoldenError> {
+    match remove(path) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(GoldenError::Io { path: dir.display().to_string(), message: e.to_string() })
+            Err(GoldenError::Io { path: path.display().to_string(), message: e.to_string() })
         }
         _ => Ok(()),
     }
