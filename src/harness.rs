@@ -97,6 +97,54 @@ fn checker<'a>(
     Checker { ctx, store, manifest, report_dir, detail: vista_report::Detail::Failing }
 }
 
+/// Each WGSL unit test (`@test` in `shaders/**/*.test.wgsl`) as a libtest
+/// test `wgsl::<file>::<fn>`: a file runs whole, once, when the first of
+/// its tests runs, and each test reports its own result.
+fn wgsl_trials(
+    project: &Project,
+    renderer: Option<Result<&'static Renderer<'static>, String>>,
+    skip: bool,
+) -> Vec<Trial> {
+    type Results = Arc<std::sync::OnceLock<Vec<vista_wgsl_test::TestResult>>>;
+    let files: Vec<(String, String)> = match project.shader_files() {
+        Ok(files) => files.into_iter().filter(|f| f.rel.ends_with(".test.wgsl")).map(|f| (f.rel, f.text)).collect(),
+        Err(e) => fail(&format!("cannot read the shaders: {e}")),
+    };
+    let sources: Arc<std::sync::OnceLock<Result<vista_render::Sources, String>>> = Arc::default();
+    let mut trials = Vec::new();
+    for (rel, text) in files {
+        let ids = vista_wgsl_test::list(&rel, &text).unwrap_or_else(|_| vec![vista_wgsl_test::test_id(&rel, "*")]);
+        let (results, rel, text): (Results, Arc<str>, Arc<str>) = (Arc::default(), rel.into(), text.into());
+        for id in ids {
+            let (project, renderer, sources, results) =
+                (project.clone(), renderer.clone(), sources.clone(), results.clone());
+            let (rel, text) = (rel.clone(), text.clone());
+            trials.push(
+                Trial::test(id.clone(), move || {
+                    let ctx = match renderer {
+                        Some(Ok(ctx)) => ctx,
+                        Some(Err(e)) => return Err(Failed::from(format!("no GPU adapter: {e}"))),
+                        None => return Err(Failed::from("listed, not run")),
+                    };
+                    let sources = sources
+                        .get_or_init(|| vista_render::Sources::of(&project).map_err(|e| e.to_string()))
+                        .as_ref()
+                        .map_err(|e| Failed::from(e.clone()))?;
+                    let all = results.get_or_init(|| vista_wgsl_test::run_file(ctx, sources, &rel, &text));
+                    // A file that does not rewrite has one result, `*`.
+                    let r = all.iter().find(|r| r.id == id).or(all.first()).ok_or_else(|| Failed::from("not run"))?;
+                    match r.passed() {
+                        true => Ok(()),
+                        false => Err(Failed::from(r.explain().join("\n"))),
+                    }
+                })
+                .with_ignored_flag(skip),
+            );
+        }
+    }
+    trials
+}
+
 fn fail(message: &str) -> ! {
     eprintln!("error: {message}");
     std::process::exit(2)
@@ -188,6 +236,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
             .with_ignored_flag(skip)
         })
         .collect();
+    trials.extend(wgsl_trials(project, renderer.clone(), skip));
     let orphans = vista_check::orphans(&store, &cases);
     if !orphans.is_empty() {
         let listed: Vec<String> = orphans.iter().map(|o| o.display().to_string()).collect();

@@ -23,6 +23,7 @@ mod mutate;
 mod render;
 mod signals;
 mod sweep;
+mod unit_tests;
 mod watch;
 
 #[derive(Parser)]
@@ -104,6 +105,15 @@ enum Command {
         /// Compare only this rectangle of both images: X,Y,W,H in pixels.
         #[arg(long, value_name = "X,Y,W,H")]
         crop: Option<String>,
+    },
+    /// Run the WGSL unit tests: `@test` functions in shaders/**/*.test.wgsl.
+    ///
+    /// Assertions from `#import wgsl_test` (expect, expectEq, expectEqU,
+    /// expectNear, expectNearV2f..V4f, expectUlp) run on the GPU; a failure
+    /// names its file:line:col and values. Exit 1 if any test fails.
+    Test {
+        /// Only the tests whose id (`wgsl::<file>::<fn>`) contains this.
+        filter: Option<String>,
     },
     /// Check the cases, then re-check the ones a saved file reaches (WGSL,
     /// kernel manifests, golden/) and rewrite the report, until interrupted.
@@ -359,6 +369,7 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             watch::watch(project, config, case.as_deref(), watch::interval(interval)?, timeout)
         }
         Command::List { names } => list::run(project, names),
+        Command::Test { filter } => unit_tests::test(project, config, filter.as_deref()),
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             render::render(project, config, render::Args { kernel, preset, set, size, crop, zoom, out })
         }

@@ -6271,6 +6271,48 @@ fn grass_tips_follow_the_cpu_projection(bin: &Path, root: &Path) {
     assert!(missed_without_wind >= 10, "without the wind only {missed_without_wind} of 25 tips move by > 1 px");
 }
 
+/// `vista test`: each `@test` of a `*.test.wgsl` file a line; a failing
+/// assertion at the user's file:line:col with its values (1/(4 pi) =
+/// 0.0795774715 from the math, not read back), up to 16 per test and a
+/// count past them; a file that does not compile fails each of its tests
+/// naming its line; a filter; the same lines on all three backends.
+fn wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends() {
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    std::fs::create_dir_all(d.path().join("shaders/lib")).unwrap();
+    let phase = "#import vista::phase::{hg_phase}\n#import wgsl_test::{expect, expectNear, expectEqU}\n\n\
+                 const PI: f32 = 3.14159265;\n\n@test\nfn isotropic_is_one_over_four_pi() {\n\
+                 \x20   expectNear(hg_phase(0.3, 0.0), 1.0 / (4.0 * PI));\n}\n\n@test\nfn deliberately_wrong() {\n\
+                 \x20   expectNear(hg_phase(1.0, 0.0), 0.08, 1e-4);\n    expect(1.0 > 2.0);\n}\n\n\
+                 @test fn twenty_failures() {\n    for (var i = 0u; i < 20u; i++) {\n        expectEqU(i, 100u);\n    }\n}\n";
+    std::fs::write(d.path().join("shaders/lib/phase.test.wgsl"), phase).unwrap();
+    std::fs::write(d.path().join("shaders/broken.test.wgsl"), "@test\nfn t() {\n    let x = nope;\n}\n").unwrap();
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let r = vista_in(Some(d.path()), &[("VISTA_BACKEND", backend)], &["test"]);
+        let lines: Vec<&str> = r.stdout.lines().collect();
+        assert_eq!(r.code, 1, "{backend}: {}{}", r.stdout, r.stderr);
+        assert!(lines.contains(&"ok     wgsl::phase::isotropic_is_one_over_four_pi"), "{backend}: {}", r.stdout);
+        let wrong = "FAIL   wgsl::phase::deliberately_wrong: shaders/lib/phase.test.wgsl";
+        assert!(
+            lines.contains(&format!("{wrong}:13:5: expectNear(actual 0.07957747, expected 0.08, tol 0.0001)").as_str()),
+            "{backend}: {}",
+            r.stdout
+        );
+        assert!(lines.contains(&format!("{wrong}:14:5: expect(false)").as_str()), "{backend}: {}", r.stdout);
+        let twenty: Vec<&&str> =
+            lines.iter().filter(|l| l.starts_with("FAIL   wgsl::phase::twenty_failures")).collect();
+        assert_eq!(twenty.len(), 17, "{backend}: 16 kept and a count: {}", r.stdout);
+        assert!(twenty[0].ends_with("phase.test.wgsl:19:9: expectEqU(actual 0, expected 100)"), "{}", twenty[0]);
+        assert!(twenty[16].ends_with("and 4 more failed assertions"), "{}", twenty[16]);
+        let broken = lines.iter().find(|l| l.starts_with("FAIL   wgsl::broken::t: ")).expect("the broken file's test");
+        assert!(broken.contains("broken.test.wgsl:3: ") && broken.contains("nope"), "{backend}: {broken}");
+        assert!(r.stdout.contains("1 passed, 3 failed"), "{backend}: {}", r.stdout);
+    }
+    let one = vista_in(Some(d.path()), &[], &["test", "isotropic"]);
+    assert_eq!((one.code, one.stdout.lines().count()), (0, 2), "{}", one.stdout);
+    assert!(one.stdout.contains("1 passed, 0 failed"), "{}", one.stdout);
+}
+
 fn main() {
     // Each test's name is its function's name, written once.
     macro_rules! tests {
@@ -6280,6 +6322,7 @@ fn main() {
     }
     let tests: &[(Needs, &str, fn())] = tests![
         Cpu unknown_kernel_lists_valid_kernels,
+        Gpu wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends,
         Cpu no_tracked_file_cites_an_issue_or_session_number,
         Cpu unknown_preset_lists_valid_presets,
         Cpu unknown_param_lists_valid_params,

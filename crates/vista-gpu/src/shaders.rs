@@ -138,7 +138,8 @@ pub const ENUMS_MODULE: &str = "vista::enums";
 
 impl ShaderSet {
     /// A set from `(relative path, text, origin)` triples; files under
-    /// `lib/` are import modules, the rest kernel files. `origin` (a real
+    /// `lib/` are import modules (but `*.test.wgsl` files), the rest kernel
+    /// files. `origin` (a real
     /// path or `<built-in>/...`) is what errors name.
     pub fn from_files(label: &str, files: impl IntoIterator<Item = (String, String, String)>) -> ShaderSet {
         let mut lib = Vec::new();
@@ -146,8 +147,11 @@ impl ShaderSet {
         for (rel, text, origin) in files {
             let source = Source::new(rel, text, origin);
             // An import module is a file under lib/ or any file with its own
-            // `#define_import_path` (a project's foreign module layout).
-            if source.rel.starts_with("lib/") || source.module.is_some() {
+            // `#define_import_path` (a project's foreign module layout); a
+            // WGSL unit test file (`*.test.wgsl`) beside the modules it
+            // tests is composed as a kernel file is.
+            let test = source.rel.ends_with(".test.wgsl") && source.module.is_none();
+            if (source.rel.starts_with("lib/") && !test) || source.module.is_some() {
                 lib.push(source);
             } else {
                 kernels.insert(source.rel.clone(), source);

@@ -31,6 +31,7 @@ builtins! {
         "lib/geometry.wgsl",
         "lib/terrain.wgsl",
         "lib/sky.wgsl",
-        "lib/cloud_slab.wgsl";
+        "lib/cloud_slab.wgsl",
+        "lib/wgsl_test.wgsl";
     kernels: "fbm", "ridged", "atmosphere", "clouds", "heightfield", "cloudmap", "landscape",
 }

@@ -1,0 +1,209 @@
+#![deny(missing_docs)]
+//! WGSL unit tests (`vista test`): `@test` functions in `*.test.wgsl`
+//! files under `shaders/`, importing what they test as kernels do, with
+//! the assertions of `#import wgsl_test` (`expect`, `expectEq`,
+//! `expectNear`, `expectNearV2f`..`V4f`, `expectUlp`; shaders/lib/wgsl_test.wgsl).
+//! Each file becomes one kernel: one pass per test (a compute entry of one
+//! invocation), one results buffer, rendered on the project's engine like
+//! any case ([`run_file`]); a failing assertion comes back with the
+//! user's file, line and column and its values ([`Failure`]).
+//!
+//! Not for: goldens (`vista-golden`) or the run loop and printing (the
+//! binary).
+
+mod rewrite;
+
+pub use rewrite::{Assertion, Rewritten, Site, TestFn, entry, rewrite};
+
+use vista_render::{OutputValue, Renderer};
+
+/// Failures a test keeps (the count goes on past them).
+const KEPT: usize = 16;
+/// Words of one kept failure: site, actual x4, expected x4, tolerance.
+const RECORD: usize = 10;
+/// Words of one test's row.
+const ROW: usize = 1 + KEPT * RECORD;
+
+/// One failed assertion, as the user wrote it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Failure {
+    /// `file:line:col` of the call.
+    pub at: String,
+    /// `expectNear(actual 0.0796, expected 0.08, tol 0.0001)`.
+    pub what: String,
+}
+
+/// One test's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestResult {
+    /// `wgsl::<file stem>::<fn>`.
+    pub id: String,
+    /// Its failures (at most 16 kept); empty when it passed.
+    pub failures: Vec<Failure>,
+    /// Failed assertions in all (past those kept).
+    pub failed: u32,
+    /// Why it could not run (a compile error at the user's line, a hang
+    /// the watchdog ended), when it did not.
+    pub error: Option<String>,
+}
+
+impl TestResult {
+    /// Whether every assertion held.
+    pub fn passed(&self) -> bool {
+        self.failed == 0 && self.error.is_none()
+    }
+
+    /// Why it failed, a line per failure: `shaders/<file>:line:col: what`,
+    /// or the error that kept it from running.
+    pub fn explain(&self) -> Vec<String> {
+        if let Some(e) = &self.error {
+            return vec![e.clone()];
+        }
+        let mut lines: Vec<String> = self.failures.iter().map(|f| format!("shaders/{}: {}", f.at, f.what)).collect();
+        let more = self.failed as usize - self.failures.len();
+        if more > 0 {
+            lines.push(format!("and {more} more failed assertion{}", if more == 1 { "" } else { "s" }));
+        }
+        lines
+    }
+}
+
+/// The project's test files: `*.test.wgsl` under `shaders/`, as paths
+/// relative to it, sorted.
+pub fn test_files(project: &vista_project::Project) -> Result<Vec<String>, vista_render::RenderError> {
+    let mut files: Vec<String> =
+        project.shader_files()?.into_iter().map(|f| f.rel).filter(|r| r.ends_with(".test.wgsl")).collect();
+    files.sort();
+    Ok(files)
+}
+
+/// The id of test `name` of file `rel`: `wgsl::<stem>::<name>`.
+pub fn test_id(rel: &str, name: &str) -> String {
+    let file = rel.rsplit('/').next().unwrap_or(rel);
+    format!("wgsl::{}::{name}", file.trim_end_matches(".test.wgsl"))
+}
+
+/// The ids of file `rel`'s tests (`text` its contents), or the error that
+/// keeps it from running.
+pub fn list(rel: &str, text: &str) -> Result<Vec<String>, String> {
+    Ok(rewrite(text)?.tests.iter().map(|t| test_id(rel, &t.name)).collect())
+}
+
+/// The manifest of file `rel` rewritten: one pass per test, the results
+/// buffer its output.
+fn manifest(rel: &str, tests: usize) -> String {
+    let mut m = format!(
+        "summary = \"the WGSL tests of {rel}\"\nshader = \"{rel}\"\n\n[[resource]]\nname = \"wgsl_test_results\"\n\
+         kind = \"buffer\"\nlength = {}\n",
+        tests * ROW
+    );
+    for i in 0..tests {
+        m.push_str(&format!("\n[[pass]]\nentry = \"{}\"\nworkgroups = [1, 1, 1]\n", entry(i)));
+    }
+    m.push_str("\n[[output]]\nresource = \"wgsl_test_results\"\n");
+    m
+}
+
+/// Runs the tests of file `rel` (`text` as the project has it) on `base`'s
+/// engine, its file replaced by the rewrite in memory: every test's
+/// result, in file order. A file that does not rewrite, compose or run
+/// fails each of its tests with that error (one result named `*` if none
+/// could be found).
+pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, text: &str) -> Vec<TestResult> {
+    let rewritten = match rewrite(text) {
+        Ok(r) => r,
+        Err(e) => return vec![broken(&test_id(rel, "*"), format!("{rel}:{e}"))],
+    };
+    let ids: Vec<String> = rewritten.tests.iter().map(|t| test_id(rel, &t.name)).collect();
+    let all_fail = |e: String| ids.iter().map(|id| broken(id, e.clone())).collect();
+    let gpu = Renderer {
+        ctx: base.ctx,
+        worker: base.worker.clone(),
+        edit: Some((rel.to_string(), rewritten.text.clone())),
+        shaders: sources.with_file("wgsl tests", rel, rewritten.text.clone()),
+        limits: base.limits,
+        root: base.root.clone(),
+    };
+    let name = format!("wgsl-test-{}", rel.replace(['/', '.'], "-"));
+    let kernel = match vista_manifest::Kernel::from_manifest(&name, rel, &manifest(rel, ids.len())) {
+        Ok(k) => k,
+        Err(e) => return all_fail(e.to_string()),
+    };
+    let params = match kernel.resolve(None, &[]) {
+        Ok(p) => p,
+        Err(e) => return all_fail(e.to_string()),
+    };
+    let rendered = match vista_render::render_with(&gpu, &kernel, &params, &[], 1, 1) {
+        Ok(r) => r,
+        Err(e) => return all_fail(one_line(&e.to_string())),
+    };
+    let words: Vec<u32> = match rendered.outputs.first().map(|o| &o.value) {
+        Some(OutputValue::Buffer { bytes, .. }) => {
+            bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect()
+        }
+        _ => return all_fail("the results buffer did not come back".into()),
+    };
+    ids.into_iter()
+        .enumerate()
+        .map(|(i, id)| {
+            let row = &words[i * ROW..(i + 1) * ROW];
+            let failures = row[1..]
+                .chunks_exact(RECORD)
+                .take((row[0] as usize).min(KEPT))
+                .map(|r| failure(rel, &rewritten.sites, r))
+                .collect();
+            TestResult { id, failures, failed: row[0], error: None }
+        })
+        .collect()
+}
+
+/// A compile error on one line: `path:line: message` (the column is the
+/// rewritten line's, so it is left out), else the error's first line.
+fn one_line(text: &str) -> String {
+    let message = text.lines().find_map(|l| l.trim().strip_prefix("error:")).map(str::trim);
+    let at = text.lines().find_map(|l| l.trim().strip_prefix("┌─ ")).map(str::trim);
+    match (at, message) {
+        (Some(at), Some(m)) => {
+            let at = at.rsplit_once(':').map_or(at, |(file_line, _col)| file_line);
+            format!("{at}: {m}")
+        }
+        _ => text.lines().next().unwrap_or_default().to_string(),
+    }
+}
+
+fn broken(id: &str, error: String) -> TestResult {
+    TestResult { id: id.to_string(), failures: Vec::new(), failed: 0, error: Some(error) }
+}
+
+/// A failure record (site, actual x4, expected x4, tolerance) as the user
+/// reads it.
+fn failure(rel: &str, sites: &[Site], r: &[u32]) -> Failure {
+    let Some(site) = (r[0] as usize).checked_sub(1).and_then(|s| sites.get(s)) else {
+        return Failure { at: rel.to_string(), what: format!("an assertion at unknown site {}", r[0]) };
+    };
+    let f = |w: u32| format_f32(f32::from_bits(w));
+    let floats = |ws: &[u32], n: u8| match n {
+        1 => f(ws[0]),
+        n => format!("({})", ws[..n as usize].iter().map(|&w| f(w)).collect::<Vec<_>>().join(", ")),
+    };
+    let name = site.assertion.name();
+    let what = match site.assertion {
+        Assertion::Expect => format!("{name}(false)"),
+        Assertion::Eq => format!("{name}(actual {}, expected {})", r[1] as i32, r[5] as i32),
+        Assertion::EqU => format!("{name}(actual {}, expected {})", r[1], r[5]),
+        Assertion::Near(n) => {
+            format!("{name}(actual {}, expected {}, tol {})", floats(&r[1..5], n), floats(&r[5..9], n), f(r[9]))
+        }
+        Assertion::Ulp => format!("{name}(actual {}, expected {}, ulps {})", f(r[1]), f(r[5]), r[9]),
+    };
+    Failure { at: format!("{rel}:{}:{}", site.line, site.col), what }
+}
+
+/// An f32 as short as it reads back exactly.
+fn format_f32(v: f32) -> String {
+    let text = format!("{v}");
+    match text.len() > 12 {
+        true => format!("{v:e}"),
+        false => text,
+    }
+}

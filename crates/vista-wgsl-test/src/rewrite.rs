@@ -1,0 +1,268 @@
+//! A test file as vista runs it: its `@test` functions found, each
+//! assertion call rewritten to carry its place (a site), and a compute
+//! entry appended per test. Lines keep their numbers, so a compile error
+//! names the user's line.
+
+/// An assertion of `wgsl_test`, as a test file spells it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Assertion {
+    /// `expect(cond)`.
+    Expect,
+    /// `expectEq(a, b)`: i32.
+    Eq,
+    /// `expectEqU(a, b)`: u32.
+    EqU,
+    /// `expectNear(a, b[, tol])` over 1 to 4 float components.
+    Near(u8),
+    /// `expectUlp(a, b, n)`.
+    Ulp,
+}
+
+impl Assertion {
+    /// Every assertion by its name.
+    const ALL: [(&'static str, Assertion); 8] = [
+        ("expect", Assertion::Expect),
+        ("expectEq", Assertion::Eq),
+        ("expectEqU", Assertion::EqU),
+        ("expectNear", Assertion::Near(1)),
+        ("expectNearV2f", Assertion::Near(2)),
+        ("expectNearV3f", Assertion::Near(3)),
+        ("expectNearV4f", Assertion::Near(4)),
+        ("expectUlp", Assertion::Ulp),
+    ];
+
+    /// The name a test file calls it by.
+    pub fn name(self) -> &'static str {
+        Assertion::ALL.iter().find(|(_, a)| *a == self).map(|(n, _)| *n).expect("every assertion is named")
+    }
+
+    fn of(name: &str) -> Option<Assertion> {
+        Assertion::ALL.iter().find(|(n, _)| *n == name).map(|(_, a)| *a)
+    }
+}
+
+/// One assertion call: where the user wrote it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Site {
+    /// Which assertion.
+    pub assertion: Assertion,
+    /// 1-based line and column of its name.
+    pub line: usize,
+    /// 1-based column.
+    pub col: usize,
+}
+
+/// One `@test` function.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TestFn {
+    /// The function's name.
+    pub name: String,
+    /// 1-based line of its `fn`.
+    pub line: usize,
+}
+
+/// A test file rewritten for the GPU.
+#[derive(Debug, Clone)]
+pub struct Rewritten {
+    /// The text vista composes: same lines, calls carrying sites, entries appended.
+    pub text: String,
+    /// The file's tests, in file order; test i's entry is [`entry`]`(i)`.
+    pub tests: Vec<TestFn>,
+    /// Every assertion call; site id i is `sites[i - 1]` (0: none).
+    pub sites: Vec<Site>,
+}
+
+/// The compute entry vista appends for test `i`.
+pub fn entry(i: usize) -> String {
+    format!("vista_test_{i}")
+}
+
+/// Byte ranges of `text` that are comments (`//` to the line's end,
+/// `/* */` nested as WGSL nests them).
+fn comments(text: &str) -> Vec<(usize, usize)> {
+    let b = text.as_bytes();
+    let (mut out, mut i) = (Vec::new(), 0);
+    while i + 1 < b.len() {
+        if b[i] == b'/' && b[i + 1] == b'/' {
+            let end = text[i..].find('\n').map_or(b.len(), |e| i + e);
+            out.push((i, end));
+            i = end;
+        } else if b[i] == b'/' && b[i + 1] == b'*' {
+            let (start, mut depth) = (i, 0usize);
+            while i + 1 < b.len() {
+                if b[i] == b'/' && b[i + 1] == b'*' {
+                    depth += 1;
+                    i += 2;
+                } else if b[i] == b'*' && b[i + 1] == b'/' {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+            out.push((start, i));
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+fn is_ident(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_'
+}
+
+/// 1-based line and column of byte `at`.
+fn place(text: &str, at: usize) -> (usize, usize) {
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let col = at - before.rfind('\n').map_or(0, |n| n + 1) + 1;
+    (line, col)
+}
+
+/// The byte after the `)` that closes the `(` at `open`, and the count of
+/// top-level arguments between them.
+fn call_end(text: &str, open: usize) -> Option<(usize, usize)> {
+    let (mut depth, mut args, mut any) = (0usize, 1usize, false);
+    for (i, c) in text[open..].char_indices() {
+        match c {
+            '(' | '[' => depth += 1,
+            ')' | ']' => {
+                depth -= 1;
+                if depth == 0 {
+                    return Some((open + i + 1, if any { args } else { 0 }));
+                }
+            }
+            ',' if depth == 1 => args += 1,
+            c if !c.is_whitespace() && depth >= 1 => any = true,
+            _ => {}
+        }
+    }
+    None
+}
+
+/// Rewrites `text` (a `*.test.wgsl` file): `@test` attributes blanked,
+/// assertion calls `name(args)` made `wgsl_test::name_at(site, args[, tol])`,
+/// `#import wgsl_test` and one compute entry per test appended. Errors
+/// name the place and what is wrong.
+pub fn rewrite(text: &str) -> Result<Rewritten, String> {
+    let comments = comments(text);
+    let in_comment = |at: usize| comments.iter().any(|&(s, e)| at >= s && at < e);
+    let b = text.as_bytes();
+    let mut edits: Vec<(usize, usize, String)> = Vec::new();
+    let (mut tests, mut sites) = (Vec::new(), Vec::new());
+    let mut i = 0;
+    while i < b.len() {
+        if in_comment(i) || !(b[i] == b'@' || is_ident(b[i])) || (i > 0 && (is_ident(b[i - 1]) || b[i - 1] == b':')) {
+            i += 1;
+            continue;
+        }
+        let start = if b[i] == b'@' { i + 1 } else { i };
+        let end = start + text[start..].bytes().take_while(|&c| is_ident(c)).count();
+        let word = &text[start..end];
+        if b[i] == b'@' {
+            if word == "test" {
+                // `@test` before `fn name(`, possibly across other attributes.
+                let rest = &text[end..];
+                let at_fn = rest.find("fn ").ok_or_else(|| {
+                    let (l, c) = place(text, i);
+                    format!("{l}:{c}: @test is not followed by a function")
+                })?;
+                let name_start = end + at_fn + 3;
+                let name: String =
+                    text[name_start..].trim_start().bytes().take_while(|&c| is_ident(c)).map(char::from).collect();
+                let (line, _) = place(text, end + at_fn);
+                tests.push(TestFn { name, line });
+                edits.push((i, end, " ".repeat(end - i)));
+            }
+            i = end;
+            continue;
+        }
+        let after = text[end..].trim_start();
+        let assertion = Assertion::of(word).filter(|_| after.starts_with('('));
+        let declared = text[..i].trim_end().ends_with("fn");
+        match assertion {
+            Some(a) if !declared => {
+                let open = text.len() - after.len();
+                let (close, args) = call_end(text, open).ok_or_else(|| {
+                    let (l, c) = place(text, i);
+                    format!("{l}:{c}: {word}( is not closed")
+                })?;
+                let want: &[usize] = match a {
+                    Assertion::Expect => &[1],
+                    Assertion::Near(_) => &[2, 3],
+                    Assertion::Ulp => &[3],
+                    _ => &[2],
+                };
+                let (line, col) = place(text, i);
+                if !want.contains(&args) {
+                    return Err(format!(
+                        "{line}:{col}: {word} takes {} arguments, not {args}",
+                        want.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" or ")
+                    ));
+                }
+                sites.push(Site { assertion: a, line, col });
+                let site = sites.len();
+                // `expectNear(a, b)` at the default tolerance.
+                let tol = if matches!(a, Assertion::Near(_)) && args == 2 { ", wgsl_test::NEAR_TOL" } else { "" };
+                edits.push((close - 1, close - 1, tol.to_string()));
+                edits.push((i, open + 1, format!("wgsl_test::{word}_at({site}u, ")));
+            }
+            _ => {}
+        }
+        i = end;
+    }
+    if tests.is_empty() {
+        return Err("no @test function".into());
+    }
+    edits.sort_by_key(|e| std::cmp::Reverse(e.0));
+    let mut out = text.to_string();
+    for (s, e, with) in edits {
+        out.replace_range(s..e, &with);
+    }
+    out.push_str("\n#import wgsl_test\n");
+    for (n, t) in tests.iter().enumerate() {
+        out.push_str(&format!(
+            "@compute @workgroup_size(1) fn {}() {{ wgsl_test::begin({n}u); {}(); }}\n",
+            entry(n),
+            t.name
+        ));
+    }
+    Ok(Rewritten { text: out, tests, sites })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn calls_carry_their_place_and_lines_keep_their_numbers() {
+        let text = "#import wgsl_test\n// expectNear(1.0, 2.0) in a comment\n@test\nfn a() {\n  expectNear(f(1.0, 2.0), 0.5);\n  expect(x > (1.0));\n}\n@test fn b() { expectNearV3f(v, w, 1e-3); }\nfn expectEq_like() {}\n";
+        let r = rewrite(text).unwrap();
+        assert_eq!(r.tests, [TestFn { name: "a".into(), line: 4 }, TestFn { name: "b".into(), line: 8 }]);
+        assert_eq!(
+            r.sites,
+            [
+                Site { assertion: Assertion::Near(1), line: 5, col: 3 },
+                Site { assertion: Assertion::Expect, line: 6, col: 3 },
+                Site { assertion: Assertion::Near(3), line: 8, col: 16 },
+            ]
+        );
+        let lines: Vec<&str> = r.text.lines().collect();
+        assert_eq!(lines[1], "// expectNear(1.0, 2.0) in a comment");
+        assert_eq!(lines[2], "     ");
+        assert_eq!(lines[4], "  wgsl_test::expectNear_at(1u, f(1.0, 2.0), 0.5, wgsl_test::NEAR_TOL);");
+        assert_eq!(lines[5], "  wgsl_test::expect_at(2u, x > (1.0));");
+        assert_eq!(lines[7], "      fn b() { wgsl_test::expectNearV3f_at(3u, v, w, 1e-3); }");
+        assert!(r.text.ends_with("fn vista_test_1() { wgsl_test::begin(1u); b(); }\n"), "{}", r.text);
+    }
+
+    #[test]
+    fn a_wrong_argument_count_and_no_test_are_named() {
+        assert_eq!(rewrite("@test fn a() {\n  expect(1, 2);\n}").unwrap_err(), "2:3: expect takes 1 arguments, not 2");
+        assert_eq!(rewrite("fn a() {}").unwrap_err(), "no @test function");
+    }
+}
