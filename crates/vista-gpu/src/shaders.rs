@@ -226,9 +226,10 @@ impl ShaderSet {
         &self.label
     }
 
-    /// Every kernel file (not `lib/`), relative names, sorted.
+    /// Every kernel file (not `lib/`, not a WGSL unit test's
+    /// `*.test.wgsl`), relative names, sorted.
     pub fn kernel_files(&self) -> Vec<String> {
-        self.kernels.keys().cloned().collect()
+        self.kernels.keys().filter(|k| !k.ends_with(".test.wgsl")).cloned().collect()
     }
 
     /// `name` is a kernel file, optionally followed by `?DEF&DEF...`: naga_oil
