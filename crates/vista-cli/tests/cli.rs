@@ -6287,6 +6287,11 @@ fn wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends() {
                  @test fn twenty_failures() {\n    for (var i = 0u; i < 20u; i++) {\n        expectEqU(i, 100u);\n    }\n}\n";
     std::fs::write(d.path().join("shaders/lib/phase.test.wgsl"), phase).unwrap();
     std::fs::write(d.path().join("shaders/broken.test.wgsl"), "@test\nfn t() {\n    let x = nope;\n}\n").unwrap();
+    // Each test its own zeroed @buffer: the first test's write is not seen by the second.
+    let buffers = "#import wgsl_test::{expectNear}\n@buffer var<storage, read_write> data: array<f32, 4>;\n\
+                   @test fn write_and_read() {\n    data[0] = 42.0;\n    expectNear(data[0], 42.0);\n}\n\
+                   @test fn starts_zeroed() {\n    expectNear(data[0], 0.0);\n}\n";
+    std::fs::write(d.path().join("shaders/buf.test.wgsl"), buffers).unwrap();
     for backend in ["lavapipe", "swiftshader", "browser"] {
         let r = vista_in(Some(d.path()), &[("VISTA_BACKEND", backend)], &["test"]);
         let lines: Vec<&str> = r.stdout.lines().collect();
@@ -6306,7 +6311,10 @@ fn wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends() {
         assert!(twenty[16].ends_with("and 4 more failed assertions"), "{}", twenty[16]);
         let broken = lines.iter().find(|l| l.starts_with("FAIL   wgsl::broken::t: ")).expect("the broken file's test");
         assert!(broken.contains("broken.test.wgsl:3: ") && broken.contains("nope"), "{backend}: {broken}");
-        assert!(r.stdout.contains("1 passed, 3 failed"), "{backend}: {}", r.stdout);
+        for ok in ["wgsl::buf::write_and_read", "wgsl::buf::starts_zeroed"] {
+            assert!(lines.contains(&format!("ok     {ok}").as_str()), "{backend}: {}", r.stdout);
+        }
+        assert!(r.stdout.contains("3 passed, 3 failed"), "{backend}: {}", r.stdout);
     }
     let one = vista_in(Some(d.path()), &[], &["test", "isotropic"]);
     assert_eq!((one.code, one.stdout.lines().count()), (0, 2), "{}", one.stdout);

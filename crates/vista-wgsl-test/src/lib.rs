@@ -13,7 +13,7 @@
 
 mod rewrite;
 
-pub use rewrite::{Assertion, Rewritten, Site, TestFn, entry, rewrite};
+pub use rewrite::{Assertion, BUFFER_GROUP, Rewritten, Site, TestBuffer, TestFn, entry, rewrite};
 
 use vista_render::{OutputValue, Renderer};
 
@@ -89,16 +89,29 @@ pub fn list(rel: &str, text: &str) -> Result<Vec<String>, String> {
     Ok(rewrite(text)?.tests.iter().map(|t| test_id(rel, &t.name)).collect())
 }
 
-/// The manifest of file `rel` rewritten: one pass per test, the results
-/// buffer its output.
-fn manifest(rel: &str, tests: usize) -> String {
+/// The manifest of file `rel` rewritten: one pass per test, each with its
+/// own zeroed copy of every `@buffer`, the results buffer the output.
+fn manifest(rel: &str, rewritten: &Rewritten) -> String {
+    let tests = rewritten.tests.len();
     let mut m = format!(
         "summary = \"the WGSL tests of {rel}\"\nshader = \"{rel}\"\n\n[[resource]]\nname = \"wgsl_test_results\"\n\
          kind = \"buffer\"\nlength = {}\n",
         tests * ROW
     );
     for i in 0..tests {
+        for b in &rewritten.buffers {
+            m.push_str(&format!(
+                "\n[[resource]]\nname = \"{}__{i}\"\nkind = \"buffer\"\nlength = {}\n",
+                b.name, b.length
+            ));
+        }
+    }
+    for i in 0..tests {
+        let bind: Vec<String> = rewritten.buffers.iter().map(|b| format!("{0} = \"{0}__{i}\"", b.name)).collect();
         m.push_str(&format!("\n[[pass]]\nentry = \"{}\"\nworkgroups = [1, 1, 1]\n", entry(i)));
+        if !bind.is_empty() {
+            m.push_str(&format!("bind = {{ {} }}\n", bind.join(", ")));
+        }
     }
     m.push_str("\n[[output]]\nresource = \"wgsl_test_results\"\n");
     m
@@ -125,7 +138,7 @@ pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, tex
         root: base.root.clone(),
     };
     let name = format!("wgsl-test-{}", rel.replace(['/', '.'], "-"));
-    let kernel = match vista_manifest::Kernel::from_manifest(&name, rel, &manifest(rel, ids.len())) {
+    let kernel = match vista_manifest::Kernel::from_manifest(&name, rel, &manifest(rel, &rewritten)) {
         Ok(k) => k,
         Err(e) => return all_fail(e.to_string()),
     };

@@ -70,6 +70,41 @@ pub struct Rewritten {
     pub tests: Vec<TestFn>,
     /// Every assertion call; site id i is `sites[i - 1]` (0: none).
     pub sites: Vec<Site>,
+    /// The `@buffer` storage variables: each test gets its own, zeroed.
+    pub buffers: Vec<TestBuffer>,
+}
+
+/// A `@buffer var<storage, read_write> name: T;` of a test file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TestBuffer {
+    /// The variable's name.
+    pub name: String,
+    /// Elements: N of `array<E, N>`, else 1.
+    pub length: u64,
+}
+
+/// The group vista binds a test file's `@buffer`s at, one binding each.
+pub const BUFFER_GROUP: u32 = 2;
+
+/// A `@buffer` declaration from just after the attribute: the variable's
+/// name and length, or what is wrong with it.
+fn buffer_decl(decl: &str) -> Result<TestBuffer, String> {
+    let decl = decl.split(';').next().unwrap_or_default();
+    let rest = decl.trim_start().strip_prefix("var<").ok_or("@buffer declares a var<storage, ...>")?;
+    let (space, rest) = rest.split_once('>').ok_or("@buffer's var<...> is not closed")?;
+    if !space.trim_start().starts_with("storage") {
+        return Err(format!("@buffer declares a storage buffer, not var<{space}>"));
+    }
+    let (name, ty) = rest.split_once(':').ok_or("@buffer's variable has no type")?;
+    let (name, ty) = (name.trim(), ty.trim());
+    let length = match ty.strip_prefix("array<").and_then(|a| a.strip_suffix('>')) {
+        None => 1,
+        Some(inner) => match inner.rsplit_once(',').map(|(_, n)| n.trim().trim_end_matches(['u', 'i'])) {
+            Some(n) => n.parse().map_err(|_| format!("@buffer {name}: array length {n} is not a number"))?,
+            None => return Err(format!("@buffer {name}: {ty} has no size; give it one (array<T, N>)")),
+        },
+    };
+    Ok(TestBuffer { name: name.to_string(), length })
 }
 
 /// The compute entry vista appends for test `i`.
@@ -153,7 +188,7 @@ pub fn rewrite(text: &str) -> Result<Rewritten, String> {
     let in_comment = |at: usize| comments.iter().any(|&(s, e)| at >= s && at < e);
     let b = text.as_bytes();
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
-    let (mut tests, mut sites) = (Vec::new(), Vec::new());
+    let (mut tests, mut sites, mut buffers) = (Vec::new(), Vec::new(), Vec::<TestBuffer>::new());
     let mut i = 0;
     while i < b.len() {
         if in_comment(i) || !(b[i] == b'@' || is_ident(b[i])) || (i > 0 && (is_ident(b[i - 1]) || b[i - 1] == b':')) {
@@ -177,6 +212,13 @@ pub fn rewrite(text: &str) -> Result<Rewritten, String> {
                 let (line, _) = place(text, end + at_fn);
                 tests.push(TestFn { name, line });
                 edits.push((i, end, " ".repeat(end - i)));
+            } else if word == "buffer" {
+                let buffer = buffer_decl(&text[end..]).map_err(|e| {
+                    let (l, c) = place(text, i);
+                    format!("{l}:{c}: {e}")
+                })?;
+                edits.push((i, end, format!("@group({BUFFER_GROUP}) @binding({})", buffers.len())));
+                buffers.push(buffer);
             }
             i = end;
             continue;
@@ -224,14 +266,17 @@ pub fn rewrite(text: &str) -> Result<Rewritten, String> {
         out.replace_range(s..e, &with);
     }
     out.push_str("\n#import wgsl_test\n");
+    // Each entry reaches every buffer (a phony use), so that each pass binds
+    // its test's own copies whether or not the test touches them.
+    let reach: String = buffers.iter().map(|b| format!("_ = {}; ", b.name)).collect();
     for (n, t) in tests.iter().enumerate() {
         out.push_str(&format!(
-            "@compute @workgroup_size(1) fn {}() {{ wgsl_test::begin({n}u); {}(); }}\n",
+            "@compute @workgroup_size(1) fn {}() {{ {reach}wgsl_test::begin({n}u); {}(); }}\n",
             entry(n),
             t.name
         ));
     }
-    Ok(Rewritten { text: out, tests, sites })
+    Ok(Rewritten { text: out, tests, sites, buffers })
 }
 
 #[cfg(test)]
@@ -258,6 +303,21 @@ mod tests {
         assert_eq!(lines[5], "  wgsl_test::expect_at(2u, x > (1.0));");
         assert_eq!(lines[7], "      fn b() { wgsl_test::expectNearV3f_at(3u, v, w, 1e-3); }");
         assert!(r.text.ends_with("fn vista_test_1() { wgsl_test::begin(1u); b(); }\n"), "{}", r.text);
+    }
+
+    #[test]
+    fn buffers_get_a_binding_and_their_length() {
+        let text = "@buffer var<storage, read_write> data: array<f32, 4>;\n@buffer var<storage, read_write> n: u32;\n\
+                    @test fn a() { data[0] = 1.0; }\n";
+        let r = rewrite(text).unwrap();
+        assert_eq!(
+            r.buffers,
+            [TestBuffer { name: "data".into(), length: 4 }, TestBuffer { name: "n".into(), length: 1 }]
+        );
+        assert!(r.text.starts_with("@group(2) @binding(0) var<storage, read_write> data"), "{}", r.text);
+        assert!(r.text.contains("fn vista_test_0() { _ = data; _ = n; wgsl_test::begin(0u); a(); }"), "{}", r.text);
+        let sizeless = rewrite("@buffer var<storage, read_write> d: array<f32>;\n@test fn a() {}").unwrap_err();
+        assert_eq!(sizeless, "1:1: @buffer d: array<f32> has no size; give it one (array<T, N>)");
     }
 
     #[test]
