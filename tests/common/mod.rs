@@ -123,7 +123,7 @@ pub fn with_edit(gpu: &Renderer<'static>, file: &str, from: &str, to: &str) -> R
     })
     .expect("the checkout's shaders");
     // In this process: the edit is not a file a worker could rebuild.
-    Renderer { ctx: gpu.ctx, worker: None, edit: None, shaders, limits: gpu.limits, root: gpu.root.clone() }
+    Renderer { ctx: gpu.ctx, worker: None, edits: Vec::new(), shaders, limits: gpu.limits, root: gpu.root.clone() }
 }
 
 /// Runs a file's GPU test functions, each named by itself (see

@@ -6321,6 +6321,48 @@ fn wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends() {
     assert!(one.stdout.contains("1 passed, 0 failed"), "{}", one.stdout);
 }
 
+/// `vista mutate` runs the project's unit tests after the goldens: a
+/// mutant in a helper the golden case cannot see (twice(0.0) is 0 for
+/// x + x and x - x alike) survives the goldens and is killed by the unit
+/// test that calls twice(3.0); without the test file it survives.
+fn mutate_counts_a_mutant_a_unit_test_kills() {
+    let manifest = "summary = \"a level through a helper at zero\"\n[[resource]]\nname = \"out\"\nkind = \"texture\"\n\
+                    format = \"r32float\"\n[[pass]]\nentry = \"main\"\n[[output]]\nresource = \"out\"\n";
+    let shader = "#import app::twice::{twice}\n@group(0) @binding(0) var out: texture_storage_2d<r32float, write>;\n\
+                  @compute @workgroup_size(8, 8, 1)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                  \x20   if any(id.xy >= textureDimensions(out)) { return; }\n\
+                  \x20   textureStore(out, id.xy, vec4(0.5 + twice(0.0), 0.0, 0.0, 1.0));\n}\n";
+    let d = kernel_project(manifest, shader);
+    std::fs::create_dir_all(d.path().join("shaders/lib")).unwrap();
+    let helper = "#define_import_path app::twice\n\nfn twice(x: f32) -> f32 {\n    return x + x;\n}\n";
+    std::fs::write(d.path().join("shaders/lib/twice.wgsl"), helper).unwrap();
+    let unit = "#import app::twice::{twice}\n#import wgsl_test::{expectNear}\n\n@test fn twice_of_three() {\n\
+                \x20   expectNear(twice(3.0), 6.0);\n}\n";
+    let test_file = d.path().join("shaders/lib/twice.test.wgsl");
+    std::fs::write(&test_file, unit).unwrap();
+    std::fs::create_dir(d.path().join("golden")).unwrap();
+    std::fs::write(cases_path(d.path()), "[[case]]\nid = \"flat\"\nkernel = \"k\"\nsize = \"8x8\"\n").unwrap();
+    assert_eq!(vista_in(Some(d.path()), &[], &["bless"]).code, 0);
+    let minus = |d: &Path| {
+        let out = d.join("m.json");
+        let r = vista_in(Some(d), &[], &["mutate", "--json", out.to_str().unwrap()]);
+        assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let m = v["mutants"].as_array().unwrap().iter().find(|m| m["file"] == "lib/twice.wgsl" && m["after"] == "-");
+        m.cloned().unwrap_or_else(|| panic!("no x - x mutant in {v}"))
+    };
+    let m = minus(d.path());
+    assert_eq!(
+        (m["outcome"].as_str(), m["killed_by"].as_str()),
+        (Some("killed"), Some("wgsl::twice::twice_of_three")),
+        "{m}"
+    );
+    let reason = m["reason"].as_str().unwrap_or_default();
+    assert!(reason.contains("twice.test.wgsl:5:5: expectNear(actual 0, expected 6"), "{reason}");
+    std::fs::remove_file(&test_file).unwrap();
+    assert_eq!(minus(d.path())["outcome"], "survived", "the goldens alone cannot see it");
+}
+
 fn main() {
     // Each test's name is its function's name, written once.
     macro_rules! tests {
@@ -6331,6 +6373,7 @@ fn main() {
     let tests: &[(Needs, &str, fn())] = tests![
         Cpu unknown_kernel_lists_valid_kernels,
         Gpu wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends,
+        Gpu mutate_counts_a_mutant_a_unit_test_kills,
         Cpu no_tracked_file_cites_an_issue_or_session_number,
         Cpu unknown_preset_lists_valid_presets,
         Cpu unknown_param_lists_valid_params,

@@ -42,7 +42,8 @@ pub struct MutantReport {
     pub mutant: Mutant,
     /// killed | survived | timeout | stillborn.
     pub outcome: String,
-    /// The case id, or `cpu-reference`, that killed it.
+    /// The case id, `cpu-reference`, or the unit test (`wgsl::<file>::<fn>`)
+    /// that killed it.
     pub killed_by: Option<String>,
     /// What the killer saw: the first problem of the case's verdict, or the
     /// agreement setting and its figures.
@@ -477,6 +478,9 @@ pub struct Judge<'a> {
     sources: vista_render::Sources,
     texts: BTreeMap<String, String>,
     baselines: BTreeMap<String, Baseline<'a>>,
+    /// The project's WGSL unit test files (`*.test.wgsl`), each `(path
+    /// under shaders/, text)`: a detector after the goldens.
+    unit_tests: Vec<(String, String)>,
 }
 
 impl<'a> Judge<'a> {
@@ -503,7 +507,22 @@ impl<'a> Judge<'a> {
                 baselines.insert(p.kernel.name().to_string(), b);
             }
         }
-        Ok(Judge { base, store, manifest, sources, texts, baselines })
+        let unit_tests: Vec<(String, String)> =
+            texts.iter().filter(|(rel, _)| rel.ends_with(".test.wgsl")).map(|(r, t)| (r.clone(), t.clone())).collect();
+        // As with the goldens: a unit test failing unmutated would kill
+        // every mutant, so the suite must pass first.
+        for (rel, text) in &unit_tests {
+            for r in vista_wgsl_test::run_file(base, &sources, rel, text) {
+                if !r.passed() {
+                    return Err(GoldenError::BadInput(format!(
+                        "unit test {} fails before any mutation ({}); fix it before mutating (vista test)",
+                        r.id,
+                        r.explain().join("; ")
+                    )));
+                }
+            }
+        }
+        Ok(Judge { base, store, manifest, sources, texts, baselines, unit_tests })
     }
 
     /// One planned mutant judged: its file mutated in memory, then every
@@ -514,12 +533,27 @@ impl<'a> Judge<'a> {
         let gpu = Renderer {
             ctx: self.base.ctx,
             worker: self.base.worker.clone(),
-            edit: Some((m.file.clone(), text.clone())),
+            edits: vec![(m.file.clone(), text.clone())],
             shaders: self.sources.with_file("mutant", &m.file, text),
             limits: self.base.limits,
             root: self.base.root.clone(),
         };
-        judge(&gpu, self.store, &self.manifest, &p.kernel, &self.baselines[p.kernel.name()], m)
+        let mut report = judge(&gpu, self.store, &self.manifest, &p.kernel, &self.baselines[p.kernel.name()], m);
+        if report.outcome == "survived" {
+            // The unit tests, after the goldens: the first failing test kills it.
+            for (rel, text) in &self.unit_tests {
+                let results = vista_wgsl_test::run_file(&gpu, &self.sources, rel, text);
+                report.cases_run += results.len();
+                if let Some(r) = results.iter().find(|r| !r.passed()) {
+                    report.outcome = "killed".into();
+                    report.killed_by = Some(r.id.clone());
+                    report.reason = r.explain().into_iter().next();
+                    report.equivalent = false;
+                    break;
+                }
+            }
+        }
+        report
     }
 }
 

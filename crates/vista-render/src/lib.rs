@@ -166,9 +166,9 @@ pub struct Renderer<'a> {
     /// Where its graphs run instead, when GPU work runs in a worker process
     /// ([`worker`]); the context then only describes the device.
     pub worker: Option<std::sync::Arc<worker::Worker>>,
-    /// The one file of the project `shaders` replaces (a mutant), so a
-    /// worker can compose the same set.
-    pub edit: Option<(String, String)>,
+    /// The files of the project `shaders` replaces (a mutant, a unit test
+    /// file's rewrite), so a worker can compose the same set.
+    pub edits: Vec<(String, String)>,
     /// The project's WGSL over the built-ins.
     pub shaders: ShaderSet,
     /// Bounds every render is held to.
@@ -203,7 +203,7 @@ impl<'a> Renderer<'a> {
         limits: RenderLimits,
         root: Option<std::path::PathBuf>,
     ) -> Renderer<'a> {
-        Renderer { ctx, worker: worker::Worker::for_config(ctx.config()), edit: None, shaders, limits, root }
+        Renderer { ctx, worker: worker::Worker::for_config(ctx.config()), edits: Vec::new(), shaders, limits, root }
     }
 
     /// A renderer on the process's shared context (made from `gpu` on
@@ -424,7 +424,7 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
     gpu.ctx.require_graph(&graph, &plan.names)?;
     let out = match &gpu.worker {
         Some(w) => {
-            let source = worker::ShaderSource { root: gpu.root.clone(), edit: gpu.edit.clone() };
+            let source = worker::ShaderSource { root: gpu.root.clone(), edits: gpu.edits.clone() };
             let case = CASE.with(|c| c.borrow().clone());
             w.run(gpu.ctx, &graph, &source, &plan.kernel, case.as_deref())?
         }

@@ -44,18 +44,25 @@ impl Sources {
     /// `shaders/`, or relative to the root for a file a `[source]` reaches
     /// outside it).
     pub fn with_file(&self, label: &str, rel: &str, text: String) -> ShaderSet {
+        self.with_files(label, &[(rel.to_string(), text)])
+    }
+
+    /// The set with each `(rel, text)` of `edits` replacing its file (as
+    /// [`Sources::with_file`]): a mutant and a unit test file's rewrite at once.
+    pub fn with_files(&self, label: &str, edits: &[(String, String)]) -> ShaderSet {
+        let edited = |rel: &str| edits.iter().find(|(r, _)| r == rel).map(|(_, t)| t.clone());
         let files: Vec<(String, String, String)> = self
             .files
             .iter()
-            .map(|f| match f.0 == rel {
-                true => (f.0.clone(), text.clone(), f.2.clone()),
-                false => f.clone(),
+            .map(|f| match edited(&f.0) {
+                Some(text) => (f.0.clone(), text, f.2.clone()),
+                None => f.clone(),
             })
             .collect();
-        let (read, edited) = (self.reader.clone(), rel.to_string());
-        let reader = vista_gpu::Reader::new(move |path| match path == edited {
-            true => read.read(path).map(|(_, origin)| (text.clone(), origin)),
-            false => read.read(path),
+        let (read, edits) = (self.reader.clone(), edits.to_vec());
+        let reader = vista_gpu::Reader::new(move |path| match edits.iter().find(|(r, _)| r == path) {
+            Some((_, text)) => read.read(path).map(|(_, origin)| (text.clone(), origin)),
+            None => read.read(path),
         });
         ShaderSet::from_files(label, files)
             .with_enums(self.enums.iter().cloned())

@@ -61,13 +61,14 @@ impl Fault {
 }
 
 /// How the worker rebuilds the parent's shaders: the project root (none:
-/// the built-ins alone) and the one file a mutant replaces.
+/// the built-ins alone) and the files a mutant or a unit test replaces.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct ShaderSource {
     /// The project root.
     pub root: Option<PathBuf>,
-    /// A file's path (as `Sources::with_file` takes it) and its text.
-    pub edit: Option<(String, String)>,
+    /// Files replaced, each a path (as `Sources::with_file` takes it) and
+    /// its text: a mutant, a unit test file's rewrite.
+    pub edits: Vec<(String, String)>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -396,9 +397,9 @@ fn shader_set(
         *cache = Some((source.root.clone(), crate::Sources::of(&project)?));
     }
     let sources = &cache.as_ref().expect("just filled").1;
-    Ok(match &source.edit {
-        None => sources.shader_set(),
-        Some((rel, text)) => sources.with_file("mutant", rel, text.clone()),
+    Ok(match source.edits.is_empty() {
+        true => sources.shader_set(),
+        false => sources.with_files("edited", &source.edits),
     })
 }
 

@@ -129,11 +129,14 @@ pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, tex
     };
     let ids: Vec<String> = rewritten.tests.iter().map(|t| test_id(rel, &t.name)).collect();
     let all_fail = |e: String| ids.iter().map(|id| broken(id, e.clone())).collect();
+    // The base's own edits (a mutant under test) stay.
+    let mut edits = base.edits.clone();
+    edits.push((rel.to_string(), rewritten.text.clone()));
     let gpu = Renderer {
         ctx: base.ctx,
         worker: base.worker.clone(),
-        edit: Some((rel.to_string(), rewritten.text.clone())),
-        shaders: sources.with_file("wgsl tests", rel, rewritten.text.clone()),
+        shaders: sources.with_files("wgsl tests", &edits),
+        edits,
         limits: base.limits,
         root: base.root.clone(),
     };
