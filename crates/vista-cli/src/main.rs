@@ -114,6 +114,9 @@ enum Command {
     Test {
         /// Only the tests whose id (`wgsl::<file>::<fn>`) contains this.
         filter: Option<String>,
+        /// Every test on lavapipe, swiftshader and browser: one test x backend table.
+        #[arg(long)]
+        matrix: bool,
     },
     /// Check the cases, then re-check the ones a saved file reaches (WGSL,
     /// kernel manifests, golden/) and rewrite the report, until interrupted.
@@ -369,7 +372,7 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             watch::watch(project, config, case.as_deref(), watch::interval(interval)?, timeout)
         }
         Command::List { names } => list::run(project, names),
-        Command::Test { filter } => unit_tests::test(project, config, filter.as_deref()),
+        Command::Test { filter, matrix } => unit_tests::test(project, config, filter.as_deref(), matrix),
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             render::render(project, config, render::Args { kernel, preset, set, size, crop, zoom, out })
         }

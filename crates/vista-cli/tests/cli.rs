@@ -6316,6 +6316,12 @@ fn wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends() {
         }
         assert!(r.stdout.contains("3 passed, 3 failed"), "{backend}: {}", r.stdout);
     }
+    let m = vista_in(Some(d.path()), &[], &["test", "--matrix"]);
+    assert_eq!(m.code, 1, "{}", m.stdout);
+    assert!(m.stdout.contains("matrix: 6 tests x 3 backends, 9 failed, 0 backend(s) skipped"), "{}", m.stdout);
+    let row = m.stdout.lines().find(|l| l.starts_with("wgsl::phase::isotropic_is_one_over_four_pi")).unwrap();
+    assert_eq!(row.split_whitespace().skip(1).collect::<Vec<_>>(), ["ok", "ok", "ok"], "{row}");
+    assert!(m.stdout.contains("- FAIL wgsl::phase::deliberately_wrong on browser: shaders/lib/phase.test.wgsl:13:5:"));
     let one = vista_in(Some(d.path()), &[], &["test", "isotropic"]);
     assert_eq!((one.code, one.stdout.lines().count()), (0, 2), "{}", one.stdout);
     assert!(one.stdout.contains("1 passed, 0 failed"), "{}", one.stdout);
