@@ -6369,6 +6369,40 @@ fn mutate_counts_a_mutant_a_unit_test_kills() {
     assert_eq!(minus(d.path())["outcome"], "survived", "the goldens alone cannot see it");
 }
 
+/// `[source] modules`: a module of constants the host generates, imported
+/// by naga_oil as `#import constants`: a binding index and values from it
+/// render 0.625 + 0.25 on every texel, on all three backends; a value of
+/// the wrong kind, and two kernels giving one module different constants,
+/// are refused before GPU work.
+fn generated_modules_give_constants_to_bindings_and_code() {
+    let manifest = "summary = \"a level from a generated module\"\n[source]\n\
+                    modules = { constants = { OUT_BINDING = 3, LEVEL = 0.625, BRIGHT = true } }\n\
+                    [[resource]]\nname = \"out\"\nkind = \"texture\"\nformat = \"r32float\"\n\
+                    [[pass]]\nentry = \"main\"\n[[output]]\nresource = \"out\"\n";
+    let shader = "#import constants\n@group(0) @binding(constants::OUT_BINDING) var out: texture_storage_2d<r32float, write>;\n\
+                  @compute @workgroup_size(8, 8, 1)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                  \x20   if any(id.xy >= textureDimensions(out)) { return; }\n    var v = constants::LEVEL;\n\
+                  \x20   if constants::BRIGHT { v = v + 0.25; }\n    textureStore(out, id.xy, vec4(v, 0.0, 0.0, 1.0));\n}\n";
+    let d = kernel_project(manifest, shader);
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let exr = d.path().join(format!("{backend}.exr"));
+        let args = ["render", "k", "--size", "8x8", "--backend", backend, "-o", exr.to_str().unwrap()];
+        let r = vista_in(Some(d.path()), &[], &args);
+        assert_eq!(r.code, 0, "{backend}: {}", r.stderr);
+        let img = vista_image::read_exr(&exr).unwrap();
+        assert!(img.data.iter().all(|p| p[0] == 0.875), "{backend}: {:?}", &img.data[..2]);
+    }
+    let bad = manifest.replace("LEVEL = 0.625", "LEVEL = \"high\"");
+    std::fs::write(d.path().join("kernels/k.toml"), &bad).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", "x.exr"]);
+    assert_rejected(&r, 2, &["[source] modules: constants.LEVEL = \"high\" is not valid"]);
+    std::fs::write(d.path().join("kernels/k.toml"), manifest).unwrap();
+    let other = manifest.replace("LEVEL = 0.625", "LEVEL = 0.5");
+    std::fs::write(d.path().join("kernels/k2.toml"), other).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", "x.exr"]);
+    assert_rejected(&r, 2, &["two kernels generate module constants with different constants"]);
+}
+
 fn main() {
     // Each test's name is its function's name, written once.
     macro_rules! tests {
@@ -6380,6 +6414,7 @@ fn main() {
         Cpu unknown_kernel_lists_valid_kernels,
         Gpu wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends,
         Gpu mutate_counts_a_mutant_a_unit_test_kills,
+        Gpu generated_modules_give_constants_to_bindings_and_code,
         Cpu no_tracked_file_cites_an_issue_or_session_number,
         Cpu unknown_preset_lists_valid_presets,
         Cpu unknown_param_lists_valid_params,

@@ -28,8 +28,10 @@ impl Sources {
             Some(r) => format!("project {}", r.display()),
             None => "built-in shaders".to_string(),
         };
-        let files = project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin)).collect();
+        let mut files: Vec<(String, String, String)> =
+            project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin)).collect();
         let (specs, reader) = source_specs(project)?;
+        files.extend(generated_modules(&specs)?);
         Ok(Sources { label, files, enums: enum_modules(project)?, specs, reader })
     }
 
@@ -68,6 +70,29 @@ impl Sources {
             .with_enums(self.enums.iter().cloned())
             .with_sources(self.specs.iter().cloned(), reader)
     }
+}
+
+/// The modules the kernels' `[source] modules` generate, as import-module
+/// files (`<generated>/<path>.wgsl`). One import path is one module in a
+/// project: two kernels that give it different constants are refused.
+fn generated_modules(
+    specs: &[(String, vista_source::SourceSpec)],
+) -> Result<Vec<(String, String, String)>, RenderError> {
+    let mut out: Vec<(String, String, String)> = Vec::new();
+    for (name, text) in specs.iter().flat_map(|(_, s)| &s.modules) {
+        let rel = format!("generated/{}.wgsl", name.replace("::", "/"));
+        match out.iter().find(|(r, _, _)| *r == rel) {
+            Some((_, other, _)) if other != text => {
+                return Err(RenderError::BadInput(format!(
+                    "[source] modules: two kernels generate module {name} with different constants; one import \
+                     path is one module in a project (rename one)"
+                )));
+            }
+            Some(_) => {}
+            None => out.push((rel, text.clone(), format!("<generated>/{name}.wgsl ([source] modules)"))),
+        }
+    }
+    Ok(out)
 }
 
 /// Every kernel's `[source]` assemblies, by id (SPEC 16), and a reader of

@@ -25,10 +25,51 @@ pub struct SourceSpec {
     /// WESL packages: an import's first name -> its folder
     /// (`bevy_render = "shaders/bevy_render"`).
     pub packages: Vec<(String, String)>,
+    /// Modules the host generates (`modules = { constants = { N = 3 } }`):
+    /// each import path with its WGSL text, one `const` per entry.
+    pub modules: Vec<(String, String)>,
 }
 
 /// The keys a `[source]` table may have.
-pub const KEYS: [&str; 5] = ["include", "prepend", "append", "replace", "packages"];
+pub const KEYS: [&str; 6] = ["include", "prepend", "append", "replace", "packages", "modules"];
+
+/// A `modules` entry: `name = { CONST = value, ... }` as the WGSL module
+/// `#define_import_path name` of typed `const`s: a non-negative integer a
+/// u32 (an engine's binding index), a negative one an i32, a number an
+/// f32, a bool a bool. (naga drops abstract-typed consts from a module, so
+/// an importer would not find them.)
+fn module_text(name: &str, v: &toml::Value) -> Result<String, String> {
+    let ident = |w: &str| {
+        w.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+            && w.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+    };
+    if !name.split("::").all(ident) {
+        return Err(format!("[source] modules: {name} is not a module path (names joined by ::)"));
+    }
+    let table = v.as_table().ok_or_else(|| {
+        format!("[source] modules: {name} = {v} is not valid; expected a table {{ NAME = number or bool }}")
+    })?;
+    let mut text = format!("#define_import_path {name}\n");
+    for (key, value) in table {
+        if !ident(key) {
+            return Err(format!("[source] modules: {name}.{key} is not a WGSL name"));
+        }
+        let literal = match value {
+            toml::Value::Integer(i) if u32::try_from(*i).is_ok() => format!("u32 = {i}u"),
+            toml::Value::Integer(i) if i32::try_from(*i).is_ok() => format!("i32 = {i}i"),
+            toml::Value::Float(f) if f.is_finite() && (f.abs() as f32).is_finite() => format!("f32 = {f:?}"),
+            toml::Value::Boolean(b) => format!("bool = {b}"),
+            other => {
+                return Err(format!(
+                    "[source] modules: {name}.{key} = {other} is not valid; expected an integer (i32 or u32), a \
+                     number an f32 holds, or a bool"
+                ));
+            }
+        };
+        text.push_str(&format!("const {key}: {literal};\n"));
+    }
+    Ok(text)
+}
 
 impl SourceSpec {
     /// Parses a `[source]` table; errors name the key and what is allowed.
@@ -102,12 +143,22 @@ impl SourceSpec {
                 return Err(format!("[source] packages = {other} is not valid; expected {{ name = \"folder\" }}"));
             }
         }
+        let modules = match t.get("modules") {
+            None => Vec::new(),
+            Some(toml::Value::Table(m)) => {
+                m.iter().map(|(name, v)| Ok((name.clone(), module_text(name, v)?))).collect::<Result<_, String>>()?
+            }
+            Some(other) => {
+                return Err(format!("[source] modules = {other} is not valid; expected {{ module = {{ NAME = 1 }} }}"));
+            }
+        };
         Ok(SourceSpec {
             include: paths("include")?,
             prepend: paths("prepend")?,
             append: paths("append")?,
             replace,
             packages,
+            modules,
         })
     }
 
@@ -123,6 +174,7 @@ impl SourceSpec {
             append: pass.append.clone().or_else(|| self.append.clone()),
             replace,
             packages: if pass.packages.is_empty() { self.packages.clone() } else { pass.packages.clone() },
+            modules: if pass.modules.is_empty() { self.modules.clone() } else { pass.modules.clone() },
         }
     }
 
@@ -134,7 +186,17 @@ impl SourceSpec {
     /// A short stable name for this spec: composed names carry it, so one
     /// module is composed per distinct (file, defs, source) set.
     pub fn id(&self) -> String {
-        blake3::hash(format!("{self:?}").as_bytes()).to_hex()[..8].to_string()
+        // The text hashed before `modules` existed, so that a spec without
+        // them keeps its id (and its composed name).
+        let SourceSpec { include, prepend, append, replace, packages, modules } = self;
+        let mut text = format!(
+            "SourceSpec {{ include: {include:?}, prepend: {prepend:?}, append: {append:?}, replace: {replace:?}, \
+             packages: {packages:?} }}"
+        );
+        if !modules.is_empty() {
+            text.push_str(&format!("{modules:?}"));
+        }
+        blake3::hash(text.as_bytes()).to_hex()[..8].to_string()
     }
 
     /// The params its replacements read, in order.
@@ -146,5 +208,61 @@ impl SourceSpec {
                 Replacement::Text(_) => None,
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The spec as it was before `modules`: its derived Debug text is what
+    /// ids hashed then.
+    mod before {
+        #[derive(Debug)]
+        #[allow(dead_code)]
+        pub struct SourceSpec {
+            pub include: Option<Vec<String>>,
+            pub prepend: Option<Vec<String>>,
+            pub append: Option<Vec<String>>,
+            pub replace: Vec<(String, super::Replacement)>,
+            pub packages: Vec<(String, String)>,
+        }
+    }
+
+    #[test]
+    fn a_spec_without_modules_keeps_its_id_and_modules_change_it() {
+        let t: toml::Table = toml::from_str("include = [\"shaders/inc\"]\nreplace = { \"{N}\" = \"4\" }\n").unwrap();
+        let spec = SourceSpec::parse(&t).unwrap();
+        let old = before::SourceSpec {
+            include: spec.include.clone(),
+            prepend: None,
+            append: None,
+            replace: spec.replace.clone(),
+            packages: Vec::new(),
+        };
+        assert_eq!(spec.id(), blake3::hash(format!("{old:?}").as_bytes()).to_hex()[..8].to_string());
+        let t: toml::Table = toml::from_str(
+            "include = [\"shaders/inc\"]\nreplace = { \"{N}\" = \"4\" }\nmodules = { constants = { LUT = 3, GAIN = 0.5, ON = true } }\n",
+        )
+        .unwrap();
+        let with = SourceSpec::parse(&t).unwrap();
+        assert_ne!(with.id(), spec.id());
+        assert_eq!(
+            with.modules,
+            [(
+                "constants".to_string(),
+                "#define_import_path constants\nconst LUT: u32 = 3u;\nconst GAIN: f32 = 0.5;\nconst ON: bool = true;\n"
+                    .to_string()
+            )]
+        );
+    }
+
+    #[test]
+    fn bad_modules_are_named() {
+        let err = |text: &str| SourceSpec::parse(&toml::from_str(text).unwrap()).unwrap_err();
+        assert!(err("modules = { c = { X = \"a\" } }").contains("modules: c.X = \"a\" is not valid"));
+        assert!(err("modules = { c = { X = 5000000000 } }").contains("expected an integer (i32 or u32)"));
+        assert!(err("modules = { \"a b\" = { X = 1 } }").contains("a b is not a module path"));
+        assert!(err("modules = { c = { \"1x\" = 1 } }").contains("c.1x is not a WGSL name"));
     }
 }
