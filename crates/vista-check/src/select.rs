@@ -34,6 +34,14 @@ pub fn select<'c>(
 ) -> Result<(Vec<&'c Case>, Option<String>), GoldenError> {
     let mut picked = vista_golden::select(cases, pick.glob.as_deref())?;
     let all = picked.len();
+    // A def a case sets that no shader reads is refused before any case runs.
+    if picked.iter().any(|c| !c.params.defs().is_empty()) {
+        let shaders = vista_render::shader_set(project)?;
+        for c in picked.iter().filter(|c| !c.params.defs().is_empty()) {
+            vista_render::check_case_defs(&shaders, &c.kernel, &c.params)
+                .map_err(|e| GoldenError::BadInput(format!("case {}: {e}", c.id)))?;
+        }
+    }
     let mut why: Vec<String> = Vec::new();
     if pick.changed {
         let shaders = vista_render::shader_set(project)?;

@@ -3537,6 +3537,14 @@ fn cases_set_defs_and_enum_values_name_them() {
     std::fs::write(cases_path(d.path()), cases.replace("defs = { BRIGHT = true }", "defs = { \"BR IGHT\" = 1 }"))
         .unwrap();
     assert_rejected(&vista_in(Some(d.path()), &[], &["check"]), 2, &["by-def", "'BR IGHT' is not a shader def name"]);
+    // A def no #if of the kernel's files reads changes nothing: refused, naming what they read.
+    std::fs::write(cases_path(d.path()), cases.replace("defs = { BRIGHT = true }", "defs = { BRIHGT = true }"))
+        .unwrap();
+    assert_rejected(
+        &vista_in(Some(d.path()), &[], &["check"]),
+        2,
+        &["defs: BRIHGT is read by no #if, #ifdef or @if of kernel k's shaders; they read: BRIGHT"],
+    );
     let bad_enum = manifest.replace("defs = { bright = \"BRIGHT\" }", "defs = { shiny = \"BRIGHT\" }");
     std::fs::write(d.path().join("kernels/k.toml"), bad_enum).unwrap();
     assert_rejected(

@@ -630,6 +630,35 @@ impl ShaderSet {
         Ok(h.finalize().to_hex()[..16].to_string())
     }
 
+    /// The names the preprocessor lines and WESL `@if`s of the files `name`
+    /// reaches test (`#ifdef X`, `#if X == 1`, `@if(X && !Y)`): the defs it
+    /// reads, so that a def a case sets and nothing reads is refused.
+    pub fn defs_read(&self, name: &str) -> Result<std::collections::BTreeSet<String>, GpuError> {
+        const NOT_DEFS: [&str; 9] = ["if", "ifdef", "ifndef", "else", "elif", "endif", "defined", "true", "false"];
+        let unit = self.unit(name)?;
+        let lib = self.imported_lib(&unit.source)?;
+        let mut out = std::collections::BTreeSet::new();
+        for text in std::iter::once(&unit.source.text).chain(lib.iter().map(|s| &s.text)) {
+            for line in text.lines().map(str::trim_start) {
+                let tests = ["#if", "#else", "#elif"].iter().any(|d| line.starts_with(d))
+                    || line.contains("@if(")
+                    || line.contains("@elif(");
+                if !tests {
+                    continue;
+                }
+                let words = line.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'));
+                out.extend(
+                    words
+                        .filter(|w| {
+                            w.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') && !NOT_DEFS.contains(w)
+                        })
+                        .map(str::to_string),
+                );
+            }
+        }
+        Ok(out)
+    }
+
     /// Each file of [`ShaderSet::import_closure`] with the hash of its text:
     /// recorded at bless time so that a check can name the files that changed.
     pub fn file_hashes(&self, name: &str) -> Result<std::collections::BTreeMap<String, String>, GpuError> {

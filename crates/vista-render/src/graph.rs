@@ -94,6 +94,38 @@ struct PassParts<'a> {
 /// Case-level replacements of resource files (`inputs = { name = "file" }`).
 pub type Inputs = [(String, String)];
 
+/// A def the case sets (`defs = { X = true }`) must be read by a `#if`,
+/// `#ifdef` or `@if` of a file some pass reaches: else it changes nothing
+/// (a typo, or a def of another kernel), and the case is refused naming
+/// it and the defs the files read. WESL passes are compiled before vista
+/// sees their `@if`s, so a kernel with one is not checked.
+pub fn check_case_defs(shaders: &vista_gpu::ShaderSet, kernel: &Kernel, p: &ParamSet) -> Result<(), RenderError> {
+    if p.defs().is_empty() {
+        return Ok(());
+    }
+    let passes = 0..kernel.graph().passes.len();
+    let names: Vec<String> =
+        passes.flat_map(|i| [Some(kernel.pass_shader_for(i, p)), kernel.vertex_shader_for(i, p)]).flatten().collect();
+    let mut read = std::collections::BTreeSet::new();
+    for name in &names {
+        if name.split('|').next().is_some_and(|f| f.ends_with(".wesl")) {
+            return Ok(());
+        }
+        read.extend(shaders.defs_read(name).map_err(|e| RenderError::BadInput(e.to_string()))?);
+    }
+    for def in p.defs().iter().map(|d| d.split_once('=').map_or(d.as_str(), |(name, _)| name)) {
+        if !read.contains(def) {
+            let known: Vec<&str> = read.iter().map(String::as_str).collect();
+            return Err(RenderError::BadInput(format!(
+                "defs: {def} is read by no #if, #ifdef or @if of kernel {}'s shaders; they read: {}",
+                kernel.name(),
+                if known.is_empty() { "none".to_string() } else { known.join(", ") }
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Plans `kernel`'s graph for `p` at `width` x `height` (the case size
 /// that resources without a `size` take), reading input files under
 /// `root` (or the case's `inputs` instead), within `max_bytes` of memory.
@@ -129,6 +161,7 @@ pub(crate) fn plan_graph(
             None => None,
         });
     }
+    check_case_defs(shaders, kernel, p)?;
     let pairs: Vec<(&str, &naga::Module)> =
         files.iter().map(|f| f.as_str()).zip(modules.iter().map(|m| &**m)).collect();
     let vertex_pairs: Vec<Option<(&str, &naga::Module)>> =

@@ -18,7 +18,7 @@ mod sources;
 pub mod worker;
 
 pub use error::{Crash, RenderError};
-pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput};
+pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput, check_case_defs};
 pub use sources::{Sources, edited_shader_set, enum_modules, shader_set, source_specs};
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
