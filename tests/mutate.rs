@@ -1,6 +1,6 @@
 //! `vista mutate` against this checkout's fbm suite: a known-bad mutant is
 //! killed (naming the case that killed it), and a change to a component the
-//! shader never reads is a survivor flagged `equivalent?`.
+//! goldens never read is killed by the unit test that reads it.
 
 mod common;
 
@@ -39,11 +39,18 @@ fn a_known_bad_mutant_is_killed_by_a_golden_case(gpu: &Renderer) {
     assert_eq!(r.cases_run, 1, "stops at the first failure: {r:?}");
 }
 
-fn a_change_the_shader_never_reads_is_equivalent(gpu: &Renderer) {
-    // pcg3d's z component: value noise reads only .x.
+fn a_change_the_goldens_never_read_is_killed_by_the_unit_test_that_does(gpu: &Renderer) {
+    // pcg3d's z component: fbm's value noise reads only .x, so every fbm
+    // case passes; shaders/lib/hash.test.wgsl checks all three words.
     let r = run_one(gpu, "lib/hash.wgsl", "v.z += v.x * v.y;", "*", "/");
-    assert_eq!(r.outcome, "survived", "{r:?}");
-    assert!(r.equivalent, "{r:?}");
+    assert_eq!(r.outcome, "killed", "{r:?}");
+    assert_eq!(r.killed_by.as_deref(), Some("wgsl::hash::pcg3d_of_the_origin"), "{r:?}");
+    let reason = r.reason.as_deref().unwrap_or_default();
+    assert!(
+        reason.contains("hash.test.wgsl:12:5: expectEqU(actual ") && reason.contains("expected 1058359340"),
+        "{r:?}"
+    );
+    assert!(!r.equivalent, "{r:?}");
 }
 
 /// The plan mutates only functions fbm's main reaches: fbm2 and the noise,
@@ -69,7 +76,7 @@ fn only_functions_the_kernel_reaches_are_mutated(_gpu: &Renderer) {
 fn main() {
     common::gpu_tests![
         a_known_bad_mutant_is_killed_by_a_golden_case,
-        a_change_the_shader_never_reads_is_equivalent,
+        a_change_the_goldens_never_read_is_killed_by_the_unit_test_that_does,
         only_functions_the_kernel_reaches_are_mutated,
     ];
 }

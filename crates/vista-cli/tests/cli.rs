@@ -6374,7 +6374,9 @@ fn mutate_counts_a_mutant_a_unit_test_kills() {
     let reason = m["reason"].as_str().unwrap_or_default();
     assert!(reason.contains("twice.test.wgsl:5:5: expectNear(actual 0, expected 6"), "{reason}");
     std::fs::remove_file(&test_file).unwrap();
-    assert_eq!(minus(d.path())["outcome"], "survived", "the goldens alone cannot see it");
+    let alone = minus(d.path());
+    assert_eq!(alone["outcome"], "survived", "the goldens alone cannot see it: {alone}");
+    assert_eq!(alone["equivalent?"], true, "its render is bit-identical: {alone}");
 }
 
 /// `[source] modules`: a module of constants the host generates, imported
