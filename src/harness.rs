@@ -106,10 +106,7 @@ fn wgsl_trials(
     skip: bool,
 ) -> Vec<Trial> {
     type Results = Arc<std::sync::OnceLock<Vec<vista_wgsl_test::TestResult>>>;
-    let files: Vec<(String, String)> = match project.shader_files() {
-        Ok(files) => files.into_iter().filter(|f| f.rel.ends_with(".test.wgsl")).map(|f| (f.rel, f.text)).collect(),
-        Err(e) => fail(&format!("cannot read the shaders: {e}")),
-    };
+    let files = vista_wgsl_test::test_files(project).unwrap_or_else(|e| fail(&format!("cannot read the shaders: {e}")));
     let sources: Arc<std::sync::OnceLock<Result<vista_render::Sources, String>>> = Arc::default();
     let mut trials = Vec::new();
     for (rel, text) in files {

@@ -19,12 +19,7 @@ fn print_result(r: &TestResult) {
 /// The project's test files (`*.test.wgsl` under `shaders/`) holding a
 /// test `filter` picks (a file runs whole), and whether `id` is shown.
 fn picked_files(project: &Project, filter: Option<&str>) -> Result<(Vec<(String, String)>, usize), GoldenError> {
-    let files: Vec<(String, String)> = project
-        .shader_files()?
-        .into_iter()
-        .filter(|f| f.rel.ends_with(".test.wgsl"))
-        .map(|f| (f.rel, f.text))
-        .collect();
+    let files = vista_wgsl_test::test_files(project)?;
     let all = files.len();
     let wanted = |id: &str| filter.is_none_or(|f| id.contains(f));
     let picked = files

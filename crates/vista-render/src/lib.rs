@@ -267,6 +267,21 @@ impl<'a> Renderer<'a> {
     }
 }
 
+/// A composition error's place (`file:line:col`, from the diagnostic's
+/// `┌─` line) and its first message line, for errors shown on one line
+/// (`vista list`, `vista test`).
+pub fn compose_error_parts(text: &str) -> (Option<&str>, &str) {
+    let at = text.lines().find_map(|l| l.trim().strip_prefix("┌─ ")).map(str::trim);
+    let message = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with("error:") || l.contains("not found") || l.contains("failed"))
+        .map(|l| l.trim_start_matches("error:").trim())
+        .find(|l| !l.is_empty())
+        .unwrap_or_else(|| text.lines().next().unwrap_or_default());
+    (at, message)
+}
+
 /// Whether every pass of `kernel` composes at its default params: `Err`
 /// holds the first error on one line (`file:line:col: message`), for
 /// `vista list`.
@@ -275,14 +290,7 @@ pub fn composes(shaders: &ShaderSet, kernel: &Kernel) -> Result<(), String> {
     for name in (0..kernel.graph().passes.len()).map(|i| kernel.pass_shader_for(i, &p)) {
         if let Err(e) = shaders.compose(&name) {
             let text = e.to_string();
-            let at = text.lines().find_map(|l| l.trim().strip_prefix("┌─ ")).map(str::trim);
-            let message = text
-                .lines()
-                .map(str::trim)
-                .filter(|l| l.starts_with("error:") || l.contains("not found") || l.contains("failed"))
-                .map(|l| l.trim_start_matches("error:").trim())
-                .find(|l| !l.is_empty())
-                .unwrap_or_else(|| text.lines().next().unwrap_or_default());
+            let (at, message) = compose_error_parts(&text);
             return Err(match at {
                 Some(at) => format!("{at}: {message}"),
                 None => message.to_string(),

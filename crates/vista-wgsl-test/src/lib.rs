@@ -68,11 +68,16 @@ impl TestResult {
     }
 }
 
-/// The project's test files: `*.test.wgsl` under `shaders/`, as paths
-/// relative to it, sorted.
-pub fn test_files(project: &vista_project::Project) -> Result<Vec<String>, vista_render::RenderError> {
-    let mut files: Vec<String> =
-        project.shader_files()?.into_iter().map(|f| f.rel).filter(|r| r.ends_with(".test.wgsl")).collect();
+/// Whether `rel` (a path under `shaders/`) names a test file.
+pub fn is_test_file(rel: &str) -> bool {
+    rel.ends_with(".test.wgsl")
+}
+
+/// The project's test files (`*.test.wgsl` under `shaders/`): each path
+/// relative to it and its text, in path order.
+pub fn test_files(project: &vista_project::Project) -> Result<Vec<(String, String)>, vista_project::ProjectError> {
+    let mut files: Vec<(String, String)> =
+        project.shader_files()?.into_iter().filter(|f| is_test_file(&f.rel)).map(|f| (f.rel, f.text)).collect();
     files.sort();
     Ok(files)
 }
@@ -176,14 +181,12 @@ pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, tex
 /// A compile error on one line: `path:line: message` (the column is the
 /// rewritten line's, so it is left out), else the error's first line.
 fn one_line(text: &str) -> String {
-    let message = text.lines().find_map(|l| l.trim().strip_prefix("error:")).map(str::trim);
-    let at = text.lines().find_map(|l| l.trim().strip_prefix("┌─ ")).map(str::trim);
-    match (at, message) {
-        (Some(at), Some(m)) => {
+    match vista_render::compose_error_parts(text) {
+        (Some(at), message) => {
             let at = at.rsplit_once(':').map_or(at, |(file_line, _col)| file_line);
-            format!("{at}: {m}")
+            format!("{at}: {message}")
         }
-        _ => text.lines().next().unwrap_or_default().to_string(),
+        (None, _) => text.lines().next().unwrap_or_default().to_string(),
     }
 }
 
