@@ -34,17 +34,18 @@ pub fn select<'c>(
 ) -> Result<(Vec<&'c Case>, Option<String>), GoldenError> {
     let mut picked = vista_golden::select(cases, pick.glob.as_deref())?;
     let all = picked.len();
+    // The project's WGSL, read once, where a case's defs or --changed need it.
+    let with_defs = picked.iter().any(|c| !c.params.defs().is_empty());
+    let shaders = (with_defs || pick.changed).then(|| vista_render::shader_set(project)).transpose()?;
     // A def a case sets that no shader reads is refused before any case runs.
-    if picked.iter().any(|c| !c.params.defs().is_empty()) {
-        let shaders = vista_render::shader_set(project)?;
+    if let Some(shaders) = shaders.as_ref().filter(|_| with_defs) {
         for c in picked.iter().filter(|c| !c.params.defs().is_empty()) {
-            vista_render::check_case_defs(&shaders, &c.kernel, &c.params)
+            vista_render::check_case_defs(shaders, &c.kernel, &c.params)
                 .map_err(|e| GoldenError::BadInput(format!("case {}: {e}", c.id)))?;
         }
     }
     let mut why: Vec<String> = Vec::new();
-    if pick.changed {
-        let shaders = vista_render::shader_set(project)?;
+    if let Some(shaders) = shaders.as_ref().filter(|_| pick.changed) {
         picked.retain(|c| {
             // Every file any pass reaches, as the manifest records them.
             let mut files = BTreeMap::new();

@@ -478,9 +478,18 @@ pub struct Judge<'a> {
     sources: vista_render::Sources,
     texts: BTreeMap<String, String>,
     baselines: BTreeMap<String, Baseline<'a>>,
-    /// The project's WGSL unit test files (`*.test.wgsl`), each `(path
-    /// under shaders/, text)`: a detector after the goldens.
-    unit_tests: Vec<(String, String)>,
+    /// The project's WGSL unit test files: a detector after the goldens.
+    unit_tests: Vec<UnitTestFile>,
+}
+
+/// A WGSL unit test file (`*.test.wgsl`) and the files its tests reach.
+struct UnitTestFile {
+    /// Its path under shaders/.
+    rel: String,
+    text: String,
+    /// Every file its composition reads (itself and the modules it
+    /// imports); `None` where they cannot be listed: it runs for every mutant.
+    reaches: Option<std::collections::BTreeSet<String>>,
 }
 
 impl<'a> Judge<'a> {
@@ -507,11 +516,19 @@ impl<'a> Judge<'a> {
                 baselines.insert(p.kernel.name().to_string(), b);
             }
         }
-        let unit_tests: Vec<(String, String)> =
-            texts.iter().filter(|(rel, _)| rel.ends_with(".test.wgsl")).map(|(r, t)| (r.clone(), t.clone())).collect();
+        let shaders = sources.shader_set();
+        let unit_tests: Vec<UnitTestFile> = texts
+            .iter()
+            .filter(|(rel, _)| vista_wgsl_test::is_test_file(rel))
+            .map(|(rel, text)| UnitTestFile {
+                rel: rel.clone(),
+                text: text.clone(),
+                reaches: shaders.file_hashes(rel).ok().map(|files| files.into_keys().collect()),
+            })
+            .collect();
         // As with the goldens: a unit test failing unmutated would kill
         // every mutant, so the suite must pass first.
-        for (rel, text) in &unit_tests {
+        for UnitTestFile { rel, text, .. } in &unit_tests {
             for r in vista_wgsl_test::run_file(base, &sources, rel, text) {
                 if !r.passed() {
                     return Err(GoldenError::BadInput(format!(
@@ -540,8 +557,10 @@ impl<'a> Judge<'a> {
         };
         let mut report = judge(&gpu, self.store, &self.manifest, &p.kernel, &self.baselines[p.kernel.name()], m);
         if report.outcome == "survived" {
-            // The unit tests, after the goldens: the first failing test kills it.
-            for (rel, text) in &self.unit_tests {
+            // The unit tests that read the mutated file, after the goldens:
+            // the first failing test kills it (the others cannot see it).
+            let reading = self.unit_tests.iter().filter(|u| u.reaches.as_ref().is_none_or(|r| r.contains(&m.file)));
+            for UnitTestFile { rel, text, .. } in reading {
                 let results = vista_wgsl_test::run_file(&gpu, &self.sources, rel, text);
                 report.cases_run += results.len();
                 if let Some(r) = results.iter().find(|r| !r.passed()) {
