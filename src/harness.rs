@@ -97,7 +97,7 @@ fn checker<'a>(
     Checker { ctx, store, manifest, report_dir, detail: vista_report::Detail::Failing }
 }
 
-/// Each WGSL unit test (`@test` in `shaders/**/*.test.wgsl`) as a libtest
+/// Each WGSL unit test (`@test` in `shaders/**/*.test.wgsl`, `.test.wesl`) as a libtest
 /// test `wgsl::<file>::<fn>`: a file runs whole, once, when the first of
 /// its tests runs, and each test reports its own result.
 fn wgsl_trials(

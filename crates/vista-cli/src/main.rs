@@ -106,9 +106,9 @@ enum Command {
         #[arg(long, value_name = "X,Y,W,H")]
         crop: Option<String>,
     },
-    /// Run the WGSL unit tests: `@test` functions in shaders/**/*.test.wgsl.
+    /// Run the WGSL unit tests: `@test` functions in shaders/**/*.test.wgsl or *.test.wesl.
     ///
-    /// Assertions from `#import wgsl_test` (expect, expectEq, expectEqU,
+    /// Assertions from `#import wgsl_test` (WESL: `import wgsl_test::{..}`; expect, expectEq, expectEqU,
     /// expectNear, expectNearV2f..V4f, expectUlp) run on the GPU; a failure
     /// names its file:line:col and values. Exit 1 if any test fails.
     Test {

@@ -1,5 +1,5 @@
 //! `vista test [FILTER]`: the project's WGSL unit tests (`@test` functions
-//! in `shaders/**/*.test.wgsl`), each file one run on the engine; a line
+//! in `shaders/**/*.test.wgsl` or `.test.wesl`), each file one run on the engine; a line
 //! per test, a failing assertion at the user's file:line with its values.
 
 use vista::Config;
@@ -16,7 +16,7 @@ fn print_result(r: &TestResult) {
     }
 }
 
-/// The project's test files (`*.test.wgsl` under `shaders/`) holding a
+/// The project's test files (`*.test.wgsl`, `*.test.wesl` under `shaders/`) holding a
 /// test `filter` picks (a file runs whole), and whether `id` is shown.
 fn picked_files(project: &Project, filter: Option<&str>) -> Result<(Vec<(String, String)>, usize), GoldenError> {
     let files = vista_wgsl_test::test_files(project)?;
@@ -52,7 +52,7 @@ pub fn test(project: &Project, config: &Config, filter: Option<&str>, matrix: bo
     if picked.is_empty() {
         match filter {
             Some(f) => println!("no WGSL test matches {f} (of {all} test files under shaders/)"),
-            None => println!("no WGSL tests: write @test functions in shaders/**/*.test.wgsl"),
+            None => println!("no WGSL tests: write @test functions in shaders/**/*.test.wgsl (or .test.wesl)"),
         }
         return Ok(0);
     }

@@ -6335,6 +6335,120 @@ fn wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends() {
     assert!(one.stdout.contains("1 passed, 0 failed"), "{}", one.stdout);
 }
 
+/// A `*.test.wesl` file in wgsl-test's spelling (`import wgsl_test::{..}`,
+/// `@test`, expect and expectNear: examples/sources' palette tests) runs
+/// unchanged on three backends, importing the WESL module it tests; a
+/// failing WESL assertion names its file, line and column, and a WESL test
+/// file that does not compile fails its tests naming its line.
+fn wesl_unit_tests_in_wgsl_test_spelling_run_unchanged_on_three_backends() {
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    let wesl = d.path().join("shaders/wesl");
+    std::fs::create_dir_all(&wesl).unwrap();
+    for f in ["palette.wesl", "palette.test.wesl"] {
+        std::fs::copy(repo().join("examples/sources/shaders/wesl").join(f), wesl.join(f)).unwrap();
+    }
+    let wrong = "import package::wesl::palette::ramp;\nimport wgsl_test::expectNear;\n\n@test\nfn rockIsHalf() {\n\
+                 \x20 expectNear(ramp(1.0).r, 0.5);\n}\n";
+    std::fs::write(wesl.join("wrong.test.wesl"), wrong).unwrap();
+    std::fs::write(wesl.join("broken.test.wesl"), "import wgsl_test::expect;\n@test\nfn t() {\n  expect(nope);\n}\n")
+        .unwrap();
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let r = vista_in(Some(d.path()), &[("VISTA_BACKEND", backend)], &["test"]);
+        let lines: Vec<&str> = r.stdout.lines().collect();
+        assert_eq!(r.code, 1, "{backend}: {}{}", r.stdout, r.stderr);
+        for ok in ["lowlandAtZero", "halfwayIsTheMean", "heightsPastOneAreRock", "redRisesWithHeight"] {
+            assert!(lines.contains(&format!("ok     wgsl::palette::{ok}").as_str()), "{backend}: {}", r.stdout);
+        }
+        let fail = "FAIL   wgsl::wrong::rockIsHalf: shaders/wesl/wrong.test.wesl:6:3: \
+                    expectNear(actual 0.45, expected 0.5, tol 0.00001)";
+        assert!(lines.contains(&fail), "{backend}: {}", r.stdout);
+        let broken = lines.iter().find(|l| l.starts_with("FAIL   wgsl::broken::t: ")).expect("the broken file's test");
+        assert!(broken.contains("broken.test.wesl:4") && broken.contains("nope"), "{backend}: {broken}");
+        assert!(r.stdout.contains("4 passed, 2 failed"), "{backend}: {}", r.stdout);
+    }
+}
+
+/// A global an imported WESL module declares is bound by its own name, as
+/// a naga_oil module's is (the wesl crate's mangled `package_io_out` is
+/// not what a manifest says): a WESL kernel's output declared in `io.wesl`.
+fn an_imported_wesl_global_is_bound_by_its_own_name() {
+    let manifest = "summary = \"output declared by an imported module\"\nshader = \"k.wesl\"\n\
+                    [[resource]]\nname = \"out\"\nkind = \"texture\"\nformat = \"rgba8unorm\"\n\
+                    [[pass]]\nentry = \"main\"\n[[output]]\nresource = \"out\"\n";
+    let d = kernel_project(manifest, "");
+    std::fs::remove_file(d.path().join("shaders/k.wgsl")).unwrap();
+    let io = "@group(0) @binding(0) var out: texture_storage_2d<rgba8unorm, write>;\n";
+    std::fs::write(d.path().join("shaders/io.wesl"), io).unwrap();
+    let k = "import package::io::out;\n@compute @workgroup_size(8, 8)\n\
+             fn main(@builtin(global_invocation_id) id: vec3u) {\n\
+             \x20   if any(id.xy >= textureDimensions(out)) { return; }\n\
+             \x20   textureStore(out, id.xy, vec4f(1.0, 0.5, 0.0, 1.0));\n}\n";
+    std::fs::write(d.path().join("shaders/k.wesl"), k).unwrap();
+    let png = d.path().join("k.png");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", png.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    let img = vista_image::load(&png).unwrap();
+    assert_eq!(img.dimensions(), (8, 8));
+}
+
+/// `@test_texture` and `@sampler` in wgsl-test's spelling: a checkerboard,
+/// a gradient, seeded noise and a file, sampled with linear and nearest
+/// filtering, each texel value worked by hand from the pattern's
+/// definition (docs/guide.md), on three backends.
+fn test_textures_and_samplers_are_generated_and_bound_on_three_backends() {
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    std::fs::create_dir_all(d.path().join("shaders")).unwrap();
+    std::fs::create_dir_all(d.path().join("inputs")).unwrap();
+    let photo = repo().join("examples/graphs/inputs/photo.png");
+    std::fs::copy(&photo, d.path().join("inputs/photo.png")).unwrap();
+    let (w, h) = vista_image::load(&photo).unwrap().dimensions();
+    let tests = format!(
+        "#import wgsl_test::{{expect, expectNear, expectEqU}}\n\
+         @test_texture(checkerboard, 8, 8, 2) var board: texture_2d<f32>;\n\
+         @test_texture(gradient, 4, 2) var ramp: texture_2d<f32>;\n\
+         @test_texture(noise, 16, 16, 7) var grain: texture_2d<f32>;\n\
+         @test_texture(noise, 16, 16, 8) var other: texture_2d<f32>;\n\
+         @test_texture(file, \"inputs/photo.png\") var photo: texture_2d<f32>;\n\
+         @sampler(linear) var blend: sampler;\n@sampler(nearest) var pick: sampler;\n\n\
+         @test fn checkerboard_cells() {{\n\
+         \x20   expectNear(textureLoad(board, vec2u(0u, 0u), 0).r, 1.0);\n\
+         \x20   expectNear(textureLoad(board, vec2u(1u, 1u), 0).r, 1.0);\n\
+         \x20   expectNear(textureLoad(board, vec2u(2u, 0u), 0).r, 0.0);\n\
+         \x20   expectNear(textureLoad(board, vec2u(3u, 3u), 0).r, 1.0);\n\
+         \x20   expectNear(textureLoad(board, vec2u(5u, 2u), 0).a, 1.0);\n}}\n\
+         @test fn gradient_at_texel_centres() {{\n\
+         \x20   let t = textureLoad(ramp, vec2u(1u, 1u), 0);\n\
+         \x20   expectNear(t.r, 0.375);\n    expectNear(t.g, 0.75);\n    expectNear(t.b, 0.0);\n}}\n\
+         @test fn linear_and_nearest_sampling() {{\n\
+         \x20   expectNear(textureSampleLevel(ramp, blend, vec2f(0.25, 0.25), 0.0).r, 0.25, 1e-3);\n\
+         \x20   expectNear(textureSampleLevel(ramp, pick, vec2f(0.26, 0.25), 0.0).r, 0.375);\n}}\n\
+         @test fn noise_is_in_the_unit_range_and_seeded() {{\n\
+         \x20   var differs = 0u;\n\
+         \x20   for (var i = 0u; i < 256u; i++) {{\n\
+         \x20       let p = vec2u(i % 16u, i / 16u);\n\
+         \x20       let a = textureLoad(grain, p, 0);\n\
+         \x20       expect(all(a >= vec4f(0.0)) && all(a <= vec4f(1.0)));\n\
+         \x20       differs += u32(any(a != textureLoad(other, p, 0)));\n    }}\n\
+         \x20   expect(differs > 250u);\n}}\n\
+         @test fn a_file_keeps_its_size() {{\n\
+         \x20   expectEqU(textureDimensions(photo).x, {w}u);\n    expectEqU(textureDimensions(photo).y, {h}u);\n}}\n"
+    );
+    std::fs::write(d.path().join("shaders/tex.test.wgsl"), tests).unwrap();
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let r = vista_in(Some(d.path()), &[("VISTA_BACKEND", backend)], &["test"]);
+        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
+        assert!(r.stdout.contains("5 passed, 0 failed"), "{backend}: {}", r.stdout);
+    }
+    // A broken annotation fails the file's tests naming its line.
+    std::fs::write(d.path().join("shaders/tex.test.wgsl"), "\n@sampler(cubic) var s: sampler;\n@test fn t() {}\n")
+        .unwrap();
+    let r = vista_in(Some(d.path()), &[], &["test"]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(r.stdout.contains("tex.test.wgsl:2:1: @sampler s: takes linear or nearest, not (cubic)"), "{}", r.stdout);
+}
+
 /// `vista mutate` runs the project's unit tests after the goldens: a
 /// mutant in a helper the golden case cannot see (twice(0.0) is 0 for
 /// x + x and x - x alike) survives the goldens and is killed by the unit
@@ -6423,6 +6537,9 @@ fn main() {
     let tests: &[(Needs, &str, fn())] = tests![
         Cpu unknown_kernel_lists_valid_kernels,
         Gpu wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends,
+        Gpu wesl_unit_tests_in_wgsl_test_spelling_run_unchanged_on_three_backends,
+        Gpu test_textures_and_samplers_are_generated_and_bound_on_three_backends,
+        Gpu an_imported_wesl_global_is_bound_by_its_own_name,
         Gpu mutate_counts_a_mutant_a_unit_test_kills,
         Gpu generated_modules_give_constants_to_bindings_and_code,
         Cpu no_tracked_file_cites_an_issue_or_session_number,

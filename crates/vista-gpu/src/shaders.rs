@@ -136,6 +136,13 @@ impl Default for Pooled {
 /// The import path of the module generated from a kernel's manifest.
 pub const ENUMS_MODULE: &str = "vista::enums";
 
+/// Whether `rel` (under `shaders/`) is a WGSL unit test file,
+/// `*.test.wgsl` or `*.test.wesl`: composed as a kernel file, never listed
+/// as one.
+pub fn is_unit_test_file(rel: &str) -> bool {
+    rel.ends_with(".test.wgsl") || rel.ends_with(".test.wesl")
+}
+
 impl ShaderSet {
     /// A set from `(relative path, text, origin)` triples; files under
     /// `lib/` are import modules (but `*.test.wgsl` files), the rest kernel
@@ -148,9 +155,9 @@ impl ShaderSet {
             let source = Source::new(rel, text, origin);
             // An import module is a file under lib/ or any file with its own
             // `#define_import_path` (a project's foreign module layout); a
-            // WGSL unit test file (`*.test.wgsl`) beside the modules it
+            // WGSL unit test file (`*.test.wgsl`, `*.test.wesl`) beside the modules it
             // tests is composed as a kernel file is.
-            let test = source.rel.ends_with(".test.wgsl") && source.module.is_none();
+            let test = is_unit_test_file(&source.rel) && source.module.is_none();
             if (source.rel.starts_with("lib/") && !test) || source.module.is_some() {
                 lib.push(source);
             } else {
@@ -227,9 +234,9 @@ impl ShaderSet {
     }
 
     /// Every kernel file (not `lib/`, not a WGSL unit test's
-    /// `*.test.wgsl`), relative names, sorted.
+    /// `*.test.wgsl` or `.wesl`), relative names, sorted.
     pub fn kernel_files(&self) -> Vec<String> {
-        self.kernels.keys().filter(|k| !k.ends_with(".test.wgsl")).cloned().collect()
+        self.kernels.keys().filter(|k| !is_unit_test_file(k)).cloned().collect()
     }
 
     /// `name` is a kernel file, optionally followed by `?DEF&DEF...`: naga_oil

@@ -482,7 +482,7 @@ pub struct Judge<'a> {
     unit_tests: Vec<UnitTestFile>,
 }
 
-/// A WGSL unit test file (`*.test.wgsl`) and the files its tests reach.
+/// A WGSL unit test file (`*.test.wgsl`, `*.test.wesl`) and the files its tests reach.
 struct UnitTestFile {
     /// Its path under shaders/.
     rel: String,

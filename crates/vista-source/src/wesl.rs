@@ -1,12 +1,15 @@
 //! `.wesl` shaders, compiled by the `wesl` crate (pinned: 0.5 and later
 //! need a newer Rust): `import package::...` resolves under `shaders/`,
-//! another package's imports through `[source] packages`, and bool defs are
-//! `@if` features.
+//! another package's imports through `[source] packages`, `wgsl_test`
+//! (the assertions of a `*.test.wesl` file) to vista's own module, and
+//! bool defs are `@if` features. An imported module's declarations are
+//! named as naga_oil names them ([`Decorated`]), so that a manifest binds an
+//! imported global by its own name in either language.
 
 use std::borrow::Cow;
 use std::cell::RefCell;
 
-use wesl::{ModulePath, ResolveError, Resolver, syntax::PathOrigin};
+use wesl::{Mangler, ModulePath, ResolveError, Resolver, syntax::PathOrigin};
 
 use crate::{Assembled, Part, SourceSpec};
 
@@ -51,8 +54,21 @@ impl Files<'_> {
     }
 }
 
+/// The file vista's assertion module is read from (a built-in, unless the
+/// project has its own), and the package name a test file imports it by.
+const WGSL_TEST: (&str, &str) = ("shaders/lib/wgsl_test.wgsl", "wgsl_test");
+
 impl Resolver for Files<'_> {
     fn resolve_source<'a>(&'a self, path: &ModulePath) -> Result<Cow<'a, str>, ResolveError> {
+        let vista_own = path.components.is_empty()
+            && matches!(&path.origin, PathOrigin::Package(p) if p == WGSL_TEST.1)
+            && !self.packages.iter().any(|(p, _)| p == WGSL_TEST.1);
+        if vista_own && let Some((text, _)) = (self.read)(WGSL_TEST.0) {
+            // The naga_oil module as WESL: its import path line blanked.
+            let lines: Vec<&str> =
+                text.lines().map(|l| if l.starts_with("#define_import_path") { "" } else { l }).collect();
+            return Ok(Cow::Owned(lines.join("\n")));
+        }
         let candidates = self.candidates(path).map_err(|e| ResolveError::ModuleNotFound(path.clone(), e))?;
         for file in &candidates {
             if let Some((text, origin)) = (self.read)(file) {
@@ -100,6 +116,7 @@ pub fn compile_wesl(
     };
     let files = Files { packages: &spec.packages, read: &checked, parts: RefCell::new(Vec::new()) };
     let mut compiler = wesl::Wesl::new("shaders").set_custom_resolver(files);
+    compiler.set_custom_mangler(Decorated);
     for (name, on) in features {
         compiler.set_feature(name, *on);
     }
@@ -111,6 +128,38 @@ pub fn compile_wesl(
     let text = result.to_string();
     let parts = compiler.resolver().parts.take();
     Ok(Assembled::untraced(text, parts))
+}
+
+/// Names an imported module's declaration as naga_oil does,
+/// `<item>X_naga_oil_mod_X<base32 of the module path>X`, where the wesl
+/// crate's own mangler writes `package__1lut_bindings_t`: a manifest then
+/// binds it by `t` (and knows its module), as it does a naga_oil import's.
+/// Unique per (module, item), and a WGSL identifier.
+struct Decorated;
+
+impl Mangler for Decorated {
+    fn mangle(&self, path: &ModulePath, item: &str) -> String {
+        format!("{item}X_naga_oil_mod_X{}X", base32(path.to_string().as_bytes()))
+    }
+}
+
+/// RFC 4648 base32 without padding, as naga_oil writes module paths.
+fn base32(bytes: &[u8]) -> String {
+    const ALPHABET: &[u8; 32] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZ234567";
+    let (mut out, mut acc, mut bits) = (String::new(), 0u32, 0u32);
+    for &b in bytes {
+        acc = (acc << 8) | b as u32;
+        bits += 8;
+        while bits >= 5 {
+            bits -= 5;
+            out.push(ALPHABET[((acc >> bits) & 31) as usize] as char);
+        }
+        acc &= (1 << bits) - 1;
+    }
+    if bits > 0 {
+        out.push(ALPHABET[((acc << (5 - bits)) & 31) as usize] as char);
+    }
+    out
 }
 
 /// The wesl crate's diagnostic with its place first: its headline says
@@ -220,6 +269,30 @@ mod tests {
         assert_eq!(paths, ["shaders/k.wesl", "shaders/m.wesl", "vendor/consts/package.wesl"]);
         let e = compile_wesl("shaders/k.wesl", &SourceSpec::default(), &[], &read).unwrap_err();
         assert!(e.contains("package consts is not in [source] packages (none)"), "{e}");
+    }
+
+    /// An imported global is named as naga_oil names one (its module's
+    /// path in base32), so a manifest binds it by its own name; `wgsl_test`
+    /// is vista's assertion module, its import path line blanked.
+    #[test]
+    fn imported_names_are_decorated_as_naga_oil_does_and_wgsl_test_is_vistas() {
+        assert_eq!(base32(b"mylib::camera"), "NV4WY2LCHI5GGYLNMVZGC");
+        assert_eq!(base32(b"f"), "MY");
+        let files: Vec<(&str, &str)> = vec![
+            (
+                "shaders/k.wesl",
+                "import package::lut::table;\nimport wgsl_test::expect;\n\
+                 @compute @workgroup_size(1) fn main() { expect(table[0] > 0.0); }\n",
+            ),
+            ("shaders/lut.wesl", "@group(0) @binding(1) var<storage> table: array<f32, 4>;\n"),
+            ("shaders/lib/wgsl_test.wgsl", "#define_import_path wgsl_test\nfn expect(c: bool) {}\n"),
+        ];
+        let read = |p: &str| files.iter().find(|(f, _)| *f == p).map(|(_, t)| (t.to_string(), format!("/p/{p}")));
+        let out = compile_wesl("shaders/k.wesl", &SourceSpec::default(), &[], &read).unwrap().text;
+        let table = format!("tableX_naga_oil_mod_X{}X", base32(b"package::lut"));
+        assert!(out.contains(&format!("var<storage> {table}")), "{out}");
+        assert!(out.contains(&format!("fn expectX_naga_oil_mod_X{}X", base32(b"wgsl_test"))), "{out}");
+        assert!(!out.contains("#define_import_path"), "{out}");
     }
 
     /// A syntax error in an imported module: the headline names its file,

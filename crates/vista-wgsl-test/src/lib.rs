@@ -1,7 +1,7 @@
 #![deny(missing_docs)]
-//! WGSL unit tests (`vista test`): `@test` functions in `*.test.wgsl`
+//! WGSL unit tests (`vista test`): `@test` functions in `*.test.wgsl` and `*.test.wesl`
 //! files under `shaders/`, importing what they test as kernels do, with
-//! the assertions of `#import wgsl_test` (`expect`, `expectEq`,
+//! the assertions of `#import wgsl_test` (WESL: `import wgsl_test::...`; `expect`, `expectEq`,
 //! `expectNear`, `expectNearV2f`..`V4f`, `expectUlp`; shaders/lib/wgsl_test.wgsl).
 //! Each file becomes one kernel: one pass per test (a compute entry of one
 //! invocation), one results buffer, rendered on the project's engine like
@@ -13,7 +13,10 @@
 
 mod rewrite;
 
-pub use rewrite::{Assertion, BUFFER_GROUP, Rewritten, Site, TestBuffer, TestFn, entry, rewrite};
+pub use rewrite::{
+    Assertion, BUFFER_GROUP, Pattern, Rewritten, Site, TEXTURE_FORMAT, TestBuffer, TestFn, TestSampler, TestTexture,
+    entry, fill_entry, rewrite,
+};
 
 use vista_render::{OutputValue, Renderer};
 
@@ -68,12 +71,13 @@ impl TestResult {
     }
 }
 
-/// Whether `rel` (a path under `shaders/`) names a test file.
+/// Whether `rel` (a path under `shaders/`) names a test file
+/// (`*.test.wgsl`, or `*.test.wesl` importing as WESL does).
 pub fn is_test_file(rel: &str) -> bool {
-    rel.ends_with(".test.wgsl")
+    vista_render::is_unit_test_file(rel)
 }
 
-/// The project's test files (`*.test.wgsl` under `shaders/`): each path
+/// The project's test files (`*.test.wgsl`, `*.test.wesl` under `shaders/`): each path
 /// relative to it and its text, in path order.
 pub fn test_files(project: &vista_project::Project) -> Result<Vec<(String, String)>, vista_project::ProjectError> {
     let mut files: Vec<(String, String)> =
@@ -85,13 +89,31 @@ pub fn test_files(project: &vista_project::Project) -> Result<Vec<(String, Strin
 /// The id of test `name` of file `rel`: `wgsl::<stem>::<name>`.
 pub fn test_id(rel: &str, name: &str) -> String {
     let file = rel.rsplit('/').next().unwrap_or(rel);
-    format!("wgsl::{}::{name}", file.trim_end_matches(".test.wgsl"))
+    let stem = file.strip_suffix(".test.wgsl").or_else(|| file.strip_suffix(".test.wesl")).unwrap_or(file);
+    format!("wgsl::{stem}::{name}")
 }
 
 /// The ids of file `rel`'s tests (`text` its contents), or the error that
 /// keeps it from running.
 pub fn list(rel: &str, text: &str) -> Result<Vec<String>, String> {
-    Ok(rewrite(text)?.tests.iter().map(|t| test_id(rel, &t.name)).collect())
+    Ok(rewrite(text, wesl(rel))?.tests.iter().map(|t| test_id(rel, &t.name)).collect())
+}
+
+/// `text` as a TOML basic string.
+fn toml_string(text: &str) -> String {
+    let escaped: String = text
+        .chars()
+        .map(|c| match c {
+            '"' | '\\' => format!("\\{c}"),
+            c if c.is_control() => format!("\\u{:04X}", c as u32),
+            c => c.to_string(),
+        })
+        .collect();
+    format!("\"{escaped}\"")
+}
+
+fn wesl(rel: &str) -> bool {
+    rel.ends_with(".wesl")
 }
 
 /// The manifest of file `rel` rewritten: one pass per test, each with its
@@ -108,6 +130,30 @@ fn manifest(rel: &str, rewritten: &Rewritten) -> String {
             m.push_str(&format!(
                 "\n[[resource]]\nname = \"{}__{i}\"\nkind = \"buffer\"\nlength = {}\n",
                 b.name, b.length
+            ));
+        }
+    }
+    for t in &rewritten.textures {
+        m.push_str(&format!("\n[[resource]]\nname = \"{}\"\nkind = \"texture\"\n", t.name));
+        match (&t.pattern, t.size) {
+            (Pattern::File(path), _) => m.push_str(&format!("file = {}\n", toml_string(path))),
+            (_, Some((w, h))) => m.push_str(&format!("format = \"{TEXTURE_FORMAT}\"\nsize = [{w}, {h}]\n")),
+            (_, None) => {}
+        }
+    }
+    for s in &rewritten.samplers {
+        let filter = if s.linear { "linear" } else { "nearest" };
+        m.push_str(&format!("\n[[resource]]\nname = \"{}\"\nkind = \"sampler\"\nfilter = \"{filter}\"\n", s.name));
+    }
+    // The generated textures are filled first, a texel per invocation.
+    for (n, t) in rewritten.textures.iter().enumerate() {
+        if let Some((w, h)) = t.size {
+            let (entry, var) = fill_entry(n);
+            m.push_str(&format!(
+                "\n[[pass]]\nentry = \"{entry}\"\nworkgroups = [{}, {}, 1]\nbind = {{ {var} = \"{}\" }}\n",
+                w.div_ceil(8),
+                h.div_ceil(8),
+                t.name
             ));
         }
     }
@@ -128,7 +174,7 @@ fn manifest(rel: &str, rewritten: &Rewritten) -> String {
 /// fails each of its tests with that error (one result named `*` if none
 /// could be found).
 pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, text: &str) -> Vec<TestResult> {
-    let rewritten = match rewrite(text) {
+    let rewritten = match rewrite(text, wesl(rel)) {
         Ok(r) => r,
         Err(e) => return vec![broken(&test_id(rel, "*"), format!("{rel}:{e}"))],
     };

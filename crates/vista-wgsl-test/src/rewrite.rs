@@ -72,6 +72,142 @@ pub struct Rewritten {
     pub sites: Vec<Site>,
     /// The `@buffer` storage variables: each test gets its own, zeroed.
     pub buffers: Vec<TestBuffer>,
+    /// The `@test_texture` textures, filled once before the tests run.
+    pub textures: Vec<TestTexture>,
+    /// The `@sampler` samplers.
+    pub samplers: Vec<TestSampler>,
+}
+
+/// What fills a `@test_texture`, in wgsl-test's words.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Pattern {
+    /// `checkerboard, W, H, CELL`: 1 on cells whose column + row is even, else 0.
+    Checkerboard(u32),
+    /// `gradient, W, H`: red (x + 0.5) / W, green (y + 0.5) / H.
+    Gradient,
+    /// `noise, W, H, SEED`: each channel a hash of (x, y, seed) in [0, 1).
+    Noise(u32),
+    /// `file, "path"`: a `.png` or `.exr` under the project root.
+    File(String),
+}
+
+/// A `@test_texture(...) var name: texture_2d<f32>;` of a test file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestTexture {
+    /// The variable's name.
+    pub name: String,
+    /// What fills it.
+    pub pattern: Pattern,
+    /// Width and height in texels (a file's own when `None`).
+    pub size: Option<(u32, u32)>,
+}
+
+/// A `@sampler(linear | nearest) var name: sampler;` of a test file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TestSampler {
+    /// The variable's name.
+    pub name: String,
+    /// `linear` (else `nearest`) filtering.
+    pub linear: bool,
+}
+
+/// The storage format generated test textures are filled in: storable and
+/// filterable in WebGPU's core, so a test samples it with either filter.
+pub const TEXTURE_FORMAT: &str = "rgba16float";
+
+/// The attribute's arguments (`@name(a, b, "c")` from just after the
+/// name), the byte after its `)`, and the declared variable's name and type.
+fn attribute_args(text: &str, after_name: usize) -> Result<(Vec<String>, String, String), String> {
+    let rest = &text[after_name..];
+    let open = rest.find('(').filter(|&o| rest[..o].trim().is_empty()).ok_or("needs its arguments in ( )")?;
+    let close = rest[open..].find(')').map(|c| open + c).ok_or("its ( is not closed")?;
+    let args = rest[open + 1..close].split(',').map(|a| a.trim().to_string()).filter(|a| !a.is_empty()).collect();
+    let decl = rest[close + 1..].split(';').next().unwrap_or_default();
+    let decl = decl.trim_start().strip_prefix("var").ok_or("is not followed by a var declaration")?;
+    let (name, ty) = decl.split_once(':').ok_or("its variable has no type")?;
+    Ok((args, name.trim().to_string(), ty.trim().to_string()))
+}
+
+/// A `@test_texture(...)` declaration from just after the attribute's name.
+fn texture_decl(text: &str, after_name: usize) -> Result<TestTexture, String> {
+    let (args, name, ty) = attribute_args(text, after_name)?;
+    if ty.replace(' ', "") != "texture_2d<f32>" {
+        return Err(format!("@test_texture {name}: a test texture is a texture_2d<f32>, not {ty}"));
+    }
+    let number = |i: usize, what: &str| -> Result<u32, String> {
+        let a = args.get(i).ok_or_else(|| format!("@test_texture {name}: {} needs {what}", args[0]))?;
+        a.trim_end_matches('u').parse().map_err(|_| format!("@test_texture {name}: {what} {a} is not a whole number"))
+    };
+    let kinds = "checkerboard, gradient, noise or file";
+    let Some(kind) = args.first() else { return Err(format!("@test_texture {name}: name its kind: {kinds}")) };
+    let (pattern, want) = match kind.as_str() {
+        "checkerboard" => (Pattern::Checkerboard(number(3, "a cell size (checkerboard, W, H, CELL)")?), 4),
+        "gradient" => (Pattern::Gradient, 3),
+        "noise" => (Pattern::Noise(number(3, "a seed (noise, W, H, SEED)")?), 4),
+        "file" => match args.get(1).and_then(|a| a.strip_prefix('"')).and_then(|a| a.strip_suffix('"')) {
+            Some(path) if args.len() == 2 => (Pattern::File(path.to_string()), 2),
+            _ => return Err(format!("@test_texture {name}: file takes one quoted path: file, \"inputs/rock.png\"")),
+        },
+        other => return Err(format!("@test_texture {name}: unknown kind {other}; kinds: {kinds}")),
+    };
+    if args.len() != want {
+        return Err(format!("@test_texture {name}: {kind} takes {} arguments, not {}", want - 1, args.len() - 1));
+    }
+    let size = match pattern {
+        Pattern::File(_) => None,
+        _ => {
+            let (w, h) = (number(1, "a width")?, number(2, "a height")?);
+            if w == 0 || h == 0 || w > 4096 || h > 4096 {
+                return Err(format!("@test_texture {name}: {w}x{h} is not a size from 1x1 to 4096x4096"));
+            }
+            Some((w, h))
+        }
+    };
+    Ok(TestTexture { name, pattern, size })
+}
+
+/// A `@sampler(...)` declaration from just after the attribute's name.
+fn sampler_decl(text: &str, after_name: usize) -> Result<TestSampler, String> {
+    let (args, name, ty) = attribute_args(text, after_name)?;
+    if ty != "sampler" {
+        return Err(format!("@sampler {name}: declares a sampler, not {ty}"));
+    }
+    let linear = match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
+        ["linear"] => true,
+        ["nearest"] => false,
+        _ => return Err(format!("@sampler {name}: takes linear or nearest, not ({})", args.join(", "))),
+    };
+    Ok(TestSampler { name, linear })
+}
+
+/// The fill entry and storage binding vista appends for test texture `i`.
+pub fn fill_entry(i: usize) -> (String, String) {
+    (format!("vista_fill_{i}"), format!("vista_fill_tex_{i}"))
+}
+
+/// The WGSL that fills generated texture `i` (bound at `binding` as a
+/// storage texture): its global and its entry, one invocation per texel.
+fn fill_code(i: usize, t: &TestTexture, binding: usize) -> String {
+    let (entry, var) = fill_entry(i);
+    let value = match t.pattern {
+        Pattern::Checkerboard(cell) => format!(
+            "let c = (p / max({cell}u, 1u)); let v = f32(((c.x + c.y) & 1u) == 0u); let rgba = vec4f(v, v, v, 1.0);"
+        ),
+        Pattern::Gradient => "let rgba = vec4f((vec2f(p) + 0.5) / vec2f(size), 0.0, 1.0);".into(),
+        Pattern::Noise(seed) => format!(
+            "var h = vec4u(p.x, p.y, {seed}u, 0x9e3779b9u) * 1664525u + 1013904223u; \
+             h = h ^ (h >> vec4u(16u)); h = h * 0x45d9f3bu; h = h ^ (h >> vec4u(16u)); \
+             h.x += h.y * h.w; h.y += h.z * h.x; h.z += h.x * h.y; h.w += h.y * h.z; \
+             let rgba = vec4f(h >> vec4u(8u)) / 16777216.0;"
+        ),
+        Pattern::File(_) => return String::new(),
+    };
+    format!(
+        "@group({BUFFER_GROUP}) @binding({binding}) var {var}: texture_storage_2d<{TEXTURE_FORMAT}, write>;\n\
+         @compute @workgroup_size(8, 8) fn {entry}(@builtin(global_invocation_id) id: vec3u) {{ \
+         let size = textureDimensions({var}); let p = id.xy; if any(p >= size) {{ return; }} \
+         {value} textureStore({var}, p, rgba); }}\n"
+    )
 }
 
 /// A `@buffer var<storage, read_write> name: T;` of a test file.
@@ -179,16 +315,18 @@ fn call_end(text: &str, open: usize) -> Option<(usize, usize)> {
     None
 }
 
-/// Rewrites `text` (a `*.test.wgsl` file): `@test` attributes blanked,
-/// assertion calls `name(args)` made `wgsl_test::name_at(site, args[, tol])`,
-/// `#import wgsl_test` and one compute entry per test appended. Errors
-/// name the place and what is wrong.
-pub fn rewrite(text: &str) -> Result<Rewritten, String> {
+/// Rewrites `text` (a `*.test.wgsl` file, or `*.test.wesl` when `wesl`):
+/// `@test` attributes blanked, assertion calls `name(args)` made
+/// `wgsl_test::name_at(site, args[, tol])`, `#import wgsl_test` (WGSL; in
+/// WESL the qualified names reach the package) and one compute entry per
+/// test appended. Errors name the place and what is wrong.
+pub fn rewrite(text: &str, wesl: bool) -> Result<Rewritten, String> {
     let comments = comments(text);
     let in_comment = |at: usize| comments.iter().any(|&(s, e)| at >= s && at < e);
     let b = text.as_bytes();
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
     let (mut tests, mut sites, mut buffers) = (Vec::new(), Vec::new(), Vec::<TestBuffer>::new());
+    let (mut textures, mut samplers, mut bindings) = (Vec::new(), Vec::new(), 0usize);
     let mut i = 0;
     while i < b.len() {
         if in_comment(i) || !(b[i] == b'@' || is_ident(b[i])) || (i > 0 && (is_ident(b[i - 1]) || b[i - 1] == b':')) {
@@ -212,12 +350,28 @@ pub fn rewrite(text: &str) -> Result<Rewritten, String> {
                 let (line, _) = place(text, end + at_fn);
                 tests.push(TestFn { name, line });
                 edits.push((i, end, " ".repeat(end - i)));
+            } else if word == "test_texture" || word == "sampler" {
+                let at = |e: String| {
+                    let (l, c) = place(text, i);
+                    format!("{l}:{c}: {e}")
+                };
+                match word {
+                    "sampler" => samplers.push(sampler_decl(text, end).map_err(at)?),
+                    _ => textures.push(texture_decl(text, end).map_err(at)?),
+                }
+                let close = end + text[end..].find(')').expect("checked above") + 1;
+                let binding = bindings;
+                bindings += 1;
+                // Keep the line count: the attribute's text may span lines.
+                let newlines = text[i..close].matches('\n').count();
+                edits.push((i, close, format!("@group({BUFFER_GROUP}) @binding({binding}){}", "\n".repeat(newlines))));
             } else if word == "buffer" {
                 let buffer = buffer_decl(&text[end..]).map_err(|e| {
                     let (l, c) = place(text, i);
                     format!("{l}:{c}: {e}")
                 })?;
-                edits.push((i, end, format!("@group({BUFFER_GROUP}) @binding({})", buffers.len())));
+                edits.push((i, end, format!("@group({BUFFER_GROUP}) @binding({bindings})")));
+                bindings += 1;
                 buffers.push(buffer);
             }
             i = end;
@@ -265,7 +419,7 @@ pub fn rewrite(text: &str) -> Result<Rewritten, String> {
     for (s, e, with) in edits {
         out.replace_range(s..e, &with);
     }
-    out.push_str("\n#import wgsl_test\n");
+    out.push_str(if wesl { "\n" } else { "\n#import wgsl_test\n" });
     // Each entry reaches every buffer (a phony use), so that each pass binds
     // its test's own copies whether or not the test touches them.
     let reach: String = buffers.iter().map(|b| format!("_ = {}; ", b.name)).collect();
@@ -276,7 +430,10 @@ pub fn rewrite(text: &str) -> Result<Rewritten, String> {
             t.name
         ));
     }
-    Ok(Rewritten { text: out, tests, sites, buffers })
+    for (n, t) in textures.iter().enumerate() {
+        out.push_str(&fill_code(n, t, bindings + n));
+    }
+    Ok(Rewritten { text: out, tests, sites, buffers, textures, samplers })
 }
 
 #[cfg(test)]
@@ -286,7 +443,7 @@ mod tests {
     #[test]
     fn calls_carry_their_place_and_lines_keep_their_numbers() {
         let text = "#import wgsl_test\n// expectNear(1.0, 2.0) in a comment\n@test\nfn a() {\n  expectNear(f(1.0, 2.0), 0.5);\n  expect(x > (1.0));\n}\n@test fn b() { expectNearV3f(v, w, 1e-3); }\nfn expectEq_like() {}\n";
-        let r = rewrite(text).unwrap();
+        let r = rewrite(text, false).unwrap();
         assert_eq!(r.tests, [TestFn { name: "a".into(), line: 4 }, TestFn { name: "b".into(), line: 8 }]);
         assert_eq!(
             r.sites,
@@ -309,20 +466,67 @@ mod tests {
     fn buffers_get_a_binding_and_their_length() {
         let text = "@buffer var<storage, read_write> data: array<f32, 4>;\n@buffer var<storage, read_write> n: u32;\n\
                     @test fn a() { data[0] = 1.0; }\n";
-        let r = rewrite(text).unwrap();
+        let r = rewrite(text, false).unwrap();
         assert_eq!(
             r.buffers,
             [TestBuffer { name: "data".into(), length: 4 }, TestBuffer { name: "n".into(), length: 1 }]
         );
         assert!(r.text.starts_with("@group(2) @binding(0) var<storage, read_write> data"), "{}", r.text);
         assert!(r.text.contains("fn vista_test_0() { _ = data; _ = n; wgsl_test::begin(0u); a(); }"), "{}", r.text);
-        let sizeless = rewrite("@buffer var<storage, read_write> d: array<f32>;\n@test fn a() {}").unwrap_err();
+        let sizeless = rewrite("@buffer var<storage, read_write> d: array<f32>;\n@test fn a() {}", false).unwrap_err();
         assert_eq!(sizeless, "1:1: @buffer d: array<f32> has no size; give it one (array<T, N>)");
     }
 
     #[test]
+    fn test_textures_and_samplers_get_bindings_patterns_and_fill_entries() {
+        let text = "@buffer var<storage, read_write> d: array<f32, 2>;\n\
+                    @test_texture(checkerboard, 64, 32, 8) var board: texture_2d<f32>;\n\
+                    @test_texture(file, \"inputs/rock.png\") var rock: texture_2d<f32>;\n\
+                    @sampler(linear) var s: sampler;\n@test fn a() {}\n";
+        let r = rewrite(text, false).unwrap();
+        assert_eq!(
+            r.textures,
+            [
+                TestTexture { name: "board".into(), pattern: Pattern::Checkerboard(8), size: Some((64, 32)) },
+                TestTexture { name: "rock".into(), pattern: Pattern::File("inputs/rock.png".into()), size: None },
+            ]
+        );
+        assert_eq!(r.samplers, [TestSampler { name: "s".into(), linear: true }]);
+        let lines: Vec<&str> = r.text.lines().collect();
+        assert_eq!(lines[1], "@group(2) @binding(1) var board: texture_2d<f32>;");
+        assert_eq!(lines[3], "@group(2) @binding(3) var s: sampler;");
+        // A fill entry for the generated texture only, at the next binding.
+        assert!(r.text.contains("@group(2) @binding(4) var vista_fill_tex_0: texture_storage_2d<rgba16float, write>;"));
+        assert!(r.text.contains("fn vista_fill_0(") && !r.text.contains("vista_fill_1"), "{}", r.text);
+        let bad = |t: &str| rewrite(&format!("{t}\n@test fn a() {{}}"), false).unwrap_err();
+        assert_eq!(
+            bad("@test_texture(plaid, 4, 4) var t: texture_2d<f32>;"),
+            "1:1: @test_texture t: unknown kind plaid; kinds: checkerboard, gradient, noise or file"
+        );
+        assert_eq!(
+            bad("@test_texture(gradient, 4, 4) var t: texture_3d<f32>;"),
+            "1:1: @test_texture t: a test texture is a texture_2d<f32>, not texture_3d<f32>"
+        );
+        assert_eq!(
+            bad("@test_texture(noise, 4, 4) var t: texture_2d<f32>;"),
+            "1:1: @test_texture t: noise needs a seed (noise, W, H, SEED)"
+        );
+        assert_eq!(
+            bad("@test_texture(gradient, 0, 4) var t: texture_2d<f32>;"),
+            "1:1: @test_texture t: 0x4 is not a size from 1x1 to 4096x4096"
+        );
+        assert_eq!(
+            bad("@sampler(bilinear) var s: sampler;"),
+            "1:1: @sampler s: takes linear or nearest, not (bilinear)"
+        );
+    }
+
+    #[test]
     fn a_wrong_argument_count_and_no_test_are_named() {
-        assert_eq!(rewrite("@test fn a() {\n  expect(1, 2);\n}").unwrap_err(), "2:3: expect takes 1 arguments, not 2");
-        assert_eq!(rewrite("fn a() {}").unwrap_err(), "no @test function");
+        assert_eq!(
+            rewrite("@test fn a() {\n  expect(1, 2);\n}", false).unwrap_err(),
+            "2:3: expect takes 1 arguments, not 2"
+        );
+        assert_eq!(rewrite("fn a() {}", false).unwrap_err(), "no @test function");
     }
 }
