@@ -11,12 +11,18 @@ CARGO_TARGET_DIR="$(cd ../.. && pwd)/target"
 export CARGO_TARGET_DIR
 cargo=${CARGO:-cargo}
 list=$("$cargo" test -q --test golden -- --list)
-for t in golden::glow::glow golden::glow::glow-blue; do
+for t in golden::glow::glow golden::glow::glow-blue wgsl::glow::core_is_one_over_e_at_the_radius; do
     echo "$list" | grep -qx "$t: test" || { echo "$list"; echo "harness-example: --list lacks $t"; exit 1; }
 done
 "$cargo" test --test golden
+# The WGSL unit test is in the report beside the cases.
+unit=wgsl::glow::core_is_one_over_e_at_the_radius
+grep -qF "\"test\":\"$unit\"" target/vista-report/results.json ||
+    { echo "harness-example: results.json does not list $unit"; exit 1; }
+grep -qF 'id="unit-tests"' target/vista-report/index.html && grep -qF "$unit" target/vista-report/index.html ||
+    { echo "harness-example: index.html has no WGSL unit tests section listing $unit"; exit 1; }
 one=$("$cargo" test -q --test golden -- --exact golden::glow::glow-blue 2>&1)
-echo "$one" | grep -q "1 passed; 0 failed; 0 ignored; 0 measured; 1 filtered out" ||
+echo "$one" | grep -q "1 passed; 0 failed; 0 ignored; 0 measured; 2 filtered out" ||
     { echo "$one"; echo "harness-example: --exact did not select one case"; exit 1; }
 for f in index.html results.json; do
     [ -f "target/vista-report/$f" ] || { echo "harness-example: no $f in examples/harness-crate/target/vista-report"; exit 1; }
@@ -38,7 +44,7 @@ if out=$(VISTA_WORKER_FAULT=segv:glow "$cargo" test -q --test golden 2>&1); then
 fi
 echo "$out" | grep -q "crashed (signal 11, SIGSEGV) in pass 1" ||
     { echo "$out"; echo "harness-example: the crash was not named"; exit 1; }
-echo "$out" | grep -q "1 passed; 1 failed" || { echo "$out"; echo "harness-example: the other case did not pass"; exit 1; }
-echo "harness-example: the crate's own cargo test ran its 2 golden cases through vista::harness::main()"
+echo "$out" | grep -q "2 passed; 1 failed" || { echo "$out"; echo "harness-example: the other case and the unit test did not pass"; exit 1; }
+echo "harness-example: the crate's own cargo test ran its 2 golden cases and its WGSL unit test through vista::harness::main()"
 # The same test binary under cargo-nextest, a process per case (where nextest is installed; else a loud line).
 bash "$ci/harness-nextest.sh"

@@ -53,6 +53,7 @@ echo "harness-nextest: $nextest"
 # 1. The crate's own two cases, each in a process of its own: one report of both.
 nx ok "$t/own.log"
 once_each target/vista-report/results.json '"id":"@",' '"id":"[^"]*",' glow glow-blue
+once_each target/vista-report/results.json '"test":"@"' '"test":"[^"]*"' wgsl::glow::core_is_one_over_e_at_the_radius
 
 # 2. 20 cases of a tiny kernel at 8x8; c18..c20 have no golden yet.
 p="$t/project"
@@ -95,6 +96,21 @@ fn ramp(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(out_image, id.xy, vec4<f32>(tiny.tint * (tiny.level * (0.5 + 0.5 * t)), 1.0));
 }
 WGSL
+# Two WGSL unit tests, one failing: each a process of its own too.
+cat >"$p/shaders/tiny.test.wgsl" <<'WGSL'
+#import wgsl_test::{expectNear}
+
+@test
+fn half_is_half() {
+    expectNear(0.5 * 1.0, 0.5);
+}
+
+@test
+fn deliberately_wrong() {
+    expectNear(0.5 * 1.0, 0.75);
+}
+WGSL
+units=(wgsl::tiny::deliberately_wrong wgsl::tiny::half_is_half)
 ids=()
 for i in $(seq 1 20); do
     id=$(printf 'c%02d' "$i")
@@ -113,7 +129,12 @@ check_run() { # pending ids..., then -- and the run's ids
     shift
     once_each "$report/results.json" '"id":"@",' '"id":"[^"]*",' "$@"
     once_each "$report/index.html" 'id="case-@"' 'id="case-[^"]*"' "$@"
-    once_each "$p/junit.xml" 'name="golden::tiny::@"' '<testcase name="[^"]*"' "$@"
+    once_each "$p/junit.xml" 'name="golden::tiny::@"' '<testcase name="golden::[^"]*"' "$@"
+    # The unit tests, recorded by their own processes, each once in every file.
+    once_each "$report/results.json" '"test":"@"' '"test":"[^"]*"' "${units[@]}"
+    once_each "$p/junit.xml" '<testcase name="@"' '<testcase name="wgsl::[^"]*"' "${units[@]}"
+    once_each "$report/index.html" '<td class="id">@</td>' '<td class="id">wgsl::[^<]*</td>' wgsl::tiny::deliberately_wrong
+    grep -qF 'Passed: <code>wgsl::tiny::half_is_half</code>' "$report/index.html" || fail "index.html does not list the passing unit test"
     once_each "$report/pending.toml" '[case.@]' '^\[case\.[A-Za-z0-9_-]*\]$' "${pending[@]}"
     # Every image the index shows is there (no process pruned another's thumbnail).
     local shown broken
@@ -126,7 +147,7 @@ check_run() { # pending ids..., then -- and the run's ids
 # Run 1: 17 pass, 3 missing (pending), each case in its own process, 4 at once.
 echo "harness-nextest: run 1 of the 20 cases, 4 processes at once"
 nx fail "$t/run1.log" --no-fail-fast --test-threads 4
-grep -qE "20 tests run: 17 passed( \([0-9]+ leaky\))?, 3 failed" "$t/run1.log" || fail "run 1 did not run 20 cases, 17 passing"
+grep -qE "22 tests run: 18 passed( \([0-9]+ leaky\))?, 4 failed" "$t/run1.log" || fail "run 1 did not run 20 cases and 2 unit tests, 18 passing"
 check_run c18 c19 c20 -- "${ids[@]}"
 
 # Run 2, after blessing c18 and with an orphaned golden: nothing of run 1
@@ -136,7 +157,7 @@ bless c18
 cp "$p/golden/tiny/c01.png" "$p/golden/tiny/gone.png"
 echo "harness-nextest: run 2 of the 20 cases, 4 processes at once, c18 blessed since run 1, an orphaned golden"
 nx fail "$t/run2.log" --no-fail-fast --test-threads 4
-grep -qE "21 tests run: 18 passed( \([0-9]+ leaky\))?, 3 failed" "$t/run2.log" || fail "run 2 did not run 20 cases and golden::orphans once"
+grep -qE "23 tests run: 19 passed( \([0-9]+ leaky\))?, 4 failed" "$t/run2.log" || fail "run 2 did not run 20 cases, 2 unit tests and golden::orphans once"
 grep -q "gone.png" "$t/run2.log" || fail "golden::orphans did not name the orphaned golden"
 check_run c19 c20 -- "${ids[@]}"
 grep -F '"id":"c18",' "$report/results.json" | grep -qF '"verdict":"pass"' || fail "c18 is not the pass of run 2"
@@ -168,5 +189,6 @@ if ! diff <(cases_of "$report/results.json") <(cases_of "$p/vista-report/results
     cat "$t/diff"; fail "the merged partitions' results.json differs from the unpartitioned run's"
 fi
 echo "harness-nextest: the merged results.json holds the $(cases_of "$report/results.json" | wc -l) cases of the unpartitioned run, verdicts and metrics equal"
+once_each "$p/vista-report/results.json" '"test":"@"' '"test":"[^"]*"' "${units[@]}"
 once_each "$p/vista-report/pending.toml" '[case.@]' '^\[case\.[A-Za-z0-9_-]*\]$' c19 c20
-echo "harness-nextest: under cargo-nextest, 2 and 20 cases each in a process of their own gave one whole report (results.json, index.html, JUnit, pending.toml: every case once, none of the run before); golden::orphans ran once; 3 partitions merged equal the whole run"
+echo "harness-nextest: under cargo-nextest, 2 and 20 cases each in a process of their own gave one whole report (results.json, index.html, JUnit, pending.toml: every case and WGSL unit test once, none of the run before); golden::orphans ran once; 3 partitions merged equal the whole run, unit tests included"

@@ -104,6 +104,7 @@ fn wgsl_trials(
     project: &Project,
     renderer: Option<Result<&'static Renderer<'static>, String>>,
     skip: bool,
+    units: &Arc<Mutex<Vec<vista_report::UnitTest>>>,
 ) -> Vec<Trial> {
     type Results = Arc<std::sync::OnceLock<Vec<vista_wgsl_test::TestResult>>>;
     let files = vista_wgsl_test::test_files(project).unwrap_or_else(|e| fail(&format!("cannot read the shaders: {e}")));
@@ -113,8 +114,8 @@ fn wgsl_trials(
         let ids = vista_wgsl_test::list(&rel, &text).unwrap_or_else(|_| vec![vista_wgsl_test::test_id(&rel, "*")]);
         let (results, rel, text): (Results, Arc<str>, Arc<str>) = (Arc::default(), rel.into(), text.into());
         for id in ids {
-            let (project, renderer, sources, results) =
-                (project.clone(), renderer.clone(), sources.clone(), results.clone());
+            let (project, renderer, sources, results, units) =
+                (project.clone(), renderer.clone(), sources.clone(), results.clone(), units.clone());
             let (rel, text) = (rel.clone(), text.clone());
             trials.push(
                 Trial::test(id.clone(), move || {
@@ -130,9 +131,12 @@ fn wgsl_trials(
                     let all = results.get_or_init(|| vista_wgsl_test::run_file(ctx, sources, &rel, &text));
                     // A file that does not rewrite has one result, `*`.
                     let r = all.iter().find(|r| r.id == id).or(all.first()).ok_or_else(|| Failed::from("not run"))?;
+                    let failures = if r.passed() { Vec::new() } else { r.explain() };
+                    let unit = vista_report::UnitTest { id: id.clone(), failures: failures.clone() };
+                    units.lock().expect("unit tests").push(unit);
                     match r.passed() {
                         true => Ok(()),
-                        false => Err(Failed::from(r.explain().join("\n"))),
+                        false => Err(Failed::from(failures.join("\n"))),
                     }
                 })
                 .with_ignored_flag(skip),
@@ -233,7 +237,8 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
             .with_ignored_flag(skip)
         })
         .collect();
-    trials.extend(wgsl_trials(project, renderer.clone(), skip));
+    let units: Arc<Mutex<Vec<vista_report::UnitTest>>> = Arc::default();
+    trials.extend(wgsl_trials(project, renderer.clone(), skip, &units));
     let orphans = vista_check::orphans(&store, &cases);
     if !orphans.is_empty() {
         let listed: Vec<String> = orphans.iter().map(|o| o.display().to_string()).collect();
@@ -252,7 +257,9 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
     let mut filed = filed.lock().expect("filed");
     // In case order, as `vista check` lists them.
     filed.sort_by_key(|f| cases.iter().position(|c| c.id == f.outcome.id));
-    if !filed.is_empty()
+    let mut units = std::mem::take(&mut *units.lock().expect("unit tests"));
+    units.sort_by(|a, b| a.id.cmp(&b.id));
+    if !(filed.is_empty() && units.is_empty())
         && let Some(Ok(ctx)) = &renderer
     {
         let run = vista_report::RunSummary {
@@ -262,6 +269,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
             },
             adapter: ctx.adapter_description(),
             backend: ctx.backend().to_string(),
+            unit_tests: units,
             ..Default::default()
         };
         let root = project.root().expect("a store has a root");

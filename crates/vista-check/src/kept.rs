@@ -45,7 +45,8 @@ pub(crate) fn remove(report_dir: &Path) -> Result<(), GoldenError> {
 }
 
 /// The hidden folder of a shared run's records in the report folder: `run`
-/// (the run's id) and `cases/<id>.cbor`, one record per case.
+/// (the run's id), `cases/<id>.cbor`, one record per case, and
+/// `units/<id>.cbor`, one per WGSL unit test.
 pub const RUN_DIR: &str = ".vista-run";
 
 /// Removes a report folder's [`RUN_DIR`] and all in it, if it is there.

@@ -229,10 +229,14 @@ pub fn merge(
     let mut outcomes: Vec<Outcome> = shards.iter().flat_map(|s| s.outcomes.iter().cloned()).collect();
     outcomes.sort_by(|a, b| a.id.cmp(&b.id));
     let first = &shards[0].run;
+    // Each shard ran the unit tests its partition held; one listing each.
+    let units: BTreeMap<String, vista_report::UnitTest> =
+        shards.iter().flat_map(|s| s.run.unit_tests.iter().map(|t| (t.id.clone(), t.clone()))).collect();
     let run = RunSummary {
         command: format!("{command} (the {n} shards of: {})", first.command),
         backend: first.backend.clone(),
         adapter: first.adapter.clone(),
+        unit_tests: units.into_values().collect(),
         ..Default::default()
     };
     let index = write_run(out, &run, &outcomes, pending, results, None)?;

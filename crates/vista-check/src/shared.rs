@@ -27,6 +27,7 @@ use crate::kept::{RUN_DIR, remove_records};
 
 const MARK: &str = "run";
 const CASES: &str = "cases";
+const UNITS: &str = "units";
 
 /// One case as one process of the run left it.
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -34,6 +35,13 @@ struct Record {
     run: String,
     outcome: Outcome,
     pending: Option<ManifestEntry>,
+}
+
+/// One WGSL unit test as one process of the run left it.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct UnitRecord {
+    run: String,
+    test: vista_report::UnitTest,
 }
 
 fn io(path: &Path, e: std::io::Error) -> GoldenError {
@@ -152,28 +160,22 @@ impl SharedRun {
         let cases = run_dir.join(CASES);
         for f in filed {
             let record = Record { run: self.id.clone(), outcome: f.outcome.clone(), pending: f.pending.clone() };
-            let path = cases.join(format!("{}.cbor", f.outcome.id));
-            let mut bytes = Vec::new();
-            ciborium::into_writer(&record, &mut bytes)
-                .map_err(|e| GoldenError::Io { path: path.display().to_string(), message: e.to_string() })?;
-            vista_image::atomic_replace(&path, &bytes)?;
+            write_record(&cases.join(format!("{}.cbor", f.outcome.id)), &record)?;
         }
-        let mut recorded: Vec<Record> = Vec::new();
-        for e in std::fs::read_dir(&cases).map_err(|e| io(&cases, e))? {
-            let path = e.map_err(|e| io(&cases, e))?.path();
-            // Skips the temp files of a write in flight (`.<name>.tmp`).
-            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            if name.starts_with('.') || !name.ends_with(".cbor") {
-                continue;
-            }
-            let bytes = std::fs::read(&path).map_err(|e| io(&path, e))?;
-            let record: Record = ciborium::from_reader(bytes.as_slice()).map_err(|e| {
-                GoldenError::BadInput(format!("{}: not a record this vista wrote: {e}", path.display()))
-            })?;
-            if record.run == self.id {
-                recorded.push(record);
-            }
+        let units = run_dir.join(UNITS);
+        if !run.unit_tests.is_empty() {
+            std::fs::create_dir_all(&units).map_err(|e| io(&units, e))?;
         }
+        for t in &run.unit_tests {
+            let record = UnitRecord { run: self.id.clone(), test: t.clone() };
+            write_record(&units.join(format!("{}.cbor", t.id.replace("::", "."))), &record)?;
+        }
+        let mut recorded: Vec<Record> =
+            read_records::<Record>(&cases)?.into_iter().filter(|r| r.run == self.id).collect();
+        let mut run = run.clone();
+        run.unit_tests =
+            read_records::<UnitRecord>(&units)?.into_iter().filter(|r| r.run == self.id).map(|r| r.test).collect();
+        run.unit_tests.sort_by(|a, b| a.id.cmp(&b.id));
         let order: BTreeMap<&str, usize> = suite.iter().enumerate().map(|(i, id)| (id.as_str(), i)).collect();
         recorded.sort_by(|a, b| {
             let at = |r: &Record| order.get(r.outcome.id.as_str()).copied().unwrap_or(usize::MAX);
@@ -182,8 +184,41 @@ impl SharedRun {
         let pending: BTreeMap<String, ManifestEntry> =
             recorded.iter().filter_map(|r| Some((r.outcome.id.clone(), r.pending.clone()?))).collect();
         let outcomes: Vec<Outcome> = recorded.into_iter().map(|r| r.outcome).collect();
-        write_run(&self.report_dir, run, &outcomes, pending, results, Some(suite))
+        write_run(&self.report_dir, &run, &outcomes, pending, results, Some(suite))
     }
+}
+
+/// Writes one record (a case's, a unit test's) atomically.
+fn write_record(path: &Path, record: &impl serde::Serialize) -> Result<(), GoldenError> {
+    let mut bytes = Vec::new();
+    ciborium::into_writer(record, &mut bytes)
+        .map_err(|e| GoldenError::Io { path: path.display().to_string(), message: e.to_string() })?;
+    Ok(vista_image::atomic_replace(path, &bytes)?)
+}
+
+/// Every record in `dir` (none if it does not exist), skipping the temp
+/// files of a write in flight (`.<name>.tmp`).
+fn read_records<R: serde::de::DeserializeOwned>(dir: &Path) -> Result<Vec<R>, GoldenError> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(io(dir, e)),
+    };
+    let mut out = Vec::new();
+    for e in entries {
+        let path = e.map_err(|e| io(dir, e))?.path();
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        if name.starts_with('.') || !name.ends_with(".cbor") {
+            continue;
+        }
+        let bytes = std::fs::read(&path).map_err(|e| io(&path, e))?;
+        out.push(
+            ciborium::from_reader(bytes.as_slice()).map_err(|e| {
+                GoldenError::BadInput(format!("{}: not a record this vista wrote: {e}", path.display()))
+            })?,
+        );
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -15,8 +15,8 @@ mod results;
 pub use matrix::{MatrixColumn, cell as matrix_cell, matrix_json, matrix_page, matrix_reason};
 pub use mutation::mutation_page;
 pub use report::{
-    CASE_MARKER, Detail, RunSummary, THUMB_EDGE, THUMBS_DIR, clear_case_folders, file_case, href, prune_thumbs,
-    view_js, write_case_files, write_index, write_report,
+    CASE_MARKER, Detail, RunSummary, THUMB_EDGE, THUMBS_DIR, UnitTest, clear_case_folders, file_case, href,
+    prune_thumbs, view_js, write_case_files, write_index, write_report,
 };
 pub use results::{case_line, github_annotations, json_results, json_text, junit_xml, verdict_name};
 

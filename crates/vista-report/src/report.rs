@@ -448,6 +448,56 @@ pub struct RunSummary {
     /// the report then holds the cases that finished.
     #[serde(default)]
     pub stopped: Option<String>,
+    /// The WGSL unit tests the run ran (`vista::harness`), in id order.
+    #[serde(default)]
+    pub unit_tests: Vec<UnitTest>,
+}
+
+/// A WGSL unit test's result as a report lists it.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct UnitTest {
+    /// `wgsl::<file stem>::<fn>`.
+    pub id: String,
+    /// Empty when it passed: a line per failed assertion (`file:line:col:
+    /// what`), or the error that kept it from running.
+    pub failures: Vec<String>,
+}
+
+impl UnitTest {
+    /// Whether every assertion held.
+    pub fn passed(&self) -> bool {
+        self.failures.is_empty()
+    }
+}
+
+/// The index's section of WGSL unit tests: a count, then each failing
+/// test with its failures, then the passing ones' ids.
+fn unit_test_section(tests: &[UnitTest]) -> String {
+    if tests.is_empty() {
+        return String::new();
+    }
+    let failing: Vec<&UnitTest> = tests.iter().filter(|t| !t.passed()).collect();
+    let mut out = format!(
+        "<section id=\"unit-tests\"><h2>WGSL unit tests</h2><p class=\"counts\"><b>{}</b> tests: \
+         <b class=\"{}\">{} failing</b>, {} passed.</p>",
+        tests.len(),
+        if failing.is_empty() { "ok" } else { "bad" },
+        failing.len(),
+        tests.len() - failing.len()
+    );
+    if !failing.is_empty() {
+        out += "<table class=\"failures\"><tr><th>test</th><th>failed assertions</th></tr>";
+        for t in &failing {
+            let lines: Vec<String> = t.failures.iter().map(|f| html_escape(f)).collect();
+            let _ = write!(out, "<tr><td class=\"id\">{}</td><td>{}</td></tr>", html_escape(&t.id), lines.join("<br>"));
+        }
+        out += "</table>";
+    }
+    let passing: Vec<String> = tests.iter().filter(|t| t.passed()).map(|t| html_escape(&t.id)).collect();
+    if !passing.is_empty() {
+        let _ = write!(out, "<p>Passed: <code>{}</code></p>", passing.join("</code>, <code>"));
+    }
+    out + "</section>\n"
 }
 
 /// The most texels a case's viewer data holds (2048 x 2048: about 67 MB
@@ -869,7 +919,7 @@ pub fn write_index(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result
         "<header><h1>vista report</h1>\
          <p class=\"counts\"><b>{n}</b> cases: <b class=\"{fcls}\">{nfail} failing</b>, {passed} passed, {xfail} expected failures.</p>\
          <p>Backend <b>{backend}</b>, adapter <code>{adapter}</code>. Command: <code class=\"cmd\">{command}</code>. Written {date}.{others}</p>{stopped}\
-         </header>\n<section id=\"summary\"><h2>Failures, worst first</h2>{summary}{expectations}</section>\n\
+         </header>\n<section id=\"summary\"><h2>Failures, worst first</h2>{summary}{expectations}</section>\n{units}\
          <section id=\"controls\"><label><input type=\"checkbox\" id=\"failures-only\"{checked}> failures only</label> \
          <label>heat map scale <select id=\"heat-scale\"><option value=\"log\">log, fixed: 1/65535 .. 1 (same in every case)</option>\
          <option value=\"max\">linear, 0 .. this case's max</option><option value=\"fixed\">linear, 0 .. the value on the right</option></select></label> \
@@ -887,6 +937,7 @@ pub fn write_index(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result
         command = html_escape(&run.command),
         date = vista_golden::now_utc(),
         checked = if failing.is_empty() { "" } else { " checked" },
+        units = unit_test_section(&run.unit_tests),
     );
     let script = format!("const HEAT_STOPS = {stops};\nconst LOG_FLOOR = {:e};\n{SCRIPT}", vista_image::LOG_FLOOR);
     let html = page(&format!("vista report: {} failing of {}", failing.len(), sorted.len()), &body, Some(&script));

@@ -51,7 +51,31 @@ pub fn junit_xml(run: &RunSummary, outcomes: &[Outcome], report_dir: &Path) -> R
     }
     let mut report = Report::new("vista check");
     report.add_test_suite(suite);
+    if !run.unit_tests.is_empty() {
+        report.add_test_suite(unit_test_suite(&run.unit_tests));
+    }
     report.to_string().map_err(|e| GoldenError::Io { path: "junit".into(), message: e.to_string() })
+}
+
+/// The JUnit suite `wgsl`: a testcase per WGSL unit test (classname
+/// `wgsl::<file>`), a failure's message its first failed assertion and
+/// its text all of them.
+fn unit_test_suite(tests: &[crate::UnitTest]) -> TestSuite {
+    let mut suite = TestSuite::new("wgsl");
+    for t in tests {
+        let status = match t.failures.first() {
+            None => TestCaseStatus::success(),
+            Some(first) => {
+                let mut s = TestCaseStatus::non_success(NonSuccessKind::Failure);
+                s.set_type("assertion").set_message(first.as_str()).set_description(t.failures.join("\n"));
+                s
+            }
+        };
+        let mut case = TestCase::new(t.id.as_str(), status);
+        case.set_classname(t.id.rsplit_once("::").map_or(t.id.as_str(), |(file, _)| file));
+        suite.add_test_case(case);
+    }
+    suite
 }
 
 /// The word a verdict is reported as.
@@ -114,6 +138,11 @@ pub fn json_results(run: &RunSummary, outcomes: &[Outcome]) -> serde_json::Value
         "command": run.command,
         "passed": outcomes.iter().filter(|o| o.passed()).count(),
         "failed": outcomes.iter().filter(|o| !o.passed()).count(),
+        "unit_tests": run.unit_tests.iter().map(|t| serde_json::json!({
+            "test": t.id,
+            "passed": t.passed(),
+            "failures": t.failures,
+        })).collect::<Vec<_>>(),
         "cases": cases,
     })
 }
@@ -195,6 +224,43 @@ mod tests {
         assert!(case_lines[1].contains(r#""id":"b\\\"c\n""#), "{text}");
         let empty = serde_json::json!({"backend": "x", "cases": []});
         assert_eq!(serde_json::from_str::<serde_json::Value>(&one_case_per_line(empty.clone())).unwrap(), empty);
+    }
+
+    /// WGSL unit tests: a JUnit suite `wgsl` (a failure's message its
+    /// first failed assertion) and `unit_tests` in the JSON.
+    #[test]
+    fn unit_tests_are_a_junit_suite_and_a_json_list() {
+        let failing = vec!["shaders/a.test.wgsl:3:5: expect(false)".to_string(), "and 2 more".to_string()];
+        let run = RunSummary {
+            unit_tests: vec![
+                crate::UnitTest { id: "wgsl::a::bad".into(), failures: failing.clone() },
+                crate::UnitTest { id: "wgsl::a::good".into(), failures: Vec::new() },
+            ],
+            ..Default::default()
+        };
+        let xml = junit_xml(&run, &[], Path::new("r")).unwrap();
+        let report = Report::deserialize_from_str(&xml).unwrap();
+        let suite = report.test_suites.iter().find(|s| s.name.as_str() == "wgsl").expect("a wgsl suite");
+        assert_eq!(suite.test_cases.len(), 2);
+        let bad = &suite.test_cases[0];
+        assert_eq!((bad.name.as_str(), bad.classname.as_deref()), ("wgsl::a::bad", Some("wgsl::a")));
+        match &bad.status {
+            TestCaseStatus::NonSuccess { kind: NonSuccessKind::Failure, message, description, .. } => {
+                assert_eq!(message.as_deref(), Some(failing[0].as_str()));
+                assert_eq!(description.as_deref(), Some(failing.join("\n").as_str()));
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(suite.test_cases[1].status, TestCaseStatus::Success { .. }));
+        let json = json_results(&run, &[]);
+        assert_eq!(
+            json["unit_tests"][0],
+            serde_json::json!({"test": "wgsl::a::bad", "passed": false, "failures": failing})
+        );
+        assert_eq!(json["unit_tests"][1]["passed"], true);
+        // No unit tests: no wgsl suite.
+        let none = junit_xml(&RunSummary::default(), &[], Path::new("r")).unwrap();
+        assert!(Report::deserialize_from_str(&none).unwrap().test_suites.iter().all(|s| s.name.as_str() != "wgsl"));
     }
 
     #[test]
