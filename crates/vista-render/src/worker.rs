@@ -617,9 +617,15 @@ impl Worker {
             match proc.heard.recv_timeout(patience) {
                 Ok(Heard::Message(FromWorker::Pass(label), _)) => pass = label,
                 Ok(Heard::Message(FromWorker::Done(result), bytes)) => {
-                    self.idle.lock().expect("workers").push(proc);
+                    let result = result.map_err(GpuError::from);
+                    // A device the watchdog gave up on still runs the hung
+                    // work, and the next run would wait behind it: that
+                    // worker is dropped (killed), the next run starts another.
+                    if !matches!(result, Err(GpuError::Timeout { .. })) {
+                        self.idle.lock().expect("workers").push(proc);
+                    }
                     return match result {
-                        Err(e) => Err(RenderError::Gpu(e.into())),
+                        Err(e) => Err(RenderError::Gpu(e)),
                         Ok(head) => {
                             *self.compile.lock().expect("compile time") += head.compile;
                             Ok(readback(head, bytes))

@@ -116,16 +116,17 @@ fn wesl(rel: &str) -> bool {
     rel.ends_with(".wesl")
 }
 
-/// The manifest of file `rel` rewritten: one pass per test, each with its
-/// own zeroed copy of every `@buffer`, the results buffer the output.
-fn manifest(rel: &str, rewritten: &Rewritten) -> String {
-    let tests = rewritten.tests.len();
+/// The manifest of file `rel` rewritten, running the tests `which` (file
+/// indexes): one pass each, each with its own zeroed copy of every
+/// `@buffer`, the generated textures filled first, the results buffer
+/// (a row per test of the file) the output.
+fn manifest(rel: &str, rewritten: &Rewritten, which: &[usize]) -> String {
     let mut m = format!(
         "summary = \"the WGSL tests of {rel}\"\nshader = \"{rel}\"\n\n[[resource]]\nname = \"wgsl_test_results\"\n\
          kind = \"buffer\"\nlength = {}\n",
-        tests * ROW
+        rewritten.tests.len() * ROW
     );
-    for i in 0..tests {
+    for &i in which {
         for b in &rewritten.buffers {
             m.push_str(&format!(
                 "\n[[resource]]\nname = \"{}__{i}\"\nkind = \"buffer\"\nlength = {}\n",
@@ -157,7 +158,7 @@ fn manifest(rel: &str, rewritten: &Rewritten) -> String {
             ));
         }
     }
-    for i in 0..tests {
+    for &i in which {
         let bind: Vec<String> = rewritten.buffers.iter().map(|b| format!("{0} = \"{0}__{i}\"", b.name)).collect();
         m.push_str(&format!("\n[[pass]]\nentry = \"{}\"\nworkgroups = [1, 1, 1]\n", entry(i)));
         if !bind.is_empty() {
@@ -168,18 +169,44 @@ fn manifest(rel: &str, rewritten: &Rewritten) -> String {
     m
 }
 
+/// Why a render of tests did not give their rows: the error as one line,
+/// and whether the device's watchdog ended it.
+struct NotRun {
+    error: String,
+    timeout: bool,
+}
+
+/// Renders tests `which` of the rewritten file `rel` on `gpu`: the results
+/// buffer's words.
+fn render_tests(gpu: &Renderer, rel: &str, rewritten: &Rewritten, which: &[usize]) -> Result<Vec<u32>, NotRun> {
+    let not_run = |error: String| NotRun { error, timeout: false };
+    let name = format!("wgsl-test-{}", rel.replace(['/', '.'], "-"));
+    let kernel = vista_manifest::Kernel::from_manifest(&name, rel, &manifest(rel, rewritten, which))
+        .map_err(|e| not_run(e.to_string()))?;
+    let params = kernel.resolve(None, &[]).map_err(|e| not_run(e.to_string()))?;
+    let rendered = vista_render::render_with(gpu, &kernel, &params, &[], 1, 1)
+        .map_err(|e| NotRun { error: one_line(&e.to_string()), timeout: e.is_timeout() })?;
+    match rendered.outputs.first().map(|o| &o.value) {
+        Some(OutputValue::Buffer { bytes, .. }) => {
+            Ok(bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect())
+        }
+        _ => Err(not_run("the results buffer did not come back".into())),
+    }
+}
+
 /// Runs the tests of file `rel` (`text` as the project has it) on `base`'s
 /// engine, its file replaced by the rewrite in memory: every test's
 /// result, in file order. A file that does not rewrite, compose or run
 /// fails each of its tests with that error (one result named `*` if none
-/// could be found).
+/// could be found). When the watchdog ends the file's run (a test that
+/// hangs), each test runs again alone, so that only the one that hangs
+/// fails for it.
 pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, text: &str) -> Vec<TestResult> {
     let rewritten = match rewrite(text, wesl(rel)) {
         Ok(r) => r,
         Err(e) => return vec![broken(&test_id(rel, "*"), format!("{rel}:{e}"))],
     };
     let ids: Vec<String> = rewritten.tests.iter().map(|t| test_id(rel, &t.name)).collect();
-    let all_fail = |e: String| ids.iter().map(|id| broken(id, e.clone())).collect();
     // The base's own edits (a mutant under test) stay.
     let mut edits = base.edits.clone();
     edits.push((rel.to_string(), rewritten.text.clone()));
@@ -191,37 +218,28 @@ pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, tex
         limits: base.limits,
         root: base.root.clone(),
     };
-    let name = format!("wgsl-test-{}", rel.replace(['/', '.'], "-"));
-    let kernel = match vista_manifest::Kernel::from_manifest(&name, rel, &manifest(rel, &rewritten)) {
-        Ok(k) => k,
-        Err(e) => return all_fail(e.to_string()),
+    let row_of = |words: &[u32], i: usize, id: &str| {
+        let row = &words[i * ROW..(i + 1) * ROW];
+        let failures = row[1..]
+            .chunks_exact(RECORD)
+            .take((row[0] as usize).min(KEPT))
+            .map(|r| failure(rel, &rewritten.sites, r))
+            .collect();
+        TestResult { id: id.to_string(), failures, failed: row[0], error: None }
     };
-    let params = match kernel.resolve(None, &[]) {
-        Ok(p) => p,
-        Err(e) => return all_fail(e.to_string()),
-    };
-    let rendered = match vista_render::render_with(&gpu, &kernel, &params, &[], 1, 1) {
-        Ok(r) => r,
-        Err(e) => return all_fail(one_line(&e.to_string())),
-    };
-    let words: Vec<u32> = match rendered.outputs.first().map(|o| &o.value) {
-        Some(OutputValue::Buffer { bytes, .. }) => {
-            bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect()
-        }
-        _ => return all_fail("the results buffer did not come back".into()),
-    };
-    ids.into_iter()
-        .enumerate()
-        .map(|(i, id)| {
-            let row = &words[i * ROW..(i + 1) * ROW];
-            let failures = row[1..]
-                .chunks_exact(RECORD)
-                .take((row[0] as usize).min(KEPT))
-                .map(|r| failure(rel, &rewritten.sites, r))
-                .collect();
-            TestResult { id, failures, failed: row[0], error: None }
-        })
-        .collect()
+    let all: Vec<usize> = (0..ids.len()).collect();
+    match render_tests(&gpu, rel, &rewritten, &all) {
+        Ok(words) => ids.iter().enumerate().map(|(i, id)| row_of(&words, i, id)).collect(),
+        Err(e) if e.timeout && ids.len() > 1 => ids
+            .iter()
+            .enumerate()
+            .map(|(i, id)| match render_tests(&gpu, rel, &rewritten, &[i]) {
+                Ok(words) => row_of(&words, i, id),
+                Err(e) => broken(id, e.error),
+            })
+            .collect(),
+        Err(e) => ids.iter().map(|id| broken(id, e.error.clone())).collect(),
+    }
 }
 
 /// A compile error on one line: `path:line: message` (the column is the
