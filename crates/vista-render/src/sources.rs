@@ -32,7 +32,9 @@ impl Sources {
             project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin)).collect();
         let (specs, reader) = source_specs(project)?;
         files.extend(generated_modules(&specs)?);
-        Ok(Sources { label, files, enums: enum_modules(project)?, specs, reader })
+        let mut enums = enum_modules(project)?;
+        enums.extend(test_file_enums(&files, &enums));
+        Ok(Sources { label, files, enums, specs, reader })
     }
 
     /// The project's shader set.
@@ -120,6 +122,45 @@ pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, Str
         }
     }
     Ok(out)
+}
+
+/// The `vista::enums` of each WGSL unit test file, which no manifest
+/// names: every kernel's enum constants (so a test of a library module
+/// that imports them composes), but a constant two kernels give different
+/// values, which is left out (a test that names it fails to compose,
+/// naming it).
+fn test_file_enums(
+    files: &[(String, String, String)],
+    kernels: &[(String, String, String)],
+) -> Vec<(String, String, String)> {
+    let mut consts: std::collections::BTreeMap<String, Option<String>> = Default::default();
+    for (_, _, text) in kernels {
+        for line in text.lines().filter(|l| l.starts_with("const ")) {
+            let name = line["const ".len()..].split(':').next().unwrap_or_default().trim().to_string();
+            consts
+                .entry(name)
+                .and_modify(|v| {
+                    if v.as_deref() != Some(line) {
+                        *v = None
+                    }
+                })
+                .or_insert_with(|| Some(line.to_string()));
+        }
+    }
+    let mut text = format!(
+        "#define_import_path {}\n\n// Every kernel's enum constants, for the WGSL unit tests; those two kernels give \
+         different values are left out.\n",
+        vista_gpu::ENUMS_MODULE
+    );
+    for line in consts.values().flatten() {
+        text.push_str(line);
+        text.push('\n');
+    }
+    files
+        .iter()
+        .filter(|f| vista_gpu::is_unit_test_file(&f.0))
+        .map(|f| (f.0.clone(), "the project's kernels (a WGSL unit test)".to_string(), text.clone()))
+        .collect()
 }
 
 /// The project's WGSL as one [`ShaderSet`].
