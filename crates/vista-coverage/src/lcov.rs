@@ -1,0 +1,117 @@
+//! Counter values mapped to files and lines, summed over runs, as LCOV.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+use crate::Counter;
+
+/// Where a span starts in the user's files.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Place {
+    /// The file as the report names it (relative to the project).
+    pub file: String,
+    /// 1-based line.
+    pub line: u32,
+    /// 1-based column.
+    pub col: u32,
+}
+
+/// A branch arm's key: its statement's line and column (the block), and
+/// the arm.
+type ArmKey = (u32, u32, u32);
+
+/// Hit counts per file: lines, and branch arms (`None`: the branching
+/// statement never ran).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Counts {
+    lines: BTreeMap<String, BTreeMap<u32, u64>>,
+    arms: BTreeMap<String, BTreeMap<ArmKey, u64>>,
+}
+
+impl Counts {
+    /// Adds one run's counter `values` (element i for counter i), each
+    /// statement's line taking the largest count of the segments on it (a
+    /// line runs as often as its most-run statement); a span `place`
+    /// cannot map (a generated statement) counts nowhere.
+    pub fn add(&mut self, counters: &[Counter], values: &[u32], place: &dyn Fn(naga::Span) -> Option<Place>) {
+        let mut run_lines: BTreeMap<(String, u32), u64> = BTreeMap::new();
+        for (c, &v) in counters.iter().zip(values) {
+            for p in c.spans.iter().filter_map(|s| place(*s)) {
+                let hits = run_lines.entry((p.file, p.line)).or_default();
+                *hits = (*hits).max(v as u64);
+            }
+            if let Some(arm) = c.arm
+                && let Some(p) = place(arm.at)
+            {
+                *self.arms.entry(p.file).or_default().entry((p.line, p.col, arm.branch)).or_default() += v as u64;
+            }
+        }
+        for ((file, line), hits) in run_lines {
+            *self.lines.entry(file).or_default().entry(line).or_default() += hits;
+        }
+    }
+
+    /// Adds another run's (or shard's) counts.
+    pub fn merge(&mut self, other: &Counts) {
+        for (file, lines) in &other.lines {
+            let mine = self.lines.entry(file.clone()).or_default();
+            for (line, hits) in lines {
+                *mine.entry(*line).or_default() += hits;
+            }
+        }
+        for (file, arms) in &other.arms {
+            let mine = self.arms.entry(file.clone()).or_default();
+            for (key, hits) in arms {
+                *mine.entry(*key).or_default() += hits;
+            }
+        }
+    }
+
+    /// The hit count of each measured line of `file`, in line order.
+    pub fn lines(&self, file: &str) -> Vec<(u32, u64)> {
+        self.lines.get(file).map(|l| l.iter().map(|(k, v)| (*k, *v)).collect()).unwrap_or_default()
+    }
+
+    /// Each arm of `file`: (line, column, arm, hits), in line order.
+    pub fn arms(&self, file: &str) -> Vec<(u32, u32, u32, u64)> {
+        self.arms.get(file).map(|a| a.iter().map(|(k, v)| (k.0, k.1, k.2, *v)).collect()).unwrap_or_default()
+    }
+
+    /// The files with measured lines.
+    pub fn files(&self) -> Vec<String> {
+        self.lines.keys().cloned().collect()
+    }
+
+    /// Lines found and hit, arms found and taken, over every file.
+    pub fn totals(&self) -> (usize, usize, usize, usize) {
+        let lines = self.lines.values().flat_map(|l| l.values());
+        let arms = self.arms.values().flat_map(|a| a.values());
+        let (lf, lh) = lines.fold((0, 0), |(f, h), &v| (f + 1, h + usize::from(v > 0)));
+        let (bf, bh) = arms.fold((0, 0), |(f, h), &v| (f + 1, h + usize::from(v > 0)));
+        (lf, lh, bf, bh)
+    }
+
+    /// The LCOV tracefile (`lcov.info`): per file `SF`, `DA` per line,
+    /// `BRDA` per arm (`-` where its statement's line never ran), the
+    /// `BRF`/`BRH` and `LF`/`LH` totals, `end_of_record`.
+    pub fn lcov(&self, test_name: &str) -> String {
+        let mut out = String::new();
+        for (file, lines) in &self.lines {
+            let _ = writeln!(out, "TN:{test_name}\nSF:{file}");
+            let arms = self.arms.get(file);
+            for (key, hits) in arms.into_iter().flatten() {
+                let ran = lines.get(&key.0).is_some_and(|&h| h > 0);
+                let taken = if ran { hits.to_string() } else { "-".into() };
+                let _ = writeln!(out, "BRDA:{},{},{},{taken}", key.0, key.1, key.2);
+            }
+            let (bf, bh) = arms.map_or((0, 0), |a| (a.len(), a.values().filter(|&&v| v > 0).count()));
+            let _ = writeln!(out, "BRF:{bf}\nBRH:{bh}");
+            for (line, hits) in lines {
+                let _ = writeln!(out, "DA:{line},{hits}");
+            }
+            let lh = lines.values().filter(|&&v| v > 0).count();
+            let _ = writeln!(out, "LF:{}\nLH:{lh}\nend_of_record", lines.len());
+        }
+        out
+    }
+}

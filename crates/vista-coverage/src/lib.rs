@@ -1,0 +1,246 @@
+#![deny(missing_docs)]
+//! Coverage of WGSL (SPEC 20): which statements and branch arms of a
+//! kernel its cases execute.
+//!
+//! [`instrument`] rewrites a validated naga module so that every
+//! straight-line run of statements (a *segment*: statements that execute
+//! the same number of times, ended by any statement that branches, loops
+//! or leaves) first adds one to its own counter, an `atomicAdd` on
+//! `vista_coverage: array<atomic<u32>>` at a group the pass does not bind.
+//! Each branch arm (an `if`'s accept and reject blocks, a `switch`'s
+//! cases, a loop's body; `&&` and `||` are `if`s in naga's IR) starts a
+//! segment of its own, so arms are counted even when empty. Functions a
+//! vertex entry reaches are left as they are (a vertex stage may not
+//! write storage in WebGPU's core): *not measured*, never *unexecuted*.
+//!
+//! [`Counts`] maps the counters back to lines through a caller's
+//! span-to-place function (the composed source's files and lines) and
+//! writes LCOV (`lcov.info`: `DA` per line, `BRDA` per arm).
+//!
+//! Not for: binding the buffer or reading it back (the engine), or which
+//! cases run (the caller).
+
+mod lcov;
+
+pub use lcov::{Counts, Place};
+
+use naga::{
+    AddressSpace, AtomicFunction, Block, Expression, Function, Handle, Literal, Module, ResourceBinding, Scalar,
+    ShaderStage, Span, Statement, StorageAccess, Type, TypeInner,
+};
+
+/// The counter buffer's WGSL variable.
+pub const VAR: &str = "vista_coverage";
+
+/// Which arm of a branch a counter counts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Arm {
+    /// The span of the `if`, `switch` or `loop` statement.
+    pub at: Span,
+    /// 0: the accept block (a case's index, a loop's body); 1: reject.
+    pub branch: u32,
+}
+
+/// One counter: the statements it counts, and the arm it starts, if any.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Counter {
+    /// The spans of the statements of its segment (possibly none: an
+    /// empty arm).
+    pub spans: Vec<Span>,
+    /// The branch arm whose start it is.
+    pub arm: Option<Arm>,
+    /// The function it is in (an entry point's name for its body).
+    pub function: String,
+}
+
+/// A module with its counters.
+#[derive(Debug, Clone)]
+pub struct Instrumented {
+    /// The instrumented module (validate it as any module).
+    pub module: Module,
+    /// Counter i is element i of [`VAR`].
+    pub counters: Vec<Counter>,
+    /// Where [`VAR`] is bound.
+    pub binding: ResourceBinding,
+    /// Functions left uninstrumented (a vertex entry reaches them): their
+    /// lines are not measured.
+    pub not_measured: Vec<String>,
+}
+
+/// The module with a counter per segment and per arm, its buffer at
+/// `group`, binding 0 (a group no pass of the module's uses).
+pub fn instrument(module: &Module, group: u32) -> Instrumented {
+    let mut m = module.clone();
+    let atomic = m.types.insert(Type { name: None, inner: TypeInner::Atomic(Scalar::U32) }, Span::UNDEFINED);
+    let array = m.types.insert(
+        Type { name: None, inner: TypeInner::Array { base: atomic, size: naga::ArraySize::Dynamic, stride: 4 } },
+        Span::UNDEFINED,
+    );
+    let binding = ResourceBinding { group, binding: 0 };
+    let global = m.global_variables.append(
+        naga::GlobalVariable {
+            name: Some(VAR.to_string()),
+            space: AddressSpace::Storage { access: StorageAccess::LOAD | StorageAccess::STORE },
+            binding: Some(binding),
+            ty: array,
+            init: None,
+            memory_decorations: naga::MemoryDecorations::empty(),
+        },
+        Span::UNDEFINED,
+    );
+    let vertex = reached_from_vertex(&m);
+    let mut counters = Vec::new();
+    let mut not_measured = Vec::new();
+    let handles: Vec<Handle<Function>> = m.functions.iter().map(|(h, _)| h).collect();
+    for h in handles {
+        let name = m.functions[h].name.clone().unwrap_or_default();
+        if vertex.contains(&h) {
+            not_measured.push(name);
+            continue;
+        }
+        instrument_function(&mut m.functions[h], global, &name, &mut counters);
+    }
+    for ep in m.entry_points.iter_mut() {
+        if ep.stage == ShaderStage::Vertex {
+            not_measured.push(ep.name.clone());
+            continue;
+        }
+        let name = ep.name.clone();
+        instrument_function(&mut ep.function, global, &name, &mut counters);
+    }
+    Instrumented { module: m, counters, binding, not_measured }
+}
+
+/// The functions a vertex entry point calls, directly or not.
+fn reached_from_vertex(m: &Module) -> Vec<Handle<Function>> {
+    let mut reached: Vec<Handle<Function>> = Vec::new();
+    let mut todo: Vec<&Block> =
+        m.entry_points.iter().filter(|e| e.stage == ShaderStage::Vertex).map(|e| &e.function.body).collect();
+    while let Some(block) = todo.pop() {
+        let mut calls = Vec::new();
+        calls_in(block, &mut calls);
+        for f in calls {
+            if !reached.contains(&f) {
+                reached.push(f);
+                todo.push(&m.functions[f].body);
+            }
+        }
+    }
+    reached
+}
+
+fn calls_in(block: &Block, out: &mut Vec<Handle<Function>>) {
+    for s in block.iter() {
+        match s {
+            Statement::Call { function, .. } => out.push(*function),
+            Statement::Block(b) => calls_in(b, out),
+            Statement::If { accept, reject, .. } => {
+                calls_in(accept, out);
+                calls_in(reject, out);
+            }
+            Statement::Switch { cases, .. } => cases.iter().for_each(|c| calls_in(&c.body, out)),
+            Statement::Loop { body, continuing, .. } => {
+                calls_in(body, out);
+                calls_in(continuing, out);
+            }
+            _ => {}
+        }
+    }
+}
+
+/// What adding a counter to a function needs.
+struct Adder<'a> {
+    expressions: &'a mut naga::Arena<Expression>,
+    global: Handle<Expression>,
+    one: Handle<Expression>,
+    function: &'a str,
+    counters: &'a mut Vec<Counter>,
+}
+
+impl Adder<'_> {
+    /// A new counter: its index and the two statements that add one to it.
+    fn counter(&mut self, arm: Option<Arm>) -> (usize, [(Statement, Span); 2]) {
+        let index = self.counters.len();
+        self.counters.push(Counter { spans: Vec::new(), arm, function: self.function.to_string() });
+        let span = arm.map_or(Span::UNDEFINED, |a| a.at);
+        let pointer = self.expressions.append(Expression::AccessIndex { base: self.global, index: index as u32 }, span);
+        let add = Statement::Atomic { pointer, fun: AtomicFunction::Add, value: self.one, result: None };
+        (index, [(Statement::Emit(naga::Range::new_from_bounds(pointer, pointer)), span), (add, span)])
+    }
+
+    /// `block` with a counter at the start of each segment (and at its
+    /// very start when it is an arm or `eager`, even if empty).
+    fn block(&mut self, block: Block, arm: Option<Arm>, eager: bool) -> Block {
+        let mut out = Block::with_capacity(block.len() + 4);
+        let mut open: Option<usize> = None;
+        if arm.is_some() || eager {
+            let (index, adds) = self.counter(arm);
+            adds.into_iter().for_each(|(s, sp)| out.push(s, sp));
+            open = Some(index);
+        }
+        for (statement, span) in block.span_into_iter() {
+            let index = match open {
+                Some(i) => i,
+                None => {
+                    let (index, adds) = self.counter(None);
+                    adds.into_iter().for_each(|(s, sp)| out.push(s, sp));
+                    open = Some(index);
+                    index
+                }
+            };
+            if span.is_defined() {
+                self.counters[index].spans.push(span);
+            }
+            // A statement that branches, loops or leaves ends the segment:
+            // what follows it may run another number of times.
+            let (statement, ends) = match statement {
+                Statement::If { condition, accept, reject } => {
+                    let accept = self.block(accept, Some(Arm { at: span, branch: 0 }), true);
+                    let reject = self.block(reject, Some(Arm { at: span, branch: 1 }), true);
+                    (Statement::If { condition, accept, reject }, true)
+                }
+                Statement::Switch { selector, cases } => {
+                    let cases = cases
+                        .into_iter()
+                        .enumerate()
+                        .map(|(i, c)| naga::SwitchCase {
+                            body: self.block(c.body, Some(Arm { at: span, branch: i as u32 }), true),
+                            ..c
+                        })
+                        .collect();
+                    (Statement::Switch { selector, cases }, true)
+                }
+                Statement::Loop { body, continuing, break_if } => {
+                    let body = self.block(body, Some(Arm { at: span, branch: 0 }), true);
+                    let continuing = self.block(continuing, None, false);
+                    (Statement::Loop { body, continuing, break_if }, true)
+                }
+                Statement::Block(b) => (Statement::Block(self.block(b, None, false)), true),
+                s @ (Statement::Return { .. } | Statement::Break | Statement::Continue | Statement::Kill) => (s, true),
+                s => (s, false),
+            };
+            out.push(statement, span);
+            if ends {
+                open = None;
+            }
+        }
+        out
+    }
+}
+
+fn instrument_function(
+    f: &mut Function,
+    global: Handle<naga::GlobalVariable>,
+    name: &str,
+    counters: &mut Vec<Counter>,
+) {
+    let global = f.expressions.append(Expression::GlobalVariable(global), Span::UNDEFINED);
+    let one = f.expressions.append(Expression::Literal(Literal::U32(1)), Span::UNDEFINED);
+    let body = std::mem::take(&mut f.body);
+    let mut adder = Adder { expressions: &mut f.expressions, global, one, function: name, counters };
+    // The body starts a segment even if empty: a call of the function counts.
+    f.body = adder.block(body, None, true);
+}
+
+#[cfg(test)]
+mod tests;

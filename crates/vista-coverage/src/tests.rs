@@ -1,0 +1,113 @@
+use super::*;
+
+/// A compute kernel with known paths, one statement per line.
+const KERNEL: &str = "@group(0) @binding(0) var<storage, read_write> out: array<u32, 8>;
+fn unused(x: u32) -> u32 {
+    return x * 2u;
+}
+@compute @workgroup_size(8)
+fn main(@builtin(local_invocation_index) i: u32) {
+    var acc = 0u;
+    if (i < 3u) {
+        acc = 1u;
+    } else {
+        acc = 2u;
+    }
+    for (var k = 0u; k < i; k++) {
+        acc += k;
+        if (k == 4u) { break; }
+    }
+    out[i] = acc;
+}
+@vertex
+fn vs(@builtin(vertex_index) v: u32) -> @builtin(position) vec4f {
+    return vec4f(f32(helper(v)), 0.0, 0.0, 1.0);
+}
+fn helper(v: u32) -> u32 {
+    return v + 1u;
+}
+";
+
+fn parse(text: &str) -> Module {
+    naga::front::wgsl::parse_str(text).unwrap()
+}
+
+fn validate(m: &Module) -> naga::valid::ModuleInfo {
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(m)
+        .unwrap_or_else(|e| panic!("{e:?}"))
+}
+
+fn line_of(text: &str) -> impl Fn(Span) -> Option<Place> + '_ {
+    move |s: Span| {
+        let r = s.to_range()?;
+        let loc = s.location(text);
+        (r.end > r.start).then(|| Place { file: "k.wgsl".into(), line: loc.line_number, col: loc.line_position })
+    }
+}
+
+/// The instrumented module validates and writes back as WGSL with one
+/// counter buffer; every counted line is a statement's; the vertex entry
+/// and what it calls are not measured.
+#[test]
+fn the_instrumented_module_validates_and_counts_statement_lines() {
+    let module = parse(KERNEL);
+    let inst = instrument(&module, 1);
+    validate(&inst.module);
+    let info = validate(&inst.module);
+    let wgsl = naga::back::wgsl::write_string(&inst.module, &info, naga::back::wgsl::WriterFlags::empty()).unwrap();
+    assert!(
+        wgsl.contains("@group(1) @binding(0) \nvar<storage, read_write> vista_coverage: array<atomic<u32>>;")
+            || wgsl.contains("var<storage, read_write> vista_coverage: array<atomic<u32>>;"),
+        "{wgsl}"
+    );
+    assert_eq!(inst.not_measured, ["helper", "vs"]);
+    let place = line_of(KERNEL);
+    let mut lines: Vec<u32> =
+        inst.counters.iter().flat_map(|c| c.spans.iter().filter_map(|s| place(*s)).map(|p| p.line)).collect();
+    lines.sort();
+    lines.dedup();
+    // unused's return (3) and main's statements, nothing else (`var acc =
+    // 0u` is a declaration with a constant: no statement in naga's IR).
+    assert_eq!(lines, [3, 8, 9, 11, 13, 14, 15, 17], "{:#?}", inst.counters);
+    // Arms: the if's two; the loop's body and its condition's two (naga
+    // lowers `for` to a loop whose body starts `if !(k < i) { break; }`);
+    // the inner if's two.
+    let mut arms: Vec<(u32, u32)> =
+        inst.counters.iter().filter_map(|c| c.arm).map(|a| (place(a.at).unwrap().line, a.branch)).collect();
+    arms.sort();
+    assert_eq!(arms, [(8, 0), (8, 1), (13, 0), (13, 0), (13, 1), (15, 0), (15, 1)]);
+}
+
+/// Counts map lines to their segments' values, summed over runs; LCOV
+/// lists every line (0 where never run) and each arm, `-` where its
+/// statement never ran.
+#[test]
+fn counts_sum_runs_and_write_lcov() {
+    let module = parse(KERNEL);
+    let inst = instrument(&module, 1);
+    let place = line_of(KERNEL);
+    // A run where only `unused` never ran: every other counter 2.
+    let values: Vec<u32> = inst.counters.iter().map(|c| if c.function == "unused" { 0 } else { 2 }).collect();
+    let mut counts = Counts::default();
+    counts.add(&inst.counters, &values, &place);
+    counts.add(&inst.counters, &values, &place);
+    let lines = counts.lines("k.wgsl");
+    assert_eq!(lines[0], (3, 0));
+    assert!(lines[1..].iter().all(|&(_, h)| h == 4), "{lines:?}");
+    let lcov = counts.lcov("vista");
+    assert!(lcov.starts_with("TN:vista\nSF:k.wgsl\n"), "{lcov}");
+    assert!(lcov.contains("DA:3,0\n") && lcov.contains("DA:9,4\n"), "{lcov}");
+    assert!(lcov.contains("BRDA:8,5,0,4\n") && lcov.contains("BRDA:8,5,1,4\n"), "{lcov}");
+    assert!(lcov.contains("BRDA:13,21,1,4\n"), "the for loop's condition: {lcov}");
+    assert!(lcov.contains("BRF:7\nBRH:7\n") && lcov.contains("LF:8\nLH:7\nend_of_record\n"), "{lcov}");
+    assert_eq!(counts.totals(), (8, 7, 7, 7));
+    // A run where nothing ran: every line 0, every arm `-` (never reached).
+    let mut none = Counts::default();
+    none.add(&inst.counters, &vec![0; inst.counters.len()], &place);
+    let lcov = none.lcov("vista");
+    assert!(lcov.contains("BRDA:8,5,0,-\n") && lcov.contains("DA:17,0\n") && lcov.contains("LH:0\n"), "{lcov}");
+    let mut twice = counts.clone();
+    twice.merge(&counts);
+    assert_eq!(twice.lines("k.wgsl")[1].1, 8);
+}
