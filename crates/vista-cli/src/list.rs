@@ -1,5 +1,6 @@
 //! `vista list`: every kernel with its params and presets; a broken
 //! manifest or WGSL that does not compose is shown and fails the listing.
+//! `--layout`: each kernel's buffer bindings, leaf by leaf.
 
 use vista_golden::GoldenError;
 use vista_project::Project;
@@ -57,4 +58,45 @@ fn list(kernels: &vista_kernels::Registry) {
         }
         println!();
     }
+}
+
+/// `vista list --layout`: for each kernel and each shader its passes
+/// compose, every buffer binding with each leaf's offset, path and type;
+/// 2 where a kernel's WGSL does not compose.
+pub fn layouts(project: &Project) -> Result<i32, GoldenError> {
+    let kernels = registry(project)?;
+    let shaders = vista_render::shader_set(project)?;
+    let mut bad = 0;
+    for k in kernels.kernels() {
+        println!("{} — {}", k.name(), k.summary());
+        let p = k.resolve(None, &[]).map_err(|e| GoldenError::BadInput(e.to_string()))?;
+        let mut seen: Vec<String> = Vec::new();
+        for i in 0..k.graph().passes.len() {
+            let name = k.pass_shader_for(i, &p);
+            if seen.contains(&name) {
+                continue;
+            }
+            seen.push(name.clone());
+            let module = match shaders.compose(&name) {
+                Ok(m) => m,
+                Err(e) => {
+                    println!("  {name}: does not compose: {}", e.to_string().lines().next().unwrap_or_default());
+                    bad += 1;
+                    continue;
+                }
+            };
+            println!("  {}:", name.split(['?', '|']).next().unwrap_or(&name));
+            for b in vista_manifest::leaves::buffer_layouts(&module) {
+                println!(
+                    "    @group({}) @binding({}) var<{}> {}: {} bytes",
+                    b.group, b.binding, b.space, b.name, b.size
+                );
+                for l in &b.leaves {
+                    println!("      {:<24} {:<32} {}", vista_manifest::leaves::offset_text(l), l.path, l.ty);
+                }
+            }
+        }
+        println!();
+    }
+    Ok(if bad == 0 { 0 } else { 2 })
 }

@@ -60,6 +60,11 @@ enum Command {
         /// Print only `KERNEL PRESET` lines (for scripts).
         #[arg(long)]
         names: bool,
+        /// Print each buffer binding's layout instead: every leaf by its
+        /// path (`lights[i].color`), byte offset and WGSL type, as an
+        /// engine packs it.
+        #[arg(long, conflicts_with = "names")]
+        layout: bool,
     },
     /// Render one kernel to a PNG (display values) or EXR (raw/linear values).
     Render {
@@ -371,7 +376,8 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             };
             watch::watch(project, config, case.as_deref(), watch::interval(interval)?, timeout)
         }
-        Command::List { names } => list::run(project, names),
+        Command::List { names: _, layout: true } => list::layouts(project),
+        Command::List { names, layout: false } => list::run(project, names),
         Command::Test { filter, matrix } => unit_tests::test(project, config, filter.as_deref(), matrix),
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             render::render(project, config, render::Args { kernel, preset, set, size, crop, zoom, out })

@@ -19,6 +19,7 @@ pub mod expr;
 pub mod graph;
 mod kernel;
 pub mod layout;
+pub mod leaves;
 pub mod manifest;
 pub mod params;
 mod size;
