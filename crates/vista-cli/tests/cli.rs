@@ -3867,7 +3867,60 @@ fn preset_naming_an_unknown_param_is_refused() {
 
 fn missing_shader_file_is_refused() {
     let m = format!("shader = \"nope.wgsl\"\n{K_MANIFEST}");
-    assert_rejected(&render_k(&m, K_SHADER), 2, &["kernel k", "shader nope.wgsl not found", "k.wgsl"]);
+    let r = render_k(&m, K_SHADER);
+    assert_rejected(&r, 2, &["kernel k", "shader nope.wgsl not found", "its kernel files: k.wgsl;"]);
+    // The project's files, not the built-ins'.
+    assert!(!r.stderr.contains("fbm.wgsl"), "{}", r.stderr);
+}
+
+/// `vista list --layout`: each buffer binding leaf by leaf, offsets by
+/// WGSL's layout rules worked by hand (vec3 takes 12 bytes at a 16-byte
+/// alignment, an array of a 32-byte struct steps by 32), so a project
+/// packs engine data at the offsets the shader reads.
+fn list_layout_prints_every_leaf_with_its_offset() {
+    let shader = "struct Light { color: vec4<f32>, dir: vec3<f32>, range: f32 }\n\
+                  struct Frame { world_position: vec3<f32>, exposure: f32, lights: array<Light, 2> }\n\
+                  @group(0) @binding(0) var<uniform> frame: Frame;\n\
+                  @group(0) @binding(1) var out: texture_storage_2d<rgba8unorm, write>;\n\
+                  @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                  \x20   textureStore(out, id.xy, vec4(frame.lights[1].color.rgb * frame.exposure, 1.0));\n}\n";
+    let d = kernel_project("summary = \"a frame of engine data\"\n", shader);
+    let r = vista_in(Some(d.path()), &[], &["list", "--layout"]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    let lines: Vec<Vec<&str>> = r.stdout.lines().map(|l| l.split_whitespace().collect()).collect();
+    let has = |want: &[&str]| lines.iter().any(|l| l == want);
+    assert!(has(&["@group(0)", "@binding(0)", "var<uniform>", "frame:", "80", "bytes"]), "{}", r.stdout);
+    for want in [
+        &["0", "world_position", "vec3<f32>"][..],
+        &["12", "exposure", "f32"],
+        &["16", "+", "32", "i", "(i", "<", "2)", "lights[i].color", "vec4<f32>"],
+        &["32", "+", "32", "i", "(i", "<", "2)", "lights[i].dir", "vec3<f32>"],
+        &["44", "+", "32", "i", "(i", "<", "2)", "lights[i].range", "f32"],
+    ] {
+        assert!(has(want), "no {want:?} in:\n{}", r.stdout);
+    }
+    assert_rejected(&vista_in(Some(d.path()), &[], &["list", "--layout", "--names"]), 2, &["--names"]);
+}
+
+/// `language = "wgsl"`: a shader file of any extension (a project's
+/// `.fx`) is read as WGSL; without it the manifest is refused naming the
+/// key, and an unknown language names what is allowed.
+fn a_shader_of_any_extension_is_wgsl_with_language() {
+    let d = kernel_project(&format!("shader = \"effects/k.fx\"\nlanguage = \"wgsl\"\n{K_MANIFEST}"), K_SHADER);
+    std::fs::create_dir_all(d.path().join("shaders/effects")).unwrap();
+    std::fs::rename(d.path().join("shaders/k.wgsl"), d.path().join("shaders/effects/k.fx")).unwrap();
+    let out = d.path().join("k.png");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    assert!(out.exists());
+    let without = format!("shader = \"effects/k.fx\"\n{K_MANIFEST}");
+    std::fs::write(d.path().join("kernels/k.toml"), without).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", out.to_str().unwrap()]);
+    assert_rejected(&r, 2, &["shader \"effects/k.fx\" is not a .wgsl or .wesl file; add language = \"wgsl\""]);
+    let unknown = format!("shader = \"effects/k.fx\"\nlanguage = \"hlsl\"\n{K_MANIFEST}");
+    std::fs::write(d.path().join("kernels/k.toml"), unknown).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["list"]);
+    assert_rejected(&r, 2, &["language = \"hlsl\" is not known; allowed: \"wgsl\""]);
 }
 
 fn malformed_manifest_names_file_line_and_column() {
@@ -6591,6 +6644,8 @@ fn main() {
         Gpu test_textures_and_samplers_are_generated_and_bound_on_three_backends,
         Gpu an_imported_wesl_global_is_bound_by_its_own_name,
         Gpu a_hanging_unit_test_is_ended_by_the_watchdog_and_fails_alone,
+        Gpu a_shader_of_any_extension_is_wgsl_with_language,
+        Cpu list_layout_prints_every_leaf_with_its_offset,
         Gpu lavapipe_ends_any_loop_after_65535_iterations,
         Gpu mutate_counts_a_mutant_a_unit_test_kills,
         Gpu generated_modules_give_constants_to_bindings_and_code,

@@ -244,10 +244,22 @@ impl ShaderSet {
     fn kernel_source(&self, name: &str) -> Result<&Source, GpuError> {
         let name = file_of(name);
         self.kernels.get(name).ok_or_else(|| {
+            // The project's own files: the built-ins' are not what a
+            // project's manifest means to name.
+            let own: Vec<&str> = self
+                .kernels
+                .values()
+                .filter(|s| !s.origin.starts_with("<built-in>") && !is_unit_test_file(&s.rel))
+                .map(|s| s.rel.as_str())
+                .collect();
+            let listed = match own.is_empty() {
+                true => self.kernel_files().join(", "),
+                false => own.join(", "),
+            };
             GpuError::Shader(format!(
-                "shader {name} not found in {} (kernel files: {})",
+                "shader {name} not found in {} (its kernel files: {listed}; a file of another extension than \
+                 .wgsl or .wesl needs language = \"wgsl\" in the manifest)",
                 self.label,
-                self.kernels.keys().cloned().collect::<Vec<_>>().join(", ")
             ))
         })
     }

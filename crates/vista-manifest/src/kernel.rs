@@ -105,6 +105,13 @@ impl Kernel {
     pub fn shader(&self) -> &str {
         &self.manifest.shader
     }
+
+    /// `language = "wgsl"`: its shader files are WGSL whatever their
+    /// extension, so vista reads them though `shaders/` lists only
+    /// `.wgsl` and `.wesl` files.
+    pub fn reads_any_extension(&self) -> bool {
+        self.manifest.language.is_some()
+    }
     /// The PNG view the manifest gives (default display).
     pub fn output(&self) -> Output {
         self.manifest.output.unwrap_or(Output::Display)

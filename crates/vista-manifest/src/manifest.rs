@@ -6,6 +6,7 @@
 //! ```toml
 //! summary = "one line"             # shown by vista list
 //! shader = "hybrid.wgsl"           # under shaders/; default "<name>.wgsl"
+//! language = "wgsl"                # optional: shader files of any extension (a project's .fx) are WGSL
 //! output = "display"               # display | hdr (PNG = 1 - exp(-exposure L), sRGB) | normalize (min..max);
 //!                                  # default display, normalize for an integer storage format
 //! display_alpha = "keep"           # keep | opaque (PNG alpha = 1; the RGB is already composited)
@@ -66,6 +67,9 @@ use crate::{Output, ParamError};
 struct RawManifest {
     summary: String,
     shader: Option<String>,
+    /// `language = "wgsl"`: the kernel's shader files are WGSL whatever
+    /// their extension (a project's `.fx`, `.shader`).
+    language: Option<String>,
     /// `output = "display" | "hdr"` (SPEC 10), or `[[output]]` tables (SPEC 14).
     output: Option<toml::Value>,
     /// Deserialized for its keys only; graph.rs reads the values.
@@ -251,6 +255,9 @@ pub struct Manifest {
     pub summary: String,
     /// The WGSL file under `shaders/` (`shader`; default `<name>.wgsl`).
     pub shader: String,
+    /// `language = "wgsl"`: its shader files are WGSL whatever their
+    /// extension.
+    pub language: Option<String>,
     /// The PNG view, where the manifest gives one (else display, or
     /// normalize for an integer format: `Kernel::view`).
     pub output: Option<Output>,
@@ -375,10 +382,31 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let pass_sources = graph.passes.iter().map(|p| &p.source);
     check_replacements(std::iter::once(&source).chain(pass_sources), &params).map_err(kfail)?;
     let shader = raw.shader.unwrap_or_else(|| format!("{name}.wgsl"));
+    let language = match raw.language.as_deref() {
+        None | Some("wgsl") => raw.language,
+        Some(other) => {
+            return Err(kfail(format!(
+                "language = \"{other}\" is not known; allowed: \"wgsl\" (a shader file of any extension read as WGSL)"
+            )));
+        }
+    };
+    let files = std::iter::once(&shader).chain(graph.passes.iter().filter_map(|p| p.shader.as_ref()));
+    for f in files {
+        let known = f.ends_with(".wgsl") || f.ends_with(".wesl");
+        if !known && language.is_none() {
+            return Err(kfail(format!(
+                "shader \"{f}\" is not a .wgsl or .wesl file; add language = \"wgsl\" to read it as WGSL"
+            )));
+        }
+        if f.ends_with(".wesl") && language.is_some() {
+            return Err(kfail(format!("shader \"{f}\" is WESL; language = \"wgsl\" is for other extensions")));
+        }
+    }
     Ok(Manifest {
         name: name.to_string(),
         summary: raw.summary,
         shader,
+        language,
         output,
         opaque_display,
         graph,

@@ -30,6 +30,7 @@ impl Sources {
         };
         let mut files: Vec<(String, String, String)> =
             project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin)).collect();
+        files.extend(other_extensions(project, &files)?);
         let (specs, reader) = source_specs(project)?;
         files.extend(generated_modules(&specs)?);
         let mut enums = enum_modules(project)?;
@@ -119,6 +120,29 @@ pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, Str
         let text = k.enum_module();
         for f in k.shader_files() {
             out.push((f.to_string(), k.name().to_string(), text.clone()));
+        }
+    }
+    Ok(out)
+}
+
+/// The shader files of kernels with `language = "wgsl"` that `shaders/`'s
+/// listing leaves out (any extension but `.wgsl` and `.wesl`), read through
+/// the project's guard; one that is not there is left to the
+/// not-found error that names the kernel files.
+fn other_extensions(
+    project: &vista_project::Project,
+    listed: &[(String, String, String)],
+) -> Result<Vec<(String, String, String)>, RenderError> {
+    let registry = vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    let mut out: Vec<(String, String, String)> = Vec::new();
+    for k in registry.kernels().iter().filter(|k| k.reads_any_extension()) {
+        for f in k.shader_files() {
+            if listed.iter().chain(&out).any(|(rel, _, _)| rel == f) {
+                continue;
+            }
+            if let Some((text, origin)) = project.read_text(&format!("shaders/{f}")) {
+                out.push((f.to_string(), text, origin));
+            }
         }
     }
     Ok(out)
