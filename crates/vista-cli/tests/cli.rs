@@ -3902,6 +3902,49 @@ fn list_layout_prints_every_leaf_with_its_offset() {
     assert_rejected(&vista_in(Some(d.path()), &[], &["list", "--layout", "--names"]), 2, &["--names"]);
 }
 
+/// Engine data by field path: a `var<uniform>` struct with a vec3, an
+/// f32 and an array of structs filled from `fields` (`lights[1].color`),
+/// every leaf not named zero; the shader reads them back into its output.
+/// A path naming no field, a wrong count and a second source are refused.
+fn uniform_structs_are_filled_by_field_path() {
+    let shader = "struct Light { color: vec4<f32>, dir: vec3<f32>, range: f32 }\n\
+                  struct Frame { world_position: vec3<f32>, exposure: f32, lights: array<Light, 2> }\n\
+                  @group(0) @binding(0) var<uniform> frame: Frame;\n\
+                  @group(0) @binding(1) var out: texture_storage_2d<rgba32float, write>;\n\
+                  @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                  \x20   let l = frame.lights[1];\n\
+                  \x20   let unset = frame.lights[0].range + frame.world_position.x + l.dir.z;\n\
+                  \x20   textureStore(out, id.xy, vec4(l.color.rgb * frame.exposure + unset, frame.world_position.y));\n}\n";
+    let manifest = |fields: &str| {
+        format!(
+            "summary = \"a frame of engine data by field\"\noutput = \"hdr\"\n\
+             [[resource]]\nname = \"frame\"\nkind = \"buffer\"\n{fields}\n\
+             [[resource]]\nname = \"out\"\nkind = \"texture\"\nformat = \"rgba32float\"\n\
+             [[pass]]\nentry = \"main\"\n"
+        )
+    };
+    let good =
+        "fields = { exposure = 2.0, \"lights[1].color\" = [0.25, 0.5, 0.125, 1.0], world_position = [0, 0.75, 0] }";
+    let d = kernel_project(&manifest(good), shader);
+    let exr = d.path().join("k.exr");
+    let render = |d: &Path| vista_in(Some(d), &[], &["render", "k", "--size", "8x8", "-o", exr.to_str().unwrap()]);
+    let r = render(d.path());
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    let img = vista_image::read_exr(&exr).unwrap();
+    assert!(img.data.iter().all(|t| *t == [0.5, 1.0, 0.25, 0.75]), "{:?}", img.data[0]);
+    for (fields, want) in [
+        (
+            "fields = { exposur = 1.0 }",
+            "fields: \"exposur\" names no field of var<uniform> Frame; fields: world_position, exposure, lights",
+        ),
+        ("fields = { world_position = [1, 2] }", "fields: \"world_position\" takes 3 numbers, not 2"),
+        ("fields = { exposure = 1.0 }\nfill = 0.0", "file, data, fill and fields are exclusive; give one"),
+    ] {
+        std::fs::write(d.path().join("kernels/k.toml"), manifest(fields)).unwrap();
+        assert_rejected(&render(d.path()), 2, &["frame", want]);
+    }
+}
+
 /// `language = "wgsl"`: a shader file of any extension (a project's
 /// `.fx`) is read as WGSL; without it the manifest is refused naming the
 /// key, and an unknown language names what is allowed.
@@ -6646,6 +6689,7 @@ fn main() {
         Gpu a_hanging_unit_test_is_ended_by_the_watchdog_and_fails_alone,
         Gpu a_shader_of_any_extension_is_wgsl_with_language,
         Cpu list_layout_prints_every_leaf_with_its_offset,
+        Gpu uniform_structs_are_filled_by_field_path,
         Gpu lavapipe_ends_any_loop_after_65535_iterations,
         Gpu mutate_counts_a_mutant_a_unit_test_kills,
         Gpu generated_modules_give_constants_to_bindings_and_code,

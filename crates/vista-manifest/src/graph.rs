@@ -58,6 +58,9 @@ pub enum ResourceKind {
         /// Its element count as an expression of the params and the case size, with
         /// `fill` or alone (a runtime-sized array needs one).
         length: Option<Expr>,
+        /// Values by field path (`world_position`, `lights.1.color`) for a
+        /// binding of one struct; every leaf not named is zero.
+        fields: Option<Vec<(String, Vec<f64>)>>,
     },
     /// A depth texture (`kind = "depth"`, depth32float): a render pass's
     /// `depth` attachment that later passes sample as `texture_depth_2d`.
@@ -515,7 +518,7 @@ fn parse_resources(
             text("kind")?.ok_or_else(|| at("needs kind = \"texture\", \"buffer\", \"sampler\" or \"depth\"".into()))?;
         let allowed: &[&str] = match kind.as_str() {
             "texture" => &["name", "kind", "format", "dimension", "size", "file", "mip_levels"],
-            "buffer" => &["name", "kind", "file", "data", "fill", "length"],
+            "buffer" => &["name", "kind", "file", "data", "fill", "length", "fields"],
             "sampler" => &["name", "kind", "filter", "address", "compare"],
             "depth" => &["name", "kind", "size"],
             other => {
@@ -609,7 +612,15 @@ fn texture_kind(
     Ok(ResourceKind::Texture { format, dimension, size, file, mip_levels })
 }
 
-/// A buffer resource's keys: its file, inline data, or fill and length.
+/// `v`'s scalars in order, nested lists flattened.
+fn flatten_numbers(v: &toml::Value, out: &mut Vec<toml::Value>) {
+    match v {
+        toml::Value::Array(l) => l.iter().for_each(|x| flatten_numbers(x, out)),
+        other => out.push(other.clone()),
+    }
+}
+
+/// A buffer resource's keys: its file, inline data, fields, or fill and length.
 fn buffer_kind(
     t: &toml::Table,
     file: Option<String>,
@@ -654,14 +665,39 @@ fn buffer_kind(
     {
         return Err(at(format!("file = \"{f}\" is not valid for a buffer; expected a .npy or .bin file")));
     }
-    let sources = [file.is_some(), data.is_some(), fill.is_some()].iter().filter(|b| **b).count();
+    let fields = match t.get("fields") {
+        None => None,
+        Some(toml::Value::Table(table)) => {
+            let mut out = Vec::new();
+            for (key, v) in table {
+                let mut flat = Vec::new();
+                flatten_numbers(v, &mut flat);
+                let values: Option<Vec<f64>> = flat.iter().map(number).collect();
+                match values {
+                    Some(values) if !values.is_empty() => out.push((key.clone(), values)),
+                    _ => {
+                        return Err(at(format!(
+                            "fields: {key} = {v} is not valid; expected a number or a list of numbers"
+                        )));
+                    }
+                }
+            }
+            Some(out)
+        }
+        Some(other) => {
+            return Err(at(format!(
+                "fields = {other} is not valid; expected a table of field paths, e.g. {{ exposure = 1.5, \"lights[0].color\" = [1, 0, 0, 1] }}"
+            )));
+        }
+    };
+    let sources = [file.is_some(), data.is_some(), fill.is_some(), fields.is_some()].iter().filter(|b| **b).count();
     if sources > 1 {
-        return Err(at("file, data and fill are exclusive; give one".into()));
+        return Err(at("file, data, fill and fields are exclusive; give one".into()));
     }
-    if length.is_some() && (file.is_some() || data.is_some()) {
-        return Err(at("length goes with fill or nothing; a file or data gives its own length".into()));
+    if length.is_some() && (file.is_some() || data.is_some() || fields.is_some()) {
+        return Err(at("length goes with fill or nothing; a file, data or fields give their own length".into()));
     }
-    Ok(ResourceKind::Buffer { file, data, fill, length })
+    Ok(ResourceKind::Buffer { file, data, fill, length, fields })
 }
 
 /// A sampler resource's keys: filter, address modes, comparison.

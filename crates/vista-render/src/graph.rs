@@ -194,7 +194,8 @@ pub(crate) fn plan_graph(
             ResourceKind::Texture { size, file, mip_levels, .. } => {
                 at.texture(r, size.as_deref(), file.as_ref(), *mip_levels, resolved.outputs.contains(&ri))
             }
-            ResourceKind::Buffer { file, data, fill, length } => {
+            ResourceKind::Buffer { fields: Some(fields), .. } => at.fields(r, fields),
+            ResourceKind::Buffer { file, data, fill, length, .. } => {
                 at.buffer(r, file.as_ref(), data.as_deref(), *fill, length.as_ref(), resolved.outputs.contains(&ri))
             }
             ResourceKind::Depth { size } => at.depth(r, size.as_deref()),
@@ -404,6 +405,50 @@ impl Planning<'_> {
             wh[i] = self.size_entry(i, e).map_err(at)?;
         }
         Ok(vista_gpu::Resource::Depth(wh))
+    }
+
+    /// A buffer of one struct from `fields`: each named field's leaves in
+    /// order (`lights[1].color` is `lights.1.color`, a vector's x y z w, a
+    /// matrix's columns), every other leaf zero.
+    fn fields(
+        &self,
+        r: &vista_manifest::graph::ResolvedResource,
+        fields: &[(String, Vec<f64>)],
+    ) -> Result<vista_gpu::Resource, RenderError> {
+        let at = |m: String| self.bad(format!("resource {}: {m}", r.spec.name));
+        let Some(e) = &r.element else {
+            return Err(at("no pass binds this buffer".into()));
+        };
+        if e.fixed != Some(1) || e.header != 0 {
+            return Err(at(format!("fields fill a binding of one struct, not {}; give data or a file", e.wgsl)));
+        }
+        let mut bytes = vec![0u8; e.stride as usize];
+        for (key, values) in fields {
+            let path = key.replace('[', ".").replace(']', "");
+            let leaves: Vec<&(u32, char, String)> =
+                e.leaves.iter().filter(|(_, _, p)| *p == path || p.starts_with(&format!("{path}."))).collect();
+            if leaves.is_empty() {
+                let mut tops: Vec<&str> = e.leaves.iter().map(|(_, _, p)| p.split('.').next().unwrap_or(p)).collect();
+                tops.dedup();
+                return Err(at(format!("fields: \"{key}\" names no field of {}; fields: {}", e.wgsl, tops.join(", "))));
+            }
+            if leaves.len() != values.len() {
+                return Err(at(format!(
+                    "fields: \"{key}\" takes {} number{}, not {}",
+                    leaves.len(),
+                    if leaves.len() == 1 { "" } else { "s" },
+                    values.len()
+                )));
+            }
+            for ((offset, kind, leaf), v) in leaves.into_iter().zip(values) {
+                let word = encode_leaf(*kind, *v).ok_or_else(|| {
+                    let (k, bits) = (leaf_numpy(*kind).0, leaf_numpy(*kind).1 * 8);
+                    at(format!("fields: {v} does not fit {leaf} ({k}{bits})"))
+                })?;
+                bytes[*offset as usize..*offset as usize + word.len()].copy_from_slice(&word);
+            }
+        }
+        Ok(vista_gpu::Resource::Buffer(bytes))
     }
 
     /// A buffer resource: its header and elements from a file, inline
@@ -1136,6 +1181,18 @@ fn read_buffer(root: Option<&Path>, file: &str, e: &Element) -> Result<Vec<u8>, 
 
 /// Numbers converted to the element's leaves in order (a whole number of
 /// elements).
+/// One leaf's bytes: an f32, or a u32/i32/u16 that holds `v` exactly.
+fn encode_leaf(kind: char, v: f64) -> Option<Vec<u8>> {
+    let whole = v.fract() == 0.0;
+    Some(match kind {
+        'f' => (v as f32).to_le_bytes().to_vec(),
+        'u' if whole && v >= 0.0 && v <= u32::MAX as f64 => (v as u32).to_le_bytes().to_vec(),
+        'i' if whole && v >= i32::MIN as f64 && v <= i32::MAX as f64 => (v as i32).to_le_bytes().to_vec(),
+        'h' if whole && v >= 0.0 && v <= u16::MAX as f64 => (v as u16).to_le_bytes().to_vec(),
+        _ => return None,
+    })
+}
+
 fn encode_values(values: &[f64], e: &Element) -> Result<Vec<u8>, String> {
     let per = e.leaves.len();
     if per == 0 || values.is_empty() || !values.len().is_multiple_of(per) {
@@ -1149,19 +1206,12 @@ fn encode_values(values: &[f64], e: &Element) -> Result<Vec<u8>, String> {
     for chunk in values.chunks(per) {
         let mut el = vec![0u8; e.stride as usize];
         for ((offset, kind, path), v) in e.leaves.iter().zip(chunk) {
-            let whole = v.fract() == 0.0;
-            let word = match kind {
-                'f' => (*v as f32).to_le_bytes().to_vec(),
-                'u' if whole && *v >= 0.0 && *v <= u32::MAX as f64 => (*v as u32).to_le_bytes().to_vec(),
-                'i' if whole && *v >= i32::MIN as f64 && *v <= i32::MAX as f64 => (*v as i32).to_le_bytes().to_vec(),
-                'h' if whole && *v >= 0.0 && *v <= u16::MAX as f64 => (*v as u16).to_le_bytes().to_vec(),
-                _ => {
-                    let (k, bits) = (leaf_numpy(*kind).0, leaf_numpy(*kind).1 * 8);
-                    return Err(match path.is_empty() {
-                        true => format!("{v} does not fit {} ({k}{bits})", e.wgsl),
-                        false => format!("{v} does not fit {path} ({k}{bits}) of {}", e.wgsl),
-                    });
-                }
+            let Some(word) = encode_leaf(*kind, *v) else {
+                let (k, bits) = (leaf_numpy(*kind).0, leaf_numpy(*kind).1 * 8);
+                return Err(match path.is_empty() {
+                    true => format!("{v} does not fit {} ({k}{bits})", e.wgsl),
+                    false => format!("{v} does not fit {path} ({k}{bits}) of {}", e.wgsl),
+                });
             };
             el[*offset as usize..*offset as usize + word.len()].copy_from_slice(&word);
         }
