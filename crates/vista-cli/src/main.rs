@@ -122,6 +122,11 @@ enum Command {
         /// Every test on lavapipe, swiftshader and browser: one test x backend table.
         #[arg(long)]
         matrix: bool,
+        /// Write each `@snapshot` test's render as its golden
+        /// (golden/wgsl/<file>/<fn>.png) instead of judging it; refused
+        /// under CI=true.
+        #[arg(long, conflicts_with = "matrix")]
+        bless: bool,
     },
     /// Check the cases, then re-check the ones a saved file reaches (WGSL,
     /// kernel manifests, golden/) and rewrite the report, until interrupted.
@@ -378,7 +383,7 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
         }
         Command::List { names: _, layout: true } => list::layouts(project),
         Command::List { names, layout: false } => list::run(project, names),
-        Command::Test { filter, matrix } => unit_tests::test(project, config, filter.as_deref(), matrix),
+        Command::Test { filter, matrix, bless } => unit_tests::test(project, config, filter.as_deref(), matrix, bless),
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             render::render(project, config, render::Args { kernel, preset, set, size, crop, zoom, out })
         }

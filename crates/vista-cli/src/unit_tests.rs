@@ -38,16 +38,28 @@ fn run_all(
     sources: &vista_render::Sources,
     files: &[(String, String)],
     filter: Option<&str>,
+    bless: bool,
 ) -> Vec<TestResult> {
     let wanted = |id: &str| filter.is_none_or(|f| id.contains(f));
     files
         .iter()
-        .flat_map(|(rel, text)| vista_wgsl_test::run_file(base, sources, rel, text))
+        .flat_map(|(rel, text)| vista_wgsl_test::run_file_with(base, sources, rel, text, bless))
         .filter(|r| wanted(&r.id))
         .collect()
 }
 
-pub fn test(project: &Project, config: &Config, filter: Option<&str>, matrix: bool) -> Result<i32, GoldenError> {
+pub fn test(
+    project: &Project,
+    config: &Config,
+    filter: Option<&str>,
+    matrix: bool,
+    bless: bool,
+) -> Result<i32, GoldenError> {
+    if bless && config.in_ci {
+        return Err(GoldenError::Refused(
+            "CI=true: refusing to bless snapshot goldens in CI; bless locally after looking at the render".into(),
+        ));
+    }
     let (picked, all) = picked_files(project, filter)?;
     if picked.is_empty() {
         match filter {
@@ -61,7 +73,7 @@ pub fn test(project: &Project, config: &Config, filter: Option<&str>, matrix: bo
         return test_matrix(project, config, &sources, &picked, filter);
     }
     let base = Renderer::shared(&config.gpu, project, config.limits)?;
-    let results = run_all(&base, &sources, &picked, filter);
+    let results = run_all(&base, &sources, &picked, filter, bless);
     results.iter().for_each(print_result);
     let failed = results.iter().filter(|r| !r.passed()).count();
     println!(
@@ -87,7 +99,7 @@ fn test_matrix(
     for &b in BACKENDS {
         let column = vista_render::own_device(&config.gpu, Some(b), None).map_err(|e| e.to_string()).map(|ctx| {
             let gpu = Renderer::with_shaders(&ctx, sources.shader_set(), config.limits, project.root().map(Into::into));
-            run_all(&gpu, sources, files, filter)
+            run_all(&gpu, sources, files, filter, false)
         });
         columns.push((b, column));
     }

@@ -6515,6 +6515,55 @@ fn a_hanging_unit_test_is_ended_by_the_watchdog_and_fails_alone() {
     assert!(r.stdout.contains("1 passed, 1 failed"), "{}", r.stdout);
 }
 
+/// `@fragment @snapshot(W, H)`: a full-screen draw judged against
+/// golden/wgsl/<file>/<fn>.png. Without a golden it fails saying how to
+/// bless; `vista test --bless` writes it (refused under CI=true, and never
+/// through a symlinked folder); it then passes on three backends; a
+/// changed shader fails naming how many texels differ.
+fn snapshot_tests_are_judged_against_a_golden_and_blessed() {
+    let d = tmp();
+    std::fs::write(d.path().join("vista.toml"), "").unwrap();
+    std::fs::create_dir_all(d.path().join("shaders")).unwrap();
+    let text = "@fragment @snapshot(32, 16)\nfn ramp_over_checker(@builtin(position) p: vec4f) -> @location(0) vec4f {\n\
+                \x20   let cell = (u32(p.x) / 8u + u32(p.y) / 8u) & 1u;\n\
+                \x20   return vec4f(p.x / 32.0, f32(cell), 0.25, 1.0);\n}\n";
+    let file = d.path().join("shaders/look.test.wgsl");
+    std::fs::write(&file, text).unwrap();
+    let test = |env: &[(&str, &str)], args: &[&str]| vista_in(Some(d.path()), env, &[&["test"], args].concat());
+    let r = test(&[], &[]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    let want = "FAIL   wgsl::look::ramp_over_checker: no golden golden/wgsl/look/ramp_over_checker.png: look at the \
+                render, then vista test --bless";
+    assert!(r.stdout.lines().any(|l| l == want), "{}", r.stdout);
+    assert_rejected(&test(&[("CI", "true")], &["--bless"]), 2, &["CI=true: refusing to bless snapshot goldens"]);
+    // A symlinked golden folder is refused, nothing written through it.
+    let elsewhere = tmp();
+    std::fs::create_dir_all(d.path().join("golden")).unwrap();
+    std::os::unix::fs::symlink(elsewhere.path(), d.path().join("golden/wgsl")).unwrap();
+    let r = test(&[], &["--bless"]);
+    assert!(r.code != 0 && r.stdout.contains("is a symlink to"), "{}", r.stdout);
+    assert_eq!(std::fs::read_dir(elsewhere.path()).unwrap().count(), 0);
+    std::fs::remove_file(d.path().join("golden/wgsl")).unwrap();
+    assert_eq!(test(&[], &["--bless"]).code, 0);
+    let golden = d.path().join("golden/wgsl/look/ramp_over_checker.png");
+    let img = vista_image::load(&golden).unwrap();
+    assert_eq!(img.dimensions(), (32, 16));
+    // Texel (9, 1): cell 1 (x / 8 = 1), red (9 + 0.5) / 32 in 8 bits.
+    let t = img.data[32 + 9];
+    assert!((t[0] - 9.5 / 32.0).abs() < 1.0 / 255.0 && t[1] == 1.0 && (t[2] - 0.25).abs() < 1.0 / 255.0, "{t:?}");
+    let m = test(&[], &["--matrix"]);
+    assert_eq!(m.code, 0, "{}", m.stdout);
+    assert!(m.stdout.contains("matrix: 1 tests x 3 backends, 0 failed"), "{}", m.stdout);
+    std::fs::write(&file, text.replace("p.x / 32.0", "p.y / 16.0")).unwrap();
+    let r = test(&[], &[]);
+    assert_eq!(r.code, 1, "{}", r.stdout);
+    assert!(
+        r.stdout.contains("differs from golden/wgsl/look/ramp_over_checker.png: 512 of 512 texels"),
+        "{}",
+        r.stdout
+    );
+}
+
 /// A global an imported WESL module declares is bound by its own name, as
 /// a naga_oil module's is (the wesl crate's mangled `package_io_out` is
 /// not what a manifest says): a WESL kernel's output declared in `io.wesl`.
@@ -6686,6 +6735,7 @@ fn main() {
         Gpu wesl_unit_tests_in_wgsl_test_spelling_run_unchanged_on_three_backends,
         Gpu test_textures_and_samplers_are_generated_and_bound_on_three_backends,
         Gpu an_imported_wesl_global_is_bound_by_its_own_name,
+        Gpu snapshot_tests_are_judged_against_a_golden_and_blessed,
         Gpu a_hanging_unit_test_is_ended_by_the_watchdog_and_fails_alone,
         Gpu a_shader_of_any_extension_is_wgsl_with_language,
         Cpu list_layout_prints_every_leaf_with_its_offset,

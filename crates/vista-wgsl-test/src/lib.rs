@@ -12,10 +12,11 @@
 //! binary).
 
 mod rewrite;
+mod snapshot;
 
 pub use rewrite::{
-    Assertion, BUFFER_GROUP, Pattern, Rewritten, Site, TEXTURE_FORMAT, TestBuffer, TestFn, TestSampler, TestTexture,
-    entry, fill_entry, rewrite,
+    Assertion, BUFFER_GROUP, Pattern, Rewritten, Site, Snapshot, TEXTURE_FORMAT, TestBuffer, TestFn, TestSampler,
+    TestTexture, entry, fill_entry, rewrite,
 };
 
 use vista_render::{OutputValue, Renderer};
@@ -96,7 +97,8 @@ pub fn test_id(rel: &str, name: &str) -> String {
 /// The ids of file `rel`'s tests (`text` its contents), or the error that
 /// keeps it from running.
 pub fn list(rel: &str, text: &str) -> Result<Vec<String>, String> {
-    Ok(rewrite(text, wesl(rel))?.tests.iter().map(|t| test_id(rel, &t.name)).collect())
+    let r = rewrite(text, wesl(rel))?;
+    Ok(r.tests.iter().map(|t| &t.name).chain(r.snapshots.iter().map(|s| &s.name)).map(|n| test_id(rel, n)).collect())
 }
 
 /// `text` as a TOML basic string.
@@ -202,6 +204,18 @@ fn render_tests(gpu: &Renderer, rel: &str, rewritten: &Rewritten, which: &[usize
 /// hangs), each test runs again alone, so that only the one that hangs
 /// fails for it.
 pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, text: &str) -> Vec<TestResult> {
+    run_file_with(base, sources, rel, text, false)
+}
+
+/// [`run_file`], and with `bless` each `@snapshot`'s render becomes its
+/// golden (`golden/wgsl/<file stem>/<fn>.png`) instead of being judged.
+pub fn run_file_with(
+    base: &Renderer,
+    sources: &vista_render::Sources,
+    rel: &str,
+    text: &str,
+    bless: bool,
+) -> Vec<TestResult> {
     let rewritten = match rewrite(text, wesl(rel)) {
         Ok(r) => r,
         Err(e) => return vec![broken(&test_id(rel, "*"), format!("{rel}:{e}"))],
@@ -228,7 +242,8 @@ pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, tex
         TestResult { id: id.to_string(), failures, failed: row[0], error: None }
     };
     let all: Vec<usize> = (0..ids.len()).collect();
-    match render_tests(&gpu, rel, &rewritten, &all) {
+    let mut results: Vec<TestResult> = match render_tests(&gpu, rel, &rewritten, &all) {
+        _ if ids.is_empty() => Vec::new(),
         Ok(words) => ids.iter().enumerate().map(|(i, id)| row_of(&words, i, id)).collect(),
         Err(e) if e.timeout && ids.len() > 1 => ids
             .iter()
@@ -239,7 +254,16 @@ pub fn run_file(base: &Renderer, sources: &vista_render::Sources, rel: &str, tex
             })
             .collect(),
         Err(e) => ids.iter().map(|id| broken(id, e.error.clone())).collect(),
+    };
+    for snap in &rewritten.snapshots {
+        let id = test_id(rel, &snap.name);
+        let result = match crate::snapshot::judge(&gpu, rel, snap, bless) {
+            Ok(()) => TestResult { id, failures: Vec::new(), failed: 0, error: None },
+            Err(e) => broken(&id, e),
+        };
+        results.push(result);
     }
+    results
 }
 
 /// A compile error on one line: `path:line: message` (the column is the

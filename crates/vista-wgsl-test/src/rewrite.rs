@@ -76,6 +76,18 @@ pub struct Rewritten {
     pub textures: Vec<TestTexture>,
     /// The `@sampler` samplers.
     pub samplers: Vec<TestSampler>,
+    /// The `@fragment @snapshot` tests, in file order.
+    pub snapshots: Vec<Snapshot>,
+}
+
+/// A `@fragment @snapshot` (or `@snapshot(W, H)`) function: a full-screen
+/// pass drawn into a W x H rgba8unorm image judged against its golden.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Snapshot {
+    /// The fragment entry's name.
+    pub name: String,
+    /// Width and height (default 64 x 64).
+    pub size: (u32, u32),
 }
 
 /// What fills a `@test_texture`, in wgsl-test's words.
@@ -178,6 +190,25 @@ fn sampler_decl(text: &str, after_name: usize) -> Result<TestSampler, String> {
         _ => return Err(format!("@sampler {name}: takes linear or nearest, not ({})", args.join(", "))),
     };
     Ok(TestSampler { name, linear })
+}
+
+/// `@snapshot` or `@snapshot(W, H)` from just after the name: the size
+/// and the byte after the attribute.
+fn snapshot_size(text: &str, after_name: usize) -> Result<((u32, u32), usize), String> {
+    let rest = &text[after_name..];
+    let Some(open) = rest.find('(').filter(|&o| rest[..o].trim().is_empty()) else {
+        return Ok(((64, 64), after_name));
+    };
+    let close = rest[open..].find(')').map(|c| open + c).ok_or("@snapshot's ( is not closed")?;
+    let args: Vec<&str> = rest[open + 1..close].split(',').map(str::trim).collect();
+    let size = match args[..] {
+        [w, h] => (w.trim_end_matches('u').parse::<u32>(), h.trim_end_matches('u').parse::<u32>()),
+        _ => return Err(format!("@snapshot takes a width and a height, not ({})", args.join(", "))),
+    };
+    match size {
+        (Ok(w), Ok(h)) if (1..=4096).contains(&w) && (1..=4096).contains(&h) => Ok(((w, h), after_name + close + 1)),
+        _ => Err(format!("@snapshot({}) is not a size from 1x1 to 4096x4096", args.join(", "))),
+    }
 }
 
 /// The fill entry and storage binding vista appends for test texture `i`.
@@ -327,6 +358,7 @@ pub fn rewrite(text: &str, wesl: bool) -> Result<Rewritten, String> {
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
     let (mut tests, mut sites, mut buffers) = (Vec::new(), Vec::new(), Vec::<TestBuffer>::new());
     let (mut textures, mut samplers, mut bindings) = (Vec::new(), Vec::new(), 0usize);
+    let mut snapshots = Vec::new();
     let mut i = 0;
     while i < b.len() {
         if in_comment(i) || !(b[i] == b'@' || is_ident(b[i])) || (i > 0 && (is_ident(b[i - 1]) || b[i - 1] == b':')) {
@@ -350,6 +382,24 @@ pub fn rewrite(text: &str, wesl: bool) -> Result<Rewritten, String> {
                 let (line, _) = place(text, end + at_fn);
                 tests.push(TestFn { name, line });
                 edits.push((i, end, " ".repeat(end - i)));
+            } else if word == "snapshot" {
+                let at = |e: String| {
+                    let (l, c) = place(text, i);
+                    format!("{l}:{c}: {e}")
+                };
+                let (size, close) = snapshot_size(text, end).map_err(at)?;
+                let rest = &text[close..];
+                let at_fn = rest.find("fn ").ok_or_else(|| at("@snapshot is not followed by a function".into()))?;
+                if !text[i.saturating_sub(200)..close + at_fn].contains("@fragment") {
+                    return Err(at("@snapshot marks a @fragment function".into()));
+                }
+                let name: String =
+                    rest[at_fn + 3..].trim_start().bytes().take_while(|&c| is_ident(c)).map(char::from).collect();
+                snapshots.push(Snapshot { name, size });
+                let newlines = text[i..close].matches('\n').count();
+                edits.push((i, close, format!("{}{}", " ".repeat(close - i - newlines), "\n".repeat(newlines))));
+                i = close;
+                continue;
             } else if word == "test_texture" || word == "sampler" {
                 let at = |e: String| {
                     let (l, c) = place(text, i);
@@ -411,8 +461,8 @@ pub fn rewrite(text: &str, wesl: bool) -> Result<Rewritten, String> {
         }
         i = end;
     }
-    if tests.is_empty() {
-        return Err("no @test function".into());
+    if tests.is_empty() && snapshots.is_empty() {
+        return Err("no @test or @snapshot function".into());
     }
     edits.sort_by_key(|e| std::cmp::Reverse(e.0));
     let mut out = text.to_string();
@@ -433,7 +483,7 @@ pub fn rewrite(text: &str, wesl: bool) -> Result<Rewritten, String> {
     for (n, t) in textures.iter().enumerate() {
         out.push_str(&fill_code(n, t, bindings + n));
     }
-    Ok(Rewritten { text: out, tests, sites, buffers, textures, samplers })
+    Ok(Rewritten { text: out, tests, sites, buffers, textures, samplers, snapshots })
 }
 
 #[cfg(test)]
@@ -527,6 +577,6 @@ mod tests {
             rewrite("@test fn a() {\n  expect(1, 2);\n}", false).unwrap_err(),
             "2:3: expect takes 1 arguments, not 2"
         );
-        assert_eq!(rewrite("fn a() {}", false).unwrap_err(), "no @test function");
+        assert_eq!(rewrite("fn a() {}", false).unwrap_err(), "no @test or @snapshot function");
     }
 }
