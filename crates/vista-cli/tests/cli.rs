@@ -6564,6 +6564,28 @@ fn snapshot_tests_are_judged_against_a_golden_and_blessed() {
     );
 }
 
+/// A WESL kernel imports a module the manifest generates
+/// (`import constants::LEVEL;`, `[source] modules`), as bevy's WESL
+/// imports the constants its host makes; the value reaches the output.
+fn a_wesl_kernel_imports_a_generated_module() {
+    let manifest = "summary = \"a level from a generated module\"\nshader = \"k.wesl\"\noutput = \"hdr\"\n\
+                    [source]\nmodules = { constants = { LEVEL = 0.625, OUT = 1 } }\n\
+                    [[resource]]\nname = \"out\"\nkind = \"texture\"\nformat = \"rgba32float\"\n\
+                    [[pass]]\nentry = \"main\"\n";
+    let d = kernel_project(manifest, "");
+    std::fs::remove_file(d.path().join("shaders/k.wgsl")).unwrap();
+    let k = "import constants::{LEVEL, OUT};\n\
+             @group(0) @binding(OUT) var out: texture_storage_2d<rgba32float, write>;\n\
+             @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3u) {\n\
+             \x20   textureStore(out, id.xy, vec4f(LEVEL, 0.0, 0.0, 1.0));\n}\n";
+    std::fs::write(d.path().join("shaders/k.wesl"), k).unwrap();
+    let exr = d.path().join("k.exr");
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", exr.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    let img = vista_image::read_exr(&exr).unwrap();
+    assert!(img.data.iter().all(|t| t[0] == 0.625), "{:?}", img.data[0]);
+}
+
 /// A global an imported WESL module declares is bound by its own name, as
 /// a naga_oil module's is (the wesl crate's mangled `package_io_out` is
 /// not what a manifest says): a WESL kernel's output declared in `io.wesl`.
@@ -6735,6 +6757,7 @@ fn main() {
         Gpu wesl_unit_tests_in_wgsl_test_spelling_run_unchanged_on_three_backends,
         Gpu test_textures_and_samplers_are_generated_and_bound_on_three_backends,
         Gpu an_imported_wesl_global_is_bound_by_its_own_name,
+        Gpu a_wesl_kernel_imports_a_generated_module,
         Gpu snapshot_tests_are_judged_against_a_golden_and_blessed,
         Gpu a_hanging_unit_test_is_ended_by_the_watchdog_and_fails_alone,
         Gpu a_shader_of_any_extension_is_wgsl_with_language,

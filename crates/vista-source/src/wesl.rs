@@ -64,10 +64,23 @@ impl Resolver for Files<'_> {
             && matches!(&path.origin, PathOrigin::Package(p) if p == WGSL_TEST.1)
             && !self.packages.iter().any(|(p, _)| p == WGSL_TEST.1);
         if vista_own && let Some((text, _)) = (self.read)(WGSL_TEST.0) {
-            // The naga_oil module as WESL: its import path line blanked.
-            let lines: Vec<&str> =
-                text.lines().map(|l| if l.starts_with("#define_import_path") { "" } else { l }).collect();
-            return Ok(Cow::Owned(lines.join("\n")));
+            return Ok(Cow::Owned(as_wesl(&text)));
+        }
+        // A module the manifest's `[source] modules` generates (`import
+        // constants::GROUP`), unless a package of that name is declared.
+        if let PathOrigin::Package(p) = &path.origin
+            && !self.packages.iter().any(|(n, _)| n == p)
+        {
+            let parts: Vec<&str> =
+                std::iter::once(p.as_str()).chain(path.components.iter().map(String::as_str)).collect();
+            let file = format!("shaders/generated/{}.wgsl", parts.join("/"));
+            if let Some((text, origin)) = (self.read)(&file) {
+                let mut parts = self.parts.borrow_mut();
+                if !parts.iter().any(|x| x.path == file) {
+                    parts.push(Part { path: file.clone(), origin, text: text.clone() });
+                }
+                return Ok(Cow::Owned(as_wesl(&text)));
+            }
         }
         let candidates = self.candidates(path).map_err(|e| ResolveError::ModuleNotFound(path.clone(), e))?;
         for file in &candidates {
@@ -87,6 +100,13 @@ impl Resolver for Files<'_> {
         let parts = self.parts.borrow();
         parts.iter().find(|p| candidates.contains(&p.path)).map(|p| p.origin.clone())
     }
+}
+
+/// A naga_oil module (vista's own, a generated one) as WESL: its
+/// `#define_import_path` line blanked, the lines kept.
+fn as_wesl(text: &str) -> String {
+    let lines: Vec<&str> = text.lines().map(|l| if l.starts_with("#define_import_path") { "" } else { l }).collect();
+    lines.join("\n")
 }
 
 /// Compiles `.wesl` shader `main` (a root-relative path under `shaders/`)
@@ -293,6 +313,30 @@ mod tests {
         assert!(out.contains(&format!("var<storage> {table}")), "{out}");
         assert!(out.contains(&format!("fn expectX_naga_oil_mod_X{}X", base32(b"wgsl_test"))), "{out}");
         assert!(!out.contains("#define_import_path"), "{out}");
+    }
+
+    /// `import constants::GROUP` reads the module `[source] modules`
+    /// generates (shaders/generated/constants.wgsl), as bevy's WESL imports
+    /// its generated constants; a declared package of that name wins.
+    #[test]
+    fn generated_modules_are_packages_of_their_own() {
+        let files: Vec<(&str, &str)> = vec![
+            (
+                "shaders/k.wesl",
+                "import constants::{GROUP, SCALE};\n@compute @workgroup_size(1) fn main() { let x = f32(GROUP) * SCALE; }\n",
+            ),
+            (
+                "shaders/generated/constants.wgsl",
+                "#define_import_path constants\nconst GROUP: u32 = 2u;\nconst SCALE: f32 = 0.5;\n",
+            ),
+        ];
+        let read = |p: &str| files.iter().find(|(f, _)| *f == p).map(|(_, t)| (t.to_string(), format!("/p/{p}")));
+        let out = compile_wesl("shaders/k.wesl", &SourceSpec::default(), &[], &read).unwrap();
+        assert!(out.text.contains("2u") && out.text.contains("0.5"), "{}", out.text);
+        assert!(out.parts.iter().any(|p| p.path == "shaders/generated/constants.wgsl"));
+        let gone = |p: &str| (p != "shaders/generated/constants.wgsl").then(|| read(p)).flatten();
+        let e = compile_wesl("shaders/k.wesl", &SourceSpec::default(), &[], &gone).unwrap_err();
+        assert!(e.contains("package constants is not in [source] packages"), "{e}");
     }
 
     /// A syntax error in an imported module: the headline names its file,
