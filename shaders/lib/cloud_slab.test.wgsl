@@ -10,12 +10,27 @@
 // published reference, seed-0 table); pcg3d as published (JCGT 2020) and
 // Jimenez's interleaved gradient noise (2014).
 //
+// The light and primary marches are tested on a uniform layer (noise_scale
+// 0 and no wind put every noise sample at the lattice point 0, where
+// Improved Noise is 0, so G = 1/2 and, at coverage 1, d = density_scale / 2;
+// profile roundings of 0.001 keep every sample on the plateau): there the
+// optical depth over a path of length L is d (1 + absorption) L exactly
+// (Beer-Lambert), the steps' transmittances multiply to exp(-d ext L), the
+// analytic integrator sums an ambient-lit layer to ambient (1 - T) / ext in
+// closed form, the Riemann one to a geometric series; with sunlight the
+// few samples are summed in Python at the documented positions (k + xi)
+// dt, xi advanced by 1 / phi per step (golden), with the sun's optical
+// depth d (5 - y) straight up, powder e^-tau (1 - powder e^-2tau), the
+// dual Henyey-Greenstein phase mix(HG(mu, g1), HG(mu, g2), blend) and
+// ambient ambient_bottom + (1 - ambient_bottom) h.
+//
 // Enum params by their index in kernels/clouds.toml: profile stratiform 0,
-// cumuliform 1, anvil 2; layer slab 0, shell 1; jitter none 0, white 1, ign 2.
+// cumuliform 1, anvil 2; layer slab 0, shell 1; jitter none 0, white 1, ign 2;
+// jitter_steps shared 0, golden 1; integrator riemann 0, analytic 1.
 // Values well below 1 are compared by their ratio to the expected value,
 // so the default tolerance (1e-5) is relative for them too.
-#import vista::cloud_slab::{CloudParams, CloudSlab, cloud_slab, expm1, light_step_layout, height01, height_profile, analytic_weight, altitude, layer_segment, cloud_density, jitter_offset}
-#import wgsl_test::{expect, expectNear, expectNearV2f, expectNearV3f}
+#import vista::cloud_slab::{CloudParams, CloudSlab, cloud_slab, expm1, light_step_layout, height01, height_profile, analytic_weight, altitude, layer_segment, cloud_density, jitter_offset, sun_optical_depth, cloud_march}
+#import wgsl_test::{expect, expectNear, expectNearV2f, expectNearV3f, expectNearV4f}
 
 // A layer from 2 to 5 km: density_scale 10, profile rounding 0.1 at the
 // base and 0.4 at the top, noise_scale 1 (stretch 1), wind (0.25, 0, 0),
@@ -29,6 +44,16 @@ fn params(profile: u32, layer: u32, coverage: f32, octaves: u32) -> CloudParams 
 
 fn slab(profile: u32, coverage: f32, octaves: u32) -> CloudSlab {
     return cloud_slab(params(profile, 0u, coverage, octaves), vec3<f32>(0.0));
+}
+
+// The uniform layer from 2 to 5 km (see the header): coverage 1, so the
+// density is density_scale / 2 everywhere in it; 3 octaves; 12 light steps
+// of spread 4; 64 equal primary steps, Riemann; ambient (0.1, 0.2, 0.3) at
+// every height (ambient_bottom 1), no powder.
+fn uniform_params(density_scale: f32, absorption: f32, layer: u32) -> CloudParams {
+    return CloudParams(2.0, 5.0, 1.0, density_scale, absorption, 0u, 0.001, 0.001, 0.0, vec3<f32>(1.0), vec3<f32>(0.0),
+                       3u, 2.0, 0.5, 0u, 100.0, 64u, 12u, 4.0, 1.0, 0.0, 0u, 0u, 0.7, -0.5, 0.5, 0.0,
+                       vec3<f32>(0.1, 0.2, 0.3), 1.0, layer, 0u);
 }
 
 @test
@@ -176,4 +201,141 @@ fn jitter_offsets() {
     expectNear(jitter_offset(1u, 9u, vec2<u32>(3u, 5u)), 0.10639894008636475, 0.0);
     // ign, seed 0: fract(52.9829189 fract(0.06711056 * 3 + 0.00583715 * 5)).
     expectNear(jitter_offset(2u, 0u, vec2<u32>(3u, 5u)), 0.2134862987264281);
+}
+
+@test
+fn sun_optical_depth_of_a_uniform_slab() {
+    // d = 1, ext 1.5: tau = 1.5 L for the path L to the top (or to
+    // max_distance), whatever the 12 growing steps.
+    let s = cloud_slab(uniform_params(2.0, 0.5, 0u), vec3<f32>(0.0));
+    expectNear(cloud_density(s, vec3<f32>(0.3, 3.0, -1.0)), 1.0);
+    let up = vec3<f32>(0.0, 1.0, 0.0);
+    let slant = vec3<f32>(0.6, 0.8, 0.0);
+    // From y = 3 straight up: L = 2; slanted: L = 2 / 0.8.
+    expectNear(sun_optical_depth(s, vec3<f32>(0.0, 3.0, 0.0), up), 3.0);
+    expectNear(sun_optical_depth(s, vec3<f32>(0.0, 3.0, 0.0), slant), 3.75);
+    // From below the layer (y = 0.5) the path starts at the base: L = 3 / 0.8.
+    expectNear(sun_optical_depth(s, vec3<f32>(1.0, 0.5, 2.0), slant), 5.625);
+    // Above the layer there is nothing to cross.
+    expectNear(sun_optical_depth(s, vec3<f32>(0.0, 6.0, 0.0), up), 0.0, 0.0);
+    // max_distance 1 km cuts the path to L = 1.
+    var c = uniform_params(2.0, 0.5, 0u);
+    c.max_distance_km = 1.0;
+    expectNear(sun_optical_depth(cloud_slab(c, vec3<f32>(0.0)), vec3<f32>(0.0, 3.0, 0.0), up), 1.5);
+}
+
+@test
+fn sun_optical_depth_of_a_uniform_shell() {
+    // The shell around (0, -R, 0), R = 6360 km, d = 1, ext 1.5. Straight up
+    // from altitude 3: L = 2; from altitude 0.5 the path starts at the
+    // inner sphere, 1.5 up, and ends 4.5 up: L = 3.
+    let s = cloud_slab(uniform_params(2.0, 0.5, 1u), vec3<f32>(0.0));
+    let up = vec3<f32>(0.0, 1.0, 0.0);
+    expectNear(sun_optical_depth(s, vec3<f32>(0.0, 3.0, 0.0), up), 3.0);
+    expectNear(sun_optical_depth(s, vec3<f32>(0.0, 0.5, 0.0), up), 4.5);
+    // Slanted (0.6, 0.8, 0) from radius R + 3 to the sphere R + 5: L = -b +
+    // sqrt(b^2 - c), b = 0.8 (R + 3), c = (R + 3)^2 - (R + 5)^2, L = 2.4997791042378594.
+    expectNear(sun_optical_depth(s, vec3<f32>(0.0, 3.0, 0.0), vec3<f32>(0.6, 0.8, 0.0)), 3.749668656356789);
+}
+
+@test
+fn sun_optical_depth_stops_past_the_cutoff() {
+    // d = 100, ext 1, L = 2 straight up: the first light step (the layout's
+    // first fraction 0.03797088665611335 of L) adds 7.594, the second r =
+    // 4^(1/11) times more, 16.208 > 16: the march stops there (the whole
+    // path would give 200).
+    let s = cloud_slab(uniform_params(200.0, 0.0, 0u), vec3<f32>(0.0));
+    expectNear(sun_optical_depth(s, vec3<f32>(0.0, 3.0, 0.0), vec3<f32>(0.0, 1.0, 0.0)), 16.208347773801464);
+}
+
+@test
+fn cloud_march_through_empty_air() {
+    // Coverage 0 (SPEC 3.6: exactly the background): no light, T = 1.
+    let s = slab(1u, 0.0, 4u);
+    let r = cloud_march(s, vec3<f32>(0.0), vec3<f32>(0.0, 1.0, 0.0), 2.0, 5.0, 0.5, vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(20.0));
+    expectNearV4f(r, vec4<f32>(0.0, 0.0, 0.0, 1.0), 0.0);
+}
+
+@test
+fn cloud_march_analytic_conserves_energy() {
+    // Up through the uniform slab (t 2 to 5), d = 1, ext 1.5, no sun, 64
+    // steps: T = exp(-4.5) = 0.011108996538242306 (Beer-Lambert) and the
+    // analytic steps telescope to ambient (1 - T) / 1.5.
+    var c = uniform_params(2.0, 0.5, 0u);
+    c.integrator = 1u;
+    let r = cloud_march(cloud_slab(c, vec3<f32>(0.0)), vec3<f32>(0.0), vec3<f32>(0.0, 1.0, 0.0), 2.0, 5.0, 0.5,
+                        vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0));
+    expectNear(r.w / 0.011108996538242306, 1.0);
+    expectNearV3f(r.xyz, vec3<f32>(0.06592606689745052, 0.13185213379490104, 0.19777820069235152));
+}
+
+@test
+fn cloud_march_riemann_steps_of_step_km() {
+    // d = 1, ext 1, t 2 to 5, no sun. step_km 0.7: n = ceil(3 / 0.7) = 5,
+    // dt = 0.6: radiance ambient dt (1 - e^-3) / (1 - e^-0.6), T = e^-3.
+    var c = uniform_params(2.0, 0.0, 0u);
+    c.step_km = 0.7;
+    let o = vec3<f32>(0.0);
+    let up = vec3<f32>(0.0, 1.0, 0.0);
+    let r = cloud_march(cloud_slab(c, o), o, up, 2.0, 5.0, 0.5, up, vec3<f32>(0.0));
+    expectNear(r.w / 0.049787068367863944, 1.0);
+    expectNearV3f(r.xyz, vec3<f32>(0.12636136137103363, 0.25272272274206725, 0.37908408411310085));
+    // step_km 0.01 would need 300 steps: capped at steps = 8, dt = 0.375.
+    c.step_km = 0.01;
+    c.steps = 8u;
+    let r8 = cloud_march(cloud_slab(c, o), o, up, 2.0, 5.0, 0.5, up, vec3<f32>(0.0));
+    expectNearV3f(r8.xyz, vec3<f32>(0.11394871528049294, 0.22789743056098588, 0.34184614584147877));
+}
+
+@test
+fn cloud_march_riemann_geometric_steps() {
+    // d = 1, ext 1, t 2 to 5, 6 steps of spread 4: step k spans the
+    // fractions (r^k - 1) / (r^6 - 1) to (r^(k+1) - 1) / (r^6 - 1) of the
+    // path, r = 4^(1/5); radiance ambient sum_k dt_k e^-(t_k - 2), T = e^-3.
+    var c = uniform_params(2.0, 0.0, 0u);
+    c.steps = 6u;
+    c.step_spread = 4.0;
+    let o = vec3<f32>(0.0);
+    let up = vec3<f32>(0.0, 1.0, 0.0);
+    let r = cloud_march(cloud_slab(c, o), o, up, 2.0, 5.0, 0.5, up, vec3<f32>(0.0));
+    expectNear(r.w / 0.049787068367863944, 1.0);
+    expectNearV3f(r.xyz, vec3<f32>(0.11723559297711464, 0.23447118595422928, 0.3517067789313439));
+}
+
+@test
+fn cloud_march_sunlit_with_golden_jitter() {
+    // d = 0.5, ext 1, along (0.6, 0.8, 0) from t 2.5 to 6.25 (the slab), 4
+    // steps of 0.9375, xi = 0.3; sun (2, 1.5, 1) straight up (mu = 0.8,
+    // phase 0.10032981883205172), powder 0.5, ambient (0.1, 0.2, 0.3) from
+    // half at the base (ambient_bottom 0.5). Golden: samples at y = 2.225,
+    // 3.43853, 3.90205, 4.36558; shared: y = 2.225, 2.975, 3.725, 4.475.
+    // T = e^-1.875 = 0.15335496684492847 either way.
+    var c = uniform_params(1.0, 0.0, 0u);
+    c.steps = 4u;
+    c.powder = 0.5;
+    c.ambient_bottom = 0.5;
+    c.jitter_steps = 1u;
+    let o = vec3<f32>(0.0);
+    let d = vec3<f32>(0.6, 0.8, 0.0);
+    let up = vec3<f32>(0.0, 1.0, 0.0);
+    let sun = vec3<f32>(2.0, 1.5, 1.0);
+    let g = cloud_march(cloud_slab(c, o), o, d, 2.5, 6.25, 0.3, up, sun);
+    expectNear(g.w, 0.15335496684492847);
+    expectNearV3f(g.xyz, vec3<f32>(0.14911283949585494, 0.2020408805041208, 0.2549689215123867));
+    c.jitter_steps = 0u;
+    let sh = cloud_march(cloud_slab(c, o), o, d, 2.5, 6.25, 0.3, up, sun);
+    expectNear(sh.w, 0.15335496684492847);
+    expectNearV3f(sh.xyz, vec3<f32>(0.14152969623327646, 0.1931056166729591, 0.24468153711264173));
+}
+
+@test
+fn cloud_march_stops_at_the_transmittance_cutoff() {
+    // d = 50, ext 1, 64 steps of 3/64 up through the slab: x = 2.34375 per
+    // step, T = e^-4x = 8.5e-5 < 1e-4 after the fourth: T is then 0 and the
+    // radiance the first four Riemann steps, ambient 50 dt sum_{k<4} e^-kx.
+    let o = vec3<f32>(0.0);
+    let up = vec3<f32>(0.0, 1.0, 0.0);
+    let r = cloud_march(cloud_slab(uniform_params(100.0, 0.0, 0u), o), o, up, 2.0, 5.0, 0.5, up, vec3<f32>(0.0));
+    expectNear(r.w, 0.0, 0.0);
+    expectNearV3f(r.xyz, vec3<f32>(0.2592329517084144, 0.5184659034168289, 0.7776988551252433));
 }

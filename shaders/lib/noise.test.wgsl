@@ -6,8 +6,8 @@
 // published (Jarzynski & Olano, JCGT 2020) with 32-bit wrapping, lattice
 // value (h.x >> 8) * 2^-24 * 2 - 1, seed folded into z as seed * 0x9E3779B9.
 // The kernels' table is Perlin's seed-0 permutation (no seed param here).
-#import vista::noise::{quintic, perlin, perlin_grad, lattice_value, value_noise, PERLIN_MAX_ABS}
-#import wgsl_test::{expect, expectNear, expectNearV3f}
+#import vista::noise::{quintic, perlin, perlin_grad, perlin_hashes, lattice_value, value_noise, PERLIN_MAX_ABS}
+#import wgsl_test::{expect, expectEqU, expectNear, expectNearV3f}
 
 @test
 fn quintic_fade_ends_middle_and_inside() {
@@ -102,4 +102,38 @@ fn noise_stays_bounded_on_a_grid() {
             }
         }
     }
+}
+
+@test
+fn perlin_hashes_follow_the_reference_chain() {
+    // Perlin's chain through the doubled table P: A = P[x] + y, B = P[x + 1] + y,
+    // AA = P[A] + z, BA = P[B] + z, AB = P[A + 1] + z, BB = P[B + 1] + z; the
+    // corners (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1) hash to
+    // P[k] | P[k + 1] << 8 for k = AA, BA, AB, BB (byte 1: the corner at z + 1).
+    var h = perlin_hashes(vec3<u32>(0u, 0u, 0u));
+    expectEqU(h.x, 26404u);
+    expectEqU(h.y, 42070u);
+    expectEqU(h.z, 28268u);
+    expectEqU(h.w, 50048u);
+    h = perlin_hashes(vec3<u32>(3u, 42u, 7u));
+    expectEqU(h.x, 64226u);
+    expectEqU(h.y, 31994u);
+    expectEqU(h.z, 59842u);
+    expectEqU(h.w, 64226u);
+    h = perlin_hashes(vec3<u32>(17u, 200u, 131u));
+    expectEqU(h.x, 2025u);
+    expectEqU(h.y, 11266u);
+    expectEqU(h.z, 51369u);
+    expectEqU(h.w, 47538u);
+    // At the top of the table the chain reads past 255 into the doubled half.
+    h = perlin_hashes(vec3<u32>(255u, 255u, 255u));
+    expectEqU(h.x, 15831u);
+    expectEqU(h.y, 32020u);
+    expectEqU(h.z, 7783u);
+    expectEqU(h.w, 9356u);
+    h = perlin_hashes(vec3<u32>(254u, 0u, 255u));
+    expectEqU(h.x, 40298u);
+    expectEqU(h.y, 7783u);
+    expectEqU(h.z, 28268u);
+    expectEqU(h.w, 16153u);
 }
