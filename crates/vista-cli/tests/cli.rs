@@ -3877,13 +3877,18 @@ fn missing_shader_file_is_refused() {
 /// WGSL's layout rules worked by hand (vec3 takes 12 bytes at a 16-byte
 /// alignment, an array of a 32-byte struct steps by 32), so a project
 /// packs engine data at the offsets the shader reads.
+/// An engine-style frame block: a vec3, an f32 and an array of structs.
+const FRAME_STRUCTS: &str = "struct Light { color: vec4<f32>, dir: vec3<f32>, range: f32 }\n\
+                             struct Frame { world_position: vec3<f32>, exposure: f32, lights: array<Light, 2> }\n\
+                             @group(0) @binding(0) var<uniform> frame: Frame;\n";
+
 fn list_layout_prints_every_leaf_with_its_offset() {
-    let shader = "struct Light { color: vec4<f32>, dir: vec3<f32>, range: f32 }\n\
-                  struct Frame { world_position: vec3<f32>, exposure: f32, lights: array<Light, 2> }\n\
-                  @group(0) @binding(0) var<uniform> frame: Frame;\n\
-                  @group(0) @binding(1) var out: texture_storage_2d<rgba8unorm, write>;\n\
-                  @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
-                  \x20   textureStore(out, id.xy, vec4(frame.lights[1].color.rgb * frame.exposure, 1.0));\n}\n";
+    let shader = format!(
+        "{FRAME_STRUCTS}@group(0) @binding(1) var out: texture_storage_2d<rgba8unorm, write>;\n\
+         @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+         \x20   textureStore(out, id.xy, vec4(frame.lights[1].color.rgb * frame.exposure, 1.0));\n}}\n"
+    );
+    let shader = shader.as_str();
     let d = kernel_project("summary = \"a frame of engine data\"\n", shader);
     let r = vista_in(Some(d.path()), &[], &["list", "--layout"]);
     assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
@@ -3907,14 +3912,14 @@ fn list_layout_prints_every_leaf_with_its_offset() {
 /// every leaf not named zero; the shader reads them back into its output.
 /// A path naming no field, a wrong count and a second source are refused.
 fn uniform_structs_are_filled_by_field_path() {
-    let shader = "struct Light { color: vec4<f32>, dir: vec3<f32>, range: f32 }\n\
-                  struct Frame { world_position: vec3<f32>, exposure: f32, lights: array<Light, 2> }\n\
-                  @group(0) @binding(0) var<uniform> frame: Frame;\n\
-                  @group(0) @binding(1) var out: texture_storage_2d<rgba32float, write>;\n\
-                  @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
-                  \x20   let l = frame.lights[1];\n\
-                  \x20   let unset = frame.lights[0].range + frame.world_position.x + l.dir.z;\n\
-                  \x20   textureStore(out, id.xy, vec4(l.color.rgb * frame.exposure + unset, frame.world_position.y));\n}\n";
+    let shader = format!(
+        "{FRAME_STRUCTS}@group(0) @binding(1) var out: texture_storage_2d<rgba32float, write>;\n\
+         @compute @workgroup_size(8, 8)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+         \x20   let l = frame.lights[1];\n\
+         \x20   let unset = frame.lights[0].range + frame.world_position.x + l.dir.z;\n\
+         \x20   textureStore(out, id.xy, vec4(l.color.rgb * frame.exposure + unset, frame.world_position.y));\n}}\n"
+    );
+    let shader = shader.as_str();
     let manifest = |fields: &str| {
         format!(
             "summary = \"a frame of engine data by field\"\noutput = \"hdr\"\n\
