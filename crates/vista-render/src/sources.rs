@@ -28,12 +28,14 @@ impl Sources {
             Some(r) => format!("project {}", r.display()),
             None => "built-in shaders".to_string(),
         };
+        // The manifests, parsed once for all that follows.
+        let registry = registry(project)?;
         let mut files: Vec<(String, String, String)> =
             project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin)).collect();
-        files.extend(other_extensions(project, &files)?);
-        let (specs, reader) = source_specs(project)?;
+        files.extend(other_extensions(project, &registry, &files));
+        let (specs, reader) = specs_of(project, &registry);
         files.extend(generated_modules(&specs)?);
-        let mut enums = enum_modules(project)?;
+        let mut enums = enums_of(&registry);
         enums.extend(test_file_enums(&files, &enums));
         Ok(Sources { label, files, enums, specs, reader })
     }
@@ -103,10 +105,22 @@ fn generated_modules(
 pub fn source_specs(
     project: &vista_project::Project,
 ) -> Result<(Vec<(String, vista_source::SourceSpec)>, vista_gpu::Reader), RenderError> {
-    let registry = vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    Ok(specs_of(project, &registry(project)?))
+}
+
+/// The project's kernel manifests.
+fn registry(project: &vista_project::Project) -> Result<vista_kernels::Registry, RenderError> {
+    vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))
+}
+
+/// [`source_specs`] of manifests already parsed.
+fn specs_of(
+    project: &vista_project::Project,
+    registry: &vista_kernels::Registry,
+) -> (Vec<(String, vista_source::SourceSpec)>, vista_gpu::Reader) {
     let project = project.clone();
     let specs = registry.kernels().iter().flat_map(|k| k.source_specs()).collect();
-    Ok((specs, vista_gpu::Reader::new(move |rel| project.read_text(rel))))
+    (specs, vista_gpu::Reader::new(move |rel| project.read_text(rel)))
 }
 
 /// Each kernel's generated `vista::enums` module (from its manifest's enum
@@ -114,7 +128,11 @@ pub fn source_specs(
 /// A manifest that does not parse contributes none (its error comes when
 /// the kernel is named).
 pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, String, String)>, RenderError> {
-    let registry = vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+    Ok(enums_of(&registry(project)?))
+}
+
+/// [`enum_modules`] of manifests already parsed.
+fn enums_of(registry: &vista_kernels::Registry) -> Vec<(String, String, String)> {
     let mut out = Vec::new();
     for k in registry.kernels() {
         let text = k.enum_module();
@@ -122,7 +140,7 @@ pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, Str
             out.push((f.to_string(), k.name().to_string(), text.clone()));
         }
     }
-    Ok(out)
+    out
 }
 
 /// The shader files of kernels with `language = "wgsl"` that `shaders/`'s
@@ -131,9 +149,9 @@ pub fn enum_modules(project: &vista_project::Project) -> Result<Vec<(String, Str
 /// not-found error that names the kernel files.
 fn other_extensions(
     project: &vista_project::Project,
+    registry: &vista_kernels::Registry,
     listed: &[(String, String, String)],
-) -> Result<Vec<(String, String, String)>, RenderError> {
-    let registry = vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+) -> Vec<(String, String, String)> {
     let mut out: Vec<(String, String, String)> = Vec::new();
     for k in registry.kernels().iter().filter(|k| k.reads_any_extension()) {
         for f in k.shader_files() {
@@ -145,7 +163,7 @@ fn other_extensions(
             }
         }
     }
-    Ok(out)
+    out
 }
 
 /// The `vista::enums` of each WGSL unit test file, which no manifest
