@@ -21,6 +21,10 @@ struct Files<'a> {
     parts: RefCell<Vec<Part>>,
 }
 
+/// The file vista's assertion module is read from (a built-in, unless the
+/// project has its own), and the package name a test file imports it by.
+const WGSL_TEST: (&str, &str) = ("shaders/lib/wgsl_test.wgsl", "wgsl_test");
+
 impl Files<'_> {
     /// The folder a module path's first component is taken in.
     fn base(&self, path: &ModulePath) -> Result<String, String> {
@@ -52,43 +56,45 @@ impl Files<'_> {
             }
         })
     }
-}
 
-/// The file vista's assertion module is read from (a built-in, unless the
-/// project has its own), and the package name a test file imports it by.
-const WGSL_TEST: (&str, &str) = ("shaders/lib/wgsl_test.wgsl", "wgsl_test");
+    /// The file of the naga_oil module a package path may name where no
+    /// `[source] packages` entry declares that package: vista's
+    /// `wgsl_test` (the assertions of a `*.test.wesl` file), else a module
+    /// the manifest's `[source] modules` generates (`import
+    /// constants::GROUP` reads shaders/generated/constants.wgsl).
+    fn naga_oil_module(&self, path: &ModulePath) -> Option<String> {
+        let PathOrigin::Package(p) = &path.origin else { return None };
+        if self.packages.iter().any(|(n, _)| n == p) {
+            return None;
+        }
+        if p == WGSL_TEST.1 && path.components.is_empty() {
+            return Some(WGSL_TEST.0.to_string());
+        }
+        let parts: Vec<&str> = std::iter::once(p.as_str()).chain(path.components.iter().map(String::as_str)).collect();
+        Some(format!("shaders/generated/{}.wgsl", parts.join("/")))
+    }
+
+    /// Keeps a file read as a part of the shader (its hash covers them).
+    fn record(&self, file: &str, origin: String, text: &str) {
+        let mut parts = self.parts.borrow_mut();
+        if !parts.iter().any(|p| p.path == file) {
+            parts.push(Part { path: file.to_string(), origin, text: text.to_string() });
+        }
+    }
+}
 
 impl Resolver for Files<'_> {
     fn resolve_source<'a>(&'a self, path: &ModulePath) -> Result<Cow<'a, str>, ResolveError> {
-        let vista_own = path.components.is_empty()
-            && matches!(&path.origin, PathOrigin::Package(p) if p == WGSL_TEST.1)
-            && !self.packages.iter().any(|(p, _)| p == WGSL_TEST.1);
-        if vista_own && let Some((text, _)) = (self.read)(WGSL_TEST.0) {
-            return Ok(Cow::Owned(as_wesl(&text)));
-        }
-        // A module the manifest's `[source] modules` generates (`import
-        // constants::GROUP`), unless a package of that name is declared.
-        if let PathOrigin::Package(p) = &path.origin
-            && !self.packages.iter().any(|(n, _)| n == p)
+        if let Some(file) = self.naga_oil_module(path)
+            && let Some((text, origin)) = (self.read)(&file)
         {
-            let parts: Vec<&str> =
-                std::iter::once(p.as_str()).chain(path.components.iter().map(String::as_str)).collect();
-            let file = format!("shaders/generated/{}.wgsl", parts.join("/"));
-            if let Some((text, origin)) = (self.read)(&file) {
-                let mut parts = self.parts.borrow_mut();
-                if !parts.iter().any(|x| x.path == file) {
-                    parts.push(Part { path: file.clone(), origin, text: text.clone() });
-                }
-                return Ok(Cow::Owned(as_wesl(&text)));
-            }
+            self.record(&file, origin, &text);
+            return Ok(Cow::Owned(as_wesl(&text)));
         }
         let candidates = self.candidates(path).map_err(|e| ResolveError::ModuleNotFound(path.clone(), e))?;
         for file in &candidates {
             if let Some((text, origin)) = (self.read)(file) {
-                let mut parts = self.parts.borrow_mut();
-                if !parts.iter().any(|p| p.path == *file) {
-                    parts.push(Part { path: file.clone(), origin, text: text.clone() });
-                }
+                self.record(file, origin, &text);
                 return Ok(Cow::Owned(without_visibility(&text)));
             }
         }
@@ -96,9 +102,10 @@ impl Resolver for Files<'_> {
     }
 
     fn display_name(&self, path: &ModulePath) -> Option<String> {
-        let candidates = self.candidates(path).ok()?;
+        let mut files = self.candidates(path).unwrap_or_default();
+        files.extend(self.naga_oil_module(path));
         let parts = self.parts.borrow();
-        parts.iter().find(|p| candidates.contains(&p.path)).map(|p| p.origin.clone())
+        parts.iter().find(|p| files.contains(&p.path)).map(|p| p.origin.clone())
     }
 }
 
