@@ -127,22 +127,39 @@ pub struct TestSampler {
 /// filterable in WebGPU's core, so a test samples it with either filter.
 pub const TEXTURE_FORMAT: &str = "rgba16float";
 
-/// The attribute's arguments (`@name(a, b, "c")` from just after the
-/// name), the byte after its `)`, and the declared variable's name and type.
-fn attribute_args(text: &str, after_name: usize) -> Result<(Vec<String>, String, String), String> {
+/// An attribute's parenthesised arguments from just after its name
+/// (`@name(a, b, "c")`), trimmed, and the byte after its `)`; `None` when
+/// no `(` follows the name.
+fn parens(text: &str, after_name: usize) -> Result<Option<(Vec<String>, usize)>, String> {
     let rest = &text[after_name..];
-    let open = rest.find('(').filter(|&o| rest[..o].trim().is_empty()).ok_or("needs its arguments in ( )")?;
+    let Some(open) = rest.find('(').filter(|&o| rest[..o].trim().is_empty()) else { return Ok(None) };
     let close = rest[open..].find(')').map(|c| open + c).ok_or("its ( is not closed")?;
     let args = rest[open + 1..close].split(',').map(|a| a.trim().to_string()).filter(|a| !a.is_empty()).collect();
-    let decl = rest[close + 1..].split(';').next().unwrap_or_default();
-    let decl = decl.trim_start().strip_prefix("var").ok_or("is not followed by a var declaration")?;
-    let (name, ty) = decl.split_once(':').ok_or("its variable has no type")?;
-    Ok((args, name.trim().to_string(), ty.trim().to_string()))
+    Ok(Some((args, after_name + close + 1)))
 }
 
-/// A `@test_texture(...)` declaration from just after the attribute's name.
-fn texture_decl(text: &str, after_name: usize) -> Result<TestTexture, String> {
-    let (args, name, ty) = attribute_args(text, after_name)?;
+/// The attribute's arguments, the byte after its `)`, and the declared
+/// variable's name and type.
+fn attribute_args(text: &str, after_name: usize) -> Result<(Vec<String>, usize, String, String), String> {
+    let (args, close) = parens(text, after_name)?.ok_or("needs its arguments in ( )")?;
+    let decl = text[close..].split(';').next().unwrap_or_default();
+    let decl = decl.trim_start().strip_prefix("var").ok_or("is not followed by a var declaration")?;
+    let (name, ty) = decl.split_once(':').ok_or("its variable has no type")?;
+    Ok((args, close, name.trim().to_string(), ty.trim().to_string()))
+}
+
+/// The first function declared at or after byte `from`: where its `fn`
+/// is and its name.
+fn function_after(text: &str, from: usize) -> Option<(usize, String)> {
+    let at = from + text[from..].find("fn ")?;
+    let name = text[at + 3..].trim_start().bytes().take_while(|&c| is_ident(c)).map(char::from).collect();
+    Some((at, name))
+}
+
+/// A `@test_texture(...)` declaration from just after the attribute's
+/// name, and the byte after the attribute.
+fn texture_decl(text: &str, after_name: usize) -> Result<(TestTexture, usize), String> {
+    let (args, close, name, ty) = attribute_args(text, after_name)?;
     if ty.replace(' ', "") != "texture_2d<f32>" {
         return Err(format!("@test_texture {name}: a test texture is a texture_2d<f32>, not {ty}"));
     }
@@ -175,12 +192,13 @@ fn texture_decl(text: &str, after_name: usize) -> Result<TestTexture, String> {
             Some((w, h))
         }
     };
-    Ok(TestTexture { name, pattern, size })
+    Ok((TestTexture { name, pattern, size }, close))
 }
 
-/// A `@sampler(...)` declaration from just after the attribute's name.
-fn sampler_decl(text: &str, after_name: usize) -> Result<TestSampler, String> {
-    let (args, name, ty) = attribute_args(text, after_name)?;
+/// A `@sampler(...)` declaration from just after the attribute's name,
+/// and the byte after the attribute.
+fn sampler_decl(text: &str, after_name: usize) -> Result<(TestSampler, usize), String> {
+    let (args, close, name, ty) = attribute_args(text, after_name)?;
     if ty != "sampler" {
         return Err(format!("@sampler {name}: declares a sampler, not {ty}"));
     }
@@ -189,24 +207,20 @@ fn sampler_decl(text: &str, after_name: usize) -> Result<TestSampler, String> {
         ["nearest"] => false,
         _ => return Err(format!("@sampler {name}: takes linear or nearest, not ({})", args.join(", "))),
     };
-    Ok(TestSampler { name, linear })
+    Ok((TestSampler { name, linear }, close))
 }
 
 /// `@snapshot` or `@snapshot(W, H)` from just after the name: the size
 /// and the byte after the attribute.
 fn snapshot_size(text: &str, after_name: usize) -> Result<((u32, u32), usize), String> {
-    let rest = &text[after_name..];
-    let Some(open) = rest.find('(').filter(|&o| rest[..o].trim().is_empty()) else {
-        return Ok(((64, 64), after_name));
-    };
-    let close = rest[open..].find(')').map(|c| open + c).ok_or("@snapshot's ( is not closed")?;
-    let args: Vec<&str> = rest[open + 1..close].split(',').map(str::trim).collect();
-    let size = match args[..] {
+    let found = parens(text, after_name).map_err(|_| "@snapshot's ( is not closed".to_string())?;
+    let Some((args, close)) = found else { return Ok(((64, 64), after_name)) };
+    let size = match &args[..] {
         [w, h] => (w.trim_end_matches('u').parse::<u32>(), h.trim_end_matches('u').parse::<u32>()),
         _ => return Err(format!("@snapshot takes a width and a height, not ({})", args.join(", "))),
     };
     match size {
-        (Ok(w), Ok(h)) if (1..=4096).contains(&w) && (1..=4096).contains(&h) => Ok(((w, h), after_name + close + 1)),
+        (Ok(w), Ok(h)) if (1..=4096).contains(&w) && (1..=4096).contains(&h) => Ok(((w, h), close)),
         _ => Err(format!("@snapshot({}) is not a size from 1x1 to 4096x4096", args.join(", "))),
     }
 }
@@ -369,60 +383,57 @@ pub fn rewrite(text: &str, wesl: bool) -> Result<Rewritten, String> {
         let end = start + text[start..].bytes().take_while(|&c| is_ident(c)).count();
         let word = &text[start..end];
         if b[i] == b'@' {
-            if word == "test" {
-                // `@test` before `fn name(`, possibly across other attributes.
-                let rest = &text[end..];
-                let at_fn = rest.find("fn ").ok_or_else(|| {
-                    let (l, c) = place(text, i);
-                    format!("{l}:{c}: @test is not followed by a function")
-                })?;
-                let name_start = end + at_fn + 3;
-                let name: String =
-                    text[name_start..].trim_start().bytes().take_while(|&c| is_ident(c)).map(char::from).collect();
-                let (line, _) = place(text, end + at_fn);
-                tests.push(TestFn { name, line });
-                edits.push((i, end, " ".repeat(end - i)));
-            } else if word == "snapshot" {
-                let at = |e: String| {
-                    let (l, c) = place(text, i);
-                    format!("{l}:{c}: {e}")
-                };
-                let (size, close) = snapshot_size(text, end).map_err(at)?;
-                let rest = &text[close..];
-                let at_fn = rest.find("fn ").ok_or_else(|| at("@snapshot is not followed by a function".into()))?;
-                if !text[i.saturating_sub(200)..close + at_fn].contains("@fragment") {
-                    return Err(at("@snapshot marks a @fragment function".into()));
+            let at = |e: &str| {
+                let (l, c) = place(text, i);
+                format!("{l}:{c}: {e}")
+            };
+            // An attribute may span lines: its replacement keeps the line breaks.
+            let breaks = |to: usize| "\n".repeat(text[i..to].matches('\n').count());
+            let blank = |to: usize| {
+                let keep = breaks(to);
+                (i, to, format!("{}{keep}", " ".repeat(to - i - keep.len())))
+            };
+            match word {
+                "test" => {
+                    // `@test` before `fn name(`, possibly across other attributes.
+                    let (fn_at, name) =
+                        function_after(text, end).ok_or_else(|| at("@test is not followed by a function"))?;
+                    tests.push(TestFn { name, line: place(text, fn_at).0 });
+                    edits.push(blank(end));
                 }
-                let name: String =
-                    rest[at_fn + 3..].trim_start().bytes().take_while(|&c| is_ident(c)).map(char::from).collect();
-                snapshots.push(Snapshot { name, size });
-                let newlines = text[i..close].matches('\n').count();
-                edits.push((i, close, format!("{}{}", " ".repeat(close - i - newlines), "\n".repeat(newlines))));
-                i = close;
-                continue;
-            } else if word == "test_texture" || word == "sampler" {
-                let at = |e: String| {
-                    let (l, c) = place(text, i);
-                    format!("{l}:{c}: {e}")
-                };
-                match word {
-                    "sampler" => samplers.push(sampler_decl(text, end).map_err(at)?),
-                    _ => textures.push(texture_decl(text, end).map_err(at)?),
+                "snapshot" => {
+                    let (size, close) = snapshot_size(text, end).map_err(|e| at(&e))?;
+                    let (fn_at, name) =
+                        function_after(text, close).ok_or_else(|| at("@snapshot is not followed by a function"))?;
+                    // The attributes of this declaration: from the end of the last one.
+                    let decl_start = text[..i].rfind(['}', ';']).map_or(0, |p| p + 1);
+                    if !text[decl_start..fn_at].contains("@fragment") {
+                        return Err(at("@snapshot marks a @fragment function"));
+                    }
+                    snapshots.push(Snapshot { name, size });
+                    edits.push(blank(close));
+                    i = close;
+                    continue;
                 }
-                let close = end + text[end..].find(')').expect("checked above") + 1;
-                let binding = bindings;
-                bindings += 1;
-                // Keep the line count: the attribute's text may span lines.
-                let newlines = text[i..close].matches('\n').count();
-                edits.push((i, close, format!("@group({BUFFER_GROUP}) @binding({binding}){}", "\n".repeat(newlines))));
-            } else if word == "buffer" {
-                let buffer = buffer_decl(&text[end..]).map_err(|e| {
-                    let (l, c) = place(text, i);
-                    format!("{l}:{c}: {e}")
-                })?;
-                edits.push((i, end, format!("@group({BUFFER_GROUP}) @binding({bindings})")));
-                bindings += 1;
-                buffers.push(buffer);
+                "test_texture" | "sampler" => {
+                    let close = if word == "sampler" {
+                        let (s, close) = sampler_decl(text, end).map_err(|e| at(&e))?;
+                        samplers.push(s);
+                        close
+                    } else {
+                        let (t, close) = texture_decl(text, end).map_err(|e| at(&e))?;
+                        textures.push(t);
+                        close
+                    };
+                    edits.push((i, close, format!("@group({BUFFER_GROUP}) @binding({bindings}){}", breaks(close))));
+                    bindings += 1;
+                }
+                "buffer" => {
+                    buffers.push(buffer_decl(&text[end..]).map_err(|e| at(&e))?);
+                    edits.push((i, end, format!("@group({BUFFER_GROUP}) @binding({bindings})")));
+                    bindings += 1;
+                }
+                _ => {}
             }
             i = end;
             continue;

@@ -12,9 +12,7 @@ use crate::rewrite::Snapshot;
 /// Where snapshot `name` of test file `rel` keeps its golden, relative to
 /// the project root.
 pub fn golden_path(rel: &str, name: &str) -> String {
-    let file = rel.rsplit('/').next().unwrap_or(rel);
-    let stem = file.strip_suffix(".test.wgsl").or_else(|| file.strip_suffix(".test.wesl")).unwrap_or(file);
-    format!("golden/wgsl/{stem}/{name}.png")
+    format!("golden/wgsl/{}/{name}.png", crate::stem(rel))
 }
 
 /// The manifest drawing `snap` of file `rel`.
