@@ -89,13 +89,7 @@ pub fn test_files(project: &vista_project::Project) -> Result<Vec<(String, Strin
 
 /// The id of test `name` of file `rel`: `wgsl::<stem>::<name>`.
 pub fn test_id(rel: &str, name: &str) -> String {
-    format!("wgsl::{}::{name}", stem(rel))
-}
-
-/// A test file's name without its folders and `.test.wgsl` / `.test.wesl`.
-fn stem(rel: &str) -> &str {
-    let file = rel.rsplit('/').next().unwrap_or(rel);
-    file.strip_suffix(".test.wgsl").or_else(|| file.strip_suffix(".test.wesl")).unwrap_or(file)
+    format!("wgsl::{}::{name}", rewrite::stem(rel))
 }
 
 /// The ids of file `rel`'s tests (`text` its contents), or the error that

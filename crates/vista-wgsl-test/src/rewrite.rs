@@ -288,6 +288,13 @@ fn buffer_decl(decl: &str) -> Result<TestBuffer, String> {
     Ok(TestBuffer { name: name.to_string(), length })
 }
 
+/// A test file's name without its folders and `.test.wgsl` / `.test.wesl`:
+/// what its test ids and snapshot goldens are named by.
+pub(crate) fn stem(rel: &str) -> &str {
+    let file = rel.rsplit('/').next().unwrap_or(rel);
+    file.strip_suffix(".test.wgsl").or_else(|| file.strip_suffix(".test.wesl")).unwrap_or(file)
+}
+
 /// The compute entry vista appends for test `i`.
 pub fn entry(i: usize) -> String {
     format!("vista_test_{i}")

@@ -12,7 +12,7 @@ use crate::rewrite::Snapshot;
 /// Where snapshot `name` of test file `rel` keeps its golden, relative to
 /// the project root.
 pub fn golden_path(rel: &str, name: &str) -> String {
-    format!("golden/wgsl/{}/{name}.png", crate::stem(rel))
+    format!("golden/wgsl/{}/{name}.png", crate::rewrite::stem(rel))
 }
 
 /// The manifest drawing `snap` of file `rel`.
