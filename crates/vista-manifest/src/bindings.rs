@@ -344,13 +344,20 @@ pub fn wgsl_type(module: &naga::Module, var: &naga::GlobalVariable) -> String {
             module.to_ctx().type_to_string(var.ty)
         }
     };
-    match var.space {
-        AddressSpace::Uniform => format!("var<uniform> {inner}"),
-        AddressSpace::Storage { access } if access.contains(StorageAccess::STORE) => {
-            format!("var<storage, read_write> {inner}")
-        }
-        AddressSpace::Storage { .. } => format!("var<storage, read> {inner}"),
-        _ => inner,
+    match buffer_space(var.space) {
+        Some(space) => format!("var<{space}> {inner}"),
+        None => inner,
+    }
+}
+
+/// A buffer's address space as WGSL writes it in `var<...>`: `uniform`,
+/// `storage, read` or `storage, read_write`; `None` for any other space.
+pub fn buffer_space(space: AddressSpace) -> Option<&'static str> {
+    match space {
+        AddressSpace::Uniform => Some("uniform"),
+        AddressSpace::Storage { access } if access.contains(StorageAccess::STORE) => Some("storage, read_write"),
+        AddressSpace::Storage { .. } => Some("storage, read"),
+        _ => None,
     }
 }
 

@@ -5,7 +5,7 @@
 //! prints, so a project writes engine data (a `View`, a `Lights`) into
 //! `.bin` files at the offsets the shader reads.
 
-use naga::{AddressSpace, ArraySize, TypeInner};
+use naga::{ArraySize, TypeInner};
 
 /// One leaf of a binding's type.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -51,14 +51,7 @@ pub fn buffer_layouts(module: &naga::Module) -> Vec<BufferLayout> {
         .iter()
         .filter_map(|(_, g)| {
             let b = g.binding?;
-            let space = match g.space {
-                AddressSpace::Uniform => "uniform".to_string(),
-                AddressSpace::Storage { access } if access.contains(naga::StorageAccess::STORE) => {
-                    "storage, read_write".to_string()
-                }
-                AddressSpace::Storage { .. } => "storage, read".to_string(),
-                _ => return None,
-            };
+            let space = crate::bindings::buffer_space(g.space)?.to_string();
             let mut leaves = Vec::new();
             walk(module, g.ty, String::new(), 0, &mut Vec::new(), &mut leaves);
             leaves.sort_by_key(|l| l.offset);
@@ -102,33 +95,15 @@ fn walk(
             walk(module, *base, format!("{path}[{index}]"), offset, strides, out);
             strides.pop();
         }
-        inner => out.push(Leaf {
+        _ => out.push(Leaf {
             path: if path.is_empty() { "(the whole)".into() } else { path.trim_start_matches('.').to_string() },
             offset,
             strides: strides.clone(),
-            ty: type_name(inner),
+            ty: {
+                use naga::common::wgsl::TypeContext;
+                module.to_ctx().type_to_string(ty)
+            },
         }),
-    }
-}
-
-/// A leaf type in WGSL's spelling.
-fn type_name(inner: &TypeInner) -> String {
-    let scalar = |s: naga::Scalar| match (s.kind, s.width) {
-        (naga::ScalarKind::Float, 2) => "f16".to_string(),
-        (naga::ScalarKind::Float, _) => "f32".to_string(),
-        (naga::ScalarKind::Sint, _) => "i32".to_string(),
-        (naga::ScalarKind::Uint, _) => "u32".to_string(),
-        (naga::ScalarKind::Bool, _) => "bool".to_string(),
-        _ => format!("{s:?}"),
-    };
-    match inner {
-        TypeInner::Scalar(s) => scalar(*s),
-        TypeInner::Vector { size, scalar: s } => format!("vec{}<{}>", *size as u8, scalar(*s)),
-        TypeInner::Matrix { columns, rows, scalar: s } => {
-            format!("mat{}x{}<{}>", *columns as u8, *rows as u8, scalar(*s))
-        }
-        TypeInner::Atomic(s) => format!("atomic<{}>", scalar(*s)),
-        other => format!("{other:?}").split_whitespace().next().unwrap_or("?").to_string(),
     }
 }
 
