@@ -637,14 +637,8 @@ fn buffer_kind(
         None => None,
         Some(toml::Value::Array(list)) => {
             let mut out = Vec::new();
-            fn flatten(v: &toml::Value, out: &mut Vec<toml::Value>) {
-                match v {
-                    toml::Value::Array(l) => l.iter().for_each(|x| flatten(x, out)),
-                    other => out.push(other.clone()),
-                }
-            }
             let mut flat = Vec::new();
-            list.iter().for_each(|v| flatten(v, &mut flat));
+            list.iter().for_each(|v| flatten_numbers(v, &mut flat));
             for v in &flat {
                 out.push(number(v).ok_or_else(|| at(format!("data entry {v} is not a number")))?);
             }
