@@ -441,10 +441,8 @@ impl Planning<'_> {
                 )));
             }
             for ((offset, kind, leaf), v) in leaves.into_iter().zip(values) {
-                let word = encode_leaf(*kind, *v).ok_or_else(|| {
-                    let (k, bits) = (leaf_numpy(*kind).0, leaf_numpy(*kind).1 * 8);
-                    at(format!("fields: {v} does not fit {leaf} ({k}{bits})"))
-                })?;
+                let word = encode_leaf(*kind, *v)
+                    .ok_or_else(|| at(format!("fields: {v} does not fit {leaf} ({})", leaf_type(*kind))))?;
                 bytes[*offset as usize..*offset as usize + word.len()].copy_from_slice(&word);
             }
         }
@@ -1179,8 +1177,6 @@ fn read_buffer(root: Option<&Path>, file: &str, e: &Element) -> Result<Vec<u8>, 
     Ok(data)
 }
 
-/// Numbers converted to the element's leaves in order (a whole number of
-/// elements).
 /// One leaf's bytes: an f32, or a u32/i32/u16 that holds `v` exactly.
 fn encode_leaf(kind: char, v: f64) -> Option<Vec<u8>> {
     let whole = v.fract() == 0.0;
@@ -1193,6 +1189,14 @@ fn encode_leaf(kind: char, v: f64) -> Option<Vec<u8>> {
     })
 }
 
+/// A leaf kind as NumPy names it with its width: `f32`, `u16`.
+fn leaf_type(kind: char) -> String {
+    let (k, bytes) = leaf_numpy(kind);
+    format!("{k}{}", bytes * 8)
+}
+
+/// Numbers converted to the element's leaves in order (a whole number of
+/// elements).
 fn encode_values(values: &[f64], e: &Element) -> Result<Vec<u8>, String> {
     let per = e.leaves.len();
     if per == 0 || values.is_empty() || !values.len().is_multiple_of(per) {
@@ -1207,10 +1211,10 @@ fn encode_values(values: &[f64], e: &Element) -> Result<Vec<u8>, String> {
         let mut el = vec![0u8; e.stride as usize];
         for ((offset, kind, path), v) in e.leaves.iter().zip(chunk) {
             let Some(word) = encode_leaf(*kind, *v) else {
-                let (k, bits) = (leaf_numpy(*kind).0, leaf_numpy(*kind).1 * 8);
+                let ty = leaf_type(*kind);
                 return Err(match path.is_empty() {
-                    true => format!("{v} does not fit {} ({k}{bits})", e.wgsl),
-                    false => format!("{v} does not fit {path} ({k}{bits}) of {}", e.wgsl),
+                    true => format!("{v} does not fit {} ({ty})", e.wgsl),
+                    false => format!("{v} does not fit {path} ({ty}) of {}", e.wgsl),
                 });
             };
             el[*offset as usize..*offset as usize + word.len()].copy_from_slice(&word);
