@@ -29,6 +29,9 @@ pub struct Config {
     /// `VISTA_ALLOW_NO_GPU=1`: without an adapter, GPU tests are reported
     /// skipped (loudly) instead of failing.
     pub allow_no_gpu: bool,
+    /// `VISTA_COVERAGE=1`: the harness also runs each case with coverage
+    /// counters (as `vista check --coverage`).
+    pub coverage: bool,
     /// `VISTA_FONT`: the font file for plot text.
     pub font: Option<PathBuf>,
     /// `VISTA_ROOT`: the project root, after `--root`.
@@ -186,6 +189,7 @@ impl Config {
             // CI systems spell it true, 1 or their own name (CI=woodpecker).
             in_ci: text("CI").is_some_and(|v| !matches!(v.to_ascii_lowercase().as_str(), "" | "0" | "false")),
             allow_no_gpu: truthy("VISTA_ALLOW_NO_GPU", text("VISTA_ALLOW_NO_GPU"))?,
+            coverage: truthy("VISTA_COVERAGE", text("VISTA_COVERAGE"))?,
             font: get("VISTA_FONT").filter(|v| !v.is_empty()).map(PathBuf::from),
             root: get("VISTA_ROOT").filter(|v| !v.is_empty()),
             crate_dir: get("CARGO_MANIFEST_DIR").filter(|v| !v.is_empty()).map(PathBuf::from),
@@ -297,6 +301,7 @@ mod tests {
                 ("VISTA_MAX_WORK", "1e6"),
                 ("CI", "true"),
                 ("VISTA_ALLOW_NO_GPU", "1"),
+                ("VISTA_COVERAGE", "1"),
                 ("VISTA_FONT", "/f.ttf"),
                 ("VISTA_VALIDATION", "1"),
                 ("VISTA_GPU_TIMEOUT_S", "7.5"),
@@ -312,7 +317,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(c.limits.max_work, 1e6);
-        assert!(c.in_ci && c.allow_no_gpu && c.gpu.validate);
+        assert!(c.in_ci && c.allow_no_gpu && c.gpu.validate && c.coverage);
         assert_eq!(c.font.as_deref(), Some(std::path::Path::new("/f.ttf")));
         assert_eq!(c.gpu.timeout, std::time::Duration::from_secs_f64(7.5));
         assert_eq!(c.compile_timeout, std::time::Duration::from_secs_f64(2.5));
@@ -326,7 +331,7 @@ mod tests {
         let d = config(&Flags::default(), &[]).unwrap();
         assert!(!d.nextest && d.nextest_run_id.is_none() && d.report_dir.is_none() && d.junit.is_none());
         assert_eq!(d.limits.max_work, vista_render::DEFAULT_MAX_WORK);
-        assert!(!d.in_ci && !d.allow_no_gpu && !d.gpu.validate);
+        assert!(!d.in_ci && !d.allow_no_gpu && !d.gpu.validate && !d.coverage);
         for (ci, is) in [("woodpecker", true), ("1", true), ("0", false), ("false", false)] {
             assert_eq!(config(&Flags::default(), &[("CI", ci)]).unwrap().in_ci, is, "CI={ci}");
         }

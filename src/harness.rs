@@ -93,8 +93,9 @@ fn checker<'a>(
     store: &'a Store,
     manifest: &'a vista_golden::Manifest,
     report_dir: &'a Path,
+    coverage: bool,
 ) -> Checker<'a> {
-    Checker { ctx, store, manifest, report_dir, detail: vista_report::Detail::Failing }
+    Checker { ctx, store, manifest, report_dir, detail: vista_report::Detail::Failing, coverage }
 }
 
 /// Each WGSL unit test (`@test` in `shaders/**/*.test.wgsl`, `.test.wesl`) as a libtest
@@ -221,7 +222,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
                     Some(Err(e)) => return Err(Failed::from(format!("no GPU adapter: {e}"))),
                     None => return Err(Failed::from("listed, not run")),
                 };
-                let f = checker(ctx, &store, &manifest, &report_dir).check(&case);
+                let f = checker(ctx, &store, &manifest, &report_dir, config.coverage).check(&case);
                 let o = &f.outcome;
                 let result = match (o.passed(), f.report_errors.is_empty()) {
                     (true, true) => Ok(()),
@@ -275,7 +276,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
         let root = project.root().expect("a store has a root");
         let results = vista_check::Results { junit: config.junit.as_ref().map(|j| root.join(j)), json: None };
         let suite: Vec<String> = cases.iter().map(|c| c.id.clone()).collect();
-        let checker = checker(ctx, &store, &manifest, &report_dir);
+        let checker = checker(ctx, &store, &manifest, &report_dir, config.coverage);
         let run = vista_check::Run { checker, summary: run, results, shared: shared.map(|s| (s, suite)) };
         let written = run.finish(&filed);
         match written {

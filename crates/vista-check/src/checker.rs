@@ -48,6 +48,9 @@ pub struct Checker<'a> {
     pub report_dir: &'a Path,
     /// Which cases get 16-bit images and the pixel viewer.
     pub detail: Detail,
+    /// Each case also runs with coverage counters (`check --coverage`),
+    /// after its judged render, which the counters never touch.
+    pub coverage: bool,
 }
 
 impl Checker<'_> {
@@ -56,6 +59,9 @@ impl Checker<'_> {
         let started = Instant::now();
         let mut checked =
             vista_golden::check_case(self.ctx, self.store, self.manifest, case, &options(self.ctx, self.detail));
+        if self.coverage {
+            checked.outcome.coverage = Some(self.cover(case));
+        }
         let check_time = started.elapsed();
         let golden = self.store.dir.join(&checked.outcome.golden_file);
         checked.outcome.files.golden_href = Some(vista_report::href(self.report_dir, &golden));
@@ -82,6 +88,18 @@ impl Checker<'_> {
             _ => None,
         };
         Filed { outcome, pending, check_time, report_time, report_errors }
+    }
+
+    /// `case`'s coverage run as LCOV, or why it was not measured.
+    fn cover(&self, case: &Case) -> Result<String, String> {
+        let run = vista_render::for_case(&case.id, || {
+            vista_render::cover_with(self.ctx, &case.kernel, &case.params, &case.inputs, case.width, case.height)
+        });
+        match run {
+            Ok(c) if c.not_measured.is_empty() => Ok(c.counts.lcov(&case.id)),
+            Ok(c) => Err(c.not_measured.join("; ")),
+            Err(e) => Err(format!("the coverage run failed: {e}")),
+        }
     }
 
     /// How many of `requested` workers check `cases` cases at once: 1 under

@@ -66,6 +66,15 @@ pub(crate) fn write_run(
         crate::kept::remove_records(report_dir)?;
     }
     vista_golden::pending::write_pending(report_dir, pending)?;
+    // A coverage run's hits, every case's summed; a run without coverage
+    // leaves no older run's file to be read as its own.
+    let lcov = report_dir.join(LCOV_FILE);
+    match coverage_total(outcomes) {
+        Some(counts) => vista_image::atomic_write(&lcov, counts.lcov("vista").as_bytes())?,
+        None if lcov.is_file() => std::fs::remove_file(&lcov)
+            .map_err(|e| GoldenError::Io { path: lcov.display().to_string(), message: e.to_string() })?,
+        None => {}
+    }
     let json_text = vista_report::json_text(&run, outcomes);
     vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;
     if let Some(p) = &results.junit {
@@ -75,6 +84,21 @@ pub(crate) fn write_run(
         vista_image::atomic_write(p, json_text.as_bytes())?;
     }
     Ok(index)
+}
+
+/// The LCOV tracefile a coverage run leaves in its report folder.
+pub const LCOV_FILE: &str = "lcov.info";
+
+/// The hits of every case a coverage run measured, summed; none when no
+/// case ran with coverage.
+pub fn coverage_total(outcomes: &[Outcome]) -> Option<vista_coverage::Counts> {
+    let mut measured = outcomes.iter().filter_map(|o| o.coverage.as_ref()).peekable();
+    measured.peek()?;
+    let mut total = vista_coverage::Counts::default();
+    for lcov in measured.flatten() {
+        total.merge(&vista_coverage::Counts::from_lcov(lcov));
+    }
+    Some(total)
 }
 
 /// `vista bless --from-report <dir>`, where a run left pending renders.

@@ -26,7 +26,7 @@ mod select;
 mod shared;
 
 pub use checker::{Checker, Filed, interrupt, interrupted, options};
-pub use files::{Results, accept_command, finish};
+pub use files::{LCOV_FILE, Results, accept_command, coverage_total, finish};
 pub use kept::{OUTCOMES_FILE, RUN_DIR};
 pub use merge::merge;
 pub use run::{Ran, Reporter, Run, in_order, mutants};

@@ -20,6 +20,8 @@ pub struct Pick {
     pub allow_orphans: bool,
     /// Cases checked at once (`--jobs`).
     pub jobs: usize,
+    /// Each case runs a second time with coverage counters (`--coverage`).
+    pub coverage: bool,
 }
 
 /// A results file's directory must exist and be writable, before any GPU work.
@@ -98,6 +100,24 @@ fn annotate(store: &Store, outcomes: &[vista_golden::Outcome]) {
     }
 }
 
+/// The coverage summary line, each case not measured, and the tracefile.
+fn print_coverage(counts: &vista_coverage::Counts, outcomes: &[vista_golden::Outcome], report_dir: &Path) {
+    for o in outcomes {
+        if let Some(Err(why)) = &o.coverage {
+            println!("coverage: {} not measured: {why}", o.id);
+        }
+    }
+    let (lf, lh, bf, bh) = counts.totals();
+    let percent = |hit: usize, found: usize| if found == 0 { 100.0 } else { 100.0 * hit as f64 / found as f64 };
+    println!(
+        "coverage: {lh} of {lf} lines ({:.1}%), {bh} of {bf} branch arms ({:.1}%) in {} files: {}",
+        percent(lh, lf),
+        percent(bh, bf),
+        counts.files().len(),
+        report_dir.join(vista_check::LCOV_FILE).display()
+    );
+}
+
 pub fn check(
     project: &Project,
     config: &Config,
@@ -129,7 +149,14 @@ pub fn check(
     // Ctrl-C: the cases that finished still get their report.
     crate::signals::stop_on_interrupt();
     let mut time = Phases::start(ctx);
-    let checker = Checker { ctx, store: &store, manifest: &manifest, report_dir: &report_dir, detail: viewers };
+    let checker = Checker {
+        ctx,
+        store: &store,
+        manifest: &manifest,
+        report_dir: &report_dir,
+        detail: viewers,
+        coverage: pick.coverage,
+    };
     time.jobs = checker.jobs(pick.jobs, picked.len());
     let summary = vista_report::RunSummary {
         command: command_line(),
@@ -190,6 +217,9 @@ pub fn check(
                 "or accept exactly what this run rendered (on another machine too, from this report folder): {accept}"
             );
         }
+    }
+    if let Some(counts) = vista_check::coverage_total(&outcomes) {
+        print_coverage(&counts, &outcomes, &report_dir);
     }
     println!("{}", time.summary(ctx, outcomes.len()));
     if let Some(line) = &run.stopped {

@@ -183,6 +183,12 @@ enum Command {
         /// validation layer one at a time, so each message names its case.
         #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=64))]
         jobs: u16,
+        /// Also run each case with a counter per WGSL statement and branch
+        /// arm, after its judged render (verdicts and goldens are those of
+        /// the plain run): which lines the cases execute, as lcov.info in
+        /// the report folder.
+        #[arg(long)]
+        coverage: bool,
     },
     /// Join the report folders of `check --partition K/N --report-dir DIR`
     /// runs into one report, results.json, JUnit and pending.toml.
@@ -410,10 +416,11 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             allow_orphans,
             full_report,
             jobs,
+            coverage,
         } => {
             let partition = partition.as_deref().map(vista_golden::selection::parse_partition).transpose()?;
             let selection = vista_check::Pick { glob: case, changed, failed, partition };
-            let pick = check::Pick { selection, allow_orphans, jobs: jobs as usize };
+            let pick = check::Pick { selection, allow_orphans, jobs: jobs as usize, coverage };
             let viewers = if full_report { vista_report::Detail::All } else { vista_report::Detail::Failing };
             check::check(project, config, &pick, report_dir, vista_check::Results { junit, json }, viewers)
         }

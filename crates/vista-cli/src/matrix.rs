@@ -43,8 +43,14 @@ pub fn matrix(
         };
         let gpu = Renderer::with_shaders(&ctx, shaders.clone(), config.limits, project.root().map(Into::into));
         let dir = report_dir.join(b);
-        let checker =
-            Checker { ctx: &gpu, store: &store, manifest: &manifest, report_dir: &dir, detail: Default::default() };
+        let checker = Checker {
+            ctx: &gpu,
+            store: &store,
+            manifest: &manifest,
+            report_dir: &dir,
+            detail: Default::default(),
+            coverage: false,
+        };
         let summary = vista_report::RunSummary {
             command: crate::check::command_line(),
             backend: b.to_string(),

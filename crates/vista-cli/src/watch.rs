@@ -111,6 +111,7 @@ pub fn watch(
             manifest: &manifest,
             report_dir: &report_dir,
             detail: Default::default(),
+            coverage: false,
         };
         let summary = vista_report::RunSummary {
             command: "vista watch".into(),

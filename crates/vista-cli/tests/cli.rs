@@ -6436,6 +6436,180 @@ fn wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends() {
     assert!(one.stdout.contains("1 passed, 0 failed"), "{}", one.stdout);
 }
 
+/// A kernel with known paths, one statement per line (`shaders/paths.wgsl`,
+/// importing `shaders/lib/tone.wgsl` through naga_oil).
+const PATHS_WGSL: &str = "// paths: every line runs a number of times worked out by hand.
+#import paths::tone::tone
+
+struct Params {
+    width: u32,
+    height: u32,
+    mode: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var output: texture_storage_2d<rgba32float, write>;
+
+fn never_called(x: f32) -> f32 {
+    return x * 3.0;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    var v = 0.0;
+    if params.mode == 1u {
+        v = 0.5;
+    }
+    var i = 0u;
+    loop {
+        if i >= 4u {
+            break;
+        }
+        if id.x == i {
+            break;
+        }
+        v += 0.125;
+        i += 1u;
+    }
+    let c = select(0.25, 0.75, id.y < 2u);
+    textureStore(output, id.xy, vec4(tone(v), c, 0.0, 1.0));
+}
+";
+
+const TONE_WGSL: &str = "#define_import_path paths::tone
+
+fn tone(v: f32) -> f32 {
+    if v > 0.5 {
+        return 1.0;
+    }
+    return v;
+}
+";
+
+/// Each file's branch arms of an lcov.info as `line,column,arm,hits`.
+fn lcov_arms(text: &str) -> std::collections::BTreeMap<String, Vec<String>> {
+    let mut out: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    let mut file = String::new();
+    for line in text.lines() {
+        if let Some(f) = line.strip_prefix("SF:") {
+            file = f.to_string();
+        } else if let Some(arm) = line.strip_prefix("BRDA:") {
+            out.entry(file.clone()).or_default().push(arm.to_string());
+        }
+    }
+    out
+}
+
+/// The hits per line of each file of an lcov.info.
+fn lcov_lines(text: &str) -> std::collections::BTreeMap<String, Vec<(u32, u64)>> {
+    let mut out: std::collections::BTreeMap<String, Vec<(u32, u64)>> = Default::default();
+    let mut file = String::new();
+    for line in text.lines() {
+        if let Some(f) = line.strip_prefix("SF:") {
+            file = f.to_string();
+        } else if let Some((l, h)) = line.strip_prefix("DA:").and_then(|r| r.split_once(',')) {
+            out.entry(file.clone()).or_default().push((l.parse().unwrap(), h.parse().unwrap()));
+        }
+    }
+    out
+}
+
+/// `check --coverage` counts each line of a kernel with known paths
+/// exactly (worked by hand for two cases of 8 x 4 texels in one 8 x 8
+/// workgroup: 32 invocations leave at the guard; the loop runs x + 1
+/// times for x < 4, else 5; `mode = 1` lifts v above 0.5 for x > 0), on
+/// lavapipe, SwiftShader and Chromium, through a naga_oil import; a
+/// function no entry calls is 0, never absent. Verdicts, goldens and the
+/// judged render's bits are those of the plain run.
+fn coverage_counts_each_line_exactly_on_three_backends() {
+    let cases = "[[case]]\nid = \"plain\"\nkernel = \"paths\"\nsize = \"8x4\"\n\n\
+                 [[case]]\nid = \"bright\"\nkernel = \"paths\"\nsize = \"8x4\"\nset = { mode = 1 }\n";
+    let d = golden_dir(cases);
+    let root = d.path();
+    std::fs::create_dir_all(root.join("shaders/lib")).unwrap();
+    std::fs::create_dir_all(root.join("kernels")).unwrap();
+    std::fs::write(root.join("shaders/paths.wgsl"), PATHS_WGSL).unwrap();
+    std::fs::write(root.join("shaders/lib/tone.wgsl"), TONE_WGSL).unwrap();
+    let manifest = "summary = \"known paths\"\n\n[[param]]\nname = \"mode\"\ntype = \"u32\"\nrange = [0, 1]\ndefault = 0\n\
+                    doc = \"1 adds 0.5\"\n";
+    std::fs::write(root.join("kernels/paths.toml"), manifest).unwrap();
+    let bless = vista_in(Some(root), &[], &["bless"]);
+    assert_eq!(bless.code, 0, "{}{}", bless.stdout, bless.stderr);
+    let goldens = |root: &Path| -> Vec<(PathBuf, Vec<u8>)> {
+        walk(&root.join("golden")).into_iter().map(|p| (p.clone(), std::fs::read(&p).unwrap())).collect()
+    };
+    let before = goldens(root);
+    let kernel: Vec<(u32, u64)> = vec![
+        (14, 0),
+        (19, 128),
+        (20, 64),
+        (23, 64),
+        (24, 32),
+        (27, 64),
+        (28, 240),
+        (29, 32),
+        (31, 208),
+        (32, 32),
+        (34, 176),
+        (35, 176),
+        (37, 64),
+        (38, 64),
+    ];
+    let tone: Vec<(u32, u64)> = vec![(4, 64), (5, 28), (7, 36)];
+    // Arms (line, column, arm): an if's accept 0, reject 1; naga makes
+    // `a || b` an if whose arm 0 evaluates b; a loop's body; the scalar
+    // select's true (y < 2: 16 texels a case) 0, false 1.
+    let arms: Vec<&str> = vec![
+        "19,5,0,64",
+        "19,5,1,64",
+        "19,8,0,128",
+        "19,8,1,0",
+        "23,5,0,32",
+        "23,5,1,32",
+        "27,5,0,240",
+        "28,9,0,32",
+        "28,9,1,208",
+        "31,9,0,32",
+        "31,9,1,176",
+        "37,13,0,32",
+        "37,13,1,32",
+    ];
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let dir = root.join(format!("report-{backend}"));
+        let r = vista_in(
+            Some(root),
+            &[("VISTA_BACKEND", backend)],
+            &["check", "--coverage", "--report-dir", dir.to_str().unwrap()],
+        );
+        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
+        let lcov = std::fs::read_to_string(dir.join("lcov.info")).expect("lcov.info");
+        let lines = lcov_lines(&lcov);
+        assert_eq!(lines.get("shaders/paths.wgsl"), Some(&kernel), "{backend}:\n{lcov}");
+        assert_eq!(lines.get("shaders/lib/tone.wgsl"), Some(&tone), "{backend}:\n{lcov}");
+        assert_eq!(lcov_arms(&lcov).get("shaders/paths.wgsl"), Some(&arms.iter().map(|a| a.to_string()).collect()));
+        assert_eq!(lcov_arms(&lcov)["shaders/lib/tone.wgsl"], ["4,5,0,28", "4,5,1,36"], "{backend}");
+        let summary = "coverage: 16 of 17 lines (94.1%), 14 of 15 branch arms (93.3%) in 2 files";
+        assert!(r.stdout.contains(summary), "{backend}: {}", r.stdout);
+        if backend == "lavapipe" {
+            // The judged render is the plain one, bit for bit.
+            for id in ["plain", "bright"] {
+                assert!(
+                    r.stdout.lines().any(|l| l.starts_with("ok") && l.contains(id) && l.contains("PSNR identical"))
+                );
+            }
+        }
+    }
+    assert_eq!(goldens(root), before, "a coverage run writes no golden");
+    // A plain check leaves no older run's lcov.info behind.
+    let dir = root.join("report-lavapipe");
+    let plain = vista_in(Some(root), &[], &["check", "--report-dir", dir.to_str().unwrap()]);
+    assert_eq!(plain.code, 0, "{}", plain.stdout);
+    assert!(!dir.join("lcov.info").exists() && !plain.stdout.contains("coverage:"), "{}", plain.stdout);
+}
+
 /// A `*.test.wesl` file in wgsl-test's spelling (`import wgsl_test::{..}`,
 /// `@test`, expect and expectNear: examples/sources' palette tests) runs
 /// unchanged on three backends, importing the WESL module it tests; a
@@ -6759,6 +6933,7 @@ fn main() {
     let tests: &[(Needs, &str, fn())] = tests![
         Cpu unknown_kernel_lists_valid_kernels,
         Gpu wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends,
+        Gpu coverage_counts_each_line_exactly_on_three_backends,
         Gpu wesl_unit_tests_in_wgsl_test_spelling_run_unchanged_on_three_backends,
         Gpu test_textures_and_samplers_are_generated_and_bound_on_three_backends,
         Gpu an_imported_wesl_global_is_bound_by_its_own_name,

@@ -91,6 +91,36 @@ impl Counts {
         (lf, lh, bf, bh)
     }
 
+    /// Counts read back from an LCOV tracefile this crate wrote (a case's,
+    /// a shard's): `SF`, `DA` and `BRDA` lines; an arm whose statement
+    /// never ran (`-`) counts 0. Other records are skipped.
+    pub fn from_lcov(text: &str) -> Counts {
+        let mut counts = Counts::default();
+        let mut file = String::new();
+        for line in text.lines() {
+            let numbers = |rest: &str| -> Vec<u64> { rest.split(',').map(|n| n.parse().unwrap_or(0)).collect() };
+            if let Some(f) = line.strip_prefix("SF:") {
+                file = f.to_string();
+                counts.lines.entry(file.clone()).or_default();
+            } else if let Some(rest) = line.strip_prefix("DA:") {
+                if let [l, hits, ..] = numbers(rest)[..] {
+                    *counts.lines.entry(file.clone()).or_default().entry(l as u32).or_default() += hits;
+                }
+            } else if let Some(rest) = line.strip_prefix("BRDA:")
+                && let [l, col, arm, hits] = numbers(rest)[..]
+            {
+                let key = (l as u32, col as u32, arm as u32);
+                *counts.arms.entry(file.clone()).or_default().entry(key).or_default() += hits;
+            }
+        }
+        counts
+    }
+
+    /// Whether nothing was measured.
+    pub fn is_empty(&self) -> bool {
+        self.lines.values().all(|l| l.is_empty())
+    }
+
     /// The LCOV tracefile (`lcov.info`): per file `SF`, `DA` per line,
     /// `BRDA` per arm (`-` where its statement's line never ran), the
     /// `BRF`/`BRH` and `LF`/`LH` totals, `end_of_record`.

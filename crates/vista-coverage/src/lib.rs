@@ -89,6 +89,11 @@ pub fn instrument(module: &Module, group: u32) -> Instrumented {
         Span::UNDEFINED,
     );
     let vertex = reached_from_vertex(&m);
+    // Expression types, to tell a scalar `select` (whose arms are counted)
+    // from a component-wise one; a module that does not validate gets none.
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(module)
+        .ok();
     let mut counters = Vec::new();
     let mut not_measured = Vec::new();
     let handles: Vec<Handle<Function>> = m.functions.iter().map(|(h, _)| h).collect();
@@ -98,17 +103,39 @@ pub fn instrument(module: &Module, group: u32) -> Instrumented {
             not_measured.push(name);
             continue;
         }
-        instrument_function(&mut m.functions[h], global, &name, &mut counters);
+        let scalar = scalar_selects(&m.functions[h], &m.types, info.as_ref().map(|i| &i[h]));
+        instrument_function(&mut m.functions[h], global, &name, &mut counters, &scalar);
     }
-    for ep in m.entry_points.iter_mut() {
+    for (i, ep) in m.entry_points.iter_mut().enumerate() {
         if ep.stage == ShaderStage::Vertex {
             not_measured.push(ep.name.clone());
             continue;
         }
         let name = ep.name.clone();
-        instrument_function(&mut ep.function, global, &name, &mut counters);
+        let scalar = scalar_selects(&ep.function, &m.types, info.as_ref().map(|info| info.get_entry_point(i)));
+        instrument_function(&mut ep.function, global, &name, &mut counters, &scalar);
     }
     Instrumented { module: m, counters, binding, not_measured }
+}
+
+/// The `select`s of `f` whose condition is a scalar bool: each picks one
+/// arm per invocation, so each arm is counted.
+fn scalar_selects(
+    f: &Function,
+    types: &naga::UniqueArena<Type>,
+    info: Option<&naga::valid::FunctionInfo>,
+) -> Vec<Handle<Expression>> {
+    let Some(info) = info else { return Vec::new() };
+    f.expressions
+        .iter()
+        .filter_map(|(h, e)| match e {
+            Expression::Select { condition, .. } => {
+                matches!(info[*condition].ty.inner_with(types), TypeInner::Scalar(s) if s.kind == naga::ScalarKind::Bool)
+                    .then_some(h)
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 /// The functions a vertex entry point calls, directly or not.
@@ -155,6 +182,8 @@ struct Adder<'a> {
     one: Handle<Expression>,
     function: &'a str,
     counters: &'a mut Vec<Counter>,
+    /// Scalar `select`s, whose arms get counters where they are emitted.
+    selects: &'a [Handle<Expression>],
 }
 
 impl Adder<'_> {
@@ -219,7 +248,24 @@ impl Adder<'_> {
                 s @ (Statement::Return { .. } | Statement::Break | Statement::Continue | Statement::Kill) => (s, true),
                 s => (s, false),
             };
+            let emitted = match &statement {
+                Statement::Emit(range) => range.clone().filter(|h| self.selects.contains(h)).collect(),
+                _ => Vec::new(),
+            };
             out.push(statement, span);
+            // A select's arms: an `if` on its condition, right after the
+            // emit that evaluates it (its condition is evaluated by then).
+            for h in emitted {
+                let Expression::Select { condition, .. } = self.expressions[h] else { continue };
+                let at = self.expressions.get_span(h);
+                let arm = |adder: &mut Self, branch| {
+                    let mut b = Block::new();
+                    adder.counter(Some(Arm { at, branch })).1.into_iter().for_each(|(s, sp)| b.push(s, sp));
+                    b
+                };
+                let (accept, reject) = (arm(self, 0), arm(self, 1));
+                out.push(Statement::If { condition, accept, reject }, Span::UNDEFINED);
+            }
             if ends {
                 open = None;
             }
@@ -233,11 +279,12 @@ fn instrument_function(
     global: Handle<naga::GlobalVariable>,
     name: &str,
     counters: &mut Vec<Counter>,
+    selects: &[Handle<Expression>],
 ) {
     let global = f.expressions.append(Expression::GlobalVariable(global), Span::UNDEFINED);
     let one = f.expressions.append(Expression::Literal(Literal::U32(1)), Span::UNDEFINED);
     let body = std::mem::take(&mut f.body);
-    let mut adder = Adder { expressions: &mut f.expressions, global, one, function: name, counters };
+    let mut adder = Adder { expressions: &mut f.expressions, global, one, function: name, counters, selects };
     // The body starts a segment even if empty: a call of the function counts.
     f.body = adder.block(body, None, true);
 }

@@ -111,3 +111,24 @@ fn counts_sum_runs_and_write_lcov() {
     twice.merge(&counts);
     assert_eq!(twice.lines("k.wgsl")[1].1, 8);
 }
+
+/// LCOV read back is the counts written: what sums cases and shards.
+#[test]
+fn lcov_reads_back_as_the_counts_it_was_written_from() {
+    let module = parse(KERNEL);
+    let inst = instrument(&module, 1);
+    let place = line_of(KERNEL);
+    let values: Vec<u32> = (0..inst.counters.len() as u32).collect();
+    let mut counts = Counts::default();
+    counts.add(&inst.counters, &values, &place);
+    assert_eq!(Counts::from_lcov(&counts.lcov("a")), counts);
+    let mut none = Counts::default();
+    none.add(&inst.counters, &vec![0; inst.counters.len()], &place);
+    assert_eq!(Counts::from_lcov(&none.lcov("a")), none, "`-` arms read as 0");
+    let mut sum = Counts::from_lcov(&counts.lcov("a"));
+    sum.merge(&Counts::from_lcov(&counts.lcov("b")));
+    let mut twice = counts.clone();
+    twice.merge(&counts);
+    assert_eq!(sum, twice);
+    assert!(Counts::default().is_empty() && !counts.is_empty());
+}

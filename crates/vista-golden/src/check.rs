@@ -120,6 +120,10 @@ pub struct Outcome {
     /// The golden judged against, relative to `golden/`
     /// (`<kernel>/<case>.png`, or a per-backend `<kernel>/<case>@<backend>.png`).
     pub golden_file: String,
+    /// A coverage run's hits of this case (`check --coverage`) as LCOV,
+    /// or why it was not measured; none without coverage.
+    #[serde(default)]
+    pub coverage: Option<Result<String, String>>,
 }
 
 impl Outcome {
@@ -310,6 +314,7 @@ pub fn judge(case: &Case, entry: Option<&ManifestEntry>, run: RunInfo, observed:
         outputs: Vec::new(),
         golden_file: case.golden_rel_path(),
         ignore: case.ignore.clone(),
+        coverage: None,
     };
     match observed {
         Err(e) => {

@@ -10,6 +10,7 @@
 
 mod browser_run;
 mod context;
+mod coverage;
 mod format;
 mod fullscreen;
 mod graph;
@@ -26,6 +27,7 @@ pub use context::{
     AdapterChoice, AdapterSettings, BACKENDS, Context, DEFAULT_TIMEOUT, DeviceFacts, GpuConfig, PassHook, RunStats,
     SWIFTSHADER_HINT, VALIDATION_LAYER_JSON,
 };
+pub use coverage::Coverage;
 pub use fullscreen::{FULLSCREEN_ENTRY, FULLSCREEN_WGSL};
 pub use graph::{
     Address, Bind, BufferUse, COMPARE_NAMES, Contents, Depth, Graph, GraphPass, GraphSlot, OutputData, Raster,

@@ -11,6 +11,7 @@ use std::sync::{Arc, Mutex};
 use naga_oil::compose::{ComposableModuleDescriptor, Composer, ComposerError, NagaModuleDescriptor, ShaderLanguage};
 
 use crate::GpuError;
+use crate::coverage::{Coverage, Origins};
 
 /// The set of WGSL sources a project has: library modules (`lib/...`,
 /// each declaring `#define_import_path vista::NAME`) and kernel files.
@@ -46,6 +47,12 @@ pub struct ShaderSet {
     reader: Reader,
     /// Assembled kernel sources by name without defs, built once per set.
     units: Arc<Mutex<HashMap<String, Arc<Unit>>>>,
+    /// Kernels compose instrumented for coverage ([`ShaderSet::covered`]).
+    coverage: bool,
+    /// Each instrumented kernel's counters, by name.
+    covers: Arc<Mutex<HashMap<String, Arc<Coverage>>>>,
+    /// This set's [`ShaderSet::covered`] twin, made once and shared by clones.
+    twin: Arc<std::sync::OnceLock<ShaderSet>>,
 }
 
 /// A root-relative path's text and origin, for files an assembly reaches
@@ -176,7 +183,43 @@ impl ShaderSet {
             sources: BTreeMap::new(),
             reader: Reader::default(),
             units: Default::default(),
+            coverage: false,
+            covers: Default::default(),
+            twin: Default::default(),
         }
+    }
+
+    /// This set composing every kernel with coverage counters (SPEC 20):
+    /// for a coverage run only, never a judged one. Its source hashes
+    /// differ from this set's, so no cache mistakes one module for the other.
+    pub fn covered(&self) -> ShaderSet {
+        if self.coverage {
+            return self.clone();
+        }
+        let make = || ShaderSet {
+            coverage: true,
+            composed: Default::default(),
+            covers: Default::default(),
+            twin: Default::default(),
+            ..self.clone()
+        };
+        self.twin.get_or_init(make).clone()
+    }
+
+    /// Whether this set composes kernels for coverage.
+    pub fn is_covered(&self) -> bool {
+        self.coverage
+    }
+
+    /// The counters of kernel `name` as this [`ShaderSet::covered`] set
+    /// composes it (composed now if not yet).
+    pub fn coverage(&self, name: &str) -> Result<Arc<Coverage>, GpuError> {
+        if !self.coverage {
+            return Err(GpuError::Request(format!("{name}: this shader set does not compose for coverage")));
+        }
+        self.compose(name)?;
+        let covers = self.covers.lock().expect("coverage cache");
+        covers.get(name).cloned().ok_or_else(|| GpuError::Shader(format!("{name}: no coverage counters")))
     }
 
     /// This set with the manifests' `[source]` assemblies (`(id, spec)`,
@@ -191,6 +234,7 @@ impl ShaderSet {
         self.sources.extend(specs);
         self.reader = reader;
         self.composed = Default::default();
+        self.twin = Default::default();
         self.units = Default::default();
         self
     }
@@ -219,6 +263,7 @@ impl ShaderSet {
             }
         }
         self.composed = Default::default();
+        self.twin = Default::default();
         self.composers = Default::default();
         self
     }
@@ -539,10 +584,29 @@ impl ShaderSet {
             (GpuError::Shader(m), Some(a)) => GpuError::Shader(locate(&m, &unit.source.origin, a)),
             (e, _) => e,
         };
-        self.compose_unit(name, &unit.source).map_err(located)
+        let (module, origins) = self.compose_unit(name, &unit.source).map_err(located)?;
+        let Some(origins) = origins else { return Ok(module) };
+        let origins = match (origins, &unit.assembled) {
+            (Origins::Direct { text, file, .. }, Some(a)) if a.traced() => {
+                Origins::Direct { text, file, assembled: Some(a.clone()) }
+            }
+            (o, _) => o,
+        };
+        let (module, coverage) = crate::coverage::instrument(&module, &origins);
+        validate(name, &module)?;
+        self.covers.lock().expect("coverage cache").insert(name.to_string(), Arc::new(coverage));
+        Ok(module)
     }
 
-    fn compose_unit(&self, name: &str, kernel: &Source) -> Result<naga::Module, GpuError> {
+    /// The file a coverage report names for a source: its path under the
+    /// project (`shaders/...`); none for a generated module.
+    fn report_path(source: &Source) -> Option<String> {
+        (!source.origin.starts_with("<generated>")).then(|| format!("shaders/{}", source.rel))
+    }
+
+    /// The module of `name`, and where its spans point when this set
+    /// composes for coverage.
+    fn compose_unit(&self, name: &str, kernel: &Source) -> Result<(naga::Module, Option<Origins>), GpuError> {
         let (source, origin) = (&kernel.text, &kernel.origin);
         // Expressions deeper or longer than the parsers' stacks take are
         // refused before any parser sees them.
@@ -560,7 +624,13 @@ impl ShaderSet {
                 ))
             })?;
             validate(name, &module)?;
-            return Ok(module);
+            // A compiler's output (WESL) is not traced to its files: not measured.
+            let origins = self.coverage.then(|| Origins::Direct {
+                text: source.clone(),
+                file: ShaderSet::report_path(kernel).unwrap_or_default(),
+                assembled: None,
+            });
+            return Ok((module, origins));
         }
         // The manifest's constants must agree with the library's even where
         // the kernel passes the index through without naming it.
@@ -583,11 +653,33 @@ impl ShaderSet {
                 ..Default::default()
             })
             .map_err(|e| GpuError::Shader(describe(&pooled.composer, &self.label, &e)))?;
+        // Span module indices are this composer's own: read them now.
+        let origins = self.coverage.then(|| self.composed_origins(&pooled.composer, name, kernel, &lib));
         // Back to the pool only after a clean composition: a failed one
         // drops its composer rather than leave a half-built state behind.
         self.composers.lock().expect("composer pool").push(pooled);
         validate(name, &module)?;
-        Ok(module)
+        Ok((module, origins))
+    }
+
+    /// Each module index of `composer` with its file and preprocessed
+    /// source as naga_oil parsed it (index 0: the kernel `name` itself).
+    fn composed_origins(&self, composer: &Composer, name: &str, kernel: &Source, lib: &[&Source]) -> Origins {
+        let defs = shader_defs(name);
+        let preprocessed = |text: &str| {
+            naga_oil::compose::preprocess::Preprocessor::default()
+                .preprocess(text, &defs)
+                .map(|o| o.preprocessed_source)
+                .unwrap_or_default()
+        };
+        let mut modules = HashMap::new();
+        modules.insert(0, (ShaderSet::report_path(kernel), preprocessed(&kernel.text)));
+        for (index, module) in &composer.module_index {
+            let Some(set) = composer.module_sets.get(module) else { continue };
+            let file = lib.iter().find(|s| s.module.as_deref() == Some(module)).and_then(|s| ShaderSet::report_path(s));
+            modules.insert(*index, (file, preprocessed(&set.sanitized_source)));
+        }
+        Origins::Composed { modules }
     }
 
     /// The text naga parses for `name` when it parses it directly (a file
@@ -597,7 +689,8 @@ impl ShaderSet {
     /// composes (`#import`, `#ifdef`, ...): naga's IR is all there is.
     pub fn source_text(&self, name: &str) -> Result<Option<SourceText>, GpuError> {
         let unit = self.unit(name)?;
-        if has_directives(&unit.source.text) {
+        // A coverage run's module has counters the text lacks.
+        if has_directives(&unit.source.text) || self.coverage {
             return Ok(None);
         }
         Ok(Some(SourceText {
@@ -616,6 +709,9 @@ impl ShaderSet {
         let kernel = &unit.source;
         let mut h = blake3::Hasher::new();
         h.update(name.as_bytes());
+        if self.coverage {
+            h.update(b"instrumented for coverage");
+        }
         match unit.assembled.as_ref().filter(|a| !a.traced()) {
             // A compiler's output (WESL): the files it read, by path, not
             // its text, whose order of declarations is the compiler's own

@@ -11,12 +11,14 @@
 //! writes), or knowing any kernel's meaning (`vista-kernels`).
 #![deny(missing_docs)]
 
+mod coverage;
 mod error;
 pub mod graph;
 mod reflect;
 mod sources;
 pub mod worker;
 
+pub use coverage::{CaseCoverage, cover, cover_with};
 pub use error::{Crash, RenderError};
 pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput, check_case_defs};
 pub use sources::{Sources, edited_shader_set, enum_modules, shader_set, source_specs};
@@ -427,17 +429,7 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         passes: std::borrow::Cow::Borrowed(&plan.passes),
         outputs: std::borrow::Cow::Borrowed(&plan.output_ids),
     };
-    // Refused here, with the kernel's names, before a worker holds a copy
-    // of the graph.
-    gpu.ctx.require_graph(&graph, &plan.names)?;
-    let out = match &gpu.worker {
-        Some(w) => {
-            let source = worker::ShaderSource { root: gpu.root.clone(), edits: gpu.edits.clone() };
-            let case = CASE.with(|c| c.borrow().clone());
-            w.run(gpu.ctx, &graph, &source, &plan.kernel, case.as_deref())?
-        }
-        None => gpu.ctx.run(&graph)?,
-    };
+    let out = execute(gpu, &graph, plan)?;
     let outputs: Vec<OutputRender> = plan
         .outputs
         .iter()
@@ -471,6 +463,26 @@ pub fn run(gpu: &Renderer, plan: &Plan) -> Result<Rendered, RenderError> {
         pass_gpu_times: out.pass_gpu_times,
         to_display: display,
         display: OnceLock::new(),
+    })
+}
+
+/// Runs `graph` (`plan`'s, or its coverage twin) on the renderer's engine,
+/// in its worker process if it has one.
+fn execute(gpu: &Renderer, graph: &vista_gpu::Graph<'_>, plan: &Plan) -> Result<vista_gpu::Readback, RenderError> {
+    // Refused here, with the kernel's names, before a worker holds a copy
+    // of the graph.
+    gpu.ctx.require_graph(graph, &plan.names)?;
+    Ok(match &gpu.worker {
+        Some(w) => {
+            let source = worker::ShaderSource {
+                root: gpu.root.clone(),
+                edits: gpu.edits.clone(),
+                coverage: graph.shaders.is_covered(),
+            };
+            let case = CASE.with(|c| c.borrow().clone());
+            w.run(gpu.ctx, graph, &source, &plan.kernel, case.as_deref())?
+        }
+        None => gpu.ctx.run(graph)?,
     })
 }
 

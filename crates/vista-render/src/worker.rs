@@ -69,6 +69,9 @@ pub struct ShaderSource {
     /// Files replaced, each a path (as `Sources::with_file` takes it) and
     /// its text: a mutant, a unit test file's rewrite.
     pub edits: Vec<(String, String)>,
+    /// Kernels composed with coverage counters (a coverage run).
+    #[serde(default)]
+    pub coverage: bool,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -277,7 +280,8 @@ fn serve() -> std::io::Result<()> {
     };
     let facts = ctx.facts().expect("a worker's device is a wgpu one");
     send(&mut *out.lock().expect("stdout"), &FromWorker::Ready(Box::new(facts)), &[])?;
-    let mut sets: Option<(ShaderSource, vista_gpu::ShaderSet)> = None;
+    // The last two sets: a coverage run alternates judged and counted renders.
+    let mut sets: Vec<(ShaderSource, vista_gpu::ShaderSet)> = Vec::new();
     let mut sources: Option<(Option<PathBuf>, crate::Sources)> = None;
     loop {
         let request = match receive::<ToWorker<'static>>(&mut input) {
@@ -292,7 +296,7 @@ fn serve() -> std::io::Result<()> {
         let same = |set: &vista_gpu::ShaderSet| {
             passes.iter().zip(&hashes).all(|(p, h)| set.source_hash(&p.shader).is_ok_and(|mine| mine == *h))
         };
-        let kept = sets.as_ref().filter(|(s, set)| *s == *source && same(set)).map(|(_, set)| set.clone());
+        let kept = sets.iter().find(|(s, set)| *s == *source && same(set)).map(|(_, set)| set.clone());
         let shaders = match kept {
             Some(set) => set,
             None => {
@@ -310,7 +314,8 @@ fn serve() -> std::io::Result<()> {
                 });
                 match built {
                     Ok(set) => {
-                        sets = Some((source.clone().into_owned(), set.clone()));
+                        sets.retain(|(s, _)| s.coverage != source.coverage);
+                        sets.push((source.clone().into_owned(), set.clone()));
                         set
                     }
                     Err(err) => {
@@ -397,10 +402,11 @@ fn shader_set(
         *cache = Some((source.root.clone(), crate::Sources::of(&project)?));
     }
     let sources = &cache.as_ref().expect("just filled").1;
-    Ok(match source.edits.is_empty() {
+    let set = match source.edits.is_empty() {
         true => sources.shader_set(),
         false => sources.with_files("edited", &source.edits),
-    })
+    };
+    Ok(if source.coverage { set.covered() } else { set })
 }
 
 enum Heard {

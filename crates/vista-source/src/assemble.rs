@@ -45,6 +45,14 @@ impl Assembled {
         let (part, at) = *self.lines.get(line.checked_sub(1)?)?;
         Some((self.parts[part].origin.as_str(), at))
     }
+
+    /// The file (its path relative to the project root) and 1-based line
+    /// that line `line` of the assembled text came from: what a coverage
+    /// report names.
+    pub fn locate_path(&self, line: usize) -> Option<(&str, usize)> {
+        let (part, at) = *self.lines.get(line.checked_sub(1)?)?;
+        Some((self.parts[part].path.as_str(), at))
+    }
 }
 
 struct State<'a> {
