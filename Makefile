@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves seed-study bench fuzz mutants scaling device-figures lavapipe swiftshader validation browser build
+.PHONY: demo test golden curves seed-study bench fuzz mutants scaling device-figures lavapipe swiftshader validation browser lcov build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -18,6 +18,10 @@ validation: lavapipe
 
 browser:
 	bash ci/install-browser.sh
+
+# genhtml, which a test runs on the lcov.info of check --coverage.
+lcov:
+	bash ci/install-lcov.sh
 
 build:
 	$(CARGO) build -p vista-cli
@@ -32,7 +36,7 @@ demo: lavapipe build
 # under the validation layer; every golden case again on SwiftShader and in
 # headless Chromium's WebGPU; then a closing count, and proof that without
 # an adapter the GPU tests are reported skipped, never ok.
-test: lavapipe swiftshader validation browser
+test: lavapipe swiftshader validation browser lcov
 	mkdir -p target
 	# The workspace's test binaries, two at a time, its golden harness on
 	# lavapipe under the Khronos validation layer (any message fails the

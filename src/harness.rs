@@ -274,7 +274,11 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
             ..Default::default()
         };
         let root = project.root().expect("a store has a root");
-        let results = vista_check::Results { junit: config.junit.as_ref().map(|j| root.join(j)), json: None };
+        let results = vista_check::Results {
+            junit: config.junit.as_ref().map(|j| root.join(j)),
+            json: None,
+            sources: ctx.shaders.text_reader(),
+        };
         let suite: Vec<String> = cases.iter().map(|c| c.id.clone()).collect();
         let checker = checker(ctx, &store, &manifest, &report_dir, config.coverage);
         let run = vista_check::Run { checker, summary: run, results, shared: shared.map(|s| (s, suite)) };

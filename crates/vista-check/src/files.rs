@@ -17,6 +17,9 @@ pub struct Results {
     pub junit: Option<PathBuf>,
     /// A copy of `results.json`.
     pub json: Option<PathBuf>,
+    /// The project's WGSL files by project-relative path, for the coverage
+    /// pages (none: the pages list counts without the text).
+    pub sources: vista_render::Reader,
 }
 
 /// What a run leaves: the report (`index.html`, whose path is returned),
@@ -46,6 +49,29 @@ pub(crate) fn write_run(
 ) -> Result<PathBuf, GoldenError> {
     let mut run = run.clone();
     run.pending = pending.keys().cloned().collect();
+    // A coverage run's pages and lcov.info (every case's hits summed); a
+    // run without coverage leaves no older run's to be read as its own.
+    let total = coverage_total(outcomes);
+    run.coverage = total.as_ref().map(vista_report::coverage_line);
+    let lcov = report_dir.join(LCOV_FILE);
+    let pages = report_dir.join(vista_report::COVERAGE_DIR);
+    let io =
+        |path: &Path, e: std::io::Error| GoldenError::Io { path: path.display().to_string(), message: e.to_string() };
+    match &total {
+        Some(counts) => {
+            vista_report::write_coverage(report_dir, counts, &|file| results.sources.read(file).map(|(text, _)| text))?;
+            vista_image::atomic_write(&lcov, counts.lcov("vista").as_bytes())?;
+        }
+        None => {
+            if lcov.is_file() {
+                std::fs::remove_file(&lcov).map_err(|e| io(&lcov, e))?;
+            }
+            // The folder itself, never through a link (remove_dir_all does not follow one).
+            if std::fs::symlink_metadata(&pages).is_ok_and(|m| m.is_dir()) {
+                std::fs::remove_dir_all(&pages).map_err(|e| io(&pages, e))?;
+            }
+        }
+    }
     if run.accept_from.is_empty() {
         run.accept_from = report_dir.display().to_string();
     }
@@ -66,15 +92,6 @@ pub(crate) fn write_run(
         crate::kept::remove_records(report_dir)?;
     }
     vista_golden::pending::write_pending(report_dir, pending)?;
-    // A coverage run's hits, every case's summed; a run without coverage
-    // leaves no older run's file to be read as its own.
-    let lcov = report_dir.join(LCOV_FILE);
-    match coverage_total(outcomes) {
-        Some(counts) => vista_image::atomic_write(&lcov, counts.lcov("vista").as_bytes())?,
-        None if lcov.is_file() => std::fs::remove_file(&lcov)
-            .map_err(|e| GoldenError::Io { path: lcov.display().to_string(), message: e.to_string() })?,
-        None => {}
-    }
     let json_text = vista_report::json_text(&run, outcomes);
     vista_image::atomic_write(&report_dir.join("results.json"), json_text.as_bytes())?;
     if let Some(p) = &results.junit {

@@ -165,6 +165,7 @@ pub fn check(
         partition: pick.selection.partition,
         ..Default::default()
     };
+    let results = Results { sources: ctx.shaders.text_reader(), ..results };
     let mut run = Run { checker, summary, results, shared: None };
     let filed = run.check(&picked, pick.jobs, &mut Terminal { report_dir: &report_dir, time: Some(&mut time) });
     let report_failed = filed.iter().any(|f| !f.report_errors.is_empty());

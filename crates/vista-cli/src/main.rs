@@ -322,7 +322,18 @@ fn main() -> ExitCode {
     }
     // merge joins report folders: it needs no project either.
     if let Command::Merge { dirs, report_dir, junit, json } = &cli.command {
-        return check::merge(dirs, report_dir, vista_check::Results { junit: junit.clone(), json: json.clone() });
+        // The project's WGSL, where the current directory has one, for the coverage pages.
+        let sources = std::env::current_dir()
+            .ok()
+            .and_then(|cwd| Project::discover(cli.root.as_deref(), config.root.clone(), &cwd).ok())
+            .and_then(|p| vista_render::shader_set(&p).ok())
+            .map(|s| s.text_reader())
+            .unwrap_or_default();
+        return check::merge(
+            dirs,
+            report_dir,
+            vista_check::Results { junit: junit.clone(), json: json.clone(), sources },
+        );
     }
     let project = match std::env::current_dir()
         .map_err(|e| GoldenError::BadInput(format!("cannot read the current directory: {e}")))
@@ -422,7 +433,8 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             let selection = vista_check::Pick { glob: case, changed, failed, partition };
             let pick = check::Pick { selection, allow_orphans, jobs: jobs as usize, coverage };
             let viewers = if full_report { vista_report::Detail::All } else { vista_report::Detail::Failing };
-            check::check(project, config, &pick, report_dir, vista_check::Results { junit, json }, viewers)
+            let results = vista_check::Results { junit, json, ..Default::default() };
+            check::check(project, config, &pick, report_dir, results, viewers)
         }
         Command::Bless { case, force, from_report: Some(dir), .. } => {
             bless::from_report(project, config, case, force, &dir)

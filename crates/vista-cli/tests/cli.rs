@@ -6600,9 +6600,53 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
                     r.stdout.lines().any(|l| l.starts_with("ok") && l.contains(id) && l.contains("PSNR identical"))
                 );
             }
+            // Debian's genhtml accepts the tracefile, reading the sources it names.
+            let html = root.join("html");
+            let genhtml = std::process::Command::new("genhtml")
+                .current_dir(root)
+                .args(["--branch-coverage", "-o", html.to_str().unwrap(), dir.join("lcov.info").to_str().unwrap()])
+                .output()
+                .unwrap_or_else(|e| panic!("genhtml: {e}; install it with `bash ci/install-lcov.sh` (Debian's lcov)"));
+            let said = String::from_utf8_lossy(&genhtml.stdout);
+            assert!(genhtml.status.success(), "{said}{}", String::from_utf8_lossy(&genhtml.stderr));
+            assert!(said.contains("lines......: 94.1% (16 of 17 lines)"), "{said}");
+            assert!(said.contains("branches...: 93.3% (14 of 15 branches)"), "{said}");
+            assert!(html.join("shaders/paths.wgsl.gcov.html").is_file(), "{said}");
+            // The report: a summary line, each case linked to its files'
+            // pages, each page every line's hits with the unrun one marked.
+            let index = std::fs::read_to_string(dir.join("index.html")).unwrap();
+            assert!(index.contains("WGSL coverage: <a href=\"coverage/index.html\">16 of 17 lines (94.1%)"), "{index}");
+            // plain never sets v = 0.5 (24) nor returns 1.0 from tone (5).
+            assert!(index.contains("coverage of this case: 14 of 17 lines"), "{index}");
+            assert!(index.contains("<a href=\"coverage/shaders_paths.wgsl.html\">shaders/paths.wgsl</a>"), "{index}");
+            let page = std::fs::read_to_string(dir.join("coverage/shaders_paths.wgsl.html")).unwrap();
+            assert!(page.contains("<tr class=\"miss\"><td class=\"n\">14</td><td class=\"hits\">0</td>"), "{page}");
+            assert!(
+                page.contains("<td class=\"n\">28</td><td class=\"hits\">240</td><td><code>        if i &gt;= 4u {")
+            );
+            assert!(page.contains("3 of 4 arms taken; never: col 8 arm 1"), "{page}");
+            let pages = std::fs::read_to_string(dir.join("coverage/index.html")).unwrap();
+            assert!(pages.contains("shaders/lib/tone.wgsl</a></td><td>3 / 3</td>"), "{pages}");
         }
     }
     assert_eq!(goldens(root), before, "a coverage run writes no golden");
+    // Shards' hits sum to the whole run's: one case each, merged.
+    let p = |name: &str| root.join(name).to_str().unwrap().to_string();
+    for k in 1..=2 {
+        let shard = format!("{k}/2");
+        let r = vista_in(
+            Some(root),
+            &[],
+            &["check", "--coverage", "--partition", &shard, "--report-dir", &p(&format!("s{k}"))],
+        );
+        assert_eq!(r.code, 0, "{}", r.stdout);
+    }
+    let merged = vista_in(Some(root), &[], &["merge", &p("s1"), &p("s2"), "--report-dir", &p("merged")]);
+    assert_eq!(merged.code, 0, "{}{}", merged.stdout, merged.stderr);
+    let whole = std::fs::read_to_string(root.join("report-lavapipe/lcov.info")).unwrap();
+    assert_eq!(std::fs::read_to_string(root.join("merged/lcov.info")).unwrap(), whole);
+    let page = std::fs::read_to_string(root.join("merged/coverage/shaders_paths.wgsl.html")).unwrap();
+    assert!(page.contains("<code>        if i &gt;= 4u {"), "the merged pages show the text: {page}");
     // A plain check leaves no older run's lcov.info behind.
     let dir = root.join("report-lavapipe");
     let plain = vista_in(Some(root), &[], &["check", "--report-dir", dir.to_str().unwrap()]);

@@ -369,6 +369,13 @@ impl ShaderSet {
         Ok(unit)
     }
 
+    /// A reader of the files this set reads (`shaders/...` its own, others
+    /// through its reader): what a coverage page shows of a file.
+    pub fn text_reader(&self) -> Reader {
+        let set = self.clone();
+        Reader::new(move |path| set.read(path))
+    }
+
     /// A root-relative path's text and origin: this set's own file (an
     /// edited one, under mutation) for `shaders/...`, else the reader's.
     fn read(&self, path: &str) -> Option<(String, String)> {

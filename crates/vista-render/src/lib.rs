@@ -26,7 +26,7 @@ use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use vista_gpu::Context;
-pub use vista_gpu::{RunStats, ShaderSet, is_unit_test_file};
+pub use vista_gpu::{Reader, RunStats, ShaderSet, is_unit_test_file};
 use vista_image::Image;
 use vista_manifest::{DisplayMap, Kernel, ParamSet};
 

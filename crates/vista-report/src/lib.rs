@@ -7,11 +7,13 @@
 //! (`vista-golden`), then hand the outcomes and images here.
 #![deny(missing_docs)]
 
+mod coverage;
 mod matrix;
 mod mutation;
 mod report;
 mod results;
 
+pub use coverage::{COVERAGE_DIR, coverage_line, coverage_page, write_coverage};
 pub use matrix::{MatrixColumn, cell as matrix_cell, matrix_json, matrix_page, matrix_reason};
 pub use mutation::mutation_page;
 pub use report::{

@@ -444,6 +444,9 @@ pub struct RunSummary {
     /// `vista merge` joins).
     #[serde(default)]
     pub partition: Option<(u64, u64)>,
+    /// A coverage run's summary line (every case's hits summed), if the
+    /// run measured coverage.
+    pub coverage: Option<String>,
     /// Why the run stopped before its last case (an interrupt), if it did:
     /// the report then holds the cases that finished.
     #[serde(default)]
@@ -725,6 +728,28 @@ fn is_plainly_identical(o: &Outcome) -> bool {
 /// provenance only what differs from this run. The command for the case's
 /// viewer is added by report.js when the row opens (its `plain` class):
 /// written into each row it was a sixth of a long suite's report.
+/// What a case's coverage run reached, each file linked to its page; or
+/// why it was not measured.
+fn case_coverage(o: &Outcome) -> String {
+    match &o.coverage {
+        None => String::new(),
+        Some(Err(why)) => format!("<p class=\"note\">coverage not measured: {}</p>", html_escape(why)),
+        Some(Ok(lcov)) => {
+            let counts = vista_coverage::Counts::from_lcov(lcov);
+            let files: Vec<String> = counts
+                .files()
+                .iter()
+                .map(|f| format!("<a href=\"{}\">{}</a>", html_escape(&crate::coverage_page(f)), html_escape(f)))
+                .collect();
+            format!(
+                "<p class=\"coverage\">coverage of this case: {}: {}</p>",
+                html_escape(&crate::coverage_line(&counts)),
+                files.join(", ")
+            )
+        }
+    }
+}
+
 fn identical_body(o: &Outcome) -> String {
     let (prov, differs) = provenance(o);
     format!(
@@ -770,6 +795,7 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
         None => String::new(),
     };
     let plain = is_plainly_identical(o);
+    let coverage = case_coverage(o);
     let body = match plain {
         true => identical_body(o),
         false => format!(
@@ -793,7 +819,7 @@ fn case_section(o: &Outcome, run: &RunSummary) -> String {
         "<details class=\"case {cls}\" id=\"{anchor}\"{open}>\
          <summary><span class=\"verdict\">{verdict}</span> <b class=\"id\">{id}</b> <span class=\"kernel\">{kernel}</span> \
          <span class=\"psnr\">PSNR {psnr}</span> <span class=\"ms\">{gpu:.1} ms</span> \
-         <span class=\"thumbs\">{thumbs}</span></summary><div class=\"body\">{body}</div></details>\n",
+         <span class=\"thumbs\">{thumbs}</span></summary><div class=\"body\">{body}{coverage}</div></details>\n",
         cls = match (failing, plain) {
             (true, _) => "fail",
             (false, true) => "pass plain",
@@ -918,7 +944,7 @@ pub fn write_index(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result
     let body = format!(
         "<header><h1>vista report</h1>\
          <p class=\"counts\"><b>{n}</b> cases: <b class=\"{fcls}\">{nfail} failing</b>, {passed} passed, {xfail} expected failures.</p>\
-         <p>Backend <b>{backend}</b>, adapter <code>{adapter}</code>. Command: <code class=\"cmd\">{command}</code>. Written {date}.{others}</p>{stopped}\
+         <p>Backend <b>{backend}</b>, adapter <code>{adapter}</code>. Command: <code class=\"cmd\">{command}</code>. Written {date}.{others}</p>{coverage}{stopped}\
          </header>\n<section id=\"summary\"><h2>Failures, worst first</h2>{summary}{expectations}</section>\n{units}\
          <section id=\"controls\"><label><input type=\"checkbox\" id=\"failures-only\"{checked}> failures only</label> \
          <label>heat map scale <select id=\"heat-scale\"><option value=\"log\">log, fixed: 1/65535 .. 1 (same in every case)</option>\
@@ -930,6 +956,10 @@ pub fn write_index(dir: &Path, run: &RunSummary, outcomes: &[Outcome]) -> Result
         n = sorted.len(),
         stopped =
             run.stopped.as_ref().map_or(String::new(), |s| format!("<p class=\"bad\"><b>{}</b></p>", html_escape(s))),
+        coverage = run.coverage.as_ref().map_or(String::new(), |c| format!(
+            "<p class=\"counts\">WGSL coverage: <a href=\"coverage/index.html\">{}</a></p>",
+            html_escape(c)
+        )),
         nfail = failing.len(),
         fcls = if failing.is_empty() { "ok" } else { "bad" },
         backend = html_escape(&run.backend),
