@@ -6654,6 +6654,79 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
     assert!(!dir.join("lcov.info").exists() && !plain.stdout.contains("coverage:"), "{}", plain.stdout);
 }
 
+/// `check --coverage` of render passes: a full-screen fragment pass and a
+/// draw of one triangle covering an 8 x 4 target, each fragment's branch
+/// split by hand (wash: rows 0-1 of 4; fs: the 4 right columns, where the
+/// interpolated x > 0); the vertex entry and the function only it calls
+/// are not measured (absent from lcov.info), never 0. Three backends.
+fn coverage_counts_fragment_passes_and_draws_and_not_vertex_code() {
+    let shader = "// tri: a full-screen pass and a draw whose fragments split at x = 0.
+struct VOut {
+    @builtin(position) pos: vec4f,
+    @location(0) shade: f32,
+}
+
+fn lift(p: vec2f) -> vec4f {
+    return vec4f(p, 0.0, 1.0);
+}
+
+@vertex
+fn vs(@location(0) p: vec2f) -> VOut {
+    return VOut(lift(p), p.x);
+}
+
+fn shade_of(x: f32) -> f32 {
+    if x > 0.0 {
+        return 1.0;
+    }
+    return 0.25;
+}
+
+@fragment
+fn fs(v: VOut) -> @location(0) vec4f {
+    return vec4f(shade_of(v.shade), 0.0, 0.0, 1.0);
+}
+
+@fragment
+fn wash(@builtin(position) at: vec4f) -> @location(0) vec4f {
+    if at.y < 2.0 {
+        return vec4f(0.0, 1.0, 0.0, 1.0);
+    }
+    return vec4f(0.0, 0.0, 1.0, 1.0);
+}
+";
+    let manifest = "summary = \"a full-screen pass and a draw\"\n\
+                    [[resource]]\nname = \"washed\"\nkind = \"texture\"\nformat = \"rgba8unorm\"\n\
+                    [[resource]]\nname = \"img\"\nkind = \"texture\"\nformat = \"rgba8unorm\"\n\
+                    [[resource]]\nname = \"tri\"\nkind = \"buffer\"\ndata = [-1.0, -1.0, 3.0, -1.0, -1.0, 3.0]\n\
+                    [[pass]]\nkind = \"render\"\nfragment = \"wash\"\ntargets = [{ resource = \"washed\" }]\n\
+                    [[pass]]\nkind = \"render\"\nvertex = \"vs\"\nfragment = \"fs\"\nvertices = [\"tri\"]\n\
+                    targets = [{ resource = \"img\" }]\n\
+                    [[output]]\nresource = \"img\"\n[[output]]\nresource = \"washed\"\n";
+    let d = golden_dir("[[case]]\nid = \"tri\"\nkernel = \"tri\"\nsize = \"8x4\"\n");
+    let root = d.path();
+    std::fs::create_dir_all(root.join("shaders")).unwrap();
+    std::fs::create_dir_all(root.join("kernels")).unwrap();
+    std::fs::write(root.join("shaders/tri.wgsl"), shader).unwrap();
+    std::fs::write(root.join("kernels/tri.toml"), manifest).unwrap();
+    let bless = vista_in(Some(root), &[], &["bless"]);
+    assert_eq!(bless.code, 0, "{}{}", bless.stdout, bless.stderr);
+    let lines: Vec<(u32, u64)> = vec![(17, 32), (18, 16), (20, 16), (25, 32), (30, 32), (31, 16), (33, 16)];
+    for backend in ["lavapipe", "swiftshader", "browser"] {
+        let dir = root.join(format!("report-{backend}"));
+        let r = vista_in(
+            Some(root),
+            &[("VISTA_BACKEND", backend)],
+            &["check", "--coverage", "--report-dir", dir.to_str().unwrap()],
+        );
+        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
+        let lcov = std::fs::read_to_string(dir.join("lcov.info")).expect("lcov.info");
+        assert_eq!(lcov_lines(&lcov).get("shaders/tri.wgsl"), Some(&lines), "{backend}:\n{lcov}");
+        let arms = ["17,5,0,16", "17,5,1,16", "30,5,0,16", "30,5,1,16"];
+        assert_eq!(lcov_arms(&lcov)["shaders/tri.wgsl"], arms, "{backend}:\n{lcov}");
+    }
+}
+
 /// A `*.test.wesl` file in wgsl-test's spelling (`import wgsl_test::{..}`,
 /// `@test`, expect and expectNear: examples/sources' palette tests) runs
 /// unchanged on three backends, importing the WESL module it tests; a
@@ -6978,6 +7051,7 @@ fn main() {
         Cpu unknown_kernel_lists_valid_kernels,
         Gpu wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends,
         Gpu coverage_counts_each_line_exactly_on_three_backends,
+        Gpu coverage_counts_fragment_passes_and_draws_and_not_vertex_code,
         Gpu wesl_unit_tests_in_wgsl_test_spelling_run_unchanged_on_three_backends,
         Gpu test_textures_and_samplers_are_generated_and_bound_on_three_backends,
         Gpu an_imported_wesl_global_is_bound_by_its_own_name,
