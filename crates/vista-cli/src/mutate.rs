@@ -145,14 +145,15 @@ fn pct(s: Option<f64>) -> String {
 
 fn finish(project: &Project, report: &Report, json: Option<&PathBuf>) -> Result<i32, GoldenError> {
     println!(
-        "{:<14} {:>7} {:>8} {:>12} {:>7} {:>8} {:>10}  score",
-        "kernel", "killed", "survived", "equivalent?", "argued", "timeout", "stillborn"
+        "{:<14} {:>7} {:>8} {:>12} {:>12} {:>7} {:>8} {:>10}  score",
+        "kernel", "killed", "survived", "not covered", "equivalent?", "argued", "timeout", "stillborn"
     );
     for (k, s) in &report.kernels {
         println!(
-            "{k:<14} {:>7} {:>8} {:>12} {:>7} {:>8} {:>10}  {}",
+            "{k:<14} {:>7} {:>8} {:>12} {:>12} {:>7} {:>8} {:>10}  {}",
             s.killed,
             s.survived,
+            s.not_covered,
             s.equivalent,
             s.argued,
             s.timeout,
@@ -161,7 +162,8 @@ fn finish(project: &Project, report: &Report, json: Option<&PathBuf>) -> Result<
         );
     }
     println!(
-        "overall score {} (killed / (killed + survived); equivalent? and argued survivors listed, not scored)",
+        "overall score {} (killed / (killed + survived + not covered); equivalent? and argued survivors listed, not \
+         scored)",
         pct(report.score)
     );
     let argued: Vec<_> = report.mutants.iter().filter(|m| m.outcome == "argued").collect();
@@ -172,6 +174,17 @@ fn finish(project: &Project, report: &Report, json: Option<&PathBuf>) -> Result<
             println!(
                 "  {}:{}:{}  {} -> {}  {}: {why}",
                 m.mutant.file, m.mutant.line, m.mutant.col, m.mutant.before, m.mutant.after, m.kernel
+            );
+        }
+    }
+    let unrun: Vec<_> = report.mutants.iter().filter(|m| m.outcome == "not covered").collect();
+    if !unrun.is_empty() {
+        println!("not covered (no case of the kernel executes the line: add a case that reaches it):");
+        for m in unrun {
+            let after = if m.mutant.after.is_empty() { "(removed)" } else { &m.mutant.after };
+            println!(
+                "  {}:{}:{}  {} -> {after}  {}",
+                m.mutant.file, m.mutant.line, m.mutant.col, m.mutant.before, m.kernel
             );
         }
     }

@@ -6647,6 +6647,35 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
     assert_eq!(std::fs::read_to_string(root.join("merged/lcov.info")).unwrap(), whole);
     let page = std::fs::read_to_string(root.join("merged/coverage/shaders_paths.wgsl.html")).unwrap();
     assert!(page.contains("<code>        if i &gt;= 4u {"), "the merged pages show the text: {page}");
+    // With the plain case alone, `v = 0.5` (24) and tone's `return 1.0` (5)
+    // run in no case: their surviving mutants are `not covered`, every
+    // other mutant on them too; a mutant on a line that runs is not.
+    std::fs::write(cases_path(root), "[[case]]\nid = \"plain\"\nkernel = \"paths\"\nsize = \"8x4\"\n").unwrap();
+    std::fs::remove_file(root.join("golden/paths/bright.png")).unwrap();
+    let m = vista_in(Some(root), &[], &["mutate", "--kernel", "paths", "--json", "m.json"]);
+    assert_eq!(m.code, 0, "{}{}", m.stdout, m.stderr);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root.join("m.json")).unwrap()).unwrap();
+    let mutants = report["mutants"].as_array().unwrap();
+    let unrun: Vec<(String, u64)> = mutants
+        .iter()
+        .filter(|m| m["outcome"] == "not covered")
+        .map(|m| (m["file"].as_str().unwrap().to_string(), m["line"].as_u64().unwrap()))
+        .collect();
+    assert!(!unrun.is_empty(), "{}", m.stdout);
+    for place in &unrun {
+        assert!(
+            [("paths.wgsl".to_string(), 24), ("lib/tone.wgsl".to_string(), 5)].contains(place),
+            "{place:?}: {}",
+            m.stdout
+        );
+    }
+    let on_unrun = mutants
+        .iter()
+        .filter(|m| (m["file"] == "paths.wgsl" && m["line"] == 24) || (m["file"] == "lib/tone.wgsl" && m["line"] == 5));
+    assert!(on_unrun.clone().all(|m| m["outcome"] == "not covered" || m["outcome"] == "stillborn"), "{}", m.stdout);
+    assert_eq!(report["kernels"]["paths"]["not_covered"].as_u64().unwrap() as usize, unrun.len());
+    assert!(m.stdout.contains("not covered (no case of the kernel executes the line"), "{}", m.stdout);
     // A plain check leaves no older run's lcov.info behind.
     let dir = root.join("report-lavapipe");
     let plain = vista_in(Some(root), &[], &["check", "--report-dir", dir.to_str().unwrap()]);

@@ -40,7 +40,8 @@ pub struct MutantReport {
     /// Where and what.
     #[serde(flatten)]
     pub mutant: Mutant,
-    /// killed | survived | timeout | stillborn.
+    /// killed | survived | not covered (a survivor on a line no case of
+    /// its kernel executes) | timeout | stillborn | argued.
     pub outcome: String,
     /// The case id, `cpu-reference`, or the unit test (`wgsl::<file>::<fn>`)
     /// that killed it.
@@ -134,7 +135,12 @@ pub struct Score {
     /// Survivors argued equivalent in the project's list (not counted).
     #[serde(default)]
     pub argued: usize,
-    /// killed / (killed + survived - equivalent?); None without any.
+    /// Survivors on a line no case of the kernel executes (counted as
+    /// survivors in the score: the suite cannot see them).
+    #[serde(default)]
+    pub not_covered: usize,
+    /// killed / (killed + survived + not covered - equivalent?); None
+    /// without any.
     pub score: Option<f64>,
 }
 
@@ -168,6 +174,7 @@ impl Report {
                         s.survived += 1;
                         s.equivalent += m.equivalent as usize;
                     }
+                    "not covered" => s.not_covered += 1,
                     "timeout" => s.timeout += 1,
                     "argued" => s.argued += 1,
                     _ => s.stillborn += 1,
@@ -176,7 +183,7 @@ impl Report {
         }
         let finish = |s: &mut Score| {
             // `equivalent?` survivors are listed, not scored (SPEC 12).
-            let n = s.killed + s.survived - s.equivalent;
+            let n = s.killed + s.survived + s.not_covered - s.equivalent;
             s.score = (n > 0).then(|| s.killed as f64 / n as f64);
         };
         kernels.values_mut().for_each(finish);
@@ -480,6 +487,9 @@ pub struct Judge<'a> {
     baselines: BTreeMap<String, Baseline<'a>>,
     /// The project's WGSL unit test files: a detector after the goldens.
     unit_tests: Vec<UnitTestFile>,
+    /// Each kernel's lines and arms its cases execute (a coverage run of
+    /// every case); none where a run could not measure them.
+    coverage: BTreeMap<String, Option<vista_coverage::Counts>>,
 }
 
 /// A WGSL unit test file (`*.test.wgsl`, `*.test.wesl`) and the files its tests reach.
@@ -510,9 +520,11 @@ impl<'a> Judge<'a> {
         texts.extend(outside_files(project)?.into_iter().map(|f| (f.rel, f.text)));
         let manifest = store.manifest()?;
         let mut baselines = BTreeMap::new();
+        let mut coverage = BTreeMap::new();
         for p in planned {
             if !baselines.contains_key(p.kernel.name()) {
                 let b = baseline(base, store, &manifest, &p.kernel, cases)?;
+                coverage.insert(p.kernel.name().to_string(), covered(base, &b));
                 baselines.insert(p.kernel.name().to_string(), b);
             }
         }
@@ -539,7 +551,7 @@ impl<'a> Judge<'a> {
                 }
             }
         }
-        Ok(Judge { base, store, manifest, sources, texts, baselines, unit_tests })
+        Ok(Judge { base, store, manifest, sources, texts, baselines, unit_tests, coverage })
     }
 
     /// One planned mutant judged: its file mutated in memory, then every
@@ -572,8 +584,42 @@ impl<'a> Judge<'a> {
                 }
             }
         }
+        if report.outcome == "survived" && self.unrun(p.kernel.name(), m) {
+            report.outcome = "not covered".into();
+            report.equivalent = false;
+        }
         report
     }
+
+    /// Whether `m`'s line is measured and no case of `kernel` executes it.
+    fn unrun(&self, kernel: &str, m: &Mutant) -> bool {
+        let Some(Some(counts)) = self.coverage.get(kernel) else { return false };
+        // A file under shaders/ is reported by its project path.
+        let lines = [format!("shaders/{}", m.file), m.file.clone()]
+            .into_iter()
+            .map(|f| counts.lines(&f))
+            .find(|l| !l.is_empty())
+            .unwrap_or_default();
+        lines.iter().any(|&(line, hits)| line == m.line && hits == 0)
+    }
+}
+
+/// The lines the baseline's cases execute, summed; none if a case's
+/// coverage run failed or could not be measured.
+fn covered(gpu: &Renderer, b: &Baseline) -> Option<vista_coverage::Counts> {
+    let mut total = vista_coverage::Counts::default();
+    for c in &b.cases {
+        let case = c.case;
+        let run = vista_render::for_case(&case.id, || {
+            vista_render::cover_with(gpu, &case.kernel, &case.params, &case.inputs, case.width, case.height)
+        })
+        .ok()?;
+        if !run.not_measured.is_empty() {
+            return None;
+        }
+        total.merge(&run.counts);
+    }
+    Some(total)
 }
 
 #[cfg(test)]

@@ -15,6 +15,7 @@ pub fn mutation_page(r: &Report) -> String {
                 ("", html_escape(k)),
                 ("", s.killed.to_string()),
                 ("", s.survived.to_string()),
+                ("", s.not_covered.to_string()),
                 ("", s.equivalent.to_string()),
                 ("", s.argued.to_string()),
                 ("", s.timeout.to_string()),
@@ -26,7 +27,7 @@ pub fn mutation_page(r: &Report) -> String {
     let survivors: Vec<Vec<(&str, String)>> = r
         .mutants
         .iter()
-        .filter(|m| m.outcome == "survived")
+        .filter(|m| m.outcome == "survived" || m.outcome == "not covered")
         .map(|m| {
             let after = if m.mutant.after.is_empty() { "(removed)" } else { &m.mutant.after };
             vec![
@@ -42,13 +43,20 @@ pub fn mutation_page(r: &Report) -> String {
                     ),
                 ),
                 ("", m.cases_run.to_string()),
-                ("", if m.equivalent { "equivalent?".into() } else { String::new() }),
+                (
+                    "",
+                    match (m.outcome.as_str(), m.equivalent) {
+                        ("not covered", _) => "not covered: no case executes the line".into(),
+                        (_, true) => "equivalent?".into(),
+                        _ => String::new(),
+                    },
+                ),
             ]
         })
         .collect();
     let body = format!(
         "<h1>vista mutate</h1><p>seed {}, sample {}, partitions {}: overall score <b>{}</b> \
-         (killed / (killed + survived); argued and <code>equivalent?</code> survivors left out).</p>{}\
+         (killed / (killed + survived + not covered); argued and <code>equivalent?</code> survivors left out).</p>{}\
          <h2>Survivors</h2>{}",
         r.seed,
         r.sample.map_or("all".to_string(), |s| s.to_string()),
@@ -56,7 +64,7 @@ pub fn mutation_page(r: &Report) -> String {
         pct(r.score),
         table(
             "",
-            &["kernel", "killed", "survived", "equivalent?", "argued", "timeout", "stillborn", "score"],
+            &["kernel", "killed", "survived", "not covered", "equivalent?", "argued", "timeout", "stillborn", "score"],
             &kernels
         ),
         table("", &["kernel", "place", "operator", "change", "detectors run", ""], &survivors),
