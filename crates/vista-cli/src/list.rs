@@ -100,3 +100,82 @@ pub fn layouts(project: &Project) -> Result<i32, GoldenError> {
     }
     Ok(if bad == 0 { 0 } else { 2 })
 }
+
+/// `vista list --coverage`: each kernel's cases run with coverage
+/// counters, then per kernel the lines and branch arms none of them
+/// reaches (a kernel without cases: every line of its files).
+pub fn coverage(project: &Project, config: &vista::Config) -> Result<i32, GoldenError> {
+    let kernels = registry(project)?;
+    let store = vista_golden::Store::of_project(project, "vista list --coverage")?;
+    let cases = store.load_cases()?;
+    let gpu = vista_render::Renderer::shared(&config.gpu, project, config.limits)?;
+    let covered = gpu.shaders.covered();
+    let mut failed = 0;
+    for k in kernels.kernels() {
+        let mine: Vec<&vista_golden::Case> = cases.iter().filter(|c| c.kernel.name() == k.name()).collect();
+        // vista's built-in kernels a project has no case of are not its own.
+        if mine.is_empty() && k.origin().starts_with("<built-in>") {
+            continue;
+        }
+        let mut counts = vista_coverage::Counts::default();
+        let mut why = Vec::new();
+        for c in &mine {
+            let run = vista_render::for_case(&c.id, || {
+                vista_render::cover_with(&gpu, &c.kernel, &c.params, &c.inputs, c.width, c.height)
+            });
+            match run {
+                Ok(r) => {
+                    counts.merge(&r.counts);
+                    why.extend(r.not_measured.into_iter().map(|w| format!("{}: {w}", c.id)));
+                }
+                Err(e) => why.push(format!("{}: the coverage run failed: {e}", c.id)),
+            }
+        }
+        if mine.is_empty() {
+            // No case: every measured line of the kernel's files is unreached.
+            let p = k.resolve(None, &[]).map_err(|e| GoldenError::BadInput(e.to_string()))?;
+            for i in 0..k.graph().passes.len() {
+                match covered.coverage(&k.pass_shader_for(i, &p)) {
+                    Ok(cov) => counts.merge(&cov.unrun()),
+                    Err(e) => why.push(e.to_string().lines().next().unwrap_or_default().to_string()),
+                }
+            }
+        }
+        println!("{}: {} by {} case(s)", k.name(), vista_report::coverage_line(&counts), mine.len());
+        for file in counts.files() {
+            let lines: Vec<u32> = counts.lines(&file).into_iter().filter(|l| l.1 == 0).map(|l| l.0).collect();
+            let arms: Vec<String> = counts
+                .arms(&file)
+                .into_iter()
+                .filter(|a| a.3 == 0)
+                .map(|(line, col, arm, _)| format!("{line}:{col} arm {arm}"))
+                .collect();
+            if !lines.is_empty() {
+                println!("  {file}: lines not reached: {}", ranges(&lines));
+            }
+            if !arms.is_empty() {
+                println!("  {file}: branch arms never taken: {}", arms.join(", "));
+            }
+        }
+        for w in &why {
+            println!("  not measured: {w}");
+        }
+        failed += usize::from(!why.is_empty());
+    }
+    Ok(if failed == 0 { 0 } else { 2 })
+}
+
+/// `3, 5-7, 9` for lines 3 5 6 7 9.
+fn ranges(lines: &[u32]) -> String {
+    let mut out: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < lines.len() {
+        let mut j = i;
+        while j + 1 < lines.len() && lines[j + 1] == lines[j] + 1 {
+            j += 1;
+        }
+        out.push(if i == j { lines[i].to_string() } else { format!("{}-{}", lines[i], lines[j]) });
+        i = j + 1;
+    }
+    out.join(", ")
+}

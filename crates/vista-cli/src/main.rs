@@ -65,6 +65,10 @@ enum Command {
         /// engine packs it.
         #[arg(long, conflicts_with = "names")]
         layout: bool,
+        /// Run every case with coverage counters and print, per kernel,
+        /// the WGSL lines and branch arms no case reaches.
+        #[arg(long, conflicts_with_all = ["names", "layout"])]
+        coverage: bool,
     },
     /// Render one kernel to a PNG (display values) or EXR (raw/linear values).
     Render {
@@ -398,8 +402,9 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             };
             watch::watch(project, config, case.as_deref(), watch::interval(interval)?, timeout)
         }
-        Command::List { names: _, layout: true } => list::layouts(project),
-        Command::List { names, layout: false } => list::run(project, names),
+        Command::List { layout: true, .. } => list::layouts(project),
+        Command::List { coverage: true, .. } => list::coverage(project, config),
+        Command::List { names, .. } => list::run(project, names),
         Command::Test { filter, matrix, bless } => unit_tests::test(project, config, filter.as_deref(), matrix, bless),
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             render::render(project, config, render::Args { kernel, preset, set, size, crop, zoom, out })

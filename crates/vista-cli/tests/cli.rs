@@ -6676,6 +6676,14 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
     assert!(on_unrun.clone().all(|m| m["outcome"] == "not covered" || m["outcome"] == "stillborn"), "{}", m.stdout);
     assert_eq!(report["kernels"]["paths"]["not_covered"].as_u64().unwrap() as usize, unrun.len());
     assert!(m.stdout.contains("not covered (no case of the kernel executes the line"), "{}", m.stdout);
+    let list = vista_in(Some(root), &[], &["list", "--coverage"]);
+    assert_eq!(list.code, 0, "{}{}", list.stdout, list.stderr);
+    let want = "paths: 14 of 17 lines (82.4%), 12 of 15 branch arms (80.0%) in 2 files by 1 case(s)\n\
+                \x20 shaders/lib/tone.wgsl: lines not reached: 5\n\
+                \x20 shaders/lib/tone.wgsl: branch arms never taken: 4:5 arm 0\n\
+                \x20 shaders/paths.wgsl: lines not reached: 14, 24\n\
+                \x20 shaders/paths.wgsl: branch arms never taken: 19:8 arm 1, 23:5 arm 0\n";
+    assert_eq!(list.stdout, want, "vista's built-in kernels without a case here are not listed");
     // A plain check leaves no older run's lcov.info behind.
     let dir = root.join("report-lavapipe");
     let plain = vista_in(Some(root), &[], &["check", "--report-dir", dir.to_str().unwrap()]);

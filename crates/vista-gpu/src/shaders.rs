@@ -606,9 +606,12 @@ impl ShaderSet {
     }
 
     /// The file a coverage report names for a source: its path under the
-    /// project (`shaders/...`); none for a generated module.
+    /// project (`shaders/...`); none for a generated module, or one of
+    /// vista's built-in modules the project does not have (no file of the
+    /// project to show it in: not measured).
     fn report_path(source: &Source) -> Option<String> {
-        (!source.origin.starts_with("<generated>")).then(|| format!("shaders/{}", source.rel))
+        let own = !source.origin.starts_with("<generated>") && !source.origin.starts_with("<built-in>");
+        own.then(|| format!("shaders/{}", source.rel))
     }
 
     /// The module of `name`, and where its spans point when this set
