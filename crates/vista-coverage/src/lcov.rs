@@ -35,7 +35,14 @@ impl Counts {
     /// cannot map (a generated statement) counts nowhere.
     pub fn add(&mut self, counters: &[Counter], values: &[u32], place: &dyn Fn(naga::Span) -> Option<Place>) {
         let mut run_lines: BTreeMap<(String, u32), u64> = BTreeMap::new();
-        for (c, &v) in counters.iter().zip(values) {
+        // A derived counter names only earlier ones: one pass in order.
+        let mut value: Vec<u32> = Vec::with_capacity(counters.len());
+        for (i, c) in counters.iter().enumerate() {
+            let v = match c.derived {
+                Some((whole, part)) => value[whole].saturating_sub(value[part]),
+                None => values.get(i).copied().unwrap_or(0),
+            };
+            value.push(v);
             for p in c.spans.iter().filter_map(|s| place(*s)) {
                 let hits = run_lines.entry((p.file, p.line)).or_default();
                 *hits = (*hits).max(v as u64);

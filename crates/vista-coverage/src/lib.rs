@@ -51,6 +51,10 @@ pub struct Counter {
     pub arm: Option<Arm>,
     /// The function it is in (an entry point's name for its body).
     pub function: String,
+    /// A counter with no word of its own: counter `.0`'s value less counter
+    /// `.1`'s (a select's false arm: its statement's runs less its true
+    /// arm's), one atomic fewer where every one costs llvmpipe compile time.
+    pub derived: Option<(usize, usize)>,
 }
 
 /// A module with its counters.
@@ -118,6 +122,35 @@ pub fn instrument(module: &Module, group: u32) -> Instrumented {
     Instrumented { module: m, counters, binding, not_measured }
 }
 
+/// Whether control may leave `s` other than to the statement after it: a
+/// return or discard anywhere inside; a break or continue not inside a
+/// loop of its own (a switch's break only leaves the switch). A segment
+/// goes on past a statement that does not escape.
+fn escapes(s: &Statement) -> bool {
+    fn inside(block: &Block, in_loop: bool, in_switch: bool) -> bool {
+        block.iter().any(|s| match s {
+            Statement::Return { .. } | Statement::Kill => true,
+            Statement::Break => !in_loop && !in_switch,
+            Statement::Continue => !in_loop,
+            Statement::Block(b) => inside(b, in_loop, in_switch),
+            Statement::If { accept, reject, .. } => {
+                inside(accept, in_loop, in_switch) || inside(reject, in_loop, in_switch)
+            }
+            Statement::Switch { cases, .. } => cases.iter().any(|c| inside(&c.body, in_loop, true)),
+            Statement::Loop { body, continuing, .. } => inside(body, true, false) || inside(continuing, true, false),
+            _ => false,
+        })
+    }
+    match s {
+        Statement::Return { .. } | Statement::Kill | Statement::Break | Statement::Continue => true,
+        Statement::Block(b) => inside(b, false, false),
+        Statement::If { accept, reject, .. } => inside(accept, false, false) || inside(reject, false, false),
+        Statement::Switch { cases, .. } => cases.iter().any(|c| inside(&c.body, false, true)),
+        Statement::Loop { body, continuing, .. } => inside(body, true, false) || inside(continuing, true, false),
+        _ => false,
+    }
+}
+
 /// The `select`s of `f` whose condition is a scalar bool: each picks one
 /// arm per invocation, so each arm is counted.
 fn scalar_selects(
@@ -180,6 +213,7 @@ struct Adder<'a> {
     expressions: &'a mut naga::Arena<Expression>,
     global: Handle<Expression>,
     one: Handle<Expression>,
+    zero: Handle<Expression>,
     function: &'a str,
     counters: &'a mut Vec<Counter>,
     /// Scalar `select`s, whose arms get counters where they are emitted.
@@ -189,20 +223,54 @@ struct Adder<'a> {
 impl Adder<'_> {
     /// A new counter: its index and the two statements that add one to it.
     fn counter(&mut self, arm: Option<Arm>) -> (usize, [(Statement, Span); 2]) {
+        self.counter_by(arm, None)
+    }
+
+    /// A new counter and the two statements that add one to it, or where
+    /// `when` is given (a condition and whether it counts when true), one
+    /// if the condition is so and none otherwise: no branch.
+    fn counter_by(
+        &mut self,
+        arm: Option<Arm>,
+        when: Option<(Handle<Expression>, bool)>,
+    ) -> (usize, [(Statement, Span); 2]) {
         let index = self.counters.len();
-        self.counters.push(Counter { spans: Vec::new(), arm, function: self.function.to_string() });
+        self.counters.push(Counter { spans: Vec::new(), arm, function: self.function.to_string(), derived: None });
         let span = arm.map_or(Span::UNDEFINED, |a| a.at);
+        let amount = match when {
+            None => None,
+            Some((condition, on)) => {
+                let (accept, reject) = if on { (self.one, self.zero) } else { (self.zero, self.one) };
+                Some(self.expressions.append(Expression::Select { condition, accept, reject }, span))
+            }
+        };
         let pointer = self.expressions.append(Expression::AccessIndex { base: self.global, index: index as u32 }, span);
-        let add = Statement::Atomic { pointer, fun: AtomicFunction::Add, value: self.one, result: None };
-        (index, [(Statement::Emit(naga::Range::new_from_bounds(pointer, pointer)), span), (add, span)])
+        let add =
+            Statement::Atomic { pointer, fun: AtomicFunction::Add, value: amount.unwrap_or(self.one), result: None };
+        // The emit starts at the condition's select where there is one.
+        (
+            index,
+            [(Statement::Emit(naga::Range::new_from_bounds(amount.unwrap_or(pointer), pointer)), span), (add, span)],
+        )
     }
 
     /// `block` with a counter at the start of each segment (and at its
     /// very start when it is an arm or `eager`, even if empty).
-    fn block(&mut self, block: Block, arm: Option<Arm>, eager: bool) -> Block {
+    /// `derived`: the block's first counter is that difference of two
+    /// counters (an if's reject arm: the if's runs less its accept arm's)
+    /// and adds nothing itself.
+    fn block(&mut self, block: Block, arm: Option<Arm>, eager: bool, derived: Option<(usize, usize)>) -> Block {
         let mut out = Block::with_capacity(block.len() + 4);
         let mut open: Option<usize> = None;
-        if arm.is_some() || eager {
+        if let Some(derived) = derived {
+            open = Some(self.counters.len());
+            self.counters.push(Counter {
+                spans: Vec::new(),
+                arm,
+                function: self.function.to_string(),
+                derived: Some(derived),
+            });
+        } else if arm.is_some() || eager {
             let (index, adds) = self.counter(arm);
             adds.into_iter().for_each(|(s, sp)| out.push(s, sp));
             open = Some(index);
@@ -220,31 +288,35 @@ impl Adder<'_> {
             if span.is_defined() {
                 self.counters[index].spans.push(span);
             }
-            // A statement that branches, loops or leaves ends the segment:
-            // what follows it may run another number of times.
+            // A statement that leaves, or that branches or loops and may
+            // leave from inside, ends the segment: what follows it may run
+            // another number of times. One that always comes back to the
+            // next statement does not: the segment goes on past it.
+            let ends = escapes(&statement);
             let (statement, ends) = match statement {
                 Statement::If { condition, accept, reject } => {
-                    let accept = self.block(accept, Some(Arm { at: span, branch: 0 }), true);
-                    let reject = self.block(reject, Some(Arm { at: span, branch: 1 }), true);
-                    (Statement::If { condition, accept, reject }, true)
+                    let taken = self.counters.len();
+                    let accept = self.block(accept, Some(Arm { at: span, branch: 0 }), true, None);
+                    let reject = self.block(reject, Some(Arm { at: span, branch: 1 }), true, Some((index, taken)));
+                    (Statement::If { condition, accept, reject }, ends)
                 }
                 Statement::Switch { selector, cases } => {
                     let cases = cases
                         .into_iter()
                         .enumerate()
                         .map(|(i, c)| naga::SwitchCase {
-                            body: self.block(c.body, Some(Arm { at: span, branch: i as u32 }), true),
+                            body: self.block(c.body, Some(Arm { at: span, branch: i as u32 }), true, None),
                             ..c
                         })
                         .collect();
-                    (Statement::Switch { selector, cases }, true)
+                    (Statement::Switch { selector, cases }, ends)
                 }
                 Statement::Loop { body, continuing, break_if } => {
-                    let body = self.block(body, Some(Arm { at: span, branch: 0 }), true);
-                    let continuing = self.block(continuing, None, false);
-                    (Statement::Loop { body, continuing, break_if }, true)
+                    let body = self.block(body, Some(Arm { at: span, branch: 0 }), true, None);
+                    let continuing = self.block(continuing, None, false, None);
+                    (Statement::Loop { body, continuing, break_if }, ends)
                 }
-                Statement::Block(b) => (Statement::Block(self.block(b, None, false)), true),
+                Statement::Block(b) => (Statement::Block(self.block(b, None, false, None)), ends),
                 s @ (Statement::Return { .. } | Statement::Break | Statement::Continue | Statement::Kill) => (s, true),
                 s => (s, false),
             };
@@ -253,18 +325,22 @@ impl Adder<'_> {
                 _ => Vec::new(),
             };
             out.push(statement, span);
-            // A select's arms: an `if` on its condition, right after the
-            // emit that evaluates it (its condition is evaluated by then).
+            // A select's arms, right after the emit that evaluates it (its
+            // condition is evaluated by then): the true arm's counter adds
+            // the condition as 0 or 1, with no branch (an `if` per select
+            // made llvmpipe's compile of the landscape kernel take minutes);
+            // the false arm is its segment's runs less the true arm's.
             for h in emitted {
                 let Expression::Select { condition, .. } = self.expressions[h] else { continue };
                 let at = self.expressions.get_span(h);
-                let arm = |adder: &mut Self, branch| {
-                    let mut b = Block::new();
-                    adder.counter(Some(Arm { at, branch })).1.into_iter().for_each(|(s, sp)| b.push(s, sp));
-                    b
-                };
-                let (accept, reject) = (arm(self, 0), arm(self, 1));
-                out.push(Statement::If { condition, accept, reject }, Span::UNDEFINED);
+                let (taken, adds) = self.counter_by(Some(Arm { at, branch: 0 }), Some((condition, true)));
+                adds.into_iter().for_each(|(s, _)| out.push(s, Span::UNDEFINED));
+                self.counters.push(Counter {
+                    spans: Vec::new(),
+                    arm: Some(Arm { at, branch: 1 }),
+                    function: self.function.to_string(),
+                    derived: Some((index, taken)),
+                });
             }
             if ends {
                 open = None;
@@ -283,10 +359,11 @@ fn instrument_function(
 ) {
     let global = f.expressions.append(Expression::GlobalVariable(global), Span::UNDEFINED);
     let one = f.expressions.append(Expression::Literal(Literal::U32(1)), Span::UNDEFINED);
+    let zero = f.expressions.append(Expression::Literal(Literal::U32(0)), Span::UNDEFINED);
     let body = std::mem::take(&mut f.body);
-    let mut adder = Adder { expressions: &mut f.expressions, global, one, function: name, counters, selects };
+    let mut adder = Adder { expressions: &mut f.expressions, global, one, zero, function: name, counters, selects };
     // The body starts a segment even if empty: a call of the function counts.
-    f.body = adder.block(body, None, true);
+    f.body = adder.block(body, None, true, None);
 }
 
 #[cfg(test)]

@@ -87,19 +87,28 @@ fn counts_sum_runs_and_write_lcov() {
     let module = parse(KERNEL);
     let inst = instrument(&module, 1);
     let place = line_of(KERNEL);
-    // A run where only `unused` never ran: every other counter 2.
-    let values: Vec<u32> = inst.counters.iter().map(|c| if c.function == "unused" { 0 } else { 2 }).collect();
+    // A run where only `unused` never ran: every counter 2 but each if's
+    // accept arm 1, so that its reject arm (the if's runs less the accept
+    // arm's, no word of its own) is 1 too.
+    let accepts: Vec<usize> = inst.counters.iter().filter_map(|c| c.derived.map(|d| d.1)).collect();
+    let values: Vec<u32> = (0..inst.counters.len())
+        .map(|i| match (inst.counters[i].function.as_str(), accepts.contains(&i)) {
+            ("unused", _) => 0,
+            (_, true) => 1,
+            _ => 2,
+        })
+        .collect();
     let mut counts = Counts::default();
     counts.add(&inst.counters, &values, &place);
     counts.add(&inst.counters, &values, &place);
     let lines = counts.lines("k.wgsl");
     assert_eq!(lines[0], (3, 0));
-    assert!(lines[1..].iter().all(|&(_, h)| h == 4), "{lines:?}");
+    assert_eq!(&lines[1..], [(8, 4), (9, 2), (11, 2), (13, 4), (14, 4), (15, 4), (17, 4)]);
     let lcov = counts.lcov("vista");
     assert!(lcov.starts_with("TN:vista\nSF:k.wgsl\n"), "{lcov}");
-    assert!(lcov.contains("DA:3,0\n") && lcov.contains("DA:9,4\n"), "{lcov}");
-    assert!(lcov.contains("BRDA:8,5,0,4\n") && lcov.contains("BRDA:8,5,1,4\n"), "{lcov}");
-    assert!(lcov.contains("BRDA:13,21,1,4\n"), "the for loop's condition: {lcov}");
+    assert!(lcov.contains("DA:3,0\n") && lcov.contains("DA:9,2\n") && lcov.contains("DA:13,4\n"), "{lcov}");
+    assert!(lcov.contains("BRDA:8,5,0,2\n") && lcov.contains("BRDA:8,5,1,2\n"), "{lcov}");
+    assert!(lcov.contains("BRDA:13,5,0,4\n") && lcov.contains("BRDA:13,21,1,2\n"), "the for loop's condition: {lcov}");
     assert!(lcov.contains("BRF:7\nBRH:7\n") && lcov.contains("LF:8\nLH:7\nend_of_record\n"), "{lcov}");
     assert_eq!(counts.totals(), (8, 7, 7, 7));
     // A run where nothing ran: every line 0, every arm `-` (never reached).
