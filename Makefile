@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves seed-study bench fuzz mutants scaling device-figures lavapipe swiftshader validation browser lcov build
+.PHONY: demo test golden curves seed-study bench fuzz mutants scaling device-figures coverage-cost lavapipe swiftshader validation browser lcov build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -51,6 +51,11 @@ test: lavapipe swiftshader validation browser lcov
 	set -o pipefail; CARGO=$(CARGO) bash ci/harness-example.sh 2>&1 | tee -a target/test.log
 	bash ci/test-summary.sh target/test.log
 	bash ci/no-gpu-skips.sh
+
+# check against check --coverage on the built-ins and examples/, each with
+# a fresh Mesa cache: the table in docs/performance.md.
+coverage-cost: lavapipe build
+	bash ci/coverage-cost.sh $(VISTA) 1
 
 # Re-render goldens after an intended change (CASE=glob to select; refused under CI=true).
 golden: lavapipe build

@@ -131,6 +131,11 @@ enum Command {
         /// under CI=true.
         #[arg(long, conflicts_with = "matrix")]
         bless: bool,
+        /// Also run each test file again with coverage counters: the WGSL
+        /// lines and branch arms the tests execute, as lcov.info and pages
+        /// under the report folder's wgsl-tests/.
+        #[arg(long, conflicts_with = "matrix")]
+        coverage: bool,
     },
     /// Check the cases, then re-check the ones a saved file reaches (WGSL,
     /// kernel manifests, golden/) and rewrite the report, until interrupted.
@@ -405,7 +410,9 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
         Command::List { layout: true, .. } => list::layouts(project),
         Command::List { coverage: true, .. } => list::coverage(project, config),
         Command::List { names, .. } => list::run(project, names),
-        Command::Test { filter, matrix, bless } => unit_tests::test(project, config, filter.as_deref(), matrix, bless),
+        Command::Test { filter, matrix, bless, coverage } => {
+            unit_tests::test(project, config, filter.as_deref(), matrix, bless, coverage)
+        }
         Command::Render { kernel, preset, set, size, crop, zoom, out } => {
             render::render(project, config, render::Args { kernel, preset, set, size, crop, zoom, out })
         }

@@ -54,6 +54,7 @@ pub fn test(
     filter: Option<&str>,
     matrix: bool,
     bless: bool,
+    coverage: bool,
 ) -> Result<i32, GoldenError> {
     if bless && config.in_ci {
         return Err(GoldenError::Refused(
@@ -82,7 +83,35 @@ pub fn test(
         base.adapter_description(),
         base.backend()
     );
+    if coverage {
+        cover(project, &base, &sources, &picked)?;
+    }
     Ok(if failed == 0 { 0 } else { 1 })
+}
+
+/// `vista test --coverage`: each picked file's tests run again with
+/// coverage counters, the hits summed into `<report dir>/wgsl-tests/`
+/// (`lcov.info` and the coverage pages), and the summary line.
+fn cover(
+    project: &Project,
+    base: &Renderer,
+    sources: &vista_render::Sources,
+    files: &[(String, String)],
+) -> Result<(), GoldenError> {
+    let mut total = vista_coverage::Counts::default();
+    for (rel, text) in files {
+        match vista_wgsl_test::cover_file(base, sources, rel, text) {
+            Ok(counts) => total.merge(&counts),
+            Err(why) => println!("coverage: {rel} not measured: {why}"),
+        }
+    }
+    let Some(dir) = project.report_dir().map(|d| d.join("wgsl-tests")) else { return Ok(()) };
+    let text = sources.shader_set().text_reader();
+    vista_report::write_coverage(&dir, &total, &|file| text.read(file).map(|(t, _)| t))?;
+    let lcov = dir.join(vista_check::LCOV_FILE);
+    vista_image::atomic_write(&lcov, total.lcov("wgsl-tests").as_bytes())?;
+    println!("coverage: {}: {}", vista_report::coverage_line(&total), lcov.display());
+    Ok(())
 }
 
 /// `vista test --matrix`: every test on lavapipe, SwiftShader and the

@@ -4710,6 +4710,9 @@ fn the_ci_recipe_runs_as_written() {
                     xml.contains("golden::marble::marble-default") && xml.contains("golden::marble::marble-calm"),
                     "{xml}"
                 );
+                // The shards' coverage, summed for the coverage service.
+                let lcov = std::fs::read_to_string(merge_job.join("vista-report/lcov.info")).unwrap();
+                assert!(lcov.contains("SF:shaders/marble.wgsl\n") && lcov.contains("LF:6\n"), "{lcov}");
                 // The merge job's artifact, unpacked on the developer's machine.
                 copy_visible(&merge_job.join("vista-report"), &root.join("vista-report"));
             }
@@ -6684,6 +6687,24 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
                 \x20 shaders/paths.wgsl: lines not reached: 14, 24\n\
                 \x20 shaders/paths.wgsl: branch arms never taken: 19:8 arm 1, 23:5 arm 0\n";
     assert_eq!(list.stdout, want, "vista's built-in kernels without a case here are not listed");
+    // The unit tests' coverage: tone(0.25) runs the if (4) and the last
+    // return (7), never `return 1.0` (5); the test's own line (6) once.
+    let test = "#import paths::tone::tone\n#import wgsl_test::{expectNear}\n\n@test\nfn low_values_pass() {\n    \
+                expectNear(tone(0.25), 0.25);\n}\n";
+    std::fs::write(root.join("shaders/lib/tone.test.wgsl"), test).unwrap();
+    let t = vista_in(Some(root), &[], &["test", "--coverage"]);
+    assert_eq!(t.code, 0, "{}{}", t.stdout, t.stderr);
+    let lcov = std::fs::read_to_string(root.join("target/vista-report/wgsl-tests/lcov.info")).unwrap();
+    let lines = lcov_lines(&lcov);
+    assert_eq!(lines["shaders/lib/tone.wgsl"], [(4, 1), (5, 0), (7, 1)], "{lcov}");
+    assert_eq!(
+        lines["shaders/lib/tone.test.wgsl"],
+        [(6, 1)],
+        "the runner's appended entries are not the file's: {lcov}"
+    );
+    assert_eq!(lcov_arms(&lcov)["shaders/lib/tone.wgsl"], ["4,5,0,0", "4,5,1,1"], "{lcov}");
+    assert!(t.stdout.contains("coverage: 3 of 4 lines (75.0%), 1 of 2 branch arms (50.0%) in 2 files"), "{}", t.stdout);
+    assert!(root.join("target/vista-report/wgsl-tests/coverage/shaders_lib_tone.wgsl.html").is_file());
     // A plain check leaves no older run's lcov.info behind.
     let dir = root.join("report-lavapipe");
     let plain = vista_in(Some(root), &[], &["check", "--report-dir", dir.to_str().unwrap()]);

@@ -123,6 +123,17 @@ impl Counts {
         counts
     }
 
+    /// Drops `file`'s lines and arms after line `last`: code appended to a
+    /// user's file (a test runner's entry points) that the file does not show.
+    pub fn keep_lines(&mut self, file: &str, last: u32) {
+        if let Some(lines) = self.lines.get_mut(file) {
+            lines.retain(|&l, _| l <= last);
+        }
+        if let Some(arms) = self.arms.get_mut(file) {
+            arms.retain(|k, _| k.0 <= last);
+        }
+    }
+
     /// Whether nothing was measured.
     pub fn is_empty(&self) -> bool {
         self.lines.values().all(|l| l.is_empty())

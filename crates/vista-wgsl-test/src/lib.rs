@@ -266,6 +266,45 @@ pub fn run_file_with(
     results
 }
 
+/// The WGSL lines and branch arms the tests of file `rel` execute: its
+/// test pass run again with coverage counters (vista-render's `cover`), on
+/// the rewrite, whose lines are the file's own. `@snapshot` draws are not
+/// counted. An error names why the file could not be measured.
+pub fn cover_file(
+    base: &Renderer,
+    sources: &vista_render::Sources,
+    rel: &str,
+    text: &str,
+) -> Result<vista_coverage::Counts, String> {
+    let rewritten = rewrite(text, wesl(rel)).map_err(|e| format!("{rel}:{e}"))?;
+    if rewritten.tests.is_empty() {
+        return Ok(vista_coverage::Counts::default());
+    }
+    let mut edits = base.edits.clone();
+    edits.push((rel.to_string(), rewritten.text.clone()));
+    let gpu = Renderer {
+        ctx: base.ctx,
+        worker: base.worker.clone(),
+        shaders: sources.with_files("wgsl tests", &edits),
+        edits,
+        limits: base.limits,
+        root: base.root.clone(),
+    };
+    let all: Vec<usize> = (0..rewritten.tests.len()).collect();
+    let name = format!("wgsl-test-{}", rel.replace(['/', '.'], "-"));
+    let kernel = vista_manifest::Kernel::from_manifest(&name, rel, &manifest(rel, &rewritten, &all))
+        .map_err(|e| e.to_string())?;
+    let params = kernel.resolve(None, &[]).map_err(|e| e.to_string())?;
+    let run = vista_render::cover_with(&gpu, &kernel, &params, &[], 1, 1).map_err(|e| one_line(&e.to_string()))?;
+    if !run.not_measured.is_empty() {
+        return Err(run.not_measured.join("; "));
+    }
+    // The entries appended after the user's last line are vista's.
+    let mut counts = run.counts;
+    counts.keep_lines(&format!("shaders/{rel}"), text.lines().count() as u32);
+    Ok(counts)
+}
+
 /// A compile error on one line: `path:line: message` (the column is the
 /// rewritten line's, so it is left out), else the error's first line.
 fn one_line(text: &str) -> String {
