@@ -21,6 +21,18 @@ grep -qF "\"test\":\"$unit\"" target/vista-report/results.json ||
     { echo "harness-example: results.json does not list $unit"; exit 1; }
 grep -qF 'id="unit-tests"' target/vista-report/index.html && grep -qF "$unit" target/vista-report/index.html ||
     { echo "harness-example: index.html has no WGSL unit tests section listing $unit"; exit 1; }
+# VISTA_COVERAGE=1: the cases and the unit test file run again with
+# counters; lcov.info beside the report sums both (the unit test's own
+# lines are in glow.test.wgsl), and the verdicts are the plain run's.
+VISTA_COVERAGE=1 "$cargo" test -q --test golden >/dev/null
+lcov=target/vista-report/lcov.info
+for sf in shaders/glow.wgsl shaders/glow.test.wgsl; do
+    grep -qx "SF:$sf" "$lcov" || { cat "$lcov"; echo "harness-example: VISTA_COVERAGE=1 left no counts of $sf"; exit 1; }
+done
+grep -q 'WGSL coverage: <a href="coverage/index.html">' target/vista-report/index.html ||
+    { echo "harness-example: the report has no coverage line"; exit 1; }
+"$cargo" test -q --test golden >/dev/null
+[ ! -e "$lcov" ] || { echo "harness-example: a run without coverage left the older lcov.info"; exit 1; }
 one=$("$cargo" test -q --test golden -- --exact golden::glow::glow-blue 2>&1)
 echo "$one" | grep -q "1 passed; 0 failed; 0 ignored; 0 measured; 2 filtered out" ||
     { echo "$one"; echo "harness-example: --exact did not select one case"; exit 1; }

@@ -106,6 +106,7 @@ fn wgsl_trials(
     renderer: Option<Result<&'static Renderer<'static>, String>>,
     skip: bool,
     units: &Arc<Mutex<Vec<vista_report::UnitTest>>>,
+    coverage: bool,
 ) -> Vec<Trial> {
     type Results = Arc<std::sync::OnceLock<Vec<vista_wgsl_test::TestResult>>>;
     let files = vista_wgsl_test::test_files(project).unwrap_or_else(|e| fail(&format!("cannot read the shaders: {e}")));
@@ -114,9 +115,11 @@ fn wgsl_trials(
     for (rel, text) in files {
         let ids = vista_wgsl_test::list(&rel, &text).unwrap_or_else(|_| vec![vista_wgsl_test::test_id(&rel, "*")]);
         let (results, rel, text): (Results, Arc<str>, Arc<str>) = (Arc::default(), rel.into(), text.into());
+        // The file's coverage run, taken by the first of its tests to finish.
+        let counted: Arc<Mutex<bool>> = Arc::default();
         for id in ids {
-            let (project, renderer, sources, results, units) =
-                (project.clone(), renderer.clone(), sources.clone(), results.clone(), units.clone());
+            let (project, renderer, sources, results, units, counted) =
+                (project.clone(), renderer.clone(), sources.clone(), results.clone(), units.clone(), counted.clone());
             let (rel, text) = (rel.clone(), text.clone());
             trials.push(
                 Trial::test(id.clone(), move || {
@@ -133,7 +136,10 @@ fn wgsl_trials(
                     // A file that does not rewrite has one result, `*`.
                     let r = all.iter().find(|r| r.id == id).or(all.first()).ok_or_else(|| Failed::from("not run"))?;
                     let failures = if r.passed() { Vec::new() } else { r.explain() };
-                    let unit = vista_report::UnitTest { id: id.clone(), failures: failures.clone() };
+                    let first = coverage && !std::mem::replace(&mut *counted.lock().expect("counted"), true);
+                    let coverage =
+                        first.then(|| vista_wgsl_test::cover_file(ctx, sources, &rel, &text).map(|c| c.lcov(&id)));
+                    let unit = vista_report::UnitTest { id: id.clone(), failures: failures.clone(), coverage };
                     units.lock().expect("unit tests").push(unit);
                     match r.passed() {
                         true => Ok(()),
@@ -239,7 +245,7 @@ pub fn run(args: &Arguments, project: &Project, command: &str) -> ! {
         })
         .collect();
     let units: Arc<Mutex<Vec<vista_report::UnitTest>>> = Arc::default();
-    trials.extend(wgsl_trials(project, renderer.clone(), skip, &units));
+    trials.extend(wgsl_trials(project, renderer.clone(), skip, &units, config.coverage));
     let orphans = vista_check::orphans(&store, &cases);
     if !orphans.is_empty() {
         let listed: Vec<String> = orphans.iter().map(|o| o.display().to_string()).collect();

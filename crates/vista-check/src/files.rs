@@ -51,7 +51,7 @@ pub(crate) fn write_run(
     run.pending = pending.keys().cloned().collect();
     // A coverage run's pages and lcov.info (every case's hits summed); a
     // run without coverage leaves no older run's to be read as its own.
-    let total = coverage_total(outcomes);
+    let total = coverage_total(outcomes, &run.unit_tests);
     run.coverage = total.as_ref().map(vista_report::coverage_line);
     let lcov = report_dir.join(LCOV_FILE);
     let pages = report_dir.join(vista_report::COVERAGE_DIR);
@@ -106,10 +106,11 @@ pub(crate) fn write_run(
 /// The LCOV tracefile a coverage run leaves in its report folder.
 pub const LCOV_FILE: &str = "lcov.info";
 
-/// The hits of every case a coverage run measured, summed; none when no
-/// case ran with coverage.
-pub fn coverage_total(outcomes: &[Outcome]) -> Option<vista_coverage::Counts> {
-    let mut measured = outcomes.iter().filter_map(|o| o.coverage.as_ref()).peekable();
+/// The hits of every case (and WGSL unit test file) a coverage run
+/// measured, summed; none when nothing ran with coverage.
+pub fn coverage_total(outcomes: &[Outcome], units: &[vista_report::UnitTest]) -> Option<vista_coverage::Counts> {
+    let cases = outcomes.iter().filter_map(|o| o.coverage.as_ref());
+    let mut measured = cases.chain(units.iter().filter_map(|u| u.coverage.as_ref())).peekable();
     measured.peek()?;
     let mut total = vista_coverage::Counts::default();
     for lcov in measured.flatten() {

@@ -219,7 +219,7 @@ pub fn check(
             );
         }
     }
-    if let Some(counts) = vista_check::coverage_total(&outcomes) {
+    if let Some(counts) = vista_check::coverage_total(&outcomes, &[]) {
         print_coverage(&counts, &outcomes, &report_dir);
     }
     println!("{}", time.summary(ctx, outcomes.len()));

@@ -464,6 +464,10 @@ pub struct UnitTest {
     /// Empty when it passed: a line per failed assertion (`file:line:col:
     /// what`), or the error that kept it from running.
     pub failures: Vec<String>,
+    /// Under coverage, one test of each file carries the file's coverage
+    /// run (LCOV), or why it was not measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<Result<String, String>>,
 }
 
 impl UnitTest {

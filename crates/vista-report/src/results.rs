@@ -233,8 +233,8 @@ mod tests {
         let failing = vec!["shaders/a.test.wgsl:3:5: expect(false)".to_string(), "and 2 more".to_string()];
         let run = RunSummary {
             unit_tests: vec![
-                crate::UnitTest { id: "wgsl::a::bad".into(), failures: failing.clone() },
-                crate::UnitTest { id: "wgsl::a::good".into(), failures: Vec::new() },
+                crate::UnitTest { id: "wgsl::a::bad".into(), failures: failing.clone(), coverage: None },
+                crate::UnitTest { id: "wgsl::a::good".into(), failures: Vec::new(), coverage: None },
             ],
             ..Default::default()
         };
