@@ -6492,6 +6492,20 @@ fn tone(v: f32) -> f32 {
 }
 ";
 
+/// `vista check --coverage` of `root` on `backend` into `report-<backend>`:
+/// the run (passed), its report folder and its lcov.info.
+fn check_coverage(root: &Path, backend: &str) -> (Run, PathBuf, String) {
+    let dir = root.join(format!("report-{backend}"));
+    let r = vista_in(
+        Some(root),
+        &[("VISTA_BACKEND", backend)],
+        &["check", "--coverage", "--report-dir", dir.to_str().unwrap()],
+    );
+    assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
+    let lcov = std::fs::read_to_string(dir.join("lcov.info")).expect("lcov.info");
+    (r, dir, lcov)
+}
+
 /// Each file's branch arms of an lcov.info as `line,column,arm,hits`.
 fn lcov_arms(text: &str) -> std::collections::BTreeMap<String, Vec<String>> {
     let mut out: std::collections::BTreeMap<String, Vec<String>> = Default::default();
@@ -6581,14 +6595,7 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
         "37,13,1,32",
     ];
     for backend in ["lavapipe", "swiftshader", "browser"] {
-        let dir = root.join(format!("report-{backend}"));
-        let r = vista_in(
-            Some(root),
-            &[("VISTA_BACKEND", backend)],
-            &["check", "--coverage", "--report-dir", dir.to_str().unwrap()],
-        );
-        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
-        let lcov = std::fs::read_to_string(dir.join("lcov.info")).expect("lcov.info");
+        let (r, dir, lcov) = check_coverage(root, backend);
         let lines = lcov_lines(&lcov);
         assert_eq!(lines.get("shaders/paths.wgsl"), Some(&kernel), "{backend}:\n{lcov}");
         assert_eq!(lines.get("shaders/lib/tone.wgsl"), Some(&tone), "{backend}:\n{lcov}");
@@ -6771,14 +6778,7 @@ fn wash(@builtin(position) at: vec4f) -> @location(0) vec4f {
     assert_eq!(bless.code, 0, "{}{}", bless.stdout, bless.stderr);
     let lines: Vec<(u32, u64)> = vec![(17, 32), (18, 16), (20, 16), (25, 32), (30, 32), (31, 16), (33, 16)];
     for backend in ["lavapipe", "swiftshader", "browser"] {
-        let dir = root.join(format!("report-{backend}"));
-        let r = vista_in(
-            Some(root),
-            &[("VISTA_BACKEND", backend)],
-            &["check", "--coverage", "--report-dir", dir.to_str().unwrap()],
-        );
-        assert_eq!(r.code, 0, "{backend}: {}{}", r.stdout, r.stderr);
-        let lcov = std::fs::read_to_string(dir.join("lcov.info")).expect("lcov.info");
+        let (_, _, lcov) = check_coverage(root, backend);
         assert_eq!(lcov_lines(&lcov).get("shaders/tri.wgsl"), Some(&lines), "{backend}:\n{lcov}");
         let arms = ["17,5,0,16", "17,5,1,16", "30,5,0,16", "30,5,1,16"];
         assert_eq!(lcov_arms(&lcov)["shaders/tri.wgsl"], arms, "{backend}:\n{lcov}");

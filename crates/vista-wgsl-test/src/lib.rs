@@ -194,6 +194,26 @@ fn render_tests(gpu: &Renderer, rel: &str, rewritten: &Rewritten, which: &[usize
     }
 }
 
+/// `base` with file `rel` replaced by its rewrite (the base's own edits,
+/// a mutant under test, stay).
+fn with_rewrite<'a>(
+    base: &Renderer<'a>,
+    sources: &vista_render::Sources,
+    rel: &str,
+    rewritten: &Rewritten,
+) -> Renderer<'a> {
+    let mut edits = base.edits.clone();
+    edits.push((rel.to_string(), rewritten.text.clone()));
+    Renderer {
+        ctx: base.ctx,
+        worker: base.worker.clone(),
+        shaders: sources.with_files("wgsl tests", &edits),
+        edits,
+        limits: base.limits,
+        root: base.root.clone(),
+    }
+}
+
 /// Runs the tests of file `rel` (`text` as the project has it) on `base`'s
 /// engine, its file replaced by the rewrite in memory: every test's
 /// result, in file order. A file that does not rewrite, compose or run
@@ -219,17 +239,7 @@ pub fn run_file_with(
         Err(e) => return vec![broken(&test_id(rel, "*"), format!("{rel}:{e}"))],
     };
     let ids: Vec<String> = rewritten.tests.iter().map(|t| test_id(rel, &t.name)).collect();
-    // The base's own edits (a mutant under test) stay.
-    let mut edits = base.edits.clone();
-    edits.push((rel.to_string(), rewritten.text.clone()));
-    let gpu = Renderer {
-        ctx: base.ctx,
-        worker: base.worker.clone(),
-        shaders: sources.with_files("wgsl tests", &edits),
-        edits,
-        limits: base.limits,
-        root: base.root.clone(),
-    };
+    let gpu = with_rewrite(base, sources, rel, &rewritten);
     let row_of = |words: &[u32], i: usize, id: &str| {
         let row = &words[i * ROW..(i + 1) * ROW];
         let failures = row[1..]
@@ -280,16 +290,7 @@ pub fn cover_file(
     if rewritten.tests.is_empty() {
         return Ok(vista_coverage::Counts::default());
     }
-    let mut edits = base.edits.clone();
-    edits.push((rel.to_string(), rewritten.text.clone()));
-    let gpu = Renderer {
-        ctx: base.ctx,
-        worker: base.worker.clone(),
-        shaders: sources.with_files("wgsl tests", &edits),
-        edits,
-        limits: base.limits,
-        root: base.root.clone(),
-    };
+    let gpu = with_rewrite(base, sources, rel, &rewritten);
     let all: Vec<usize> = (0..rewritten.tests.len()).collect();
     let name = format!("wgsl-test-{}", rel.replace(['/', '.'], "-"));
     let kernel = vista_manifest::Kernel::from_manifest(&name, rel, &manifest(rel, &rewritten, &all))
