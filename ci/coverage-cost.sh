@@ -25,12 +25,12 @@ for project in . examples/project examples/graphs examples/render examples/sourc
             took=$(echo "$(date +%s.%N) - $start" | bc)
             if [ "$mode" = plain ]; then plain+=("$took"); else covered+=("$took"); fi
             cases=$(grep -o '^[0-9]* passed' <<<"$out" | head -1 | cut -d' ' -f1)
-            [ "$mode" = coverage ] && summary=$(grep '^coverage: [0-9]* of' <<<"$out" | tail -1)
+            [ "$mode" = coverage ] && summary=$(grep '^coverage: [0-9.]*% of lines' <<<"$out" | tail -1)
         done
     done
     median() { printf '%s\n' "$@" | sort -n | awk '{a[NR]=$1} END {print (NR%2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }
     p=$(median "${plain[@]}"); c=$(median "${covered[@]}")
-    lines=$(sed -E 's/^coverage: ([0-9]+ of [0-9]+) lines \(([0-9.]+%)\).*/\1 (\2)/' <<<"$summary")
-    arms=$(sed -E 's/.*, ([0-9]+ of [0-9]+) branch arms \(([0-9.]+%)\).*/\1 (\2)/' <<<"$summary")
+    lines=$(sed -E 's/^coverage: ([0-9.]+%) of lines.*\(([0-9]+ of [0-9]+) lines.*/\2 (\1)/' <<<"$summary")
+    arms=$(sed -E 's/.*, ([0-9.]+%) of branches.*, ([0-9]+ of [0-9]+) branch arms\).*/\2 (\1)/' <<<"$summary")
     printf '| %s | %s | %.1f | %.1f | %.2f | %s | %s |\n' "$project" "$cases" "$p" "$c" "$(echo "$c / $p" | bc -l)" "$lines" "$arms"
 done

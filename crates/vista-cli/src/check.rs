@@ -107,13 +107,9 @@ fn print_coverage(counts: &vista_coverage::Counts, outcomes: &[vista_golden::Out
             println!("coverage: {} not measured: {why}", o.id);
         }
     }
-    let (lf, lh, bf, bh) = counts.totals();
-    let percent = |hit: usize, found: usize| if found == 0 { 100.0 } else { 100.0 * hit as f64 / found as f64 };
     println!(
-        "coverage: {lh} of {lf} lines ({:.1}%), {bh} of {bf} branch arms ({:.1}%) in {} files: {}",
-        percent(lh, lf),
-        percent(bh, bf),
-        counts.files().len(),
+        "coverage: {}: {}",
+        vista_report::coverage_line(counts),
         report_dir.join(vista_check::LCOV_FILE).display()
     );
 }

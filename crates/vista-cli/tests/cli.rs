@@ -6601,7 +6601,7 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
         assert_eq!(lines.get("shaders/lib/tone.wgsl"), Some(&tone), "{backend}:\n{lcov}");
         assert_eq!(lcov_arms(&lcov).get("shaders/paths.wgsl"), Some(&arms.iter().map(|a| a.to_string()).collect()));
         assert_eq!(lcov_arms(&lcov)["shaders/lib/tone.wgsl"], ["4,5,0,28", "4,5,1,36"], "{backend}");
-        let summary = "coverage: 16 of 17 lines (94.1%), 14 of 15 branch arms (93.3%) in 2 files";
+        let summary = "coverage: 94.1% of lines, 93.3% of branches in 2 files (16 of 17 lines, 14 of 15 branch arms)";
         assert!(r.stdout.contains(summary), "{backend}: {}", r.stdout);
         if backend == "lavapipe" {
             // The judged render is the plain one, bit for bit.
@@ -6625,9 +6625,12 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
             // The report: a summary line, each case linked to its files'
             // pages, each page every line's hits with the unrun one marked.
             let index = std::fs::read_to_string(dir.join("index.html")).unwrap();
-            assert!(index.contains("WGSL coverage: <a href=\"coverage/index.html\">16 of 17 lines (94.1%)"), "{index}");
+            assert!(
+                index.contains("WGSL coverage: <a href=\"coverage/index.html\">94.1% of lines, 93.3% of branches"),
+                "{index}"
+            );
             // plain never sets v = 0.5 (24) nor returns 1.0 from tone (5).
-            assert!(index.contains("coverage of this case: 14 of 17 lines"), "{index}");
+            assert!(index.contains("coverage of this case: 82.4% of lines"), "{index}");
             assert!(index.contains("<a href=\"coverage/shaders_paths.wgsl.html\">shaders/paths.wgsl</a>"), "{index}");
             let page = std::fs::read_to_string(dir.join("coverage/shaders_paths.wgsl.html")).unwrap();
             assert!(page.contains("<tr class=\"miss\"><td class=\"n\">14</td><td class=\"hits\">0</td>"), "{page}");
@@ -6688,7 +6691,7 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
     assert!(m.stdout.contains("not covered (no case of the kernel executes the line"), "{}", m.stdout);
     let list = vista_in(Some(root), &[], &["list", "--coverage"]);
     assert_eq!(list.code, 0, "{}{}", list.stdout, list.stderr);
-    let want = "paths: 14 of 17 lines (82.4%), 12 of 15 branch arms (80.0%) in 2 files by 1 case(s)\n\
+    let want = "paths: 82.4% of lines, 80.0% of branches in 2 files (14 of 17 lines, 12 of 15 branch arms) by 1 case(s)\n\
                 \x20 shaders/lib/tone.wgsl: lines not reached: 5\n\
                 \x20 shaders/lib/tone.wgsl: branch arms never taken: 4:5 arm 0\n\
                 \x20 shaders/paths.wgsl: lines not reached: 14, 24\n\
@@ -6710,7 +6713,11 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
         "the runner's appended entries are not the file's: {lcov}"
     );
     assert_eq!(lcov_arms(&lcov)["shaders/lib/tone.wgsl"], ["4,5,0,0", "4,5,1,1"], "{lcov}");
-    assert!(t.stdout.contains("coverage: 3 of 4 lines (75.0%), 1 of 2 branch arms (50.0%) in 2 files"), "{}", t.stdout);
+    assert!(
+        t.stdout.contains("coverage: 75.0% of lines, 50.0% of branches in 2 files (3 of 4 lines, 1 of 2"),
+        "{}",
+        t.stdout
+    );
     assert!(root.join("target/vista-report/wgsl-tests/coverage/shaders_lib_tone.wgsl.html").is_file());
     // A plain check leaves no older run's lcov.info behind.
     let dir = root.join("report-lavapipe");

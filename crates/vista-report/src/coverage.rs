@@ -36,11 +36,13 @@ fn percent(hit: usize, found: usize) -> String {
     }
 }
 
-/// The summary line: lines and arms reached over every file.
+/// The summary line: lines and arms reached over every file, as
+/// `94.1% of lines, 93.3% of branches in 2 files (16 of 17 lines, 14 of 15
+/// branch arms)`.
 pub fn coverage_line(counts: &Counts) -> String {
     let (lf, lh, bf, bh) = counts.totals();
     format!(
-        "{lh} of {lf} lines ({}), {bh} of {bf} branch arms ({}) in {} files",
+        "{} of lines, {} of branches in {} files ({lh} of {lf} lines, {bh} of {bf} branch arms)",
         percent(lh, lf),
         percent(bh, bf),
         counts.files().len()
