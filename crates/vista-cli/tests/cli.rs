@@ -6601,6 +6601,10 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
         assert_eq!(lines.get("shaders/lib/tone.wgsl"), Some(&tone), "{backend}:\n{lcov}");
         assert_eq!(lcov_arms(&lcov).get("shaders/paths.wgsl"), Some(&arms.iter().map(|a| a.to_string()).collect()));
         assert_eq!(lcov_arms(&lcov)["shaders/lib/tone.wgsl"], ["4,5,0,28", "4,5,1,36"], "{backend}");
+        // Functions at their `fn` line with their calls: main once per
+        // invocation (64 a case), tone once per texel, never_called never.
+        let functions = "FN:18,main\nFN:13,never_called\nFNDA:128,main\nFNDA:0,never_called\nFNF:2\nFNH:1\n";
+        assert!(lcov.contains(functions) && lcov.contains("FN:3,tone\nFNDA:64,tone\n"), "{backend}:\n{lcov}");
         let summary = "coverage: 94.1% of lines, 93.3% of branches in 2 files (16 of 17 lines, 14 of 15 branch arms)";
         assert!(r.stdout.contains(summary), "{backend}: {}", r.stdout);
         if backend == "lavapipe" {
@@ -6621,6 +6625,7 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
             assert!(genhtml.status.success(), "{said}{}", String::from_utf8_lossy(&genhtml.stderr));
             assert!(said.contains("lines......: 94.1% (16 of 17 lines)"), "{said}");
             assert!(said.contains("branches...: 93.3% (14 of 15 branches)"), "{said}");
+            assert!(said.contains("functions..: 66.7% (2 of 3 functions)"), "{said}");
             assert!(html.join("shaders/paths.wgsl.gcov.html").is_file(), "{said}");
             // The report: a summary line, each case linked to its files'
             // pages, each page every line's hits with the unrun one marked.

@@ -26,6 +26,8 @@ type ArmKey = (u32, u32, u32);
 pub struct Counts {
     lines: BTreeMap<String, BTreeMap<u32, u64>>,
     arms: BTreeMap<String, BTreeMap<ArmKey, u64>>,
+    /// Per file, each function by name: its declaration's line and calls.
+    functions: BTreeMap<String, BTreeMap<String, (u32, u64)>>,
 }
 
 impl Counts {
@@ -58,8 +60,24 @@ impl Counts {
         }
     }
 
+    /// Adds one run's calls of each function: `(declaration, name, its
+    /// first counter)`, the counter that counts its body's start.
+    pub fn add_functions(&mut self, functions: &[(Place, String, usize)], values: &[u32]) {
+        for (at, name, counter) in functions {
+            let calls = values.get(*counter).copied().unwrap_or(0) as u64;
+            let entry = self.functions.entry(at.file.clone()).or_default().entry(name.clone()).or_insert((at.line, 0));
+            entry.1 += calls;
+        }
+    }
+
     /// Adds another run's (or shard's) counts.
     pub fn merge(&mut self, other: &Counts) {
+        for (file, functions) in &other.functions {
+            let mine = self.functions.entry(file.clone()).or_default();
+            for (name, (line, calls)) in functions {
+                mine.entry(name.clone()).or_insert((*line, 0)).1 += calls;
+            }
+        }
         for (file, lines) in &other.lines {
             let mine = self.lines.entry(file.clone()).or_default();
             for (line, hits) in lines {
@@ -113,6 +131,12 @@ impl Counts {
                 if let [l, hits, ..] = numbers(rest)[..] {
                     *counts.lines.entry(file.clone()).or_default().entry(l as u32).or_default() += hits;
                 }
+            } else if let Some((l, name)) = line.strip_prefix("FN:").and_then(|r| r.split_once(',')) {
+                let at = l.parse().unwrap_or(0);
+                counts.functions.entry(file.clone()).or_default().entry(name.to_string()).or_insert((at, 0)).0 = at;
+            } else if let Some((calls, name)) = line.strip_prefix("FNDA:").and_then(|r| r.split_once(',')) {
+                let calls: u64 = calls.parse().unwrap_or(0);
+                counts.functions.entry(file.clone()).or_default().entry(name.to_string()).or_insert((0, 0)).1 += calls;
             } else if let Some(rest) = line.strip_prefix("BRDA:")
                 && let [l, col, arm, hits] = numbers(rest)[..]
             {
@@ -132,6 +156,9 @@ impl Counts {
         if let Some(arms) = self.arms.get_mut(file) {
             arms.retain(|k, _| k.0 <= last);
         }
+        if let Some(functions) = self.functions.get_mut(file) {
+            functions.retain(|_, f| f.0 <= last);
+        }
     }
 
     /// Whether nothing was measured.
@@ -139,13 +166,24 @@ impl Counts {
         self.lines.values().all(|l| l.is_empty())
     }
 
-    /// The LCOV tracefile (`lcov.info`): per file `SF`, `DA` per line,
+    /// The LCOV tracefile (`lcov.info`): per file `SF`, `FN`/`FNDA` per
+    /// function (its declaration's line, its calls) and `FNF`/`FNH`, `DA` per line,
     /// `BRDA` per arm (`-` where its statement's line never ran), the
     /// `BRF`/`BRH` and `LF`/`LH` totals, `end_of_record`.
     pub fn lcov(&self, test_name: &str) -> String {
         let mut out = String::new();
         for (file, lines) in &self.lines {
             let _ = writeln!(out, "TN:{test_name}\nSF:{file}");
+            let functions = self.functions.get(file);
+            for (name, (line, _)) in functions.into_iter().flatten() {
+                let _ = writeln!(out, "FN:{line},{name}");
+            }
+            for (name, (_, calls)) in functions.into_iter().flatten() {
+                let _ = writeln!(out, "FNDA:{calls},{name}");
+            }
+            if let Some(f) = functions {
+                let _ = writeln!(out, "FNF:{}\nFNH:{}", f.len(), f.values().filter(|v| v.1 > 0).count());
+            }
             let arms = self.arms.get(file);
             for (key, hits) in arms.into_iter().flatten() {
                 let ran = lines.get(&key.0).is_some_and(|&h| h > 0);

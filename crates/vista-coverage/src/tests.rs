@@ -130,6 +130,9 @@ fn lcov_reads_back_as_the_counts_it_was_written_from() {
     let values: Vec<u32> = (0..inst.counters.len() as u32).collect();
     let mut counts = Counts::default();
     counts.add(&inst.counters, &values, &place);
+    let main = Place { file: "k.wgsl".into(), line: 8, col: 1 };
+    counts.add_functions(&[(main, "main".into(), 1)], &values);
+    assert!(counts.lcov("a").contains("FN:8,main\nFNDA:1,main\nFNF:1\nFNH:1\n"), "{}", counts.lcov("a"));
     assert_eq!(Counts::from_lcov(&counts.lcov("a")), counts);
     let mut none = Counts::default();
     none.add(&inst.counters, &vec![0; inst.counters.len()], &place);

@@ -29,6 +29,9 @@ pub struct Coverage {
     /// Functions a vertex entry reaches: not measured.
     pub not_measured: Vec<String>,
     places: HashMap<(usize, usize), Place>,
+    /// Each counted function: its declaration, its name as written, the
+    /// counter of its body's start.
+    functions: Vec<(Place, String, usize)>,
 }
 
 impl Coverage {
@@ -42,6 +45,7 @@ impl Coverage {
         counts.add(&self.counters, values, &|s: Span| {
             s.to_range().and_then(|r| self.places.get(&(r.start, r.end))).cloned()
         });
+        counts.add_functions(&self.functions, values);
     }
 
     /// Every measured line and arm of the file, none of them run: what a
@@ -75,8 +79,27 @@ pub(crate) fn instrument(module: &naga::Module, origins: &Origins) -> (naga::Mod
             Some(((r.start, r.end), placer.place(r.start)?))
         })
         .collect();
-    let coverage =
-        Coverage { counters: done.counters, group: done.binding.group, not_measured: done.not_measured, places };
+    // A function's counters are contiguous, its body's start first; its
+    // declaration is found in the text one of its statements lies in.
+    let mut functions = Vec::new();
+    for (i, c) in done.counters.iter().enumerate() {
+        if i > 0 && done.counters[i - 1].function == c.function {
+            continue;
+        }
+        let mine = done.counters[i..].iter().take_while(|d| d.function == c.function);
+        let start = mine.flat_map(|d| d.spans.iter()).find_map(|s| s.to_range()).map(|r| r.start);
+        let name = undecorated(&c.function).to_string();
+        if let Some(at) = start.and_then(|s| placer.declaration_of(&name, s)) {
+            functions.push((at, name, i));
+        }
+    }
+    let coverage = Coverage {
+        counters: done.counters,
+        group: done.binding.group,
+        not_measured: done.not_measured,
+        places,
+        functions,
+    };
     (done.module, coverage)
 }
 
@@ -98,6 +121,19 @@ impl<'a> Placer<'a> {
             }
         }
         Placer { origins, starts }
+    }
+
+    /// Where `fn name` is declared in the text that span start `within`
+    /// lies in.
+    fn declaration_of(&self, name: &str, within: usize) -> Option<Place> {
+        let at = match self.origins {
+            Origins::Direct { text, .. } => declaration(text, "fn", name)?,
+            Origins::Composed { modules } => {
+                let index = within >> SPAN_SHIFT;
+                declaration(&modules.get(&index)?.1, "fn", name)? + self.starts.get(&index)? + (index << SPAN_SHIFT)
+            }
+        };
+        self.place(at)
     }
 
     fn place(&self, start: usize) -> Option<Place> {
