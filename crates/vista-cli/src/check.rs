@@ -301,6 +301,11 @@ pub(crate) fn command_line() -> String {
 /// `vista merge`: the shards' report folders joined into `out`; prints each
 /// case that did not pass as `check` does, then the totals; exit 1 if any
 /// failed, 2 for bad input (a shard missing, given twice, of another split).
+/// The WGSL files of `project` (none: no text) for the coverage pages.
+pub fn sources_of(project: Option<Project>) -> vista_render::Reader {
+    project.and_then(|p| vista_render::shader_set(&p).ok()).map(|s| s.text_reader()).unwrap_or_default()
+}
+
 pub fn merge(dirs: &[PathBuf], out: &Path, results: Results) -> std::process::ExitCode {
     match merged(dirs, out, results) {
         Ok(code) => std::process::ExitCode::from(code),

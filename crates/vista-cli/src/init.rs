@@ -91,6 +91,27 @@ pub const FILES: &[(&str, &str)] = &[
     ("golden/cases.toml", CASES),
 ];
 
+/// `vista init DIR`: [`init`], each file written named, then the next step.
+pub fn run(dir: &Path) -> std::process::ExitCode {
+    match init(dir) {
+        Ok(written) => {
+            for p in &written {
+                println!("wrote {}", p.display());
+            }
+            println!(
+                "next: cd {} && vista bless && vista check   (then edit kernels/rings.toml and \
+                 shaders/rings.wgsl, or add your own kernel beside them)",
+                dir.display()
+            );
+            std::process::ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}
+
 /// Writes the project into `dir` (created if missing); refuses, before
 /// writing anything, if any of its files exists.
 pub fn init(dir: &Path) -> Result<Vec<PathBuf>, GoldenError> {

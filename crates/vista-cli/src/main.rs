@@ -311,38 +311,17 @@ fn main() -> ExitCode {
     }
     // init makes a project, so it needs none.
     if let Command::Init { dir } = &cli.command {
-        return match init::init(dir) {
-            Ok(written) => {
-                for p in &written {
-                    println!("wrote {}", p.display());
-                }
-                println!(
-                    "next: cd {} && vista bless && vista check   (then edit kernels/rings.toml and \
-                     shaders/rings.wgsl, or add your own kernel beside them)",
-                    dir.display()
-                );
-                ExitCode::SUCCESS
-            }
-            Err(e) => {
-                eprintln!("error: {e}");
-                ExitCode::from(e.exit_code() as u8)
-            }
-        };
+        return init::run(dir);
     }
     // merge joins report folders: it needs no project either.
     if let Command::Merge { dirs, report_dir, junit, json } = &cli.command {
         // The project's WGSL, where the current directory has one, for the coverage pages.
-        let sources = std::env::current_dir()
+        let here = std::env::current_dir()
             .ok()
-            .and_then(|cwd| Project::discover(cli.root.as_deref(), config.root.clone(), &cwd).ok())
-            .and_then(|p| vista_render::shader_set(&p).ok())
-            .map(|s| s.text_reader())
-            .unwrap_or_default();
-        return check::merge(
-            dirs,
-            report_dir,
-            vista_check::Results { junit: junit.clone(), json: json.clone(), sources },
-        );
+            .and_then(|cwd| Project::discover(cli.root.as_deref(), config.root.clone(), &cwd).ok());
+        let results =
+            vista_check::Results { junit: junit.clone(), json: json.clone(), sources: check::sources_of(here) };
+        return check::merge(dirs, report_dir, results);
     }
     let project = match std::env::current_dir()
         .map_err(|e| GoldenError::BadInput(format!("cannot read the current directory: {e}")))
