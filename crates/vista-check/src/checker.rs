@@ -92,10 +92,7 @@ impl Checker<'_> {
 
     /// `case`'s coverage run as LCOV, or why it was not measured.
     fn cover(&self, case: &Case) -> Result<String, String> {
-        let run = vista_render::for_case(&case.id, || {
-            vista_render::cover_with(self.ctx, &case.kernel, &case.params, &case.inputs, case.width, case.height)
-        });
-        match run {
+        match vista_golden::cover_case(self.ctx, case) {
             Ok(c) if c.not_measured.is_empty() => Ok(c.counts.lcov(&case.id)),
             Ok(c) => Err(c.not_measured.join("; ")),
             Err(e) => Err(format!("the coverage run failed: {e}")),

@@ -120,10 +120,7 @@ pub fn coverage(project: &Project, config: &vista::Config) -> Result<i32, Golden
         let mut counts = vista_coverage::Counts::default();
         let mut why = Vec::new();
         for c in &mine {
-            let run = vista_render::for_case(&c.id, || {
-                vista_render::cover_with(&gpu, &c.kernel, &c.params, &c.inputs, c.width, c.height)
-            });
-            match run {
+            match vista_golden::cover_case(&gpu, c) {
                 Ok(r) => {
                     counts.merge(&r.counts);
                     why.extend(r.not_measured.into_iter().map(|w| format!("{}: {w}", c.id)));

@@ -23,7 +23,7 @@ pub use bless::{BlessOptions, BlessRow, BlessSummary, bless};
 pub use cases::{Case, bless_all_command, load_cases, parse_cases, select};
 pub use check::{Observed, Outcome, Verdict, changed_files, first_out_of_range, guards, judge};
 pub use outputs::{BAD_PIXEL_LIMIT, output_guards, unwritten_problem};
-pub use run::{CheckOptions, Checked, check_case, run_info};
+pub use run::{CheckOptions, Checked, check_case, cover_case, run_info};
 pub use store::{DriverThreshold, Manifest, ManifestEntry, RunInfo, Store, params_hash};
 
 use vista_gpu::GpuError;

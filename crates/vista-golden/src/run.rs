@@ -352,6 +352,14 @@ pub fn render_case(ctx: &Renderer, case: &Case) -> Result<Rendered, vista_render
     })
 }
 
+/// A case's coverage run: its kernel, params, size and replacement inputs
+/// with coverage counters (vista-render's `cover`), counted as the case's.
+pub fn cover_case(ctx: &Renderer, case: &Case) -> Result<vista_render::CaseCoverage, vista_render::RenderError> {
+    vista_render::for_case(&case.id, || {
+        vista_render::cover_with(ctx, &case.kernel, &case.params, &case.inputs, case.width, case.height)
+    })
+}
+
 /// Whether two renders are bit-identical in every output.
 pub fn same_render(a: &Rendered, b: &Rendered) -> bool {
     a.raw.bit_identical(&b.raw)

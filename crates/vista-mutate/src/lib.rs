@@ -609,11 +609,7 @@ impl<'a> Judge<'a> {
 fn covered(gpu: &Renderer, b: &Baseline) -> Option<vista_coverage::Counts> {
     let mut total = vista_coverage::Counts::default();
     for c in &b.cases {
-        let case = c.case;
-        let run = vista_render::for_case(&case.id, || {
-            vista_render::cover_with(gpu, &case.kernel, &case.params, &case.inputs, case.width, case.height)
-        })
-        .ok()?;
+        let run = vista_golden::cover_case(gpu, c.case).ok()?;
         if !run.not_measured.is_empty() {
             return None;
         }

@@ -61,11 +61,11 @@ pub fn cover(gpu: &Renderer, plan: &Plan) -> Result<CaseCoverage, RenderError> {
         return Ok(out);
     }
     let mut resources = plan.resources.clone();
-    let mut names = plan.names.clone();
+    let mut resource_names = plan.names.clone();
     let first = resources.len();
     for (name, cov) in &counted {
         resources.push(Resource::Buffer(vec![0; cov.buffer_size() as usize]));
-        names.push(format!("coverage counters of {name}"));
+        resource_names.push(format!("coverage counters of {name}"));
     }
     let passes: Vec<vista_gpu::GraphPass> = plan
         .passes
@@ -89,7 +89,7 @@ pub fn cover(gpu: &Renderer, plan: &Plan) -> Result<CaseCoverage, RenderError> {
         passes: Cow::Owned(passes),
         outputs: Cow::Owned(outputs),
     };
-    let twin = Plan { names, ..plan.clone() };
+    let twin = Plan { names: resource_names, ..plan.clone() };
     let readback = crate::execute(gpu, &graph, &twin)?;
     for ((_, cov), data) in counted.iter().zip(readback.outputs) {
         let OutputData::Buffer(bytes) = data else { unreachable!("counter buffers read back as buffers") };
