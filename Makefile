@@ -5,7 +5,7 @@ export XDG_RUNTIME_DIR ?= /tmp
 CARGO ?= cargo
 VISTA := target/debug/vista
 
-.PHONY: demo test golden curves seed-study bench fuzz mutants scaling device-figures coverage-cost lavapipe swiftshader validation browser lcov build
+.PHONY: demo test golden curves seed-study bench fuzz mutants scaling device-figures coverage-cost lavapipe swiftshader validation browser lcov python build
 
 lavapipe:
 	bash ci/install-lavapipe.sh
@@ -23,6 +23,10 @@ browser:
 lcov:
 	bash ci/install-lcov.sh
 
+# python3, for examples/sources' template renderer ([source] command).
+python:
+	bash ci/install-python.sh
+
 build:
 	$(CARGO) build -p vista-cli
 
@@ -36,7 +40,7 @@ demo: lavapipe build
 # under the validation layer; every golden case again on SwiftShader and in
 # headless Chromium's WebGPU; then a closing count, and proof that without
 # an adapter the GPU tests are reported skipped, never ok.
-test: lavapipe swiftshader validation browser lcov
+test: lavapipe swiftshader validation browser lcov python
 	mkdir -p target
 	# The workspace's test binaries, two at a time, its golden harness on
 	# lavapipe under the Khronos validation layer (any message fails the

@@ -866,6 +866,44 @@ fn sources_mips() -> Result<(), String> {
     .map(|_| ())
 }
 
+/// examples/sources, blur (a template the project renders itself through
+/// `[source] command`: tools/render_template.py unrolls the taps) at 64 x
+/// 64: the source PNG (16-bit, v / 65535) blurred by the Gaussian
+/// exp(-i^2 / (2 sigma^2)), i in -4..4, sigma 1.75, normalised, along rows
+/// then columns, edges clamped; alpha 1. Both passes store rgba32float:
+/// nine f32 products summed twice, well inside 2e-6.
+fn sources_blur() -> Result<(), String> {
+    let (radius, sigma) = (4i64, 1.75f64);
+    let source = vista_image::read_png16(&example("sources/inputs/ridges.png")).map_err(|e| e.to_string())?;
+    let (sw, sh) = (source.width as i64, source.height as i64);
+    let raw: Vec<f64> = (-radius..=radius).map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp()).collect();
+    let total: f64 = raw.iter().sum();
+    let weight = |i: i64| raw[(i + radius) as usize] / total;
+    let texel = |x: i64, y: i64| source.data[(y.clamp(0, sh - 1) * sw + x.clamp(0, sw - 1)) as usize].map(f64::from);
+    let row = |x: i64, y: i64| {
+        let mut c = [0.0; 3];
+        for i in -radius..=radius {
+            let t = texel(x + i, y);
+            (0..3).for_each(|k| c[k] += weight(i) * t[k]);
+        }
+        c
+    };
+    let (w, h, got) = texels(&render_example("sources", "blur", 64, 64)?)?;
+    if (w, h) != (64, 64) {
+        return Err(format!("blur: {w}x{h}, want 64x64"));
+    }
+    compare("blur", w, &got, |x, y| {
+        let mut c = [0.0; 3];
+        for j in -radius..=radius {
+            // The rows pass's texture is 64 x 64 too: its edge clamps the same way.
+            let r = row(i64::from(x), (i64::from(y) + j).clamp(0, i64::from(h) - 1));
+            (0..3).for_each(|k| c[k] += weight(j) * r[k]);
+        }
+        Some(([c[0], c[1], c[2], 1.0], [2e-6, 2e-6, 2e-6, 0.0]))
+    })
+    .map(|_| ())
+}
+
 /// PCG hash (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT
 /// 2020): one LCG step, then the RXS-M-XS output permutation.
 fn pcg(v: u32) -> u32 {
@@ -1037,7 +1075,7 @@ fn main() {
         false => vista_gpu::Context::shared(&common::config().gpu).err().map(|e| e.to_string()),
     };
     let skip = no_gpu.is_some() && allow_no_gpu();
-    let tests: [(&str, Check); 14] = [
+    let tests: [(&str, Check); 15] = [
         ("references::graphs::row_offsets", graphs_row_offsets),
         ("references::harness_crate::glow", harness_crate_glow),
         ("references::project::marble", project_marble),
@@ -1046,6 +1084,7 @@ fn main() {
         ("references::render::grass", render_grass),
         ("references::render::sky_fullscreen_fisheye", render_sky_fisheye),
         ("references::render::sky_fullscreen_latlong", render_sky_latlong),
+        ("references::sources::blur", sources_blur),
         ("references::sources::cells", sources_cells),
         ("references::sources::clouds_joined", sources_clouds_joined),
         ("references::sources::clouds_joined_thin_exponential", sources_clouds_joined_thin_exponential),

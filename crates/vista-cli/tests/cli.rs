@@ -4966,7 +4966,7 @@ fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
 /// SwiftShader and in Chromium, under the validation layer, and by
 /// mutation, sweep and bench.
 fn the_sources_example_passes_on_every_backend_with_a_copied_binary() {
-    let (_t, bin, root) = copied_example("sources", 8);
+    let (_t, bin, root) = copied_example("sources", 9);
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
     let validated = run_in(&bin, &root, &[("VISTA_VALIDATION", "1")], &["check"]);
     assert_eq!(validated.code, 0, "{}{}", validated.stdout, validated.stderr);
@@ -4985,6 +4985,96 @@ fn the_sources_example_passes_on_every_backend_with_a_copied_binary() {
     assert_eq!(sweep.code, 0, "{}", sweep.stderr);
     let bench = run(&["bench", "cells", "--size", "64x64", "--runs", "2", "--json"]);
     assert!(bench.code == 0 && bench.stdout.contains("\"mpix_per_s\":"), "{}", bench.stderr);
+}
+
+/// `[source] command` (examples/sources, blur): the project's own template
+/// renderer runs once for every process of a check (workers included),
+/// its output cached by the template, the script and the inputs; an
+/// input's edit is named by --changed; a failing script, a timeout and a
+/// command that prints nothing are one error line each, naming the
+/// command (and its stderr's last lines), before any GPU work.
+fn a_projects_own_preprocessor_runs_through_source_command() {
+    let t = tmp();
+    let root = t.path().join("sources");
+    copy_tree(&repo().join("examples/sources"), &root);
+    let _ = std::fs::remove_dir_all(root.join("target"));
+    let run = |args: &[&str]| vista_in(Some(&root), &[], args);
+    let edit = |rel: &str, f: &dyn Fn(String) -> String| {
+        let p = root.join(rel);
+        std::fs::write(&p, f(std::fs::read_to_string(&p).unwrap())).unwrap();
+    };
+    // Count the runs: the same renderer, logged.
+    edit("kernels/blur.toml", &|s| {
+        s.replace(
+            "command = [\"python3\",",
+            "command = [\"sh\", \"-c\", \"echo run >> runs.log; exec python3 \\\"$@\\\"\", \"gen\",",
+        )
+    });
+    let runs = || std::fs::read_to_string(root.join("runs.log")).map(|s| s.lines().count()).unwrap_or(0);
+    for _ in 0..2 {
+        let r = run(&["check", "--case", "blur*", "--jobs", "2"]);
+        assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    }
+    assert_eq!(runs(), 1, "one run, then the cache");
+    // Coverage: a command's output (and the wesl crate's) is not the
+    // user's lines, so neither file is measured.
+    for case in ["blur", "relief"] {
+        let r = run(&["check", "--coverage", "--case", case]);
+        assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+        let lcov = std::fs::read_to_string(root.join("target/vista-report/lcov.info")).unwrap_or_default();
+        assert!(!lcov.contains("SF:"), "{case}: {lcov}");
+    }
+    // An input changed: run again, and --changed names it.
+    edit("tools/blur.json", &|s| s.replace("1.75", "2.0"));
+    let r = run(&["check", "--changed", "--json", "r.json"]);
+    assert_eq!(r.code, 1, "a wider blur differs from the golden: {}", r.stdout);
+    assert!(r.stdout.contains("selected 1 of"), "{}", r.stdout);
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(root.join("r.json")).unwrap()).unwrap();
+    let changed = v["cases"][0]["changed_files"].to_string();
+    assert!(changed.contains("tools/blur.json"), "{changed}");
+    assert_eq!(runs(), 2);
+    // watch follows the inputs too.
+    let log = t.path().join("watch.log");
+    let mut child = watching(&root, &log, &["--case", "blur", "--interval", "100", "--timeout", "60"]);
+    let first = wait_for_line(&log, "(watching; Ctrl-C ends)");
+    assert!(first.contains("0 passed, 1 failed"), "{first}");
+    edit("tools/blur.json", &|s| s.replace("2.0", "1.75"));
+    let after = wait_for_line(&log, "1 passed, 0 failed");
+    child.kill().ok();
+    child.wait().ok();
+    assert!(after.contains("changed: tools/blur.json -> re-checking 1 case"), "{after}");
+    // The script fails: its stderr's last lines, one line, exit 2 for render.
+    edit("tools/render_template.py", &|s| {
+        s.replace("def main():", "def main():\n    raise SystemExit(\"sigma too wide\")")
+    });
+    let r = run(&["render", "blur", "--size", "8x8", "-o", "x.png"]);
+    assert_rejected(
+        &r,
+        2,
+        &[
+            "kernel blur",
+            "shaders/blur/gaussian.wgsl.tmpl: [source] command `sh -c",
+            "exited with status 1; its stderr ends: sigma too wide",
+        ],
+    );
+    // Other kernels do not depend on it.
+    assert_eq!(run(&["check", "--case", "cells"]).code, 0);
+    // A timeout kills it; printing nothing is refused.
+    edit("kernels/blur.toml", &|s| {
+        let command = s.lines().find(|l| l.starts_with("command = ")).unwrap().to_string();
+        s.replace(&command, "command = [\"sh\", \"-c\", \"sleep 30\"]\ntimeout = 0.5")
+    });
+    let start = std::time::Instant::now();
+    let r = run(&["render", "blur", "--size", "8x8", "-o", "x.png"]);
+    assert_rejected(&r, 2, &["[source] command `sh -c sleep 30` timed out after 0.5 s and was killed"]);
+    assert!(start.elapsed() < std::time::Duration::from_secs(20), "{:?}", start.elapsed());
+    edit("kernels/blur.toml", &|s| s.replace("sleep 30", "true"));
+    let r = run(&["render", "blur", "--size", "8x8", "-o", "x.png"]);
+    assert_rejected(&r, 2, &["[source] command `sh -c true` printed nothing"]);
+    // Keys a command needs, named.
+    edit("kernels/blur.toml", &|s| s.replace("command = [\"sh\", \"-c\", \"true\"]\n", ""));
+    let r = run(&["render", "blur", "--size", "8x8", "-o", "x.png"]);
+    assert_rejected(&r, 2, &["[source] inputs and timeout belong to a command"]);
 }
 
 /// Every file an assembly reaches, and every replacement, is in the shader
@@ -7222,6 +7312,7 @@ fn main() {
         Gpu the_sources_example_passes_on_every_backend_with_a_copied_binary,
         Gpu included_files_outside_shaders_are_mutated_and_watched,
         Gpu assembled_sources_name_their_own_files,
+        Gpu a_projects_own_preprocessor_runs_through_source_command,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,
         Gpu graph_inputs_are_checked_before_gpu_work,
         Gpu memory_past_the_budget_is_refused_before_allocation,

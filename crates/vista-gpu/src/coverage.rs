@@ -60,8 +60,9 @@ impl Coverage {
 /// Where the spans of a composed module point.
 #[derive(Debug)]
 pub(crate) enum Origins {
-    /// naga parsed `text` directly: `file`'s own, or an assembly of files.
-    Direct { text: String, file: String, assembled: Option<vista_source::Assembled> },
+    /// naga parsed `text` directly: `file`'s own, or an assembly of files
+    /// (neither: a compiler's or a command's output, not measured).
+    Direct { text: String, file: Option<String>, assembled: Option<vista_source::Assembled> },
     /// naga_oil composed it: each module index's file (none for a
     /// generated module) and preprocessed source (index 0: the kernel).
     Composed { modules: HashMap<usize, (Option<String>, String)> },
@@ -141,7 +142,7 @@ impl<'a> Placer<'a> {
             Origins::Direct { text, file, assembled } => {
                 let (line, col) = line_col(text, start)?;
                 match assembled {
-                    None => Some(Place { file: file.clone(), line, col }),
+                    None => Some(Place { file: file.clone()?, line, col }),
                     Some(a) => {
                         let (path, at) = a.locate_path(line as usize)?;
                         Some(Place { file: path.to_string(), line: at as u32, col })
@@ -283,5 +284,18 @@ mod tests {
         let lines: Vec<u32> = counted_lines(&set, "k.wgsl").into_iter().map(|(_, l)| l).collect();
         assert_eq!(lines, [4, 5, 7]);
         assert_eq!(set.covered().coverage("k.wgsl").unwrap().group, 3);
+    }
+
+    /// A command's output and the wesl crate's are not the user's lines:
+    /// nothing of them is measured (never a count on a line the file lacks).
+    #[test]
+    fn generated_and_compiled_text_is_not_measured() {
+        let kernel = "@group(0) @binding(0) var<storage, read_write> out: array<f32>;\n@compute @workgroup_size(1)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n    if id.x > 3u {\n        out[id.x] = 1.0;\n    }\n}\n";
+        let origin = crate::generated_origin("/p/shaders/k.tmpl", "python3 t.py {shader}");
+        let set = crate::ShaderSet::from_files("test", [("k.tmpl".into(), kernel.into(), origin)]);
+        assert!(counted_lines(&set, "k.tmpl").is_empty());
+        let set = crate::ShaderSet::from_files("test", [("k.wesl".into(), kernel.into(), "/p/shaders/k.wesl".into())]);
+        assert!(set.compose("k.wesl").is_ok());
+        assert!(counted_lines(&set, "k.wesl").is_empty());
     }
 }

@@ -53,6 +53,25 @@ pub struct ShaderSet {
     covers: Arc<Mutex<HashMap<String, Arc<Coverage>>>>,
     /// This set's [`ShaderSet::covered`] twin, made once and shared by clones.
     twin: Arc<std::sync::OnceLock<ShaderSet>>,
+    /// Kernel files a `[source] command` generated: the inputs it read
+    /// (root-relative path, hash), or why there is no text (the command
+    /// failed), said when the file is composed.
+    generated: BTreeMap<String, Result<Vec<(String, String)>, String>>,
+}
+
+/// The origin of a file a `[source] command` generated from `path`: what
+/// errors name, and a mark that coverage does not measure it (its lines
+/// are the command's output, not the user's file).
+pub fn generated_origin(path: &str, command: &str) -> String {
+    format!("{path} (as `{command}` generated it)")
+}
+
+/// The end of a `.wesl` kernel's origin once compiled: its text is the
+/// compiler's, not traced to the user's lines.
+const COMPILED_BY_WESL: &str = " (as the wesl crate compiled it)";
+
+fn is_generated(origin: &str) -> bool {
+    origin.ends_with("` generated it)")
 }
 
 /// A root-relative path's text and origin, for files an assembly reaches
@@ -186,7 +205,23 @@ impl ShaderSet {
             coverage: false,
             covers: Default::default(),
             twin: Default::default(),
+            generated: BTreeMap::new(),
         }
+    }
+
+    /// This set with the files `[source] command`s generated (already
+    /// among its files, their origins from [`generated_origin`]): each with
+    /// the inputs the command read, which join its file hashes, or the
+    /// command's failure, which composing the file reports.
+    pub fn with_generated(
+        mut self,
+        files: impl IntoIterator<Item = (String, Result<Vec<(String, String)>, String>)>,
+    ) -> ShaderSet {
+        self.generated.extend(files);
+        self.units = Default::default();
+        self.composed = Default::default();
+        self.twin = Default::default();
+        self
     }
 
     /// This set composing every kernel with coverage counters (SPEC 20):
@@ -288,6 +323,9 @@ impl ShaderSet {
     /// shader defs (boolean) to compose it with, e.g. `fbm.wgsl?VISTA_HASH_PLANE`.
     fn kernel_source(&self, name: &str) -> Result<&Source, GpuError> {
         let name = file_of(name);
+        if let Some(Err(why)) = self.generated.get(name) {
+            return Err(GpuError::Shader(why.clone()));
+        }
         self.kernels.get(name).ok_or_else(|| {
             // The project's own files: the built-ins' are not what a
             // project's manifest means to name.
@@ -359,7 +397,7 @@ impl ShaderSet {
                 // A compiler's output names its root file as compiled.
                 let origin = match a.traced() {
                     true => kernel.origin.clone(),
-                    false => format!("{} (as the wesl crate compiled it)", kernel.origin),
+                    false => format!("{}{COMPILED_BY_WESL}", kernel.origin),
                 };
                 Unit { source: Source::new(kernel.rel.clone(), a.text.clone(), origin), assembled: Some(a) }
             }
@@ -610,7 +648,9 @@ impl ShaderSet {
     /// vista's built-in modules the project does not have (no file of the
     /// project to show it in: not measured).
     fn report_path(source: &Source) -> Option<String> {
-        let own = !source.origin.starts_with("<generated>") && !source.origin.starts_with("<built-in>");
+        let own = !source.origin.starts_with("<generated>")
+            && !source.origin.starts_with("<built-in>")
+            && !is_generated(&source.origin);
         own.then(|| format!("shaders/{}", source.rel))
     }
 
@@ -635,9 +675,10 @@ impl ShaderSet {
             })?;
             validate(name, &module)?;
             // A compiler's output (WESL) is not traced to its files: not measured.
+            let compiled = kernel.origin.ends_with(COMPILED_BY_WESL);
             let origins = self.coverage.then(|| Origins::Direct {
                 text: source.clone(),
-                file: ShaderSet::report_path(kernel).unwrap_or_default(),
+                file: ShaderSet::report_path(kernel).filter(|_| !compiled),
                 assembled: None,
             });
             return Ok((module, origins));
@@ -808,7 +849,17 @@ impl ShaderSet {
             }
             None => vec![(name.to_string(), hash(&kernel.text))],
         };
-        Ok(parts.into_iter().chain(lib.iter().map(|e| (e.rel.clone(), hash(&e.text)))).chain(enums).collect())
+        // What a command read besides the file, by its root-relative path.
+        let inputs = match self.generated.get(&kernel.rel) {
+            Some(Ok(inputs)) => inputs.iter().map(|(path, h)| (shader_rel(path), h.clone())).collect(),
+            _ => Vec::new(),
+        };
+        Ok(parts
+            .into_iter()
+            .chain(lib.iter().map(|e| (e.rel.clone(), hash(&e.text))))
+            .chain(enums)
+            .chain(inputs)
+            .collect())
     }
 
     /// The kernel file and the lib modules it reaches through `#import`

@@ -272,6 +272,24 @@ impl Kernel {
         out
     }
 
+    /// Each shader file a `[source] command` generates, with its generator
+    /// (a pass's files with the pass's merged `[source]`), in pass order.
+    /// Two passes that generate one file differently are the caller's to
+    /// refuse.
+    pub fn generated_files(&self) -> Vec<(String, vista_source::Generator)> {
+        let mut out: Vec<(String, vista_source::Generator)> = Vec::new();
+        for (i, pass) in self.graph().passes.iter().enumerate() {
+            let Some(g) = self.source_for(i).generator() else { continue };
+            let file = pass.shader.as_deref().unwrap_or(self.shader());
+            for file in std::iter::once(file).chain(pass.vertex_file()) {
+                if !out.iter().any(|(f, known)| f == file && *known == g) {
+                    out.push((file.to_string(), g.clone()));
+                }
+            }
+        }
+        out
+    }
+
     /// What each pass composes, without defs: its file, or `file|id` where
     /// a `[source]` assembles it ([`Kernel::source_specs`]). The shader
     /// hash and per-file hashes are taken over these.

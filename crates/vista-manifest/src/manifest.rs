@@ -393,7 +393,9 @@ pub fn parse(name: &str, origin: &str, text: &str) -> Result<Manifest, ParamErro
     let files = std::iter::once(&shader).chain(graph.passes.iter().filter_map(|p| p.shader.as_ref()));
     for f in files {
         let known = f.ends_with(".wgsl") || f.ends_with(".wesl");
-        if !known && language.is_none() {
+        // A command's output is WGSL whatever its template is called.
+        let generated = source.command.is_some() || graph.passes.iter().any(|p| p.source.command.is_some());
+        if !known && language.is_none() && !generated {
             return Err(kfail(format!(
                 "shader \"{f}\" is not a .wgsl or .wesl file; add language = \"wgsl\" to read it as WGSL"
             )));

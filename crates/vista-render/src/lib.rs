@@ -11,6 +11,7 @@
 //! writes), or knowing any kernel's meaning (`vista-kernels`).
 #![deny(missing_docs)]
 
+mod command;
 mod coverage;
 mod error;
 pub mod graph;
@@ -307,6 +308,20 @@ pub fn composes(shaders: &ShaderSet, kernel: &Kernel) -> Result<(), String> {
 pub fn paths_outside_shaders(project: &vista_project::Project) -> Result<Vec<String>, RenderError> {
     let (specs, _) = source_specs(project)?;
     let mut out: Vec<String> = Vec::new();
+    // What a `[source] command` reads: its inputs and script.
+    if let Some(root) = project.root() {
+        let registry =
+            vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
+        for k in registry.kernels() {
+            for (file, g) in k.generated_files() {
+                for p in command::dependencies(root, &format!("shaders/{file}"), &g) {
+                    if !out.contains(&p) {
+                        out.push(p);
+                    }
+                }
+            }
+        }
+    }
     for (_, s) in specs {
         let named = s.include.iter().chain(&s.prepend).chain(&s.append).flatten().cloned();
         for p in named.chain(s.packages.into_iter().map(|(_, dir)| dir)) {

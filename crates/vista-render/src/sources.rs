@@ -6,6 +6,10 @@ use vista_gpu::ShaderSet;
 
 use crate::RenderError;
 
+/// A file a `[source] command` generated: its path under `shaders/` and
+/// the inputs it read (root-relative path, hash), or why there is no text.
+type GeneratedFile = (String, Result<Vec<(String, String)>, String>);
+
 /// A project's WGSL read once: its `shaders/` files over the built-ins,
 /// each kernel's generated `vista::enums` module, its `[source]`
 /// assemblies and a reader of the files they reach outside `shaders/`.
@@ -19,6 +23,8 @@ pub struct Sources {
     enums: Vec<(String, String, String)>,
     specs: Vec<(String, vista_source::SourceSpec)>,
     reader: vista_gpu::Reader,
+    /// Files a `[source] command` generated: the inputs it read, or why not.
+    generated: Vec<GeneratedFile>,
 }
 
 impl Sources {
@@ -33,11 +39,12 @@ impl Sources {
         let mut files: Vec<(String, String, String)> =
             project.shader_files()?.into_iter().map(|f| (f.rel, f.text, f.origin)).collect();
         files.extend(other_extensions(project, &registry, &files));
+        let generated = generate(project, &registry, &mut files);
         let (specs, reader) = specs_of(project, &registry);
         files.extend(generated_modules(&specs)?);
         let mut enums = enums_of(&registry);
         enums.extend(test_file_enums(&files, &enums));
-        Ok(Sources { label, files, enums, specs, reader })
+        Ok(Sources { label, files, enums, specs, reader, generated })
     }
 
     /// The project's shader set.
@@ -45,6 +52,7 @@ impl Sources {
         ShaderSet::from_files(&self.label, self.files.iter().cloned())
             .with_enums(self.enums.iter().cloned())
             .with_sources(self.specs.iter().cloned(), self.reader.clone())
+            .with_generated(self.generated.iter().cloned())
     }
 
     /// The set with file `rel` holding `text` instead (a path relative to
@@ -74,7 +82,53 @@ impl Sources {
         ShaderSet::from_files(label, files)
             .with_enums(self.enums.iter().cloned())
             .with_sources(self.specs.iter().cloned(), reader)
+            .with_generated(self.generated.iter().cloned())
     }
+}
+
+/// Runs every kernel's `[source] command`s (or takes their cached output)
+/// and puts each output in place of its template among `files`. A command
+/// that fails, or a file two passes generate differently, is kept as the
+/// file's error, said when a case composes it.
+fn generate(
+    project: &vista_project::Project,
+    registry: &vista_kernels::Registry,
+    files: &mut Vec<(String, String, String)>,
+) -> Vec<GeneratedFile> {
+    let mut out: Vec<GeneratedFile> = Vec::new();
+    let mut by: Vec<(String, String, vista_source::Generator)> = Vec::new();
+    for k in registry.kernels() {
+        for (file, g) in k.generated_files() {
+            if let Some((_, other, known)) = by.iter().find(|(f, _, _)| *f == file) {
+                if *known != g {
+                    let why = format!(
+                        "shaders/{file}: kernels {other} and {} generate it with different [source] commands or \
+                         inputs (`{}`, `{}`); give each its own file",
+                        k.name(),
+                        known.display(),
+                        g.display()
+                    );
+                    out.retain(|(f, _)| *f != file);
+                    out.push((file, Err(why)));
+                }
+                continue;
+            }
+            by.push((file.clone(), k.name().to_string(), g.clone()));
+            let made = match project.root() {
+                Some(root) => crate::command::generate(root, &file, &g),
+                None => Err(format!("shaders/{file}: a [source] command runs in a project root; there is none")),
+            };
+            match made {
+                Ok(made) => {
+                    files.retain(|(rel, _, _)| *rel != file);
+                    files.push((file.clone(), made.text, made.origin));
+                    out.push((file, Ok(made.inputs)));
+                }
+                Err(why) => out.push((file, Err(why))),
+            }
+        }
+    }
+    out
 }
 
 /// The modules the kernels' `[source] modules` generate, as import-module

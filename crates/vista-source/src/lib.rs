@@ -16,7 +16,7 @@ mod spec;
 mod wesl;
 
 pub use assemble::{Assembled, Part, assemble};
-pub use spec::{Replacement, SourceSpec};
+pub use spec::{DEFAULT_COMMAND_TIMEOUT_MS, Generator, Replacement, SourceSpec};
 pub use wesl::compile_wesl;
 
 /// How deep brackets may nest in a shader file, and how many binary

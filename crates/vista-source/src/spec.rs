@@ -28,10 +28,48 @@ pub struct SourceSpec {
     /// Modules the host generates (`modules = { constants = { N = 3 } }`):
     /// each import path with its WGSL text, one `const` per entry.
     pub modules: Vec<(String, String)>,
+    /// The project's own generator (`command = ["python3", "tools/t.py",
+    /// "{shader}", "{out}"]`), run on the shader file before anything else;
+    /// its output is the WGSL assembled and composed.
+    pub command: Option<Vec<String>>,
+    /// Files the command reads besides the shader (root-relative): they
+    /// join the cache key and `--changed`/`watch` follow them.
+    pub inputs: Option<Vec<String>>,
+    /// How long the command may run, in milliseconds (default
+    /// [`DEFAULT_COMMAND_TIMEOUT_MS`]).
+    pub timeout_ms: Option<u64>,
 }
 
 /// The keys a `[source]` table may have.
-pub const KEYS: [&str; 6] = ["include", "prepend", "append", "replace", "packages", "modules"];
+pub const KEYS: [&str; 9] =
+    ["include", "prepend", "append", "replace", "packages", "modules", "command", "inputs", "timeout"];
+
+/// How long a `[source] command` may run unless `timeout` says: 30 s.
+pub const DEFAULT_COMMAND_TIMEOUT_MS: u64 = 30_000;
+
+/// The longest `timeout` allowed: 10 minutes.
+const MAX_COMMAND_TIMEOUT_S: f64 = 600.0;
+
+/// A `[source] command` with its inputs and timeout: how one shader file's
+/// WGSL is generated.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct Generator {
+    /// The program and its arguments; `{shader}` becomes the shader's
+    /// root-relative path, `{out}` the file the output is to be written to
+    /// (without `{out}`, the command's standard output is the WGSL).
+    pub command: Vec<String>,
+    /// Root-relative files it reads besides the shader.
+    pub inputs: Vec<String>,
+    /// How long it may run.
+    pub timeout_ms: u64,
+}
+
+impl Generator {
+    /// The command as one line, for messages: `python3 tools/t.py {shader} {out}`.
+    pub fn display(&self) -> String {
+        self.command.join(" ")
+    }
+}
 
 /// A `modules` entry: `name = { CONST = value, ... }` as the WGSL module
 /// `#define_import_path name` of typed `const`s: a non-negative integer a
@@ -152,6 +190,41 @@ impl SourceSpec {
                 return Err(format!("[source] modules = {other} is not valid; expected {{ module = {{ NAME = 1 }} }}"));
             }
         };
+        let command = match t.get("command") {
+            None => None,
+            Some(v) => {
+                let words: Option<Vec<String>> =
+                    v.as_array().and_then(|a| a.iter().map(|w| w.as_str().map(str::to_string)).collect());
+                match words {
+                    Some(w) if !w.is_empty() && !w[0].is_empty() => Some(w),
+                    _ => {
+                        return Err(format!(
+                            "[source] command = {v} is not valid; expected a list of strings, the program first \
+                             ([\"python3\", \"tools/render.py\", \"{{shader}}\", \"{{out}}\"])"
+                        ));
+                    }
+                }
+            }
+        };
+        let timeout_ms = match t.get("timeout") {
+            None => None,
+            Some(v) => {
+                let s = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+                match s {
+                    Some(s) if s > 0.0 && s <= MAX_COMMAND_TIMEOUT_S => Some((s * 1000.0).ceil() as u64),
+                    _ => {
+                        return Err(format!(
+                            "[source] timeout = {v} is not valid; expected seconds, more than 0 and at most \
+                             {MAX_COMMAND_TIMEOUT_S}"
+                        ));
+                    }
+                }
+            }
+        };
+        let inputs = paths("inputs")?;
+        if command.is_none() && (inputs.is_some() || timeout_ms.is_some()) {
+            return Err("[source] inputs and timeout belong to a command; add command = [...]".into());
+        }
         Ok(SourceSpec {
             include: paths("include")?,
             prepend: paths("prepend")?,
@@ -159,6 +232,9 @@ impl SourceSpec {
             replace,
             packages,
             modules,
+            command,
+            inputs,
+            timeout_ms,
         })
     }
 
@@ -175,12 +251,25 @@ impl SourceSpec {
             replace,
             packages: if pass.packages.is_empty() { self.packages.clone() } else { pass.packages.clone() },
             modules: if pass.modules.is_empty() { self.modules.clone() } else { pass.modules.clone() },
+            command: pass.command.clone().or_else(|| self.command.clone()),
+            inputs: pass.inputs.clone().or_else(|| self.inputs.clone()),
+            timeout_ms: pass.timeout_ms.or(self.timeout_ms),
         }
     }
 
-    /// Whether the spec changes nothing (no `[source]` at all).
+    /// Whether the spec assembles nothing (no `[source]` at all, or only a
+    /// `command`, which runs before assembly: [`SourceSpec::generator`]).
     pub fn is_empty(&self) -> bool {
-        *self == SourceSpec::default()
+        SourceSpec { command: None, inputs: None, timeout_ms: None, ..self.clone() } == SourceSpec::default()
+    }
+
+    /// The `command` that generates the shader's text, if any.
+    pub fn generator(&self) -> Option<Generator> {
+        Some(Generator {
+            command: self.command.clone()?,
+            inputs: self.inputs.clone().unwrap_or_default(),
+            timeout_ms: self.timeout_ms.unwrap_or(DEFAULT_COMMAND_TIMEOUT_MS),
+        })
     }
 
     /// A short stable name for this spec: composed names carry it, so one
@@ -188,7 +277,8 @@ impl SourceSpec {
     pub fn id(&self) -> String {
         // The text hashed before `modules` existed, so that a spec without
         // them keeps its id (and its composed name).
-        let SourceSpec { include, prepend, append, replace, packages, modules } = self;
+        // A command runs before assembly and is not part of it.
+        let SourceSpec { include, prepend, append, replace, packages, modules, .. } = self;
         let mut text = format!(
             "SourceSpec {{ include: {include:?}, prepend: {prepend:?}, append: {append:?}, replace: {replace:?}, \
              packages: {packages:?} }}"
@@ -264,5 +354,43 @@ mod tests {
         assert!(err("modules = { c = { X = 5000000000 } }").contains("expected an integer (i32 or u32)"));
         assert!(err("modules = { \"a b\" = { X = 1 } }").contains("a b is not a module path"));
         assert!(err("modules = { c = { \"1x\" = 1 } }").contains("c.1x is not a WGSL name"));
+    }
+}
+
+#[cfg(test)]
+mod command_tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<SourceSpec, String> {
+        SourceSpec::parse(&toml::from_str(text).unwrap())
+    }
+
+    #[test]
+    fn a_command_runs_before_assembly_and_merges_per_key() {
+        let kernel =
+            parse("command = [\"python3\", \"tools/t.py\", \"{shader}\"]\ninputs = [\"tools/blur.json\"]\n").unwrap();
+        // Only a command: nothing to assemble, and no new assembly id.
+        assert!(kernel.is_empty());
+        assert_eq!(kernel.id(), SourceSpec::default().id());
+        let g = kernel.generator().unwrap();
+        assert_eq!(g.inputs, ["tools/blur.json"]);
+        assert_eq!(g.timeout_ms, DEFAULT_COMMAND_TIMEOUT_MS);
+        assert_eq!(g.display(), "python3 tools/t.py {shader}");
+        let pass = parse("timeout = 2.5").unwrap_err();
+        assert!(pass.contains("inputs and timeout belong to a command"), "{pass}");
+        let pass = parse("command = [\"sh\", \"gen.sh\"]\ntimeout = 2.5").unwrap();
+        let m = kernel.merged(&pass);
+        let g = m.generator().unwrap();
+        assert_eq!((g.command[0].as_str(), g.inputs.len(), g.timeout_ms), ("sh", 1, 2500));
+        assert!(SourceSpec::default().generator().is_none());
+    }
+
+    #[test]
+    fn bad_commands_are_named() {
+        assert!(parse("command = []").unwrap_err().contains("[source] command = [] is not valid"));
+        assert!(parse("command = \"python3 t.py\"").unwrap_err().contains("expected a list of strings"));
+        assert!(parse("command = [\"a\"]\ntimeout = 0").unwrap_err().contains("[source] timeout = 0 is not valid"));
+        assert!(parse("command = [\"a\"]\ntimeout = 601").unwrap_err().contains("at most 600"));
+        assert!(parse("command = [\"a\"]\ninputs = [\"../x\"]").unwrap_err().contains("[source] inputs: \"../x\""));
     }
 }
