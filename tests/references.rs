@@ -904,6 +904,71 @@ fn sources_blur() -> Result<(), String> {
     .map(|_| ())
 }
 
+/// examples/render, view_rays: an engine-style View uniform given by leaf
+/// path (inputs/view.toml; the dense-fog case sets three leaves over it
+/// inline), drawn by a full-screen pass at 64 x 48. The reference builds
+/// each fragment's ray from the camera itself, not the file's matrices:
+/// eye (0, 2, 6) looking at (0, 1, 0), y up, 60 deg vertical field of view
+/// at aspect 64 / 48, through the texel centre; above the horizon
+/// mix(fog colour, zenith (0.18, 0.36, 0.85), dir.y), below it the ground
+/// plane y = 0 at t = 2 / -dir.y, mix(fog colour, (0.32, 0.27, 0.2),
+/// exp(-density max(t - 1, 0))); then the grade (columns (1, 0, 0),
+/// (0.08, 0.95, 0), (0, 0, 0.9)) and the exposure. A matrix packed row by
+/// row, a mat3x3 column without its padding or a fog block at the wrong
+/// offset moves every texel. Texels within 0.02 of the horizon are left
+/// out (the fog's slope there); allowance: f16 storage plus 2e-5 for the
+/// f32 ray (the near point's subtraction from the eye).
+fn render_view_rays_case(case: &str, exposure: f64, density: f64, fog: [f64; 3]) -> Result<(), String> {
+    let ctx = vista_gpu::Context::shared(&common::config().gpu).map_err(|e| e.to_string())?;
+    let project = vista_project::Project::at(&example("render")).map_err(|e| e.to_string())?;
+    let store = vista_golden::Store::of_project(&project, "references").map_err(|e| e.to_string())?;
+    let cases = store.load_cases().map_err(|e| e.to_string())?;
+    let c = cases.iter().find(|c| c.id == case).ok_or_else(|| format!("no case {case}"))?;
+    let gpu = vista_render::Renderer::new(ctx, &project, common::config().limits).map_err(|e| e.to_string())?;
+    let out = vista_render::render_with(&gpu, &c.kernel, &c.params, &c.inputs, c.width, c.height)
+        .map_err(|e| format!("{case}: {e}"))?;
+    let (w, h, got) = texels(&out)?;
+    let (eye, target) = ([0.0, 2.0, 6.0], [0.0, 1.0, 0.0]);
+    let norm = |v: [f64; 3]| {
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|c| c / l)
+    };
+    let cross =
+        |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let f = norm([target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]]);
+    let side = norm(cross(f, [0.0, 1.0, 0.0]));
+    let up = cross(side, f);
+    let (tan, aspect) = (30f64.to_radians().tan(), f64::from(w) / f64::from(h));
+    compare(case, w, &got, |x, y| {
+        let ndc = [2.0 * (f64::from(x) + 0.5) / f64::from(w) - 1.0, 1.0 - 2.0 * (f64::from(y) + 0.5) / f64::from(h)];
+        let (a, b) = (ndc[0] * aspect * tan, ndc[1] * tan);
+        let dir = norm([0, 1, 2].map(|k| a * side[k] + b * up[k] + f[k]));
+        if dir[1].abs() < 0.02 {
+            return None;
+        }
+        let mix = |p: [f64; 3], q: [f64; 3], t: f64| [0, 1, 2].map(|k| p[k] + (q[k] - p[k]) * t);
+        let c = match dir[1] >= 0.0 {
+            true => mix(fog, [0.18, 0.36, 0.85], dir[1]),
+            false => {
+                let t = -eye[1] / dir[1];
+                mix(fog, [0.32, 0.27, 0.2], (-density * (t - 1.0).max(0.0)).exp())
+            }
+        };
+        let graded = [c[0] + 0.08 * c[1], 0.95 * c[1], 0.9 * c[2]].map(|v| v * exposure);
+        let allow = graded.map(|v| f16_rounding(v) + 2e-5);
+        Some(([graded[0], graded[1], graded[2], 1.0], [allow[0], allow[1], allow[2], 0.0]))
+    })
+    .map(|_| ())
+}
+
+fn render_view_rays() -> Result<(), String> {
+    render_view_rays_case("view-rays", 1.25, 0.08, [0.7, 0.75, 0.8])
+}
+
+fn render_view_rays_dense_fog() -> Result<(), String> {
+    render_view_rays_case("view-rays-dense-fog", 1.5, 0.3, [0.55, 0.6, 0.7])
+}
+
 /// PCG hash (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT
 /// 2020): one LCG step, then the RXS-M-XS output permutation.
 fn pcg(v: u32) -> u32 {
@@ -1075,7 +1140,7 @@ fn main() {
         false => vista_gpu::Context::shared(&common::config().gpu).err().map(|e| e.to_string()),
     };
     let skip = no_gpu.is_some() && allow_no_gpu();
-    let tests: [(&str, Check); 15] = [
+    let tests: [(&str, Check); 17] = [
         ("references::graphs::row_offsets", graphs_row_offsets),
         ("references::harness_crate::glow", harness_crate_glow),
         ("references::project::marble", project_marble),
@@ -1084,6 +1149,8 @@ fn main() {
         ("references::render::grass", render_grass),
         ("references::render::sky_fullscreen_fisheye", render_sky_fisheye),
         ("references::render::sky_fullscreen_latlong", render_sky_latlong),
+        ("references::render::view_rays", render_view_rays),
+        ("references::render::view_rays_dense_fog", render_view_rays_dense_fog),
         ("references::sources::blur", sources_blur),
         ("references::sources::cells", sources_cells),
         ("references::sources::clouds_joined", sources_clouds_joined),

@@ -60,14 +60,19 @@ fn list(kernels: &vista_kernels::Registry) {
     }
 }
 
-/// `vista list --layout`: for each kernel and each shader its passes
-/// compose, every buffer binding with each leaf's offset, path and type;
-/// 2 where a kernel's WGSL does not compose.
-pub fn layouts(project: &Project) -> Result<i32, GoldenError> {
+/// `vista list --layout [KERNEL]`: for each kernel (or only `only`) and
+/// each shader its passes compose, every buffer binding with each leaf's
+/// offset, path and type, and for a binding given by leaf path whether
+/// each leaf is `set` or left `zero`; 2 where a kernel's WGSL does not
+/// compose.
+pub fn layouts(project: &Project, only: Option<&str>) -> Result<i32, GoldenError> {
     let kernels = registry(project)?;
+    if let Some(name) = only {
+        kernels.find(name).map_err(|e| GoldenError::BadInput(e.to_string()))?;
+    }
     let shaders = vista_render::shader_set(project)?;
     let mut bad = 0;
-    for k in kernels.kernels() {
+    for k in kernels.kernels().iter().filter(|k| only.is_none_or(|n| n == k.name())) {
         println!("{} — {}", k.name(), k.summary());
         let p = k.resolve(None, &[]).map_err(|e| GoldenError::BadInput(e.to_string()))?;
         let mut seen: Vec<String> = Vec::new();
@@ -86,13 +91,34 @@ pub fn layouts(project: &Project) -> Result<i32, GoldenError> {
                 }
             };
             println!("  {}:", name.split(['?', '|']).next().unwrap_or(&name));
+            let pass = &k.graph().passes[i];
             for b in vista_manifest::leaves::buffer_layouts(&module) {
+                // The resource bound to it, if the manifest gives it by leaf path.
+                let bound = pass.bind.iter().find(|(v, _)| *v == b.name).map(|(_, l)| l.resource.as_str());
+                let given = vista_render::leaf_values::manifest_leaves(project.root(), k, bound.unwrap_or(&b.name))
+                    .map_err(GoldenError::BadInput)?;
                 println!(
-                    "    @group({}) @binding({}) var<{}> {}: {} bytes",
-                    b.group, b.binding, b.space, b.name, b.size
+                    "    @group({}) @binding({}) var<{}> {}: {} bytes{}",
+                    b.group,
+                    b.binding,
+                    b.space,
+                    b.name,
+                    b.size,
+                    if given.is_some() { " (given by leaf path; others zero)" } else { "" }
                 );
                 for l in &b.leaves {
-                    println!("      {:<24} {:<32} {}", vista_manifest::leaves::offset_text(l), l.path, l.ty);
+                    let set = match &given {
+                        Some(g) if vista_render::leaf_values::is_given(&l.path, g) => "  set",
+                        Some(_) => "  zero",
+                        None => "",
+                    };
+                    let line = format!(
+                        "      {:<24} {:<32} {:<14}{set}",
+                        vista_manifest::leaves::offset_text(l),
+                        l.path,
+                        l.ty
+                    );
+                    println!("{}", line.trim_end());
                 }
             }
         }

@@ -65,6 +65,9 @@ enum Command {
         /// engine packs it.
         #[arg(long, conflicts_with = "names")]
         layout: bool,
+        /// With --layout: only this kernel.
+        #[arg(requires = "layout")]
+        kernel: Option<String>,
         /// Run every case with coverage counters and print, per kernel,
         /// the WGSL lines and branch arms no case reaches.
         #[arg(long, conflicts_with_all = ["names", "layout"])]
@@ -386,7 +389,7 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             };
             watch::watch(project, config, case.as_deref(), watch::interval(interval)?, timeout)
         }
-        Command::List { layout: true, .. } => list::layouts(project),
+        Command::List { layout: true, kernel, .. } => list::layouts(project, kernel.as_deref()),
         Command::List { coverage: true, .. } => list::coverage(project, config),
         Command::List { names, .. } => list::run(project, names),
         Command::Test { filter, matrix, bless, coverage } => {

@@ -6304,13 +6304,68 @@ fn indices_past_the_vertex_count_are_refused() {
     assert!(!out.exists());
 }
 
+/// Struct data by leaf path (examples/render, view_rays): the View
+/// uniform from a TOML file, the same from JSON (identical render), a
+/// case's inline leaves over it; `list --layout KERNEL` marks each leaf set
+/// or zero; a misspelt path names the nearest leaves, a wrong count the
+/// leaf's, a bad file value its file and key.
+fn struct_data_by_leaf_path_from_files_and_cases() {
+    let t = tmp();
+    let root = t.path().join("render");
+    copy_tree(&repo().join("examples/render"), &root);
+    let run = |args: &[&str]| vista_in(Some(&root), &[], args);
+    let l = run(&["list", "--layout", "view_rays"]);
+    assert_eq!(l.code, 0, "{}", l.stderr);
+    assert!(l.stdout.contains("var<uniform> view: 256 bytes (given by leaf path; others zero)"), "{}", l.stdout);
+    let line =
+        |path: &str| l.stdout.lines().find(|x| x.split_whitespace().nth(1) == Some(path)).unwrap_or("").to_string();
+    assert!(line("color_grading").starts_with("      160 ") && line("color_grading").ends_with("set"), "{}", l.stdout);
+    assert!(line("fog.density").ends_with("set") && line("frame_count").ends_with("zero"), "{}", l.stdout);
+    assert!(!l.stdout.contains("sky_fullscreen"), "only the kernel named");
+    assert_rejected(&run(&["list", "--layout", "nope"]), 2, &["unknown kernel 'nope'"]);
+    // The same leaves as JSON render the same frame.
+    let toml: toml::Table = toml::from_str(&std::fs::read_to_string(root.join("inputs/view.toml")).unwrap()).unwrap();
+    std::fs::write(root.join("inputs/view.json"), serde_json::to_string_pretty(&toml).unwrap()).unwrap();
+    let manifest = root.join("kernels/view_rays.toml");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(&manifest, text.replace("inputs/view.toml", "inputs/view.json")).unwrap();
+    let r = run(&["check", "--case", "view-rays*"]);
+    assert!(r.code == 0 && r.stdout.contains("2 passed"), "{}{}", r.stdout, r.stderr);
+    // Without the case's three leaves, the dense-fog case is the plain view.
+    let cases = root.join("golden/cases.toml");
+    let text = std::fs::read_to_string(&cases).unwrap();
+    let inline =
+        "inputs = { view = { exposure = 1.5, \"fog.density\" = 0.3, \"fog.color\" = [0.55, 0.6, 0.7, 1.0] } }\n";
+    assert!(text.contains(inline));
+    std::fs::write(&cases, text.replace(inline, "")).unwrap();
+    assert_eq!(run(&["check", "--case", "view-rays-dense-fog"]).code, 1, "the case's leaves reach the render");
+    for (bad, want) in [
+        (
+            "{ \"fog.densty\" = 0.3 }",
+            "fields: \"fog.densty\" names no leaf of var<uniform> View; nearest: fog.density, fog.start, fog.color",
+        ),
+        ("{ \"fog.color\" = [1, 2, 3] }", "fields: \"fog.color\" takes 4 numbers, not 3"),
+        ("\"inputs/bad.toml\"", "inputs/bad.toml: \"fog.density\" = \"thick\" is not valid; expected a number"),
+        ("7", "inputs: view = 7 is not valid; expected a file path"),
+    ] {
+        std::fs::write(root.join("inputs/bad.toml"), "[fog]\ndensity = \"thick\"\n").unwrap();
+        std::fs::write(
+            &cases,
+            format!("{text}\n[[case]]\nid = \"bad\"\nkernel = \"view_rays\"\ninputs = {{ view = {bad} }}\n"),
+        )
+        .unwrap();
+        let r = run(&["check", "--case", "bad"]);
+        assert!(r.code != 0 && format!("{}{}", r.stdout, r.stderr).contains(want), "{bad}: {}{}", r.stdout, r.stderr);
+    }
+}
+
 /// examples/render (SPEC 17's examples a and b), copied with a copied
 /// binary: its goldens pass on lavapipe, SwiftShader and Chromium; the
 /// full-screen sky draws what the built-in compute sky dispatches (within
 /// 120 dB on lavapipe, the other-driver threshold elsewhere); the
 /// bloom's glow is its own output; a halved up-sample fails the check.
 fn the_render_example_passes_on_every_backend_with_a_copied_binary() {
-    let (_t, bin, root) = copied_example("render", 7);
+    let (_t, bin, root) = copied_example("render", 9);
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
     let sets = ["--preset", "sunset", "--set", "projection=fisheye", "--size", "48x40"];
     let reference = root.join("compute.exr");
@@ -7313,6 +7368,7 @@ fn main() {
         Gpu included_files_outside_shaders_are_mutated_and_watched,
         Gpu assembled_sources_name_their_own_files,
         Gpu a_projects_own_preprocessor_runs_through_source_command,
+        Gpu struct_data_by_leaf_path_from_files_and_cases,
         Gpu the_pass_graph_examples_pass_on_every_backend_and_agree_with_the_cpu,
         Gpu graph_inputs_are_checked_before_gpu_work,
         Gpu memory_past_the_budget_is_refused_before_allocation,

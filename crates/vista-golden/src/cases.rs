@@ -60,7 +60,7 @@ struct RawCase {
     #[serde(default)]
     expect_fail: Vec<Expectation>,
     #[serde(default)]
-    inputs: BTreeMap<String, String>,
+    inputs: BTreeMap<String, toml::Value>,
     #[serde(default)]
     tolerances: BTreeMap<String, toml::Value>,
     #[serde(default)]
@@ -231,6 +231,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
                 )));
             }
         }
+        let mut inline: Vec<(String, String)> = Vec::new();
         if !raw.inputs.is_empty() {
             let g = kernel.graph();
             if g.resources.is_empty() {
@@ -239,14 +240,30 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
                     kernel.name()
                 )));
             }
-            for (name, file) in &raw.inputs {
+            for (name, value) in &raw.inputs {
                 let Some(r) = g.resources.iter().find(|r| &r.name == name) else {
                     let names: Vec<&str> = g.resources.iter().map(|r| r.name.as_str()).collect();
                     return Err(bad(format!("inputs: {name} names no resource; resources: {}", names.join(", "))));
                 };
+                // A buffer's leaf values inline: carried as JSON among the files.
+                let file = match value {
+                    toml::Value::String(f) => f.clone(),
+                    toml::Value::Table(t) if r.kind_name() == "buffer" => {
+                        let json = serde_json::to_string(t).map_err(|e| bad(format!("inputs: {name}: {e}")))?;
+                        inline.push((name.clone(), format!("{}{json}", vista_render::leaf_values::INLINE)));
+                        continue;
+                    }
+                    other => {
+                        return Err(bad(format!(
+                            "inputs: {name} = {other} is not valid; expected a file path (or, for a buffer, a table \
+                             of leaf values {{ \"view.exposure\" = 2.0 }})"
+                        )));
+                    }
+                };
+                let file = &file;
                 let want: &[&str] = match r.kind_name() {
                     "texture" => &[".png", ".exr"],
-                    "buffer" => &[".npy", ".bin"],
+                    "buffer" => &[".npy", ".bin", ".toml", ".json"],
                     _ => &[],
                 };
                 if file.starts_with('/') || file.split(['/', '\\']).any(|c| c == "..") {
@@ -304,7 +321,12 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             max_bad_ratio: raw.max_bad_ratio,
             ignore: raw.ignore,
             expect_fail: raw.expect_fail,
-            inputs: raw.inputs.into_iter().collect(),
+            inputs: raw
+                .inputs
+                .into_iter()
+                .filter_map(|(n, v)| v.as_str().map(|f| (n, f.to_string())))
+                .chain(inline)
+                .collect(),
             tolerances,
             doc: raw.doc,
         });

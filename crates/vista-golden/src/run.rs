@@ -91,6 +91,9 @@ pub fn inputs_of(case: &Case, root: Option<&std::path::Path>) -> Vec<(String, St
             }
             ResourceKind::Buffer { file, data, .. } => {
                 let what = match (replaced.or(file.clone()), data) {
+                    (Some(f), _) if f.starts_with(vista_render::leaf_values::INLINE) => {
+                        format!("buffer from the case's leaf values {}", &f[vista_render::leaf_values::INLINE.len()..])
+                    }
                     (Some(f), _) if f.ends_with(".npy") => {
                         match at(&f).and_then(|p| vista_image::npy::read_npy(&p).map_err(|e| e.to_string())) {
                             Ok(n) => format!("buffer from {f} (dtype {}, shape {:?})", n.descr, n.shape),

@@ -655,9 +655,11 @@ fn buffer_kind(
         Some(v) => Some(Expr::parse_entry(v, params).map_err(|e| at(format!("length {e}")))?),
     };
     if let Some(f) = &file
-        && !(f.ends_with(".npy") || f.ends_with(".bin"))
+        && ![".npy", ".bin", ".toml", ".json"].iter().any(|e| f.ends_with(e))
     {
-        return Err(at(format!("file = \"{f}\" is not valid for a buffer; expected a .npy or .bin file")));
+        return Err(at(format!(
+            "file = \"{f}\" is not valid for a buffer; expected a .npy or .bin file, or .toml or .json leaf values"
+        )));
     }
     let fields = match t.get("fields") {
         None => None,

@@ -194,9 +194,37 @@ pub(crate) fn plan_graph(
             ResourceKind::Texture { size, file, mip_levels, .. } => {
                 at.texture(r, size.as_deref(), file.as_ref(), *mip_levels, resolved.outputs.contains(&ri))
             }
-            ResourceKind::Buffer { fields: Some(fields), .. } => at.fields(r, fields),
-            ResourceKind::Buffer { file, data, fill, length, .. } => {
-                at.buffer(r, file.as_ref(), data.as_deref(), *fill, length.as_ref(), resolved.outputs.contains(&ri))
+            ResourceKind::Buffer { file, data, fill, length, fields } => {
+                use crate::leaf_values::is_leaf_file;
+                let replaced = at.inputs.iter().find(|(n, _)| *n == r.spec.name).map(|(_, f)| f.as_str());
+                let own_leaves = file.as_deref().filter(|f| is_leaf_file(f));
+                match replaced {
+                    // Leaf values in layers: the manifest's fields, its file's,
+                    // then the case's (a file or an inline table) over them.
+                    Some(f) if is_leaf_file(f) => {
+                        let mut all = fields.clone().unwrap_or_default();
+                        if let Some(own) = own_leaves {
+                            all.extend(at.leaf_file(r, own)?);
+                        }
+                        all.extend(at.leaf_file(r, f)?);
+                        at.fields(r, &all)
+                    }
+                    None if own_leaves.is_some() || fields.is_some() => {
+                        let mut all = fields.clone().unwrap_or_default();
+                        if let Some(own) = own_leaves {
+                            all.extend(at.leaf_file(r, own)?);
+                        }
+                        at.fields(r, &all)
+                    }
+                    _ => at.buffer(
+                        r,
+                        file.as_ref(),
+                        data.as_deref(),
+                        *fill,
+                        length.as_ref(),
+                        resolved.outputs.contains(&ri),
+                    ),
+                }
             }
             ResourceKind::Depth { size } => at.depth(r, size.as_deref()),
             ResourceKind::Sampler { linear, address, compare } => {
@@ -407,6 +435,22 @@ impl Planning<'_> {
         Ok(vista_gpu::Resource::Depth(wh))
     }
 
+    /// The leaf values of a `.toml` or `.json` file (root-relative), or of a
+    /// case's inline table.
+    fn leaf_file(
+        &self,
+        r: &vista_manifest::graph::ResolvedResource,
+        file: &str,
+    ) -> Result<Vec<(String, Vec<f64>)>, RenderError> {
+        let at = |m: String| self.bad(format!("resource {}: {m}", r.spec.name));
+        if let Some(json) = file.strip_prefix(crate::leaf_values::INLINE) {
+            return crate::leaf_values::parse("the case's inputs", json).map_err(at);
+        }
+        let bytes = read_input(self.root, file, &under(self.root, file).map_err(at)?).map_err(at)?;
+        let text = String::from_utf8(bytes).map_err(|_| at(format!("file {file} is not UTF-8 text")))?;
+        crate::leaf_values::parse(file, &text).map_err(at)
+    }
+
     /// A buffer of one struct from `fields`: each named field's leaves in
     /// order (`lights[1].color` is `lights.1.color`, a vector's x y z w, a
     /// matrix's columns), every other leaf zero.
@@ -428,9 +472,14 @@ impl Planning<'_> {
             let leaves: Vec<&(u32, char, String)> =
                 e.leaves.iter().filter(|(_, _, p)| *p == path || p.starts_with(&format!("{path}."))).collect();
             if leaves.is_empty() {
-                let mut tops: Vec<&str> = e.leaves.iter().map(|(_, _, p)| p.split('.').next().unwrap_or(p)).collect();
-                tops.dedup();
-                return Err(at(format!("fields: \"{key}\" names no field of {}; fields: {}", e.wgsl, tops.join(", "))));
+                let mut known: Vec<String> = e.leaves.iter().map(|(_, _, p)| user_path(p)).collect();
+                known.dedup();
+                let near = crate::leaf_values::nearest(key, known.iter().map(String::as_str));
+                return Err(at(format!(
+                    "fields: \"{key}\" names no leaf of {}; nearest: {} (vista list --layout lists every leaf)",
+                    e.wgsl,
+                    near.join(", ")
+                )));
             }
             if leaves.len() != values.len() {
                 return Err(at(format!(
@@ -1105,6 +1154,29 @@ fn file_extent(file: &str, [fw, fh]: [u32; 2], size: Option<[u32; 3]>, cube: boo
 fn under(root: Option<&Path>, file: &str) -> Result<PathBuf, String> {
     let root = root.ok_or_else(|| format!("file {file} needs a project root (vista.toml) to be found under"))?;
     Ok(root.join(file))
+}
+
+/// A leaf's path as a user writes it: `lights[0].color` for the element
+/// path `lights.0.color.x` (a vector's or matrix's components are one leaf).
+fn user_path(p: &str) -> String {
+    let component = |s: &str| {
+        matches!(s, "x" | "y" | "z" | "w")
+            || (s.len() == 4 && s.starts_with('c') && s.as_bytes()[2] == b'r' && s[1..2].parse::<u8>().is_ok())
+    };
+    let parts: Vec<&str> = p.split('.').collect();
+    let keep = match parts.last() {
+        Some(last) if parts.len() > 1 && component(last) => &parts[..parts.len() - 1],
+        _ => &parts[..],
+    };
+    let mut out = String::new();
+    for part in keep {
+        match part.parse::<u32>() {
+            Ok(i) => out.push_str(&format!("[{i}]")),
+            Err(_) if out.is_empty() => out.push_str(part),
+            Err(_) => out.push_str(&format!(".{part}")),
+        }
+    }
+    out
 }
 
 /// An input file's bytes: a regular file inside the project after

@@ -15,6 +15,7 @@ mod command;
 mod coverage;
 mod error;
 pub mod graph;
+pub mod leaf_values;
 mod reflect;
 mod sources;
 pub mod worker;
