@@ -231,53 +231,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
                 )));
             }
         }
-        let mut inline: Vec<(String, String)> = Vec::new();
-        if !raw.inputs.is_empty() {
-            let g = kernel.graph();
-            if g.resources.is_empty() {
-                return Err(bad(format!(
-                    "inputs: kernel {} has no [[resource]] files to replace (a pass graph's inputs)",
-                    kernel.name()
-                )));
-            }
-            for (name, value) in &raw.inputs {
-                let Some(r) = g.resources.iter().find(|r| &r.name == name) else {
-                    let names: Vec<&str> = g.resources.iter().map(|r| r.name.as_str()).collect();
-                    return Err(bad(format!("inputs: {name} names no resource; resources: {}", names.join(", "))));
-                };
-                // A buffer's leaf values inline: carried as JSON among the files.
-                let file = match value {
-                    toml::Value::String(f) => f.clone(),
-                    toml::Value::Table(t) if r.kind_name() == "buffer" => {
-                        let json = serde_json::to_string(t).map_err(|e| bad(format!("inputs: {name}: {e}")))?;
-                        inline.push((name.clone(), format!("{}{json}", vista_render::leaf_values::INLINE)));
-                        continue;
-                    }
-                    other => {
-                        return Err(bad(format!(
-                            "inputs: {name} = {other} is not valid; expected a file path (or, for a buffer, a table \
-                             of leaf values {{ \"view.exposure\" = 2.0 }})"
-                        )));
-                    }
-                };
-                let file = &file;
-                let want: &[&str] = match r.kind_name() {
-                    "texture" => &[".png", ".exr"],
-                    "buffer" => &[".npy", ".bin", ".toml", ".json"],
-                    _ => &[],
-                };
-                if file.starts_with('/') || file.split(['/', '\\']).any(|c| c == "..") {
-                    return Err(bad(format!("inputs: {name} = \"{file}\" must be a path under the project root")));
-                }
-                if !want.iter().any(|e| file.ends_with(e)) {
-                    return Err(bad(format!(
-                        "inputs: {name} = \"{file}\" is not valid for a {}; expected a {} file",
-                        r.kind_name(),
-                        if want.is_empty() { "(none: a sampler has no file)".to_string() } else { want.join(" or ") }
-                    )));
-                }
-            }
-        }
+        let inputs = case_inputs(kernel, &raw.inputs).map_err(bad)?;
         let mut tolerances = Vec::new();
         for (name, v) in &raw.tolerances {
             let outputs: Vec<&str> = kernel.graph().outputs.iter().filter_map(|o| o.resource.as_deref()).collect();
@@ -321,12 +275,7 @@ pub fn parse_cases(path: &Path, text: &str, kernels: &vista_kernels::Registry) -
             max_bad_ratio: raw.max_bad_ratio,
             ignore: raw.ignore,
             expect_fail: raw.expect_fail,
-            inputs: raw
-                .inputs
-                .into_iter()
-                .filter_map(|(n, v)| v.as_str().map(|f| (n, f.to_string())))
-                .chain(inline)
-                .collect(),
+            inputs,
             tolerances,
             doc: raw.doc,
         });
@@ -370,4 +319,61 @@ pub fn select<'a>(cases: &'a [Case], glob: Option<&str>) -> Result<Vec<&'a Case>
         )));
     }
     Ok(picked)
+}
+
+/// A case's `inputs`: resource files replaced (`(name, path)`), and a
+/// buffer's inline leaf values carried as [`vista_render::leaf_values::INLINE`]
+/// JSON; the error says what is allowed.
+fn case_inputs(
+    kernel: &vista_kernels::Kernel,
+    raw: &BTreeMap<String, toml::Value>,
+) -> Result<Vec<(String, String)>, String> {
+    let mut inline: Vec<(String, String)> = Vec::new();
+    if !raw.is_empty() {
+        let g = kernel.graph();
+        if g.resources.is_empty() {
+            return Err(format!(
+                "inputs: kernel {} has no [[resource]] files to replace (a pass graph's inputs)",
+                kernel.name()
+            ));
+        }
+        for (name, value) in raw {
+            let Some(r) = g.resources.iter().find(|r| &r.name == name) else {
+                let names: Vec<&str> = g.resources.iter().map(|r| r.name.as_str()).collect();
+                return Err(format!("inputs: {name} names no resource; resources: {}", names.join(", ")));
+            };
+            // A buffer's leaf values inline: carried as JSON among the files.
+            let file = match value {
+                toml::Value::String(f) => f.clone(),
+                toml::Value::Table(t) if r.kind_name() == "buffer" => {
+                    let json = serde_json::to_string(t).map_err(|e| format!("inputs: {name}: {e}"))?;
+                    inline.push((name.clone(), format!("{}{json}", vista_render::leaf_values::INLINE)));
+                    continue;
+                }
+                other => {
+                    return Err(format!(
+                        "inputs: {name} = {other} is not valid; expected a file path (or, for a buffer, a table \
+                         of leaf values {{ \"view.exposure\" = 2.0 }})"
+                    ));
+                }
+            };
+            let file = &file;
+            let want: &[&str] = match r.kind_name() {
+                "texture" => &[".png", ".exr"],
+                "buffer" => &[".npy", ".bin", ".toml", ".json"],
+                _ => &[],
+            };
+            if file.starts_with('/') || file.split(['/', '\\']).any(|c| c == "..") {
+                return Err(format!("inputs: {name} = \"{file}\" must be a path under the project root"));
+            }
+            if !want.iter().any(|e| file.ends_with(e)) {
+                return Err(format!(
+                    "inputs: {name} = \"{file}\" is not valid for a {}; expected a {} file",
+                    r.kind_name(),
+                    if want.is_empty() { "(none: a sampler has no file)".to_string() } else { want.join(" or ") }
+                ));
+            }
+        }
+    }
+    Ok(raw.iter().filter_map(|(n, v)| v.as_str().map(|f| (n.clone(), f.to_string()))).chain(inline).collect())
 }

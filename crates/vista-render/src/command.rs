@@ -38,6 +38,12 @@ const MAX_OUTPUT: u64 = guard::MAX_TEXT_BYTES;
 /// again by the next [`crate::Sources`] of the same project (a worker's).
 static MEMO: Mutex<Option<HashMap<String, Result<String, String>>>> = Mutex::new(None);
 
+/// Held while a command runs (see [`generate`]).
+static RUNNING: Mutex<()> = Mutex::new(());
+
+/// Numbers each run's `{out}` file within this process.
+static RUNS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
 /// The folder of cached outputs under `root`.
 const CACHE: &str = "target/vista-cache/command";
 
@@ -87,6 +93,12 @@ pub(crate) fn generate(root: &Path, file: &str, g: &Generator) -> Result<Generat
     if let Some(known) = MEMO.lock().expect("command memo").get_or_insert_default().get(&key) {
         return known.clone().map(done);
     }
+    // One run at a time in this process: threads that ask for the same
+    // output at once (a test binary's) wait, then find it in the memo.
+    let _running = RUNNING.lock().expect("command lock");
+    if let Some(known) = MEMO.lock().expect("command memo").get_or_insert_default().get(&key) {
+        return known.clone().map(done);
+    }
     let result = cached_or_run(root, &shader, g, &key).map_err(fail);
     MEMO.lock().expect("command memo").get_or_insert_default().insert(key, result.clone());
     result.map(done)
@@ -102,7 +114,9 @@ fn cached_or_run(root: &Path, shader: &str, g: &Generator, key: &str) -> Result<
     {
         return Ok(text);
     }
-    let out = dir.join(format!(".out-{}-{key}.wgsl", std::process::id()));
+    // Unique to this process and run: another process may run the same command now.
+    let run_id = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let out = dir.join(format!(".out-{}-{run_id}-{key}.wgsl", std::process::id()));
     let out_rel = format!("{CACHE}/{}", out.file_name().unwrap_or_default().to_string_lossy());
     let uses_out = g.command.iter().any(|w| w.contains("{out}"));
     let argv: Vec<String> =
