@@ -969,6 +969,54 @@ fn render_view_rays_dense_fog() -> Result<(), String> {
     render_view_rays_case("view-rays-dense-fog", 1.5, 0.3, [0.55, 0.6, 0.7])
 }
 
+/// examples/sources, tonemap (WESL: curves under module-scope @if blocks,
+/// the method a feature each case turns on by enum value or def, stops and
+/// bands from [source] modules) at 64 x 24: radiance 2^s tint, s = -4 +
+/// 9 (x + 0.5) / 64, tint by band of 8 rows (1, 0.6, 0.3), (1, 1, 1),
+/// (0.3, 0.6, 1); then Reinhard c / (1 + c), exponential 1 - e^-c or
+/// Narkowicz's ACES fit c (2.51 c + 0.03) / (c (2.43 c + 0.59) + 0.14)
+/// clamped to [0, 1]; alpha (4 curve + asked) / 16: the compiled curve's
+/// index and the method param's (the ACES case turns the feature on by a
+/// def and leaves the param at reinhard). Allowance: f16 storage plus
+/// 1e-5 for f32 (exp2 within a few ulp of 2^5).
+fn sources_tonemap_case(case: &str, method: &str, asked: f64) -> Result<(), String> {
+    let ctx = vista_gpu::Context::shared(&common::config().gpu).map_err(|e| e.to_string())?;
+    let project = vista_project::Project::at(&example("sources")).map_err(|e| e.to_string())?;
+    let store = vista_golden::Store::of_project(&project, "references").map_err(|e| e.to_string())?;
+    let cases = store.load_cases().map_err(|e| e.to_string())?;
+    let c = cases.iter().find(|c| c.id == case).ok_or_else(|| format!("no case {case}"))?;
+    let gpu = vista_render::Renderer::new(ctx, &project, common::config().limits).map_err(|e| e.to_string())?;
+    let out = vista_render::render_with(&gpu, &c.kernel, &c.params, &c.inputs, c.width, c.height)
+        .map_err(|e| format!("{case}: {e}"))?;
+    let (w, h, got) = texels(&out)?;
+    let (curve, id): (fn(f64) -> f64, f64) = match method {
+        "reinhard" => (|c| c / (1.0 + c), 0.0),
+        "exponential" => (|c| 1.0 - (-c).exp(), 1.0),
+        _ => (|c| (c * (2.51 * c + 0.03) / (c * (2.43 * c + 0.59) + 0.14)).clamp(0.0, 1.0), 2.0),
+    };
+    let tints = [[1.0, 0.6, 0.3], [1.0, 1.0, 1.0], [0.3, 0.6, 1.0]];
+    compare(case, w, &got, |x, y| {
+        let s = -4.0 + 9.0 * (f64::from(x) + 0.5) / f64::from(w);
+        let band = ((y * 3) / h).min(2) as usize;
+        let c = tints[band].map(|t| curve(s.exp2() * t));
+        let allow = c.map(|v| f16_rounding(v) + 1e-5);
+        Some(([c[0], c[1], c[2], (4.0 * id + asked) / 16.0], [allow[0], allow[1], allow[2], 0.0]))
+    })
+    .map(|_| ())
+}
+
+fn sources_tonemap_reinhard() -> Result<(), String> {
+    sources_tonemap_case("tonemap-reinhard", "reinhard", 0.0)
+}
+
+fn sources_tonemap_exponential() -> Result<(), String> {
+    sources_tonemap_case("tonemap-exponential", "exponential", 1.0)
+}
+
+fn sources_tonemap_aces() -> Result<(), String> {
+    sources_tonemap_case("tonemap-aces", "aces", 0.0)
+}
+
 /// PCG hash (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT
 /// 2020): one LCG step, then the RXS-M-XS output permutation.
 fn pcg(v: u32) -> u32 {
@@ -1140,7 +1188,7 @@ fn main() {
         false => vista_gpu::Context::shared(&common::config().gpu).err().map(|e| e.to_string()),
     };
     let skip = no_gpu.is_some() && allow_no_gpu();
-    let tests: [(&str, Check); 17] = [
+    let tests: [(&str, Check); 20] = [
         ("references::graphs::row_offsets", graphs_row_offsets),
         ("references::harness_crate::glow", harness_crate_glow),
         ("references::project::marble", project_marble),
@@ -1157,6 +1205,9 @@ fn main() {
         ("references::sources::clouds_joined_thin_exponential", sources_clouds_joined_thin_exponential),
         ("references::sources::mips", sources_mips),
         ("references::sources::relief", sources_relief),
+        ("references::sources::tonemap_aces", sources_tonemap_aces),
+        ("references::sources::tonemap_exponential", sources_tonemap_exponential),
+        ("references::sources::tonemap_reinhard", sources_tonemap_reinhard),
         ("references::sources::transmittance", sources_transmittance),
     ];
     if let Some(e) = no_gpu.as_ref().filter(|_| skip) {

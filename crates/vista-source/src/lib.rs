@@ -14,6 +14,7 @@
 mod assemble;
 mod spec;
 mod wesl;
+mod wesl_blocks;
 
 pub use assemble::{Assembled, Part, assemble};
 pub use spec::{DEFAULT_COMMAND_TIMEOUT_MS, Generator, Replacement, SourceSpec};

@@ -134,10 +134,20 @@ pub fn compile_wesl(
     // it (its parser recurses on expressions too); the first refusal wins.
     let refused = RefCell::new(None);
     let checked = |path: &str| {
-        let found = read(path)?;
+        let mut found = read(path)?;
         if let Err(e) = crate::check_depth(&found.0, &found.1) {
             refused.borrow_mut().get_or_insert(e);
             return None;
+        }
+        // Module-scope `@if(X) { ... }` blocks, which this wesl crate cannot read.
+        if path.ends_with(".wesl") {
+            match crate::wesl_blocks::flatten_blocks(&found.0, &found.1) {
+                Ok(text) => found.0 = text,
+                Err(e) => {
+                    refused.borrow_mut().get_or_insert(e);
+                    return None;
+                }
+            }
         }
         Some(found)
     };
@@ -268,6 +278,32 @@ mod tests {
             without_visibility(src),
             "@group(0) @binding(1)        var t: f32;\n       fn f() {}\nfn publicity() { let public_x = 1; }\n"
         );
+    }
+
+    /// Module-scope `@if(X) { ... } @else { ... }` blocks (newer WESL, which
+    /// this crate's parser refuses) choose their declarations by feature,
+    /// in the root module and an imported one.
+    #[test]
+    fn module_scope_if_blocks_choose_declarations() {
+        let files: Vec<(&str, &str)> = vec![
+            (
+                "shaders/k.wesl",
+                "import package::bits::BITS;\n@if(R16) {\n  fn tag() -> u32 { return 1u; }\n} @else {\n  fn tag() -> u32 { return 2u; }\n}\n@compute @workgroup_size(1) fn main() { let x = BITS + tag(); }\n",
+            ),
+            ("shaders/bits.wesl", "@if(R16) {\n  const BITS: u32 = 16u;\n}\n@else {\n  const BITS: u32 = 32u;\n}\n"),
+        ];
+        let read = |p: &str| files.iter().find(|(f, _)| *f == p).map(|(_, t)| (t.to_string(), format!("/p/{p}")));
+        let spec = SourceSpec::default();
+        let on = compile_wesl("shaders/k.wesl", &spec, &[("R16".into(), true)], &read).unwrap().text;
+        assert!(on.contains("16u") && on.contains("1u") && !on.contains("32u") && !on.contains("2u"), "{on}");
+        let off = compile_wesl("shaders/k.wesl", &spec, &[("R16".into(), false)], &read).unwrap().text;
+        assert!(off.contains("32u") && off.contains("2u") && !off.contains("16u"), "{off}");
+        let broken = |p: &str| match p {
+            "shaders/k.wesl" => Some(("@else {\n fn f() {}\n}\n".to_string(), "/p/shaders/k.wesl".to_string())),
+            _ => None,
+        };
+        let e = compile_wesl("shaders/k.wesl", &spec, &[], &broken).unwrap_err();
+        assert_eq!(e, "/p/shaders/k.wesl:1: @else block without an @if block before it");
     }
 
     /// A package's root module, a module of this package, features, and
