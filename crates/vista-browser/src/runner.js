@@ -69,8 +69,8 @@ function vistaChunk(offset, length) {
 // A pass graph (SPEC 14; a one-pass kernel is a graph of one pass): job = { resources: [texture | buffer |
 // sampler], passes: [{ key, wgsl (the project's text, or naga's rewrite of a composed module), entry, constants (WebGPU
 // pipeline constants), workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding,
-// layout, owned (base64) | resource, level (a texture's one mip level, or null: all) }] }], outputs: [resource
-// index] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
+// layout, owned (base64) | resource, level (a texture's one mip level, or null: all) }] }], outputs: [{ resource
+// (index), and for a texture: level, z (first layer), width, height, layers (of that level) }] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
 // the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64), usage (WebGPU usage names the passes
 // bind it with; copies are added) }, made and bound with exactly its declared bytes; a sampler: { kind,
 // filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
@@ -278,21 +278,22 @@ async function vistaRun(job) {
     const copyStart = performance.now();
     const parts = [];
     for (const o of job.outputs) {
-      const r = job.resources[o];
-      const physical = made[current[o]];
+      const r = job.resources[o.resource];
+      const physical = made[current[o.resource]];
       const encoder = d.createCommandEncoder();
       let readback;
       let unpad = null;
       if (r.kind === "texture" || r.kind === "depth") {
         // A depth texture's depth aspect reads back as 4-byte floats.
-        const [texelBytes, layers] = r.kind === "depth" ? [4, 1] : [r.texel_bytes, r.layers];
-        const rowBytes = r.width * texelBytes;
+        // One mip level, one layer or all (o.z the first), as the host computed them.
+        const [texelBytes, layers] = r.kind === "depth" ? [4, 1] : [r.texel_bytes, o.layers];
+        const rowBytes = o.width * texelBytes;
         const paddedRow = Math.ceil(rowBytes / 256) * 256;
-        const rows = r.height * layers;
+        const rows = o.height * layers;
         readback = d.createBuffer({ size: paddedRow * rows, usage: B.COPY_DST | B.MAP_READ });
-        const size = { width: r.width, height: r.height, depthOrArrayLayers: layers };
-        const source = { texture: physical, aspect: r.kind === "depth" ? "depth-only" : "all" };
-        encoder.copyTextureToBuffer(source, { buffer: readback, bytesPerRow: paddedRow, rowsPerImage: r.height }, size);
+        const size = { width: o.width, height: o.height, depthOrArrayLayers: layers };
+        const source = { texture: physical, mipLevel: o.level, origin: { x: 0, y: 0, z: o.z }, aspect: r.kind === "depth" ? "depth-only" : "all" };
+        encoder.copyTextureToBuffer(source, { buffer: readback, bytesPerRow: paddedRow, rowsPerImage: o.height }, size);
         unpad = { rowBytes, paddedRow, rows };
       } else {
         const size = Math.max(4, Math.ceil(r.size / 4) * 4);

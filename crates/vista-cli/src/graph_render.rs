@@ -21,7 +21,8 @@ pub fn output_path(out: &Path, first: bool, name: &str, buffer: bool) -> PathBuf
         return out.to_path_buf();
     }
     let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
-    out.with_file_name(format!("{stem}.{name}.{ext}"))
+    // A level or layer ("bloom@3") as bloom-3: no @ in a file name.
+    out.with_file_name(format!("{stem}.{}.{ext}", name.replace('@', "-")))
 }
 
 /// Renders a kernel and writes its outputs, the first through `frame`

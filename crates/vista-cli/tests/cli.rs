@@ -2274,6 +2274,8 @@ entry = "look"
 bind = { env_cube = "env", probe_out = "probe", nearest = "nearest" }
 [[output]]
 resource = "probe"
+[[output]]
+resource = "env@layer3"
 "#;
     let shader = "@group(0) @binding(0) var faces: texture_storage_2d_array<rgba16float, write>;
 @group(0) @binding(1) var env_cube: texture_cube<f32>;
@@ -2305,7 +2307,18 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
         assert_eq!((right[0], up[0]), (5.0 / 8.0, 5.0 / 8.0), "{backend}: both on +Z");
         assert!((right[1] - 0.75).abs() <= 1.0 / 16.0, "{backend}: u at (0.5, 0, 1) is {}", right[1]);
         assert!((up[2] - 0.25).abs() <= 1.0 / 16.0, "{backend}: v at (0, 0.5, 1) is {}", up[2]);
+        // One face as an output of its own: layer 3 (-Y), 16 x 16, read back alone.
+        let face = vista_image::load(&d.path().join(format!("probe-{backend}.env-layer3.exr"))).unwrap();
+        assert_eq!((face.width, face.height), (16, 16), "{backend}");
+        assert_eq!(face.get(15, 0), [0.5, 31.0 / 32.0, 1.0 / 32.0, 1.0], "{backend}: face 3, its last column");
     }
+    // A layer the cube lacks is refused before any GPU work.
+    std::fs::write(d.path().join("kernels/k.toml"), manifest.replace("env@layer3", "env@layer6")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "16x16", "-o", "x.exr"]);
+    assert_rejected(&r, 2, &["[[output]] resource = \"env@layer6\": env has 6 layers; allowed: @layer0 .. @layer5"]);
+    std::fs::write(d.path().join("kernels/k.toml"), manifest.replace("env@layer3", "probe@layer0")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "16x16", "-o", "x.exr"]);
+    assert_rejected(&r, 2, &["probe is not a 2d-array or cube texture; only they have layers"]);
     // A cube's faces are square.
     std::fs::write(d.path().join("kernels/k.toml"), manifest.replace("size = [16]\n", "")).unwrap();
     let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "16x8", "-o", "x.exr"]);
@@ -2343,7 +2356,7 @@ bind = { dst = "pyramid@0" }
             k - 1
         );
     }
-    manifest += "[[pass]]\nentry = \"look\"\nbind = { all = \"pyramid\", probe_out = \"probe\" }\n[[output]]\nresource = \"probe\"\n[[output]]\nresource = \"pyramid\"\n";
+    manifest += "[[pass]]\nentry = \"look\"\nbind = { all = \"pyramid\", probe_out = \"probe\" }\n[[output]]\nresource = \"probe\"\n[[output]]\nresource = \"pyramid\"\n[[output]]\nresource = \"pyramid@2\"\n[[output]]\nresource = \"pyramid@4\"\n";
     let shader = "@group(0) @binding(0) var dst: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(1) var src: texture_2d<f32>;
 @group(1) @binding(0) var all: texture_2d<f32>;
@@ -2395,6 +2408,12 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
         // The pyramid as an output is its level 0.
         let base = vista_image::load(&d.path().join(format!("probe-{backend}.pyramid.exr"))).unwrap();
         assert_eq!((base.width, base.height, base.get(15, 3)), (16, 16, [15.0, 3.0, 45.0, 16.0]), "{backend}");
+        // Levels judged as outputs of their own, read back at their size:
+        // level 2's texel (3, 1) is the mean of level 0's 4 x 4 block at (12, 4).
+        let level = |k: u32| vista_image::load(&d.path().join(format!("probe-{backend}.pyramid-{k}.exr"))).unwrap();
+        let (two, four) = (level(2), level(4));
+        assert_eq!((two.width, two.height, two.get(3, 1)), (4, 4, [13.5, 5.5, 13.5 * 5.5, 4.0]), "{backend}");
+        assert_eq!((four.width, four.height, four.get(0, 0)), (1, 1, [7.5, 7.5, 56.25, 1.0]), "{backend}");
     }
     let write = |m: &str| std::fs::write(d.path().join("kernels/k.toml"), m).unwrap();
     let render = || vista_in(Some(d.path()), &[], &["render", "k", "--size", "16x16", "-o", "x.exr"]);
@@ -2408,6 +2427,12 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_rejected(&render(), 2, &["pass 2 (down)", "dst writes pyramid@1 and src binds all of pyramid's levels"]);
     write(&manifest.replace("src = \"pyramid@0\"", "src = \"pyramid@1\""));
     assert_rejected(&render(), 2, &["pass 2 (down)", "dst writes pyramid@1 and src binds pyramid@1 too"]);
+    write(&manifest.replace("resource = \"pyramid@4\"", "resource = \"pyramid@5\""));
+    assert_rejected(
+        &render(),
+        2,
+        &["[[output]] resource = \"pyramid@5\": pyramid has 5 mip levels; allowed: pyramid@0 .. pyramid@4"],
+    );
     write(&manifest.replace("mip_levels = 5", "mip_levels = 0"));
     assert_rejected(&render(), 2, &["mip_levels = 0 is not valid; expected an integer in [1, 15]"]);
 }
@@ -3940,7 +3965,7 @@ fn uniform_structs_are_filled_by_field_path() {
     for (fields, want) in [
         (
             "fields = { exposur = 1.0 }",
-            "fields: \"exposur\" names no field of var<uniform> Frame; fields: world_position, exposure, lights",
+            "fields: \"exposur\" names no leaf of var<uniform> Frame; nearest: exposure, lights[0].dir, lights[1].dir",
         ),
         ("fields = { world_position = [1, 2] }", "fields: \"world_position\" takes 3 numbers, not 2"),
         ("fields = { exposure = 1.0 }\nfill = 0.0", "file, data, fill and fields are exclusive; give one"),
@@ -4966,7 +4991,7 @@ fn the_real_kernels_example_passes_on_every_backend_with_a_copied_binary() {
 /// SwiftShader and in Chromium, under the validation layer, and by
 /// mutation, sweep and bench.
 fn the_sources_example_passes_on_every_backend_with_a_copied_binary() {
-    let (_t, bin, root) = copied_example("sources", 9);
+    let (_t, bin, root) = copied_example("sources", 12);
     let run = |args: &[&str]| run_in(&bin, &root, &[], args);
     let validated = run_in(&bin, &root, &[("VISTA_VALIDATION", "1")], &["check"]);
     assert_eq!(validated.code, 0, "{}{}", validated.stdout, validated.stderr);

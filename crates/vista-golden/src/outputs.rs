@@ -222,7 +222,8 @@ pub fn keeps_raw(kernel: &Kernel, format: &str) -> bool {
 pub fn output_files(golden_dir: &Path, case: &Case, key: &str, index: usize, out: &OutputRender) -> OutputFiles {
     let stem = match index {
         0 => key.to_string(),
-        _ => format!("{key}.{}", out.name),
+        // A level or layer ("bloom@3") without the @ that marks a per-backend golden.
+        _ => format!("{key}.{}", out.name.replace('@', "-")),
     };
     let at = |ext: &str| golden_dir.join(case.kernel.name()).join(format!("{stem}.{ext}"));
     match &out.value {

@@ -92,7 +92,19 @@ impl Context {
                 "slots": slots, "raster": raster,
             }));
         }
-        let job = json!({ "resources": resources, "passes": passes, "outputs": g.outputs });
+        // A texture output's level, first layer and extent as the page copies it.
+        let outputs: Vec<Value> = g
+            .outputs
+            .iter()
+            .map(|o| match o.texture(&g.resources[o.resource]) {
+                Some(t) => json!({
+                    "resource": o.resource, "level": o.level, "z": o.first_layer(),
+                    "width": t.width, "height": t.height, "layers": t.layers,
+                }),
+                None => json!({ "resource": o.resource }),
+            })
+            .collect();
+        let job = json!({ "resources": resources, "passes": passes, "outputs": outputs });
         let label = g.passes.first().map(|p| p.shader.clone()).unwrap_or_default();
         let _serial = self.submit_lock.lock().expect("submit lock");
         let out = b.browser.run(&label, &job).map_err(|e| match e {
@@ -109,7 +121,7 @@ impl Context {
         let mut outputs = Vec::new();
         let mut sentinels = Vec::new();
         for (&o, bytes) in g.outputs.iter().zip(out.outputs) {
-            match g.resources[o].read_as() {
+            match o.texture(&g.resources[o.resource]) {
                 Some(t) => {
                     let format = crate::format::parse(t.format)?;
                     let row = t.width as usize * format.texel_bytes();

@@ -186,6 +186,52 @@ impl Resource {
     }
 }
 
+/// One output read back after the last pass: a resource and, for a
+/// texture, one mip level and one layer or all of them
+/// (`[[output]] resource = "bloom@3"`, `"cube@layer2"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct OutputRef {
+    /// Index of the resource in [`Graph::resources`].
+    pub resource: usize,
+    /// The mip level read (0: the full-size image).
+    pub level: u32,
+    /// The one layer read (`None`: every layer, stacked top to bottom).
+    pub layer: Option<u32>,
+}
+
+impl OutputRef {
+    /// The whole of resource `resource` (level 0, every layer).
+    pub fn whole(resource: usize) -> OutputRef {
+        OutputRef { resource, level: 0, layer: None }
+    }
+
+    /// The texture this output reads back from `r` (`None` for a buffer):
+    /// its level's size, one layer or all. Only level 0 starts filled with
+    /// a sentinel, so a deeper level has no unwritten texels to find.
+    pub fn texture(&self, r: &Resource) -> Option<TextureDesc> {
+        let mut t = r.read_as()?;
+        if self.level > 0 {
+            t.width = (t.width >> self.level).max(1);
+            t.height = (t.height >> self.level).max(1);
+            if t.dimension == Dimension::D3 {
+                t.layers = (t.layers >> self.level).max(1);
+            }
+            if t.contents == Contents::Sentinel {
+                t.contents = Contents::Zeros;
+            }
+        }
+        if self.layer.is_some() {
+            t.layers = 1;
+        }
+        Some(t)
+    }
+
+    /// The first layer (or depth slice) read.
+    pub fn first_layer(&self) -> u32 {
+        self.layer.unwrap_or(0)
+    }
+}
+
 /// What feeds one binding of a pass.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Bind {
@@ -421,7 +467,7 @@ pub struct Graph<'a> {
     pub passes: std::borrow::Cow<'a, [GraphPass]>,
     /// Resources read back after the last pass (after its swaps: a swapped
     /// name reads the resource it binds then).
-    pub outputs: std::borrow::Cow<'a, [usize]>,
+    pub outputs: std::borrow::Cow<'a, [OutputRef]>,
 }
 
 /// The usages each buffer resource needs, by index (`None` for other

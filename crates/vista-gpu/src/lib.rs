@@ -30,8 +30,9 @@ pub use context::{
 pub use coverage::Coverage;
 pub use fullscreen::{FULLSCREEN_ENTRY, FULLSCREEN_WGSL};
 pub use graph::{
-    Address, Bind, BufferUse, COMPARE_NAMES, Contents, Depth, Graph, GraphPass, GraphSlot, OutputData, Raster,
-    RasterTarget, Readback, Resource, SamplerDesc, TextureDesc, VertexBuffer, buffer_size, buffer_usages, run_order,
+    Address, Bind, BufferUse, COMPARE_NAMES, Contents, Depth, Graph, GraphPass, GraphSlot, OutputData, OutputRef,
+    Raster, RasterTarget, Readback, Resource, SamplerDesc, TextureDesc, VertexBuffer, buffer_size, buffer_usages,
+    run_order,
 };
 pub use limits::Needs;
 pub use shaders::{

@@ -221,7 +221,7 @@ impl Context {
         let mut outputs = Vec::new();
         let mut sentinels = Vec::new();
         for &o in g.outputs.iter() {
-            let (data, held) = self.read_resource(w, g, &made, o, current[o], which)?;
+            let (data, held) = self.read_resource(w, g, &made, o, current[o.resource], which)?;
             outputs.push(data);
             sentinels.push(held);
         }
@@ -588,10 +588,11 @@ impl Context {
         w: &WgpuEngine,
         g: &Graph<'_>,
         made: &Made,
-        logical: usize,
+        output: crate::graph::OutputRef,
         physical: usize,
         which: usize,
     ) -> Result<(OutputData, Vec<usize>), GpuError> {
+        let logical = output.resource;
         let d = &w.device;
         let staging_of = |size: u64| {
             take(&w.spares, |s| &mut s.staging, &size).unwrap_or_else(|| {
@@ -603,7 +604,7 @@ impl Context {
                 })
             })
         };
-        let t = match (g.resources[logical].read_as(), &g.resources[logical]) {
+        let t = match (output.texture(&g.resources[logical]), &g.resources[logical]) {
             (Some(t), _) => t,
             (None, Resource::Buffer(bytes)) => {
                 let size = crate::graph::buffer_size(bytes);
@@ -637,8 +638,8 @@ impl Context {
                 encoder.copy_texture_to_buffer(
                     wgpu::TexelCopyTextureInfo {
                         texture: &made.textures[&physical],
-                        mip_level: 0,
-                        origin: wgpu::Origin3d { x: 0, y, z: layer },
+                        mip_level: output.level,
+                        origin: wgpu::Origin3d { x: 0, y, z: output.first_layer() + layer },
                         aspect,
                     },
                     wgpu::TexelCopyBufferInfo {

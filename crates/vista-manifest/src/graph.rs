@@ -395,6 +395,33 @@ pub struct OutputSpec {
     pub exposure: Option<f64>,
 }
 
+impl OutputSpec {
+    /// `resource` split into the resource's name, its mip level and one
+    /// layer: `"bloom@3"` is level 3 of bloom, `"cube@layer2"` layer 2 of
+    /// cube, `"arr@1@layer0"` both (`None` without `resource`).
+    pub fn target(&self) -> Option<(&str, u32, Option<u32>)> {
+        split_target(self.resource.as_deref()?).ok()
+    }
+}
+
+/// `name[@level][@layerN]` into its parts; the error says what is allowed.
+fn split_target(text: &str) -> Result<(&str, u32, Option<u32>), String> {
+    let (rest, layer) = match text.rsplit_once("@layer") {
+        None => (text, None),
+        Some((n, l)) => match l.parse::<u32>() {
+            Ok(l) => (n, Some(l)),
+            Err(_) => return Err(format!("\"{text}\": @layer needs a layer number, e.g. {n}@layer0")),
+        },
+    };
+    match rest.split_once('@') {
+        None => Ok((rest, 0, layer)),
+        Some((n, level)) => match level.parse::<u32>() {
+            Ok(level) => Ok((n, level, layer)),
+            Err(_) => Err(format!("\"{text}\": a level is a number ({n}@2) and a layer @layerN ({n}@layer1)")),
+        },
+    }
+}
+
 /// A kernel's pass graph.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GraphSpec {
@@ -472,6 +499,13 @@ pub(crate) fn parse(
     let res = parse_resources(resources, params, fail)?;
     let out_passes = parse_passes(passes, &res, params, fail)?;
     let outs = parse_outputs(outputs, default_view, fail)?;
+    // A level past the texture's mip count is refused here, by name.
+    for o in outs.iter().filter(|o| o.resource.as_deref().is_some_and(|r| r.contains('@'))) {
+        let text = o.resource.as_deref().unwrap_or_default();
+        let (name, level, _) = split_target(text).map_err(|m| fail(format!("[[output]] resource = {m}")))?;
+        let leveled = if level > 0 { format!("{name}@{level}") } else { name.to_string() };
+        Level::parse(&leveled, &res).map_err(|m| fail(format!("[[output]] resource = {m}")))?;
+    }
     if outs.iter().any(|o| o.view == Some(Output::Hdr))
         && params.iter().any(|p| p.name == "exposure" && p.ty != crate::params::ParamType::F32)
     {
@@ -1260,6 +1294,9 @@ fn parse_outputs(
             Some(r) => fail(format!("[[output]] {r}: {m}")),
             None => fail(format!("[[output]]: {m}")),
         };
+        if let Some(r) = resource {
+            split_target(r).map_err(|m| fail(format!("[[output]] resource = {m}")))?;
+        }
         let view = match t.get("view") {
             None => default_view,
             Some(toml::Value::String(v)) => Some(match v.as_str() {
@@ -1479,6 +1516,9 @@ pub struct Resolved {
     /// order; without tables, or for a lone one without `resource`, the
     /// first texture a pass writes.
     pub outputs: Vec<usize>,
+    /// Per output, the mip level and the one layer it reads (`(0, None)`:
+    /// the whole texture, or a buffer).
+    pub output_views: Vec<(u32, Option<u32>)>,
 }
 
 /// One resource with what reflection adds to its table.
@@ -1639,10 +1679,10 @@ pub fn resolve(
             None => None,
         });
     }
-    let outputs = check_swaps_and_outputs(graph, &resources, &bad)?;
+    let (outputs, output_views) = check_swaps_and_outputs(graph, &resources, &bad)?.into_iter().unzip();
     check_default_output(graph, &resources, &all_slots, &bad)?;
     check_read_before_written(graph, &resources, &bad)?;
-    Ok(Resolved { resources, slots: all_slots, outputs, draws })
+    Ok(Resolved { resources, slots: all_slots, outputs, output_views, draws })
 }
 
 /// A buffer binding's element (its WGSL type's stride, header and
@@ -2073,11 +2113,14 @@ fn needs_kind(
 
 /// Swapped resources are alike; every output names a resource some pass
 /// writes (or swaps). Returns the outputs' resources ([`Resolved::outputs`]).
+/// An output's resource index with the mip level and layer it reads.
+type OutputAt = (usize, (u32, Option<u32>));
+
 fn check_swaps_and_outputs(
     graph: &GraphSpec,
     resources: &[ResolvedResource],
     bad: &dyn Fn(String) -> ParamError,
-) -> Result<Vec<usize>, ParamError> {
+) -> Result<Vec<OutputAt>, ParamError> {
     for (i, pass) in graph.passes.iter().enumerate() {
         for (a, b) in &pass.swap {
             let (ra, rb) = (
@@ -2095,8 +2138,8 @@ fn check_swaps_and_outputs(
     }
     let mut outputs = Vec::new();
     for o in &graph.outputs {
-        let Some(name) = &o.resource else { continue };
-        let Some(ri) = resources.iter().position(|r| &r.spec.name == name) else {
+        let Some((name, level, layer)) = o.target() else { continue };
+        let Some(ri) = resources.iter().position(|r| r.spec.name == name) else {
             let n: Vec<&str> = resources.iter().map(|r| r.spec.name.as_str()).collect();
             return Err(bad(format!(
                 "[[output]] resource = \"{name}\" names no resource; resources: {}",
@@ -2111,13 +2154,21 @@ fn check_swaps_and_outputs(
                 r.spec.kind_name()
             )));
         }
-        outputs.push(ri);
+        if let Some(l) = layer
+            && !matches!(r.dimension, Some(Dimension::D2Array | Dimension::Cube))
+        {
+            return Err(bad(format!(
+                "[[output]] resource = \"{name}@layer{l}\": {name} is not a 2d-array or cube texture; only they have layers"
+            )));
+        }
+        outputs.push((ri, (level, layer)));
     }
     if graph.outputs.iter().all(|o| o.resource.is_none()) {
         // No [[output]] tables, or a lone one without `resource`.
         let first = resources.iter().position(|r| r.written && r.spec.kind_name() == "texture");
-        outputs
-            .push(first.ok_or_else(|| bad("no pass writes a texture; name the outputs in [[output]] tables".into()))?);
+        let first =
+            first.ok_or_else(|| bad("no pass writes a texture; name the outputs in [[output]] tables".into()))?;
+        outputs.push((first, (0, None)));
     }
     Ok(outputs)
 }

@@ -82,7 +82,7 @@ pub fn cover(gpu: &Renderer, plan: &Plan) -> Result<CaseCoverage, RenderError> {
             p
         })
         .collect();
-    let outputs: Vec<usize> = (first..first + counted.len()).collect();
+    let outputs: Vec<vista_gpu::OutputRef> = (first..first + counted.len()).map(vista_gpu::OutputRef::whole).collect();
     let graph = vista_gpu::Graph {
         shaders: &shaders,
         resources: Cow::Owned(resources),

@@ -64,7 +64,7 @@ pub struct Plan {
     /// The passes in order.
     pub passes: Vec<vista_gpu::GraphPass>,
     /// Resource index of each output, in `outputs` order.
-    pub output_ids: Vec<usize>,
+    pub output_ids: Vec<vista_gpu::OutputRef>,
     /// The outputs, the main one first.
     pub outputs: Vec<PlannedOutput>,
     /// Whether the kernel is deterministic (render-twice check).
@@ -76,7 +76,8 @@ pub struct Plan {
 impl Plan {
     /// The first output's texture as it reads back, where it is one.
     pub fn main_texture(&self) -> Option<vista_gpu::TextureDesc> {
-        self.resources.get(*self.output_ids.first()?)?.read_as()
+        let o = self.output_ids.first()?;
+        o.texture(self.resources.get(o.resource)?)
     }
 }
 
@@ -253,7 +254,7 @@ pub(crate) fn plan_graph(
             files.push(vfile.clone());
         }
     }
-    let (outputs, output_ids) = at.outputs(&resources, &resolved);
+    let (outputs, output_ids) = at.outputs(&resources, &resolved)?;
     // The kernel's resources come first, by name; what passes own after them.
     let names = resolved.resources.iter().map(|r| r.spec.name.clone()).collect();
     Ok(Plan {
@@ -1022,18 +1023,36 @@ impl Planning<'_> {
         &self,
         resources: &[vista_gpu::Resource],
         resolved: &vista_manifest::graph::Resolved,
-    ) -> (Vec<PlannedOutput>, Vec<usize>) {
+    ) -> Result<(Vec<PlannedOutput>, Vec<vista_gpu::OutputRef>), RenderError> {
         let (kernel, p) = (self.kernel, self.p);
         let g = kernel.graph();
         let mut outputs = Vec::new();
+        let mut ids = Vec::new();
         for (i, &r) in resolved.outputs.iter().enumerate() {
             // The i-th [[output]] table (a lone one may leave `resource` out).
             let spec = g.outputs.get(i);
-            let name = resolved.resources[r].spec.name.clone();
+            let (level, layer) = resolved.output_views.get(i).copied().unwrap_or((0, None));
+            let id = vista_gpu::OutputRef { resource: r, level, layer };
+            // A level or layer is named as the manifest writes it ("bloom@3").
+            let name = match (level, layer) {
+                (0, None) => resolved.resources[r].spec.name.clone(),
+                _ => spec.and_then(|o| o.resource.clone()).unwrap_or_default(),
+            };
+            if let (Some(l), Some(t)) = (layer, resources[r].read_as())
+                && l >= t.layers
+            {
+                return Err(self.bad(format!(
+                    "[[output]] resource = \"{name}\": {} has {} layers; allowed: @layer0 .. @layer{}",
+                    resolved.resources[r].spec.name,
+                    t.layers,
+                    t.layers - 1
+                )));
+            }
+            ids.push(id);
             let kind = match &resources[r] {
                 vista_gpu::Resource::Texture(_) | vista_gpu::Resource::Depth(_) => {
                     // A depth output reads back as r32float.
-                    let t = resources[r].read_as().expect("a texture");
+                    let t = id.texture(&resources[r]).expect("a texture");
                     let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.default_view(t.format));
                     let display = kernel.display_map_with(p, view, t.format, spec.and_then(|o| o.exposure));
                     PlannedKind::Texture { format: t.format, view, display }
@@ -1052,7 +1071,7 @@ impl Planning<'_> {
                 kind,
             });
         }
-        (outputs, resolved.outputs.clone())
+        Ok((outputs, ids))
     }
 }
 

@@ -94,7 +94,7 @@ enum ToWorker<'a> {
         source: Cow<'a, ShaderSource>,
         resources: Cow<'a, [vista_gpu::Resource]>,
         passes: Cow<'a, [vista_gpu::GraphPass]>,
-        outputs: Cow<'a, [usize]>,
+        outputs: Cow<'a, [vista_gpu::OutputRef]>,
         /// Each pass's source hash in the parent's set: a worker whose set
         /// differs (a file saved since it read the project) reads it again.
         hashes: Vec<String>,

@@ -119,7 +119,7 @@ fn write_output_images(
     let case_dir = case_folder(dir, &id)?;
     for (name, actual, expected) in images {
         let write = |which: &str, img: &Image| -> Result<String, GoldenError> {
-            let file = format!("{name}.{which}8.png");
+            let file = format!("{}.{which}8.png", name.replace('@', "-"));
             vista_image::write_png8(&case_dir.join(&file), img)?;
             Ok(format!("{id}/{file}"))
         };
