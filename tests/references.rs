@@ -1017,6 +1017,36 @@ fn sources_tonemap_aces() -> Result<(), String> {
     sources_tonemap_case("tonemap-aces", "aces", 0.0)
 }
 
+/// examples/graphs, mip_chain: one rgba32float texture's levels 1, 2 and 3,
+/// each its own output at its own size (32, 16, 8), each texel the mean of
+/// the 2^k x 2^k block of the photo (16-bit PNG, v / 65535) under it: the
+/// level by level 2 x 2 means are that block's mean. Allowance: f32 sums
+/// of four (an ulp per level), 1e-6.
+fn graphs_mip_chain() -> Result<(), String> {
+    let source = vista_image::read_png16(&example("graphs/inputs/photo.png")).map_err(|e| e.to_string())?;
+    let out = render_example("graphs", "mip_chain", 64, 64)?;
+    for level in 1..=3u32 {
+        let (w, h, got) = texels_named(&out, &format!("chain@{level}"))?;
+        let side = 64 >> level;
+        if (w, h) != (side, side) {
+            return Err(format!("chain@{level} is {w}x{h}; want {side}x{side}"));
+        }
+        let block = 1usize << level;
+        compare(&format!("mip_chain level {level}"), w, &got, |x, y| {
+            let mut c = [0.0f64; 4];
+            for by in 0..block {
+                for bx in 0..block {
+                    let t = source.data[(y as usize * block + by) * 64 + x as usize * block + bx];
+                    (0..4).for_each(|k| c[k] += f64::from(t[k]));
+                }
+            }
+            let n = (block * block) as f64;
+            Some((c.map(|v| v / n), [1e-6; 4]))
+        })?;
+    }
+    Ok(())
+}
+
 /// PCG hash (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT
 /// 2020): one LCG step, then the RXS-M-XS output permutation.
 fn pcg(v: u32) -> u32 {
@@ -1188,7 +1218,8 @@ fn main() {
         false => vista_gpu::Context::shared(&common::config().gpu).err().map(|e| e.to_string()),
     };
     let skip = no_gpu.is_some() && allow_no_gpu();
-    let tests: [(&str, Check); 20] = [
+    let tests: [(&str, Check); 21] = [
+        ("references::graphs::mip_chain", graphs_mip_chain),
         ("references::graphs::row_offsets", graphs_row_offsets),
         ("references::harness_crate::glow", harness_crate_glow),
         ("references::project::marble", project_marble),
