@@ -2325,6 +2325,134 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_rejected(&r, 2, &["resource env", "a cube's faces are square but the case is 16x8", "size = [N]"]);
 }
 
+/// A separate vertex file takes `source` keys of its own over the pass's,
+/// and may be an import module (its own `#define_import_path`, as bevy's
+/// full-screen vertex shader is); a pass's `replace` key is refused only
+/// when none of its files holds it, naming them all.
+fn a_vertex_module_takes_its_own_source_keys() {
+    let manifest = r###"summary = "a full-screen pass whose vertex shader is an engine's module"
+[source]
+replace = { "##GAIN##" = "0.5" }
+[[resource]]
+name = "frame"
+kind = "texture"
+format = "rgba16float"
+[[pass]]
+kind = "render"
+vertex = { shader = "engine/fullscreen.wgsl", entry = "fullscreen_vertex_shader", source = { replace = { "##DEPTH##" = "0.0" } } }
+fragment = "fs"
+count = 3
+targets = [{ resource = "frame" }]
+"###;
+    let fragment = "@fragment\nfn fs(@location(0) uv: vec2<f32>) -> @location(0) vec4<f32> {\n    return vec4<f32>(uv * ##GAIN##, 0.25, 1.0);\n}\n";
+    let d = kernel_project(manifest, fragment);
+    std::fs::create_dir(d.path().join("shaders/engine")).unwrap();
+    let vertex = "#define_import_path my_engine::fullscreen
+
+struct FullscreenVertexOutput {
+    @builtin(position) position: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+}
+
+// One triangle over the screen: uv 0..2 along each axis, (0, 0) top left.
+@vertex
+fn fullscreen_vertex_shader(@builtin(vertex_index) index: u32) -> FullscreenVertexOutput {
+    let uv = vec2<f32>(f32(index >> 1u), f32(index & 1u)) * 2.0;
+    return FullscreenVertexOutput(vec4<f32>(uv * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0), ##DEPTH##, 1.0), uv);
+}
+";
+    std::fs::write(d.path().join("shaders/engine/fullscreen.wgsl"), vertex).unwrap();
+    for (backend, frame) in probe_on_every_backend(d.path(), "8x8") {
+        for (x, y) in [(0u32, 0u32), (7, 2), (3, 7)] {
+            let uv = [(x as f32 + 0.5) / 8.0, (y as f32 + 0.5) / 8.0];
+            assert_eq!(frame.get(x, y), [uv[0] * 0.5, uv[1] * 0.5, 0.25, 1.0], "{backend}: ({x}, {y})");
+        }
+    }
+    let write = |m: &str| std::fs::write(d.path().join("kernels/k.toml"), m).unwrap();
+    let render = || vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", "x.exr"]);
+    write(&manifest.replace("\"##GAIN##\" = \"0.5\"", "\"##GAIN##\" = \"0.5\", \"##GIAN##\" = \"1\""));
+    assert_rejected(
+        &render(),
+        2,
+        &["\"##GIAN##\" is found in no file the pass reaches (shaders/k.wgsl, shaders/engine/fullscreen.wgsl)"],
+    );
+    write(&manifest.replace(", source = { replace = { \"##DEPTH##\" = \"0.0\" } }", ""));
+    let r = render();
+    assert!(
+        r.code == 2 && r.stderr.contains("engine/fullscreen.wgsl"),
+        "the unreplaced key fails to compose there: {}",
+        r.stderr
+    );
+    write(&manifest.replace("source = { replace", "source = { nope"));
+    assert_rejected(&render(), 2, &["vertex [source]: unknown key nope"]);
+}
+
+/// A `dimension = "cube-array"` resource (`size = [edge, cubes]`): 6 N
+/// layers written through a 2d-array storage view, sampled through a
+/// `texture_cube_array` view by cube index; one layer is an output of its
+/// own. A cube array without its size is refused naming it.
+fn cube_arrays_are_written_as_layers_and_sampled_by_cube() {
+    let manifest = r#"summary = "two cubes written face by face, sampled as a cube array"
+[[resource]]
+name = "env"
+kind = "texture"
+format = "rgba16float"
+dimension = "cube-array"
+size = [8, 2]
+[[resource]]
+name = "nearest"
+kind = "sampler"
+filter = "nearest"
+[[resource]]
+name = "probe"
+kind = "texture"
+format = "rgba16float"
+size = [4, 1]
+[[pass]]
+entry = "bake"
+bind = { faces = "env" }
+[[pass]]
+entry = "look"
+bind = { envs = "env", probe_out = "probe", nearest = "nearest" }
+[[output]]
+resource = "probe"
+[[output]]
+resource = "env@layer7"
+"#;
+    let shader = "@group(0) @binding(0) var faces: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(1) var envs: texture_cube_array<f32>;
+@group(0) @binding(2) var nearest: sampler;
+@group(1) @binding(0) var probe_out: texture_storage_2d<rgba16float, write>;
+
+@compute @workgroup_size(8, 8, 1)
+fn bake(@builtin(global_invocation_id) id: vec3<u32>) {
+    let d = textureDimensions(faces);
+    if any(id.xy >= d) || id.z >= textureNumLayers(faces) { return; }
+    textureStore(faces, id.xy, id.z, vec4(f32(id.z + 1u) / 16.0, f32(textureNumLayers(faces)) / 16.0, 0.0, 1.0));
+}
+
+@compute @workgroup_size(4, 1, 1)
+fn look(@builtin(global_invocation_id) id: vec3<u32>) {
+    // +X of cube 0, +X of cube 1, -Z of cube 1, -Y of cube 1.
+    var dirs = array<vec3<f32>, 4>(vec3(1.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, -1.0), vec3(0.0, -1.0, 0.0));
+    var cubes = array<u32, 4>(0u, 1u, 1u, 1u);
+    if id.x >= 4u { return; }
+    textureStore(probe_out, vec2(id.x, 0u), textureSampleLevel(envs, nearest, dirs[id.x], cubes[id.x], 0.0));
+}
+";
+    let d = kernel_project(manifest, shader);
+    for (backend, probe) in probe_on_every_backend(d.path(), "8x8") {
+        let layers: Vec<f32> = (0..4).map(|x| probe.get(x, 0)[0] * 16.0 - 1.0).collect();
+        assert_eq!(layers, [0.0, 6.0, 11.0, 9.0], "{backend}: the layer each (cube, direction) finds");
+        assert_eq!(probe.get(0, 0)[1], 12.0 / 16.0, "{backend}: 12 layers");
+        let layer = vista_image::load(&d.path().join(format!("probe-{backend}.env-layer7.exr"))).unwrap();
+        assert_eq!((layer.width, layer.height, layer.get(3, 5)[0]), (8, 8, 8.0 / 16.0), "{backend}");
+    }
+    std::fs::write(d.path().join("kernels/k.toml"), manifest.replace("size = [8, 2]\n", "")).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", "x.exr"]);
+    assert_rejected(&r, 2, &["resource env", "a cube-array needs size = [edge, cubes]"]);
+}
+
 /// `mip_levels` and `bind = { v = "t@level" }`: one texture's levels
 /// written pass by pass (each the 2x2 mean of the level above, dispatched
 /// over its own size by `dispatch = "t@level"`), then read through one view
@@ -7361,6 +7489,8 @@ fn main() {
         Gpu float_outputs_keep_raw_values_beside_their_view,
         Gpu cube_textures_are_written_as_layers_and_sampled_as_cubes,
         Gpu mip_levels_are_written_one_by_one_and_read_together,
+        Gpu cube_arrays_are_written_as_layers_and_sampled_by_cube,
+        Gpu a_vertex_module_takes_its_own_source_keys,
         Gpu a_group_of_passes_repeats_as_one_step,
         Gpu limits_are_reported_unsupported_by_name,
         Gpu each_backend_checks_into_its_own_report,

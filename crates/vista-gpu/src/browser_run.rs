@@ -213,7 +213,7 @@ impl Context {
                 } }),
                 json!({ "resource": resource, "level": null }),
             ),
-            Bind::Sampled { resource, depth, cube, level } => {
+            Bind::Sampled { resource, depth, view, level } => {
                 let t = texture(*resource)?;
                 let format = crate::format::parse(t.format)?;
                 let sample = match (depth, format.sample_kind()) {
@@ -224,10 +224,7 @@ impl Context {
                     (_, SampleKind::Float) => "float",
                 };
                 (
-                    json!({ "texture": { "sampleType": sample, "viewDimension": match cube {
-                        true => "cube",
-                        false => t.dimension.name(),
-                    } } }),
+                    json!({ "texture": { "sampleType": sample, "viewDimension": view.unwrap_or(t.dimension).name() } }),
                     json!({ "resource": resource, "level": level }),
                 )
             }

@@ -46,7 +46,7 @@ pub(crate) fn wgpu_format(f: &Format) -> wgpu::TextureFormat {
 pub(crate) fn texture_dimension(d: Dimension) -> wgpu::TextureDimension {
     match d {
         Dimension::D1 => wgpu::TextureDimension::D1,
-        Dimension::D2 | Dimension::D2Array | Dimension::Cube => wgpu::TextureDimension::D2,
+        Dimension::D2 | Dimension::D2Array | Dimension::Cube | Dimension::CubeArray => wgpu::TextureDimension::D2,
         Dimension::D3 => wgpu::TextureDimension::D3,
     }
 }
@@ -59,6 +59,7 @@ pub(crate) fn view_dimension(d: Dimension) -> wgpu::TextureViewDimension {
         Dimension::D2Array => wgpu::TextureViewDimension::D2Array,
         Dimension::D3 => wgpu::TextureViewDimension::D3,
         Dimension::Cube => wgpu::TextureViewDimension::Cube,
+        Dimension::CubeArray => wgpu::TextureViewDimension::CubeArray,
     }
 }
 

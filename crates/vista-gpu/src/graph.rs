@@ -258,14 +258,15 @@ pub enum Bind {
         level: u32,
     },
     /// A texture resource bound for sampling or loads; `depth` for
-    /// `texture_depth_2d`, `cube` for `texture_cube` over six layers.
+    /// `texture_depth_2d`, `view` for `texture_cube` (`texture_cube_array`)
+    /// over its layers.
     Sampled {
         /// Index of the texture in [`Graph::resources`].
         resource: usize,
         /// Bound with a depth sample type.
         depth: bool,
-        /// Viewed as a cube rather than by its own dimension.
-        cube: bool,
+        /// Viewed as a cube or cube array rather than by its own dimension.
+        view: Option<Dimension>,
         /// The one mip level it sees; `None`: all of them.
         level: Option<u32>,
     },
@@ -576,13 +577,10 @@ pub fn buffer_size(bytes: &[u8]) -> u64 {
     bytes.len().max(4).next_multiple_of(4) as u64
 }
 
-/// The view a binding of `t` sees: six layers as a cube for a sampled
-/// `texture_cube`, else the texture's own dimension.
-pub(crate) fn view_dimension(t: &TextureDesc, cube: bool) -> wgpu::TextureViewDimension {
-    match cube {
-        true => wgpu::TextureViewDimension::Cube,
-        false => crate::format::view_dimension(t.dimension),
-    }
+/// The view a binding of `t` sees: its layers as a cube or cube array for a
+/// sampled `texture_cube` (`_array`), else the texture's own dimension.
+pub(crate) fn view_dimension(t: &TextureDesc, view: Option<Dimension>) -> wgpu::TextureViewDimension {
+    crate::format::view_dimension(view.unwrap_or(t.dimension))
 }
 
 /// The order passes run in: each group (a pass with span n and the n - 1

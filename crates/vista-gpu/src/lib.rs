@@ -36,7 +36,7 @@ pub use graph::{
 };
 pub use limits::Needs;
 pub use shaders::{
-    DEFAULT_COMPOSE_LIMIT, ENUMS_MODULE, Reader, ShaderSet, SourceText, compose_limit, generated_origin,
+    DEFAULT_COMPOSE_LIMIT, ENUMS_MODULE, Reader, ReplaceKeys, ShaderSet, SourceText, compose_limit, generated_origin,
     is_unit_test_file, resolve_overrides, runaway_compositions, set_compose_limit, validate,
 };
 pub use tint::TintWgsl;

@@ -59,6 +59,18 @@ pub struct ShaderSet {
     generated: BTreeMap<String, Result<Vec<(String, String)>, String>>,
 }
 
+/// What one module's assembly did with its `replace` keys
+/// ([`ShaderSet::replace_keys`]).
+#[derive(Debug, Clone, Default)]
+pub struct ReplaceKeys {
+    /// Keys found in no line of its files.
+    pub missed: Vec<String>,
+    /// Keys it replaced.
+    pub applied: Vec<String>,
+    /// Every file it reached (root-relative).
+    pub files: Vec<String>,
+}
+
 /// The origin of a file a `[source] command` generated from `path`: what
 /// errors name, and a mark that coverage does not measure it (its lines
 /// are the command's output, not the user's file).
@@ -326,7 +338,10 @@ impl ShaderSet {
         if let Some(Err(why)) = self.generated.get(name) {
             return Err(GpuError::Shader(why.clone()));
         }
-        self.kernels.get(name).ok_or_else(|| {
+        // An import module may be composed as a pass's file too (bevy's
+        // full-screen vertex shader is a module with its own import path).
+        let module = || self.lib.iter().find(|s| s.rel == name && !s.origin.starts_with("<built-in>"));
+        self.kernels.get(name).or_else(module).ok_or_else(|| {
             // The project's own files: the built-ins' are not what a
             // project's manifest means to name.
             let own: Vec<&str> = self
@@ -405,6 +420,18 @@ impl ShaderSet {
         let unit = Arc::new(unit);
         self.units.lock().expect("unit cache").insert(key, unit.clone());
         Ok(unit)
+    }
+
+    /// `name`'s assembly's `replace` keys: those it found in no line, those
+    /// it applied, and every file it reached (`None`: no assembly, no
+    /// keys). A pass refuses a key none of its modules applied.
+    pub fn replace_keys(&self, name: &str) -> Result<Option<ReplaceKeys>, GpuError> {
+        let unit = self.unit(name)?;
+        Ok(unit.assembled.as_ref().filter(|a| a.traced()).map(|a| ReplaceKeys {
+            missed: a.unmatched.clone(),
+            applied: a.replaced.iter().map(|(k, _)| k.clone()).collect(),
+            files: a.parts.iter().map(|p| p.path.clone()).collect(),
+        }))
     }
 
     /// A reader of the files this set reads (`shaders/...` its own, others

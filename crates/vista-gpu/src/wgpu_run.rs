@@ -476,7 +476,7 @@ impl Context {
                     multisampled: false,
                 }
             }
-            Bind::Sampled { resource, depth, cube, .. } => {
+            Bind::Sampled { resource, depth, view, .. } => {
                 let Resource::Texture(t) = &g.resources[resource] else {
                     return Err(GpuError::Request(format!("{}: a texture bound to a non-texture", pass.label)));
                 };
@@ -490,7 +490,7 @@ impl Context {
                             wgpu::TextureSampleType::Float { filterable: !format.is_float32() || filterable32 }
                         }
                     },
-                    view_dimension: view_dimension(t, cube),
+                    view_dimension: view_dimension(t, view),
                     multisampled: false,
                 }
             }
@@ -743,14 +743,17 @@ fn bind_groups(
                     return Some(made.textures[&current[resource]].create_view(&Default::default()));
                 }
                 let Resource::Texture(t) = &g.resources[resource] else { return None };
-                let cube = matches!(s.bind, Bind::Sampled { cube: true, .. });
+                let view = match s.bind {
+                    Bind::Sampled { view, .. } => view,
+                    _ => None,
+                };
                 // A storage view sees one level; a sampled one, its level or all.
                 let level = match s.bind {
                     Bind::StorageTexture { level, .. } | Bind::Sampled { level: Some(level), .. } => Some(level),
                     _ => None,
                 };
                 Some(made.textures[&current[resource]].create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(view_dimension(t, cube)),
+                    dimension: Some(view_dimension(t, view)),
                     base_mip_level: level.unwrap_or(0),
                     mip_level_count: level.map(|_| 1),
                     ..Default::default()

@@ -452,7 +452,7 @@ pub fn reflect_all(
             (AddressSpace::Storage { access }, _) => Feed::Buffer { read_only: !access.contains(StorageAccess::STORE) },
             (_, TypeInner::Image { dim, arrayed, class: ImageClass::Storage { format, access } }) => {
                 let dimension = match Dimension::of_naga(*dim, *arrayed) {
-                    Some(Dimension::Cube) | None => {
+                    Some(Dimension::Cube | Dimension::CubeArray) | None => {
                         return Err(unfed("a storage texture of dimension 1d, 2d, 2d-array or 3d"));
                     }
                     Some(d) => d,

@@ -182,10 +182,13 @@ pub enum VertexStage {
     /// composed with the pass's defs and source keys; what both entries bind
     /// must agree, and params fill only the pass shader's uniforms.
     File {
-        /// The kernel file (relative to `shaders/`).
+        /// The kernel file (relative to `shaders/`), or an import module's
+        /// (a file with its own `#define_import_path`).
         shader: String,
         /// The `@vertex` entry.
         entry: String,
+        /// `source = { ... }`: `[source]` keys for this file, over the pass's.
+        source: Box<vista_source::SourceSpec>,
     },
 }
 
@@ -297,7 +300,7 @@ impl PassSpec {
         let mut out = vec![(file, self.entry.as_str())];
         match &self.raster {
             Some(RasterSpec { vertex: VertexStage::Entry(vs), .. }) => out.push((file, vs)),
-            Some(RasterSpec { vertex: VertexStage::File { shader, entry }, .. }) => out.push((shader, entry)),
+            Some(RasterSpec { vertex: VertexStage::File { shader, entry, .. }, .. }) => out.push((shader, entry)),
             _ => {}
         }
         out
@@ -307,6 +310,14 @@ impl PassSpec {
     pub fn vertex_file(&self) -> Option<&str> {
         match &self.raster {
             Some(RasterSpec { vertex: VertexStage::File { shader, .. }, .. }) => Some(shader),
+            _ => None,
+        }
+    }
+
+    /// The `source` keys a separate vertex file takes over the pass's.
+    pub fn vertex_source(&self) -> Option<&vista_source::SourceSpec> {
+        match &self.raster {
+            Some(RasterSpec { vertex: VertexStage::File { source, .. }, .. }) => Some(source),
             _ => None,
         }
     }
@@ -1084,16 +1095,25 @@ fn parse_vertex_stage(t: &toml::Table, at: &dyn Fn(String) -> ParamError) -> Res
         Some(toml::Value::String(v)) if v == "fullscreen" => VertexStage::Fullscreen,
         Some(toml::Value::String(v)) if valid_name(v) => VertexStage::Entry(v.clone()),
         Some(toml::Value::Table(v)) => {
-            if let Some(k) = v.keys().find(|k| !["shader", "entry"].contains(&k.as_str())) {
-                return Err(at(format!("vertex: unknown key {k}; allowed: shader, entry")));
+            if let Some(k) = v.keys().find(|k| !["shader", "entry", "source"].contains(&k.as_str())) {
+                return Err(at(format!("vertex: unknown key {k}; allowed: shader, entry, source")));
             }
+            let source = match v.get("source") {
+                None => Default::default(),
+                Some(toml::Value::Table(s)) => {
+                    vista_source::SourceSpec::parse(s).map_err(|e| at(format!("vertex {e}")))?
+                }
+                Some(other) => {
+                    return Err(at(format!("vertex source = {other} is not valid; expected a table of [source] keys")));
+                }
+            };
             let shader = string_key(v, "shader", at)?.ok_or_else(|| at("vertex needs shader = \"<file>\"".into()))?;
             let entry =
                 string_key(v, "entry", at)?.ok_or_else(|| at("vertex needs entry = \"<@vertex entry>\"".into()))?;
             if !valid_name(&entry) {
                 return Err(at(format!("vertex entry = \"{entry}\" is not a WGSL function name")));
             }
-            VertexStage::File { shader, entry }
+            VertexStage::File { shader, entry, source: Box::new(source) }
         }
         Some(other) => {
             return Err(at(format!(
@@ -1820,8 +1840,9 @@ fn check_targets(
         let r = &mut resources[ri];
         match (r.dimension, t.layer) {
             (None, None) => r.dimension = Some(Dimension::D2),
-            (Some(Dimension::D2), None) | (Some(Dimension::D2Array | Dimension::Cube), Some(_)) => {}
-            (Some(d @ (Dimension::D2Array | Dimension::Cube)), None) => {
+            (Some(Dimension::D2), None)
+            | (Some(Dimension::D2Array | Dimension::Cube | Dimension::CubeArray), Some(_)) => {}
+            (Some(d @ (Dimension::D2Array | Dimension::Cube | Dimension::CubeArray)), None) => {
                 return Err(bad(format!(
                     "{label}: targets[{n}] {name} is a {} texture, drawn one layer at a time: \"{name}@layer0\" ..",
                     d.name()
@@ -2021,7 +2042,7 @@ fn storage_slot(
     let dim = storage.dimension;
     match r.dimension {
         // A cube's six faces are written through a 2d-array view.
-        Some(Dimension::Cube) if dim == Dimension::D2Array => {}
+        Some(Dimension::Cube | Dimension::CubeArray) if dim == Dimension::D2Array => {}
         Some(d) if d != dim => {
             return Err(bad(format!(
                 "{label}: resource {} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
@@ -2079,8 +2100,8 @@ fn sampled_slot(
     let r = &mut resources[ri];
     match r.dimension {
         // Six layers sampled as a cube, or a cube read as its 2d-array of faces.
-        Some(Dimension::Cube) if dim == Dimension::D2Array => {}
-        Some(d) if d != dim && !(d == Dimension::D2Array && dim == Dimension::Cube) => {
+        Some(Dimension::Cube | Dimension::CubeArray) if dim == Dimension::D2Array => {}
+        Some(d) if d != dim && !(d == Dimension::D2Array && dim.is_cube()) => {
             return Err(bad(format!(
                 "{label}: resource {rn} has dimension {} but is bound to {}; would fit: dimension = \"{}\"",
                 d.name(),
@@ -2155,7 +2176,7 @@ fn check_swaps_and_outputs(
             )));
         }
         if let Some(l) = layer
-            && !matches!(r.dimension, Some(Dimension::D2Array | Dimension::Cube))
+            && !matches!(r.dimension, Some(Dimension::D2Array | Dimension::Cube | Dimension::CubeArray))
         {
             return Err(bad(format!(
                 "[[output]] resource = \"{name}@layer{l}\": {name} is not a 2d-array or cube texture; only they have layers"

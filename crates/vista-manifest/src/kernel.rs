@@ -258,12 +258,35 @@ impl Kernel {
         self.manifest.source.merged(&self.graph().passes[i].source)
     }
 
+    /// How pass `i`'s separate vertex file is assembled: the pass's
+    /// [`Kernel::source_for`] with the vertex's own `source` keys over it.
+    pub fn vertex_source_for(&self, i: usize) -> vista_source::SourceSpec {
+        let pass = self.source_for(i);
+        match self.graph().passes[i].vertex_source() {
+            Some(own) => pass.merged(own),
+            None => pass,
+        }
+    }
+
+    /// Each file of pass `i` with how it is assembled: the pass's shader,
+    /// then its separate vertex file.
+    fn pass_files(&self, i: usize) -> Vec<(&str, vista_source::SourceSpec)> {
+        let pass = &self.graph().passes[i];
+        let file = pass.shader.as_deref().unwrap_or(self.shader());
+        let mut out = vec![(file, self.source_for(i))];
+        if let Some(v) = pass.vertex_file() {
+            out.push((v, self.vertex_source_for(i)));
+        }
+        out
+    }
+
     /// Every distinct assembly the kernel's passes use, by
     /// [`vista_source::SourceSpec::id`] (none without `[source]`).
     pub fn source_specs(&self) -> Vec<(String, vista_source::SourceSpec)> {
         let n = self.graph().passes.len();
         let mut out: Vec<(String, vista_source::SourceSpec)> = Vec::new();
-        for spec in (0..n).map(|i| self.source_for(i)).filter(|s| !s.is_empty()) {
+        let specs = (0..n).flat_map(|i| self.pass_files(i).into_iter().map(|(_, s)| s));
+        for spec in specs.filter(|s| !s.is_empty()) {
             let id = spec.id();
             if !out.iter().any(|(known, _)| *known == id) {
                 out.push((id, spec));
@@ -278,12 +301,11 @@ impl Kernel {
     /// refuse.
     pub fn generated_files(&self) -> Vec<(String, vista_source::Generator)> {
         let mut out: Vec<(String, vista_source::Generator)> = Vec::new();
-        for (i, pass) in self.graph().passes.iter().enumerate() {
-            let Some(g) = self.source_for(i).generator() else { continue };
-            let file = pass.shader.as_deref().unwrap_or(self.shader());
-            for file in std::iter::once(file).chain(pass.vertex_file()) {
+        for i in 0..self.graph().passes.len() {
+            for (file, spec) in self.pass_files(i) {
+                let Some(g) = spec.generator() else { continue };
                 if !out.iter().any(|(f, known)| f == file && *known == g) {
-                    out.push((file.to_string(), g.clone()));
+                    out.push((file.to_string(), g));
                 }
             }
         }
@@ -295,10 +317,8 @@ impl Kernel {
     /// hash and per-file hashes are taken over these.
     pub fn shader_units(&self) -> Vec<String> {
         let mut out: Vec<String> = Vec::new();
-        for (i, pass) in self.graph().passes.iter().enumerate() {
-            let file = pass.shader.as_deref().unwrap_or(self.shader());
-            let spec = self.source_for(i);
-            for file in std::iter::once(file).chain(pass.vertex_file()) {
+        for i in 0..self.graph().passes.len() {
+            for (file, spec) in self.pass_files(i) {
                 let unit = if spec.is_empty() { file.to_string() } else { format!("{file}|{}", spec.id()) };
                 if !out.contains(&unit) {
                     out.push(unit);
@@ -428,7 +448,7 @@ impl Kernel {
     /// it, composed for `p` with the pass's defs and source keys.
     pub fn vertex_shader_for(&self, i: usize, p: &ParamSet) -> Option<String> {
         let pass = &self.graph().passes[i];
-        pass.vertex_file().map(|file| self.with_defs(file, &pass.defs, &self.source_for(i), p))
+        pass.vertex_file().map(|file| self.with_defs(file, &pass.defs, &self.vertex_source_for(i), p))
     }
 
     /// The value of every `override` constant of `module` for `p`: a param

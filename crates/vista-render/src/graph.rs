@@ -95,6 +95,34 @@ struct PassParts<'a> {
 /// Case-level replacements of resource files (`inputs = { name = "file" }`).
 pub type Inputs = [(String, String)];
 
+/// Every `replace` key of a pass is found in some file its modules reach
+/// (the pass's shader or its separate vertex file): refused otherwise,
+/// naming the key and every file the pass reaches.
+pub fn check_replace_keys(shaders: &vista_gpu::ShaderSet, kernel: &Kernel, p: &ParamSet) -> Result<(), RenderError> {
+    for i in 0..kernel.graph().passes.len() {
+        let units = std::iter::once(kernel.pass_shader_for(i, p)).chain(kernel.vertex_shader_for(i, p));
+        let mut keys: Vec<vista_gpu::ReplaceKeys> = Vec::new();
+        for name in units {
+            // A source that does not assemble is the user's to fix, as when composing.
+            keys.extend(shaders.replace_keys(&name).map_err(|e| match e {
+                vista_gpu::GpuError::Shader(m) => RenderError::BadInput(m),
+                other => RenderError::Gpu(other),
+            })?);
+        }
+        let applied = |k: &String| keys.iter().any(|r| r.applied.contains(k));
+        if let Some(key) = keys.iter().flat_map(|r| &r.missed).find(|k| !applied(k)) {
+            let mut files: Vec<&str> = Vec::new();
+            for f in keys.iter().flat_map(|r| &r.files) {
+                if !files.contains(&f.as_str()) {
+                    files.push(f);
+                }
+            }
+            return Err(RenderError::BadInput(vista_source::unmatched_error(key, &files)));
+        }
+    }
+    Ok(())
+}
+
 /// A def the case sets (`defs = { X = true }`) must be read by a `#if`,
 /// `#ifdef` or `@if` of a file some pass reaches: else it changes nothing
 /// (a typo, or a def of another kernel), and the case is refused naming
@@ -149,6 +177,11 @@ pub(crate) fn plan_graph(
             other => RenderError::Gpu(other),
         })
     };
+    // Keys no file of a pass holds, before composing leaves them in the text.
+    check_replace_keys(shaders, kernel, p).map_err(|e| match e {
+        RenderError::BadInput(m) => bad(m),
+        other => other,
+    })?;
     let mut files = Vec::new();
     let mut modules = Vec::new();
     // A draw's vertex entry in another file: its composed file and module.
@@ -334,7 +367,8 @@ impl Planning<'_> {
         let file = self.file_of(&r.spec.name, file);
         let at = |m: String| bad(format!("resource {}: {m}", r.spec.name));
         let dim = r.dimension.unwrap_or(Dimension::D2);
-        // Six square layers: written through a 2d-array view, sampled through a cube view.
+        // Six square layers (per cube of an array): written through a
+        // 2d-array view, sampled through a cube (array) view.
         let dimension = dim.stored();
         let cube = dim == Dimension::Cube;
         let mut extent = match size {
@@ -343,8 +377,12 @@ impl Planning<'_> {
                 for (i, e) in exprs.iter().enumerate() {
                     v[i] = self.size_entry(i, e).map_err(at)?;
                 }
-                // A cube's size is its face's edge.
-                Some(if cube { [v[0], v[0], 6] } else { v })
+                // A cube's size is its face's edge; a cube array's, the edge and the cubes.
+                Some(match dim {
+                    Dimension::Cube => [v[0], v[0], 6],
+                    Dimension::CubeArray => [v[0], v[0], v[1].saturating_mul(6)],
+                    _ => v,
+                })
             }
             None => None,
         };
@@ -379,6 +417,9 @@ impl Planning<'_> {
             (None, Dimension::Cube) if width == height => [width, width, 6],
             (None, Dimension::Cube) => {
                 return Err(at(format!("a cube's faces are square but the case is {width}x{height}; give size = [N]")));
+            }
+            (None, Dimension::CubeArray) => {
+                return Err(at("a cube-array needs size = [edge, cubes] (its faces' edge and how many cubes)".into()));
             }
             (None, _) => [width, height, 1],
         };
@@ -601,7 +642,7 @@ impl Planning<'_> {
                     Usage::Sampled { kind, dim } => Bind::Sampled {
                         resource: *r,
                         depth: *kind == vista_manifest::graph::SampledKind::Depth,
-                        cube: *dim == Dimension::Cube,
+                        view: dim.is_cube().then_some(*dim),
                         level: s.level,
                     },
                     Usage::Sampler { .. } => Bind::Sampler(*r),

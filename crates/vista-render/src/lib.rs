@@ -22,7 +22,7 @@ pub mod worker;
 
 pub use coverage::{CaseCoverage, cover, cover_with};
 pub use error::{Crash, RenderError};
-pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput, check_case_defs};
+pub use graph::{Inputs, Plan, PlannedKind, PlannedOutput, check_case_defs, check_replace_keys};
 pub use sources::{Sources, edited_shader_set, enum_modules, shader_set, source_specs};
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
@@ -291,6 +291,7 @@ pub fn compose_error_parts(text: &str) -> (Option<&str>, &str) {
 /// `vista list`.
 pub fn composes(shaders: &ShaderSet, kernel: &Kernel) -> Result<(), String> {
     let p = kernel.resolve(None, &[]).map_err(|e| e.to_string())?;
+    check_replace_keys(shaders, kernel, &p).map_err(|e| e.to_string())?;
     for name in (0..kernel.graph().passes.len()).map(|i| kernel.pass_shader_for(i, &p)) {
         if let Err(e) = shaders.compose(&name) {
             let text = e.to_string();

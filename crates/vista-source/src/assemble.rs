@@ -24,6 +24,10 @@ pub struct Assembled {
     pub parts: Vec<Part>,
     /// Each replacement applied: its key and the text put in its place.
     pub replaced: Vec<(String, String)>,
+    /// The `replace` keys found in no line of this file's assembly: refused
+    /// ([`unmatched_error`]) only when no other module of the pass holds them
+    /// (a key of a separate vertex file).
+    pub unmatched: Vec<String>,
     /// For each line of `text`: the index of its part and its 1-based line there.
     lines: Vec<(usize, usize)>,
 }
@@ -31,7 +35,7 @@ pub struct Assembled {
 impl Assembled {
     /// A text whose lines are not traced to files (a compiler's output).
     pub(crate) fn untraced(text: String, parts: Vec<Part>) -> Assembled {
-        Assembled { text, parts, replaced: Vec::new(), lines: Vec::new() }
+        Assembled { text, parts, replaced: Vec::new(), unmatched: Vec::new(), lines: Vec::new() }
     }
 
     /// Whether each line is traced to the file it came from.
@@ -85,6 +89,7 @@ pub fn assemble(
     }
     let mut params = values.iter();
     let mut replaced = Vec::new();
+    let mut unmatched = Vec::new();
     for (key, value) in &spec.replace {
         let value = match value {
             Replacement::Text(t) => t.clone(),
@@ -93,11 +98,8 @@ pub fn assemble(
             }
         };
         if !st.lines.iter().any(|(l, _, _)| l.contains(key.as_str())) {
-            let files: Vec<&str> = st.parts.iter().map(|p| p.path.as_str()).collect();
-            return Err(format!(
-                "[source] replace: \"{key}\" is found in no file the pass reaches ({}); keys match within one line",
-                files.join(", ")
-            ));
+            unmatched.push(key.clone());
+            continue;
         }
         let mut out = Vec::with_capacity(st.lines.len());
         for (line, part, at) in st.lines {
@@ -117,8 +119,18 @@ pub fn assemble(
         text,
         parts: st.parts,
         replaced,
+        unmatched,
         lines: st.lines.into_iter().map(|(_, part, at)| (part, at)).collect(),
     })
+}
+
+/// The refusal of a `replace` key that no file of a pass holds: `files`,
+/// every file the pass's modules reach.
+pub fn unmatched_error(key: &str, files: &[&str]) -> String {
+    format!(
+        "[source] replace: \"{key}\" is found in no file the pass reaches ({}); keys match within one line",
+        files.join(", ")
+    )
 }
 
 /// How deep `#include`s may nest: expanding them recurses, and a chain
@@ -356,7 +368,10 @@ mod tests {
         assert_eq!(a.locate(7), Some(("/proj/shaders/common.wgsl", 1)));
         assert_eq!(a.replaced[0], ("##FORMAT##".into(), "rgba16float".into()));
         let typo = SourceSpec { replace: vec![("{OUTPUT_FORMAT}".into(), Replacement::Text("r".into()))], ..spec };
-        let e = run(&fs, &typo, &["rgba16float".into()]).unwrap_err();
+        let a = run(&fs, &typo, &["rgba16float".into()]).unwrap();
+        assert_eq!(a.unmatched, ["{OUTPUT_FORMAT}"], "left for the pass to refuse if no other file holds it");
+        let files: Vec<&str> = a.parts.iter().map(|p| p.path.as_str()).collect();
+        let e = unmatched_error("{OUTPUT_FORMAT}", &files);
         assert!(e.contains("\"{OUTPUT_FORMAT}\" is found in no file the pass reaches (shaders/noise.wgsl, shaders/k.wgsl, shaders/common.wgsl)"), "{e}");
         let missing = SourceSpec { prepend: Some(vec!["shaders/nope.wgsl".into()]), ..Default::default() };
         assert_eq!(

@@ -16,7 +16,7 @@ mod spec;
 mod wesl;
 mod wesl_blocks;
 
-pub use assemble::{Assembled, Part, assemble};
+pub use assemble::{Assembled, Part, assemble, unmatched_error};
 pub use spec::{DEFAULT_COMMAND_TIMEOUT_MS, Generator, Replacement, SourceSpec};
 pub use wesl::compile_wesl;
 

@@ -33,15 +33,19 @@ pub enum Dimension {
     /// `cube`: six square layers, sampled as a cube (stored and written as
     /// their 2d-array).
     Cube,
+    /// `cube-array`: cubes of six square layers each, sampled as a cube
+    /// array (stored and written as their 2d-array).
+    CubeArray,
 }
 
 impl Dimension {
     /// Every dimension, in order.
-    pub const ALL: [Dimension; 5] = [Dimension::D1, Dimension::D2, Dimension::D2Array, Dimension::D3, Dimension::Cube];
+    pub const ALL: [Dimension; 6] =
+        [Dimension::D1, Dimension::D2, Dimension::D2Array, Dimension::D3, Dimension::Cube, Dimension::CubeArray];
     /// The names of the dimensions a storage texture may have, for messages.
     pub const STORAGE_NAMES: &'static str = "1d|2d|2d-array|3d";
     /// The names of every dimension, for messages.
-    pub const NAMES: &'static str = "1d|2d|2d-array|3d|cube";
+    pub const NAMES: &'static str = "1d|2d|2d-array|3d|cube|cube-array";
 
     /// The manifest's (and WebGPU's view) name.
     pub fn name(self) -> &'static str {
@@ -51,6 +55,7 @@ impl Dimension {
             Dimension::D2Array => "2d-array",
             Dimension::D3 => "3d",
             Dimension::Cube => "cube",
+            Dimension::CubeArray => "cube-array",
         }
     }
 
@@ -64,23 +69,22 @@ impl Dimension {
     pub fn texture_name(self) -> &'static str {
         match self {
             Dimension::D1 => "1d",
-            Dimension::D2 | Dimension::D2Array | Dimension::Cube => "2d",
+            Dimension::D2 | Dimension::D2Array | Dimension::Cube | Dimension::CubeArray => "2d",
             Dimension::D3 => "3d",
         }
     }
 
     /// Entries of a manifest's `size` for this dimension (a cube's is its
-    /// face's edge).
+    /// face's edge; a cube array's, the edge and the number of cubes).
     pub fn size_entries(self) -> usize {
         match self {
             Dimension::D1 | Dimension::Cube => 1,
-            Dimension::D2 => 2,
+            Dimension::D2 | Dimension::CubeArray => 2,
             Dimension::D2Array | Dimension::D3 => 3,
         }
     }
 
-    /// The dimension of a WGSL texture type as naga reflects it; `None` for
-    /// a cube array, which vista does not bind.
+    /// The dimension of a WGSL texture type as naga reflects it.
     pub fn of_naga(dim: naga::ImageDimension, arrayed: bool) -> Option<Dimension> {
         use naga::ImageDimension as I;
         match (dim, arrayed) {
@@ -89,15 +93,21 @@ impl Dimension {
             (I::D2, true) => Some(Dimension::D2Array),
             (I::D3, false) => Some(Dimension::D3),
             (I::Cube, false) => Some(Dimension::Cube),
+            (I::Cube, true) => Some(Dimension::CubeArray),
             _ => None,
         }
     }
 
+    /// Whether it is sampled as cubes (`cube`, `cube-array`).
+    pub fn is_cube(self) -> bool {
+        matches!(self, Dimension::Cube | Dimension::CubeArray)
+    }
+
     /// How the texture of a resource with this dimension is stored: a cube
-    /// as its six layers.
+    /// as its six layers, a cube array as its 6 N.
     pub fn stored(self) -> Dimension {
         match self {
-            Dimension::Cube => Dimension::D2Array,
+            Dimension::Cube | Dimension::CubeArray => Dimension::D2Array,
             d => d,
         }
     }
@@ -153,9 +163,11 @@ mod tests {
         for d in Dimension::ALL {
             assert_eq!(Dimension::parse(d.name()), Some(d));
         }
-        assert_eq!(Dimension::parse("cube-array"), None);
+        assert_eq!(Dimension::parse("cube-array"), Some(Dimension::CubeArray));
+        assert_eq!(Dimension::parse("cubearray"), None);
+        assert_eq!(Dimension::CubeArray.stored(), Dimension::D2Array);
         assert_eq!(Dimension::of_naga(naga::ImageDimension::D2, true), Some(Dimension::D2Array));
-        assert_eq!(Dimension::of_naga(naga::ImageDimension::Cube, true), None);
+        assert_eq!(Dimension::of_naga(naga::ImageDimension::Cube, true), Some(Dimension::CubeArray));
         assert_eq!((Dimension::Cube.stored(), Dimension::Cube.texture_name()), (Dimension::D2Array, "2d"));
         let rw = naga::StorageAccess::LOAD | naga::StorageAccess::STORE;
         assert_eq!(Access::of_naga(rw).web(), "read-write");
