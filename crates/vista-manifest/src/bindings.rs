@@ -51,6 +51,10 @@ pub struct Binding {
     pub binding: u32,
     /// The WGSL variable name.
     pub name: String,
+    /// The import path of the module that declares it (`None`: the pass's
+    /// own file), so a `bind` key may name it by path
+    /// (`"package::post::lut_bindings::lut"`).
+    pub module: Option<String>,
     /// What feeds it.
     pub feed: Feed,
     /// A render pass's vertex entry reaches it (it is visible to the
@@ -95,6 +99,19 @@ pub(crate) fn storage_format(name: &str) -> Result<&'static str, String> {
 /// A storage texture's format, where WebGPU's core lets one have it.
 fn format_name(f: naga::StorageFormat) -> Option<&'static str> {
     vista_texel::Format::of_naga(f).filter(|f| f.is_storable()).map(|f| f.name)
+}
+
+impl Binding {
+    /// Whether a `bind` key names this variable: by its name, or by its
+    /// module's import path and its name (`package::post::lut_bindings::lut`,
+    /// `mylib::camera::frame`).
+    pub fn named(&self, key: &str) -> bool {
+        key == self.name
+            || self
+                .module
+                .as_deref()
+                .is_some_and(|m| key.strip_prefix(m).and_then(|r| r.strip_prefix("::")).is_some_and(|n| n == self.name))
+    }
 }
 
 /// A name as its declaring module spells it, and that module's import
@@ -431,7 +448,7 @@ pub fn reflect_all(
     for g in globals {
         let var = &module.global_variables[g];
         let Some(rb) = &var.binding else { continue };
-        let name = undecorate(var.name.as_deref().unwrap_or_default()).0;
+        let (name, module_path) = undecorate(var.name.as_deref().unwrap_or_default());
         let unfed = |feed: &str| {
             bad(format!(
                 "pass {entry}: {name} (@group({}) @binding({}), {}) cannot be fed; it would need {feed}",
@@ -490,6 +507,7 @@ pub fn reflect_all(
             group: rb.group,
             binding: rb.binding,
             name,
+            module: module_path,
             feed,
             vertex: stage == naga::ShaderStage::Vertex,
             global: g,
