@@ -74,7 +74,8 @@ function vistaChunk(offset, length) {
 // the whole resource] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
 // the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64), usage (WebGPU usage names the passes
 // bind it with; copies are added) }, made and bound with exactly its declared bytes; a sampler: { kind,
-// filter, address [u, v, w], compare (or null) }. Each slot's `layout` is its bind group layout entry (without
+// filter, address [u, v, w], compare (or null) }; a depth texture: { kind, width, height, contents (f32 values,
+// base64, or null), fill ({ wgsl, vertex, fragment }: the pass that draws the values in, with contents) }. Each slot's `layout` is its bind group layout entry (without
 // binding and visibility; `vertex`: the render pass's vertex entry reads it too); a texture slot's view
 // dimension is its layout's. A render pass has `raster` (SPEC 17): { vertex (WGSL: vista's full-screen triangle or
 // another file's; null: vertex_entry is in the pass's own module), vertex_entry, vertex_constants, targets: [{ resource, level, layer, clear, clear_once (the first run only),
@@ -169,7 +170,31 @@ async function vistaRun(job) {
         made.push(texture);
       } else if (r.kind === "depth") {
         // Cleared by the pass that tests against it; sampled as texture_depth_2d.
-        made.push(d.createTexture({ size: [r.width, r.height], format: "depth32float", usage: T.RENDER_ATTACHMENT | T.TEXTURE_BINDING | T.COPY_SRC }));
+        const texture = d.createTexture({ size: [r.width, r.height], format: "depth32float", usage: T.RENDER_ATTACHMENT | T.TEXTURE_BINDING | T.COPY_SRC });
+        if (r.contents) {
+          // WebGPU copies into no depth32float texture: an r32float texture of
+          // the values is drawn into it, each texel's value as frag_depth.
+          const values = d.createTexture({ size: [r.width, r.height], format: "r32float", usage: T.TEXTURE_BINDING | T.COPY_DST });
+          scratch.push(values);
+          d.queue.writeTexture({ texture: values }, fromBase64(r.contents), { bytesPerRow: r.width * 4, rowsPerImage: r.height }, [r.width, r.height]);
+          const module = d.createShaderModule({ code: r.fill.wgsl });
+          const layout = d.createBindGroupLayout({ entries: [{ binding: 0, visibility: GPUShaderStage.FRAGMENT, texture: { sampleType: "unfilterable-float" } }] });
+          const pipeline = d.createRenderPipeline({
+            layout: d.createPipelineLayout({ bindGroupLayouts: [layout] }),
+            vertex: { module, entryPoint: r.fill.vertex },
+            fragment: { module, entryPoint: r.fill.fragment, targets: [] },
+            depthStencil: { format: "depth32float", depthWriteEnabled: true, depthCompare: "always" },
+          });
+          const group = d.createBindGroup({ layout, entries: [{ binding: 0, resource: values.createView() }] });
+          const encoder = d.createCommandEncoder();
+          const fill = encoder.beginRenderPass({ colorAttachments: [], depthStencilAttachment: { view: texture.createView(), depthClearValue: 1, depthLoadOp: "clear", depthStoreOp: "store" } });
+          fill.setPipeline(pipeline);
+          fill.setBindGroup(0, group);
+          fill.draw(3);
+          fill.end();
+          d.queue.submit([encoder.finish()]);
+        }
+        made.push(texture);
       } else if (r.kind === "buffer") {
         const bytes = fromBase64(r.contents);
         const usage = r.usage.reduce((u, name) => u | B[name], B.COPY_SRC | B.COPY_DST);

@@ -2325,6 +2325,108 @@ fn look(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_rejected(&r, 2, &["resource env", "a cube's faces are square but the case is 16x8", "size = [N]"]);
 }
 
+/// A depth texture filled from a file (`file = "inputs/depth.npy"`,
+/// f32 (H, W)): WebGPU copies into no depth32float texture, so vista draws
+/// the values in (frag_depth) before the first pass; a pass then reads
+/// them as `texture_depth_2d` and as unfilterable `texture_2d<f32>`,
+/// exactly, on every backend. Values outside [0, 1] and a file of another
+/// size than `size` are refused naming the file.
+fn a_depth_texture_is_filled_from_a_file() {
+    let manifest = r#"summary = "a G-buffer depth from a file, read two ways"
+[[resource]]
+name = "scene_depth"
+kind = "depth"
+file = "inputs/depth.npy"
+[[resource]]
+name = "probe"
+kind = "texture"
+format = "rgba32float"
+size = [8, 4]
+[[pass]]
+entry = "read"
+bind = { as_depth = "scene_depth", as_float = "scene_depth", probe_out = "probe" }
+"#;
+    let shader = "@group(0) @binding(0) var as_depth: texture_depth_2d;
+@group(0) @binding(1) var as_float: texture_2d<f32>;
+@group(0) @binding(2) var probe_out: texture_storage_2d<rgba32float, write>;
+
+@compute @workgroup_size(8, 4, 1)
+fn read(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= vec2<u32>(8u, 4u)) { return; }
+    let d = textureLoad(as_depth, id.xy, 0);
+    let f = textureLoad(as_float, id.xy, 0).r;
+    textureStore(probe_out, id.xy, vec4(d, f, f32(textureDimensions(as_depth).x), 1.0));
+}
+";
+    let d = kernel_project(manifest, shader);
+    std::fs::create_dir(d.path().join("inputs")).unwrap();
+    // Depths a G-buffer holds: k / 32 across, a far plane of 1 in the last row.
+    let depth = |x: u32, y: u32| if y == 3 { 1.0f32 } else { (x + 8 * y) as f32 / 32.0 };
+    let values: Vec<u8> = (0..4).flat_map(|y| (0..8).flat_map(move |x| depth(x, y).to_le_bytes())).collect();
+    vista_image::npy::write_npy(&d.path().join("inputs/depth.npy"), "<f4", &[4, 8], &values).unwrap();
+    for (backend, probe) in probe_on_every_backend(d.path(), "8x4") {
+        for (x, y) in [(0u32, 0u32), (5, 1), (7, 2), (3, 3)] {
+            let want = depth(x, y);
+            assert_eq!(probe.get(x, y), [want, want, 8.0, 1.0], "{backend}: ({x}, {y})");
+        }
+    }
+    let write_values = |v: &[f32], shape: &[u64]| {
+        let bytes: Vec<u8> = v.iter().flat_map(|f| f.to_le_bytes()).collect();
+        vista_image::npy::write_npy(&d.path().join("inputs/depth.npy"), "<f4", shape, &bytes).unwrap();
+    };
+    let render = || vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x4", "-o", "x.exr"]);
+    let mut far = vec![0.5f32; 32];
+    far[9] = 1.5;
+    write_values(&far, &[4, 8]);
+    assert_rejected(
+        &render(),
+        2,
+        &["file inputs/depth.npy holds 1.5 at (1, 1); a depth32float texture holds depths in [0, 1]"],
+    );
+    write_values(&[0.5; 32], &[4, 8]);
+    std::fs::write(
+        d.path().join("kernels/k.toml"),
+        manifest.replace("file = \"inputs/depth.npy\"", "file = \"inputs/depth.npy\"\nsize = [4, 4]"),
+    )
+    .unwrap();
+    assert_rejected(&render(), 2, &["file inputs/depth.npy is 8x4 but size says 4x4"]);
+}
+
+/// A structured-dtype `.npy` (examples/graphs' boids) is read by its
+/// fields' names: the file as written passes; the same bytes with two
+/// fields' names swapped, or a field of another type, are refused naming
+/// the field, before any GPU work.
+fn structured_npy_fields_are_the_struct_members() {
+    let t = tmp();
+    let root = t.path().join("graphs");
+    copy_tree(&repo().join("examples/graphs"), &root);
+    let render = || vista_in(Some(&root), &[], &["render", "boids", "--size", "16x16", "-o", "b.png"]);
+    assert_eq!(render().code, 0, "{}", render().stderr);
+    let path = root.join("inputs/boids.npy");
+    let original = std::fs::read(&path).unwrap();
+    // The same bytes under a header with one text swapped for another of its length.
+    let header = |from: &str, to: &str| {
+        assert_eq!(from.len(), to.len());
+        let at = original.windows(from.len()).position(|w| w == from.as_bytes()).expect("in the header");
+        let mut bytes = original.clone();
+        bytes[at..at + to.len()].copy_from_slice(to.as_bytes());
+        std::fs::write(&path, bytes).unwrap();
+    };
+    header(
+        "('position', '<f4', (2,)), ('velocity', '<f4', (2,))",
+        "('velocity', '<f4', (2,)), ('position', '<f4', (2,))",
+    );
+    assert_rejected(
+        &render(),
+        2,
+        &[
+            "inputs/boids.npy: field 'velocity' lies at byte 0 of each element but var<storage, read> array<Boid> has it at byte 8",
+        ],
+    );
+    header("('flock', '<u4')", "('flock', '<f4')");
+    assert_rejected(&render(), 2, &["field 'flock' is <f4 x 1 but var<storage, read> array<Boid> has u4 x 1"]);
+}
+
 /// A separate vertex file takes `source` keys of its own over the pass's,
 /// and may be an import module (its own `#define_import_path`, as bevy's
 /// full-screen vertex shader is); a pass's `replace` key is refused only
@@ -7252,7 +7354,8 @@ fn a_wesl_kernel_imports_a_generated_module() {
 
 /// A global an imported WESL module declares is bound by its own name, as
 /// a naga_oil module's is (the wesl crate's mangled `package_io_out` is
-/// not what a manifest says): a WESL kernel's output declared in `io.wesl`.
+/// not what a manifest says), or by its module path
+/// (`"package::io::out"`): a WESL kernel's output declared in `io.wesl`.
 fn an_imported_wesl_global_is_bound_by_its_own_name() {
     let manifest = "summary = \"output declared by an imported module\"\nshader = \"k.wesl\"\n\
                     [[resource]]\nname = \"out\"\nkind = \"texture\"\nformat = \"rgba8unorm\"\n\
@@ -7271,6 +7374,19 @@ fn an_imported_wesl_global_is_bound_by_its_own_name() {
     assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
     let img = vista_image::load(&png).unwrap();
     assert_eq!(img.dimensions(), (8, 8));
+    // Or by its module's path, as bevy's host names it, to a resource of another name.
+    let by_path =
+        manifest.replace("name = \"out\"", "name = \"frame\"").replace("resource = \"out\"", "resource = \"frame\"");
+    let by_path =
+        by_path.replace("entry = \"main\"\n", "entry = \"main\"\nbind = { \"package::io::out\" = \"frame\" }\n");
+    std::fs::write(d.path().join("kernels/k.toml"), &by_path).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", png.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    assert_eq!(vista_image::load(&png).unwrap().get(2, 3), img.get(2, 3));
+    std::fs::write(d.path().join("kernels/k.toml"), by_path.replace("package::io::out", "package::other::out"))
+        .unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", png.to_str().unwrap()]);
+    assert_rejected(&r, 2, &["bind names package::other::out, which k.wesl does not declare"]);
 }
 
 /// `@test_texture` and `@sampler` in wgsl-test's spelling: a checkerboard,
@@ -7491,6 +7607,8 @@ fn main() {
         Gpu mip_levels_are_written_one_by_one_and_read_together,
         Gpu cube_arrays_are_written_as_layers_and_sampled_by_cube,
         Gpu a_vertex_module_takes_its_own_source_keys,
+        Gpu structured_npy_fields_are_the_struct_members,
+        Gpu a_depth_texture_is_filled_from_a_file,
         Gpu a_group_of_passes_repeats_as_one_step,
         Gpu limits_are_reported_unsupported_by_name,
         Gpu each_backend_checks_into_its_own_report,

@@ -360,6 +360,7 @@ fn case_inputs(
             let file = &file;
             let want: &[&str] = match r.kind_name() {
                 "texture" => &[".png", ".exr"],
+                "depth" => &[".npy", ".exr"],
                 "buffer" => &[".npy", ".bin", ".toml", ".json"],
                 _ => &[],
             };

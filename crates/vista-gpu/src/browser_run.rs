@@ -47,7 +47,18 @@ impl Context {
                     "kind": "buffer", "size": bytes.len(), "contents": b64(bytes),
                     "usage": usages[i].unwrap_or_default().web_names(),
                 }),
-                Resource::Depth([w, h]) => json!({ "kind": "depth", "width": w, "height": h }),
+                Resource::Depth([w, h], values) if values.is_empty() => {
+                    json!({ "kind": "depth", "width": w, "height": h, "contents": null })
+                }
+                // First values: the page draws them in with vista's fill pass.
+                Resource::Depth([w, h], values) => json!({
+                    "kind": "depth", "width": w, "height": h, "contents": b64(values),
+                    "fill": {
+                        "wgsl": crate::fullscreen::depth_fill_wgsl(),
+                        "vertex": crate::fullscreen::FULLSCREEN_ENTRY,
+                        "fragment": crate::fullscreen::DEPTH_FILL_ENTRY,
+                    },
+                }),
                 Resource::Sampler(s) => json!({
                     "kind": "sampler",
                     "filter": if s.linear { "linear" } else { "nearest" },
@@ -206,7 +217,7 @@ impl Context {
             }
             // A depth resource: texture_depth_2d, or texture_2d<f32> as WebGPU
             // allows (unfilterable-float).
-            Bind::Sampled { resource, depth, .. } if matches!(g.resources[*resource], Resource::Depth(_)) => (
+            Bind::Sampled { resource, depth, .. } if matches!(g.resources[*resource], Resource::Depth(..)) => (
                 json!({ "texture": {
                     "sampleType": if *depth { "depth" } else { "unfilterable-float" },
                     "viewDimension": "2d", "multisampled": false,

@@ -21,3 +21,23 @@ fn vista_fullscreen(@builtin(vertex_index) i: u32) -> VistaFullscreen {
 
 /// The vertex entry of [`FULLSCREEN_WGSL`].
 pub const FULLSCREEN_ENTRY: &str = "vista_fullscreen";
+
+/// The fragment entry of [`depth_fill_wgsl`].
+pub const DEPTH_FILL_ENTRY: &str = "vista_depth_fill";
+
+/// A pass that writes a depth texture's first values from an r32float
+/// texture of them (WebGPU copies into no depth32float texture): the
+/// full-screen triangle and a fragment entry returning each texel's value
+/// as `frag_depth`.
+pub fn depth_fill_wgsl() -> String {
+    format!(
+        "{FULLSCREEN_WGSL}
+@group(0) @binding(0) var vista_depth_values: texture_2d<f32>;
+
+@fragment
+fn {DEPTH_FILL_ENTRY}(@builtin(position) p: vec4<f32>) -> @builtin(frag_depth) f32 {{
+    return textureLoad(vista_depth_values, vec2<u32>(p.xy), 0).r;
+}}
+"
+    )
+}

@@ -162,8 +162,11 @@ pub enum Resource {
     /// A sampler.
     Sampler(SamplerDesc),
     /// A depth32float texture of this width and height: a render pass's
-    /// depth attachment, sampled by later passes as `texture_depth_2d`.
-    Depth([u32; 2]),
+    /// depth attachment, sampled by later passes as `texture_depth_2d`;
+    /// with its first values (f32, little-endian, rows top to bottom) when
+    /// a file gives them, else none (cleared by the pass that tests
+    /// against it).
+    Depth([u32; 2], #[serde(with = "wire::bytes")] Vec<u8>),
 }
 
 impl Resource {
@@ -172,7 +175,7 @@ impl Resource {
     pub fn read_as(&self) -> Option<TextureDesc> {
         match self {
             Resource::Texture(t) => Some(t.clone()),
-            Resource::Depth([width, height]) => Some(TextureDesc {
+            Resource::Depth([width, height], _) => Some(TextureDesc {
                 format: "r32float",
                 dimension: Dimension::D2,
                 width: *width,

@@ -65,8 +65,12 @@ pub enum ResourceKind {
     /// A depth texture (`kind = "depth"`, depth32float): a render pass's
     /// `depth` attachment that later passes sample as `texture_depth_2d`.
     Depth {
-        /// `[w, h]` as expressions; `None`: the case size.
+        /// `[w, h]` as expressions; `None`: the file's size, else the case size.
         size: Option<Vec<Expr>>,
+        /// Its first values (`file = "inputs/depth.npy"`: f32 (H, W), or
+        /// an EXR's red channel), in [0, 1]; `None`: cleared by the pass
+        /// that tests against it.
+        file: Option<String>,
     },
     /// A sampler (`kind = "sampler"`).
     Sampler {
@@ -565,7 +569,7 @@ fn parse_resources(
             "texture" => &["name", "kind", "format", "dimension", "size", "file", "mip_levels"],
             "buffer" => &["name", "kind", "file", "data", "fill", "length", "fields"],
             "sampler" => &["name", "kind", "filter", "address", "compare"],
-            "depth" => &["name", "kind", "size"],
+            "depth" => &["name", "kind", "size", "file"],
             other => {
                 return Err(at(format!("kind = \"{other}\" is not valid; expected texture|buffer|sampler|depth")));
             }
@@ -584,7 +588,14 @@ fn parse_resources(
         let kind = match kind.as_str() {
             "texture" => texture_kind(t, file, params, &at)?,
             "buffer" => buffer_kind(t, file, params, &at)?,
-            "depth" => ResourceKind::Depth { size: depth_size(t, params, &at)? },
+            "depth" => {
+                if let Some(f) = file.as_ref().filter(|f| !f.ends_with(".npy") && !f.ends_with(".exr")) {
+                    return Err(at(format!(
+                        "file = \"{f}\" is not valid for a depth texture; expected .npy (f32) or .exr"
+                    )));
+                }
+                ResourceKind::Depth { size: depth_size(t, params, &at)?, file }
+            }
             _ => sampler_kind(t, &at)?,
         };
         res.push(ResourceSpec { name, kind });
@@ -1605,7 +1616,7 @@ pub fn resolve(
             // Bound by the pass's bind, else to the resource of its own name
             // unless the bind gives that resource to another variable (a
             // uniform `sky` beside `bind = { sky_faces = "sky" }`).
-            let given = pass.bind.iter().find(|(v, _)| *v == b.name).map(|(_, r)| r);
+            let given = pass.bind.iter().find(|(v, _)| b.named(v)).map(|(_, r)| r);
             let level = given.and_then(|r| r.level);
             let bound = given.map(|r| r.resource.clone()).or_else(|| {
                 graph
@@ -1902,7 +1913,7 @@ fn check_read_before_written(
 ) -> Result<(), ParamError> {
     let swapped = |name: &str| graph.passes.iter().any(|p| p.swap.iter().any(|(a, b)| a == name || b == name));
     for r in resources {
-        if matches!(&r.spec.kind, ResourceKind::Texture { file: None, .. } | ResourceKind::Depth { .. })
+        if matches!(&r.spec.kind, ResourceKind::Texture { file: None, .. } | ResourceKind::Depth { file: None, .. })
             && r.read
             && !r.written
             && !swapped(&r.spec.name)
@@ -1929,7 +1940,7 @@ fn check_bind_declared(
     bad: &dyn Fn(String) -> ParamError,
 ) -> Result<(), ParamError> {
     for (var, _) in &pass.bind {
-        let declared = bindings.iter().any(|b| &b.name == var)
+        let declared = bindings.iter().any(|b| b.named(var))
             || module
                 .global_variables
                 .iter()

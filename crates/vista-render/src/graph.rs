@@ -260,7 +260,7 @@ pub(crate) fn plan_graph(
                     ),
                 }
             }
-            ResourceKind::Depth { size } => at.depth(r, size.as_deref()),
+            ResourceKind::Depth { size, file } => at.depth(r, size.as_deref(), file.as_ref()),
             ResourceKind::Sampler { linear, address, compare } => {
                 let a = |s: &str| vista_gpu::Address::parse(s).expect("manifest checks address modes");
                 Ok(vista_gpu::Resource::Sampler(vista_gpu::SamplerDesc {
@@ -468,13 +468,37 @@ impl Planning<'_> {
         &self,
         r: &vista_manifest::graph::ResolvedResource,
         size: Option<&[vista_manifest::expr::Expr]>,
+        file: Option<&String>,
     ) -> Result<vista_gpu::Resource, RenderError> {
         let at = |m: String| self.bad(format!("resource {}: {m}", r.spec.name));
         let mut wh = [self.width, self.height];
         for (i, e) in size.unwrap_or_default().iter().enumerate() {
             wh[i] = self.size_entry(i, e).map_err(at)?;
         }
-        Ok(vista_gpu::Resource::Depth(wh))
+        let Some(f) = self.file_of(&r.spec.name, file) else { return Ok(vista_gpu::Resource::Depth(wh, Vec::new())) };
+        // First values: f32 (H, W) from a .npy, or an EXR's red channel.
+        let (fw, fh, values): (u32, u32, Vec<f32>) = match f.ends_with(".npy") {
+            true => {
+                let (_, [w, h], bytes) = read_texture_npy(self.root, &f, Some("r32float")).map_err(at)?;
+                (w, h, bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
+            }
+            false => {
+                let (_, image) = read_texture(self.root, &f, self.max_bytes).map_err(at)?;
+                (image.width, image.height, image.data.iter().map(|t| t[0]).collect())
+            }
+        };
+        if size.is_some() && [fw, fh] != wh {
+            return Err(at(format!("file {f} is {fw}x{fh} but size says {}x{}", wh[0], wh[1])));
+        }
+        if let Some(i) = values.iter().position(|v| !(0.0..=1.0).contains(v)) {
+            return Err(at(format!(
+                "file {f} holds {} at ({}, {}); a depth32float texture holds depths in [0, 1]",
+                values[i],
+                i as u32 % fw,
+                i as u32 / fw
+            )));
+        }
+        Ok(vista_gpu::Resource::Depth([fw, fh], values.iter().flat_map(|v| v.to_le_bytes()).collect()))
     }
 
     /// The leaf values of a `.toml` or `.json` file (root-relative), or of a
@@ -722,7 +746,7 @@ impl Planning<'_> {
                     [((b.len() as u32 - e.header) / e.stride.max(1)).max(1), 1, 1]
                 }
                 vista_gpu::Resource::Sampler(_) => [width, height, 1],
-                vista_gpu::Resource::Depth([w, h]) => [*w, *h, 1],
+                vista_gpu::Resource::Depth([w, h], _) => [*w, *h, 1],
             }
         };
         Ok(match (&pass.workgroups, &pass.dispatch) {
@@ -848,7 +872,7 @@ impl Planning<'_> {
             targets.push(vista_gpu::RasterTarget { resource: ri, level, layer, clear, clear_once: implicit, blend });
         }
         if let (Some(name), Some((w, h, first))) = (r.depth.as_ref().and_then(|d| d.resource.as_ref()), &size)
-            && let vista_gpu::Resource::Depth([dw, dh]) = &resources[index(name)]
+            && let vista_gpu::Resource::Depth([dw, dh], _) = &resources[index(name)]
             && (dw, dh) != (w, h)
         {
             return Err(self.bad(format!(
@@ -887,7 +911,7 @@ impl Planning<'_> {
                     Some(name) => index(name),
                     None => {
                         let (w, h, _) = size.clone().expect("a render pass has targets");
-                        resources.push(vista_gpu::Resource::Depth([w, h]));
+                        resources.push(vista_gpu::Resource::Depth([w, h], Vec::new()));
                         resources.len() - 1
                     }
                 };
@@ -1091,7 +1115,7 @@ impl Planning<'_> {
             }
             ids.push(id);
             let kind = match &resources[r] {
-                vista_gpu::Resource::Texture(_) | vista_gpu::Resource::Depth(_) => {
+                vista_gpu::Resource::Texture(_) | vista_gpu::Resource::Depth(..) => {
                     // A depth output reads back as r32float.
                     let t = id.texture(&resources[r]).expect("a texture");
                     let view = spec.and_then(|o| o.view).unwrap_or_else(|| kernel.default_view(t.format));
@@ -1265,9 +1289,14 @@ fn read_buffer(root: Option<&Path>, file: &str, e: &Element) -> Result<Vec<u8>, 
                 && e.leaves.iter().all(|l| l.1 == leaf_kind);
             if !(simple_ok || (n.descr.starts_with('[') && n.item_bytes == e.stride as u64)) {
                 return Err(format!(
-                    "file {file} has dtype {} but {} needs {descr} (or any dtype of {} bytes per element)",
+                    "file {file} has dtype {} but {} needs {descr} (or a structured dtype of its members, {} \
+                     bytes per element)",
                     n.descr, e.wgsl, e.stride
                 ));
+            }
+            // A structured dtype's fields are the struct's members, by name.
+            if n.descr.starts_with('[') {
+                crate::dtype::check_structured(file, &n.descr, e)?;
             }
             n.data
         }

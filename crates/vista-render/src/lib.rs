@@ -13,6 +13,7 @@
 
 mod command;
 mod coverage;
+mod dtype;
 mod error;
 pub mod graph;
 pub mod leaf_values;
