@@ -409,7 +409,7 @@ impl Context {
                 Resource::Depth(size, values) => {
                     let texture = depth_texture(d, *size);
                     if !values.is_empty() {
-                        fill_depth(w, &texture, *size, values);
+                        crate::context::fill_depth(w, &texture, *size, values);
                     }
                     made.textures.insert(i, texture);
                 }
@@ -817,109 +817,6 @@ fn depth_texture(d: &wgpu::Device, [width, height]: [u32; 2]) -> wgpu::Texture {
             | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     })
-}
-
-/// Fills depth texture `texture` with `values` (f32 per texel): WebGPU
-/// copies into no depth32float texture, so an r32float texture of the
-/// values is drawn into its depth aspect by a full-screen pass writing
-/// `frag_depth` ([`crate::fullscreen::DEPTH_FILL_WGSL`]), as the page does.
-fn fill_depth(w: &WgpuEngine, texture: &wgpu::Texture, [width, height]: [u32; 2], values: &[u8]) {
-    let d = &w.device;
-    let extent = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
-    let source = d.create_texture(&wgpu::TextureDescriptor {
-        label: Some("depth values"),
-        size: extent,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    w.queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture: &source,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        values,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * width), rows_per_image: Some(height) },
-        extent,
-    );
-    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("depth fill"),
-        source: wgpu::ShaderSource::Wgsl(crate::fullscreen::depth_fill_wgsl().into()),
-    });
-    let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("depth fill"),
-        entries: &[wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        }],
-    });
-    let pipeline_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("depth fill"),
-        bind_group_layouts: &[Some(&layout)],
-        ..Default::default()
-    });
-    let pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("depth fill"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some(crate::fullscreen::FULLSCREEN_ENTRY),
-            buffers: &[],
-            compilation_options: Default::default(),
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some(crate::fullscreen::DEPTH_FILL_ENTRY),
-            targets: &[],
-            compilation_options: Default::default(),
-        }),
-        primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: wgpu::TextureFormat::Depth32Float,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        multiview_mask: None,
-        cache: None,
-    });
-    let view = source.create_view(&Default::default());
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("depth fill"),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) }],
-    });
-    let target = texture.create_view(&Default::default());
-    let mut encoder = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("depth fill"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &target,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.draw(0..3, 0..1);
-    }
-    w.queue.submit([encoder.finish()]);
 }
 
 /// The stages that see a binding: a render pass's fragment stage (and its
