@@ -137,6 +137,19 @@ fn render_example_with(
     common::render_in_project(ctx, &example(name), kernel, &set, (width, height))
 }
 
+/// Golden case `case` of example `name` rendered as `vista check` renders
+/// it: its params, defs, inputs (leaf values inline too) and size.
+fn render_case(name: &str, case: &str) -> Result<vista_render::Rendered, String> {
+    let ctx = vista_gpu::Context::shared(&common::config().gpu).map_err(|e| e.to_string())?;
+    let project = vista_project::Project::at(&example(name)).map_err(|e| e.to_string())?;
+    let store = vista_golden::Store::of_project(&project, "references").map_err(|e| e.to_string())?;
+    let cases = store.load_cases().map_err(|e| e.to_string())?;
+    let c = cases.iter().find(|c| c.id == case).ok_or_else(|| format!("no case {case}"))?;
+    let gpu = vista_render::Renderer::new(ctx, &project, common::config().limits).map_err(|e| e.to_string())?;
+    vista_render::render_with(&gpu, &c.kernel, &c.params, &c.inputs, c.width, c.height)
+        .map_err(|e| format!("{case}: {e}"))
+}
+
 /// The texture output named `name` (raw f32 RGBA, rows top to bottom).
 fn texels_named(out: &vista_render::Rendered, name: &str) -> Result<(u32, u32, Vec<[f32; 4]>), String> {
     match out.outputs.iter().find(|o| o.name == name).map(|o| &o.value) {
@@ -919,15 +932,7 @@ fn sources_blur() -> Result<(), String> {
 /// out (the fog's slope there); allowance: f16 storage plus 2e-5 for the
 /// f32 ray (the near point's subtraction from the eye).
 fn render_view_rays_case(case: &str, exposure: f64, density: f64, fog: [f64; 3]) -> Result<(), String> {
-    let ctx = vista_gpu::Context::shared(&common::config().gpu).map_err(|e| e.to_string())?;
-    let project = vista_project::Project::at(&example("render")).map_err(|e| e.to_string())?;
-    let store = vista_golden::Store::of_project(&project, "references").map_err(|e| e.to_string())?;
-    let cases = store.load_cases().map_err(|e| e.to_string())?;
-    let c = cases.iter().find(|c| c.id == case).ok_or_else(|| format!("no case {case}"))?;
-    let gpu = vista_render::Renderer::new(ctx, &project, common::config().limits).map_err(|e| e.to_string())?;
-    let out = vista_render::render_with(&gpu, &c.kernel, &c.params, &c.inputs, c.width, c.height)
-        .map_err(|e| format!("{case}: {e}"))?;
-    let (w, h, got) = texels(&out)?;
+    let (w, h, got) = texels(&render_case("render", case)?)?;
     let (eye, target) = ([0.0, 2.0, 6.0], [0.0, 1.0, 0.0]);
     let norm = |v: [f64; 3]| {
         let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -980,15 +985,7 @@ fn render_view_rays_dense_fog() -> Result<(), String> {
 /// def and leaves the param at reinhard). Allowance: f16 storage plus
 /// 1e-5 for f32 (exp2 within a few ulp of 2^5).
 fn sources_tonemap_case(case: &str, method: &str, asked: f64) -> Result<(), String> {
-    let ctx = vista_gpu::Context::shared(&common::config().gpu).map_err(|e| e.to_string())?;
-    let project = vista_project::Project::at(&example("sources")).map_err(|e| e.to_string())?;
-    let store = vista_golden::Store::of_project(&project, "references").map_err(|e| e.to_string())?;
-    let cases = store.load_cases().map_err(|e| e.to_string())?;
-    let c = cases.iter().find(|c| c.id == case).ok_or_else(|| format!("no case {case}"))?;
-    let gpu = vista_render::Renderer::new(ctx, &project, common::config().limits).map_err(|e| e.to_string())?;
-    let out = vista_render::render_with(&gpu, &c.kernel, &c.params, &c.inputs, c.width, c.height)
-        .map_err(|e| format!("{case}: {e}"))?;
-    let (w, h, got) = texels(&out)?;
+    let (w, h, got) = texels(&render_case("sources", case)?)?;
     let (curve, id): (fn(f64) -> f64, f64) = match method {
         "reinhard" => (|c| c / (1.0 + c), 0.0),
         "exponential" => (|c| 1.0 - (-c).exp(), 1.0),
