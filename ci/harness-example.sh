@@ -12,7 +12,7 @@ export CARGO_TARGET_DIR
 cargo=${CARGO:-cargo}
 list=$("$cargo" test -q --test golden -- --list)
 for t in golden::glow::glow golden::glow::glow-blue wgsl::glow::core_is_one_over_e_at_the_radius; do
-    echo "$list" | grep -qx "$t: test" || { echo "$list"; echo "harness-example: --list lacks $t"; exit 1; }
+    grep -qx "$t: test" <<<"$list" || { echo "$list"; echo "harness-example: --list lacks $t"; exit 1; }
 done
 "$cargo" test --test golden
 # The WGSL unit test is in the report beside the cases.
@@ -34,7 +34,7 @@ grep -q 'WGSL coverage: <a href="coverage/index.html">' target/vista-report/inde
 "$cargo" test -q --test golden >/dev/null
 [ ! -e "$lcov" ] || { echo "harness-example: a run without coverage left the older lcov.info"; exit 1; }
 one=$("$cargo" test -q --test golden -- --exact golden::glow::glow-blue 2>&1)
-echo "$one" | grep -q "1 passed; 0 failed; 0 ignored; 0 measured; 2 filtered out" ||
+grep -q "1 passed; 0 failed; 0 ignored; 0 measured; 2 filtered out" <<<"$one" ||
     { echo "$one"; echo "harness-example: --exact did not select one case"; exit 1; }
 for f in index.html results.json; do
     [ -f "target/vista-report/$f" ] || { echo "harness-example: no $f in examples/harness-crate/target/vista-report"; exit 1; }
@@ -46,17 +46,17 @@ trap 'rm -f "$orphan"' EXIT
 if out=$("$cargo" test -q --test golden 2>&1); then
     echo "$out"; echo "harness-example: an orphaned golden did not fail the run"; exit 1
 fi
-echo "$out" | grep -q "golden::orphans.*FAILED\|---- golden::orphans" ||
+grep -q "golden::orphans.*FAILED\|---- golden::orphans" <<<"$out" ||
     { echo "$out"; echo "harness-example: the orphaned golden did not fail golden::orphans"; exit 1; }
-echo "$out" | grep -q "gone.png" || { echo "$out"; echo "harness-example: golden::orphans did not name the file"; exit 1; }
+grep -q "gone.png" <<<"$out" || { echo "$out"; echo "harness-example: golden::orphans did not name the file"; exit 1; }
 rm -f "$orphan"
 # A driver crash (injected) fails its case's test alone: the worker dies, the next case gets a new one.
 if out=$(VISTA_WORKER_FAULT=segv:glow "$cargo" test -q --test golden 2>&1); then
     echo "$out"; echo "harness-example: a crashed case did not fail the run"; exit 1
 fi
-echo "$out" | grep -q "crashed (signal 11, SIGSEGV) in pass 1" ||
+grep -q "crashed (signal 11, SIGSEGV) in pass 1" <<<"$out" ||
     { echo "$out"; echo "harness-example: the crash was not named"; exit 1; }
-echo "$out" | grep -q "2 passed; 1 failed" || { echo "$out"; echo "harness-example: the other case and the unit test did not pass"; exit 1; }
+grep -q "2 passed; 1 failed" <<<"$out" || { echo "$out"; echo "harness-example: the other case and the unit test did not pass"; exit 1; }
 echo "harness-example: the crate's own cargo test ran its 2 golden cases and its WGSL unit test through vista::harness::main()"
 # The same test binary under cargo-nextest, a process per case (where nextest is installed; else a loud line).
 bash "$ci/harness-nextest.sh"

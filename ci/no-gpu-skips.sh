@@ -15,7 +15,7 @@ built=$(${CARGO:-cargo} test --workspace --no-run --message-format=json 2>/dev/n
     grep -E '"profile":\{[^}]*"test":true' | grep '"executable":"/')
 run_suite() { # package-dir suite
     local exe
-    exe=$(echo "$built" | grep -F "\"src_path\":\"$1/tests/$2.rs\"" | sed -E 's/.*"executable":"([^"]*)".*/\1/' | head -n 1)
+    exe=$(echo "$built" | grep -F "\"src_path\":\"$1/tests/$2.rs\"" | sed -E 's/.*"executable":"([^"]*)".*/\1/' | awk 'NR == 1')
     [ -n "$exe" ] || { echo "no-gpu-skips: no test executable for $1/tests/$2.rs"; exit 1; }
     (cd "$1" && "$exe")
 }
@@ -39,7 +39,7 @@ n=$(echo "$results" | wc -l)
 if [ "$n" -ne "${#suites[@]}" ]; then
     cat "$log"; echo "no-gpu-skips: expected ${#suites[@]} suites, saw $n"; exit 1
 fi
-if echo "$results" | grep -vqE ' 0 passed; 0 failed; [1-9][0-9]* ignored'; then
+if grep -vqE ' 0 passed; 0 failed; [1-9][0-9]* ignored' <<<"$results"; then
     echo "$results"; echo "no-gpu-skips: a GPU test passed or failed without an adapter instead of being ignored"; exit 1
 fi
 # The skip run must leave the last real report whole: every file it links exists.
@@ -59,7 +59,7 @@ echo "no-gpu-skips: without an adapter all $skipped GPU tests of ${#suites[@]} s
 VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json VISTA_ALLOW_NO_GPU=1 \
     run_suite "$root/crates/vista-cli" cli >"$log" 2>&1 || { cat "$log"; echo "no-gpu-skips: the CLI suite failed without an adapter"; exit 1; }
 cli=$(grep -E '^test result:' "$log")
-if ! echo "$cli" | grep -qE ' [1-9][0-9]* passed; 0 failed; [1-9][0-9]* ignored'; then
+if ! grep -qE ' [1-9][0-9]* passed; 0 failed; [1-9][0-9]* ignored' <<<"$cli"; then
     echo "$cli"; echo "no-gpu-skips: the CLI suite did not both run its bad-input tests and ignore its rendering ones"; exit 1
 fi
 echo "no-gpu-skips: CLI suite without an adapter: $(echo "$cli" | sed 's/.*ok\. //; s/; 0 measured.*//')"
