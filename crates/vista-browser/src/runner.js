@@ -70,8 +70,7 @@ function vistaChunk(offset, length) {
 // sampler], passes: [{ key, wgsl (the project's text, or naga's rewrite of a composed module), entry, constants (WebGPU
 // pipeline constants), workgroups, repeat, span, swap: [[a, b]], slots: [{ group, binding,
 // layout, owned (base64) | resource, level (a texture's one mip level, or null: all) }] }], outputs: [{ resource
-// (index), and for a texture: level, z (first layer), width, height, layers (of that level) }, or a bare index:
-// the whole resource] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
+// (index), and for a texture: level, z (first layer), width, height, layers (of that level) }] }. A texture: { kind, format, dimension, width, height, layers, mip_levels, texel_bytes, contents (base64 or null: zeros), fill (one texel, base64, repeated over
 // the texture: the unwritten sentinel; or null) }; a buffer: { kind, contents (base64), usage (WebGPU usage names the passes
 // bind it with; copies are added) }, made and bound with exactly its declared bytes; a sampler: { kind,
 // filter, address [u, v, w], compare (or null) }; a depth texture: { kind, width, height, contents (f32 values,
@@ -303,9 +302,7 @@ async function vistaRun(job) {
     }
     const copyStart = performance.now();
     const parts = [];
-    for (const given of job.outputs) {
-      // A bare index is the whole resource: level 0, every layer.
-      const o = typeof given === "number" ? { resource: given, level: 0, z: 0, width: job.resources[given].width, height: job.resources[given].height, layers: job.resources[given].layers } : given;
+    for (const o of job.outputs) {
       const r = job.resources[o.resource];
       const physical = made[current[o.resource]];
       const encoder = d.createCommandEncoder();

@@ -94,7 +94,7 @@ fn job(key: &str, wgsl: &str, u: &[u8], table: &[u32], w: u32, h: u32) -> Value 
                 { "group": 0, "binding": 2, "layout": { "buffer": { "type": "read-only-storage" } }, "owned": base64(&table) },
             ],
         }],
-        "outputs": [0],
+        "outputs": [{ "resource": 0, "level": 0, "z": 0, "width": w, "height": h, "layers": 1 }],
     })
 }
 
