@@ -232,25 +232,21 @@ pub(crate) fn plan_graph(
                 use crate::leaf_values::is_leaf_file;
                 let replaced = at.inputs.iter().find(|(n, _)| *n == r.spec.name).map(|(_, f)| f.as_str());
                 let own_leaves = file.as_deref().filter(|f| is_leaf_file(f));
-                match replaced {
-                    // Leaf values in layers: the manifest's fields, its file's,
-                    // then the case's (a file or an inline table) over them.
-                    Some(f) if is_leaf_file(f) => {
+                let case_leaves = replaced.filter(|f| is_leaf_file(f));
+                // Leaf values in layers: the manifest's fields, its file's, then
+                // the case's (a file or an inline table) over them; a case's
+                // .bin or .npy replaces them all.
+                let by_leaf =
+                    case_leaves.is_some() || (replaced.is_none() && (own_leaves.is_some() || fields.is_some()));
+                match by_leaf {
+                    true => {
                         let mut all = fields.clone().unwrap_or_default();
-                        if let Some(own) = own_leaves {
-                            all.extend(at.leaf_file(r, own)?);
-                        }
-                        all.extend(at.leaf_file(r, f)?);
-                        at.fields(r, &all)
-                    }
-                    None if own_leaves.is_some() || fields.is_some() => {
-                        let mut all = fields.clone().unwrap_or_default();
-                        if let Some(own) = own_leaves {
-                            all.extend(at.leaf_file(r, own)?);
+                        for f in own_leaves.into_iter().chain(case_leaves) {
+                            all.extend(at.leaf_file(r, f)?);
                         }
                         at.fields(r, &all)
                     }
-                    _ => at.buffer(
+                    false => at.buffer(
                         r,
                         file.as_ref(),
                         data.as_deref(),

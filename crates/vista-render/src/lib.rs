@@ -309,12 +309,11 @@ pub fn composes(shaders: &ShaderSet, kernel: &Kernel) -> Result<(), String> {
 /// The folders and files the project's `[source]` tables name outside
 /// `shaders/` (include folders, joined files, WESL packages), each once.
 pub fn paths_outside_shaders(project: &vista_project::Project) -> Result<Vec<String>, RenderError> {
-    let (specs, _) = source_specs(project)?;
+    let registry = sources::registry(project)?;
+    let specs = registry.kernels().iter().flat_map(|k| k.source_specs());
     let mut out: Vec<String> = Vec::new();
     // What a `[source] command` reads: its inputs and script.
     if let Some(root) = project.root() {
-        let registry =
-            vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))?;
         for k in registry.kernels() {
             for (file, g) in k.generated_files() {
                 for p in command::dependencies(root, &format!("shaders/{file}"), &g) {

@@ -163,7 +163,7 @@ pub fn source_specs(
 }
 
 /// The project's kernel manifests.
-fn registry(project: &vista_project::Project) -> Result<vista_kernels::Registry, RenderError> {
+pub(crate) fn registry(project: &vista_project::Project) -> Result<vista_kernels::Registry, RenderError> {
     vista_kernels::Registry::of_project(project).map_err(|e| RenderError::BadInput(e.to_string()))
 }
 
