@@ -82,8 +82,10 @@ pub fn generated_origin(path: &str, command: &str) -> String {
 /// compiler's, not traced to the user's lines.
 const COMPILED_BY_WESL: &str = " (as the wesl crate compiled it)";
 
+/// Whether a text is a command's or the wesl crate's output: not the
+/// user's lines, so coverage does not measure it.
 fn is_generated(origin: &str) -> bool {
-    origin.ends_with("` generated it)")
+    origin.ends_with("` generated it)") || origin.ends_with(COMPILED_BY_WESL)
 }
 
 /// A root-relative path's text and origin, for files an assembly reaches
@@ -671,7 +673,8 @@ impl ShaderSet {
     }
 
     /// The file a coverage report names for a source: its path under the
-    /// project (`shaders/...`); none for a generated module, or one of
+    /// project (`shaders/...`); none for a generated module, a command's or
+    /// the wesl crate's output, or one of
     /// vista's built-in modules the project does not have (no file of the
     /// project to show it in: not measured).
     fn report_path(source: &Source) -> Option<String> {
@@ -702,10 +705,9 @@ impl ShaderSet {
             })?;
             validate(name, &module)?;
             // A compiler's output (WESL) is not traced to its files: not measured.
-            let compiled = kernel.origin.ends_with(COMPILED_BY_WESL);
             let origins = self.coverage.then(|| Origins::Direct {
                 text: source.clone(),
-                file: ShaderSet::report_path(kernel).filter(|_| !compiled),
+                file: ShaderSet::report_path(kernel),
                 assembled: None,
             });
             return Ok((module, origins));
