@@ -5271,14 +5271,27 @@ fn a_projects_own_preprocessor_runs_through_source_command() {
         assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
     }
     assert_eq!(runs(), 1, "one run, then the cache");
-    // Coverage: a command's output (and the wesl crate's) is not the
-    // user's lines, so neither file is measured.
-    for case in ["blur", "relief"] {
+    // Coverage: a command's output is not the user's lines, so it is not
+    // measured; the wesl crate's output is traced back to the .wesl files
+    // (tonemap's three cases, 64 x 24 texels each, worked by hand: each
+    // case its own curve; tint's first arm the first 8 of 24 rows; the
+    // edge guard never taken, 64 x 24 being whole 16 x 4 workgroups).
+    let coverage_of = |case: &str| {
         let r = run(&["check", "--coverage", "--case", case]);
         assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
-        let lcov = std::fs::read_to_string(root.join("target/vista-report/lcov.info")).unwrap_or_default();
-        assert!(!lcov.contains("SF:"), "{case}: {lcov}");
-    }
+        lcov_lines(&std::fs::read_to_string(root.join("target/vista-report/lcov.info")).unwrap_or_default())
+    };
+    assert!(coverage_of("blur").is_empty());
+    let lcov = coverage_of("tonemap-*");
+    let curves: Vec<(u32, u64)> = vec![(8, 1536), (9, 1536), (10, 1536), (16, 1536), (23, 1536)];
+    assert_eq!(lcov.get("shaders/post/curves.wesl"), Some(&curves), "{lcov:?}");
+    let all = 3 * 1536;
+    let tonemap: Vec<(u32, u64)> = [(20, all), (21, 1536), (23, 3072), (28, all), (29, all), (30, 0)]
+        .into_iter()
+        .chain([32, 33, 34, 35, 37].map(|l| (l, all)))
+        .collect();
+    assert_eq!(lcov.get("shaders/post/tonemap.wesl"), Some(&tonemap), "{lcov:?}");
+    assert_eq!(lcov.len(), 2, "the generated constants module is not measured: {lcov:?}");
     // An input changed: run again, and --changed names it.
     edit("tools/blur.json", &|s| s.replace("1.75", "2.0"));
     let r = run(&["check", "--changed", "--json", "r.json"]);

@@ -144,8 +144,12 @@ impl<'a> Placer<'a> {
                 match assembled {
                     None => Some(Place { file: file.clone()?, line, col }),
                     Some(a) => {
-                        let (path, at) = a.locate_path(line as usize)?;
-                        Some(Place { file: path.to_string(), line: at as u32, col })
+                        let (part, at) = a.locate_part(line as usize)?;
+                        crate::shaders::measured(&part.origin).then(|| Place {
+                            file: part.path.clone(),
+                            line: at as u32,
+                            col,
+                        })
                     }
                 }
             }
@@ -289,13 +293,31 @@ mod tests {
     /// A command's output and the wesl crate's are not the user's lines:
     /// nothing of them is measured (never a count on a line the file lacks).
     #[test]
-    fn generated_and_compiled_text_is_not_measured() {
+    fn generated_text_is_not_measured_and_compiled_wesl_is_traced() {
         let kernel = "@group(0) @binding(0) var<storage, read_write> out: array<f32>;\n@compute @workgroup_size(1)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n    if id.x > 3u {\n        out[id.x] = 1.0;\n    }\n}\n";
         let origin = crate::generated_origin("/p/shaders/k.tmpl", "python3 t.py {shader}");
         let set = crate::ShaderSet::from_files("test", [("k.tmpl".into(), kernel.into(), origin)]);
         assert!(counted_lines(&set, "k.tmpl").is_empty());
+        // The same text as WGSL and as WESL counts the same lines.
+        let set = crate::ShaderSet::from_files("test", [("k.wgsl".into(), kernel.into(), "/p/shaders/k.wgsl".into())]);
+        let wgsl: Vec<u32> = counted_lines(&set, "k.wgsl").into_iter().map(|(_, l)| l).collect();
         let set = crate::ShaderSet::from_files("test", [("k.wesl".into(), kernel.into(), "/p/shaders/k.wesl".into())]);
-        assert!(set.compose("k.wesl").is_ok());
-        assert!(counted_lines(&set, "k.wesl").is_empty());
+        let wesl = counted_lines(&set, "k.wesl");
+        assert_eq!(wesl.iter().map(|(_, l)| *l).collect::<Vec<_>>(), wgsl);
+        assert_eq!(wesl, [("shaders/k.wesl".to_string(), 4), ("shaders/k.wesl".to_string(), 5)]);
+        // An imported module's statements on its own file's lines (worked
+        // by hand: the kernel's 4 and 5, the module's 3, 5 and 6).
+        let kernel = "import package::m::twice;\n@group(0) @binding(0) var<storage, read_write> out: array<f32>;\n@compute @workgroup_size(1) fn main(@builtin(global_invocation_id) id: vec3<u32>) {\n    let v = twice(f32(id.x));\n    out[id.x] = v;\n}\n";
+        let module = "// doubles\nfn twice(x: f32) -> f32 {\n    var y = x;\n    // the other half\n    y += x;\n    return y;\n}\n";
+        let set = crate::ShaderSet::from_files(
+            "test",
+            [
+                ("k.wesl".into(), kernel.into(), "/p/shaders/k.wesl".into()),
+                ("m.wesl".into(), module.into(), "/p/shaders/m.wesl".into()),
+            ],
+        );
+        let k = |l: u32| ("shaders/k.wesl".to_string(), l);
+        let m = |l: u32| ("shaders/m.wesl".to_string(), l);
+        assert_eq!(counted_lines(&set, "k.wesl"), [k(4), k(5), m(3), m(5), m(6)]);
     }
 }

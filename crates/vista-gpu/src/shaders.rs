@@ -79,13 +79,18 @@ pub fn generated_origin(path: &str, command: &str) -> String {
 }
 
 /// The end of a `.wesl` kernel's origin once compiled: its text is the
-/// compiler's, not traced to the user's lines.
+/// compiler's (coverage follows its lines back to the modules' files).
 const COMPILED_BY_WESL: &str = " (as the wesl crate compiled it)";
 
-/// Whether a text is a command's or the wesl crate's output: not the
-/// user's lines, so coverage does not measure it.
-fn is_generated(origin: &str) -> bool {
-    origin.ends_with("` generated it)") || origin.ends_with(COMPILED_BY_WESL)
+/// Whether coverage measures the lines of a text of this origin: not a
+/// command's or the wesl crate's output as a whole, a generated module, or
+/// one of vista's built-in modules the project does not have (no file of
+/// the project to show it in).
+pub(crate) fn measured(origin: &str) -> bool {
+    !(origin.ends_with("` generated it)")
+        || origin.ends_with(COMPILED_BY_WESL)
+        || origin.starts_with("<generated>")
+        || origin.starts_with("<built-in>"))
 }
 
 /// A root-relative path's text and origin, for files an assembly reaches
@@ -412,9 +417,9 @@ impl ShaderSet {
             None => Unit { source: kernel.clone(), assembled: None },
             Some(a) => {
                 // A compiler's output names its root file as compiled.
-                let origin = match a.traced() {
-                    true => kernel.origin.clone(),
-                    false => format!("{}{COMPILED_BY_WESL}", kernel.origin),
+                let origin = match a.is_compiled() {
+                    false => kernel.origin.clone(),
+                    true => format!("{}{COMPILED_BY_WESL}", kernel.origin),
                 };
                 Unit { source: Source::new(kernel.rel.clone(), a.text.clone(), origin), assembled: Some(a) }
             }
@@ -429,7 +434,7 @@ impl ShaderSet {
     /// keys). A pass refuses a key none of its modules applied.
     pub fn replace_keys(&self, name: &str) -> Result<Option<ReplaceKeys>, GpuError> {
         let unit = self.unit(name)?;
-        Ok(unit.assembled.as_ref().filter(|a| a.traced()).map(|a| ReplaceKeys {
+        Ok(unit.assembled.as_ref().filter(|a| !a.is_compiled()).map(|a| ReplaceKeys {
             missed: a.unmatched.clone(),
             applied: a.replaced.iter().map(|(k, _)| k.clone()).collect(),
             files: a.parts.iter().map(|p| p.path.clone()).collect(),
@@ -673,15 +678,9 @@ impl ShaderSet {
     }
 
     /// The file a coverage report names for a source: its path under the
-    /// project (`shaders/...`); none for a generated module, a command's or
-    /// the wesl crate's output, or one of
-    /// vista's built-in modules the project does not have (no file of the
-    /// project to show it in: not measured).
+    /// project (`shaders/...`) where its lines are [`measured`].
     fn report_path(source: &Source) -> Option<String> {
-        let own = !source.origin.starts_with("<generated>")
-            && !source.origin.starts_with("<built-in>")
-            && !is_generated(&source.origin);
-        own.then(|| format!("shaders/{}", source.rel))
+        measured(&source.origin).then(|| format!("shaders/{}", source.rel))
     }
 
     /// The module of `name`, and where its spans point when this set
@@ -792,7 +791,7 @@ impl ShaderSet {
         if self.coverage {
             h.update(b"instrumented for coverage");
         }
-        match unit.assembled.as_ref().filter(|a| !a.traced()) {
+        match unit.assembled.as_ref().filter(|a| a.is_compiled()) {
             // A compiler's output (WESL): the files it read, by path, not
             // its text, whose order of declarations is the compiler's own
             // and need not repeat from one process to the next.

@@ -28,25 +28,41 @@ pub struct Assembled {
     /// ([`unmatched_error`]) only when no other module of the pass holds them
     /// (a key of a separate vertex file).
     pub unmatched: Vec<String>,
-    /// For each line of `text`: the index of its part and its 1-based line there.
-    lines: Vec<(usize, usize)>,
+    /// For each line of `text`: the index of its part and its 1-based line
+    /// there (`None`: a line a compiler wrote that is no file's).
+    lines: Vec<Option<(usize, usize)>>,
+    /// A compiler's output (WESL): its declarations in the compiler's
+    /// order, which need not repeat from one process to the next, and its
+    /// lines traced for coverage only (its errors are the compiler's).
+    compiled: bool,
 }
 
 impl Assembled {
-    /// A text whose lines are not traced to files (a compiler's output).
-    pub(crate) fn untraced(text: String, parts: Vec<Part>) -> Assembled {
-        Assembled { text, parts, replaced: Vec::new(), unmatched: Vec::new(), lines: Vec::new() }
+    /// A compiler's output over `parts`, with what is known of each line's
+    /// file and line (`lines` empty: nothing).
+    pub(crate) fn compiled(text: String, parts: Vec<Part>, lines: Vec<Option<(usize, usize)>>) -> Assembled {
+        Assembled { text, parts, replaced: Vec::new(), unmatched: Vec::new(), lines, compiled: true }
     }
 
-    /// Whether each line is traced to the file it came from.
+    /// Whether lines are traced to the files they came from.
     pub fn traced(&self) -> bool {
         !self.lines.is_empty()
     }
 
+    /// Whether a compiler wrote the text (WESL) rather than vista joining
+    /// files line by line.
+    pub fn is_compiled(&self) -> bool {
+        self.compiled
+    }
+
     /// The file (its origin) and 1-based line that line `line` (1-based)
-    /// of the assembled text came from.
+    /// of the assembled text came from: what an error names. None for a
+    /// compiler's output, whose errors name its own lines.
     pub fn locate(&self, line: usize) -> Option<(&str, usize)> {
-        let (part, at) = *self.lines.get(line.checked_sub(1)?)?;
+        if self.compiled {
+            return None;
+        }
+        let (part, at) = (*self.lines.get(line.checked_sub(1)?)?)?;
         Some((self.parts[part].origin.as_str(), at))
     }
 
@@ -54,8 +70,13 @@ impl Assembled {
     /// that line `line` of the assembled text came from: what a coverage
     /// report names.
     pub fn locate_path(&self, line: usize) -> Option<(&str, usize)> {
-        let (part, at) = *self.lines.get(line.checked_sub(1)?)?;
-        Some((self.parts[part].path.as_str(), at))
+        self.locate_part(line).map(|(p, at)| (p.path.as_str(), at))
+    }
+
+    /// The part and 1-based line there that line `line` came from.
+    pub fn locate_part(&self, line: usize) -> Option<(&Part, usize)> {
+        let (part, at) = (*self.lines.get(line.checked_sub(1)?)?)?;
+        Some((&self.parts[part], at))
     }
 }
 
@@ -120,7 +141,8 @@ pub fn assemble(
         parts: st.parts,
         replaced,
         unmatched,
-        lines: st.lines.into_iter().map(|(_, part, at)| (part, at)).collect(),
+        lines: st.lines.into_iter().map(|(_, part, at)| Some((part, at))).collect(),
+        compiled: false,
     })
 }
 

@@ -15,6 +15,7 @@ mod assemble;
 mod spec;
 mod wesl;
 mod wesl_blocks;
+mod wesl_lines;
 
 pub use assemble::{Assembled, Part, assemble, unmatched_error};
 pub use spec::{DEFAULT_COMMAND_TIMEOUT_MS, Generator, Replacement, SourceSpec};

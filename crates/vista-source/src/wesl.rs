@@ -8,6 +8,7 @@
 
 use std::borrow::Cow;
 use std::cell::RefCell;
+use std::collections::HashMap;
 
 use wesl::{Mangler, ModulePath, ResolveError, Resolver, syntax::PathOrigin};
 
@@ -19,6 +20,9 @@ struct Files<'a> {
     packages: &'a [(String, String)],
     read: &'a dyn Fn(&str) -> Option<(String, String)>,
     parts: RefCell<Vec<Part>>,
+    /// Each module path (as the mangler spells it) with its file and the
+    /// text handed to the compiler: what its spans point into.
+    given: RefCell<HashMap<String, (String, String)>>,
 }
 
 /// The file vista's assertion module is read from (a built-in, unless the
@@ -74,6 +78,12 @@ impl Files<'_> {
         Some(format!("shaders/generated/{}.wgsl", parts.join("/")))
     }
 
+    /// Keeps the text handed to the compiler for module `path`.
+    fn give(&self, path: &ModulePath, file: &str, text: String) -> String {
+        self.given.borrow_mut().insert(path.to_string(), (file.to_string(), text.clone()));
+        text
+    }
+
     /// Keeps a file read as a part of the shader (its hash covers them).
     fn record(&self, file: &str, origin: String, text: &str) {
         let mut parts = self.parts.borrow_mut();
@@ -89,13 +99,13 @@ impl Resolver for Files<'_> {
             && let Some((text, origin)) = (self.read)(&file)
         {
             self.record(&file, origin, &text);
-            return Ok(Cow::Owned(as_wesl(&text)));
+            return Ok(Cow::Owned(self.give(path, &file, as_wesl(&text))));
         }
         let candidates = self.candidates(path).map_err(|e| ResolveError::ModuleNotFound(path.clone(), e))?;
         for file in &candidates {
             if let Some((text, origin)) = (self.read)(file) {
                 self.record(file, origin, &text);
-                return Ok(Cow::Owned(without_visibility(&text)));
+                return Ok(Cow::Owned(self.give(path, file, without_visibility(&text))));
             }
         }
         Err(ResolveError::ModuleNotFound(path.clone(), format!("tried {}", candidates.join(", "))))
@@ -151,7 +161,8 @@ pub fn compile_wesl(
         }
         Some(found)
     };
-    let files = Files { packages: &spec.packages, read: &checked, parts: RefCell::new(Vec::new()) };
+    let files =
+        Files { packages: &spec.packages, read: &checked, parts: RefCell::new(Vec::new()), given: Default::default() };
     let mut compiler = wesl::Wesl::new("shaders").set_custom_resolver(files);
     compiler.set_custom_mangler(Decorated);
     for (name, on) in features {
@@ -164,7 +175,18 @@ pub fn compile_wesl(
     let result = result.map_err(|e| located(&plain(&e.to_string())))?;
     let text = result.to_string();
     let parts = compiler.resolver().parts.take();
-    Ok(Assembled::untraced(text, parts))
+    let given = compiler.resolver().given.take();
+    // A declaration's module: the one its decorated name spells, else the root.
+    let module_of = |name: &str| {
+        let path = match name.split_once(crate::wesl_lines::DECORATION) {
+            Some((_, rest)) => String::from_utf8(unbase32(rest.strip_suffix('X')?)?).ok()?,
+            None => root.to_string(),
+        };
+        let (file, text) = given.get(&path)?;
+        Some((parts.iter().position(|p| p.path == *file)?, text.as_str()))
+    };
+    let lines = crate::wesl_lines::trace(&result.syntax, &text, module_of).unwrap_or_default();
+    Ok(Assembled::compiled(text, parts, lines))
 }
 
 /// Names an imported module's declaration as naga_oil does,
@@ -197,6 +219,26 @@ fn base32(bytes: &[u8]) -> String {
         out.push(ALPHABET[((acc << (5 - bits)) & 31) as usize] as char);
     }
     out
+}
+
+/// The bytes of [`base32`]'s text; `None` for a letter outside its alphabet.
+fn unbase32(text: &str) -> Option<Vec<u8>> {
+    let (mut out, mut acc, mut bits) = (Vec::new(), 0u32, 0u32);
+    for c in text.bytes() {
+        let v = match c {
+            b'A'..=b'Z' => c - b'A',
+            b'2'..=b'7' => c - b'2' + 26,
+            _ => return None,
+        };
+        acc = (acc << 5) | v as u32;
+        bits += 5;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+            acc &= (1 << bits) - 1;
+        }
+    }
+    Some(out)
 }
 
 /// The wesl crate's diagnostic with its place first: its headline says
@@ -304,6 +346,59 @@ mod tests {
         };
         let e = compile_wesl("shaders/k.wesl", &spec, &[], &broken).unwrap_err();
         assert_eq!(e, "/p/shaders/k.wesl:1: @else block without an @if block before it");
+    }
+
+    /// Each statement of the compiled text is traced to its own module's
+    /// file and line (worked by hand below); braces and `else {` are not.
+    #[test]
+    fn compiled_lines_are_traced_to_their_modules_lines() {
+        let files: Vec<(&str, &str)> = vec![
+            (
+                "shaders/k.wesl",
+                "import package::m::scale;\n\n@group(0) @binding(0) var<storage, read_write> out: array<f32>;\n\n\
+                 @compute @workgroup_size(1)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n    \
+                 var v = scale(f32(id.x));\n    if v > 2.0 {\n        v = 2.0;\n    } else if v < 0.5 {\n        \
+                 v = 0.5;\n    }\n    out[id.x] = v;\n}\n",
+            ),
+            (
+                "shaders/m.wesl",
+                "// helper\nfn scale(x: f32) -> f32 {\n    var s = 0.0;\n    for (var i = 0u; i < 3u; i++) {\n        \
+                 s += x;\n    }\n    return s;\n}\n",
+            ),
+        ];
+        let read = |p: &str| files.iter().find(|(f, _)| *f == p).map(|(_, t)| (t.to_string(), format!("/p/{p}")));
+        let a = compile_wesl("shaders/k.wesl", &SourceSpec::default(), &[], &read).unwrap();
+        assert!(a.traced() && a.is_compiled());
+        let expected = [
+            ("@compute", "shaders/k.wesl", 5),
+            ("fn main(", "shaders/k.wesl", 6),
+            ("var v = ", "shaders/k.wesl", 7),
+            ("if v > 2.0", "shaders/k.wesl", 8),
+            ("v = 2.0;", "shaders/k.wesl", 9),
+            ("else if v < 0.5", "shaders/k.wesl", 10),
+            ("v = 0.5;", "shaders/k.wesl", 11),
+            ("out[id.x] = v;", "shaders/k.wesl", 13),
+            ("fn scaleX_naga_oil_mod_X", "shaders/m.wesl", 2),
+            ("var s = 0.0;", "shaders/m.wesl", 3),
+            ("for (", "shaders/m.wesl", 4),
+            ("s += x;", "shaders/m.wesl", 5),
+            ("return s;", "shaders/m.wesl", 7),
+        ];
+        let lines: Vec<&str> = a.text.lines().collect();
+        for (start, file, line) in expected {
+            let at = lines
+                .iter()
+                .position(|l| l.trim_start().starts_with(start))
+                .unwrap_or_else(|| panic!("{start}: {}", a.text));
+            assert_eq!(a.locate_path(at + 1), Some((file, line)), "{start}");
+        }
+        for (i, l) in lines.iter().enumerate() {
+            if l.trim() == "}" || l.trim() == "else {" {
+                assert_eq!(a.locate_path(i + 1), None, "{l}");
+            }
+        }
+        // Errors keep naming the compiler's lines.
+        assert_eq!(a.locate(1), None);
     }
 
     /// A package's root module, a module of this package, features, and
