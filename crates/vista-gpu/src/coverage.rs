@@ -68,6 +68,21 @@ pub(crate) enum Origins {
     Composed { modules: HashMap<usize, (Option<String>, String)> },
 }
 
+/// The end of a `.wesl` kernel's origin once compiled: its text is the
+/// compiler's (coverage follows its lines back to the modules' files).
+pub(crate) const COMPILED_BY_WESL: &str = " (as the wesl crate compiled it)";
+
+/// Whether coverage measures the lines of a text of this origin: not a
+/// command's or the wesl crate's output as a whole, a generated module, or
+/// one of vista's built-in modules the project does not have (no file of
+/// the project to show it in).
+pub(crate) fn measured(origin: &str) -> bool {
+    !(origin.ends_with("` generated it)")
+        || origin.ends_with(COMPILED_BY_WESL)
+        || origin.starts_with("<generated>")
+        || origin.starts_with("<built-in>"))
+}
+
 /// `module` instrumented, and its counters placed through `origins`.
 pub(crate) fn instrument(module: &naga::Module, origins: &Origins) -> (naga::Module, Coverage) {
     let group = module.global_variables.iter().filter_map(|(_, g)| g.binding.as_ref().map(|b| b.group + 1)).max();
@@ -145,11 +160,7 @@ impl<'a> Placer<'a> {
                     None => Some(Place { file: file.clone()?, line, col }),
                     Some(a) => {
                         let (part, at) = a.locate_part(line as usize)?;
-                        crate::shaders::measured(&part.origin).then(|| Place {
-                            file: part.path.clone(),
-                            line: at as u32,
-                            col,
-                        })
+                        measured(&part.origin).then(|| Place { file: part.path.clone(), line: at as u32, col })
                     }
                 }
             }

@@ -78,21 +78,6 @@ pub fn generated_origin(path: &str, command: &str) -> String {
     format!("{path} (as `{command}` generated it)")
 }
 
-/// The end of a `.wesl` kernel's origin once compiled: its text is the
-/// compiler's (coverage follows its lines back to the modules' files).
-const COMPILED_BY_WESL: &str = " (as the wesl crate compiled it)";
-
-/// Whether coverage measures the lines of a text of this origin: not a
-/// command's or the wesl crate's output as a whole, a generated module, or
-/// one of vista's built-in modules the project does not have (no file of
-/// the project to show it in).
-pub(crate) fn measured(origin: &str) -> bool {
-    !(origin.ends_with("` generated it)")
-        || origin.ends_with(COMPILED_BY_WESL)
-        || origin.starts_with("<generated>")
-        || origin.starts_with("<built-in>"))
-}
-
 /// A root-relative path's text and origin, for files an assembly reaches
 /// outside `shaders/` (the project layer reads them; this crate reads none).
 #[derive(Clone, Default)]
@@ -419,7 +404,7 @@ impl ShaderSet {
                 // A compiler's output names its root file as compiled.
                 let origin = match a.is_compiled() {
                     false => kernel.origin.clone(),
-                    true => format!("{}{COMPILED_BY_WESL}", kernel.origin),
+                    true => format!("{}{}", kernel.origin, crate::coverage::COMPILED_BY_WESL),
                 };
                 Unit { source: Source::new(kernel.rel.clone(), a.text.clone(), origin), assembled: Some(a) }
             }
@@ -680,7 +665,7 @@ impl ShaderSet {
     /// The file a coverage report names for a source: its path under the
     /// project (`shaders/...`) where its lines are [`measured`].
     fn report_path(source: &Source) -> Option<String> {
-        measured(&source.origin).then(|| format!("shaders/{}", source.rel))
+        crate::coverage::measured(&source.origin).then(|| format!("shaders/{}", source.rel))
     }
 
     /// The module of `name`, and where its spans point when this set
