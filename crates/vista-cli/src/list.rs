@@ -135,7 +135,7 @@ pub fn coverage(project: &Project, config: &vista::Config) -> Result<i32, Golden
     let store = vista_golden::Store::of_project(project, "vista list --coverage")?;
     let cases = store.load_cases()?;
     let gpu = vista_render::Renderer::shared(&config.gpu, project, config.limits)?;
-    let covered = gpu.shaders.covered();
+    let covered = gpu.shaders.covered(gpu.ctx.vertex_writes_storage());
     let mut failed = 0;
     for k in kernels.kernels() {
         let mine: Vec<&vista_golden::Case> = cases.iter().filter(|c| c.kernel.name() == k.name()).collect();

@@ -9,9 +9,11 @@
 //! `vista_coverage: array<atomic<u32>>` at a group the pass does not bind.
 //! Each branch arm (an `if`'s accept and reject blocks, a `switch`'s
 //! cases, a loop's body; `&&` and `||` are `if`s in naga's IR) starts a
-//! segment of its own, so arms are counted even when empty. Functions a
-//! vertex entry reaches are left as they are (a vertex stage may not
-//! write storage in WebGPU's core): *not measured*, never *unexecuted*.
+//! segment of its own, so arms are counted even when empty. Vertex entries
+//! and the functions they reach are counted only where the device lets
+//! the vertex stage write storage (wgpu's `VERTEX_WRITABLE_STORAGE`; not
+//! WebGPU's core); elsewhere they are left as they are: *not measured*,
+//! never *unexecuted*.
 //!
 //! [`Counts`] maps the counters back to lines through a caller's
 //! span-to-place function (the composed source's files and lines) and
@@ -66,14 +68,15 @@ pub struct Instrumented {
     pub counters: Vec<Counter>,
     /// Where [`VAR`] is bound.
     pub binding: ResourceBinding,
-    /// Functions left uninstrumented (a vertex entry reaches them): their
-    /// lines are not measured.
+    /// Functions left uninstrumented (a vertex entry reaches them, and the
+    /// vertex stage may not write storage): their lines are not measured.
     pub not_measured: Vec<String>,
 }
 
 /// The module with a counter per segment and per arm, its buffer at
-/// `group`, binding 0 (a group no pass of the module's uses).
-pub fn instrument(module: &Module, group: u32) -> Instrumented {
+/// `group`, binding 0 (a group no pass of the module's uses); `vertex`:
+/// whether vertex entries may write it (they are counted then).
+pub fn instrument(module: &Module, group: u32, vertex: bool) -> Instrumented {
     let mut m = module.clone();
     let atomic = m.types.insert(Type { name: None, inner: TypeInner::Atomic(Scalar::U32) }, Span::UNDEFINED);
     let array = m.types.insert(
@@ -92,7 +95,7 @@ pub fn instrument(module: &Module, group: u32) -> Instrumented {
         },
         Span::UNDEFINED,
     );
-    let vertex = reached_from_vertex(&m);
+    let uncounted = if vertex { Vec::new() } else { reached_from_vertex(&m) };
     // Expression types, to tell a scalar `select` (whose arms are counted)
     // from a component-wise one; a module that does not validate gets none.
     let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
@@ -103,7 +106,7 @@ pub fn instrument(module: &Module, group: u32) -> Instrumented {
     let handles: Vec<Handle<Function>> = m.functions.iter().map(|(h, _)| h).collect();
     for h in handles {
         let name = m.functions[h].name.clone().unwrap_or_default();
-        if vertex.contains(&h) {
+        if uncounted.contains(&h) {
             not_measured.push(name);
             continue;
         }
@@ -111,7 +114,7 @@ pub fn instrument(module: &Module, group: u32) -> Instrumented {
         instrument_function(&mut m.functions[h], global, &name, &mut counters, &scalar);
     }
     for (i, ep) in m.entry_points.iter_mut().enumerate() {
-        if ep.stage == ShaderStage::Vertex {
+        if ep.stage == ShaderStage::Vertex && !vertex {
             not_measured.push(ep.name.clone());
             continue;
         }

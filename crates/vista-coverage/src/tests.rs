@@ -47,12 +47,12 @@ fn line_of(text: &str) -> impl Fn(Span) -> Option<Place> + '_ {
 }
 
 /// The instrumented module validates and writes back as WGSL with one
-/// counter buffer; every counted line is a statement's; the vertex entry
-/// and what it calls are not measured.
+/// counter buffer; every counted line is a statement's; without vertex
+/// counting, the vertex entry and what it calls are not measured.
 #[test]
 fn the_instrumented_module_validates_and_counts_statement_lines() {
     let module = parse(KERNEL);
-    let inst = instrument(&module, 1);
+    let inst = instrument(&module, 1, false);
     validate(&inst.module);
     let info = validate(&inst.module);
     let wgsl = naga::back::wgsl::write_string(&inst.module, &info, naga::back::wgsl::WriterFlags::empty()).unwrap();
@@ -79,13 +79,31 @@ fn the_instrumented_module_validates_and_counts_statement_lines() {
     assert_eq!(arms, [(8, 0), (8, 1), (13, 0), (13, 0), (13, 1), (15, 0), (15, 1)]);
 }
 
+/// Where the vertex stage may write storage, the vertex entry and what
+/// it calls are counted like any function, and the module still validates.
+#[test]
+fn vertex_code_is_counted_where_the_vertex_stage_may_write_storage() {
+    let inst = instrument(&parse(KERNEL), 1, true);
+    validate(&inst.module);
+    assert!(inst.not_measured.is_empty(), "{:?}", inst.not_measured);
+    let place = line_of(KERNEL);
+    let mut lines: Vec<u32> =
+        inst.counters.iter().flat_map(|c| c.spans.iter().filter_map(|s| place(*s)).map(|p| p.line)).collect();
+    lines.sort();
+    lines.dedup();
+    // The compute lines as without, and vs's return (21) and helper's (24).
+    assert_eq!(lines, [3, 8, 9, 11, 13, 14, 15, 17, 21, 24], "{:#?}", inst.counters);
+    let functions: std::collections::BTreeSet<&str> = inst.counters.iter().map(|c| c.function.as_str()).collect();
+    assert!(functions.contains("vs") && functions.contains("helper"), "{functions:?}");
+}
+
 /// Counts map lines to their segments' values, summed over runs; LCOV
 /// lists every line (0 where never run) and each arm, `-` where its
 /// statement never ran.
 #[test]
 fn counts_sum_runs_and_write_lcov() {
     let module = parse(KERNEL);
-    let inst = instrument(&module, 1);
+    let inst = instrument(&module, 1, false);
     let place = line_of(KERNEL);
     // A run where only `unused` never ran: every counter 2 but each if's
     // accept arm 1, so that its reject arm (the if's runs less the accept
@@ -125,7 +143,7 @@ fn counts_sum_runs_and_write_lcov() {
 #[test]
 fn lcov_reads_back_as_the_counts_it_was_written_from() {
     let module = parse(KERNEL);
-    let inst = instrument(&module, 1);
+    let inst = instrument(&module, 1, false);
     let place = line_of(KERNEL);
     let values: Vec<u32> = (0..inst.counters.len() as u32).collect();
     let mut counts = Counts::default();

@@ -377,7 +377,10 @@ impl Context {
         // Blending into 32-bit float render targets, where the driver has it.
         // 16-bit floats and dual-source blending in shaders (`enable f16;`,
         // `enable dual_source_blending;`), where the driver has them.
+        // Storage writes from the vertex stage, so that coverage counts
+        // vertex code (WebGPU's core has none: a browser never counts it).
         let wanted = specific
+            | wgpu::Features::VERTEX_WRITABLE_STORAGE
             | wgpu::Features::FLOAT32_FILTERABLE
             | wgpu::Features::FLOAT32_BLENDABLE
             | wgpu::Features::RG11B10UFLOAT_RENDERABLE
@@ -980,6 +983,17 @@ fn pick(adapters: Vec<wgpu::Adapter>, choice: &AdapterChoice) -> Option<wgpu::Ad
 }
 
 impl Context {
+    /// Whether the vertex stage may write storage buffers on this device
+    /// (wgpu's `VERTEX_WRITABLE_STORAGE`): coverage then counts vertex code.
+    pub fn vertex_writes_storage(&self) -> bool {
+        let feature = wgpu::Features::VERTEX_WRITABLE_STORAGE;
+        match &self.engine {
+            Engine::Wgpu(w) => w.device.features().contains(feature),
+            Engine::Browser(_) => false,
+            Engine::Described(f) => f.features.contains(feature),
+        }
+    }
+
     /// The device's limit `name` (WebGPU's spelling), where the backend
     /// reports it.
     pub fn limit(&self, name: &str) -> Option<u64> {

@@ -26,7 +26,8 @@ pub struct Coverage {
     /// The group the counter buffer binds at (binding 0): one past the
     /// highest the kernel binds.
     pub group: u32,
-    /// Functions a vertex entry reaches: not measured.
+    /// Functions a vertex entry reaches, where the vertex stage may not
+    /// write storage: not measured.
     pub not_measured: Vec<String>,
     places: HashMap<(usize, usize), Place>,
     /// Each counted function: its declaration, its name as written, the
@@ -61,7 +62,8 @@ impl Coverage {
 #[derive(Debug)]
 pub(crate) enum Origins {
     /// naga parsed `text` directly: `file`'s own, or an assembly of files
-    /// (neither: a compiler's or a command's output, not measured).
+    /// (a compiler's output traced to its modules' files; neither: a
+    /// command's output, or a compiler's not traced: not measured).
     Direct { text: String, file: Option<String>, assembled: Option<vista_source::Assembled> },
     /// naga_oil composed it: each module index's file (none for a
     /// generated module) and preprocessed source (index 0: the kernel).
@@ -84,9 +86,9 @@ pub(crate) fn measured(origin: &str) -> bool {
 }
 
 /// `module` instrumented, and its counters placed through `origins`.
-pub(crate) fn instrument(module: &naga::Module, origins: &Origins) -> (naga::Module, Coverage) {
+pub(crate) fn instrument(module: &naga::Module, origins: &Origins, vertex: bool) -> (naga::Module, Coverage) {
     let group = module.global_variables.iter().filter_map(|(_, g)| g.binding.as_ref().map(|b| b.group + 1)).max();
-    let done = vista_coverage::instrument(module, group.unwrap_or(0));
+    let done = vista_coverage::instrument(module, group.unwrap_or(0), vertex);
     let spans = done.counters.iter().flat_map(|c| c.spans.iter().copied().chain(c.arm.map(|a| a.at)));
     let placer = Placer::new(module, origins);
     let places = spans
@@ -248,7 +250,7 @@ mod tests {
 
     /// Each counted line of `name` in `set`, as (file, line) pairs, sorted.
     fn counted_lines(set: &crate::ShaderSet, name: &str) -> Vec<(String, u32)> {
-        let cov = set.covered().coverage(name).unwrap();
+        let cov = set.covered(false).coverage(name).unwrap();
         let mut counts = Counts::default();
         cov.add(&mut counts, &vec![1; cov.counters.len()]);
         let mut out: Vec<(String, u32)> = counts
@@ -286,10 +288,10 @@ mod tests {
             .map(|(f, l)| (f.to_string(), l))
             .collect();
         assert_eq!(lines, want);
-        let cov = set.covered().coverage("k.wgsl").unwrap();
+        let cov = set.covered(false).coverage("k.wgsl").unwrap();
         assert_eq!(cov.group, 1, "one past the kernel's highest group");
         assert!(set.coverage("k.wgsl").is_err(), "a judged set has no counters");
-        assert_ne!(set.source_hash("k.wgsl").unwrap(), set.covered().source_hash("k.wgsl").unwrap());
+        assert_ne!(set.source_hash("k.wgsl").unwrap(), set.covered(false).source_hash("k.wgsl").unwrap());
     }
 
     #[test]
@@ -298,7 +300,7 @@ mod tests {
         let set = crate::ShaderSet::from_files("test", [("k.wgsl".into(), kernel.into(), "/p/shaders/k.wgsl".into())]);
         let lines: Vec<u32> = counted_lines(&set, "k.wgsl").into_iter().map(|(_, l)| l).collect();
         assert_eq!(lines, [4, 5, 7]);
-        assert_eq!(set.covered().coverage("k.wgsl").unwrap().group, 3);
+        assert_eq!(set.covered(false).coverage("k.wgsl").unwrap().group, 3);
     }
 
     /// A command's output and the wesl crate's are not the user's lines:

@@ -49,10 +49,14 @@ pub struct ShaderSet {
     units: Arc<Mutex<HashMap<String, Arc<Unit>>>>,
     /// Kernels compose instrumented for coverage ([`ShaderSet::covered`]).
     coverage: bool,
+    /// Vertex code is counted too (the device lets the vertex stage write
+    /// storage).
+    vertex_counted: bool,
     /// Each instrumented kernel's counters, by name.
     covers: Arc<Mutex<HashMap<String, Arc<Coverage>>>>,
-    /// This set's [`ShaderSet::covered`] twin, made once and shared by clones.
-    twin: Arc<std::sync::OnceLock<ShaderSet>>,
+    /// This set's [`ShaderSet::covered`] twins (vertex code not counted,
+    /// counted), each made once and shared by clones.
+    twin: Arc<[std::sync::OnceLock<ShaderSet>; 2]>,
     /// Kernel files a `[source] command` generated: the inputs it read
     /// (root-relative path, hash), or why there is no text (the command
     /// failed), said when the file is composed.
@@ -207,6 +211,7 @@ impl ShaderSet {
             reader: Reader::default(),
             units: Default::default(),
             coverage: false,
+            vertex_counted: false,
             covers: Default::default(),
             twin: Default::default(),
             generated: BTreeMap::new(),
@@ -231,23 +236,31 @@ impl ShaderSet {
     /// This set composing every kernel with coverage counters (SPEC 20):
     /// for a coverage run only, never a judged one. Its source hashes
     /// differ from this set's, so no cache mistakes one module for the other.
-    pub fn covered(&self) -> ShaderSet {
-        if self.coverage {
+    /// `vertex`: whether the device lets the vertex stage write storage,
+    /// so that vertex entries and what they call are counted too.
+    pub fn covered(&self, vertex: bool) -> ShaderSet {
+        if self.coverage && self.vertex_counted == vertex {
             return self.clone();
         }
         let make = || ShaderSet {
             coverage: true,
+            vertex_counted: vertex,
             composed: Default::default(),
             covers: Default::default(),
             twin: Default::default(),
             ..self.clone()
         };
-        self.twin.get_or_init(make).clone()
+        self.twin[usize::from(vertex)].get_or_init(make).clone()
     }
 
     /// Whether this set composes kernels for coverage.
     pub fn is_covered(&self) -> bool {
         self.coverage
+    }
+
+    /// Whether this covered set counts vertex code too.
+    pub fn counts_vertex(&self) -> bool {
+        self.vertex_counted
     }
 
     /// The counters of kernel `name` as this [`ShaderSet::covered`] set
@@ -656,7 +669,7 @@ impl ShaderSet {
             }
             (o, _) => o,
         };
-        let (module, coverage) = crate::coverage::instrument(&module, &origins);
+        let (module, coverage) = crate::coverage::instrument(&module, &origins, self.vertex_counted);
         validate(name, &module)?;
         self.covers.lock().expect("coverage cache").insert(name.to_string(), Arc::new(coverage));
         Ok(module)
@@ -688,7 +701,7 @@ impl ShaderSet {
                 ))
             })?;
             validate(name, &module)?;
-            // A compiler's output (WESL) is not traced to its files: not measured.
+            // An assembly's (a compiler's) lines are placed through it, below.
             let origins = self.coverage.then(|| Origins::Direct {
                 text: source.clone(),
                 file: ShaderSet::report_path(kernel),
@@ -775,6 +788,9 @@ impl ShaderSet {
         h.update(name.as_bytes());
         if self.coverage {
             h.update(b"instrumented for coverage");
+        }
+        if self.vertex_counted {
+            h.update(b"vertex code counted");
         }
         match unit.assembled.as_ref().filter(|a| a.is_compiled()) {
             // A compiler's output (WESL): the files it read, by path, not

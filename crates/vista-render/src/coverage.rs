@@ -36,7 +36,13 @@ pub fn cover_with(
 
 /// Runs `plan` with counters and returns the hits.
 pub fn cover(gpu: &Renderer, plan: &Plan) -> Result<CaseCoverage, RenderError> {
-    let shaders = gpu.shaders.covered();
+    // Vertex code is counted where the device lets the vertex stage write
+    // storage, except in a case with a pass whose vertex entry lies in a
+    // module of its own: that module's counters would need a binding of
+    // their own beside the pass's shader's.
+    let separate = plan.passes.iter().any(|p| p.raster.as_ref().is_some_and(|r| r.vertex_shader.is_some()));
+    let vertex = gpu.ctx.vertex_writes_storage() && !separate;
+    let shaders = gpu.shaders.covered(vertex);
     let mut names: Vec<&str> = plan.passes.iter().map(|p| p.shader.as_str()).collect();
     names.sort_unstable();
     names.dedup();
@@ -77,7 +83,7 @@ pub fn cover(gpu: &Renderer, plan: &Plan) -> Result<CaseCoverage, RenderError> {
                 group: counted[i].1.group,
                 binding: 0,
                 bind: Bind::Storage { resource: first + i, read_only: false },
-                vertex: false,
+                vertex,
             });
             p
         })

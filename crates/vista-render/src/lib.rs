@@ -495,6 +495,7 @@ fn execute(gpu: &Renderer, graph: &vista_gpu::Graph<'_>, plan: &Plan) -> Result<
                 root: gpu.root.clone(),
                 edits: gpu.edits.clone(),
                 coverage: graph.shaders.is_covered(),
+                vertex_counted: graph.shaders.counts_vertex(),
             };
             let case = CASE.with(|c| c.borrow().clone());
             w.run(gpu.ctx, graph, &source, &plan.kernel, case.as_deref())?

@@ -72,6 +72,9 @@ pub struct ShaderSource {
     /// Kernels composed with coverage counters (a coverage run).
     #[serde(default)]
     pub coverage: bool,
+    /// Vertex code counted too (the device lets the vertex stage write storage).
+    #[serde(default)]
+    pub vertex_counted: bool,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -406,7 +409,7 @@ fn shader_set(
         true => sources.shader_set(),
         false => sources.with_files("edited", &source.edits),
     };
-    Ok(if source.coverage { set.covered() } else { set })
+    Ok(if source.coverage { set.covered(source.vertex_counted) } else { set })
 }
 
 enum Heard {

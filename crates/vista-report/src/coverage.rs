@@ -140,7 +140,7 @@ fn file_page(file: &str, counts: &Counts, text: Option<&str>) -> String {
     let body = format!(
         "<header><h1>{file}</h1><p class=\"counts\">{lh} of {lf} lines ({lp}), {bh} of {bf} branch arms ({bp}). \
          <a href=\"index.html\">Every file</a>.</p><p>Hits per line over every case; a red line ran in no case; a blank \
-         count: no statement there, or not measured (a function only a vertex stage calls). For <code>&amp;&amp;</code> \
+         count: no statement there, or not measured (a function only a vertex stage calls, on a device whose vertex stage cannot write storage). For <code>&amp;&amp;</code> \
          and <code>||</code>, arm 0 is the right-hand side evaluated, arm 1 the short cut.</p>{missing}</header>\n\
          <section><table class=\"source\">{out}</table></section>",
         file = html_escape(file),
