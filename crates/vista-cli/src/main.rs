@@ -247,36 +247,7 @@ enum Command {
     Sweep(sweep::Args),
     /// Mutation testing: single-token mutants of a kernel's WGSL against its
     /// golden cases and CPU reference; prints the score and the survivors.
-    Mutate {
-        /// Only this kernel's mutants (against its golden cases).
-        #[arg(long, conflicts_with = "case")]
-        kernel: Option<String>,
-        /// The kernels of the cases whose id matches this glob, against those cases.
-        #[arg(long = "case", value_name = "GLOB")]
-        case: Option<String>,
-        /// Mutants per kernel, sampled with --seed (default: all).
-        #[arg(long)]
-        sample: Option<usize>,
-        /// The sampling seed: the same seed, the same mutants.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Worker threads sharing the device.
-        #[arg(long, default_value_t = 1)]
-        jobs: usize,
-        /// A deterministic slice of the mutants, nextest's syntax: k/n or count:k/n.
-        #[arg(long)]
-        partition: Option<String>,
-        /// Write the report as JSON (score, mutants[] with file, line, col, operator, before, after, outcome, killed_by).
-        #[arg(long)]
-        json: Option<PathBuf>,
-        /// Join partition reports (JSON files) into one score and report instead of running.
-        #[arg(long, num_args = 1.., value_name = "JSON")]
-        merge: Vec<PathBuf>,
-        /// Survivors argued equivalent (TOML [[mutant]] kernel, file, line, col, after, why):
-        /// excluded from the score and listed apart.
-        #[arg(long, value_name = "TOML")]
-        equivalent: Option<PathBuf>,
-    },
+    Mutate(mutate::Args),
     /// Median kernel throughput after a warm-up (excludes device creation and compilation).
     Bench(bench::Args),
 }
@@ -437,11 +408,7 @@ fn run(project: &Project, config: &Config, cmd: Command) -> Result<i32, GoldenEr
             bless::bless(project, config, BlessOptions { glob: case, force, prune, in_ci: config.in_ci, per_backend })
         }
         Command::Sweep(args) => sweep::sweep(project, config, args),
-        Command::Mutate { kernel, case, sample, seed, jobs, partition, json, merge, equivalent } => mutate::mutate(
-            project,
-            config,
-            mutate::Args { kernel, case, sample, seed, jobs, partition, json, merge, equivalent },
-        ),
+        Command::Mutate(args) => mutate::mutate(project, config, args),
         Command::Bench(args) => bench::bench(project, config, args),
     }
 }

@@ -13,16 +13,41 @@ use crate::input::bad;
 /// A mutant may loop for ever; the watchdog ends it as a timeout.
 const MUTANT_TIMEOUT: Duration = Duration::from_secs(20);
 
+/// `vista mutate`'s arguments.
+#[derive(clap::Args)]
 pub struct Args {
+    /// Only this kernel's mutants (against its golden cases).
+    #[arg(long, conflicts_with = "case")]
     pub kernel: Option<String>,
+    /// The kernels of the cases whose id matches this glob, against those cases.
+    #[arg(long = "case", value_name = "GLOB")]
     pub case: Option<String>,
+    /// Mutants per kernel, sampled with --seed (default: all).
+    #[arg(long)]
     pub sample: Option<usize>,
+    /// The sampling seed: the same seed, the same mutants.
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Worker threads sharing the device.
+    #[arg(long, default_value_t = 1)]
     pub jobs: usize,
+    /// A deterministic slice of the mutants, nextest's syntax: k/n or count:k/n.
+    #[arg(long)]
     pub partition: Option<String>,
+    /// Write the report as JSON (score, mutants[] with file, line, col, operator, before, after, outcome, killed_by).
+    #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Join partition reports (JSON files) into one score and report instead of running.
+    #[arg(long, num_args = 1.., value_name = "JSON")]
     pub merge: Vec<PathBuf>,
+    /// Survivors argued equivalent (TOML [[mutant]] kernel, file, line, col, after, why):
+    /// excluded from the score and listed apart.
+    #[arg(long, value_name = "TOML")]
     pub equivalent: Option<PathBuf>,
+    /// Judge by the golden cases alone (no CPU reference, no WGSL unit
+    /// tests): what the goldens check by themselves.
+    #[arg(long)]
+    pub goldens_only: bool,
 }
 
 /// The argued-equivalent list, if one was given.
@@ -92,13 +117,14 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
     };
     let planned = vista_mutate::plan(&files, &shaders, &kernels, &opts)?;
     eprintln!(
-        "vista mutate: {} mutants of {} kernel(s) (seed {}, sample {}, partition {}/{})",
+        "vista mutate: {} mutants of {} kernel(s) (seed {}, sample {}, partition {}/{}){}",
         planned.len(),
         kernels.len(),
         a.seed,
         a.sample.map_or("all".to_string(), |s| s.to_string()),
         partition.0,
-        partition.1
+        partition.1,
+        if a.goldens_only { "; judged by the golden cases alone" } else { "" }
     );
     let ctx = vista_render::own_device(&config.gpu, None, Some(MUTANT_TIMEOUT))?;
     let bar = ProgressBar::new(planned.len() as u64);
@@ -108,7 +134,7 @@ pub fn mutate(project: &Project, config: &vista::Config, a: Args) -> Result<i32,
     );
     let base =
         vista_render::Renderer::with_shaders(&ctx, shaders.clone(), config.limits, project.root().map(Into::into));
-    let judge = vista_mutate::Judge::new(&base, project, &store, &cases, &planned)?;
+    let judge = vista_mutate::Judge::new(&base, project, &store, &cases, &planned)?.goldens_only(a.goldens_only);
     let mut results = vista_check::mutants(&judge, &planned, a.jobs, &mut Progress(&bar));
     bar.finish_and_clear();
     let unused = vista_mutate::apply_argued(&mut results, &argued);

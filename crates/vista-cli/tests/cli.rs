@@ -7144,6 +7144,64 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
     assert!(!dir.join("lcov.info").exists() && !plain.stdout.contains("coverage:"), "{}", plain.stdout);
 }
 
+/// `vista mutate` composes each mutant before running a case: a mutant in
+/// code every case's defs leave out (tone's `#ifdef WIDE` line 8) runs no
+/// case and survives as `equivalent?`, saying why; `--goldens-only` judges
+/// by the golden cases alone, so a mutant of a line only a unit test runs
+/// (`return 1.0`, line 5: the test calls tone(0.75), the case never
+/// exceeds 0.5) is killed by that test without it and `not covered` with it.
+fn mutate_skips_code_defs_leave_out_and_judges_by_goldens_alone() {
+    let d = golden_dir("[[case]]\nid = \"plain\"\nkernel = \"paths\"\nsize = \"8x4\"\n");
+    let root = d.path();
+    std::fs::create_dir_all(root.join("shaders/lib")).unwrap();
+    std::fs::create_dir_all(root.join("kernels")).unwrap();
+    std::fs::write(root.join("shaders/paths.wgsl"), PATHS_WGSL).unwrap();
+    let tone = TONE_WGSL.replace("    return v;", "#ifdef WIDE\n    return v * 4.0;\n#endif\n    return v;");
+    std::fs::write(root.join("shaders/lib/tone.wgsl"), tone).unwrap();
+    let manifest = "summary = \"known paths\"\n\n[[param]]\nname = \"mode\"\ntype = \"u32\"\nrange = [0, 1]\ndefault = 0\n\
+                    doc = \"1 adds 0.5\"\n";
+    std::fs::write(root.join("kernels/paths.toml"), manifest).unwrap();
+    let test = "#import paths::tone::tone\n#import wgsl_test::{expectNear}\n\n@test\nfn high_values_saturate() {\n    \
+                expectNear(tone(0.75), 1.0);\n}\n";
+    std::fs::write(root.join("shaders/lib/tone.test.wgsl"), test).unwrap();
+    let bless = vista_in(Some(root), &[], &["bless"]);
+    assert_eq!(bless.code, 0, "{}{}", bless.stdout, bless.stderr);
+    let mutants_of = |extra: &[&str]| {
+        let mut args = vec!["mutate", "--kernel", "paths", "--json", "m.json"];
+        args.extend(extra);
+        let m = vista_in(Some(root), &[], &args);
+        assert_eq!(m.code, 0, "{}{}", m.stdout, m.stderr);
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(root.join("m.json")).unwrap()).unwrap();
+        (m, report["mutants"].as_array().unwrap().clone())
+    };
+    let on = |mutants: &[serde_json::Value], line: u64| -> Vec<serde_json::Value> {
+        mutants.iter().filter(|m| m["file"] == "lib/tone.wgsl" && m["line"] == line).cloned().collect()
+    };
+    let (_, all) = mutants_of(&[]);
+    let wide = on(&all, 8);
+    assert!(!wide.is_empty(), "mutants of the WIDE line: {all:?}");
+    // No golden case runs; the unit test (which composes tone alike) does.
+    let judged = |m: &serde_json::Value| (m["outcome"].clone(), m["equivalent?"].clone(), m["cases_run"].clone());
+    for m in &wide {
+        assert_eq!(judged(m), ("survived".into(), true.into(), 1.into()), "{m}");
+        assert!(m["reason"].as_str().unwrap().contains("defs leave out"), "{m}");
+    }
+    let saturate = on(&all, 5);
+    assert!(saturate.iter().any(|m| m["killed_by"] == "wgsl::tone::high_values_saturate"), "{saturate:?}");
+    let (g, alone) = mutants_of(&["--goldens-only"]);
+    assert!(g.stderr.contains("judged by the golden cases alone"), "{}", g.stderr);
+    assert!(alone.iter().all(|m| !m["killed_by"].as_str().unwrap_or("").starts_with("wgsl::")), "{alone:?}");
+    for m in on(&alone, 5) {
+        assert!(m["outcome"] == "not covered" || m["outcome"] == "stillborn", "{m}");
+    }
+    let alone_wide = on(&alone, 8);
+    assert_eq!(alone_wide.len(), wide.len());
+    for m in &alone_wide {
+        assert_eq!(judged(m), ("survived".into(), true.into(), 0.into()), "{m}");
+    }
+}
+
 /// `check --coverage` of render passes: a full-screen fragment pass and a
 /// draw of one triangle covering an 8 x 4 target, each fragment's branch
 /// split by hand (wash: rows 0-1 of 4; fs: the 4 right columns, where the
@@ -7553,6 +7611,7 @@ fn main() {
         Cpu unknown_kernel_lists_valid_kernels,
         Gpu wgsl_unit_tests_name_each_failure_at_its_line_on_three_backends,
         Gpu coverage_counts_each_line_exactly_on_three_backends,
+        Gpu mutate_skips_code_defs_leave_out_and_judges_by_goldens_alone,
         Gpu coverage_counts_fragment_passes_and_draws_and_vertex_code_where_it_can,
         Gpu wesl_unit_tests_in_wgsl_test_spelling_run_unchanged_on_three_backends,
         Gpu test_textures_and_samplers_are_generated_and_bound_on_three_backends,

@@ -618,6 +618,17 @@ impl ShaderSet {
         Ok(module)
     }
 
+    /// `name` composed and written back as WGSL by naga: the program alone,
+    /// without comments, spans or layout. Two sets that give one program
+    /// compile `name` alike (a mutant in code `name`'s defs leave out
+    /// changes nothing).
+    pub fn program(&self, name: &str) -> Result<String, GpuError> {
+        let module = self.compose(name)?;
+        let info = validate(name, &module)?;
+        naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
+            .map_err(|e| GpuError::Shader(format!("{name}: naga's WGSL writer failed: {e}")))
+    }
+
     /// [`ShaderSet::compose_uncached`] on a thread of its own, given at most
     /// [`compose_limit`]: naga's WGSL front end slows quadratically with a
     /// module's constants (10,000 `const` lines take seconds, 400,000 hours),

@@ -346,11 +346,13 @@ pub fn plan(
     Ok(all.into_iter().enumerate().filter(|(i, _)| i % n == k - 1).map(|(_, p)| p).collect())
 }
 
-/// One golden case as the unmutated kernel renders it: the case and the
-/// unmutated raw output's hash.
+/// One golden case as the unmutated kernel renders it: the case, the
+/// unmutated raw output's hash, and the shaders its passes compose (none
+/// where it could not be planned here).
 struct CaseBaseline<'a> {
     case: &'a Case,
     raw_hash: String,
+    shaders: Option<Vec<String>>,
 }
 
 /// What an unmutated kernel looks like to its detectors: its golden cases
@@ -397,7 +399,7 @@ fn baseline<'a>(
                 o.problems.join("; ")
             )));
         }
-        out.push(CaseBaseline { case: c, raw_hash: checked.raw_hash.unwrap_or_default() });
+        out.push(CaseBaseline { case: c, raw_hash: checked.raw_hash.unwrap_or_default(), shaders: shaders_of(gpu, c) });
     }
     let mut settings = Vec::new();
     if kernel.has_reference() {
@@ -415,14 +417,54 @@ fn baseline<'a>(
     Ok(Baseline { cases: out, settings })
 }
 
+/// The shaders (with their defs) the passes of `c`'s plan compose.
+fn shaders_of(gpu: &Renderer, c: &Case) -> Option<Vec<String>> {
+    let plan = vista_render::plan(
+        &gpu.shaders,
+        gpu.root.as_deref(),
+        &c.kernel,
+        &c.params,
+        &c.inputs,
+        c.width,
+        c.height,
+        &gpu.limits,
+    )
+    .ok()?;
+    let mut names: Vec<String> = plan
+        .passes
+        .iter()
+        .flat_map(|p| std::iter::once(p.shader.clone()).chain(p.raster.as_ref().and_then(|r| r.vertex_shader.clone())))
+        .collect();
+    names.sort();
+    names.dedup();
+    Some(names)
+}
+
+/// Whether `mutated` composes each of `names` to the program `original`
+/// does: the mutant lies in code those shaders' defs leave out, so their
+/// renders are the unmutated ones and need not run.
+fn same_programs(original: &ShaderSet, mutated: &ShaderSet, names: Option<&Vec<String>>) -> bool {
+    names.is_some_and(|names| {
+        names.iter().all(|n| match (original.program(n), mutated.program(n)) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        })
+    })
+}
+
 /// Runs one mutant against the detectors; the first failure kills it.
+/// `original`: the unmutated shaders; `goldens_only`: the golden cases are
+/// the only detector.
+#[allow(clippy::too_many_arguments)]
 fn judge(
     gpu: &Renderer,
+    original: &ShaderSet,
     store: &Store,
     manifest: &Manifest,
     kernel: &Kernel,
     base: &Baseline,
     m: &Mutant,
+    goldens_only: bool,
 ) -> MutantReport {
     let report = |outcome: &str, killed_by: Option<(String, String)>, equivalent: bool, cases_run: usize| {
         let (killed_by, reason) = killed_by.unzip();
@@ -439,22 +481,32 @@ fn judge(
     };
     let failed = |timed_out: bool| if timed_out { "timeout" } else { "stillborn" };
     let mut identical = true;
-    for (n, b) in base.cases.iter().enumerate() {
+    let mut run = 0;
+    for b in &base.cases {
         let c = b.case;
+        if same_programs(original, &gpu.shaders, b.shaders.as_ref()) {
+            continue;
+        }
+        run += 1;
         let checked = vista_golden::check_case(gpu, store, manifest, c, &ONCE);
         // A render that failed is the mutant's failure to run, not a kill.
         let Some(raw_hash) = &checked.raw_hash else {
-            return report(failed(checked.timed_out), None, false, n + 1);
+            return report(failed(checked.timed_out), None, false, run);
         };
         identical &= *raw_hash == b.raw_hash;
         let o = &checked.outcome;
         if !o.passed() {
             let why = o.problems.first().cloned().unwrap_or_default();
-            return report("killed", Some((c.id.clone(), why)), false, n + 1);
+            return report("killed", Some((c.id.clone(), why)), false, run);
         }
     }
-    let mut run = base.cases.len();
-    for (s, hash) in &base.settings {
+    let settings = if goldens_only { &[][..] } else { &base.settings[..] };
+    if run == 0 && settings.is_empty() {
+        let mut r = report("survived", None, true, 0);
+        r.reason = Some("every case composes the unmutated program: the mutant lies in code its defs leave out".into());
+        return r;
+    }
+    for (s, hash) in settings {
         run += 1;
         match agreement::judge_setting(gpu, s) {
             Ok(j) => {
@@ -490,6 +542,8 @@ pub struct Judge<'a> {
     /// Each kernel's lines and arms its cases execute (a coverage run of
     /// every case); none where a run could not measure them.
     coverage: BTreeMap<String, Option<vista_coverage::Counts>>,
+    /// The golden cases are the only detector ([`Judge::goldens_only`]).
+    goldens_only: bool,
 }
 
 /// A WGSL unit test file (`*.test.wgsl`, `*.test.wesl`) and the files its tests reach.
@@ -551,7 +605,14 @@ impl<'a> Judge<'a> {
                 }
             }
         }
-        Ok(Judge { base, store, manifest, sources, texts, baselines, unit_tests, coverage })
+        Ok(Judge { base, store, manifest, sources, texts, baselines, unit_tests, coverage, goldens_only: false })
+    }
+
+    /// This judge with the golden cases as the only detector (no CPU
+    /// reference, no unit tests): what the goldens check by themselves.
+    pub fn goldens_only(mut self, on: bool) -> Self {
+        self.goldens_only = on;
+        self
     }
 
     /// One planned mutant judged: its file mutated in memory, then every
@@ -567,8 +628,10 @@ impl<'a> Judge<'a> {
             limits: self.base.limits,
             root: self.base.root.clone(),
         };
-        let mut report = judge(&gpu, self.store, &self.manifest, &p.kernel, &self.baselines[p.kernel.name()], m);
-        if report.outcome == "survived" {
+        let base = &self.baselines[p.kernel.name()];
+        let mut report =
+            judge(&gpu, &self.base.shaders, self.store, &self.manifest, &p.kernel, base, m, self.goldens_only);
+        if report.outcome == "survived" && !self.goldens_only {
             // The unit tests that read the mutated file, after the goldens:
             // the first failing test kills it (the others cannot see it).
             let reading = self.unit_tests.iter().filter(|u| u.reaches.as_ref().is_none_or(|r| r.contains(&m.file)));
