@@ -118,29 +118,7 @@ impl Binding {
 /// path where naga_oil decorated it (`frameX_naga_oil_mod_X<base32>X`:
 /// an item of an imported module).
 pub fn undecorate(name: &str) -> (String, Option<String>) {
-    const PRE: &str = "X_naga_oil_mod_X";
-    let Some((item, rest)) = name.split_once(PRE) else { return (name.to_string(), None) };
-    let encoded = rest.strip_suffix('X').unwrap_or(rest);
-    // RFC 4648 base32 without padding, as naga_oil writes it.
-    let (mut bits, mut acc, mut out) = (0u32, 0u32, Vec::new());
-    for c in encoded.bytes() {
-        let v = match c {
-            b'A'..=b'Z' => c - b'A',
-            b'2'..=b'7' => c - b'2' + 26,
-            _ => return (name.to_string(), None),
-        };
-        acc = (acc << 5) | v as u32;
-        bits += 5;
-        if bits >= 8 {
-            bits -= 8;
-            out.push((acc >> bits) as u8);
-            acc &= (1 << bits) - 1;
-        }
-    }
-    match String::from_utf8(out) {
-        Ok(module) => (item.to_string(), Some(module)),
-        Err(_) => (name.to_string(), None),
-    }
+    vista_source::undecorate(name)
 }
 
 /// The entry point `entry` of `stage` in `module`.

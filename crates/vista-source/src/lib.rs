@@ -19,7 +19,7 @@ mod wesl_lines;
 
 pub use assemble::{Assembled, Part, assemble, unmatched_error};
 pub use spec::{DEFAULT_COMMAND_TIMEOUT_MS, Generator, Replacement, SourceSpec};
-pub use wesl::compile_wesl;
+pub use wesl::{compile_wesl, undecorate};
 
 /// How deep brackets may nest in a shader file, and how many binary
 /// operators one statement may chain: naga's and the wesl crate's parsers

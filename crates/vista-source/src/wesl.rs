@@ -178,10 +178,7 @@ pub fn compile_wesl(
     let given = compiler.resolver().given.take();
     // A declaration's module: the one its decorated name spells, else the root.
     let module_of = |name: &str| {
-        let path = match name.split_once(crate::wesl_lines::DECORATION) {
-            Some((_, rest)) => String::from_utf8(unbase32(rest.strip_suffix('X')?)?).ok()?,
-            None => root.to_string(),
-        };
+        let path = undecorate(name).1.unwrap_or_else(|| root.to_string());
         let (file, text) = given.get(&path)?;
         Some((parts.iter().position(|p| p.path == *file)?, text.as_str()))
     };
@@ -221,14 +218,20 @@ fn base32(bytes: &[u8]) -> String {
     out
 }
 
-/// The bytes of [`base32`]'s text; `None` for a letter outside its alphabet.
-fn unbase32(text: &str) -> Option<Vec<u8>> {
-    let (mut out, mut acc, mut bits) = (Vec::new(), 0u32, 0u32);
-    for c in text.bytes() {
+/// A declaration's name as its module wrote it and that module's path,
+/// from the name naga_oil (or [`Decorated`]) gives an imported one:
+/// `frameX_naga_oil_mod_XNV4WY2LCHI5GGYLNMVZGCX` is `frame` of
+/// `mylib::camera`. A name that is not so decorated is itself, no module.
+pub fn undecorate(name: &str) -> (String, Option<String>) {
+    let Some((item, rest)) = name.split_once(crate::wesl_lines::DECORATION) else { return (name.to_string(), None) };
+    let encoded = rest.strip_suffix('X').unwrap_or(rest);
+    // RFC 4648 base32 without padding, as naga_oil writes it.
+    let (mut bits, mut acc, mut out) = (0u32, 0u32, Vec::new());
+    for c in encoded.bytes() {
         let v = match c {
             b'A'..=b'Z' => c - b'A',
             b'2'..=b'7' => c - b'2' + 26,
-            _ => return None,
+            _ => return (name.to_string(), None),
         };
         acc = (acc << 5) | v as u32;
         bits += 5;
@@ -238,7 +241,10 @@ fn unbase32(text: &str) -> Option<Vec<u8>> {
             acc &= (1 << bits) - 1;
         }
     }
-    Some(out)
+    match String::from_utf8(out) {
+        Ok(module) => (item.to_string(), Some(module)),
+        Err(_) => (name.to_string(), None),
+    }
 }
 
 /// The wesl crate's diagnostic with its place first: its headline says
