@@ -5292,6 +5292,11 @@ fn a_projects_own_preprocessor_runs_through_source_command() {
         .collect();
     assert_eq!(lcov.get("shaders/post/tonemap.wesl"), Some(&tonemap), "{lcov:?}");
     assert_eq!(lcov.len(), 2, "the generated constants module is not measured: {lcov:?}");
+    // Three `curve`s, one per `@if` block, each its own function.
+    let raw = std::fs::read_to_string(root.join("target/vista-report/lcov.info")).unwrap();
+    let curves =
+        "FN:7,curve@7\nFN:15,curve@15\nFN:22,curve@22\nFNDA:1536,curve@7\nFNDA:1536,curve@15\nFNDA:1536,curve@22\n";
+    assert!(raw.contains(curves), "{raw}");
     // An input changed: run again, and --changed names it.
     edit("tools/blur.json", &|s| s.replace("1.75", "2.0"));
     let r = run(&["check", "--changed", "--json", "r.json"]);
@@ -7014,9 +7019,10 @@ fn coverage_counts_each_line_exactly_on_three_backends() {
         assert_eq!(lines.get("shaders/lib/tone.wgsl"), Some(&tone), "{backend}:\n{lcov}");
         assert_eq!(lcov_arms(&lcov).get("shaders/paths.wgsl"), Some(&arms.iter().map(|a| a.to_string()).collect()));
         assert_eq!(lcov_arms(&lcov)["shaders/lib/tone.wgsl"], ["4,5,0,28", "4,5,1,36"], "{backend}");
-        // Functions at their `fn` line with their calls: main once per
-        // invocation (64 a case), tone once per texel, never_called never.
-        let functions = "FN:18,main\nFN:13,never_called\nFNDA:128,main\nFNDA:0,never_called\nFNF:2\nFNH:1\n";
+        // Functions at their `fn` line (in line order) with their calls:
+        // main once per invocation (64 a case), tone once per texel,
+        // never_called never.
+        let functions = "FN:13,never_called\nFN:18,main\nFNDA:0,never_called\nFNDA:128,main\nFNF:2\nFNH:1\n";
         assert!(lcov.contains(functions) && lcov.contains("FN:3,tone\nFNDA:64,tone\n"), "{backend}:\n{lcov}");
         let summary = "coverage: 94.1% of lines, 93.3% of branches in 2 files (16 of 17 lines, 14 of 15 branch arms)";
         assert!(r.stdout.contains(summary), "{backend}: {}", r.stdout);

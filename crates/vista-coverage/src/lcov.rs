@@ -26,8 +26,10 @@ type ArmKey = (u32, u32, u32);
 pub struct Counts {
     lines: BTreeMap<String, BTreeMap<u32, u64>>,
     arms: BTreeMap<String, BTreeMap<ArmKey, u64>>,
-    /// Per file, each function by name: its declaration's line and calls.
-    functions: BTreeMap<String, BTreeMap<String, (u32, u64)>>,
+    /// Per file, each function by its declaration's line and name: its
+    /// calls (one name may be declared on several lines: WESL `@if`
+    /// alternatives, `#ifdef` branches).
+    functions: BTreeMap<String, BTreeMap<(u32, String), u64>>,
 }
 
 impl Counts {
@@ -65,8 +67,7 @@ impl Counts {
     pub fn add_functions(&mut self, functions: &[(Place, String, usize)], values: &[u32]) {
         for (at, name, counter) in functions {
             let calls = values.get(*counter).copied().unwrap_or(0) as u64;
-            let entry = self.functions.entry(at.file.clone()).or_default().entry(name.clone()).or_insert((at.line, 0));
-            entry.1 += calls;
+            *self.functions.entry(at.file.clone()).or_default().entry((at.line, name.clone())).or_default() += calls;
         }
     }
 
@@ -74,8 +75,8 @@ impl Counts {
     pub fn merge(&mut self, other: &Counts) {
         for (file, functions) in &other.functions {
             let mine = self.functions.entry(file.clone()).or_default();
-            for (name, (line, calls)) in functions {
-                mine.entry(name.clone()).or_insert((*line, 0)).1 += calls;
+            for (key, calls) in functions {
+                *mine.entry(key.clone()).or_default() += calls;
             }
         }
         for (file, lines) in &other.lines {
@@ -122,21 +123,29 @@ impl Counts {
     pub fn from_lcov(text: &str) -> Counts {
         let mut counts = Counts::default();
         let mut file = String::new();
+        // A function's name as written (see `lcov`) to its key.
+        let mut written: BTreeMap<String, (u32, String)> = BTreeMap::new();
         for line in text.lines() {
             let numbers = |rest: &str| -> Vec<u64> { rest.split(',').map(|n| n.parse().unwrap_or(0)).collect() };
             if let Some(f) = line.strip_prefix("SF:") {
                 file = f.to_string();
+                written.clear();
                 counts.lines.entry(file.clone()).or_default();
             } else if let Some(rest) = line.strip_prefix("DA:") {
                 if let [l, hits, ..] = numbers(rest)[..] {
                     *counts.lines.entry(file.clone()).or_default().entry(l as u32).or_default() += hits;
                 }
             } else if let Some((l, name)) = line.strip_prefix("FN:").and_then(|r| r.split_once(',')) {
-                let at = l.parse().unwrap_or(0);
-                counts.functions.entry(file.clone()).or_default().entry(name.to_string()).or_insert((at, 0)).0 = at;
+                let at: u32 = l.parse().unwrap_or(0);
+                let base = name.strip_suffix(&format!("@{at}")).unwrap_or(name);
+                let key = (at, base.to_string());
+                counts.functions.entry(file.clone()).or_default().entry(key.clone()).or_default();
+                written.insert(name.to_string(), key);
             } else if let Some((calls, name)) = line.strip_prefix("FNDA:").and_then(|r| r.split_once(',')) {
                 let calls: u64 = calls.parse().unwrap_or(0);
-                counts.functions.entry(file.clone()).or_default().entry(name.to_string()).or_insert((0, 0)).1 += calls;
+                if let Some(key) = written.get(name) {
+                    *counts.functions.entry(file.clone()).or_default().entry(key.clone()).or_default() += calls;
+                }
             } else if let Some(rest) = line.strip_prefix("BRDA:")
                 && let [l, col, arm, hits] = numbers(rest)[..]
             {
@@ -157,7 +166,7 @@ impl Counts {
             arms.retain(|k, _| k.0 <= last);
         }
         if let Some(functions) = self.functions.get_mut(file) {
-            functions.retain(|_, f| f.0 <= last);
+            functions.retain(|k, _| k.0 <= last);
         }
     }
 
@@ -167,7 +176,9 @@ impl Counts {
     }
 
     /// The LCOV tracefile (`lcov.info`): per file `SF`, `FN`/`FNDA` per
-    /// function (its declaration's line, its calls) and `FNF`/`FNH`, `DA` per line,
+    /// function (its declaration's line, its calls; a name declared on
+    /// several lines of the file is written `name@line` for each, as LCOV
+    /// joins `FNDA` to `FN` by name) and `FNF`/`FNH`, `DA` per line,
     /// `BRDA` per arm (`-` where its statement's line never ran), the
     /// `BRF`/`BRH` and `LF`/`LH` totals, `end_of_record`.
     pub fn lcov(&self, test_name: &str) -> String {
@@ -175,14 +186,23 @@ impl Counts {
         for (file, lines) in &self.lines {
             let _ = writeln!(out, "TN:{test_name}\nSF:{file}");
             let functions = self.functions.get(file);
-            for (name, (line, _)) in functions.into_iter().flatten() {
-                let _ = writeln!(out, "FN:{line},{name}");
+            let written = |(line, name): &(u32, String)| match functions
+                .into_iter()
+                .flatten()
+                .filter(|(k, _)| k.1 == *name)
+                .count()
+            {
+                1 => name.clone(),
+                _ => format!("{name}@{line}"),
+            };
+            for (key, _) in functions.into_iter().flatten() {
+                let _ = writeln!(out, "FN:{},{}", key.0, written(key));
             }
-            for (name, (_, calls)) in functions.into_iter().flatten() {
-                let _ = writeln!(out, "FNDA:{calls},{name}");
+            for (key, calls) in functions.into_iter().flatten() {
+                let _ = writeln!(out, "FNDA:{calls},{}", written(key));
             }
             if let Some(f) = functions {
-                let _ = writeln!(out, "FNF:{}\nFNH:{}", f.len(), f.values().filter(|v| v.1 > 0).count());
+                let _ = writeln!(out, "FNF:{}\nFNH:{}", f.len(), f.values().filter(|&&v| v > 0).count());
             }
             let arms = self.arms.get(file);
             for (key, hits) in arms.into_iter().flatten() {

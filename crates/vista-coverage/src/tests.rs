@@ -162,3 +162,25 @@ fn lcov_reads_back_as_the_counts_it_was_written_from() {
     assert_eq!(sum, twice);
     assert!(Counts::default().is_empty() && !counts.is_empty());
 }
+
+/// One name declared on two lines of a file (WESL `@if` alternatives) is
+/// two functions, written `name@line` (LCOV joins `FNDA` to `FN` by name)
+/// and read back as they were; alone, a name is written as it is.
+#[test]
+fn a_name_declared_on_two_lines_is_two_functions() {
+    let mut counts = Counts::from_lcov("SF:c.wesl\nDA:8,3\nend_of_record\n");
+    let at = |line| Place { file: "c.wesl".into(), line, col: 1 };
+    let functions =
+        [(at(7), "curve".to_string(), 0), (at(22), "curve".to_string(), 1), (at(30), "other".to_string(), 2)];
+    counts.add_functions(&functions, &[3, 5, 0]);
+    let lcov = counts.lcov("t");
+    let want =
+        "FN:7,curve@7\nFN:22,curve@22\nFN:30,other\nFNDA:3,curve@7\nFNDA:5,curve@22\nFNDA:0,other\nFNF:3\nFNH:2\n";
+    assert!(lcov.contains(want), "{lcov}");
+    assert_eq!(Counts::from_lcov(&lcov), counts);
+    let mut twice = Counts::from_lcov(&lcov);
+    twice.merge(&counts);
+    assert!(twice.lcov("t").contains("FNDA:6,curve@7\nFNDA:10,curve@22\n"), "{}", twice.lcov("t"));
+    counts.keep_lines("c.wesl", 10);
+    assert!(counts.lcov("t").contains("FN:7,curve\nFNDA:3,curve\nFNF:1\nFNH:1\n"), "{}", counts.lcov("t"));
+}

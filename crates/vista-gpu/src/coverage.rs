@@ -107,7 +107,9 @@ pub(crate) fn instrument(module: &naga::Module, origins: &Origins, vertex: bool)
         let mine = done.counters[i..].iter().take_while(|d| d.function == c.function);
         let start = mine.flat_map(|d| d.spans.iter()).find_map(|s| s.to_range()).map(|r| r.start);
         let name = undecorated(&c.function).to_string();
-        if let Some(at) = start.and_then(|s| placer.declaration_of(&name, s)) {
+        // An imported function keeps its decorated name in a compiler's output (WESL).
+        let declared = |s| placer.declaration_of(&name, s).or_else(|| placer.declaration_of(&c.function, s));
+        if let Some(at) = start.and_then(declared) {
             functions.push((at, name, i));
         }
     }
