@@ -9,6 +9,12 @@
 //! kernel's GPU-vs-CPU agreement settings at the bounds the agreement tests
 //! use (`vista_golden::agreement`), stopping at the first failure.
 //!
+//! Before a case runs, the mutant's shaders for it are composed and
+//! written back by naga: a case whose shaders all come out as the
+//! unmutated program (the mutant lies in code the case's defs leave out)
+//! is not run, its render being the unmutated one. [`Judge::goldens_only`]
+//! makes the golden cases the only detector.
+//!
 //! Outcomes: killed (naming what killed it), survived, timeout (the GPU
 //! watchdog fired), stillborn (naga or the pipeline rejects the mutant; not
 //! counted). A survivor bit-identical to the unmutated render on every case
