@@ -94,7 +94,7 @@ pub fn layouts(project: &Project, only: Option<&str>) -> Result<i32, GoldenError
             let pass = &k.graph().passes[i];
             for b in vista_manifest::leaves::buffer_layouts(&module) {
                 // The resource bound to it, if the manifest gives it by leaf path.
-                let bound = pass.bind.iter().find(|(v, _)| *v == b.name).map(|(_, l)| l.resource.as_str());
+                let bound = pass.bind.iter().find(|(v, _)| b.named(v)).map(|(_, l)| l.resource.as_str());
                 let given = vista_render::leaf_values::manifest_leaves(project.root(), k, bound.unwrap_or(&b.name))
                     .map_err(GoldenError::BadInput)?;
                 println!(

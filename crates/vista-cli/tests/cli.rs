@@ -7437,7 +7437,9 @@ fn a_wesl_kernel_imports_a_generated_module() {
 /// A global an imported WESL module declares is bound by its own name, as
 /// a naga_oil module's is (the wesl crate's mangled `package_io_out` is
 /// not what a manifest says), or by its module path
-/// (`"package::io::out"`): a WESL kernel's output declared in `io.wesl`.
+/// (`"package::io::out"`): a WESL kernel's output declared in `io.wesl`;
+/// a uniform bound by path to a buffer given by leaf path is read, and
+/// `list --layout` marks its leaves set or zero.
 fn an_imported_wesl_global_is_bound_by_its_own_name() {
     let manifest = "summary = \"output declared by an imported module\"\nshader = \"k.wesl\"\n\
                     [[resource]]\nname = \"out\"\nkind = \"texture\"\nformat = \"rgba8unorm\"\n\
@@ -7469,6 +7471,33 @@ fn an_imported_wesl_global_is_bound_by_its_own_name() {
         .unwrap();
     let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", png.to_str().unwrap()]);
     assert_rejected(&r, 2, &["bind names package::other::out, which k.wesl does not declare"]);
+    // A uniform of the module bound by path to a buffer given by leaf path:
+    // the render reads the leaf, and `list --layout` marks it set.
+    let io = format!(
+        "{io}struct Tint {{\n    gain: f32,\n    bias: f32,\n}}\n@group(0) @binding(1) var<uniform> tint: Tint;\n"
+    );
+    std::fs::write(d.path().join("shaders/io.wesl"), io).unwrap();
+    let k = k
+        .replace("import package::io::out;", "import package::io::{out, tint};")
+        .replace("vec4f(1.0,", "vec4f(tint.gain,");
+    std::fs::write(d.path().join("shaders/k.wesl"), k).unwrap();
+    let with_tint = by_path
+        .replace("[[pass]]", "[[resource]]\nname = \"look\"\nkind = \"buffer\"\nfields = { gain = 0.5 }\n[[pass]]")
+        .replace(
+            "bind = { \"package::io::out\" = \"frame\" }",
+            "bind = { \"package::io::out\" = \"frame\", \"package::io::tint\" = \"look\" }",
+        );
+    std::fs::write(d.path().join("kernels/k.toml"), &with_tint).unwrap();
+    let r = vista_in(Some(d.path()), &[], &["render", "k", "--size", "8x8", "-o", png.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    let red = vista_image::load(&png).unwrap().get(2, 3)[0];
+    assert!((red - 128.0 / 255.0).abs() < 1e-6, "gain 0.5 in rgba8unorm: {red}");
+    let l = vista_in(Some(d.path()), &[], &["list", "--layout", "k"]);
+    assert_eq!(l.code, 0, "{}{}", l.stdout, l.stderr);
+    assert!(l.stdout.contains("var<uniform> tint: 8 bytes (given by leaf path; others zero)"), "{}", l.stdout);
+    let leaf =
+        |path: &str| l.stdout.lines().find(|x| x.split_whitespace().nth(1) == Some(path)).unwrap_or("").to_string();
+    assert!(leaf("gain").ends_with("set") && leaf("bias").ends_with("zero"), "{}", l.stdout);
 }
 
 /// `@test_texture` and `@sampler` in wgsl-test's spelling: a checkerboard,

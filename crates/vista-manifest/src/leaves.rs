@@ -31,6 +31,8 @@ pub struct BufferLayout {
     pub binding: u32,
     /// The variable as its module names it (naga_oil's decoration removed).
     pub name: String,
+    /// The import path of the module that declares it, where imported.
+    pub module: Option<String>,
     /// `uniform`, `storage, read` or `storage, read_write`.
     pub space: String,
     /// Its type's size in bytes (a runtime-sized array's fixed part plus
@@ -38,6 +40,18 @@ pub struct BufferLayout {
     pub size: u32,
     /// Every leaf in offset order.
     pub leaves: Vec<Leaf>,
+}
+
+impl BufferLayout {
+    /// Whether a pass's `bind` key names this variable: by its name, or
+    /// by its module's path and name (`engine::view::view`).
+    pub fn named(&self, key: &str) -> bool {
+        key == self.name
+            || self
+                .module
+                .as_deref()
+                .is_some_and(|m| key.strip_prefix(m).and_then(|r| r.strip_prefix("::")).is_some_and(|n| n == self.name))
+    }
 }
 
 /// The buffer bindings of `module`, in group and binding order.
@@ -55,10 +69,12 @@ pub fn buffer_layouts(module: &naga::Module) -> Vec<BufferLayout> {
             let mut leaves = Vec::new();
             walk(module, g.ty, String::new(), 0, &mut Vec::new(), &mut leaves);
             leaves.sort_by_key(|l| l.offset);
+            let (name, from) = crate::bindings::undecorate(g.name.as_deref().unwrap_or_default());
             Some(BufferLayout {
                 group: b.group,
                 binding: b.binding,
-                name: crate::bindings::undecorate(g.name.as_deref().unwrap_or_default()).0,
+                name,
+                module: from,
                 space,
                 size: layouter[g.ty].size,
                 leaves,
