@@ -5348,6 +5348,28 @@ fn a_projects_own_preprocessor_runs_through_source_command() {
     edit("kernels/blur.toml", &|s| s.replace("command = [\"sh\", \"-c\", \"true\"]\n", ""));
     let r = run(&["render", "blur", "--size", "8x8", "-o", "x.png"]);
     assert_rejected(&r, 2, &["[source] inputs and timeout belong to a command"]);
+    // Two passes of the kernel generating its one file differently (the
+    // second reads one more input) are refused, naming both generators.
+    for f in ["kernels/blur.toml", "tools/render_template.py"] {
+        std::fs::copy(repo().join("examples/sources").join(f), root.join(f)).unwrap();
+    }
+    edit("kernels/blur.toml", &|s| {
+        let command =
+            s.lines().find(|l| l.starts_with("command = ")).unwrap().trim_start_matches("command = ").to_string();
+        let own =
+            format!("source = {{ command = {command}, inputs = [\"tools/blur.json\", \"inputs/ridges.png\"] }}\n");
+        s.replace("entry = \"blur_columns\"\n", &format!("entry = \"blur_columns\"\n{own}"))
+    });
+    let r = run(&["render", "blur", "--size", "8x8", "-o", "x.png"]);
+    assert_rejected(
+        &r,
+        2,
+        &[
+            "shaders/blur/gaussian.wgsl.tmpl: two passes of kernel blur generate it with different [source] commands",
+            "inputs tools/blur.json, timeout 30 s`; `python3",
+            "inputs tools/blur.json inputs/ridges.png, timeout 30 s`); give each its own file",
+        ],
+    );
 }
 
 /// Every file an assembly reaches, and every replacement, is in the shader

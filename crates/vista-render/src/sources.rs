@@ -101,12 +101,15 @@ fn generate(
         for (file, g) in k.generated_files() {
             if let Some((_, other, known)) = by.iter().find(|(f, _, _)| *f == file) {
                 if *known != g {
+                    let who = match other == k.name() {
+                        true => format!("two passes of kernel {other}"),
+                        false => format!("kernels {other} and {}", k.name()),
+                    };
                     let why = format!(
-                        "shaders/{file}: kernels {other} and {} generate it with different [source] commands or \
-                         inputs (`{}`, `{}`); give each its own file",
-                        k.name(),
-                        known.display(),
-                        g.display()
+                        "shaders/{file}: {who} generate it with different [source] commands, inputs or timeouts \
+                         (`{}`; `{}`); give each its own file",
+                        known.describe(),
+                        g.describe()
                     );
                     out.retain(|(f, _)| *f != file);
                     out.push((file, Err(why)));

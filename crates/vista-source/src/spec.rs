@@ -69,6 +69,14 @@ impl Generator {
     pub fn display(&self) -> String {
         self.command.join(" ")
     }
+
+    /// The command, its inputs and its timeout, for telling two generators
+    /// apart: `python3 t.py {shader} {out}, inputs a.json, timeout 60 s`.
+    pub fn describe(&self) -> String {
+        let inputs =
+            if self.inputs.is_empty() { "no inputs".to_string() } else { format!("inputs {}", self.inputs.join(" ")) };
+        format!("{}, {inputs}, timeout {} s", self.display(), self.timeout_ms as f64 / 1000.0)
+    }
 }
 
 /// A `modules` entry: `name = { CONST = value, ... }` as the WGSL module
