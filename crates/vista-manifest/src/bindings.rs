@@ -106,12 +106,14 @@ impl Binding {
     /// module's import path and its name (`package::post::lut_bindings::lut`,
     /// `mylib::camera::frame`).
     pub fn named(&self, key: &str) -> bool {
-        key == self.name
-            || self
-                .module
-                .as_deref()
-                .is_some_and(|m| key.strip_prefix(m).and_then(|r| r.strip_prefix("::")).is_some_and(|n| n == self.name))
+        names(key, &self.name, self.module.as_deref())
     }
+}
+
+/// Whether a `bind` key names variable `name` of the module at import path
+/// `module`: by its name, or by the path and its name.
+pub fn names(key: &str, name: &str, module: Option<&str>) -> bool {
+    key == name || module.is_some_and(|m| key.strip_prefix(m).and_then(|r| r.strip_prefix("::")) == Some(name))
 }
 
 /// A name as its declaring module spells it, and that module's import

@@ -46,11 +46,7 @@ impl BufferLayout {
     /// Whether a pass's `bind` key names this variable: by its name, or
     /// by its module's path and name (`engine::view::view`).
     pub fn named(&self, key: &str) -> bool {
-        key == self.name
-            || self
-                .module
-                .as_deref()
-                .is_some_and(|m| key.strip_prefix(m).and_then(|r| r.strip_prefix("::")).is_some_and(|n| n == self.name))
+        crate::bindings::names(key, &self.name, self.module.as_deref())
     }
 }
 
