@@ -305,8 +305,9 @@ mod tests {
         assert_eq!(set.covered(false).coverage("k.wgsl").unwrap().group, 3);
     }
 
-    /// A command's output and the wesl crate's are not the user's lines:
-    /// nothing of them is measured (never a count on a line the file lacks).
+    /// A command's output is not the user's lines: nothing of it is
+    /// measured. The wesl crate's output is traced back to each module's
+    /// own lines (never a count on a line the file lacks).
     #[test]
     fn generated_text_is_not_measured_and_compiled_wesl_is_traced() {
         let kernel = "@group(0) @binding(0) var<storage, read_write> out: array<f32>;\n@compute @workgroup_size(1)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {\n    if id.x > 3u {\n        out[id.x] = 1.0;\n    }\n}\n";
