@@ -186,6 +186,10 @@ pub fn compile_wesl(
     Ok(Assembled::compiled(text, parts, lines))
 }
 
+/// What naga_oil (and [`Decorated`]) puts between an imported
+/// declaration's name and its module's base32 path.
+const DECORATION: &str = "X_naga_oil_mod_X";
+
 /// Names an imported module's declaration as naga_oil does,
 /// `<item>X_naga_oil_mod_X<base32 of the module path>X`, where the wesl
 /// crate's own mangler writes `package__1lut_bindings_t`: a manifest then
@@ -195,7 +199,7 @@ struct Decorated;
 
 impl Mangler for Decorated {
     fn mangle(&self, path: &ModulePath, item: &str) -> String {
-        format!("{item}X_naga_oil_mod_X{}X", base32(path.to_string().as_bytes()))
+        format!("{item}{DECORATION}{}X", base32(path.to_string().as_bytes()))
     }
 }
 
@@ -223,7 +227,7 @@ fn base32(bytes: &[u8]) -> String {
 /// `frameX_naga_oil_mod_XNV4WY2LCHI5GGYLNMVZGCX` is `frame` of
 /// `mylib::camera`. A name that is not so decorated is itself, no module.
 pub fn undecorate(name: &str) -> (String, Option<String>) {
-    let Some((item, rest)) = name.split_once(crate::wesl_lines::DECORATION) else { return (name.to_string(), None) };
+    let Some((item, rest)) = name.split_once(DECORATION) else { return (name.to_string(), None) };
     let encoded = rest.strip_suffix('X').unwrap_or(rest);
     // RFC 4648 base32 without padding, as naga_oil writes it.
     let (mut bits, mut acc, mut out) = (0u32, 0u32, Vec::new());

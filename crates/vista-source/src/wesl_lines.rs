@@ -61,8 +61,8 @@ pub(crate) fn trace<'a>(
         for line in &mut lines[first..first + header] {
             *line = line_of(start);
         }
-        let item = name.split_once(DECORATION).map_or(name.as_str(), |(item, _)| item);
-        lines[first + header] = keyword_at(source, start, item).and_then(line_of);
+        let item = crate::wesl::undecorate(&name).0;
+        lines[first + header] = keyword_at(source, start, &item).and_then(line_of);
         let mut statements = Vec::new();
         collect(&f.body.statements, &mut statements);
         let mut cursor = header + 1;
@@ -75,10 +75,6 @@ pub(crate) fn trace<'a>(
     }
     Some(lines)
 }
-
-/// What the wesl crate's mangler (vista's `Decorated`) puts between an
-/// imported declaration's name and its module's path.
-pub(crate) const DECORATION: &str = "X_naga_oil_mod_X";
 
 fn name_of(decl: &GlobalDeclaration) -> Option<String> {
     let ident = match decl {
