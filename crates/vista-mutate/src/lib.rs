@@ -353,12 +353,13 @@ pub fn plan(
 }
 
 /// One golden case as the unmutated kernel renders it: the case, the
-/// unmutated raw output's hash, and the shaders its passes compose (none
-/// where it could not be planned here).
+/// unmutated raw output's hash, and each shader its passes compose with
+/// its unmutated program ([`ShaderSet::program`]; none where it could not
+/// be planned or written here).
 struct CaseBaseline<'a> {
     case: &'a Case,
     raw_hash: String,
-    shaders: Option<Vec<String>>,
+    programs: Option<Vec<(String, String)>>,
 }
 
 /// What an unmutated kernel looks like to its detectors: its golden cases
@@ -405,7 +406,11 @@ fn baseline<'a>(
                 o.problems.join("; ")
             )));
         }
-        out.push(CaseBaseline { case: c, raw_hash: checked.raw_hash.unwrap_or_default(), shaders: shaders_of(gpu, c) });
+        out.push(CaseBaseline {
+            case: c,
+            raw_hash: checked.raw_hash.unwrap_or_default(),
+            programs: programs_of(gpu, c),
+        });
     }
     let mut settings = Vec::new();
     if kernel.has_reference() {
@@ -423,8 +428,9 @@ fn baseline<'a>(
     Ok(Baseline { cases: out, settings })
 }
 
-/// The shaders (with their defs) the passes of `c`'s plan compose.
-fn shaders_of(gpu: &Renderer, c: &Case) -> Option<Vec<String>> {
+/// The shaders (with their defs) the passes of `c`'s plan compose, each
+/// with its program.
+fn programs_of(gpu: &Renderer, c: &Case) -> Option<Vec<(String, String)>> {
     let plan = vista_render::plan(
         &gpu.shaders,
         gpu.root.as_deref(),
@@ -443,28 +449,30 @@ fn shaders_of(gpu: &Renderer, c: &Case) -> Option<Vec<String>> {
         .collect();
     names.sort();
     names.dedup();
-    Some(names)
+    names.into_iter().map(|n| gpu.shaders.program(&n).ok().map(|p| (n, p))).collect()
 }
 
-/// Whether `mutated` composes each of `names` to the program `original`
-/// does: the mutant lies in code those shaders' defs leave out, so their
-/// renders are the unmutated ones and need not run.
-fn same_programs(original: &ShaderSet, mutated: &ShaderSet, names: Option<&Vec<String>>) -> bool {
-    names.is_some_and(|names| {
-        names.iter().all(|n| match (original.program(n), mutated.program(n)) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
+/// Whether the mutant composes each shader of a case to its unmutated
+/// program (`programs`, the baseline's): the mutant lies in code those
+/// shaders' defs leave out, so the case's render is the unmutated one and
+/// need not run. `written`: the mutant's programs, each written once.
+fn same_programs(
+    mutated: &ShaderSet,
+    programs: Option<&Vec<(String, String)>>,
+    written: &mut BTreeMap<String, Option<String>>,
+) -> bool {
+    programs.is_some_and(|programs| {
+        programs.iter().all(|(n, unmutated)| {
+            let mine = written.entry(n.clone()).or_insert_with(|| mutated.program(n).ok());
+            mine.as_ref() == Some(unmutated)
         })
     })
 }
 
 /// Runs one mutant against the detectors; the first failure kills it.
-/// `original`: the unmutated shaders; `goldens_only`: the golden cases are
-/// the only detector.
-#[allow(clippy::too_many_arguments)]
+/// `goldens_only`: the golden cases are the only detector.
 fn judge(
     gpu: &Renderer,
-    original: &ShaderSet,
     store: &Store,
     manifest: &Manifest,
     kernel: &Kernel,
@@ -488,9 +496,10 @@ fn judge(
     let failed = |timed_out: bool| if timed_out { "timeout" } else { "stillborn" };
     let mut identical = true;
     let mut run = 0;
+    let mut written = BTreeMap::new();
     for b in &base.cases {
         let c = b.case;
-        if same_programs(original, &gpu.shaders, b.shaders.as_ref()) {
+        if same_programs(&gpu.shaders, b.programs.as_ref(), &mut written) {
             continue;
         }
         run += 1;
@@ -635,8 +644,7 @@ impl<'a> Judge<'a> {
             root: self.base.root.clone(),
         };
         let base = &self.baselines[p.kernel.name()];
-        let mut report =
-            judge(&gpu, &self.base.shaders, self.store, &self.manifest, &p.kernel, base, m, self.goldens_only);
+        let mut report = judge(&gpu, self.store, &self.manifest, &p.kernel, base, m, self.goldens_only);
         if report.outcome == "survived" && !self.goldens_only {
             // The unit tests that read the mutated file, after the goldens:
             // the first failing test kills it (the others cannot see it).
