@@ -12,14 +12,16 @@
 #![deny(missing_docs)]
 
 mod assemble;
+mod decoration;
 mod spec;
 mod wesl;
 mod wesl_blocks;
 mod wesl_lines;
 
 pub use assemble::{Assembled, Part, assemble, unmatched_error};
+pub use decoration::undecorate;
 pub use spec::{DEFAULT_COMMAND_TIMEOUT_MS, Generator, Replacement, SourceSpec};
-pub use wesl::{compile_wesl, undecorate};
+pub use wesl::compile_wesl;
 
 /// How deep brackets may nest in a shader file, and how many binary
 /// operators one statement may chain: naga's and the wesl crate's parsers

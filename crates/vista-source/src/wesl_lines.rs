@@ -61,7 +61,7 @@ pub(crate) fn trace<'a>(
         for line in &mut lines[first..first + header] {
             *line = line_of(start);
         }
-        let item = crate::wesl::undecorate(&name).0;
+        let item = crate::decoration::undecorate(&name).0;
         lines[first + header] = keyword_at(source, start, &item).and_then(line_of);
         let mut statements = Vec::new();
         collect(&f.body.statements, &mut statements);
