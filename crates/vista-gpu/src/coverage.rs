@@ -106,7 +106,7 @@ pub(crate) fn instrument(module: &naga::Module, origins: &Origins, vertex: bool)
         }
         let mine = done.counters[i..].iter().take_while(|d| d.function == c.function);
         let start = mine.flat_map(|d| d.spans.iter()).find_map(|s| s.to_range()).map(|r| r.start);
-        let name = undecorated(&c.function).to_string();
+        let name = vista_source::undecorate(&c.function).0;
         // An imported function keeps its decorated name in a compiler's output (WESL).
         let declared = |s| placer.declaration_of(&name, s).or_else(|| placer.declaration_of(&c.function, s));
         if let Some(at) = start.and_then(declared) {
@@ -198,15 +198,9 @@ fn source_start(module: &naga::Module, index: usize, text: &str) -> Option<usize
     let constants = module.constants.iter().map(|(h, c)| ("const", c.name.as_deref(), module.constants.get_span(h)));
     functions.chain(globals).chain(constants).find_map(|(keyword, name, span)| {
         let at = ours(span)?;
-        let found = declaration(text, keyword, undecorated(name?))?;
+        let found = declaration(text, keyword, &vista_source::undecorate(name?).0)?;
         at.checked_sub(found)
     })
-}
-
-/// A name as its module wrote it: naga_oil decorates an imported one
-/// (`fbmX_naga_oil_mod_X<base32>X`).
-fn undecorated(name: &str) -> &str {
-    name.split_once("X_naga_oil_mod_X").map_or(name, |(n, _)| n)
 }
 
 /// The offset of `keyword` in the one declaration `keyword [<...>] name`
@@ -245,7 +239,7 @@ mod tests {
         assert_eq!(declaration(text, "fn", "outer"), Some(text.find("fn outer").unwrap()));
         assert_eq!(declaration(text, "fn", "out"), None, "no fn named out");
         assert_eq!(declaration("fn a() {}\nfn  a() {}", "fn", "a"), None, "two: ambiguous");
-        assert_eq!(undecorated("fbmX_naga_oil_mod_XNV4TUOTMNFRAX"), "fbm");
+        assert_eq!(vista_source::undecorate("fbmX_naga_oil_mod_XNV4TUOTMNFRAX").0, "fbm");
         assert_eq!(line_col("ab\ncd", 4), Some((2, 2)));
         assert_eq!(line_col("ab", 9), None);
     }
